@@ -1,0 +1,2 @@
+//! Symbolic expression engine (work in progress: see issue 2).
+#![warn(missing_docs)]
