@@ -1,0 +1,121 @@
+//! Typed failures. Numerical failures carry the time, the state and the solution computed so
+//! far, so that a caller can inspect or plot what happened before the failure.
+
+use crate::Solution;
+use std::fmt;
+
+/// Where a numerical failure happened: time, state, and the partial solution.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FailurePoint {
+    /// Time of the last accepted state.
+    pub t: f64,
+    /// The last accepted state.
+    pub y: Vec<f64>,
+    /// Everything computed up to `t` (outputs, events, statistics).
+    pub partial: Box<Solution>,
+}
+
+/// Errors of the solvers.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum OdeError {
+    /// The options or the initial data are unusable (dimension mismatch, non-finite `y0`,
+    /// negative tolerances, unsorted `t_eval`, missing `h0` for a fixed-step method, …).
+    InvalidInput {
+        /// What is wrong.
+        reason: String,
+    },
+    /// The step size fell below `|t| · 10 · ε` (Hairer's test `0.1|h| ≤ |t|·uround`).
+    StepSizeUnderflow {
+        /// The step size that was too small.
+        h: f64,
+        /// Time, state, partial solution.
+        at: FailurePoint,
+    },
+    /// `f` or the new state became non-finite (NaN or ±∞) and reducing the step did not help.
+    NonFinite {
+        /// Time, state, partial solution.
+        at: FailurePoint,
+    },
+    /// More than `max_steps` step attempts.
+    MaxSteps {
+        /// The limit that was reached.
+        max_steps: usize,
+        /// Time, state, partial solution.
+        at: FailurePoint,
+    },
+    /// The explicit method detected stiffness and [`crate::StiffnessAction::Error`] was set.
+    Stiff {
+        /// Time, state, partial solution.
+        at: FailurePoint,
+    },
+    /// The Newton matrix of an implicit method is singular even after step reductions.
+    SingularMatrix {
+        /// Time, state, partial solution.
+        at: FailurePoint,
+    },
+    /// The nonlinear solve of a fixed-step implicit method did not converge.
+    NoConvergence {
+        /// Time, state, partial solution.
+        at: FailurePoint,
+    },
+}
+
+impl OdeError {
+    /// The failure point (time, state, partial solution), for numerical failures.
+    pub fn failure_point(&self) -> Option<&FailurePoint> {
+        match self {
+            OdeError::InvalidInput { .. } => None,
+            OdeError::StepSizeUnderflow { at, .. }
+            | OdeError::NonFinite { at }
+            | OdeError::MaxSteps { at, .. }
+            | OdeError::Stiff { at }
+            | OdeError::SingularMatrix { at }
+            | OdeError::NoConvergence { at } => Some(at),
+        }
+    }
+}
+
+impl fmt::Display for OdeError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            OdeError::InvalidInput { reason } => write!(f, "invalid input: {reason}"),
+            OdeError::StepSizeUnderflow { h, at } => {
+                write!(f, "step size underflow (h = {h:e}) at t = {}", at.t)
+            }
+            OdeError::NonFinite { at } => write!(f, "non-finite state at t = {}", at.t),
+            OdeError::MaxSteps { max_steps, at } => {
+                write!(
+                    f,
+                    "more than max_steps = {max_steps} steps needed; stopped at t = {}",
+                    at.t
+                )
+            }
+            OdeError::Stiff { at } => {
+                write!(f, "the problem seems to become stiff at t = {}", at.t)
+            }
+            OdeError::SingularMatrix { at } => {
+                write!(f, "singular iteration matrix at t = {}", at.t)
+            }
+            OdeError::NoConvergence { at } => {
+                write!(f, "nonlinear iteration did not converge at t = {}", at.t)
+            }
+        }
+    }
+}
+
+impl std::error::Error for OdeError {}
+
+pub(crate) fn invalid(reason: impl Into<String>) -> OdeError {
+    OdeError::InvalidInput {
+        reason: reason.into(),
+    }
+}
+
+pub(crate) fn point(t: f64, y: &[f64], partial: &Solution) -> FailurePoint {
+    FailurePoint {
+        t,
+        y: y.to_vec(),
+        partial: Box::new(partial.clone()),
+    }
+}

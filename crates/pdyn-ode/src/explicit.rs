@@ -1,0 +1,302 @@
+//! The adaptive driver shared by the explicit Runge–Kutta pairs (DOPRI5, Tsit5, DOP853).
+//!
+//! The loop is Hairer's (dopri5.f `DOPCOR`): before each attempt the step is clipped so that
+//! the integration lands exactly on `tf` (`h = tf − t` when `t + 1.01h` would pass it); the
+//! method computes its stages, the new state and the error `err`; the shared
+//! [`PiState`](crate::controller) accepts or rejects and proposes the next step; after an
+//! accepted step the event locator and the output at requested times use the method's dense
+//! output, prepared only when needed.
+
+use crate::controller::{initial_step, Controller, PiState};
+use crate::error::{invalid, point, OdeError};
+use crate::events::{check_t_eval, DenseOutput, Event, EventState, Output};
+use crate::options::{Options, StiffnessAction};
+use crate::problem::OdeSystem;
+use crate::solution::{Solution, Stats, Status};
+use crate::Method;
+
+/// One explicit embedded Runge–Kutta pair: stages, error estimate, dense output. It owns its
+/// workspace (allocated once in [`ExplicitRk::new`]).
+pub(crate) trait ExplicitRk: DenseOutput {
+    /// The public method tag.
+    const METHOD: Method;
+    /// Order of the propagated solution (used by the initial-step estimate).
+    const ORDER: i32;
+    /// Stiffness threshold on `h|λ|` (dopri5.f: 3.25, dop853.f: 6.1).
+    const STIFF_THRESHOLD: f64;
+    /// Default controller.
+    fn default_controller() -> Controller;
+    /// I-exponent of the controller for parameters `c`.
+    fn alpha(c: &Controller) -> f64;
+    /// Allocates the workspace for dimension `n`.
+    fn new(n: usize) -> Self;
+    /// Buffer holding `f(t, y)` at the start of the next step.
+    fn f_start(&mut self) -> &mut [f64];
+    /// Computes one step of size `h` from `(t, y)`, writes the new state to `y_new` and
+    /// returns the scaled error norm.
+    #[allow(clippy::too_many_arguments)]
+    fn attempt<S: OdeSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        y_new: &mut [f64],
+        atol: &[f64],
+        rtol: &[f64],
+        stats: &mut Stats,
+    ) -> f64;
+    /// Work to do once the step is accepted (e.g. DOP853's `f(t+h, y_new)`).
+    fn on_accept<S: OdeSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        t_new: f64,
+        y_new: &[f64],
+        stats: &mut Stats,
+    );
+    /// Hairer's stiffness indicator `h|λ|` for the accepted step.
+    fn stiffness(&self, h: f64, y_new: &[f64]) -> f64;
+    /// Prepares the dense output of the accepted step `[t, t + h]`.
+    #[allow(clippy::too_many_arguments)]
+    fn prepare_dense<S: OdeSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        y_new: &[f64],
+        stats: &mut Stats,
+    );
+    /// Makes the last stage the first of the next step.
+    fn advance(&mut self);
+}
+
+/// Validated common inputs.
+pub(crate) struct Setup {
+    pub n: usize,
+    pub dir: f64,
+    pub atol: Vec<f64>,
+    pub rtol: Vec<f64>,
+    pub hmax: f64,
+}
+
+pub(crate) fn setup<S: OdeSystem + ?Sized>(
+    sys: &S,
+    t0: f64,
+    tf: f64,
+    y0: &[f64],
+    opts: &Options,
+) -> Result<Setup, OdeError> {
+    let n = sys.dim();
+    if y0.len() != n {
+        return Err(invalid(format!(
+            "y0 has {} components, the system {n}",
+            y0.len()
+        )));
+    }
+    if !t0.is_finite() || !tf.is_finite() {
+        return Err(invalid("t0 and tf must be finite"));
+    }
+    if y0.iter().any(|v| !v.is_finite()) {
+        return Err(invalid("y0 must be finite"));
+    }
+    let atol = opts.atol.check(n, "atol").map_err(invalid)?;
+    let rtol = opts.rtol.check(n, "rtol").map_err(invalid)?;
+    if atol.iter().zip(&rtol).any(|(a, r)| *a == 0.0 && *r == 0.0) {
+        return Err(invalid("atol and rtol cannot both be zero for a component"));
+    }
+    if let Some(te) = &opts.t_eval {
+        check_t_eval(te, t0, tf).map_err(invalid)?;
+    }
+    if let Some(h) = opts.h0 {
+        if !h.is_finite() || h == 0.0 {
+            return Err(invalid("h0 must be finite and nonzero"));
+        }
+    }
+    let hmax = match opts.max_step {
+        Some(m) if m.is_nan() || m <= 0.0 => return Err(invalid("max_step must be positive")),
+        Some(m) => m.abs(),
+        None => (tf - t0).abs(),
+    };
+    Ok(Setup {
+        n,
+        dir: if tf >= t0 { 1.0 } else { -1.0 },
+        atol,
+        rtol,
+        hmax,
+    })
+}
+
+/// Integrates with the explicit pair `M` from `t0` to `tf`.
+pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
+    sys: &S,
+    t0: f64,
+    tf: f64,
+    y0: &[f64],
+    opts: &Options,
+    events: &[Event<'_>],
+    stiff_action: StiffnessAction,
+) -> Result<Solution, OdeError> {
+    let Setup {
+        n,
+        dir,
+        atol,
+        rtol,
+        hmax,
+    } = setup(sys, t0, tf, y0, opts)?;
+    let mut sol = Solution::new(M::METHOD, n);
+    let mut y = y0.to_vec();
+    let mut y_new = vec![0.0; n];
+    let mut ytmp = vec![0.0; n];
+    let mut ytmp2 = vec![0.0; n];
+    let mut rk = M::new(n);
+    let ctrl = opts.controller.unwrap_or_else(M::default_controller);
+    let mut pi = PiState::new(&ctrl, M::alpha(&ctrl));
+
+    let mut out = Output::new(opts.t_eval.as_deref(), dir);
+    out.start(&mut sol, t0, y0);
+    if t0 == tf {
+        return Ok(sol);
+    }
+    sys.rhs(t0, &y, rk.f_start());
+    sol.stats.fevals += 1;
+    let mut h = match opts.h0 {
+        Some(h0) => h0.abs().min(hmax) * dir,
+        None => {
+            let f0 = rk.f_start().to_vec();
+            sol.stats.fevals += 1;
+            initial_step(
+                sys,
+                t0,
+                &y,
+                &f0,
+                dir,
+                M::ORDER,
+                hmax,
+                &atol,
+                &rtol,
+                &mut ytmp,
+                &mut ytmp2,
+            )
+        }
+    };
+    let mut ev = EventState::new(events, n, t0, y0);
+    let mut t = t0;
+    let mut reject = false;
+    let mut last = false;
+    let mut nstep = 0usize;
+    let (mut iasti, mut nonsti) = (0usize, 0usize);
+    let nstiff = opts.stiffness_check_interval.max(1);
+    let mut nonfinite_in_row = 0usize;
+    loop {
+        if nstep >= opts.max_steps {
+            return Err(OdeError::MaxSteps {
+                max_steps: opts.max_steps,
+                at: point(t, &y, &sol),
+            });
+        }
+        if 0.1 * h.abs() <= t.abs() * f64::EPSILON || h == 0.0 {
+            return Err(OdeError::StepSizeUnderflow {
+                h,
+                at: point(t, &y, &sol),
+            });
+        }
+        if (t + 1.01 * h - tf) * dir > 0.0 {
+            h = tf - t;
+            last = true;
+        }
+        nstep += 1;
+        let err = rk.attempt(sys, t, &y, h, &mut y_new, &atol, &rtol, &mut sol.stats);
+        if !err.is_finite() {
+            nonfinite_in_row += 1;
+            if nonfinite_in_row > 20 {
+                return Err(OdeError::NonFinite {
+                    at: point(t, &y, &sol),
+                });
+            }
+        } else {
+            nonfinite_in_row = 0;
+        }
+        let (accepted, mut hnew) = pi.propose(err, h);
+        if accepted {
+            sol.stats.accepted += 1;
+            let t_new = if last { tf } else { t + h };
+            rk.on_accept(sys, t_new, &y_new, &mut sol.stats);
+            // Hairer's stiffness detection.
+            if sol.stats.accepted % nstiff == 0 || iasti > 0 {
+                let hlamb = rk.stiffness(h, &y_new);
+                if hlamb > M::STIFF_THRESHOLD {
+                    nonsti = 0;
+                    iasti += 1;
+                    if iasti == 15 {
+                        sol.stats.stiffness_detected_at.get_or_insert(t);
+                        if stiff_action == StiffnessAction::Error {
+                            return Err(OdeError::Stiff {
+                                at: point(t, &y, &sol),
+                            });
+                        }
+                    }
+                } else {
+                    nonsti += 1;
+                    if nonsti == 6 {
+                        iasti = 0;
+                    }
+                }
+            }
+            let crossed = !events.is_empty() && ev.check(t_new, &y_new);
+            if crossed || out.needs_dense(t_new) {
+                rk.prepare_dense(sys, t, &y, h, &y_new, &mut sol.stats);
+            }
+            let stop = if crossed {
+                ev.locate(&rk, t, t_new, &mut sol.events)
+            } else {
+                None
+            };
+            out.emit(&mut sol, &rk, t_new, &y_new, stop.map(|s| s.0), &mut ytmp);
+            if let Some((_, idx)) = stop {
+                sol.status = Status::TerminalEvent(idx);
+                return Ok(sol);
+            }
+            std::mem::swap(&mut y, &mut y_new);
+            t = t_new;
+            rk.advance();
+            if last {
+                return Ok(sol);
+            }
+            if hnew.abs() > hmax {
+                hnew = dir * hmax;
+            }
+            if reject {
+                hnew = dir * hnew.abs().min(h.abs());
+            }
+            reject = false;
+        } else {
+            reject = true;
+            last = false;
+            sol.stats.rejected += 1;
+        }
+        h = hnew;
+    }
+}
+
+/// `out_j = y_j + h Σ_m a_m k_{m,j}` over the nonzero `a_m` (stage-major `k`).
+#[inline(always)]
+pub(crate) fn stage_input(y: &[f64], k: &[f64], n: usize, a_row: &[f64], h: f64, out: &mut [f64]) {
+    if a_row.len() == 1 {
+        // `y + (h a21) k1`, in the order of the Fortran codes.
+        let ha = h * a_row[0];
+        for j in 0..n {
+            out[j] = y[j] + ha * k[j];
+        }
+        return;
+    }
+    for j in 0..n {
+        let mut acc = 0.0;
+        for (m, &a) in a_row.iter().enumerate() {
+            if a != 0.0 {
+                acc += a * k[m * n + j];
+            }
+        }
+        out[j] = y[j] + h * acc;
+    }
+}

@@ -1,0 +1,289 @@
+//! **DOPRI5** — Dormand–Prince 5(4), MATLAB's `ode45` and SciPy's `RK45`.
+//!
+//! Explicit, adaptive, 7 stages with FSAL (6 new evaluations of `f` per step), order 5
+//! propagated (local extrapolation), embedded order 4 for the error estimate, continuous
+//! extension of order 4 (Shampine's; coefficients `d` of dopri5.f). Not symplectic.
+//!
+//! J. R. Dormand, P. J. Prince, *A family of embedded Runge–Kutta formulae*, J. Comput. Appl.
+//! Math. 6 (1980) 19–26. Controller, initial step, stiffness detection and dense output as in
+//! E. Hairer's dopri5.f (Hairer, Nørsett & Wanner, *Solving ODEs I*, 2nd ed., §II.4–II.6):
+//!
+//! * error `e = h Σ_i (b_i − b̂_i) k_i`, norm and PI controller of [`crate::controller`] with
+//!   `α = 1/5 − 0.75β` (defaults safety 0.9, fac_min 0.2, fac_max 10, β = 0.04);
+//! * stiffness indicator `h|λ| ≈ |h|·‖k7 − k6‖ / ‖y1 − ŷ6‖` (stages 6 and 7 both at `t + h`),
+//!   stiff when it exceeds 3.25 fifteen times in a row;
+//! * dense output `u(t + θh) = y0 + θ(Δ + (1−θ)(B + θ(C + (1−θ)D)))` with `Δ = y1 − y0`,
+//!   `B = h k1 − Δ`, `C = Δ − h k7 − B`, `D = h Σ d_i k_i`.
+//!
+//! Statistics reproduce dopri5.f exactly (Arenstorf orbit, rtol = atol = 1e-7, h0 = 1e-4:
+//! 217 accepted, 21 rejected, 1429 evaluations of `f`).
+
+use crate::controller::Controller;
+use crate::events::DenseOutput;
+use crate::explicit::{stage_input, ExplicitRk};
+use crate::problem::OdeSystem;
+use crate::solution::Stats;
+use crate::tableau::Tableau;
+use crate::Method;
+
+/// One-line description for `--method help`.
+pub const DOC: &str = "Dormand-Prince 5(4), adaptive explicit RK, FSAL, 4th-order dense output \
+(ode45/RK45); Hairer's dopri5.f controller and stiffness detection. Dormand & Prince 1980.";
+
+/// The Dormand–Prince 5(4) tableau.
+pub const TABLEAU: Tableau<7> = Tableau {
+    a: [
+        [0.0; 7],
+        [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0, 0.0],
+        [
+            19372.0 / 6561.0,
+            -25360.0 / 2187.0,
+            64448.0 / 6561.0,
+            -212.0 / 729.0,
+            0.0,
+            0.0,
+            0.0,
+        ],
+        [
+            9017.0 / 3168.0,
+            -355.0 / 33.0,
+            46732.0 / 5247.0,
+            49.0 / 176.0,
+            -5103.0 / 18656.0,
+            0.0,
+            0.0,
+        ],
+        [
+            35.0 / 384.0,
+            0.0,
+            500.0 / 1113.0,
+            125.0 / 192.0,
+            -2187.0 / 6784.0,
+            11.0 / 84.0,
+            0.0,
+        ],
+    ],
+    b: [
+        35.0 / 384.0,
+        0.0,
+        500.0 / 1113.0,
+        125.0 / 192.0,
+        -2187.0 / 6784.0,
+        11.0 / 84.0,
+        0.0,
+    ],
+    b_hat: Some([
+        5179.0 / 57600.0,
+        0.0,
+        7571.0 / 16695.0,
+        393.0 / 640.0,
+        -92097.0 / 339200.0,
+        187.0 / 2100.0,
+        1.0 / 40.0,
+    ]),
+    c: [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0],
+    order: 5,
+    embedded_order: 4,
+    fsal: true,
+};
+
+/// Error weights `b − b̂` exactly as dopri5.f writes them (E1, E3, …, E7).
+const E: [f64; 7] = [
+    71.0 / 57600.0,
+    0.0,
+    -71.0 / 16695.0,
+    71.0 / 1920.0,
+    -17253.0 / 339200.0,
+    22.0 / 525.0,
+    -1.0 / 40.0,
+];
+
+/// Dense-output coefficients `d` of dopri5.f (Shampine 1986).
+const D: [f64; 7] = [
+    -12715105075.0 / 11282082432.0,
+    0.0,
+    87487479700.0 / 32700410799.0,
+    -10690763975.0 / 1880347072.0,
+    701980252875.0 / 199316789632.0,
+    -1453857185.0 / 822651844.0,
+    69997945.0 / 29380423.0,
+];
+
+/// Workspace: stages `k` (stage-major), the stage-6 input `ŷ6`, dense coefficients.
+pub(crate) struct Dopri5 {
+    n: usize,
+    k: Vec<f64>,
+    ysti: Vec<f64>,
+    cont: Vec<f64>,
+    t_old: f64,
+    h: f64,
+}
+
+impl DenseOutput for Dopri5 {
+    #[inline]
+    fn interpolate(&self, t: f64, out: &mut [f64]) {
+        let n = self.n;
+        let s = (t - self.t_old) / self.h;
+        let s1 = 1.0 - s;
+        let c = &self.cont;
+        for i in 0..n {
+            out[i] = c[i]
+                + s * (c[n + i] + s1 * (c[2 * n + i] + s * (c[3 * n + i] + s1 * c[4 * n + i])));
+        }
+    }
+}
+
+impl ExplicitRk for Dopri5 {
+    const METHOD: Method = Method::Dopri5;
+    const ORDER: i32 = 5;
+    const STIFF_THRESHOLD: f64 = 3.25;
+
+    fn default_controller() -> Controller {
+        Controller::dopri5()
+    }
+
+    fn alpha(c: &Controller) -> f64 {
+        0.2 - c.beta * 0.75
+    }
+
+    fn new(n: usize) -> Self {
+        Dopri5 {
+            n,
+            k: vec![0.0; 7 * n],
+            ysti: vec![0.0; n],
+            cont: vec![0.0; 5 * n],
+            t_old: 0.0,
+            h: 1.0,
+        }
+    }
+
+    fn f_start(&mut self) -> &mut [f64] {
+        &mut self.k[..self.n]
+    }
+
+    fn attempt<S: OdeSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        y_new: &mut [f64],
+        atol: &[f64],
+        rtol: &[f64],
+        stats: &mut Stats,
+    ) -> f64 {
+        let n = self.n;
+        let a = &TABLEAU.a;
+        let c = &TABLEAU.c;
+        let xph = t + h;
+        for s in 1..5 {
+            stage_input(y, &self.k, n, &a[s][..s], h, &mut self.ysti);
+            let (done, rest) = self.k.split_at_mut(s * n);
+            let _ = done;
+            sys.rhs(t + c[s] * h, &self.ysti, &mut rest[..n]);
+        }
+        stage_input(y, &self.k, n, &a[5][..5], h, &mut self.ysti);
+        {
+            let (_, rest) = self.k.split_at_mut(5 * n);
+            sys.rhs(xph, &self.ysti, &mut rest[..n]);
+        }
+        stage_input(y, &self.k, n, &a[6][..6], h, y_new);
+        {
+            let (_, rest) = self.k.split_at_mut(6 * n);
+            sys.rhs(xph, y_new, &mut rest[..n]);
+        }
+        stats.fevals += 6;
+        let k = &self.k;
+        let mut err = 0.0;
+        for i in 0..n {
+            let e = (E[0] * k[i]
+                + E[2] * k[2 * n + i]
+                + E[3] * k[3 * n + i]
+                + E[4] * k[4 * n + i]
+                + E[5] * k[5 * n + i]
+                + E[6] * k[6 * n + i])
+                * h;
+            let sk = atol[i] + rtol[i] * y[i].abs().max(y_new[i].abs());
+            err += (e / sk) * (e / sk);
+        }
+        (err / n as f64).sqrt()
+    }
+
+    fn on_accept<S: OdeSystem + ?Sized>(&mut self, _: &S, _: f64, _: &[f64], _: &mut Stats) {}
+
+    fn stiffness(&self, h: f64, y_new: &[f64]) -> f64 {
+        let n = self.n;
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..n {
+            let dk = self.k[6 * n + i] - self.k[5 * n + i];
+            let dy = y_new[i] - self.ysti[i];
+            num += dk * dk;
+            den += dy * dy;
+        }
+        if den > 0.0 {
+            h.abs() * (num / den).sqrt()
+        } else {
+            0.0
+        }
+    }
+
+    fn prepare_dense<S: OdeSystem + ?Sized>(
+        &mut self,
+        _: &S,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        y_new: &[f64],
+        _: &mut Stats,
+    ) {
+        let n = self.n;
+        let k = &self.k;
+        self.t_old = t;
+        self.h = h;
+        for i in 0..n {
+            let ydiff = y_new[i] - y[i];
+            let bspl = h * k[i] - ydiff;
+            self.cont[i] = y[i];
+            self.cont[n + i] = ydiff;
+            self.cont[2 * n + i] = bspl;
+            self.cont[3 * n + i] = -h * k[6 * n + i] + ydiff - bspl;
+            self.cont[4 * n + i] = h
+                * (D[0] * k[i]
+                    + D[2] * k[2 * n + i]
+                    + D[3] * k[3 * n + i]
+                    + D[4] * k[4 * n + i]
+                    + D[5] * k[5 * n + i]
+                    + D[6] * k[6 * n + i]);
+        }
+    }
+
+    fn advance(&mut self) {
+        let n = self.n;
+        self.k.copy_within(6 * n..7 * n, 0);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tableau::order_residual;
+
+    #[test]
+    fn tableau_row_sums_and_order_conditions() {
+        assert!(TABLEAU.row_sum_residual() < 1e-15);
+        let a = TABLEAU.a_rows();
+        assert!(order_residual(&a, &TABLEAU.b, 5) < 1e-14);
+        assert!(
+            order_residual(&a, &TABLEAU.b, 6) > 1e-5,
+            "order is exactly 5"
+        );
+        let bh = TABLEAU.b_hat.unwrap();
+        assert!(order_residual(&a, &bh, 4) < 1e-14);
+        for i in 0..7 {
+            assert!((TABLEAU.b[i] - bh[i] - E[i]).abs() < 1e-16);
+            assert_eq!(TABLEAU.b[i], TABLEAU.a[6][i], "FSAL: b is the last row");
+        }
+    }
+}

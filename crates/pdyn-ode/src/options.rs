@@ -1,0 +1,130 @@
+//! Solver options (`rtol`, `atol`, `h0`, `max_step`, `max_steps`, `t_eval`, …) and the
+//! parameters of the shared step-size controller.
+//!
+//! Names follow SciPy's `solve_ivp` and MATLAB's `odeset`. Every default is documented on its
+//! field and set in the single `impl Default for Options`.
+
+use crate::controller::Controller;
+
+/// Absolute or relative tolerance: one value for all components or one per component.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Tolerance {
+    /// The same tolerance for every component.
+    Scalar(f64),
+    /// One tolerance per component (length must equal the system dimension).
+    PerComponent(Vec<f64>),
+}
+
+impl Tolerance {
+    /// Tolerance of component `i`.
+    #[inline]
+    pub fn get(&self, i: usize) -> f64 {
+        match self {
+            Tolerance::Scalar(v) => *v,
+            Tolerance::PerComponent(v) => v[i],
+        }
+    }
+
+    pub(crate) fn check(&self, n: usize, name: &str) -> Result<Vec<f64>, String> {
+        let v: Vec<f64> = match self {
+            Tolerance::Scalar(v) => vec![*v; n],
+            Tolerance::PerComponent(v) => {
+                if v.len() != n {
+                    return Err(format!("{name} has {} components, the system {n}", v.len()));
+                }
+                v.clone()
+            }
+        };
+        if v.iter().any(|x| !x.is_finite() || *x < 0.0) {
+            return Err(format!("{name} must be finite and non-negative"));
+        }
+        Ok(v)
+    }
+}
+
+impl From<f64> for Tolerance {
+    fn from(v: f64) -> Self {
+        Tolerance::Scalar(v)
+    }
+}
+
+impl From<Vec<f64>> for Tolerance {
+    fn from(v: Vec<f64>) -> Self {
+        Tolerance::PerComponent(v)
+    }
+}
+
+/// What an explicit method does when its stiffness detector fires (Hairer's test
+/// `h·|λ| > 3.25` for DOPRI5, `> 6.1` for DOP853, 15 times in a row, checked every
+/// [`Options::stiffness_check_interval`] accepted steps).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StiffnessAction {
+    /// Keep integrating (the count is still reported in [`crate::Stats::stiffness_detected_at`]).
+    Ignore,
+    /// Stop with [`crate::OdeError::Stiff`].
+    Error,
+}
+
+/// Options shared by every method. Start from `Options::default()` and override fields.
+///
+/// ```
+/// let opts = pdyn_ode::Options { rtol: 1e-8.into(), atol: 1e-10.into(), ..Default::default() };
+/// assert_eq!(opts.max_steps, 1_000_000);
+/// ```
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Relative tolerance. Default `1e-6` (MATLAB's default is `1e-3`, which is often
+    /// silently inaccurate).
+    pub rtol: Tolerance,
+    /// Absolute tolerance. Default `1e-9` (MATLAB: `1e-6`).
+    pub atol: Tolerance,
+    /// First step size (magnitude; the sign follows the integration direction). For adaptive
+    /// methods `None` means Hairer's initial-step estimate; fixed-step methods require it and
+    /// use `n = ceil(|tf − t0| / h0)` equal steps. Default `None`.
+    pub h0: Option<f64>,
+    /// Largest step size allowed (magnitude). Default `None` = `|tf − t0|`.
+    pub max_step: Option<f64>,
+    /// Maximum number of step attempts (accepted + rejected). Default `1_000_000`.
+    pub max_steps: usize,
+    /// Output times. `None` (default): output after every accepted step (and at `t0`).
+    /// `Some(ts)`: output exactly at these times (monotone in the integration direction, within
+    /// `[t0, tf]`), computed by each method's dense output.
+    pub t_eval: Option<Vec<f64>>,
+    /// Step-size controller parameters. `None` (default): the method's published defaults
+    /// ([`Controller::dopri5`], [`Controller::dop853`], [`Controller::radau5`]).
+    pub controller: Option<Controller>,
+    /// Stiffness detection in the explicit methods: accepted steps between two checks
+    /// (Hairer's `NSTIFF`). Default `1000`. Once a check fires the test runs at every step
+    /// until it has failed 6 times in a row.
+    pub stiffness_check_interval: usize,
+    /// What to do when stiffness is detected. Default [`StiffnessAction::Ignore`]
+    /// (`Method::Auto` switches to Radau5 regardless).
+    pub on_stiffness: StiffnessAction,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            rtol: Tolerance::Scalar(1e-6),
+            atol: Tolerance::Scalar(1e-9),
+            h0: None,
+            max_step: None,
+            max_steps: 1_000_000,
+            t_eval: None,
+            controller: None,
+            stiffness_check_interval: 1000,
+            on_stiffness: StiffnessAction::Ignore,
+        }
+    }
+}
+
+impl Options {
+    /// Options with `rtol = atol = tol`.
+    pub fn with_tol(tol: f64) -> Self {
+        Options {
+            rtol: tol.into(),
+            atol: tol.into(),
+            ..Default::default()
+        }
+    }
+}
