@@ -4,6 +4,8 @@
 #![warn(missing_docs)]
 // Numerical kernels index several arrays with one index; iterator chains would obscure the math.
 #![allow(clippy::needless_range_loop)]
+// Published coefficients are kept with all the digits of their source.
+#![allow(clippy::excessive_precision)]
 
 pub mod controller;
 mod error;

@@ -1,6 +1,6 @@
 //! Reference problems and their published data (copied from Hairer–Nørsett–Wanner and the
 //! Bari test set; see each function).
-#![allow(dead_code)]
+#![allow(dead_code, clippy::excessive_precision)]
 
 use pdyn_ode::{FnSystem, FnSystemWithJacobian, OdeSystem};
 
