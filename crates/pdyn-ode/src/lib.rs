@@ -11,6 +11,7 @@ pub mod controller;
 mod error;
 pub mod events;
 mod explicit;
+mod fixed;
 pub mod methods;
 mod options;
 pub mod problem;
@@ -27,43 +28,137 @@ pub use problem::{
 };
 pub use solution::{Direction, EventHit, Solution, Stats, Status};
 
-/// The integration methods.
+/// The integration methods. See [`Method::all`] and [`Method::doc`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum Method {
-    /// Dormand–Prince 5(4) ([`methods::dopri5`]).
+    /// Dormand–Prince 5(4) ([`methods::dopri5`]), adaptive; MATLAB's `ode45`.
     Dopri5,
+    /// Tsitouras 5(4) ([`methods::tsit5`]), adaptive.
+    Tsit5,
+    /// Dormand–Prince 8(5,3) ([`methods::dop853`]), adaptive.
+    Dop853,
+    /// Classical Runge–Kutta 4 ([`methods::rk4`]), fixed step.
+    Rk4,
+    /// Velocity Verlet ([`methods::symplectic`]), fixed step, symplectic, order 2.
+    VelocityVerlet,
+    /// Yoshida's composition ([`methods::symplectic`]), fixed step, symplectic, order 4.
+    Yoshida4,
+    /// Kahan–Li composition ([`methods::symplectic`]), fixed step, symplectic, order 6.
+    KahanLi6,
+    /// Kahan–Li composition ([`methods::symplectic`]), fixed step, symplectic, order 8.
+    KahanLi8,
+    /// Gauss–Legendre 2 stages ([`methods::gauss`]), implicit, fixed step, symplectic, order 4.
+    Gauss4,
+    /// Gauss–Legendre 3 stages ([`methods::gauss`]), implicit, fixed step, symplectic, order 6.
+    Gauss6,
+}
+
+/// What kind of integrator a method is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MethodKind {
+    /// Explicit with error control (uses `rtol`, `atol`, `h0` as first step).
+    Adaptive,
+    /// Implicit with error control, for stiff problems.
+    Stiff,
+    /// Fixed step `h0`, not symplectic.
+    FixedStep,
+    /// Fixed step `h0`, symplectic.
+    Symplectic,
 }
 
 impl Method {
     /// Every method, in the order `--method help` lists them.
     pub fn all() -> &'static [Method] {
-        &[Method::Dopri5]
+        &[
+            Method::Dopri5,
+            Method::Tsit5,
+            Method::Dop853,
+            Method::Rk4,
+            Method::VelocityVerlet,
+            Method::Yoshida4,
+            Method::KahanLi6,
+            Method::KahanLi8,
+            Method::Gauss4,
+            Method::Gauss6,
+        ]
     }
 
-    /// Short lowercase name (`dopri5`, …), accepted by [`Method::from_name`].
+    /// Short lowercase name (`dopri5`, `tsit5`, …), accepted by [`Method::from_name`].
     pub fn name(self) -> &'static str {
         match self {
             Method::Dopri5 => "dopri5",
+            Method::Tsit5 => "tsit5",
+            Method::Dop853 => "dop853",
+            Method::Rk4 => "rk4",
+            Method::VelocityVerlet => "verlet",
+            Method::Yoshida4 => "yoshida4",
+            Method::KahanLi6 => "kahanli6",
+            Method::KahanLi8 => "kahanli8",
+            Method::Gauss4 => "gauss4",
+            Method::Gauss6 => "gauss6",
         }
     }
 
     /// One-paragraph description: order, adaptivity, symplecticity, paper.
     pub fn doc(self) -> &'static str {
+        use methods::*;
         match self {
-            Method::Dopri5 => methods::dopri5::DOC,
+            Method::Dopri5 => dopri5::DOC,
+            Method::Tsit5 => tsit5::DOC,
+            Method::Dop853 => dop853::DOC,
+            Method::Rk4 => rk4::DOC,
+            Method::VelocityVerlet => symplectic::DOC_VERLET,
+            Method::Yoshida4 => symplectic::DOC_YOSHIDA4,
+            Method::KahanLi6 => symplectic::DOC_KAHAN_LI6,
+            Method::KahanLi8 => symplectic::DOC_KAHAN_LI8,
+            Method::Gauss4 => gauss::DOC_GAUSS4,
+            Method::Gauss6 => gauss::DOC_GAUSS6,
         }
     }
 
-    /// Parses a name as printed by [`Method::name`] (case-insensitive; `ode45`, `rk45` are
-    /// aliases of `dopri5`).
+    /// Nominal order of the propagated solution.
+    pub fn order(self) -> u32 {
+        match self {
+            Method::Dopri5 | Method::Tsit5 => 5,
+            Method::Dop853 | Method::KahanLi8 => 8,
+            Method::Rk4 | Method::Yoshida4 | Method::Gauss4 => 4,
+            Method::VelocityVerlet => 2,
+            Method::KahanLi6 | Method::Gauss6 => 6,
+        }
+    }
+
+    /// Kind of method.
+    pub fn kind(self) -> MethodKind {
+        match self {
+            Method::Dopri5 | Method::Tsit5 | Method::Dop853 => MethodKind::Adaptive,
+            Method::Rk4 => MethodKind::FixedStep,
+            Method::VelocityVerlet
+            | Method::Yoshida4
+            | Method::KahanLi6
+            | Method::KahanLi8
+            | Method::Gauss4
+            | Method::Gauss6 => MethodKind::Symplectic,
+        }
+    }
+
+    /// Parses a name as printed by [`Method::name`] (case-insensitive; `ode45`/`rk45` are
+    /// aliases of `dopri5`, `leapfrog` of `verlet`).
     pub fn from_name(name: &str) -> Option<Method> {
         let lower = name.to_ascii_lowercase();
         match lower.as_str() {
             "ode45" | "rk45" => return Some(Method::Dopri5),
+            "leapfrog" | "velocity-verlet" => return Some(Method::VelocityVerlet),
             _ => {}
         }
         Method::all().iter().copied().find(|m| m.name() == lower)
+    }
+
+    fn needs_second_order(self) -> bool {
+        matches!(
+            self,
+            Method::VelocityVerlet | Method::Yoshida4 | Method::KahanLi6 | Method::KahanLi8
+        )
     }
 }
 
@@ -75,6 +170,15 @@ impl std::fmt::Display for Method {
 
 /// Integrates `M y' = f(t, y)` from `t_span.0` to `t_span.1` (either direction) starting at
 /// `y0`, with `method` and `opts`.
+///
+/// ```
+/// use pdyn_ode::{solve, FnSystem, Method, Options};
+/// let decay = FnSystem::new(1, |_t, y: &[f64], dy: &mut [f64]| dy[0] = -y[0]);
+/// let sol = solve(Method::Dopri5, &decay, (0.0, 1.0), &[1.0], &Options::default()).unwrap();
+/// let (t, y) = sol.last().unwrap();
+/// assert_eq!(t, 1.0);
+/// assert!((y[0] - (-1.0f64).exp()).abs() < 1e-7);
+/// ```
 pub fn solve<S: OdeSystem + ?Sized>(
     method: Method,
     sys: &S,
@@ -95,15 +199,123 @@ pub fn solve_with_events<S: OdeSystem + ?Sized>(
     events: &[Event<'_>],
 ) -> Result<Solution, OdeError> {
     let (t0, tf) = t_span;
+    if method.needs_second_order() {
+        return Err(error::invalid(format!(
+            "{method} integrates second-order separable systems: use solve_second_order"
+        )));
+    }
+    if sys.mass_kind() != MassKind::Identity {
+        return Err(error::invalid(format!(
+            "{method} does not support a mass matrix (use radau5)"
+        )));
+    }
+    let n = sys.dim();
+    let act = opts.on_stiffness;
     match method {
-        Method::Dopri5 => explicit::integrate::<methods::dopri5::Dopri5, S>(
+        Method::Dopri5 => {
+            explicit::integrate::<methods::dopri5::Dopri5, S>(sys, t0, tf, y0, opts, events, act)
+        }
+        Method::Tsit5 => {
+            explicit::integrate::<methods::tsit5::Tsit5, S>(sys, t0, tf, y0, opts, events, act)
+        }
+        Method::Dop853 => {
+            explicit::integrate::<methods::dop853::Dop853, S>(sys, t0, tf, y0, opts, events, act)
+        }
+        Method::Rk4 => fixed::integrate_fixed(
+            method,
             sys,
+            sys,
+            methods::rk4::Rk4::new(n),
             t0,
             tf,
             y0,
             opts,
             events,
-            opts.on_stiffness,
         ),
+        Method::Gauss4 => fixed::integrate_fixed(
+            method,
+            sys,
+            sys,
+            methods::gauss::Gauss::new(&methods::gauss::GAUSS4, n),
+            t0,
+            tf,
+            y0,
+            opts,
+            events,
+        ),
+        Method::Gauss6 => fixed::integrate_fixed(
+            method,
+            sys,
+            sys,
+            methods::gauss::Gauss::new(&methods::gauss::GAUSS6, n),
+            t0,
+            tf,
+            y0,
+            opts,
+            events,
+        ),
+        Method::VelocityVerlet | Method::Yoshida4 | Method::KahanLi6 | Method::KahanLi8 => {
+            unreachable!("handled above")
+        }
     }
+}
+
+/// Integrates the second-order system `q'' = a(t, q, q')` from `(q0, v0)`. The solution's
+/// state is `y = (q, v)` (length `2 · dim`). Symplectic compositions require
+/// [`SecondOrderSystem::separable`]; every other method integrates the first-order form.
+pub fn solve_second_order<S: SecondOrderSystem + ?Sized>(
+    method: Method,
+    sys: &S,
+    t_span: (f64, f64),
+    q0: &[f64],
+    v0: &[f64],
+    opts: &Options,
+) -> Result<Solution, OdeError> {
+    solve_second_order_with_events(method, sys, t_span, q0, v0, opts, &[])
+}
+
+/// As [`solve_second_order`], with events (`g` receives `y = (q, v)`).
+pub fn solve_second_order_with_events<S: SecondOrderSystem + ?Sized>(
+    method: Method,
+    sys: &S,
+    t_span: (f64, f64),
+    q0: &[f64],
+    v0: &[f64],
+    opts: &Options,
+    events: &[Event<'_>],
+) -> Result<Solution, OdeError> {
+    let n = sys.dim();
+    if q0.len() != n || v0.len() != n {
+        return Err(error::invalid(format!(
+            "q0 and v0 must have {n} components (got {} and {})",
+            q0.len(),
+            v0.len()
+        )));
+    }
+    let mut y0 = q0.to_vec();
+    y0.extend_from_slice(v0);
+    let first = FirstOrderForm(sys);
+    let w: &'static [f64] = match method {
+        Method::VelocityVerlet => &methods::symplectic::VERLET,
+        Method::Yoshida4 => &methods::symplectic::YOSHIDA4,
+        Method::KahanLi6 => &methods::symplectic::KAHAN_LI6,
+        Method::KahanLi8 => &methods::symplectic::KAHAN_LI8,
+        _ => return solve_with_events(method, &first, t_span, &y0, opts, events),
+    };
+    if !sys.separable() {
+        return Err(error::invalid(format!(
+            "{method} needs a separable system (acceleration independent of velocity); use gauss4/gauss6"
+        )));
+    }
+    fixed::integrate_fixed(
+        method,
+        sys,
+        &first,
+        methods::symplectic::Composition::new(w, n),
+        t_span.0,
+        t_span.1,
+        &y0,
+        opts,
+        events,
+    )
 }

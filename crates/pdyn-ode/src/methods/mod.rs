@@ -1,3 +1,8 @@
 //! One integrator family per file; each file opens with its mathematics and its paper.
 
+pub mod dop853;
 pub mod dopri5;
+pub mod gauss;
+pub mod rk4;
+pub mod symplectic;
+pub mod tsit5;
