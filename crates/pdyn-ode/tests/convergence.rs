@@ -1,0 +1,121 @@
+//! Observed order of convergence of every method on a smooth nonlinear problem (Kepler,
+//! e = 0.2, one period: the exact solution returns to the initial state). Adaptive methods are
+//! run with a fixed step (`h0 = max_step = h`, huge tolerances so no step is rejected). The
+//! observed order `log2(e(h)/e(h/2))` must be within ±0.2 of the nominal order (for the
+//! compositions, which are applied to a symmetric base method, the even order `p` is checked).
+use pdyn_ode::{solve_second_order, FnSecondOrder, Method, Options};
+use std::f64::consts::PI;
+
+const E: f64 = 0.2;
+
+fn kepler() -> impl pdyn_ode::SecondOrderSystem {
+    FnSecondOrder::new(2, true, |_t, q: &[f64], _v: &[f64], a: &mut [f64]| {
+        let r2 = q[0] * q[0] + q[1] * q[1];
+        let r3 = r2 * r2.sqrt();
+        a[0] = -q[0] / r3;
+        a[1] = -q[1] / r3;
+    })
+}
+
+fn error_after_one_period(method: Method, steps: usize) -> f64 {
+    let q0 = [1.0 - E, 0.0];
+    let v0 = [0.0, ((1.0 + E) / (1.0 - E)).sqrt()];
+    let t_end = 2.0 * PI;
+    let h = t_end / steps as f64;
+    let opts = Options {
+        h0: Some(h),
+        max_step: Some(h),
+        rtol: 1e10.into(),
+        atol: 1e10.into(),
+        ..Default::default()
+    };
+    let sol = solve_second_order(method, &kepler(), (0.0, t_end), &q0, &v0, &opts).unwrap();
+    assert_eq!(sol.stats.rejected, 0);
+    assert!(sol.stats.accepted.abs_diff(steps) <= 1, "{:?}", sol.stats);
+    let (_, y) = sol.last().unwrap();
+    let exact = [q0[0], q0[1], v0[0], v0[1]];
+    y.iter()
+        .zip(exact)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max)
+}
+
+fn check(method: Method, steps: usize) {
+    let e1 = error_after_one_period(method, steps);
+    let e2 = error_after_one_period(method, 2 * steps);
+    let p = (e1 / e2).log2();
+    let nominal = method.order() as f64;
+    assert!(
+        (p - nominal).abs() <= 0.2,
+        "{method}: observed order {p:.3} (errors {e1:e}, {e2:e}), nominal {nominal}"
+    );
+    assert!(
+        e2 > 1e-13,
+        "{method}: error {e2:e} too close to round-off for a fair measure"
+    );
+}
+
+#[test]
+fn dopri5_is_order_5() {
+    check(Method::Dopri5, 200);
+}
+
+#[test]
+fn tsit5_is_order_5() {
+    check(Method::Tsit5, 200);
+}
+
+#[test]
+fn dop853_is_order_8() {
+    check(Method::Dop853, 50);
+}
+
+#[test]
+fn rk4_is_order_4() {
+    check(Method::Rk4, 800);
+}
+
+#[test]
+fn verlet_is_order_2() {
+    check(Method::VelocityVerlet, 200);
+}
+
+#[test]
+fn yoshida4_is_order_4() {
+    check(Method::Yoshida4, 100);
+}
+
+#[test]
+fn kahan_li6_is_order_6() {
+    check(Method::KahanLi6, 50);
+}
+
+#[test]
+fn kahan_li8_is_order_8() {
+    check(Method::KahanLi8, 50);
+}
+
+#[test]
+fn gauss4_is_order_4() {
+    check(Method::Gauss4, 100);
+}
+
+#[test]
+fn gauss6_is_order_6() {
+    check(Method::Gauss6, 50);
+}
+
+#[test]
+#[ignore = "exploration: prints error tables"]
+fn print_tables() {
+    for m in Method::all() {
+        let mut line = format!("{m:10}");
+        let mut prev = f64::NAN;
+        for n in [25, 50, 100, 200, 400, 800, 1600] {
+            let e = error_after_one_period(*m, n);
+            line += &format!(" {n}:{e:.1e}({:.2})", (prev / e).log2());
+            prev = e;
+        }
+        println!("{line}");
+    }
+}
