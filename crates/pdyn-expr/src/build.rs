@@ -1,0 +1,562 @@
+//! Canonicalising constructors: the only way nodes enter a [`Pool`].
+//!
+//! Automatic simplification in the sense of Cohen (*Computer Algebra and Symbolic
+//! Computation*, ch. 3): sums and products are flattened, numbers folded exactly, like terms
+//! (`2*x + 3*x = 5*x`) and like powers (`x*x^2 = x^3`) collected, children sorted by
+//! [`Pool::order`]. A numeric factor is distributed over a single sum (`-(a - b) = b - a`),
+//! integer powers over products, and `sqrt` of declared-positive factors is taken out
+//! (`sqrt(m^2*g) = m*sqrt(g)` for `m > 0`). Odd/even functions normalise the sign of their
+//! argument (`cos(b - a) = cos(a - b)`), and exact values at `0` and multiples of `pi/2` fold.
+
+use crate::number::Number;
+use crate::pool::{Constant, Func, Id, Node, Pool};
+use rustc_hash::FxHashMap;
+
+impl Pool {
+    /// `a + b`.
+    pub fn add2(&mut self, a: Id, b: Id) -> Id {
+        self.add(&[a, b])
+    }
+
+    /// `a - b`.
+    pub fn sub(&mut self, a: Id, b: Id) -> Id {
+        let nb = self.neg(b);
+        self.add(&[a, nb])
+    }
+
+    /// `-a`.
+    pub fn neg(&mut self, a: Id) -> Id {
+        self.mul(&[Pool::MINUS_ONE, a])
+    }
+
+    /// `a * b`.
+    pub fn mul2(&mut self, a: Id, b: Id) -> Id {
+        self.mul(&[a, b])
+    }
+
+    /// `a / b`.
+    pub fn div(&mut self, a: Id, b: Id) -> Id {
+        let inv = self.pow(b, Pool::MINUS_ONE);
+        self.mul(&[a, inv])
+    }
+
+    /// `a^n` for an integer `n`.
+    pub fn powi(&mut self, a: Id, n: i64) -> Id {
+        let e = self.int(n);
+        self.pow(a, e)
+    }
+
+    /// `sqrt(a)`, i.e. `a^(1/2)`.
+    pub fn sqrt(&mut self, a: Id) -> Id {
+        let half = self.num(Number::ratio(1, 2));
+        self.pow(a, half)
+    }
+
+    /// Splits a term into numeric coefficient and the rest: `3*x*y -> (3, x*y)`.
+    pub fn split_coeff(&mut self, t: Id) -> (Number, Id) {
+        match self.node(t) {
+            Node::Num(n) => (*n, Pool::ONE),
+            Node::Mul(fs) => {
+                if let Node::Num(c) = self.node(fs[0]) {
+                    let c = *c;
+                    let rest: Vec<Id> = fs[1..].to_vec();
+                    let rest = if rest.len() == 1 {
+                        rest[0]
+                    } else {
+                        self.intern(Node::Mul(rest.into_boxed_slice()))
+                    };
+                    (c, rest)
+                } else {
+                    (Number::ONE, t)
+                }
+            }
+            _ => (Number::ONE, t),
+        }
+    }
+
+    /// `c * rest`.
+    pub fn scale(&mut self, c: Number, rest: Id) -> Id {
+        let cid = self.num(c);
+        self.mul(&[cid, rest])
+    }
+
+    /// Canonical sum of `terms`.
+    pub fn add(&mut self, terms: &[Id]) -> Id {
+        let mut constant = Number::ZERO;
+        let mut coeffs: FxHashMap<Id, Number> = FxHashMap::default();
+        let mut order: Vec<Id> = Vec::new();
+        let mut stack: Vec<Id> = terms.iter().rev().copied().collect();
+        while let Some(t) = stack.pop() {
+            match self.node(t) {
+                Node::Add(ts) => stack.extend(ts.iter().rev().copied()),
+                Node::Num(n) => constant = constant.add(*n),
+                _ => {
+                    let (c, rest) = self.split_coeff(t);
+                    match coeffs.get_mut(&rest) {
+                        Some(acc) => *acc = acc.add(c),
+                        None => {
+                            coeffs.insert(rest, c);
+                            order.push(rest);
+                        }
+                    }
+                }
+            }
+        }
+        let mut out: Vec<Id> = Vec::with_capacity(order.len() + 1);
+        for rest in order {
+            let c = coeffs[&rest];
+            if !c.is_zero() {
+                let term = self.scale_term(c, rest);
+                out.push(term);
+            }
+        }
+        out.sort_by(|a, b| self.order(*a, *b));
+        if !constant.is_zero() {
+            let c = self.num(constant);
+            out.insert(0, c);
+        }
+        match out.len() {
+            0 => Pool::ZERO,
+            1 => out[0],
+            _ => self.intern(Node::Add(out.into_boxed_slice())),
+        }
+    }
+
+    /// `c * rest` for a `rest` that came out of [`Pool::split_coeff`] (no coefficient, not a
+    /// number), built directly without re-canonicalising the factors.
+    fn scale_term(&mut self, c: Number, rest: Id) -> Id {
+        if c.is_one() {
+            return rest;
+        }
+        let cid = self.num(c);
+        match self.node(rest) {
+            Node::Mul(fs) => {
+                let mut v = Vec::with_capacity(fs.len() + 1);
+                v.push(cid);
+                v.extend_from_slice(fs);
+                self.intern(Node::Mul(v.into_boxed_slice()))
+            }
+            // A number times a sum is distributed by `mul`; do the same here for consistency.
+            Node::Add(_) => self.mul(&[cid, rest]),
+            _ => self.intern(Node::Mul(Box::new([cid, rest]))),
+        }
+    }
+
+    /// Canonical product of `factors`.
+    pub fn mul(&mut self, factors: &[Id]) -> Id {
+        let mut coeff = Number::ONE;
+        let mut exps: FxHashMap<Id, Vec<Id>> = FxHashMap::default();
+        let mut bases: Vec<Id> = Vec::new();
+        let mut stack: Vec<Id> = factors.iter().rev().copied().collect();
+        while let Some(f) = stack.pop() {
+            let (b, e) = match self.node(f) {
+                Node::Mul(fs) => {
+                    stack.extend(fs.iter().rev().copied());
+                    continue;
+                }
+                Node::Num(n) => {
+                    coeff = coeff.mul(*n);
+                    continue;
+                }
+                Node::Pow(b, e) => (*b, *e),
+                _ => (f, Pool::ONE),
+            };
+            match exps.get_mut(&b) {
+                Some(v) => v.push(e),
+                None => {
+                    exps.insert(b, vec![e]);
+                    bases.push(b);
+                }
+            }
+        }
+        if coeff.is_zero() {
+            return Pool::ZERO;
+        }
+        let mut out: Vec<Id> = Vec::with_capacity(bases.len() + 1);
+        let mut reflatten = false;
+        for b in bases {
+            let es = &exps[&b];
+            let p = if es.len() == 1 {
+                if es[0] == Pool::ONE {
+                    b
+                } else {
+                    // Already a canonical Pow node unless the base is a number (2^(1/2)).
+                    let e = es[0];
+                    self.pow(b, e)
+                }
+            } else {
+                let es = es.clone();
+                let e = self.add(&es);
+                self.pow(b, e)
+            };
+            match self.node(p) {
+                Node::Num(n) => coeff = coeff.mul(*n),
+                Node::Mul(_) => {
+                    reflatten = true;
+                    out.push(p)
+                }
+                Node::Pow(pb, _) if *pb != b => {
+                    reflatten = true;
+                    out.push(p)
+                }
+                _ => out.push(p),
+            }
+        }
+        if reflatten {
+            let c = self.num(coeff);
+            out.push(c);
+            return self.mul(&out);
+        }
+        if coeff.is_zero() {
+            return Pool::ZERO;
+        }
+        out.sort_by(|a, b| self.order(*a, *b));
+        if out.is_empty() {
+            return self.num(coeff);
+        }
+        if coeff.is_one() && out.len() == 1 {
+            return out[0];
+        }
+        if out.len() == 1 && matches!(self.node(out[0]), Node::Add(_)) {
+            // Distribute a number over a sum: 2*(a + b) = 2*a + 2*b.
+            if let Node::Add(ts) = self.node(out[0]) {
+                let ts = ts.to_vec();
+                let terms: Vec<Id> = ts
+                    .into_iter()
+                    .map(|t| {
+                        let (c, rest) = self.split_coeff(t);
+                        let nc = c.mul(coeff);
+                        if rest == Pool::ONE {
+                            self.num(nc)
+                        } else {
+                            self.scale_term(nc, rest)
+                        }
+                    })
+                    .collect();
+                return self.add(&terms);
+            }
+        }
+        if !coeff.is_one() {
+            let c = self.num(coeff);
+            out.insert(0, c);
+        }
+        self.intern(Node::Mul(out.into_boxed_slice()))
+    }
+
+    /// Canonical power `b^e`.
+    pub fn pow(&mut self, b: Id, e: Id) -> Id {
+        if e == Pool::ZERO {
+            return Pool::ONE;
+        }
+        if e == Pool::ONE || b == Pool::ONE {
+            return b;
+        }
+        let en = self.as_num(e);
+        match (self.node(b).clone(), en) {
+            (Node::Num(x), Some(y)) => {
+                if let Some(r) = x.pow(y) {
+                    return self.num(r);
+                }
+                // Exact base, fractional exponent without exact root: 2^(3/2) = 2*2^(1/2).
+                if let (Some(xr), Some(yr)) = (x.as_rational(), y.as_rational()) {
+                    let (p, q) = (yr.numer(), yr.denom());
+                    let whole = p.div_euclid(q);
+                    let frac = p.rem_euclid(q);
+                    if whole != 0 && xr.numer() > 0 {
+                        let w = self.num(x.pow(Number::int(whole)).unwrap_or(Number::Float(
+                            x.to_f64().powf(whole as f64),
+                        )));
+                        let fe = self.num(Number::ratio(frac, q));
+                        let fp = self.intern(Node::Pow(b, fe));
+                        return self.mul(&[w, fp]);
+                    }
+                }
+                self.intern(Node::Pow(b, e))
+            }
+            (Node::Const(Constant::E), _) => self.call(Func::Exp, &[e]),
+            (Node::Pow(b2, e2), Some(y)) => {
+                let y_int = y.as_integer().is_some();
+                if y_int || self.is_positive(b2) {
+                    let ne = self.mul(&[e2, e]);
+                    return self.pow(b2, ne);
+                }
+                if let Some(n) = self.as_num(e2).and_then(|n| n.as_integer()) {
+                    let prod = Number::int(n).mul(y);
+                    if n % 2 == 0 && prod.as_integer().is_some() {
+                        // sqrt(x^2) = |x| for real x.
+                        let a = self.call(Func::Abs, &[b2]);
+                        let pe = self.num(prod);
+                        return self.pow(a, pe);
+                    }
+                }
+                self.intern(Node::Pow(b, e))
+            }
+            (Node::Pow(b2, e2), None) if self.is_positive(b2) => {
+                let ne = self.mul(&[e2, e]);
+                self.pow(b2, ne)
+            }
+            (Node::Mul(fs), Some(y)) => {
+                if y.as_integer().is_some() {
+                    let ps: Vec<Id> = fs.iter().map(|&f| self.pow(f, e)).collect();
+                    return self.mul(&ps);
+                }
+                let (pos, rest): (Vec<Id>, Vec<Id>) =
+                    fs.iter().partition(|&&f| self.is_positive(f));
+                if pos.is_empty() {
+                    return self.intern(Node::Pow(b, e));
+                }
+                let mut ps: Vec<Id> = pos.iter().map(|&f| self.pow(f, e)).collect();
+                match rest.len() {
+                    0 => {}
+                    1 => ps.push(self.pow(rest[0], e)),
+                    _ => {
+                        let r = self.mul(&rest);
+                        ps.push(self.pow(r, e));
+                    }
+                }
+                self.mul(&ps)
+            }
+            (Node::Call(Func::Exp, args), _) => {
+                let u = self.mul(&[args[0], e]);
+                self.call(Func::Exp, &[u])
+            }
+            (Node::Call(Func::Abs, args), Some(y))
+                if y.as_integer().is_some_and(|n| n % 2 == 0) =>
+            {
+                self.pow(args[0], e)
+            }
+            _ => self.intern(Node::Pow(b, e)),
+        }
+    }
+
+    /// True when `id` is known to be strictly positive for all real values of its symbols.
+    pub fn is_positive(&self, id: Id) -> bool {
+        match self.node(id) {
+            Node::Num(n) => n.is_positive(),
+            Node::Const(_) => true,
+            Node::Sym(s) => self.symbol_info(*s).positive,
+            Node::Pow(b, e) => {
+                self.is_positive(*b)
+                    || (self.as_num(*e).and_then(|n| n.as_integer()).is_some_and(|n| n % 2 == 0)
+                        && self.is_nonzero_square_base(*b))
+            }
+            Node::Mul(fs) => fs.iter().all(|&f| self.is_positive(f)),
+            Node::Add(ts) => ts.iter().all(|&t| self.is_positive(t)),
+            Node::Call(Func::Exp | Func::Cosh, _) => true,
+            _ => false,
+        }
+    }
+
+    fn is_nonzero_square_base(&self, b: Id) -> bool {
+        // x^2 > 0 needs x != 0; only claim it for bases that cannot vanish.
+        match self.node(b) {
+            Node::Num(n) => !n.is_zero(),
+            _ => self.is_positive(b),
+        }
+    }
+
+    /// True when the expression "looks negative": a negative number, a product with a negative
+    /// coefficient, or a sum whose first term looks negative. Used to normalise signs.
+    pub fn looks_negative(&self, id: Id) -> bool {
+        match self.node(id) {
+            Node::Num(n) => n.is_negative(),
+            Node::Mul(fs) => self.as_num(fs[0]).is_some_and(|c| c.is_negative()),
+            Node::Add(ts) => self.looks_negative(ts[0]),
+            _ => false,
+        }
+    }
+
+    /// `k` such that `id = k*pi` for a rational `k`.
+    fn pi_multiple(&self, id: Id) -> Option<crate::number::Rational> {
+        match self.node(id) {
+            Node::Const(Constant::Pi) => Some(crate::number::Rational::ONE),
+            Node::Mul(fs) if fs.len() == 2 => {
+                let c = self.as_num(fs[0])?.as_rational()?;
+                matches!(self.node(fs[1]), Node::Const(Constant::Pi)).then_some(c)
+            }
+            _ => None,
+        }
+    }
+
+    /// Canonical function call. Arity must match [`Func::arity`] (checked by the parser).
+    pub fn call(&mut self, f: Func, args: &[Id]) -> Id {
+        debug_assert_eq!(args.len(), f.arity());
+        let u = args[0];
+        let odd = |p: &mut Pool, f: Func, u: Id| -> Id {
+            let nu = p.neg(u);
+            let inner = p.call(f, &[nu]);
+            p.neg(inner)
+        };
+        match f {
+            Func::Sin | Func::Tan | Func::Asin | Func::Atan | Func::Sinh | Func::Tanh => {
+                if u == Pool::ZERO {
+                    return Pool::ZERO;
+                }
+                if self.looks_negative(u) {
+                    return odd(self, f, u);
+                }
+                if let Some(k) = self.pi_multiple(u) {
+                    match f {
+                        Func::Sin | Func::Tan if k.is_integer() => return Pool::ZERO,
+                        Func::Sin if k.denom() == 2 => {
+                            let s = if k.numer().rem_euclid(4) == 1 { 1 } else { -1 };
+                            return self.int(s);
+                        }
+                        _ => {}
+                    }
+                }
+            }
+            Func::Cos | Func::Cosh => {
+                if u == Pool::ZERO {
+                    return Pool::ONE;
+                }
+                if self.looks_negative(u) {
+                    let nu = self.neg(u);
+                    return self.call(f, &[nu]);
+                }
+                if f == Func::Cos {
+                    if let Some(k) = self.pi_multiple(u) {
+                        if k.is_integer() {
+                            return self.int(if k.numer() % 2 == 0 { 1 } else { -1 });
+                        }
+                        if k.denom() == 2 {
+                            return Pool::ZERO;
+                        }
+                    }
+                }
+            }
+            Func::Exp => {
+                if u == Pool::ZERO {
+                    return Pool::ONE;
+                }
+                if let Node::Call(Func::Log, a) = self.node(u) {
+                    return a[0];
+                }
+            }
+            Func::Log => {
+                if u == Pool::ONE {
+                    return Pool::ZERO;
+                }
+                match self.node(u) {
+                    Node::Call(Func::Exp, a) => return a[0],
+                    Node::Const(Constant::E) => return Pool::ONE,
+                    _ => {}
+                }
+            }
+            Func::Abs => {
+                if let Some(n) = self.as_num(u) {
+                    return self.num(if n.is_negative() { n.neg() } else { n });
+                }
+                if self.is_positive(u) || matches!(self.node(u), Node::Call(Func::Abs, _)) {
+                    return u;
+                }
+                if self.looks_negative(u) {
+                    let nu = self.neg(u);
+                    return self.call(Func::Abs, &[nu]);
+                }
+                if let Node::Mul(fs) = self.node(u) {
+                    let (pos, rest): (Vec<Id>, Vec<Id>) =
+                        fs.iter().partition(|&&f| self.is_positive(f));
+                    if !pos.is_empty() {
+                        let r = self.mul(&rest);
+                        let a = self.call(Func::Abs, &[r]);
+                        let mut v = pos;
+                        v.push(a);
+                        return self.mul(&v);
+                    }
+                }
+            }
+            Func::Sign => {
+                if let Some(n) = self.as_num(u) {
+                    let s = if n.is_positive() {
+                        1
+                    } else if n.is_negative() {
+                        -1
+                    } else {
+                        0
+                    };
+                    return self.int(s);
+                }
+                if self.is_positive(u) {
+                    return Pool::ONE;
+                }
+                if self.looks_negative(u) {
+                    return odd(self, f, u);
+                }
+            }
+            Func::Min | Func::Max => {
+                let v = args[1];
+                if u == v {
+                    return u;
+                }
+                if let (Some(a), Some(b)) = (self.as_num(u), self.as_num(v)) {
+                    let a_smaller = a.total_cmp(b).is_le();
+                    return if (f == Func::Min) == a_smaller { u } else { v };
+                }
+                // Commutative: order the arguments canonically.
+                if self.order(u, v).is_gt() {
+                    return self.call(f, &[v, u]);
+                }
+            }
+            Func::Acos | Func::Atan2 => {}
+        }
+        self.intern(Node::Call(f, args.to_vec().into_boxed_slice()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn like_terms_and_powers_collect() {
+        let mut p = Pool::new();
+        let x = p.var("x");
+        let y = p.var("y");
+        let xx = p.add(&[x, x, x]);
+        let three = p.int(3);
+        assert_eq!(xx, p.mul(&[three, x]));
+        let x2 = p.mul(&[x, x]);
+        assert_eq!(x2, p.powi(x, 2));
+        let a = p.add(&[x, y]);
+        let b = p.add(&[y, x]);
+        assert_eq!(a, b, "sums are order independent");
+        let d = p.sub(a, y);
+        assert_eq!(d, x);
+        let q = p.div(x2, x);
+        assert_eq!(q, x);
+    }
+
+    #[test]
+    fn sqrt_of_square_needs_positivity() {
+        let mut p = Pool::new();
+        let x = p.var("x");
+        let x2 = p.powi(x, 2);
+        let s = p.sqrt(x2);
+        assert_eq!(s, p.call(Func::Abs, &[x]));
+        let ms = p.symbol("m", true);
+        let m = p.sym(ms);
+        let m2 = p.powi(m, 2);
+        let g = p.var("g");
+        let prod = p.mul(&[m2, g]);
+        let s = p.sqrt(prod);
+        let sg = p.sqrt(g);
+        assert_eq!(s, p.mul(&[m, sg]));
+    }
+
+    #[test]
+    fn trig_signs_and_special_values() {
+        let mut p = Pool::new();
+        let a = p.var("a");
+        let b = p.var("b");
+        let d1 = p.sub(a, b);
+        let d2 = p.sub(b, a);
+        assert_eq!(p.call(Func::Cos, &[d1]), p.call(Func::Cos, &[d2]));
+        let s1 = p.call(Func::Sin, &[d1]);
+        let s2 = p.call(Func::Sin, &[d2]);
+        assert_eq!(s1, p.neg(s2));
+        let pi = p.constant(Constant::Pi);
+        assert_eq!(p.call(Func::Sin, &[pi]), Pool::ZERO);
+        assert_eq!(p.call(Func::Cos, &[pi]), Pool::MINUS_ONE);
+    }
+}

@@ -1,0 +1,494 @@
+//! From syntax to expressions: name resolution, shape checking (scalars and 3-vectors) and
+//! vector functions.
+//!
+//! Names are resolved through a [`Scope`]: a model file knows its parameters, coordinates and
+//! definitions and reports anything else as an error with a suggestion; [`FreeScope`] (used on
+//! the command line) creates a symbol for any new name and makes a coordinate of every name
+//! written with a prime (`x'`) or as a function of time (`x(t)`).
+
+use crate::error::{suggest, ExprError};
+use crate::number::{Number, Rational};
+use crate::pool::{Constant, Func, Id, Pool, SymId};
+use crate::syntax::{parse, parse_equation, Ast, BinOp};
+use rustc_hash::FxHashSet;
+use std::ops::Range;
+
+/// A scalar or a 3-vector (components along the fixed i, j, k).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Value {
+    /// A scalar expression.
+    Scalar(Id),
+    /// A vector `[x, y, z]`.
+    Vector([Id; 3]),
+}
+
+impl Value {
+    /// The scalar, if this is one.
+    pub fn scalar(self) -> Option<Id> {
+        match self {
+            Value::Scalar(s) => Some(s),
+            Value::Vector(_) => None,
+        }
+    }
+    /// The vector, if this is one.
+    pub fn vector(self) -> Option<[Id; 3]> {
+        match self {
+            Value::Vector(v) => Some(v),
+            Value::Scalar(_) => None,
+        }
+    }
+    /// Applies `f` to each scalar component.
+    pub fn map(self, mut f: impl FnMut(Id) -> Id) -> Value {
+        match self {
+            Value::Scalar(s) => Value::Scalar(f(s)),
+            Value::Vector([a, b, c]) => Value::Vector([f(a), f(b), f(c)]),
+        }
+    }
+    /// "scalar" or "vector", for messages.
+    pub fn kind(self) -> &'static str {
+        match self {
+            Value::Scalar(_) => "scalar",
+            Value::Vector(_) => "vector",
+        }
+    }
+}
+
+/// What a name means.
+#[derive(Clone, Copy, Debug)]
+pub enum Binding {
+    /// A value (a parameter symbol, a definition, a number...).
+    Value(Value),
+    /// A coordinate: an unknown or prescribed function of time; `x'` is its rate.
+    Coordinate(SymId),
+}
+
+/// Resolves names for [`lower`].
+pub trait Scope {
+    /// The meaning of `name`, or `None` when unknown (then `pi` and `e` are the constants).
+    fn resolve(&mut self, pool: &mut Pool, name: &str) -> Option<Binding>;
+    /// Names in scope, for "did you mean" suggestions.
+    fn names(&self) -> Vec<String>;
+}
+
+/// A permissive scope: every unknown name becomes a symbol; names listed in `coordinates`, or
+/// used with a prime or as `x(t)` anywhere in the expression, are coordinates.
+#[derive(Clone, Debug, Default)]
+pub struct FreeScope {
+    /// Names treated as functions of time.
+    pub coordinates: FxHashSet<String>,
+    /// Names declared strictly positive.
+    pub positive: FxHashSet<String>,
+}
+
+impl FreeScope {
+    /// A scope with the given coordinates.
+    pub fn with_coordinates<'a>(names: impl IntoIterator<Item = &'a str>) -> FreeScope {
+        FreeScope {
+            coordinates: names.into_iter().map(str::to_string).collect(),
+            positive: Default::default(),
+        }
+    }
+
+    /// Adds every name used with a prime or as `x(t)` in `ast` to the coordinates.
+    pub fn learn(&mut self, ast: &Ast) {
+        match ast {
+            Ast::Prime { expr, .. } => {
+                if let Ast::Ident { name, .. } = &**expr {
+                    self.coordinates.insert(name.clone());
+                }
+                self.learn(expr);
+            }
+            Ast::Call { name, args, .. } => {
+                if Func::from_name(name).is_none()
+                    && !VECTOR_FUNCS.contains(&name.as_str())
+                    && matches!(args.as_slice(), [Ast::Ident { name: t, .. }] if t == "t")
+                {
+                    self.coordinates.insert(name.clone());
+                }
+                args.iter().for_each(|a| self.learn(a));
+            }
+            Ast::Neg { expr, .. } | Ast::Component { expr, .. } => self.learn(expr),
+            Ast::Binary { lhs, rhs, .. } => {
+                self.learn(lhs);
+                self.learn(rhs);
+            }
+            Ast::Vector { items, .. } => items.iter().for_each(|a| self.learn(a)),
+            Ast::Num { .. } | Ast::Ident { .. } => {}
+        }
+    }
+}
+
+impl Scope for FreeScope {
+    fn resolve(&mut self, pool: &mut Pool, name: &str) -> Option<Binding> {
+        if name == "pi" || name == "e" {
+            return None;
+        }
+        let s = pool.symbol(name, self.positive.contains(name));
+        if self.coordinates.contains(name) {
+            Some(Binding::Coordinate(s))
+        } else {
+            Some(Binding::Value(Value::Scalar(pool.sym(s))))
+        }
+    }
+    fn names(&self) -> Vec<String> {
+        Vec::new()
+    }
+}
+
+const VECTOR_FUNCS: [&str; 5] = ["dot", "cross", "norm", "unit", "sqrt"];
+
+/// Converts a numeric literal exactly (falls back to `f64` for huge exponents or mantissas).
+pub fn literal(text: &str) -> Option<Number> {
+    let (mant, exp) = match text.find(['e', 'E']) {
+        Some(i) => (&text[..i], text[i + 1..].parse::<i32>().ok()?),
+        None => (text, 0),
+    };
+    let (int, frac) = match mant.find('.') {
+        Some(i) => (&mant[..i], &mant[i + 1..]),
+        None => (mant, ""),
+    };
+    let digits = format!("{int}{frac}");
+    let exp10 = exp as i64 - frac.len() as i64;
+    let exact = (|| {
+        let m: i128 = digits.parse().ok()?;
+        if exp10.abs() > 36 {
+            return None;
+        }
+        let p = 10i128.checked_pow(exp10.unsigned_abs() as u32)?;
+        if exp10 >= 0 {
+            Rational::new(m.checked_mul(p)?, 1)
+        } else {
+            Rational::new(m, p)
+        }
+    })();
+    match exact {
+        Some(r) => Some(Number::Rat(r)),
+        None => text.parse::<f64>().ok().map(Number::Float),
+    }
+}
+
+/// Lowers a parsed expression into `pool`, resolving names through `scope`.
+pub fn lower(pool: &mut Pool, ast: &Ast, scope: &mut dyn Scope) -> Result<Value, ExprError> {
+    Lowerer { pool, scope }.value(ast)
+}
+
+struct Lowerer<'a> {
+    pool: &'a mut Pool,
+    scope: &'a mut dyn Scope,
+}
+
+impl Lowerer<'_> {
+    fn value(&mut self, ast: &Ast) -> Result<Value, ExprError> {
+        match ast {
+            Ast::Num { text, span } => {
+                let n = literal(text)
+                    .ok_or_else(|| ExprError::new(span.clone(), format!("invalid number `{text}`")))?;
+                Ok(Value::Scalar(self.pool.num(n)))
+            }
+            Ast::Ident { name, span } => self.ident(name, span),
+            Ast::Neg { expr, .. } => {
+                let v = self.value(expr)?;
+                Ok(v.map(|x| self.pool.neg(x)))
+            }
+            Ast::Binary { op, lhs, rhs, span } => {
+                let a = self.value(lhs)?;
+                let b = self.value(rhs)?;
+                self.binary(*op, a, b, span.clone(), lhs.span(), rhs.span())
+            }
+            Ast::Call {
+                name,
+                name_span,
+                args,
+                span,
+            } => self.call(name, name_span, args, span),
+            Ast::Vector { items, span } => {
+                if items.len() < 2 || items.len() > 3 {
+                    return Err(ExprError::new(
+                        span.clone(),
+                        format!("a vector has 2 or 3 components, this one has {}", items.len()),
+                    ));
+                }
+                let mut c = [Pool::ZERO; 3];
+                for (i, it) in items.iter().enumerate() {
+                    c[i] = self.scalar(it, "a vector component")?;
+                }
+                Ok(Value::Vector(c))
+            }
+            Ast::Prime { expr, count, .. } => {
+                let v = self.value(expr)?;
+                let mut v = v;
+                for _ in 0..*count {
+                    v = v.map(|x| self.pool.dt(x));
+                }
+                Ok(v)
+            }
+            Ast::Component { expr, index, span } => match self.value(expr)? {
+                Value::Vector(c) => Ok(Value::Scalar(c[*index])),
+                Value::Scalar(_) => Err(ExprError::new(
+                    span.clone(),
+                    "component access on a scalar".to_string(),
+                )
+                .with_help("`.x`, `.y`, `.z` apply to vectors such as `[a, b, c]`")),
+            },
+        }
+    }
+
+    fn scalar(&mut self, ast: &Ast, what: &str) -> Result<Id, ExprError> {
+        match self.value(ast)? {
+            Value::Scalar(s) => Ok(s),
+            Value::Vector(_) => Err(ExprError::new(
+                ast.span(),
+                format!("{what} must be a scalar, but this is a vector"),
+            )
+            .with_help("take a component (`v.x`), `norm(v)` or `dot(a, b)`")),
+        }
+    }
+
+    fn ident(&mut self, name: &str, span: &Range<usize>) -> Result<Value, ExprError> {
+        if name == "t" {
+            return Ok(Value::Scalar(self.pool.time()));
+        }
+        match self.scope.resolve(self.pool, name) {
+            Some(Binding::Value(v)) => return Ok(v),
+            Some(Binding::Coordinate(s)) => return Ok(Value::Scalar(self.pool.coord(s, 0))),
+            None => {}
+        }
+        match name {
+            "pi" => return Ok(Value::Scalar(self.pool.constant(Constant::Pi))),
+            "e" => return Ok(Value::Scalar(self.pool.constant(Constant::E))),
+            _ => {}
+        }
+        let mut names = self.scope.names();
+        names.extend(["t", "pi", "e"].map(String::from));
+        let mut err = ExprError::new(span.clone(), format!("undefined name `{name}`"));
+        if Func::from_name(name).is_some() || VECTOR_FUNCS.contains(&name) {
+            err = err.with_help(format!("`{name}` is a function: write `{name}(...)`"));
+        } else if let Some(s) = suggest(name, names.iter().map(String::as_str)) {
+            err = err.with_help(format!("did you mean `{s}`?"));
+        } else {
+            err = err.with_help("declare it as a parameter, coordinate or definition");
+        }
+        Err(err)
+    }
+
+    fn binary(
+        &mut self,
+        op: BinOp,
+        a: Value,
+        b: Value,
+        span: Range<usize>,
+        lspan: Range<usize>,
+        rspan: Range<usize>,
+    ) -> Result<Value, ExprError> {
+        use Value::{Scalar as S, Vector as V};
+        let p = &mut *self.pool;
+        let r = match (op, a, b) {
+            (BinOp::Add, S(x), S(y)) => S(p.add2(x, y)),
+            (BinOp::Sub, S(x), S(y)) => S(p.sub(x, y)),
+            (BinOp::Add, V(x), V(y)) => V([0, 1, 2].map(|i| p.add2(x[i], y[i]))),
+            (BinOp::Sub, V(x), V(y)) => V([0, 1, 2].map(|i| p.sub(x[i], y[i]))),
+            (BinOp::Add | BinOp::Sub, _, _) => {
+                let verb = if op == BinOp::Add { "add" } else { "subtract" };
+                return Err(ExprError::new(
+                    span,
+                    format!("cannot {verb} a {} and a {}", a.kind(), b.kind()),
+                )
+                .with_help("both sides of + and - must be scalars, or both vectors"));
+            }
+            (BinOp::Mul, S(x), S(y)) => S(p.mul2(x, y)),
+            (BinOp::Mul, S(s), V(v)) | (BinOp::Mul, V(v), S(s)) => V(v.map(|c| p.mul2(s, c))),
+            (BinOp::Mul, V(_), V(_)) => {
+                return Err(ExprError::new(span, "cannot multiply two vectors")
+                    .with_help("use dot(a, b) or cross(a, b)"))
+            }
+            (BinOp::Div, S(x), S(y)) => S(p.div(x, y)),
+            (BinOp::Div, V(v), S(s)) => V(v.map(|c| p.div(c, s))),
+            (BinOp::Div, _, V(_)) => {
+                return Err(ExprError::new(rspan, "cannot divide by a vector")
+                    .with_help("divide by a scalar such as norm(v)"))
+            }
+            (BinOp::Pow, S(x), S(y)) => S(p.pow(x, y)),
+            (BinOp::Pow, V(_), _) => {
+                return Err(ExprError::new(lspan, "cannot raise a vector to a power")
+                    .with_help("use dot(v, v) for the squared length"))
+            }
+            (BinOp::Pow, S(_), V(_)) => {
+                return Err(ExprError::new(rspan, "an exponent must be a scalar"))
+            }
+        };
+        Ok(r)
+    }
+
+    fn call(
+        &mut self,
+        name: &str,
+        name_span: &Range<usize>,
+        args: &[Ast],
+        span: &Range<usize>,
+    ) -> Result<Value, ExprError> {
+        let arity = |n: usize| -> Result<(), ExprError> {
+            if args.len() == n {
+                Ok(())
+            } else {
+                let plural = if n == 1 { "" } else { "s" };
+                Err(ExprError::new(
+                    span.clone(),
+                    format!("`{name}` takes {n} argument{plural}, got {}", args.len()),
+                ))
+            }
+        };
+        match name {
+            "sqrt" => {
+                arity(1)?;
+                let x = self.scalar(&args[0], "the argument of `sqrt`")?;
+                return Ok(Value::Scalar(self.pool.sqrt(x)));
+            }
+            "dot" | "cross" => {
+                arity(2)?;
+                let a = self.vector(&args[0], name)?;
+                let b = self.vector(&args[1], name)?;
+                return Ok(if name == "dot" {
+                    Value::Scalar(crate::vector::dot(self.pool, a, b))
+                } else {
+                    Value::Vector(crate::vector::cross(self.pool, a, b))
+                });
+            }
+            "norm" | "unit" => {
+                arity(1)?;
+                let a = self.vector(&args[0], name)?;
+                return Ok(if name == "norm" {
+                    Value::Scalar(crate::vector::norm(self.pool, a))
+                } else {
+                    Value::Vector(crate::vector::unit(self.pool, a))
+                });
+            }
+            _ => {}
+        }
+        if let Some(f) = Func::from_name(name) {
+            arity(f.arity())?;
+            let mut xs = Vec::with_capacity(args.len());
+            for a in args {
+                xs.push(self.scalar(a, &format!("the argument of `{name}`"))?);
+            }
+            return Ok(Value::Scalar(self.pool.call(f, &xs)));
+        }
+        // `x(t)`: a coordinate written as a function of time, MATLAB style.
+        if let [Ast::Ident { name: tn, .. }] = args {
+            if tn == "t" {
+                if let Some(Binding::Coordinate(s)) = self.scope.resolve(self.pool, name) {
+                    return Ok(Value::Scalar(self.pool.coord(s, 0)));
+                }
+            }
+        }
+        let known = Func::ALL
+            .iter()
+            .map(|f| f.name())
+            .chain(VECTOR_FUNCS.iter().copied());
+        let mut err = ExprError::new(name_span.clone(), format!("unknown function `{name}`"));
+        err = match suggest(name, known) {
+            Some(s) => err.with_help(format!("did you mean `{s}`?")),
+            None => err.with_help(
+                "functions: sin cos tan asin acos atan atan2 sinh cosh tanh exp log sqrt abs \
+                 sign min max dot cross norm unit",
+            ),
+        };
+        Err(err)
+    }
+
+    fn vector(&mut self, ast: &Ast, fname: &str) -> Result<[Id; 3], ExprError> {
+        match self.value(ast)? {
+            Value::Vector(v) => Ok(v),
+            Value::Scalar(_) => Err(ExprError::new(
+                ast.span(),
+                format!("`{fname}` expects a vector, but this is a scalar"),
+            )
+            .with_help("write vectors as [x, y, z]")),
+        }
+    }
+}
+
+impl Pool {
+    /// Parses and lowers `src` with a [`FreeScope`] (unknown names become symbols; primed names
+    /// and `x(t)` become coordinates).
+    pub fn parse_value(&mut self, src: &str) -> Result<Value, ExprError> {
+        let ast = parse(src)?;
+        let mut scope = FreeScope::default();
+        scope.learn(&ast);
+        lower(self, &ast, &mut scope)
+    }
+
+    /// Like [`Pool::parse_value`], for a scalar.
+    pub fn parse_scalar(&mut self, src: &str) -> Result<Id, ExprError> {
+        let ast = parse(src)?;
+        let mut scope = FreeScope::default();
+        scope.learn(&ast);
+        match lower(self, &ast, &mut scope)? {
+            Value::Scalar(s) => Ok(s),
+            Value::Vector(_) => Err(ExprError::new(ast.span(), "expected a scalar, got a vector")),
+        }
+    }
+
+    /// Parses with an explicit scope.
+    pub fn parse_in(&mut self, src: &str, scope: &mut dyn Scope) -> Result<Value, ExprError> {
+        let ast = parse(src)?;
+        lower(self, &ast, scope)
+    }
+
+    /// Parses an equation `lhs = rhs` (or a bare expression, meaning `= 0`) into `lhs - rhs`.
+    pub fn parse_equation_in(&mut self, src: &str, scope: &mut dyn Scope) -> Result<Value, ExprError> {
+        let (l, r) = parse_equation(src)?;
+        let lv = lower(self, &l, scope)?;
+        let Some(r) = r else { return Ok(lv) };
+        let rv = lower(self, &r, scope)?;
+        match (lv, rv) {
+            (Value::Scalar(a), Value::Scalar(b)) => Ok(Value::Scalar(self.sub(a, b))),
+            (Value::Vector(a), Value::Vector(b)) => {
+                Ok(Value::Vector([0, 1, 2].map(|i| self.sub(a[i], b[i]))))
+            }
+            _ => Err(ExprError::new(
+                l.span().start..r.span().end,
+                format!("the two sides are a {} and a {}", lv.kind(), rv.kind()),
+            )),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn literals_are_exact() {
+        assert_eq!(literal("1.5e-3"), Some(Number::ratio(3, 2000)));
+        assert_eq!(literal(".5"), Some(Number::ratio(1, 2)));
+        assert_eq!(literal("12"), Some(Number::int(12)));
+        assert!(matches!(literal("1e300"), Some(Number::Float(_))));
+    }
+
+    #[test]
+    fn shape_errors_have_spans() {
+        let mut p = Pool::new();
+        let e = p.parse_value("[1, 2, 3] + x").unwrap_err();
+        assert_eq!(e.span, 0..13);
+        assert!(e.message.contains("vector and a scalar"));
+        let e = p.parse_value("sn(x)").unwrap_err();
+        assert_eq!(e.span, 0..2);
+        assert_eq!(e.help.as_deref(), Some("did you mean `sin`?"));
+        let e = p.parse_value("sin([1,2,3])").unwrap_err();
+        assert!(e.message.contains("must be a scalar"), "{e}");
+        let e = p.parse_value("atan2(y)").unwrap_err();
+        assert!(e.message.contains("takes 2 arguments"), "{e}");
+    }
+
+    #[test]
+    fn vector_functions() {
+        let mut p = Pool::new();
+        let v = p.parse_value("cross([1, 0, 0], [0, 1, 0])").unwrap();
+        let k = p.parse_value("[0, 0, 1]").unwrap();
+        assert_eq!(v, k);
+        let n = p.parse_value("norm([3, 4])").unwrap();
+        assert_eq!(n, Value::Scalar(p.int(5)));
+        let c = p.parse_value("[a, b, c].y").unwrap();
+        assert_eq!(c, Value::Scalar(p.var("b")));
+    }
+}

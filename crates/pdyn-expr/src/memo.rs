@@ -1,0 +1,16 @@
+//! Per-pool caches of pure transformations (expand, simplify, derivatives).
+//!
+//! Nodes are immutable and hash-consed, so a transformation's result for an id never changes;
+//! caching it makes repeated work on shared subexpressions (chains of links, Jacobians) linear
+//! in the DAG size instead of the tree size.
+
+use crate::pool::Id;
+use rustc_hash::FxHashMap;
+
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Memo {
+    pub expand: FxHashMap<Id, Id>,
+    pub simplify: FxHashMap<Id, Id>,
+    /// (expression, variable, total time derivative?) → derivative.
+    pub diff: FxHashMap<(Id, Id, bool), Id>,
+}

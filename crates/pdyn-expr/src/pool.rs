@@ -1,0 +1,524 @@
+//! The expression pool: an arena of hash-consed, immutable nodes.
+//!
+//! Every expression is an [`Id`] into a [`Pool`]. A node holds the ids of its children, and the
+//! pool interns nodes, so structurally identical subexpressions are stored once and compare
+//! equal by id in O(1). Nodes are only created through the canonicalising constructors in
+//! [`crate::build`], which keeps every stored node in canonical form (flattened sums and
+//! products, collected like terms, folded constants, deterministic child order).
+
+use crate::number::Number;
+use rustc_hash::FxHashMap;
+use std::cmp::Ordering;
+
+/// Handle of an expression node in a [`Pool`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Id(pub(crate) u32);
+
+impl Id {
+    /// Position of the node in its pool (creation order: children come before parents).
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// Handle of a named symbol (parameter or coordinate) in a [`Pool`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct SymId(pub(crate) u32);
+
+/// Mathematical constants with their own node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Constant {
+    /// π
+    Pi,
+    /// Euler's number e
+    E,
+}
+
+impl Constant {
+    /// Numeric value.
+    pub fn value(self) -> f64 {
+        match self {
+            Constant::Pi => std::f64::consts::PI,
+            Constant::E => std::f64::consts::E,
+        }
+    }
+}
+
+/// Built-in scalar functions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[allow(missing_docs)]
+pub enum Func {
+    Sin,
+    Cos,
+    Tan,
+    Asin,
+    Acos,
+    Atan,
+    Atan2,
+    Sinh,
+    Cosh,
+    Tanh,
+    Exp,
+    Log,
+    Abs,
+    Sign,
+    Min,
+    Max,
+}
+
+impl Func {
+    /// Every function, for name lookup and suggestions.
+    pub const ALL: [Func; 16] = [
+        Func::Sin,
+        Func::Cos,
+        Func::Tan,
+        Func::Asin,
+        Func::Acos,
+        Func::Atan,
+        Func::Atan2,
+        Func::Sinh,
+        Func::Cosh,
+        Func::Tanh,
+        Func::Exp,
+        Func::Log,
+        Func::Abs,
+        Func::Sign,
+        Func::Min,
+        Func::Max,
+    ];
+    /// The name used in the expression language.
+    pub fn name(self) -> &'static str {
+        match self {
+            Func::Sin => "sin",
+            Func::Cos => "cos",
+            Func::Tan => "tan",
+            Func::Asin => "asin",
+            Func::Acos => "acos",
+            Func::Atan => "atan",
+            Func::Atan2 => "atan2",
+            Func::Sinh => "sinh",
+            Func::Cosh => "cosh",
+            Func::Tanh => "tanh",
+            Func::Exp => "exp",
+            Func::Log => "log",
+            Func::Abs => "abs",
+            Func::Sign => "sign",
+            Func::Min => "min",
+            Func::Max => "max",
+        }
+    }
+    /// Number of arguments.
+    pub fn arity(self) -> usize {
+        match self {
+            Func::Atan2 | Func::Min | Func::Max => 2,
+            _ => 1,
+        }
+    }
+    /// Look a function up by name.
+    pub fn from_name(name: &str) -> Option<Func> {
+        Func::ALL.iter().copied().find(|f| f.name() == name)
+    }
+}
+
+/// One node of the expression DAG.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub enum Node {
+    /// A number.
+    Num(Number),
+    /// π or e.
+    Const(Constant),
+    /// Time `t`.
+    Time,
+    /// A constant symbol (parameter).
+    Sym(SymId),
+    /// A coordinate (unknown function of time) differentiated `order` times: `x`, `x'`, `x''`.
+    Coord(SymId, u8),
+    /// Sum of at least two terms, canonically ordered; a numeric term comes first.
+    Add(Box<[Id]>),
+    /// Product of at least two factors, canonically ordered; a numeric coefficient comes first.
+    Mul(Box<[Id]>),
+    /// `base ^ exponent`.
+    Pow(Id, Id),
+    /// A function call.
+    Call(Func, Box<[Id]>),
+}
+
+/// What is known about a symbol.
+#[derive(Clone, Debug)]
+pub struct Symbol {
+    /// Its name.
+    pub name: String,
+    /// Declared strictly positive (masses, lengths, g...): enables `sqrt(x^2) = x`.
+    pub positive: bool,
+}
+
+/// Arena and interner of expression nodes, plus the symbol table.
+#[derive(Clone, Debug)]
+pub struct Pool {
+    nodes: Vec<Node>,
+    interned: FxHashMap<Node, Id>,
+    symbols: Vec<Symbol>,
+    symbol_ids: FxHashMap<String, SymId>,
+    pub(crate) memo: crate::memo::Memo,
+}
+
+impl Default for Pool {
+    fn default() -> Self {
+        Pool::new()
+    }
+}
+
+impl Pool {
+    /// An empty pool holding the constants 0, 1, -1.
+    pub fn new() -> Pool {
+        let mut p = Pool {
+            nodes: Vec::new(),
+            interned: FxHashMap::default(),
+            symbols: Vec::new(),
+            symbol_ids: FxHashMap::default(),
+            memo: Default::default(),
+        };
+        p.intern(Node::Num(Number::ZERO));
+        p.intern(Node::Num(Number::ONE));
+        p.intern(Node::Num(Number::MINUS_ONE));
+        p
+    }
+
+    /// The expression `0`.
+    pub const ZERO: Id = Id(0);
+    /// The expression `1`.
+    pub const ONE: Id = Id(1);
+    /// The expression `-1`.
+    pub const MINUS_ONE: Id = Id(2);
+
+    /// Interns a node that is already canonical. Use the constructors in [`crate::build`].
+    pub(crate) fn intern(&mut self, node: Node) -> Id {
+        if let Some(&id) = self.interned.get(&node) {
+            return id;
+        }
+        let id = Id(self.nodes.len() as u32);
+        self.nodes.push(node.clone());
+        self.interned.insert(node, id);
+        id
+    }
+
+    /// The node behind an id.
+    pub fn node(&self, id: Id) -> &Node {
+        &self.nodes[id.index()]
+    }
+
+    /// Number of distinct nodes stored.
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// True when only the built-in constants are stored.
+    pub fn is_empty(&self) -> bool {
+        self.nodes.len() <= 3
+    }
+
+    /// The symbol named `name`, created if new. Positivity is kept from the first declaration
+    /// unless `positive` is true.
+    pub fn symbol(&mut self, name: &str, positive: bool) -> SymId {
+        if let Some(&s) = self.symbol_ids.get(name) {
+            if positive {
+                self.symbols[s.0 as usize].positive = true;
+            }
+            return s;
+        }
+        let s = SymId(self.symbols.len() as u32);
+        self.symbols.push(Symbol {
+            name: name.to_string(),
+            positive,
+        });
+        self.symbol_ids.insert(name.to_string(), s);
+        s
+    }
+
+    /// Looks a symbol up without creating it.
+    pub fn find_symbol(&self, name: &str) -> Option<SymId> {
+        self.symbol_ids.get(name).copied()
+    }
+
+    /// Information about a symbol.
+    pub fn symbol_info(&self, s: SymId) -> &Symbol {
+        &self.symbols[s.0 as usize]
+    }
+
+    /// Marks a symbol as strictly positive (affects expressions built afterwards).
+    pub fn assume_positive(&mut self, s: SymId) {
+        self.symbols[s.0 as usize].positive = true;
+    }
+
+    /// Name of a symbol.
+    pub fn name(&self, s: SymId) -> &str {
+        &self.symbols[s.0 as usize].name
+    }
+
+    /// The expression for a constant symbol.
+    pub fn sym(&mut self, s: SymId) -> Id {
+        self.intern(Node::Sym(s))
+    }
+
+    /// Shorthand: the expression for the symbol named `name` (created if new).
+    pub fn var(&mut self, name: &str) -> Id {
+        let s = self.symbol(name, false);
+        self.sym(s)
+    }
+
+    /// The expression for coordinate `s` differentiated `order` times.
+    pub fn coord(&mut self, s: SymId, order: u8) -> Id {
+        self.intern(Node::Coord(s, order))
+    }
+
+    /// The expression `t`.
+    pub fn time(&mut self) -> Id {
+        self.intern(Node::Time)
+    }
+
+    /// The expression for a number.
+    pub fn num(&mut self, n: Number) -> Id {
+        let n = match n {
+            Number::Float(f) if f == 0.0 => Number::ZERO,
+            other => other,
+        };
+        self.intern(Node::Num(n))
+    }
+
+    /// The expression for an integer.
+    pub fn int(&mut self, n: i64) -> Id {
+        self.num(Number::int(n))
+    }
+
+    /// The expression for π or e.
+    pub fn constant(&mut self, c: Constant) -> Id {
+        self.intern(Node::Const(c))
+    }
+
+    /// The number, when `id` is a numeric constant.
+    pub fn as_num(&self, id: Id) -> Option<Number> {
+        match self.node(id) {
+            Node::Num(n) => Some(*n),
+            _ => None,
+        }
+    }
+
+    /// True when `id` is the exact number zero.
+    pub fn is_zero(&self, id: Id) -> bool {
+        id == Pool::ZERO
+    }
+
+    /// Calls `f` on each child of `id`.
+    pub fn for_each_child(&self, id: Id, mut f: impl FnMut(Id)) {
+        match self.node(id) {
+            Node::Add(c) | Node::Mul(c) | Node::Call(_, c) => c.iter().for_each(|&x| f(x)),
+            Node::Pow(b, e) => {
+                f(*b);
+                f(*e);
+            }
+            _ => {}
+        }
+    }
+
+    /// True if `needle` occurs anywhere in `hay`.
+    pub fn contains(&self, hay: Id, needle: Id) -> bool {
+        let mut seen = rustc_hash::FxHashSet::default();
+        let mut stack = vec![hay];
+        while let Some(x) = stack.pop() {
+            if x == needle {
+                return true;
+            }
+            if x.0 < needle.0 || !seen.insert(x) {
+                // Children are always older than parents: nothing below `x` can be `needle`.
+                continue;
+            }
+            self.for_each_child(x, |c| stack.push(c));
+        }
+        false
+    }
+
+    /// True if any node in `hay` satisfies `pred`.
+    pub fn any_node(&self, hay: Id, pred: &dyn Fn(&Node) -> bool) -> bool {
+        let mut seen = rustc_hash::FxHashSet::default();
+        let mut stack = vec![hay];
+        while let Some(x) = stack.pop() {
+            if !seen.insert(x) {
+                continue;
+            }
+            if pred(self.node(x)) {
+                return true;
+            }
+            self.for_each_child(x, |c| stack.push(c));
+        }
+        false
+    }
+
+    /// The distinct nodes reachable from `roots`, children before parents.
+    pub fn topo_order(&self, roots: &[Id]) -> Vec<Id> {
+        let mut seen = rustc_hash::FxHashSet::default();
+        let mut out = Vec::new();
+        let mut stack: Vec<(Id, bool)> = roots.iter().rev().map(|&r| (r, false)).collect();
+        while let Some((x, expanded)) = stack.pop() {
+            if expanded {
+                out.push(x);
+                continue;
+            }
+            if !seen.insert(x) {
+                continue;
+            }
+            stack.push((x, true));
+            let mut kids = Vec::new();
+            self.for_each_child(x, |c| kids.push(c));
+            for c in kids.into_iter().rev() {
+                if !seen.contains(&c) {
+                    stack.push((c, false));
+                }
+            }
+        }
+        out
+    }
+
+    /// Number of distinct nodes reachable from `roots` (the DAG size).
+    pub fn dag_size(&self, roots: &[Id]) -> usize {
+        self.topo_order(roots).len()
+    }
+
+    /// Size of the expression written out as a tree (shared nodes counted each time),
+    /// saturating at `cap`. Used as the cost in `simplify`.
+    pub fn tree_size(&self, id: Id, cap: usize) -> usize {
+        let mut n = 0usize;
+        let mut stack = vec![id];
+        while let Some(x) = stack.pop() {
+            n += match self.node(x) {
+                // Small integers and leaves cost 1; a non-integer coefficient a bit more.
+                Node::Num(Number::Rat(r)) if !r.is_integer() => 2,
+                _ => 1,
+            };
+            if n >= cap {
+                return cap;
+            }
+            self.for_each_child(x, |c| stack.push(c));
+        }
+        n
+    }
+
+    /// Canonical order of expressions: numbers, constants, `t`, symbols by name, coordinates
+    /// by name then derivative order, then compound nodes. Powers sort with their base so that
+    /// `a^2*b` keeps `a` before `b`. Deterministic: depends only on structure and names.
+    pub fn order(&self, a: Id, b: Id) -> Ordering {
+        // Ties between distinct nodes (possible only for exotic shapes) fall back to the id,
+        // which is unique per structure within a pool, so sorting stays canonical.
+        self.order_struct(a, b).then(a.cmp(&b))
+    }
+
+    fn order_struct(&self, a: Id, b: Id) -> Ordering {
+        if a == b {
+            return Ordering::Equal;
+        }
+        // Compare terms by their non-numeric factors first (so `-a` sorts with `a`), then by
+        // coefficient.
+        let (one_a, one_b) = ([a], [b]);
+        let (ca, fa) = self.factor_view(a, &one_a);
+        let (cb, fb) = self.factor_view(b, &one_b);
+        for (x, y) in fa.iter().zip(fb) {
+            let o = self.order_factor(*x, *y);
+            if o != Ordering::Equal {
+                return o;
+            }
+        }
+        fa.len().cmp(&fb.len()).then_with(|| match (ca, cb) {
+            (Some(x), Some(y)) => self.order_plain(x, y),
+            (None, Some(_)) => Ordering::Less,
+            (Some(_), None) => Ordering::Greater,
+            (None, None) => Ordering::Equal,
+        })
+    }
+
+    /// (numeric coefficient, other factors) of a term; `one` is `[a]`, used for non-products.
+    fn factor_view<'a>(&'a self, a: Id, one: &'a [Id; 1]) -> (Option<Id>, &'a [Id]) {
+        match self.node(a) {
+            Node::Mul(fs) => match self.node(fs[0]) {
+                Node::Num(_) => (Some(fs[0]), &fs[1..]),
+                _ => (None, &fs[..]),
+            },
+            Node::Num(_) => (Some(a), &[]),
+            _ => (None, one),
+        }
+    }
+
+    fn order_factor(&self, a: Id, b: Id) -> Ordering {
+        if a == b {
+            return Ordering::Equal;
+        }
+        let (ba, ea) = self.base_exp(a);
+        let (bb, eb) = self.base_exp(b);
+        if ba != bb {
+            return self.order_plain(ba, bb);
+        }
+        match (ea, eb) {
+            (None, None) => Ordering::Equal,
+            (None, Some(_)) => Ordering::Less,
+            (Some(_), None) => Ordering::Greater,
+            (Some(x), Some(y)) => self.order_struct(x, y),
+        }
+    }
+
+    fn base_exp(&self, a: Id) -> (Id, Option<Id>) {
+        match self.node(a) {
+            Node::Pow(b, e) => (*b, Some(*e)),
+            _ => (a, None),
+        }
+    }
+
+    fn rank(node: &Node) -> u8 {
+        match node {
+            Node::Num(_) => 0,
+            Node::Const(_) => 1,
+            Node::Time => 2,
+            Node::Sym(_) => 3,
+            Node::Coord(..) => 4,
+            Node::Call(..) => 5,
+            Node::Pow(..) => 6,
+            Node::Mul(_) => 7,
+            Node::Add(_) => 8,
+        }
+    }
+
+    fn order_plain(&self, a: Id, b: Id) -> Ordering {
+        if a == b {
+            return Ordering::Equal;
+        }
+        let (na, nb) = (self.node(a), self.node(b));
+        let r = Pool::rank(na).cmp(&Pool::rank(nb));
+        if r != Ordering::Equal {
+            return r;
+        }
+        match (na, nb) {
+            (Node::Num(x), Node::Num(y)) => x.total_cmp(*y),
+            (Node::Const(x), Node::Const(y)) => x.cmp(y),
+            (Node::Sym(x), Node::Sym(y)) => self.name(*x).cmp(self.name(*y)),
+            (Node::Coord(x, i), Node::Coord(y, j)) => {
+                self.name(*x).cmp(self.name(*y)).then(i.cmp(j))
+            }
+            (Node::Call(f, xs), Node::Call(g, ys)) => f.cmp(g).then_with(|| self.order_lists(xs, ys)),
+            (Node::Pow(b1, e1), Node::Pow(b2, e2)) => {
+                self.order_struct(*b1, *b2)
+                    .then_with(|| self.order_struct(*e1, *e2))
+            }
+            (Node::Mul(xs), Node::Mul(ys)) | (Node::Add(xs), Node::Add(ys)) => {
+                self.order_lists(xs, ys)
+            }
+            _ => a.cmp(&b),
+        }
+    }
+
+    fn order_lists(&self, xs: &[Id], ys: &[Id]) -> Ordering {
+        for (x, y) in xs.iter().zip(ys) {
+            let o = self.order_struct(*x, *y);
+            if o != Ordering::Equal {
+                return o;
+            }
+        }
+        xs.len().cmp(&ys.len())
+    }
+}

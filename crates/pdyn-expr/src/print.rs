@@ -1,0 +1,470 @@
+//! Printing: plain text that parses back to the same expression, LaTeX, and Rust source.
+//!
+//! All three printers share one view of products: sign, numerator factors and denominator
+//! factors (numeric negative exponents and the coefficient's denominator go below the line),
+//! so `-3*x/(2*y^2)` prints the same way in every format.
+
+use crate::number::Number;
+use crate::pool::{Constant, Func, Id, Node, Pool};
+
+/// One factor of a product as printed.
+#[derive(Clone, Copy, Debug)]
+enum Factor {
+    Number(Number),
+    /// `base^exp` with `exp` a positive number (1 for a bare base).
+    Power(Id, Number),
+    /// `base^exp` with a symbolic exponent.
+    Symbolic(Id, Id),
+}
+
+struct Fraction {
+    negative: bool,
+    num: Vec<Factor>,
+    den: Vec<Factor>,
+}
+
+fn fraction(p: &Pool, id: Id) -> Fraction {
+    let mut f = Fraction {
+        negative: false,
+        num: Vec::new(),
+        den: Vec::new(),
+    };
+    let factors: Vec<Id> = match p.node(id) {
+        Node::Mul(fs) => fs.to_vec(),
+        _ => vec![id],
+    };
+    for x in factors {
+        match p.node(x) {
+            Node::Num(n) => {
+                let n = if n.is_negative() {
+                    f.negative = !f.negative;
+                    n.neg()
+                } else {
+                    *n
+                };
+                match n {
+                    Number::Rat(r) => {
+                        if r.numer() != 1 {
+                            f.num.push(Factor::Number(Number::int(r.numer())));
+                        }
+                        if r.denom() != 1 {
+                            f.den.push(Factor::Number(Number::int(r.denom())));
+                        }
+                    }
+                    Number::Float(_) => f.num.push(Factor::Number(n)),
+                }
+            }
+            Node::Pow(b, e) => match p.as_num(*e) {
+                Some(en) if en.is_negative() => f.den.push(Factor::Power(*b, en.neg())),
+                Some(en) => f.num.push(Factor::Power(*b, en)),
+                None => f.num.push(Factor::Symbolic(*b, *e)),
+            },
+            _ => f.num.push(Factor::Power(x, Number::ONE)),
+        }
+    }
+    f
+}
+
+/// Operator precedence of what a node prints as (higher binds tighter).
+fn precedence(p: &Pool, id: Id) -> u8 {
+    match p.node(id) {
+        Node::Add(_) => 1,
+        Node::Mul(_) => 2,
+        Node::Num(n) => match n {
+            _ if n.is_negative() => 1,
+            Number::Rat(r) if !r.is_integer() => 2,
+            _ => 5,
+        },
+        Node::Pow(_, e) => match p.as_num(*e) {
+            Some(en) if en.is_negative() => 2,
+            Some(en) if en == Number::ratio(1, 2) => 5,
+            _ => 3,
+        },
+        _ => 5,
+    }
+}
+
+/// Text printer (the format the parser reads).
+pub struct TextPrinter<'a> {
+    pool: &'a Pool,
+}
+
+impl Pool {
+    /// Plain text, re-parsable to the same expression: `-g*m*sin(theta) + m*r*omega^2`.
+    pub fn to_text(&self, id: Id) -> String {
+        TextPrinter { pool: self }.expr(id)
+    }
+
+    /// LaTeX (math mode, without delimiters): `\frac{g m \cos\left(\theta\right)}{\sin\left(\phi\right)}`.
+    pub fn to_latex(&self, id: Id) -> String {
+        LatexPrinter { pool: self }.expr(id)
+    }
+
+    /// A Rust `f64` expression. `leaf` names symbols, coordinates and `t` (e.g. `|n| ...`);
+    /// the default [`Pool::rust_leaf_name`] uses the symbol name, `x_d1` for `x'`, and `t`.
+    pub fn to_rust(&self, id: Id, leaf: &dyn Fn(&Pool, &Node) -> String) -> String {
+        RustPrinter { pool: self, leaf }.expr(id)
+    }
+
+    /// Default Rust identifier for a leaf node.
+    pub fn rust_leaf_name(&self, node: &Node) -> String {
+        match node {
+            Node::Sym(s) => self.name(*s).to_string(),
+            Node::Coord(s, 0) => self.name(*s).to_string(),
+            Node::Coord(s, k) => format!("{}_d{k}", self.name(*s)),
+            Node::Time => "t".to_string(),
+            _ => String::new(),
+        }
+    }
+}
+
+impl TextPrinter<'_> {
+    fn expr(&self, id: Id) -> String {
+        let p = self.pool;
+        match p.node(id) {
+            Node::Add(ts) => {
+                let mut s = String::new();
+                for (i, &t) in ts.iter().enumerate() {
+                    let (neg, body) = self.term(t);
+                    match (i, neg) {
+                        (0, true) => s += &format!("-{body}"),
+                        (0, false) => s += &body,
+                        (_, true) => s += &format!(" - {body}"),
+                        (_, false) => s += &format!(" + {body}"),
+                    }
+                }
+                s
+            }
+            Node::Mul(_) | Node::Num(_) | Node::Pow(..) => {
+                let (neg, body) = self.term(id);
+                if neg {
+                    format!("-{body}")
+                } else {
+                    body
+                }
+            }
+            Node::Const(Constant::Pi) => "pi".into(),
+            Node::Const(Constant::E) => "e".into(),
+            Node::Time => "t".into(),
+            Node::Sym(s) => p.name(*s).to_string(),
+            Node::Coord(s, k) => format!("{}{}", p.name(*s), "'".repeat(*k as usize)),
+            Node::Call(f, args) => {
+                let a: Vec<String> = args.iter().map(|&x| self.expr(x)).collect();
+                format!("{}({})", f.name(), a.join(", "))
+            }
+        }
+    }
+
+    /// A term without its sign: (is negative, text).
+    fn term(&self, id: Id) -> (bool, String) {
+        let f = fraction(self.pool, id);
+        let num = self.factors(&f.num);
+        let num = if num.is_empty() { "1".to_string() } else { num };
+        if f.den.is_empty() {
+            return (f.negative, num);
+        }
+        let den = self.factors(&f.den);
+        let den = if f.den.len() > 1 { format!("({den})") } else { den };
+        (f.negative, format!("{num}/{den}"))
+    }
+
+    fn factors(&self, fs: &[Factor]) -> String {
+        let parts: Vec<String> = fs.iter().map(|f| self.factor(*f)).collect();
+        parts.join("*")
+    }
+
+    fn factor(&self, f: Factor) -> String {
+        let p = self.pool;
+        match f {
+            Factor::Number(n) => n.to_string(),
+            Factor::Power(b, e) if e.is_one() => self.wrap(b, 3),
+            Factor::Power(b, e) if e == Number::ratio(1, 2) => format!("sqrt({})", self.expr(b)),
+            Factor::Power(b, e) => {
+                let es = match e {
+                    Number::Rat(r) if r.is_integer() => e.to_string(),
+                    _ => format!("({e})"),
+                };
+                format!("{}^{es}", self.wrap(b, 4))
+            }
+            Factor::Symbolic(b, e) => {
+                let es = if precedence(p, e) >= 4 && !p.looks_negative(e) {
+                    self.expr(e)
+                } else {
+                    format!("({})", self.expr(e))
+                };
+                format!("{}^{es}", self.wrap(b, 4))
+            }
+        }
+    }
+
+    fn wrap(&self, id: Id, min_prec: u8) -> String {
+        if precedence(self.pool, id) >= min_prec && !self.pool.looks_negative(id) {
+            self.expr(id)
+        } else {
+            format!("({})", self.expr(id))
+        }
+    }
+}
+
+/// LaTeX name of a symbol: Greek letters, subscripts after `_`, multi-letter names upright.
+pub fn latex_name(name: &str) -> String {
+    const GREEK: [&str; 34] = [
+        "alpha", "beta", "gamma", "delta", "epsilon", "varepsilon", "zeta", "eta", "theta",
+        "vartheta", "iota", "kappa", "lambda", "mu", "nu", "xi", "pi", "rho", "sigma", "tau",
+        "upsilon", "phi", "varphi", "chi", "psi", "omega", "Gamma", "Delta", "Theta", "Lambda",
+        "Xi", "Sigma", "Phi", "Omega",
+    ];
+    let one = |s: &str| -> String {
+        if GREEK.contains(&s) {
+            format!("\\{s}")
+        } else if s.chars().count() > 1 && !s.chars().all(|c| c.is_ascii_digit()) {
+            format!("\\mathrm{{{s}}}")
+        } else {
+            s.to_string()
+        }
+    };
+    match name.split_once('_') {
+        Some((base, sub)) if !base.is_empty() && !sub.is_empty() => {
+            format!("{}_{{{}}}", one(base), one(sub))
+        }
+        _ => one(name),
+    }
+}
+
+struct LatexPrinter<'a> {
+    pool: &'a Pool,
+}
+
+impl LatexPrinter<'_> {
+    fn expr(&self, id: Id) -> String {
+        let p = self.pool;
+        match p.node(id) {
+            Node::Add(ts) => {
+                let mut s = String::new();
+                for (i, &t) in ts.iter().enumerate() {
+                    let (neg, body) = self.term(t);
+                    s += match (i, neg) {
+                        (0, true) => "-",
+                        (0, false) => "",
+                        (_, true) => " - ",
+                        (_, false) => " + ",
+                    };
+                    s += &body;
+                }
+                s
+            }
+            Node::Mul(_) | Node::Num(_) | Node::Pow(..) => {
+                let (neg, body) = self.term(id);
+                if neg {
+                    format!("-{body}")
+                } else {
+                    body
+                }
+            }
+            Node::Const(Constant::Pi) => "\\pi".into(),
+            Node::Const(Constant::E) => "e".into(),
+            Node::Time => "t".into(),
+            Node::Sym(s) => latex_name(p.name(*s)),
+            Node::Coord(s, k) => {
+                let n = latex_name(p.name(*s));
+                match k {
+                    0 => n,
+                    1 => format!("\\dot{{{n}}}"),
+                    2 => format!("\\ddot{{{n}}}"),
+                    3 => format!("\\dddot{{{n}}}"),
+                    _ => format!("{n}^{{({k})}}"),
+                }
+            }
+            Node::Call(f, args) => {
+                let a: Vec<String> = args.iter().map(|&x| self.expr(x)).collect();
+                let a = a.join(", ");
+                match f {
+                    Func::Abs => format!("\\left|{a}\\right|"),
+                    Func::Sin | Func::Cos | Func::Tan | Func::Sinh | Func::Cosh | Func::Tanh
+                    | Func::Exp | Func::Log | Func::Min | Func::Max => {
+                        format!("\\{}\\left({a}\\right)", f.name())
+                    }
+                    Func::Asin => format!("\\arcsin\\left({a}\\right)"),
+                    Func::Acos => format!("\\arccos\\left({a}\\right)"),
+                    Func::Atan => format!("\\arctan\\left({a}\\right)"),
+                    Func::Atan2 | Func::Sign => {
+                        format!("\\operatorname{{{}}}\\left({a}\\right)", f.name())
+                    }
+                }
+            }
+        }
+    }
+
+    fn term(&self, id: Id) -> (bool, String) {
+        let f = fraction(self.pool, id);
+        let num = self.factors(&f.num);
+        let num = if num.is_empty() { "1".to_string() } else { num };
+        if f.den.is_empty() {
+            return (f.negative, num);
+        }
+        (f.negative, format!("\\frac{{{num}}}{{{}}}", self.factors(&f.den)))
+    }
+
+    fn factors(&self, fs: &[Factor]) -> String {
+        let mut s = String::new();
+        for (i, f) in fs.iter().enumerate() {
+            let part = self.factor(*f);
+            if i > 0 {
+                s += if part.starts_with(|c: char| c.is_ascii_digit()) {
+                    " \\cdot "
+                } else {
+                    " "
+                };
+            }
+            s += &part;
+        }
+        s
+    }
+
+    fn factor(&self, f: Factor) -> String {
+        let p = self.pool;
+        let base = |b: Id| -> String {
+            if precedence(p, b) >= 4 && !p.looks_negative(b) {
+                self.expr(b)
+            } else {
+                format!("\\left({}\\right)", self.expr(b))
+            }
+        };
+        match f {
+            Factor::Number(n) => match n {
+                Number::Float(x) => format!("{x:e}").replace('e', " \\times 10^{") + "}",
+                _ => n.to_string(),
+            },
+            Factor::Power(b, e) if e.is_one() => {
+                if precedence(p, b) >= 3 && !p.looks_negative(b) {
+                    self.expr(b)
+                } else {
+                    format!("\\left({}\\right)", self.expr(b))
+                }
+            }
+            Factor::Power(b, e) if e == Number::ratio(1, 2) => format!("\\sqrt{{{}}}", self.expr(b)),
+            Factor::Power(b, e) => {
+                let es = match e {
+                    Number::Rat(r) if !r.is_integer() => {
+                        format!("\\frac{{{}}}{{{}}}", r.numer(), r.denom())
+                    }
+                    _ => e.to_string(),
+                };
+                format!("{}^{{{es}}}", base(b))
+            }
+            Factor::Symbolic(b, e) => format!("{}^{{{}}}", base(b), self.expr(e)),
+        }
+    }
+}
+
+struct RustPrinter<'a> {
+    pool: &'a Pool,
+    leaf: &'a dyn Fn(&Pool, &Node) -> String,
+}
+
+impl RustPrinter<'_> {
+    fn num(n: Number) -> String {
+        let x = n.to_f64();
+        if x.is_nan() {
+            "f64::NAN".into()
+        } else if x.is_infinite() {
+            if x > 0.0 { "f64::INFINITY" } else { "f64::NEG_INFINITY" }.into()
+        } else {
+            format!("{x:?}_f64")
+        }
+    }
+
+    fn expr(&self, id: Id) -> String {
+        let p = self.pool;
+        match p.node(id) {
+            Node::Num(n) => {
+                let s = Self::num(*n);
+                if n.is_negative() {
+                    format!("({s})")
+                } else {
+                    s
+                }
+            }
+            Node::Const(Constant::Pi) => "std::f64::consts::PI".into(),
+            Node::Const(Constant::E) => "std::f64::consts::E".into(),
+            node @ (Node::Time | Node::Sym(_) | Node::Coord(..)) => (self.leaf)(p, node),
+            Node::Add(ts) => {
+                let parts: Vec<String> = ts.iter().map(|&t| self.expr(t)).collect();
+                format!("({})", parts.join(" + "))
+            }
+            Node::Mul(fs) => {
+                let parts: Vec<String> = fs.iter().map(|&t| self.expr(t)).collect();
+                format!("({})", parts.join(" * "))
+            }
+            Node::Pow(b, e) => {
+                let bs = self.expr(*b);
+                match p.as_num(*e) {
+                    Some(n) if n == Number::ratio(1, 2) => format!("{bs}.sqrt()"),
+                    Some(n) if n == Number::ratio(-1, 2) => format!("(1.0_f64 / {bs}.sqrt())"),
+                    Some(n) if n.as_integer().is_some_and(|k| k.abs() < i32::MAX as i64) => {
+                        format!("{bs}.powi({})", n.as_integer().unwrap_or(1))
+                    }
+                    _ => format!("{bs}.powf({})", self.expr(*e)),
+                }
+            }
+            Node::Call(f, args) => {
+                let a = self.expr(args[0]);
+                match f {
+                    Func::Atan2 => format!("{a}.atan2({})", self.expr(args[1])),
+                    Func::Min => format!("{a}.min({})", self.expr(args[1])),
+                    Func::Max => format!("{a}.max({})", self.expr(args[1])),
+                    Func::Log => format!("{a}.ln()"),
+                    Func::Sign => format!(
+                        "{{ let s: f64 = {a}; if s > 0.0 {{ 1.0 }} else if s < 0.0 {{ -1.0 }} else {{ 0.0 }} }}"
+                    ),
+                    _ => format!("{a}.{}()", f.name()),
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::pool::Pool;
+
+    fn text(src: &str) -> String {
+        let mut p = Pool::new();
+        let e = p.parse_scalar(src).unwrap();
+        p.to_text(e)
+    }
+
+    #[test]
+    fn text_reads_naturally() {
+        assert_eq!(text("x + x + x"), "3*x");
+        assert_eq!(text("-(a - b)"), "-a + b");
+        assert_eq!(text("3*x/(2*y^2)"), "3*x/(2*y^2)");
+        assert_eq!(text("m*g*cos(theta)"), "g*m*cos(theta)");
+        assert_eq!(text("x^(1/2)"), "sqrt(x)");
+        assert_eq!(text("1/sqrt(x)"), "1/sqrt(x)");
+        assert_eq!(text("x''*R"), "R*x''");
+        assert_eq!(text("(a+b)^2"), "(a + b)^2");
+        assert_eq!(text("2^(-x)"), "2^(-x)");
+    }
+
+    #[test]
+    fn latex_uses_greek_and_fractions() {
+        let mut p = Pool::new();
+        let e = p.parse_scalar("g*m*cos(theta)/sin(phi) + th''").unwrap();
+        assert_eq!(
+            p.to_latex(e),
+            "\\frac{g m \\cos\\left(\\theta\\right)}{\\sin\\left(\\phi\\right)} + \\ddot{\\mathrm{th}}"
+        );
+        let e = p.parse_scalar("m_A*omega^2").unwrap();
+        assert_eq!(p.to_latex(e), "m_{A} \\omega^{2}");
+    }
+
+    #[test]
+    fn rust_source_evaluates() {
+        let mut p = Pool::new();
+        let e = p.parse_scalar("sqrt(x^2 + y^2)*sign(-x)").unwrap();
+        let s = p.to_rust(e, &|p, n| p.rust_leaf_name(n));
+        assert!(s.contains(".sqrt()"), "{s}");
+        assert!(s.contains(".powi(2)"), "{s}");
+    }
+}

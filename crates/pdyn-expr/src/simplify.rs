@@ -1,0 +1,408 @@
+//! Simplification, in the spirit of MATLAB's and SymPy's `simplify`: try a few normal forms and
+//! keep the shortest.
+//!
+//! The main normal form is a ratio of two polynomials over atoms ([`crate::poly`]):
+//! 1. atoms are simplified first (function arguments, bases of fractional powers), and
+//!    `b^(p/q)` becomes the atom `b^(1/q)` raised to `p`, so `x^(3/2)/sqrt(x) = x`;
+//! 2. optionally, `sin`/`cos`/`tan` of sums and integer multiples are expanded
+//!    (`cos(a - b) = cos a cos b + sin a sin b`), exposing cancellations between angles;
+//! 3. for every angle `u`, the numerator and denominator are reduced modulo
+//!    `sin(u)^2 + cos(u)^2 - 1` by eliminating `sin^2` or `cos^2`, whichever leaves fewer terms;
+//! 4. the GCD of numerator and denominator is cancelled.
+//!
+//! The candidates (the input, and the rational form with and without trig expansion) are
+//! compared by [`Pool::tree_size`]; ties keep the earlier candidate.
+
+use crate::number::{Number, Rational};
+use crate::poly::{gcd, Budget, Mono, Poly};
+use crate::pool::{Func, Id, Node, Pool};
+use rustc_hash::FxHashMap;
+
+/// Work allowed per rational-form attempt (polynomial term operations).
+const BUDGET: u64 = 400_000;
+/// Largest tree handed to the rational normal form.
+const MAX_TREE: usize = 20_000;
+
+impl Pool {
+    /// Simplifies `e` (see the module documentation). Memoised.
+    pub fn simplify(&mut self, e: Id) -> Id {
+        if let Some(&r) = self.memo.simplify.get(&e) {
+            return r;
+        }
+        let r = self.simplify_uncached(e);
+        self.memo.simplify.insert(e, r);
+        self.memo.simplify.insert(r, r);
+        r
+    }
+
+    fn simplify_uncached(&mut self, e: Id) -> Id {
+        if matches!(
+            self.node(e),
+            Node::Num(_) | Node::Const(_) | Node::Time | Node::Sym(_) | Node::Coord(..)
+        ) {
+            return e;
+        }
+        let base = self.simplify_args(e);
+        let mut best = base;
+        let mut best_cost = self.tree_size(base, usize::MAX);
+        if best_cost > MAX_TREE {
+            return best;
+        }
+        for expand_trig in [false, true] {
+            if let Some(c) = self.rational_form(base, expand_trig) {
+                let cost = self.tree_size(c, best_cost + 1);
+                if cost < best_cost {
+                    best = c;
+                    best_cost = cost;
+                }
+            }
+        }
+        best
+    }
+
+    /// Rebuilds `e` with simplified function arguments and power bases/exponents.
+    fn simplify_args(&mut self, e: Id) -> Id {
+        match self.node(e).clone() {
+            Node::Add(ts) => {
+                let ts: Vec<Id> = ts.iter().map(|&t| self.simplify_args(t)).collect();
+                self.add(&ts)
+            }
+            Node::Mul(fs) => {
+                let fs: Vec<Id> = fs.iter().map(|&f| self.simplify_args(f)).collect();
+                self.mul(&fs)
+            }
+            Node::Pow(b, x) => {
+                let b = self.simplify_args(b);
+                let x = self.simplify(x);
+                self.pow(b, x)
+            }
+            Node::Call(f, args) => {
+                let args: Vec<Id> = args.iter().map(|&a| self.simplify(a)).collect();
+                self.call(f, &args)
+            }
+            _ => e,
+        }
+    }
+
+    /// `e` as a reduced ratio of polynomials, converted back to an expression; `None` when it
+    /// does not apply (floating-point coefficients) or exceeds the work budget.
+    fn rational_form(&mut self, e: Id, expand_trig: bool) -> Option<Id> {
+        let mut cx = RationalForm::new(BUDGET, expand_trig);
+        let (num, den) = cx.convert(self, e)?;
+        let (num, den) = cx.reduce_pythagorean(self, num, den)?;
+        let (num, den) = cx.cancel(num, den)?;
+        let n = cx.to_expr(self, &num);
+        let d = cx.to_expr(self, &den);
+        Some(self.div(n, d))
+    }
+
+    /// Simplifies both sides' difference and reports whether it is zero: a sound but
+    /// incomplete equality test (false can mean "could not prove").
+    pub fn provably_equal(&mut self, a: Id, b: Id) -> bool {
+        let d = self.sub(a, b);
+        let d = self.expand(d);
+        self.simplify(d) == Pool::ZERO
+    }
+}
+
+/// Conversion between expressions and polynomials over a shared table of atoms.
+pub(crate) struct RationalForm {
+    atoms: Vec<Id>,
+    index: FxHashMap<Id, u32>,
+    pub(crate) budget: Budget,
+    expand_trig: bool,
+}
+
+pub(crate) type Frac = (Poly, Poly);
+
+fn one() -> Poly {
+    Poly::constant(Rational::ONE)
+}
+
+impl RationalForm {
+    pub(crate) fn new(budget: u64, expand_trig: bool) -> RationalForm {
+        RationalForm {
+            atoms: Vec::new(),
+            index: FxHashMap::default(),
+            budget: Budget(budget),
+            expand_trig,
+        }
+    }
+
+    fn atom(&mut self, id: Id) -> Poly {
+        let k = match self.index.get(&id) {
+            Some(&k) => k,
+            None => {
+                let k = self.atoms.len() as u32;
+                self.atoms.push(id);
+                self.index.insert(id, k);
+                k
+            }
+        };
+        Poly::atom(k)
+    }
+
+    pub(crate) fn convert(&mut self, p: &mut Pool, e: Id) -> Option<Frac> {
+        match p.node(e).clone() {
+            Node::Num(Number::Rat(r)) => Some((Poly::constant(r), one())),
+            Node::Num(Number::Float(_)) => None,
+            Node::Add(ts) => {
+                let mut acc: Frac = (Poly::zero(), one());
+                for t in ts.iter() {
+                    let f = self.convert(p, *t)?;
+                    acc = self.add(acc, f)?;
+                }
+                Some(acc)
+            }
+            Node::Mul(fs) => {
+                let mut acc: Frac = (one(), one());
+                for f in fs.iter() {
+                    let x = self.convert(p, *f)?;
+                    let b = &mut self.budget;
+                    acc = (acc.0.mul(&x.0, b)?, acc.1.mul(&x.1, b)?);
+                }
+                Some(acc)
+            }
+            Node::Pow(b, x) => {
+                let r = p.as_num(x).and_then(Number::as_rational);
+                match r {
+                    Some(r) if r.is_integer() => {
+                        let base = self.convert(p, b)?;
+                        self.power(base, r.numer())
+                    }
+                    Some(r) => {
+                        // b^(p/q) = (b^(1/q))^p with b^(1/q) an atom.
+                        let inv_q = p.num(Number::ratio(1, r.denom()));
+                        let root = p.pow(b, inv_q);
+                        if matches!(p.node(root), Node::Pow(rb, _) if *rb == b) {
+                            let a = self.atom(root);
+                            self.power((a, one()), r.numer())
+                        } else {
+                            // The root simplified (sqrt(m^2) = m for m > 0): use root^p.
+                            let pe = p.int(r.numer());
+                            let v = p.pow(root, pe);
+                            if v == e {
+                                return Some((self.atom(e), one()));
+                            }
+                            self.convert(p, v)
+                        }
+                    }
+                    None => Some((self.atom(e), one())),
+                }
+            }
+            Node::Call(f @ (Func::Sin | Func::Cos | Func::Tan), args) if self.expand_trig => {
+                match expand_trig_call(p, f, args[0]) {
+                    Some(x) => self.convert(p, x),
+                    None => Some((self.atom(e), one())),
+                }
+            }
+            _ => Some((self.atom(e), one())),
+        }
+    }
+
+    fn power(&mut self, (n, d): Frac, k: i64) -> Option<Frac> {
+        let b = &mut self.budget;
+        let m = u32::try_from(k.unsigned_abs()).ok()?;
+        if m > 64 {
+            return None;
+        }
+        let (n, d) = (n.pow(m, b)?, d.pow(m, b)?);
+        if k < 0 {
+            if n.is_zero() {
+                return None; // division by zero: leave it to evaluation (inf)
+            }
+            Some((d, n))
+        } else {
+            Some((n, d))
+        }
+    }
+
+    fn add(&mut self, (n1, d1): Frac, (n2, d2): Frac) -> Option<Frac> {
+        let b = &mut self.budget;
+        if d1 == d2 {
+            return Some((n1.add(&n2, b)?, d1));
+        }
+        if d1.as_constant().is_some() || d2.as_constant().is_some() {
+            return Some((n1.mul(&d2, b)?.add(&n2.mul(&d1, b)?, b)?, d1.mul(&d2, b)?));
+        }
+        let g = gcd(&d1, &d2, b)?;
+        let c1 = d1.div_exact(&g, b)?;
+        let c2 = d2.div_exact(&g, b)?;
+        let n = n1.mul(&c2, b)?.add(&n2.mul(&c1, b)?, b)?;
+        Some((n, d1.mul(&c2, b)?))
+    }
+
+    /// Eliminates sin^2 or cos^2 of each angle, whichever leaves fewer terms.
+    fn reduce_pythagorean(&mut self, p: &Pool, mut num: Poly, mut den: Poly) -> Option<Frac> {
+        let mut pairs: Vec<(u32, u32)> = Vec::new();
+        for (i, &a) in self.atoms.iter().enumerate() {
+            if let Node::Call(Func::Sin, args) = p.node(a) {
+                let cos = self.atoms.iter().position(
+                    |&c| matches!(p.node(c), Node::Call(Func::Cos, cargs) if cargs[0] == args[0]),
+                );
+                if let Some(j) = cos {
+                    pairs.push((i as u32, j as u32));
+                }
+            }
+        }
+        for (s, c) in pairs {
+            let b = &mut self.budget;
+            let ns = eliminate_square(&num, s, c, b)?;
+            let ds = eliminate_square(&den, s, c, b)?;
+            let nc = eliminate_square(&num, c, s, b)?;
+            let dc = eliminate_square(&den, c, s, b)?;
+            // Fewer terms first, then lower total degree.
+            let size = |a: &Poly, b: &Poly| {
+                let deg = |p: &Poly| -> u32 {
+                    p.terms.keys().map(|m| m.iter().map(|&(_, e)| e).sum::<u32>()).sum()
+                };
+                (a.terms.len() + b.terms.len(), deg(a) + deg(b))
+            };
+            let (s0, s1, s2) = (size(&num, &den), size(&ns, &ds), size(&nc, &dc));
+            if s1 < s0 && s1 <= s2 {
+                num = ns;
+                den = ds;
+            } else if s2 < s0 {
+                num = nc;
+                den = dc;
+            }
+        }
+        Some((num, den))
+    }
+
+    fn cancel(&mut self, num: Poly, den: Poly) -> Option<Frac> {
+        let b = &mut self.budget;
+        if num.is_zero() {
+            return Some((Poly::zero(), one()));
+        }
+        let (num, den) = if den.as_constant().is_some() {
+            (num, den)
+        } else {
+            let g = gcd(&num, &den, b)?;
+            (num.div_exact(&g, b)?, den.div_exact(&g, b)?)
+        };
+        // Normalise: denominator with leading coefficient 1.
+        let (_, lc) = den.leading()?;
+        let inv = lc.recip()?;
+        let k = Poly::constant(inv);
+        Some((num.mul(&k, b)?, den.mul(&k, b)?))
+    }
+
+    pub(crate) fn to_expr(&self, p: &mut Pool, poly: &Poly) -> Id {
+        let mut terms = Vec::with_capacity(poly.terms.len());
+        for (m, c) in &poly.terms {
+            let mut fs = Vec::with_capacity(m.len() + 1);
+            fs.push(p.num(Number::Rat(*c)));
+            for &(a, e) in m {
+                let base = self.atoms[a as usize];
+                fs.push(p.powi(base, e as i64));
+            }
+            terms.push(p.mul(&fs));
+        }
+        p.add(&terms)
+    }
+}
+
+/// Replaces `x^k` (k ≥ 2) by `x^(k mod 2) * (1 - y^2)^(k div 2)`, i.e. uses `x^2 = 1 - y^2`.
+fn eliminate_square(poly: &Poly, x: u32, y: u32, b: &mut Budget) -> Option<Poly> {
+    let mut one_minus_y2 = Poly::constant(Rational::ONE);
+    one_minus_y2 = one_minus_y2.sub(&Poly::atom(y).pow(2, b)?, b)?;
+    let mut out = Poly::zero();
+    for (m, c) in &poly.terms {
+        let k = m.iter().find(|&&(a, _)| a == x).map_or(0, |&(_, e)| e);
+        let term_poly = |mono: Mono| {
+            let mut t = Poly::zero();
+            t.terms.insert(mono, *c);
+            t
+        };
+        if k < 2 {
+            out = out.add(&term_poly(m.clone()), b)?;
+            continue;
+        }
+        let mut rest: Mono = m.iter().copied().filter(|&(a, _)| a != x).collect();
+        if k % 2 == 1 {
+            rest.push((x, 1));
+            rest.sort_by(|p, q| q.0.cmp(&p.0));
+        }
+        let f = one_minus_y2.pow(k / 2, b)?;
+        out = out.add(&term_poly(rest).mul(&f, b)?, b)?;
+    }
+    Some(out)
+}
+
+/// `sin`, `cos`, `tan` of a sum or of an integer multiple, written in terms of simpler angles.
+fn expand_trig_call(p: &mut Pool, f: Func, u: Id) -> Option<Id> {
+    if f == Func::Tan {
+        let s = p.call(Func::Sin, &[u]);
+        let c = p.call(Func::Cos, &[u]);
+        return Some(p.div(s, c));
+    }
+    let (a, b) = match p.node(u).clone() {
+        Node::Add(ts) => {
+            let a = ts[0];
+            let b = p.add(&ts[1..]);
+            (a, b)
+        }
+        Node::Mul(fs) => {
+            let k = p.as_num(fs[0])?.as_integer()?;
+            if !(2..=8).contains(&k) {
+                return None;
+            }
+            let rest = p.mul(&fs[1..]);
+            let km1 = p.int(k - 1);
+            (p.mul2(km1, rest), rest)
+        }
+        _ => return None,
+    };
+    let (sa, ca) = (p.call(Func::Sin, &[a]), p.call(Func::Cos, &[a]));
+    let (sb, cb) = (p.call(Func::Sin, &[b]), p.call(Func::Cos, &[b]));
+    Some(match f {
+        Func::Sin => {
+            let x = p.mul2(sa, cb);
+            let y = p.mul2(ca, sb);
+            p.add2(x, y)
+        }
+        _ => {
+            let x = p.mul2(ca, cb);
+            let y = p.mul2(sa, sb);
+            p.sub(x, y)
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::pool::Pool;
+
+    fn simp(src: &str) -> String {
+        let mut p = Pool::new();
+        let e = p.parse_scalar(src).unwrap();
+        let s = p.simplify(e);
+        p.to_text(s)
+    }
+
+    #[test]
+    fn pythagorean_identity() {
+        assert_eq!(simp("sin(x)^2 + cos(x)^2"), "1");
+        assert_eq!(simp("3*sin(x)^2 + 3*cos(x)^2 + y"), "3 + y");
+        assert_eq!(simp("a*sin(x)^2 + a*cos(x)^2"), "a");
+        assert_eq!(simp("sin(x)^4 - cos(x)^4"), "1 - 2*cos(x)^2");
+    }
+
+    #[test]
+    fn rational_cancellation() {
+        assert_eq!(simp("(x^2 - 1)/(x - 1)"), "1 + x");
+        assert_eq!(simp("(a*b + a*c)/(b + c)"), "a");
+        assert_eq!(simp("x^(3/2)/sqrt(x)"), "x");
+        assert_eq!(simp("1/x + 1/y - (x + y)/(x*y)"), "0");
+    }
+
+    #[test]
+    fn trig_of_sums() {
+        assert_eq!(
+            simp("cos(p - q)*sin(q) + cos(q)*sin(p - q)"),
+            "sin(p)"
+        );
+        assert_eq!(simp("sin(2*x) - 2*sin(x)*cos(x)"), "0");
+    }
+}

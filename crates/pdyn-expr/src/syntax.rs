@@ -1,0 +1,507 @@
+//! The expression language: tokens and a recursive-descent parser producing a spanned AST.
+//!
+//! ```text
+//! equation := expr ('=' | '==') expr
+//! expr     := term (('+' | '-') term)*
+//! term     := unary (('*' | '/') unary)*
+//! unary    := ('-' | '+') unary | power
+//! power    := postfix (('^' | '**') unary)?          right associative: 2^-x, -x^2 = -(x^2)
+//! postfix  := primary ("'" | '.' ('x'|'y'|'z'))*     x'' is the second time derivative
+//! primary  := number | ident | ident '(' args ')' | '(' expr ')' | '[' expr, expr (, expr)? ']'
+//! ```
+//! Numbers: `12`, `1.5`, `.5`, `1.5e-3`. Identifiers: letters (Unicode allowed, e.g. `θ`),
+//! digits and `_`, not starting with a digit.
+
+use crate::error::ExprError;
+use std::ops::Range;
+
+/// Binary operators.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum BinOp {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Pow,
+}
+
+/// A parsed expression with source spans.
+#[derive(Clone, Debug, PartialEq)]
+#[allow(missing_docs)]
+pub enum Ast {
+    /// A numeric literal, kept as text so that it converts exactly.
+    Num { text: String, span: Range<usize> },
+    /// A name.
+    Ident { name: String, span: Range<usize> },
+    /// `-expr`.
+    Neg { expr: Box<Ast>, span: Range<usize> },
+    /// `lhs op rhs`.
+    Binary {
+        op: BinOp,
+        lhs: Box<Ast>,
+        rhs: Box<Ast>,
+        span: Range<usize>,
+    },
+    /// `name(args)`.
+    Call {
+        name: String,
+        name_span: Range<usize>,
+        args: Vec<Ast>,
+        span: Range<usize>,
+    },
+    /// `[a, b, c]` (or `[a, b]` for a planar vector).
+    Vector { items: Vec<Ast>, span: Range<usize> },
+    /// `expr'` repeated `count` times: time derivative.
+    Prime {
+        expr: Box<Ast>,
+        count: u8,
+        span: Range<usize>,
+    },
+    /// `expr.x` (component 0), `.y` (1), `.z` (2).
+    Component {
+        expr: Box<Ast>,
+        index: usize,
+        span: Range<usize>,
+    },
+}
+
+impl Ast {
+    /// Byte span covered by this node.
+    pub fn span(&self) -> Range<usize> {
+        match self {
+            Ast::Num { span, .. }
+            | Ast::Ident { span, .. }
+            | Ast::Neg { span, .. }
+            | Ast::Binary { span, .. }
+            | Ast::Call { span, .. }
+            | Ast::Vector { span, .. }
+            | Ast::Prime { span, .. }
+            | Ast::Component { span, .. } => span.clone(),
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum Tok {
+    Num(String),
+    Ident(String),
+    Op(char),
+    Pow,
+    Prime,
+    Eq,
+    End,
+}
+
+struct Lexer<'a> {
+    src: &'a str,
+    pos: usize,
+}
+
+impl<'a> Lexer<'a> {
+    fn next(&mut self) -> Result<(Tok, Range<usize>), ExprError> {
+        let bytes = self.src.as_bytes();
+        while self.pos < bytes.len() && (bytes[self.pos] as char).is_ascii_whitespace() {
+            self.pos += 1;
+        }
+        let start = self.pos;
+        let Some(c) = self.src[self.pos..].chars().next() else {
+            return Ok((Tok::End, start..start));
+        };
+        if c.is_ascii_digit()
+            || (c == '.' && self.src[self.pos + 1..].starts_with(|d: char| d.is_ascii_digit()))
+        {
+            return self.number(start);
+        }
+        if c.is_alphabetic() || c == '_' {
+            let mut end = start;
+            for (i, ch) in self.src[start..].char_indices() {
+                if ch.is_alphanumeric() || ch == '_' {
+                    end = start + i + ch.len_utf8();
+                } else {
+                    break;
+                }
+            }
+            self.pos = end;
+            return Ok((Tok::Ident(self.src[start..end].to_string()), start..end));
+        }
+        self.pos += c.len_utf8();
+        let tok = match c {
+            '+' | '-' | '/' | '(' | ')' | '[' | ']' | ',' | '.' => Tok::Op(c),
+            '*' => {
+                if self.src[self.pos..].starts_with('*') {
+                    self.pos += 1;
+                    Tok::Pow
+                } else {
+                    Tok::Op('*')
+                }
+            }
+            '^' => Tok::Pow,
+            '\'' => Tok::Prime,
+            '=' => {
+                if self.src[self.pos..].starts_with('=') {
+                    self.pos += 1;
+                }
+                Tok::Eq
+            }
+            other => {
+                return Err(ExprError::new(
+                    start..self.pos,
+                    format!("unexpected character `{other}`"),
+                )
+                .with_help(
+                    "expressions use numbers, names, + - * / ^, ( ), [a, b, c], x' and f(x)",
+                ))
+            }
+        };
+        Ok((tok, start..self.pos))
+    }
+
+    fn number(&mut self, start: usize) -> Result<(Tok, Range<usize>), ExprError> {
+        let b = self.src.as_bytes();
+        let mut i = start;
+        while i < b.len() && b[i].is_ascii_digit() {
+            i += 1;
+        }
+        if i < b.len() && b[i] == b'.' {
+            i += 1;
+            while i < b.len() && b[i].is_ascii_digit() {
+                i += 1;
+            }
+        }
+        if i < b.len() && (b[i] == b'e' || b[i] == b'E') {
+            let mut j = i + 1;
+            if j < b.len() && (b[j] == b'+' || b[j] == b'-') {
+                j += 1;
+            }
+            if j < b.len() && b[j].is_ascii_digit() {
+                while j < b.len() && b[j].is_ascii_digit() {
+                    j += 1;
+                }
+                i = j;
+            }
+        }
+        self.pos = i;
+        Ok((Tok::Num(self.src[start..i].to_string()), start..i))
+    }
+}
+
+/// Deepest nesting accepted, so that hostile input cannot overflow the stack.
+const MAX_DEPTH: usize = 200;
+
+struct Parser<'a> {
+    lex: Lexer<'a>,
+    tok: Tok,
+    span: Range<usize>,
+    depth: usize,
+}
+
+impl<'a> Parser<'a> {
+    fn new(src: &'a str) -> Result<Parser<'a>, ExprError> {
+        let mut lex = Lexer { src, pos: 0 };
+        let (tok, span) = lex.next()?;
+        Ok(Parser {
+            lex,
+            tok,
+            span,
+            depth: 0,
+        })
+    }
+
+    fn bump(&mut self) -> Result<(), ExprError> {
+        let (t, s) = self.lex.next()?;
+        self.tok = t;
+        self.span = s;
+        Ok(())
+    }
+
+    fn describe(&self) -> String {
+        match &self.tok {
+            Tok::End => "end of input".to_string(),
+            Tok::Num(n) => format!("number `{n}`"),
+            Tok::Ident(n) => format!("name `{n}`"),
+            Tok::Op(c) => format!("`{c}`"),
+            Tok::Pow => "`^`".to_string(),
+            Tok::Prime => "`'`".to_string(),
+            Tok::Eq => "`=`".to_string(),
+        }
+    }
+
+    fn expect(&mut self, c: char, what: &str) -> Result<Range<usize>, ExprError> {
+        if self.tok == Tok::Op(c) {
+            let s = self.span.clone();
+            self.bump()?;
+            Ok(s)
+        } else {
+            Err(ExprError::new(
+                self.span.clone(),
+                format!("expected `{c}` {what}, found {}", self.describe()),
+            ))
+        }
+    }
+
+    fn enter(&mut self) -> Result<(), ExprError> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            return Err(ExprError::new(
+                self.span.clone(),
+                format!("expression nested more than {MAX_DEPTH} levels deep"),
+            ));
+        }
+        Ok(())
+    }
+
+    fn expr(&mut self) -> Result<Ast, ExprError> {
+        self.enter()?;
+        let mut lhs = self.term()?;
+        loop {
+            let op = match self.tok {
+                Tok::Op('+') => BinOp::Add,
+                Tok::Op('-') => BinOp::Sub,
+                _ => break,
+            };
+            self.bump()?;
+            let rhs = self.term()?;
+            lhs = binary(op, lhs, rhs);
+        }
+        self.depth -= 1;
+        Ok(lhs)
+    }
+
+    fn term(&mut self) -> Result<Ast, ExprError> {
+        let mut lhs = self.unary()?;
+        loop {
+            let op = match self.tok {
+                Tok::Op('*') => BinOp::Mul,
+                Tok::Op('/') => BinOp::Div,
+                _ => break,
+            };
+            self.bump()?;
+            let rhs = self.unary()?;
+            lhs = binary(op, lhs, rhs);
+        }
+        Ok(lhs)
+    }
+
+    fn unary(&mut self) -> Result<Ast, ExprError> {
+        self.enter()?;
+        let out = match self.tok {
+            Tok::Op('-') => {
+                let start = self.span.start;
+                self.bump()?;
+                let e = self.unary()?;
+                let span = start..e.span().end;
+                Ast::Neg {
+                    expr: Box::new(e),
+                    span,
+                }
+            }
+            Tok::Op('+') => {
+                self.bump()?;
+                self.unary()?
+            }
+            _ => self.power()?,
+        };
+        self.depth -= 1;
+        Ok(out)
+    }
+
+    fn power(&mut self) -> Result<Ast, ExprError> {
+        let base = self.postfix()?;
+        if self.tok == Tok::Pow {
+            self.bump()?;
+            let exp = self.unary()?;
+            return Ok(binary(BinOp::Pow, base, exp));
+        }
+        Ok(base)
+    }
+
+    fn postfix(&mut self) -> Result<Ast, ExprError> {
+        let mut e = self.primary()?;
+        loop {
+            match &self.tok {
+                Tok::Prime => {
+                    let start = e.span().start;
+                    let mut count = 0u8;
+                    let mut end = self.span.end;
+                    while self.tok == Tok::Prime {
+                        count = count.saturating_add(1);
+                        end = self.span.end;
+                        self.bump()?;
+                    }
+                    e = Ast::Prime {
+                        expr: Box::new(e),
+                        count,
+                        span: start..end,
+                    };
+                }
+                Tok::Op('.') => {
+                    self.bump()?;
+                    let index = match &self.tok {
+                        Tok::Ident(n) if n == "x" => 0,
+                        Tok::Ident(n) if n == "y" => 1,
+                        Tok::Ident(n) if n == "z" => 2,
+                        _ => {
+                            return Err(ExprError::new(
+                                self.span.clone(),
+                                format!("expected a component after `.`, found {}", self.describe()),
+                            )
+                            .with_help("components are `.x`, `.y` and `.z`"))
+                        }
+                    };
+                    let span = e.span().start..self.span.end;
+                    self.bump()?;
+                    e = Ast::Component {
+                        expr: Box::new(e),
+                        index,
+                        span,
+                    };
+                }
+                _ => return Ok(e),
+            }
+        }
+    }
+
+    fn primary(&mut self) -> Result<Ast, ExprError> {
+        let span = self.span.clone();
+        match self.tok.clone() {
+            Tok::Num(text) => {
+                self.bump()?;
+                Ok(Ast::Num { text, span })
+            }
+            Tok::Ident(name) => {
+                self.bump()?;
+                if self.tok == Tok::Op('(') {
+                    self.bump()?;
+                    let mut args = Vec::new();
+                    if self.tok != Tok::Op(')') {
+                        args.push(self.expr()?);
+                        while self.tok == Tok::Op(',') {
+                            self.bump()?;
+                            args.push(self.expr()?);
+                        }
+                    }
+                    let close = self.expect(')', &format!("to close the call of `{name}`"))?;
+                    Ok(Ast::Call {
+                        name,
+                        name_span: span.clone(),
+                        args,
+                        span: span.start..close.end,
+                    })
+                } else {
+                    Ok(Ast::Ident { name, span })
+                }
+            }
+            Tok::Op('(') => {
+                self.bump()?;
+                let e = self.expr()?;
+                self.expect(')', "to close `(`")?;
+                Ok(e)
+            }
+            Tok::Op('[') => {
+                self.bump()?;
+                let mut items = vec![self.expr()?];
+                while self.tok == Tok::Op(',') {
+                    self.bump()?;
+                    items.push(self.expr()?);
+                }
+                let close = self.expect(']', "to close the vector")?;
+                Ok(Ast::Vector {
+                    items,
+                    span: span.start..close.end,
+                })
+            }
+            _ => Err(ExprError::new(
+                span,
+                format!("expected a number, name, `(` or `[`, found {}", self.describe()),
+            )),
+        }
+    }
+
+    fn finish(&mut self) -> Result<(), ExprError> {
+        if self.tok != Tok::End {
+            let msg = format!("unexpected {} after the end of the expression", self.describe());
+            let mut e = ExprError::new(self.span.clone(), msg);
+            if matches!(self.tok, Tok::Ident(_) | Tok::Num(_) | Tok::Op('(')) {
+                e = e.with_help("write multiplication explicitly with `*`");
+            }
+            return Err(e);
+        }
+        Ok(())
+    }
+}
+
+fn binary(op: BinOp, lhs: Ast, rhs: Ast) -> Ast {
+    let span = lhs.span().start..rhs.span().end;
+    Ast::Binary {
+        op,
+        lhs: Box::new(lhs),
+        rhs: Box::new(rhs),
+        span,
+    }
+}
+
+/// Parses one expression.
+pub fn parse(src: &str) -> Result<Ast, ExprError> {
+    let mut p = Parser::new(src)?;
+    let e = p.expr()?;
+    if p.tok == Tok::Eq {
+        return Err(ExprError::new(p.span.clone(), "unexpected `=` in an expression")
+            .with_help("an equation is only accepted where one is expected"));
+    }
+    p.finish()?;
+    Ok(e)
+}
+
+/// Parses `lhs = rhs` (or `lhs == rhs`). An expression without `=` means `expr = 0`.
+pub fn parse_equation(src: &str) -> Result<(Ast, Option<Ast>), ExprError> {
+    let mut p = Parser::new(src)?;
+    let lhs = p.expr()?;
+    if p.tok == Tok::Eq {
+        p.bump()?;
+        let rhs = p.expr()?;
+        p.finish()?;
+        return Ok((lhs, Some(rhs)));
+    }
+    p.finish()?;
+    Ok((lhs, None))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn precedence_and_spans() {
+        let e = parse("a + b*c^2").unwrap();
+        match e {
+            Ast::Binary {
+                op: BinOp::Add,
+                rhs,
+                span,
+                ..
+            } => {
+                assert_eq!(span, 0..9);
+                assert!(matches!(*rhs, Ast::Binary { op: BinOp::Mul, .. }));
+            }
+            other => panic!("{other:?}"),
+        }
+        assert!(matches!(parse("-x^2").unwrap(), Ast::Neg { .. }));
+        assert!(matches!(parse("x''").unwrap(), Ast::Prime { count: 2, .. }));
+        assert!(matches!(parse("r.z").unwrap(), Ast::Component { index: 2, .. }));
+    }
+
+    #[test]
+    fn errors_are_located() {
+        let e = parse("2*(x + 1").unwrap_err();
+        assert_eq!(e.span, 8..8);
+        assert!(e.message.contains("expected `)`"));
+        let e = parse("2 x").unwrap_err();
+        assert_eq!(e.span, 2..3);
+        assert!(e.help.unwrap().contains('*'));
+        let e = parse("x # y").unwrap_err();
+        assert_eq!(e.span, 2..3);
+        let deep = "(".repeat(10_000) + "x" + &")".repeat(10_000);
+        assert!(parse(&deep).unwrap_err().message.contains("nested"));
+    }
+}
