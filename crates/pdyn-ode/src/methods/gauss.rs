@@ -5,8 +5,9 @@
 //! Stages `Z_i = h Σ_j a_ij f(t + c_j h, y + Z_j)` are solved by fixed-point iteration
 //! (suited to non-stiff Hamiltonian problems; Hairer, Lubich & Wanner, *Geometric Numerical
 //! Integration*, §VIII.6): the iteration starts from `h Σ_j a_ij F_j` with the stage
-//! derivatives `F_j` of the previous step and runs until the increment is zero or stops
-//! decreasing (round-off level), at most 100 sweeps; then `y_1 = y + h Σ_i b_i F_i`. The
+//! derivatives `F_j` of the previous step and runs until the increment is at round-off level
+//! (`‖ΔZ‖ ≤ 2ε max(1, ‖y‖)`, or it stops decreasing below `1e-13 max(1, ‖y‖)`), at most
+//! 100 sweeps; then `y_1 = y + h Σ_i b_i F_i`. The
 //! nodes `c_i` are the zeros of the shifted Legendre polynomial of degree `s`; order `2s`.
 //!
 //! J. C. Butcher, *Implicit Runge–Kutta processes*, Math. Comp. 18 (1964) 50–64;
@@ -129,13 +130,13 @@ impl<P: OdeSystem + ?Sized, const S: usize> FixedStepper<P> for Gauss<S> {
             if !dz.is_finite() {
                 break;
             }
-            if dz == 0.0 || (dz >= dz_prev && dz <= 1e-10 * scale) {
+            if dz <= 2.0 * f64::EPSILON * scale || (dz >= dz_prev && dz <= 1e-13 * scale) {
                 converged = true;
                 break;
             }
             dz_prev = dz;
         }
-        if !converged && dz_prev > 1e-10 * scale {
+        if !converged && dz_prev > 1e-12 * scale {
             return Err(StepFailure::NoConvergence);
         }
         for k in 0..n {
