@@ -159,6 +159,13 @@ impl Pool {
                     continue;
                 }
                 Node::Pow(b, e) => (*b, *e),
+                Node::Add(_) => match self.add_content(f) {
+                    Some((c, prim)) => {
+                        coeff = coeff.mul(c);
+                        (prim, Pool::ONE)
+                    }
+                    None => (f, Pool::ONE),
+                },
                 _ => (f, Pool::ONE),
             };
             match exps.get_mut(&b) {
@@ -263,9 +270,10 @@ impl Pool {
                     let whole = p.div_euclid(q);
                     let frac = p.rem_euclid(q);
                     if whole != 0 && xr.numer() > 0 {
-                        let w = self.num(x.pow(Number::int(whole)).unwrap_or(Number::Float(
-                            x.to_f64().powf(whole as f64),
-                        )));
+                        let w = self.num(
+                            x.pow(Number::int(whole))
+                                .unwrap_or(Number::Float(x.to_f64().powf(whole as f64))),
+                        );
                         let fe = self.num(Number::ratio(frac, q));
                         let fp = self.intern(Node::Pow(b, fe));
                         return self.mul(&[w, fp]);
@@ -274,6 +282,19 @@ impl Pool {
                 self.intern(Node::Pow(b, e))
             }
             (Node::Const(Constant::E), _) => self.call(Func::Exp, &[e]),
+            (Node::Add(_), Some(y)) => {
+                // Canonical sums under powers: (2a + 2b)^k = 2^k (a + b)^k, so that every
+                // arrangement of the same product reaches the same node.
+                match self.add_content(b) {
+                    Some((c, prim)) if y.as_integer().is_some() || c.is_positive() => {
+                        let cp = self.num(c);
+                        let cpow = self.pow(cp, e);
+                        let pp = self.pow(prim, e);
+                        self.mul(&[cpow, pp])
+                    }
+                    _ => self.intern(Node::Pow(b, e)),
+                }
+            }
             (Node::Pow(b2, e2), Some(y)) => {
                 let y_int = y.as_integer().is_some();
                 if y_int || self.is_positive(b2) {
@@ -329,6 +350,49 @@ impl Pool {
         }
     }
 
+    /// For a sum with rational coefficients, `(c, p)` with `sum = c * p`, `p` primitive (integer
+    /// coefficients with GCD 1) and its first non-constant term positive; `None` when `c = 1`.
+    pub fn add_content(&mut self, sum: Id) -> Option<(Number, Id)> {
+        let Node::Add(ts) = self.node(sum) else {
+            return None;
+        };
+        let ts = ts.to_vec();
+        let mut num_gcd: i64 = 0;
+        let mut den_lcm: i64 = 1;
+        let mut sign_neg = None;
+        let mut parts = Vec::with_capacity(ts.len());
+        for &t in &ts {
+            let (c, rest) = self.split_coeff(t);
+            let r = c.as_rational()?;
+            if rest != Pool::ONE && sign_neg.is_none() {
+                sign_neg = Some(r.numer() < 0);
+            }
+            num_gcd = gcd_i64(num_gcd, r.numer());
+            let g = gcd_i64(den_lcm, r.denom());
+            den_lcm = (den_lcm / g).checked_mul(r.denom())?;
+            parts.push((r, rest));
+        }
+        let mut content = crate::number::Rational::new(num_gcd as i128, den_lcm as i128)?;
+        if sign_neg == Some(true) {
+            content = content.checked_neg()?;
+        }
+        if content == crate::number::Rational::ONE || content.numer() == 0 {
+            return None;
+        }
+        let inv = content.recip()?;
+        let mut terms = Vec::with_capacity(parts.len());
+        for (r, rest) in parts {
+            let c = Number::Rat(r.checked_mul(inv)?);
+            terms.push(if rest == Pool::ONE {
+                self.num(c)
+            } else {
+                self.scale_term(c, rest)
+            });
+        }
+        let prim = self.add(&terms);
+        Some((Number::Rat(content), prim))
+    }
+
     /// True when `id` is known to be strictly positive for all real values of its symbols.
     pub fn is_positive(&self, id: Id) -> bool {
         match self.node(id) {
@@ -337,7 +401,10 @@ impl Pool {
             Node::Sym(s) => self.symbol_info(*s).positive,
             Node::Pow(b, e) => {
                 self.is_positive(*b)
-                    || (self.as_num(*e).and_then(|n| n.as_integer()).is_some_and(|n| n % 2 == 0)
+                    || (self
+                        .as_num(*e)
+                        .and_then(|n| n.as_integer())
+                        .is_some_and(|n| n % 2 == 0)
                         && self.is_nonzero_square_base(*b))
             }
             Node::Mul(fs) => fs.iter().all(|&f| self.is_positive(f)),
@@ -502,6 +569,16 @@ impl Pool {
         }
         self.intern(Node::Call(f, args.to_vec().into_boxed_slice()))
     }
+}
+
+fn gcd_i64(a: i64, b: i64) -> i64 {
+    let (mut a, mut b) = (a.unsigned_abs(), b.unsigned_abs());
+    while b != 0 {
+        let r = a % b;
+        a = b;
+        b = r;
+    }
+    a.min(i64::MAX as u64) as i64
 }
 
 #[cfg(test)]

@@ -1,1 +1,553 @@
-//! TODO
+//! Compilation of expressions into a flat register program for fast `f64` evaluation.
+//!
+//! A [`Program`] evaluates a list of output expressions at once. Its instructions are the
+//! distinct nodes of their DAG in topological order, so a subexpression shared by several
+//! outputs (or by a right-hand side and its Jacobian) is computed once: common-subexpression
+//! elimination comes free from hash-consing. Registers are laid out as
+//! `[inputs | constants | temporaries]` in one workspace allocated by [`Program::workspace`];
+//! [`Program::eval`] then allocates nothing.
+//!
+//! Lowering choices: subtraction instead of multiplying by −1, one division per product (all
+//! factors with negative exponents go below the line), `x^2 = x*x`, `x^(k/2)` through `sqrt`.
+//! Division by zero, `log` of a negative number and the like give `inf`/`NaN`, as IEEE
+//! arithmetic does; they never panic.
+
+use crate::lu::{lu_factor_in_place, lu_solve_in_place, SingularMatrix};
+use crate::number::Number;
+use crate::pool::{Func, Id, Node, Pool};
+use rustc_hash::FxHashMap;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Op {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Neg,
+    Powi,
+    Powf,
+    Sqrt,
+    Sin,
+    Cos,
+    Tan,
+    Asin,
+    Acos,
+    Atan,
+    Atan2,
+    Sinh,
+    Cosh,
+    Tanh,
+    Exp,
+    Ln,
+    Abs,
+    Sign,
+    Min,
+    Max,
+}
+
+/// One instruction: `reg[dst] = op(reg[a], reg[b])`; for `Powi`, `b` holds the exponent.
+#[derive(Clone, Copy, Debug)]
+struct Instr {
+    op: Op,
+    a: u32,
+    b: u32,
+}
+
+/// Why a set of expressions could not be compiled.
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum CompileError {
+    /// An output depends on a symbol, coordinate or `t` that is not among the inputs.
+    MissingInput {
+        /// The leaf, printed.
+        name: String,
+    },
+}
+
+impl std::fmt::Display for CompileError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            CompileError::MissingInput { name } => {
+                write!(
+                    f,
+                    "`{name}` has no value: it is not among the program inputs"
+                )
+            }
+        }
+    }
+}
+
+impl std::error::Error for CompileError {}
+
+/// A compiled set of expressions; see the module documentation.
+#[derive(Clone, Debug)]
+pub struct Program {
+    n_inputs: usize,
+    consts: Vec<f64>,
+    instrs: Vec<Instr>,
+    outputs: Vec<u32>,
+}
+
+struct Compiler<'a> {
+    pool: &'a mut Pool,
+    reg: FxHashMap<Id, u32>,
+    const_regs: FxHashMap<u64, u32>,
+    consts: Vec<f64>,
+    /// Temporaries before renumbering: (op, a, b) with operands as provisional registers.
+    instrs: Vec<Instr>,
+    n_inputs: u32,
+}
+
+/// Provisional registers: inputs `0..n`, constants `CONST_BASE + k`, temporaries `TEMP_BASE + k`;
+/// renumbered to the dense layout once the number of constants is known.
+const CONST_BASE: u32 = 1 << 30;
+const TEMP_BASE: u32 = 1 << 31;
+
+impl Compiler<'_> {
+    fn constant(&mut self, x: f64) -> u32 {
+        if let Some(&r) = self.const_regs.get(&x.to_bits()) {
+            return r;
+        }
+        let r = CONST_BASE + self.consts.len() as u32;
+        self.consts.push(x);
+        self.const_regs.insert(x.to_bits(), r);
+        r
+    }
+
+    fn emit(&mut self, op: Op, a: u32, b: u32) -> u32 {
+        self.instrs.push(Instr { op, a, b });
+        TEMP_BASE + self.instrs.len() as u32 - 1
+    }
+
+    fn value(&mut self, id: Id) -> Result<u32, CompileError> {
+        if let Some(&r) = self.reg.get(&id) {
+            return Ok(r);
+        }
+        // Children first, iteratively, so deep expressions cannot overflow the stack.
+        for n in self.pool.topo_order(&[id]) {
+            if !self.reg.contains_key(&n) {
+                let r = self.node(n)?;
+                self.reg.insert(n, r);
+            }
+        }
+        Ok(self.reg[&id])
+    }
+
+    fn node(&mut self, id: Id) -> Result<u32, CompileError> {
+        let p = &*self.pool;
+        Ok(match p.node(id).clone() {
+            Node::Num(n) => self.constant(n.to_f64()),
+            Node::Const(c) => self.constant(c.value()),
+            Node::Time | Node::Sym(_) | Node::Coord(..) => {
+                return Err(CompileError::MissingInput {
+                    name: p.to_text(id),
+                })
+            }
+            Node::Add(ts) => {
+                let mut acc: Option<u32> = None;
+                for &t in ts.iter() {
+                    let (c, rest) = self.pool.split_coeff(t);
+                    let (neg, term) = if c.is_negative() && rest != Pool::ONE {
+                        let pos = self.pool.scale(c.neg(), rest);
+                        (true, pos)
+                    } else {
+                        (false, t)
+                    };
+                    let v = self.value(term)?;
+                    acc = Some(match (acc, neg) {
+                        (None, false) => v,
+                        (None, true) => self.emit(Op::Neg, v, 0),
+                        (Some(a), false) => self.emit(Op::Add, a, v),
+                        (Some(a), true) => self.emit(Op::Sub, a, v),
+                    });
+                }
+                acc.unwrap_or_else(|| self.constant(0.0))
+            }
+            Node::Mul(fs) => {
+                let mut num: Vec<Id> = Vec::new();
+                let mut den: Vec<Id> = Vec::new();
+                let mut negate = false;
+                for &f in fs.iter() {
+                    match self.pool.node(f).clone() {
+                        Node::Num(c) if c == Number::MINUS_ONE => negate = true,
+                        Node::Pow(b, e) => match self.pool.as_num(e) {
+                            Some(x) if x.is_negative() => {
+                                let pe = self.pool.num(x.neg());
+                                den.push(self.pool.pow(b, pe));
+                            }
+                            _ => num.push(f),
+                        },
+                        _ => num.push(f),
+                    }
+                }
+                let mut acc = self.product(&num)?;
+                if !den.is_empty() {
+                    let d = match self.product(&den)? {
+                        Some(d) => d,
+                        None => self.constant(1.0),
+                    };
+                    let n = match acc {
+                        Some(n) => n,
+                        None => self.constant(1.0),
+                    };
+                    acc = Some(self.emit(Op::Div, n, d));
+                }
+                let v = match acc {
+                    Some(v) => v,
+                    None => self.constant(1.0),
+                };
+                if negate {
+                    self.emit(Op::Neg, v, 0)
+                } else {
+                    v
+                }
+            }
+            Node::Pow(b, e) => self.power(b, e)?,
+            Node::Call(f, args) => {
+                let a = self.value(args[0])?;
+                let b = if args.len() > 1 {
+                    self.value(args[1])?
+                } else {
+                    0
+                };
+                let op = match f {
+                    Func::Sin => Op::Sin,
+                    Func::Cos => Op::Cos,
+                    Func::Tan => Op::Tan,
+                    Func::Asin => Op::Asin,
+                    Func::Acos => Op::Acos,
+                    Func::Atan => Op::Atan,
+                    Func::Atan2 => Op::Atan2,
+                    Func::Sinh => Op::Sinh,
+                    Func::Cosh => Op::Cosh,
+                    Func::Tanh => Op::Tanh,
+                    Func::Exp => Op::Exp,
+                    Func::Log => Op::Ln,
+                    Func::Abs => Op::Abs,
+                    Func::Sign => Op::Sign,
+                    Func::Min => Op::Min,
+                    Func::Max => Op::Max,
+                };
+                self.emit(op, a, b)
+            }
+        })
+    }
+
+    fn product(&mut self, fs: &[Id]) -> Result<Option<u32>, CompileError> {
+        let mut acc = None;
+        for &f in fs {
+            let v = self.value(f)?;
+            acc = Some(match acc {
+                None => v,
+                Some(a) => self.emit(Op::Mul, a, v),
+            });
+        }
+        Ok(acc)
+    }
+
+    fn power(&mut self, b: Id, e: Id) -> Result<u32, CompileError> {
+        let bv = self.value(b)?;
+        let Some(x) = self.pool.as_num(e) else {
+            let ev = self.value(e)?;
+            return Ok(self.emit(Op::Powf, bv, ev));
+        };
+        if x.is_negative() {
+            let pe = self.pool.num(x.neg());
+            let pos = self.pool.pow(b, pe);
+            let pv = self.value(pos)?;
+            let one = self.constant(1.0);
+            return Ok(self.emit(Op::Div, one, pv));
+        }
+        if let Some(k) = x.as_integer() {
+            return Ok(match k {
+                2 => self.emit(Op::Mul, bv, bv),
+                3 => {
+                    let sq = self.emit(Op::Mul, bv, bv);
+                    self.emit(Op::Mul, sq, bv)
+                }
+                k if k <= i32::MAX as i64 => self.emit(Op::Powi, bv, k as u32),
+                _ => {
+                    let c = self.constant(k as f64);
+                    self.emit(Op::Powf, bv, c)
+                }
+            });
+        }
+        if let Some(r) = x.as_rational() {
+            if r.denom() == 2 {
+                // b^(k/2) = sqrt(b) * b^((k-1)/2)
+                let s = self.emit(Op::Sqrt, bv, 0);
+                let whole = (r.numer() - 1) / 2;
+                if whole == 0 {
+                    return Ok(s);
+                }
+                let we = self.pool.int(whole);
+                let wp = self.pool.pow(b, we);
+                let wv = self.value(wp)?;
+                return Ok(self.emit(Op::Mul, s, wv));
+            }
+        }
+        let c = self.constant(x.to_f64());
+        Ok(self.emit(Op::Powf, bv, c))
+    }
+}
+
+impl Program {
+    /// Compiles `outputs` as functions of `inputs` (leaf expressions: symbols, coordinates and
+    /// their rates, `t`), in the order given.
+    pub fn compile(
+        pool: &mut Pool,
+        inputs: &[Id],
+        outputs: &[Id],
+    ) -> Result<Program, CompileError> {
+        let mut c = Compiler {
+            pool,
+            reg: FxHashMap::default(),
+            const_regs: FxHashMap::default(),
+            consts: Vec::new(),
+            instrs: Vec::new(),
+            n_inputs: inputs.len() as u32,
+        };
+        for (i, &x) in inputs.iter().enumerate() {
+            c.reg.insert(x, i as u32);
+        }
+        let mut outs = Vec::with_capacity(outputs.len());
+        for &o in outputs {
+            outs.push(c.value(o)?);
+        }
+        let n_consts = c.consts.len() as u32;
+        let base = c.n_inputs;
+        let remap = |r: u32| -> u32 {
+            if r >= TEMP_BASE {
+                base + n_consts + (r - TEMP_BASE)
+            } else if r >= CONST_BASE {
+                base + (r - CONST_BASE)
+            } else {
+                r
+            }
+        };
+        let instrs = c
+            .instrs
+            .iter()
+            .map(|i| Instr {
+                op: i.op,
+                a: remap(i.a),
+                b: if i.op == Op::Powi { i.b } else { remap(i.b) },
+            })
+            .collect();
+        Ok(Program {
+            n_inputs: inputs.len(),
+            consts: c.consts,
+            instrs,
+            outputs: outs.into_iter().map(remap).collect(),
+        })
+    }
+
+    /// Number of instructions (the program's size).
+    pub fn len(&self) -> usize {
+        self.instrs.len()
+    }
+
+    /// True when every output is an input or a constant.
+    pub fn is_empty(&self) -> bool {
+        self.instrs.is_empty()
+    }
+
+    /// Number of inputs expected by [`Program::eval`].
+    pub fn n_inputs(&self) -> usize {
+        self.n_inputs
+    }
+
+    /// Number of outputs written by [`Program::eval`].
+    pub fn n_outputs(&self) -> usize {
+        self.outputs.len()
+    }
+
+    /// A register file for [`Program::eval`], with the constants loaded.
+    pub fn workspace(&self) -> Vec<f64> {
+        let mut w = vec![0.0; self.n_inputs + self.consts.len() + self.instrs.len()];
+        w[self.n_inputs..self.n_inputs + self.consts.len()].copy_from_slice(&self.consts);
+        w
+    }
+
+    /// Evaluates every output. `ws` must come from [`Program::workspace`]; `inputs` and `out`
+    /// must have the lengths [`Program::n_inputs`] and [`Program::n_outputs`].
+    ///
+    /// # Panics
+    /// If a slice is shorter than required (a programming error, not a data error).
+    #[inline]
+    pub fn eval(&self, inputs: &[f64], ws: &mut [f64], out: &mut [f64]) {
+        let n = self.n_inputs;
+        ws[..n].copy_from_slice(&inputs[..n]);
+        let start = n + self.consts.len();
+        let (done, temps) = ws.split_at_mut(start);
+        let temps = &mut temps[..self.instrs.len()];
+        for (k, ins) in self.instrs.iter().enumerate() {
+            let get = |r: u32, done: &[f64], temps: &[f64]| -> f64 {
+                let r = r as usize;
+                if r < start {
+                    done[r]
+                } else {
+                    temps[r - start]
+                }
+            };
+            let a = get(ins.a, done, temps);
+            let v = match ins.op {
+                Op::Neg => -a,
+                Op::Sqrt => a.sqrt(),
+                Op::Sin => a.sin(),
+                Op::Cos => a.cos(),
+                Op::Tan => a.tan(),
+                Op::Asin => a.asin(),
+                Op::Acos => a.acos(),
+                Op::Atan => a.atan(),
+                Op::Sinh => a.sinh(),
+                Op::Cosh => a.cosh(),
+                Op::Tanh => a.tanh(),
+                Op::Exp => a.exp(),
+                Op::Ln => a.ln(),
+                Op::Abs => a.abs(),
+                Op::Sign => {
+                    if a > 0.0 {
+                        1.0
+                    } else if a < 0.0 {
+                        -1.0
+                    } else {
+                        a * 0.0 // 0 for 0, NaN for NaN
+                    }
+                }
+                Op::Powi => a.powi(ins.b as i32),
+                _ => {
+                    let b = get(ins.b, done, temps);
+                    match ins.op {
+                        Op::Add => a + b,
+                        Op::Sub => a - b,
+                        Op::Mul => a * b,
+                        Op::Div => a / b,
+                        Op::Powf => a.powf(b),
+                        Op::Atan2 => a.atan2(b),
+                        Op::Min => a.min(b),
+                        Op::Max => a.max(b),
+                        _ => f64::NAN,
+                    }
+                }
+            };
+            temps[k] = v;
+        }
+        for (o, &r) in out.iter_mut().zip(&self.outputs) {
+            let r = r as usize;
+            *o = if r < start { done[r] } else { temps[r - start] };
+        }
+    }
+}
+
+impl Pool {
+    /// `∂f_i/∂v_j`, row-major (`fs.len() × vars.len()`).
+    pub fn jacobian(&mut self, fs: &[Id], vars: &[Id]) -> Vec<Id> {
+        let mut out = Vec::with_capacity(fs.len() * vars.len());
+        for &f in fs {
+            for &v in vars {
+                out.push(self.diff(f, v));
+            }
+        }
+        out
+    }
+}
+
+/// A linear system `A x = b` compiled for numeric solution at evaluation time: the entries are
+/// one [`Program`], the solve an in-place LU. Owns its buffers; `solve` allocates nothing.
+#[derive(Clone, Debug)]
+pub struct CompiledLinearSystem {
+    program: Program,
+    n: usize,
+    ws: Vec<f64>,
+    ab: Vec<f64>,
+    perm: Vec<usize>,
+    work: Vec<f64>,
+}
+
+impl CompiledLinearSystem {
+    /// Compiles a square system.
+    pub fn new(
+        pool: &mut Pool,
+        sys: &crate::linsolve::LinearSystem,
+        inputs: &[Id],
+    ) -> Result<CompiledLinearSystem, CompileError> {
+        let n = sys.cols();
+        debug_assert_eq!(sys.rows(), n);
+        let mut outs = sys.a.clone();
+        outs.extend_from_slice(&sys.b);
+        let program = Program::compile(pool, inputs, &outs)?;
+        let ws = program.workspace();
+        Ok(CompiledLinearSystem {
+            program,
+            n,
+            ws,
+            ab: vec![0.0; n * n + n],
+            perm: vec![0; n],
+            work: vec![0.0; n],
+        })
+    }
+
+    /// Solves for the unknowns at `inputs`, writing them to `x`.
+    pub fn solve(&mut self, inputs: &[f64], x: &mut [f64]) -> Result<(), SingularMatrix> {
+        let n = self.n;
+        self.program.eval(inputs, &mut self.ws, &mut self.ab);
+        let (a, b) = self.ab.split_at_mut(n * n);
+        lu_factor_in_place(a, n, &mut self.perm)?;
+        lu_solve_in_place(a, n, &self.perm, b, &mut self.work);
+        x[..n].copy_from_slice(&b[..n]);
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn evaluates_and_shares_subexpressions() {
+        let mut p = Pool::new();
+        let (x, y) = (p.var("x"), p.var("y"));
+        let f1 = p.parse_scalar("-GM*x/(x^2 + y^2)^(3/2)").unwrap();
+        let f2 = p.parse_scalar("-GM*y/(x^2 + y^2)^(3/2)").unwrap();
+        let gm = p.var("GM");
+        let prog = Program::compile(&mut p, &[x, y, gm], &[f1, f2]).unwrap();
+        let mut ws = prog.workspace();
+        let mut out = [0.0; 2];
+        prog.eval(&[0.6, 0.8, 2.0], &mut ws, &mut out);
+        assert!(
+            (out[0] + 1.2).abs() < 1e-15 && (out[1] + 1.6).abs() < 1e-15,
+            "{out:?}"
+        );
+        // x^2, y^2, sum, sqrt, product, reciprocal/division shared: far fewer than 2× one output.
+        assert!(prog.len() <= 12, "{} instructions", prog.len());
+    }
+
+    #[test]
+    fn bad_arithmetic_gives_nan_or_inf_not_panic() {
+        let mut p = Pool::new();
+        let x = p.var("x");
+        let outs: Vec<Id> = ["1/x", "log(x - 1)", "sqrt(x - 1)", "x^(-3/2)", "sign(x)"]
+            .iter()
+            .map(|s| p.parse_scalar(s).unwrap())
+            .collect();
+        let prog = Program::compile(&mut p, &[x], &outs).unwrap();
+        let mut ws = prog.workspace();
+        let mut out = [0.0; 5];
+        prog.eval(&[0.0], &mut ws, &mut out);
+        assert!(out[0].is_infinite());
+        assert!(out[1].is_nan());
+        assert!(out[2].is_nan());
+        assert!(out[3].is_infinite());
+        assert_eq!(out[4], 0.0);
+    }
+
+    #[test]
+    fn missing_inputs_are_named() {
+        let mut p = Pool::new();
+        let e = p.parse_scalar("a*b").unwrap();
+        let a = p.var("a");
+        let err = Program::compile(&mut p, &[a], &[e]).unwrap_err();
+        assert_eq!(err, CompileError::MissingInput { name: "b".into() });
+    }
+}

@@ -195,7 +195,11 @@ mod tests {
         let d = p.parse_scalar("2*x*x' + 3*t^2").unwrap();
         assert_eq!(p.dt(e), d);
         let s = p.parse_scalar("x^2").unwrap();
-        assert_eq!(p.dt(s), Pool::ZERO, "a name never written as x' or x(t) is a constant");
+        assert_eq!(
+            p.dt(s),
+            Pool::ZERO,
+            "a name never written as x' or x(t) is a constant"
+        );
     }
 
     #[test]

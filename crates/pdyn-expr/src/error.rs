@@ -41,13 +41,23 @@ impl ExprError {
     /// Renders `origin:line:col: error: message`, the source line, a caret under the span, and
     /// the help. `source` is the whole text the span refers to.
     pub fn render(&self, source: &str, origin: &str) -> String {
-        render_diagnostic(source, origin, &self.span, &self.message, self.help.as_deref())
+        render_diagnostic(
+            source,
+            origin,
+            &self.span,
+            &self.message,
+            self.help.as_deref(),
+        )
     }
 }
 
 impl fmt::Display for ExprError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{} (at bytes {}..{})", self.message, self.span.start, self.span.end)?;
+        write!(
+            f,
+            "{} (at bytes {}..{})",
+            self.message, self.span.start, self.span.end
+        )?;
         if let Some(h) = &self.help {
             write!(f, "; {h}")?;
         }
@@ -86,7 +96,9 @@ pub fn render_diagnostic(
     let end = floor_char_boundary(source, span.end.clamp(start, source.len()));
     let (line, col) = line_col(source, start);
     let line_start = source[..start].rfind('\n').map_or(0, |i| i + 1);
-    let line_end = source[start..].find('\n').map_or(source.len(), |i| start + i);
+    let line_end = source[start..]
+        .find('\n')
+        .map_or(source.len(), |i| start + i);
     let text = &source[line_start..line_end];
     let width = source[start..end.min(line_end)].chars().count().max(1);
     let gutter = line.to_string().len();
@@ -153,7 +165,10 @@ mod tests {
         let src = "a + b\n2*sn(x)";
         let e = ExprError::new(8..10, "unknown function `sn`").with_help("did you mean `sin`?");
         let r = e.render(src, "model.toml");
-        assert!(r.starts_with("model.toml:2:3: error: unknown function `sn`"), "{r}");
+        assert!(
+            r.starts_with("model.toml:2:3: error: unknown function `sn`"),
+            "{r}"
+        );
         assert!(r.contains("2 | 2*sn(x)\n  |   ^^\n"), "{r}");
         assert!(r.contains("help: did you mean `sin`?"), "{r}");
     }

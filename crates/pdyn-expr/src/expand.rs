@@ -46,7 +46,11 @@ impl Pool {
                 let b = self.expanded(b);
                 let e = self.expanded(e);
                 match self.as_num(e).and_then(|x| x.as_integer()) {
-                    Some(k) if k > 1 && k <= MAX_EXPAND_POWER && matches!(self.node(b), Node::Add(_)) => {
+                    Some(k)
+                        if k > 1
+                            && k <= MAX_EXPAND_POWER
+                            && matches!(self.node(b), Node::Add(_)) =>
+                    {
                         let mut acc = b;
                         for _ in 1..k {
                             acc = self.distribute(acc, b);

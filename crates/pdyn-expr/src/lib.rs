@@ -34,15 +34,15 @@ pub mod lower;
 pub mod lu;
 mod memo;
 pub mod number;
-pub mod pool;
 pub mod poly;
+pub mod pool;
 pub mod print;
 pub mod simplify;
 pub mod subs;
 pub mod syntax;
 pub mod vector;
 
-// pub use compile::Program;
+pub use compile::Program;
 pub use error::ExprError;
 pub use lower::{Binding, FreeScope, Scope, Value};
 pub use number::{Number, Rational};

@@ -72,7 +72,11 @@ impl std::fmt::Display for LinearError {
                 write!(f, "equation {} is not linear in the unknowns", equation + 1)
             }
             LinearError::Underdetermined { free } => {
-                write!(f, "{} unknown(s) are not determined by the equations", free.len())
+                write!(
+                    f,
+                    "{} unknown(s) are not determined by the equations",
+                    free.len()
+                )
             }
             LinearError::Inconsistent { equation } => {
                 write!(f, "equation {} contradicts the others", equation + 1)
@@ -89,7 +93,11 @@ const SOLVE_BUDGET: u64 = 4_000_000;
 
 impl Pool {
     /// Writes `eqs` (each meaning `= 0`) as `A x = b` in `unknowns` (leaf expressions).
-    pub fn linear_system(&mut self, eqs: &[Id], unknowns: &[Id]) -> Result<LinearSystem, LinearError> {
+    pub fn linear_system(
+        &mut self,
+        eqs: &[Id],
+        unknowns: &[Id],
+    ) -> Result<LinearSystem, LinearError> {
         let zero: FxHashMap<Id, Id> = unknowns.iter().map(|&u| (u, Pool::ZERO)).collect();
         let mut a = Vec::with_capacity(eqs.len() * unknowns.len());
         let mut b = Vec::with_capacity(eqs.len());
@@ -97,7 +105,10 @@ impl Pool {
             for &u in unknowns {
                 let c = self.diff(eq, u);
                 if unknowns.iter().any(|&v| self.contains(c, v)) {
-                    return Err(LinearError::NotLinear { equation: i, unknown: u });
+                    return Err(LinearError::NotLinear {
+                        equation: i,
+                        unknown: u,
+                    });
                 }
                 a.push(c);
             }
@@ -126,12 +137,16 @@ impl Pool {
             let mut l = Poly::constant(crate::number::Rational::ONE);
             for (_, d) in &fr {
                 let g = gcd(&l, d, &mut rf.budget).ok_or(LinearError::TooLarge)?;
-                let q = d.div_exact(&g, &mut rf.budget).ok_or(LinearError::TooLarge)?;
+                let q = d
+                    .div_exact(&g, &mut rf.budget)
+                    .ok_or(LinearError::TooLarge)?;
                 l = l.mul(&q, &mut rf.budget).ok_or(LinearError::TooLarge)?;
             }
             let mut row = Vec::with_capacity(n + 1);
             for (num, den) in fr {
-                let k = l.div_exact(&den, &mut rf.budget).ok_or(LinearError::TooLarge)?;
+                let k = l
+                    .div_exact(&den, &mut rf.budget)
+                    .ok_or(LinearError::TooLarge)?;
                 row.push(num.mul(&k, &mut rf.budget).ok_or(LinearError::TooLarge)?);
             }
             rows.push(row);
@@ -158,8 +173,12 @@ impl Pool {
             let budget = &mut rf.budget;
             for i in r + 1..m {
                 for j in k + 1..=n {
-                    let t1 = rows[r][k].mul(&rows[i][j], budget).ok_or(LinearError::TooLarge)?;
-                    let t2 = rows[i][k].mul(&rows[r][j], budget).ok_or(LinearError::TooLarge)?;
+                    let t1 = rows[r][k]
+                        .mul(&rows[i][j], budget)
+                        .ok_or(LinearError::TooLarge)?;
+                    let t2 = rows[i][k]
+                        .mul(&rows[r][j], budget)
+                        .ok_or(LinearError::TooLarge)?;
                     let d = t1.sub(&t2, budget).ok_or(LinearError::TooLarge)?;
                     rows[i][j] = d.div_exact(&prev, budget).ok_or(LinearError::TooLarge)?;
                 }
@@ -174,7 +193,9 @@ impl Pool {
         }
         for i in n..m {
             if !self.poly_is_zero(&rf, &rows[i][n]) {
-                return Err(LinearError::Inconsistent { equation: origin[i] });
+                return Err(LinearError::Inconsistent {
+                    equation: origin[i],
+                });
             }
         }
         // Fraction-free back substitution: x_i = y_i / det.
@@ -250,6 +271,9 @@ mod tests {
         let e3 = p.parse_scalar("x - y").unwrap();
         let e4 = p.parse_scalar("x - 1").unwrap();
         let sys = p.linear_system(&[e1, e3, e4], &[x, y]).unwrap();
-        assert!(matches!(p.solve_linear(&sys), Err(super::LinearError::Inconsistent { .. })));
+        assert!(matches!(
+            p.solve_linear(&sys),
+            Err(super::LinearError::Inconsistent { .. })
+        ));
     }
 }

@@ -181,8 +181,9 @@ impl Lowerer<'_> {
     fn value(&mut self, ast: &Ast) -> Result<Value, ExprError> {
         match ast {
             Ast::Num { text, span } => {
-                let n = literal(text)
-                    .ok_or_else(|| ExprError::new(span.clone(), format!("invalid number `{text}`")))?;
+                let n = literal(text).ok_or_else(|| {
+                    ExprError::new(span.clone(), format!("invalid number `{text}`"))
+                })?;
                 Ok(Value::Scalar(self.pool.num(n)))
             }
             Ast::Ident { name, span } => self.ident(name, span),
@@ -205,7 +206,10 @@ impl Lowerer<'_> {
                 if items.len() < 2 || items.len() > 3 {
                     return Err(ExprError::new(
                         span.clone(),
-                        format!("a vector has 2 or 3 components, this one has {}", items.len()),
+                        format!(
+                            "a vector has 2 or 3 components, this one has {}",
+                            items.len()
+                        ),
                     ));
                 }
                 let mut c = [Pool::ZERO; 3];
@@ -424,7 +428,10 @@ impl Pool {
         scope.learn(&ast);
         match lower(self, &ast, &mut scope)? {
             Value::Scalar(s) => Ok(s),
-            Value::Vector(_) => Err(ExprError::new(ast.span(), "expected a scalar, got a vector")),
+            Value::Vector(_) => Err(ExprError::new(
+                ast.span(),
+                "expected a scalar, got a vector",
+            )),
         }
     }
 
@@ -435,7 +442,11 @@ impl Pool {
     }
 
     /// Parses an equation `lhs = rhs` (or a bare expression, meaning `= 0`) into `lhs - rhs`.
-    pub fn parse_equation_in(&mut self, src: &str, scope: &mut dyn Scope) -> Result<Value, ExprError> {
+    pub fn parse_equation_in(
+        &mut self,
+        src: &str,
+        scope: &mut dyn Scope,
+    ) -> Result<Value, ExprError> {
         let (l, r) = parse_equation(src)?;
         let lv = lower(self, &l, scope)?;
         let Some(r) = r else { return Ok(lv) };

@@ -22,7 +22,11 @@ impl std::error::Error for SingularMatrix {}
 
 /// Factorises the row-major `n×n` matrix `a` in place into `L U` (unit lower `L`), recording
 /// row swaps in `perm` (length `n`).
-pub fn lu_factor_in_place(a: &mut [f64], n: usize, perm: &mut [usize]) -> Result<(), SingularMatrix> {
+pub fn lu_factor_in_place(
+    a: &mut [f64],
+    n: usize,
+    perm: &mut [usize],
+) -> Result<(), SingularMatrix> {
     debug_assert_eq!(a.len(), n * n);
     let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let tiny = scale * 1e-14;
@@ -39,7 +43,7 @@ pub fn lu_factor_in_place(a: &mut [f64], n: usize, perm: &mut [usize]) -> Result
                 piv = i;
             }
         }
-        if !(best > tiny) {
+        if best.is_nan() || best <= tiny {
             return Err(SingularMatrix { pivot: k });
         }
         if piv != k {
@@ -94,7 +98,9 @@ mod tests {
         // Deterministic pseudo-random matrices; check the residual of the solution.
         let mut seed = 12345u64;
         let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
         };
         for n in 1..8 {
@@ -117,6 +123,9 @@ mod tests {
     fn singular_is_reported() {
         let mut a = vec![1.0, 2.0, 2.0, 4.0];
         let mut perm = vec![0; 2];
-        assert_eq!(lu_factor_in_place(&mut a, 2, &mut perm), Err(SingularMatrix { pivot: 1 }));
+        assert_eq!(
+            lu_factor_in_place(&mut a, 2, &mut perm),
+            Err(SingularMatrix { pivot: 1 })
+        );
     }
 }

@@ -117,7 +117,11 @@ impl Rational {
         }
         let n = int_root(self.num.unsigned_abs(), q as u32)?;
         let d = int_root(self.den as u64, q as u32)?;
-        let n = if self.num < 0 { -(n as i128) } else { n as i128 };
+        let n = if self.num < 0 {
+            -(n as i128)
+        } else {
+            n as i128
+        };
         Rational::new(n, d as i128)
     }
     /// Sign: -1, 0 or 1.
@@ -131,12 +135,7 @@ fn int_root(x: u64, q: u32) -> Option<u64> {
         return Some(x);
     }
     let guess = (x as f64).powf(1.0 / q as f64).round() as u64;
-    for r in guess.saturating_sub(1)..=guess + 1 {
-        if r.checked_pow(q) == Some(x) {
-            return Some(r);
-        }
-    }
-    None
+    (guess.saturating_sub(1)..=guess + 1).find(|&r| r.checked_pow(q) == Some(x))
 }
 
 impl Ord for Rational {
@@ -184,6 +183,7 @@ impl std::hash::Hash for Number {
     }
 }
 
+#[allow(clippy::should_implement_trait)] // by-value helpers named like the math; no operator overloading wanted
 impl Number {
     /// Zero.
     pub const ZERO: Number = Number::Rat(Rational::ZERO);
@@ -346,9 +346,15 @@ mod tests {
         let a = Number::ratio(6, -4);
         assert_eq!(a, Number::ratio(-3, 2));
         assert_eq!(a.add(Number::ratio(3, 2)), Number::ZERO);
-        assert_eq!(Number::ratio(9, 4).pow(Number::ratio(1, 2)), Some(Number::ratio(3, 2)));
+        assert_eq!(
+            Number::ratio(9, 4).pow(Number::ratio(1, 2)),
+            Some(Number::ratio(3, 2))
+        );
         assert_eq!(Number::int(2).pow(Number::ratio(1, 2)), None);
-        assert_eq!(Number::int(2).pow(Number::int(-3)), Some(Number::ratio(1, 8)));
+        assert_eq!(
+            Number::int(2).pow(Number::int(-3)),
+            Some(Number::ratio(1, 8))
+        );
     }
 
     #[test]

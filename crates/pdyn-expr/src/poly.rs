@@ -197,7 +197,11 @@ impl Poly {
 
     /// Atoms that occur.
     pub fn vars(&self) -> Vec<u32> {
-        let mut v: Vec<u32> = self.terms.keys().flat_map(|m| m.iter().map(|&(a, _)| a)).collect();
+        let mut v: Vec<u32> = self
+            .terms
+            .keys()
+            .flat_map(|m| m.iter().map(|&(a, _)| a))
+            .collect();
         v.sort_unstable();
         v.dedup();
         v
@@ -279,7 +283,11 @@ impl Poly {
 pub fn gcd(a: &Poly, c: &Poly, b: &mut Budget) -> Option<Poly> {
     b.spend(a.terms.len() + c.terms.len())?;
     if a.is_zero() {
-        return if c.is_zero() { Some(Poly::zero()) } else { c.monic() };
+        return if c.is_zero() {
+            Some(Poly::zero())
+        } else {
+            c.monic()
+        };
     }
     if c.is_zero() {
         return a.monic();
@@ -331,7 +339,7 @@ mod tests {
         let mut out = Poly::zero();
         for (m, c) in terms {
             let mut m: Mono = m.to_vec();
-            m.sort_by(|a, b| b.0.cmp(&a.0));
+            m.sort_by_key(|&(a, _)| std::cmp::Reverse(a));
             out.add_term(m, Rational::int(*c)).unwrap();
         }
         out
@@ -358,7 +366,10 @@ mod tests {
         let mut b = Budget(1_000_000);
         let x2m1 = p(&[(&[(0, 2)], 1), (&[], -1)]);
         let x1 = p(&[(&[(0, 1)], 1), (&[(1, 1)], 1)]);
-        assert_eq!(gcd(&x2m1, &x1, &mut b).unwrap(), Poly::constant(Rational::ONE));
+        assert_eq!(
+            gcd(&x2m1, &x1, &mut b).unwrap(),
+            Poly::constant(Rational::ONE)
+        );
         let xm1 = p(&[(&[(0, 1)], 1), (&[], -1)]);
         assert_eq!(gcd(&x2m1, &xm1, &mut b).unwrap(), xm1);
     }

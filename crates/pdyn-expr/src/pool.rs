@@ -279,7 +279,7 @@ impl Pool {
     /// The expression for a number.
     pub fn num(&mut self, n: Number) -> Id {
         let n = match n {
-            Number::Float(f) if f == 0.0 => Number::ZERO,
+            Number::Float(0.0) => Number::ZERO,
             other => other,
         };
         self.intern(Node::Num(n))
@@ -500,11 +500,12 @@ impl Pool {
             (Node::Coord(x, i), Node::Coord(y, j)) => {
                 self.name(*x).cmp(self.name(*y)).then(i.cmp(j))
             }
-            (Node::Call(f, xs), Node::Call(g, ys)) => f.cmp(g).then_with(|| self.order_lists(xs, ys)),
-            (Node::Pow(b1, e1), Node::Pow(b2, e2)) => {
-                self.order_struct(*b1, *b2)
-                    .then_with(|| self.order_struct(*e1, *e2))
+            (Node::Call(f, xs), Node::Call(g, ys)) => {
+                f.cmp(g).then_with(|| self.order_lists(xs, ys))
             }
+            (Node::Pow(b1, e1), Node::Pow(b2, e2)) => self
+                .order_struct(*b1, *b2)
+                .then_with(|| self.order_struct(*e1, *e2)),
             (Node::Mul(xs), Node::Mul(ys)) | (Node::Add(xs), Node::Add(ys)) => {
                 self.order_lists(xs, ys)
             }

@@ -8,7 +8,7 @@ use crate::number::Number;
 use crate::pool::{Constant, Func, Id, Node, Pool};
 
 /// One factor of a product as printed.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 enum Factor {
     Number(Number),
     /// `base^exp` with `exp` a positive number (1 for a bare base).
@@ -164,7 +164,11 @@ impl TextPrinter<'_> {
             return (f.negative, num);
         }
         let den = self.factors(&f.den);
-        let den = if f.den.len() > 1 { format!("({den})") } else { den };
+        let den = if f.den.len() > 1 {
+            format!("({den})")
+        } else {
+            den
+        };
         (f.negative, format!("{num}/{den}"))
     }
 
@@ -209,10 +213,40 @@ impl TextPrinter<'_> {
 /// LaTeX name of a symbol: Greek letters, subscripts after `_`, multi-letter names upright.
 pub fn latex_name(name: &str) -> String {
     const GREEK: [&str; 34] = [
-        "alpha", "beta", "gamma", "delta", "epsilon", "varepsilon", "zeta", "eta", "theta",
-        "vartheta", "iota", "kappa", "lambda", "mu", "nu", "xi", "pi", "rho", "sigma", "tau",
-        "upsilon", "phi", "varphi", "chi", "psi", "omega", "Gamma", "Delta", "Theta", "Lambda",
-        "Xi", "Sigma", "Phi", "Omega",
+        "alpha",
+        "beta",
+        "gamma",
+        "delta",
+        "epsilon",
+        "varepsilon",
+        "zeta",
+        "eta",
+        "theta",
+        "vartheta",
+        "iota",
+        "kappa",
+        "lambda",
+        "mu",
+        "nu",
+        "xi",
+        "pi",
+        "rho",
+        "sigma",
+        "tau",
+        "upsilon",
+        "phi",
+        "varphi",
+        "chi",
+        "psi",
+        "omega",
+        "Gamma",
+        "Delta",
+        "Theta",
+        "Lambda",
+        "Xi",
+        "Sigma",
+        "Phi",
+        "Omega",
     ];
     let one = |s: &str| -> String {
         if GREEK.contains(&s) {
@@ -280,8 +314,16 @@ impl LatexPrinter<'_> {
                 let a = a.join(", ");
                 match f {
                     Func::Abs => format!("\\left|{a}\\right|"),
-                    Func::Sin | Func::Cos | Func::Tan | Func::Sinh | Func::Cosh | Func::Tanh
-                    | Func::Exp | Func::Log | Func::Min | Func::Max => {
+                    Func::Sin
+                    | Func::Cos
+                    | Func::Tan
+                    | Func::Sinh
+                    | Func::Cosh
+                    | Func::Tanh
+                    | Func::Exp
+                    | Func::Log
+                    | Func::Min
+                    | Func::Max => {
                         format!("\\{}\\left({a}\\right)", f.name())
                     }
                     Func::Asin => format!("\\arcsin\\left({a}\\right)"),
@@ -302,7 +344,10 @@ impl LatexPrinter<'_> {
         if f.den.is_empty() {
             return (f.negative, num);
         }
-        (f.negative, format!("\\frac{{{num}}}{{{}}}", self.factors(&f.den)))
+        (
+            f.negative,
+            format!("\\frac{{{num}}}{{{}}}", self.factors(&f.den)),
+        )
     }
 
     fn factors(&self, fs: &[Factor]) -> String {
@@ -342,7 +387,9 @@ impl LatexPrinter<'_> {
                     format!("\\left({}\\right)", self.expr(b))
                 }
             }
-            Factor::Power(b, e) if e == Number::ratio(1, 2) => format!("\\sqrt{{{}}}", self.expr(b)),
+            Factor::Power(b, e) if e == Number::ratio(1, 2) => {
+                format!("\\sqrt{{{}}}", self.expr(b))
+            }
             Factor::Power(b, e) => {
                 let es = match e {
                     Number::Rat(r) if !r.is_integer() => {
@@ -368,7 +415,12 @@ impl RustPrinter<'_> {
         if x.is_nan() {
             "f64::NAN".into()
         } else if x.is_infinite() {
-            if x > 0.0 { "f64::INFINITY" } else { "f64::NEG_INFINITY" }.into()
+            if x > 0.0 {
+                "f64::INFINITY"
+            } else {
+                "f64::NEG_INFINITY"
+            }
+            .into()
         } else {
             format!("{x:?}_f64")
         }

@@ -254,7 +254,10 @@ impl RationalForm {
             // Fewer terms first, then lower total degree.
             let size = |a: &Poly, b: &Poly| {
                 let deg = |p: &Poly| -> u32 {
-                    p.terms.keys().map(|m| m.iter().map(|&(_, e)| e).sum::<u32>()).sum()
+                    p.terms
+                        .keys()
+                        .map(|m| m.iter().map(|&(_, e)| e).sum::<u32>())
+                        .sum()
                 };
                 (a.terms.len() + b.terms.len(), deg(a) + deg(b))
             };
@@ -322,7 +325,7 @@ fn eliminate_square(poly: &Poly, x: u32, y: u32, b: &mut Budget) -> Option<Poly>
         let mut rest: Mono = m.iter().copied().filter(|&(a, _)| a != x).collect();
         if k % 2 == 1 {
             rest.push((x, 1));
-            rest.sort_by(|p, q| q.0.cmp(&p.0));
+            rest.sort_by_key(|&(a, _)| std::cmp::Reverse(a));
         }
         let f = one_minus_y2.pow(k / 2, b)?;
         out = out.add(&term_poly(rest).mul(&f, b)?, b)?;
@@ -399,10 +402,7 @@ mod tests {
 
     #[test]
     fn trig_of_sums() {
-        assert_eq!(
-            simp("cos(p - q)*sin(q) + cos(q)*sin(p - q)"),
-            "sin(p)"
-        );
+        assert_eq!(simp("cos(p - q)*sin(q) + cos(q)*sin(p - q)"), "sin(p)");
         assert_eq!(simp("sin(2*x) - 2*sin(x)*cos(x)"), "0");
     }
 }

@@ -344,7 +344,10 @@ impl<'a> Parser<'a> {
                         _ => {
                             return Err(ExprError::new(
                                 self.span.clone(),
-                                format!("expected a component after `.`, found {}", self.describe()),
+                                format!(
+                                    "expected a component after `.`, found {}",
+                                    self.describe()
+                                ),
                             )
                             .with_help("components are `.x`, `.y` and `.z`"))
                         }
@@ -413,14 +416,20 @@ impl<'a> Parser<'a> {
             }
             _ => Err(ExprError::new(
                 span,
-                format!("expected a number, name, `(` or `[`, found {}", self.describe()),
+                format!(
+                    "expected a number, name, `(` or `[`, found {}",
+                    self.describe()
+                ),
             )),
         }
     }
 
     fn finish(&mut self) -> Result<(), ExprError> {
         if self.tok != Tok::End {
-            let msg = format!("unexpected {} after the end of the expression", self.describe());
+            let msg = format!(
+                "unexpected {} after the end of the expression",
+                self.describe()
+            );
             let mut e = ExprError::new(self.span.clone(), msg);
             if matches!(self.tok, Tok::Ident(_) | Tok::Num(_) | Tok::Op('(')) {
                 e = e.with_help("write multiplication explicitly with `*`");
@@ -446,8 +455,10 @@ pub fn parse(src: &str) -> Result<Ast, ExprError> {
     let mut p = Parser::new(src)?;
     let e = p.expr()?;
     if p.tok == Tok::Eq {
-        return Err(ExprError::new(p.span.clone(), "unexpected `=` in an expression")
-            .with_help("an equation is only accepted where one is expected"));
+        return Err(
+            ExprError::new(p.span.clone(), "unexpected `=` in an expression")
+                .with_help("an equation is only accepted where one is expected"),
+        );
     }
     p.finish()?;
     Ok(e)
@@ -488,7 +499,10 @@ mod tests {
         }
         assert!(matches!(parse("-x^2").unwrap(), Ast::Neg { .. }));
         assert!(matches!(parse("x''").unwrap(), Ast::Prime { count: 2, .. }));
-        assert!(matches!(parse("r.z").unwrap(), Ast::Component { index: 2, .. }));
+        assert!(matches!(
+            parse("r.z").unwrap(),
+            Ast::Component { index: 2, .. }
+        ));
     }
 
     #[test]

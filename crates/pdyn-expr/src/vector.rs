@@ -10,14 +10,12 @@ pub fn dot(p: &mut Pool, a: [Id; 3], b: [Id; 3]) -> Id {
 
 /// `a × b`.
 pub fn cross(p: &mut Pool, a: [Id; 3], b: [Id; 3]) -> [Id; 3] {
-    let mut c = [Pool::ZERO; 3];
-    for i in 0..3 {
+    [0, 1, 2].map(|i| {
         let (j, k) = ((i + 1) % 3, (i + 2) % 3);
         let l = p.mul2(a[j], b[k]);
         let r = p.mul2(a[k], b[j]);
-        c[i] = p.sub(l, r);
-    }
-    c
+        p.sub(l, r)
+    })
 }
 
 /// `|a|`.
