@@ -73,13 +73,13 @@ impl Controller {
         }
     }
 
-    /// radau5.f defaults: safety 0.9, fac_min 0.125 (`h_new/h ≥ 1/8`), fac_max 5, and
+    /// radau5.f defaults: safety 0.9, fac_min 0.2, fac_max 8 (`0.2 ≤ h_new/h ≤ 8`), with
     /// Gustafsson's predictive controller (β is unused by Radau5).
     pub fn radau5() -> Self {
         Controller {
             safety: 0.9,
-            fac_min: 0.125,
-            fac_max: 5.0,
+            fac_min: 0.2,
+            fac_max: 8.0,
             beta: 0.0,
         }
     }

@@ -206,6 +206,7 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
             last = true;
         }
         nstep += 1;
+        sol.stats.steps += 1;
         let err = rk.attempt(sys, t, &y, h, &mut y_new, &atol, &rtol, &mut sol.stats);
         if !err.is_finite() {
             nonfinite_in_row += 1;
@@ -273,7 +274,9 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
         } else {
             reject = true;
             last = false;
-            sol.stats.rejected += 1;
+            if sol.stats.accepted >= 1 {
+                sol.stats.rejected += 1;
+            }
         }
         h = hnew;
     }

@@ -12,6 +12,7 @@ mod error;
 pub mod events;
 mod explicit;
 mod fixed;
+pub mod linalg;
 pub mod methods;
 mod options;
 pub mod problem;
@@ -52,6 +53,12 @@ pub enum Method {
     Gauss4,
     /// Gauss–Legendre 3 stages ([`methods::gauss`]), implicit, fixed step, symplectic, order 6.
     Gauss6,
+    /// Radau IIA order 5 ([`methods::radau5`]), implicit, adaptive, for stiff problems.
+    Radau5,
+    /// DOPRI5 while the problem is non-stiff, switching to Radau5 for the rest of the
+    /// integration when DOPRI5's stiffness detector fires (checked every
+    /// [`Options::stiffness_check_interval`] accepted steps).
+    Auto,
 }
 
 /// What kind of integrator a method is.
@@ -81,6 +88,8 @@ impl Method {
             Method::KahanLi8,
             Method::Gauss4,
             Method::Gauss6,
+            Method::Radau5,
+            Method::Auto,
         ]
     }
 
@@ -97,6 +106,8 @@ impl Method {
             Method::KahanLi8 => "kahanli8",
             Method::Gauss4 => "gauss4",
             Method::Gauss6 => "gauss6",
+            Method::Radau5 => "radau5",
+            Method::Auto => "auto",
         }
     }
 
@@ -114,13 +125,15 @@ impl Method {
             Method::KahanLi8 => symplectic::DOC_KAHAN_LI8,
             Method::Gauss4 => gauss::DOC_GAUSS4,
             Method::Gauss6 => gauss::DOC_GAUSS6,
+            Method::Radau5 => radau5::DOC,
+            Method::Auto => AUTO_DOC,
         }
     }
 
     /// Nominal order of the propagated solution.
     pub fn order(self) -> u32 {
         match self {
-            Method::Dopri5 | Method::Tsit5 => 5,
+            Method::Dopri5 | Method::Tsit5 | Method::Radau5 | Method::Auto => 5,
             Method::Dop853 | Method::KahanLi8 => 8,
             Method::Rk4 | Method::Yoshida4 | Method::Gauss4 => 4,
             Method::VelocityVerlet => 2,
@@ -133,6 +146,7 @@ impl Method {
         match self {
             Method::Dopri5 | Method::Tsit5 | Method::Dop853 => MethodKind::Adaptive,
             Method::Rk4 => MethodKind::FixedStep,
+            Method::Radau5 | Method::Auto => MethodKind::Stiff,
             Method::VelocityVerlet
             | Method::Yoshida4
             | Method::KahanLi6
@@ -204,7 +218,7 @@ pub fn solve_with_events<S: OdeSystem + ?Sized>(
             "{method} integrates second-order separable systems: use solve_second_order"
         )));
     }
-    if sys.mass_kind() != MassKind::Identity {
+    if sys.mass_kind() != MassKind::Identity && method != Method::Radau5 {
         return Err(error::invalid(format!(
             "{method} does not support a mass matrix (use radau5)"
         )));
@@ -254,8 +268,88 @@ pub fn solve_with_events<S: OdeSystem + ?Sized>(
             opts,
             events,
         ),
+        Method::Radau5 => methods::radau5::integrate(sys, t0, tf, y0, opts, events),
+        Method::Auto => auto(sys, t0, tf, y0, opts, events),
         Method::VelocityVerlet | Method::Yoshida4 | Method::KahanLi6 | Method::KahanLi8 => {
-            unreachable!("handled above")
+            Err(error::invalid("unreachable: second-order method"))
+        }
+    }
+}
+
+const AUTO_DOC: &str = "DOPRI5 with Hairer's stiffness detection; switches to Radau5 for the \
+rest of the interval when the problem becomes stiff.";
+
+/// `Method::Auto`: DOPRI5 until its stiffness detector fires, then Radau5 from that point.
+fn auto<S: OdeSystem + ?Sized>(
+    sys: &S,
+    t0: f64,
+    tf: f64,
+    y0: &[f64],
+    opts: &Options,
+    events: &[Event<'_>],
+) -> Result<Solution, OdeError> {
+    let first = explicit::integrate::<methods::dopri5::Dopri5, S>(
+        sys,
+        t0,
+        tf,
+        y0,
+        opts,
+        events,
+        StiffnessAction::Error,
+    );
+    let at = match first {
+        Err(OdeError::Stiff { at }) => at,
+        other => return other,
+    };
+    let mut sol = *at.partial;
+    let ts = at.t;
+    let mut o2 = opts.clone();
+    if let Some(te) = &opts.t_eval {
+        let dir = if tf >= t0 { 1.0 } else { -1.0 };
+        o2.t_eval = Some(
+            te.iter()
+                .copied()
+                .filter(|t| (t - ts) * dir > 0.0)
+                .collect(),
+        );
+    }
+    o2.h0 = None;
+    let rest = methods::radau5::integrate(sys, ts, tf, &at.y, &o2, events);
+    let merge = |sol: &mut Solution, mut r: Solution| {
+        let skip = usize::from(opts.t_eval.is_none() && r.t.first() == Some(&ts));
+        sol.t.extend_from_slice(&r.t[skip..]);
+        sol.y.extend_from_slice(&r.y[skip * r.n..]);
+        sol.events.append(&mut r.events);
+        let (a, b) = (&mut sol.stats, &r.stats);
+        a.steps += b.steps;
+        a.accepted += b.accepted;
+        a.rejected += b.rejected;
+        a.fevals += b.fevals;
+        a.jac_fevals += b.jac_fevals;
+        a.jacobians += b.jacobians;
+        a.lu_decompositions += b.lu_decompositions;
+        a.linear_solves += b.linear_solves;
+        sol.status = r.status;
+        sol.method = Method::Radau5;
+    };
+    match rest {
+        Ok(r) => {
+            merge(&mut sol, r);
+            Ok(sol)
+        }
+        Err(mut e) => {
+            if let Some(fp) = match &mut e {
+                OdeError::StepSizeUnderflow { at, .. }
+                | OdeError::NonFinite { at }
+                | OdeError::MaxSteps { at, .. }
+                | OdeError::SingularMatrix { at } => Some(at),
+                _ => None,
+            } {
+                let mut full = sol.clone();
+                merge(&mut full, (*fp.partial).clone());
+                *fp.partial = full;
+            }
+            Err(e)
         }
     }
 }

@@ -5,9 +5,13 @@ use crate::Method;
 /// Work statistics, counted as Hairer's codes count them (see each method's docs).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Stats {
+    /// Step attempts (Hairer's NSTEP: accepted, rejected, and for Radau5 also the attempts
+    /// abandoned because Newton failed).
+    pub steps: usize,
     /// Accepted steps.
     pub accepted: usize,
-    /// Rejected steps (error test failed, or Newton failed to converge).
+    /// Steps rejected by the error test, counted as Hairer's codes count them (NREJCT):
+    /// rejections before the first accepted step are not included (they are in `steps`).
     pub rejected: usize,
     /// Evaluations of `f` (including those for finite-difference Jacobians, which Hairer's
     /// RADAU5 does *not* count in NFCN: see [`Stats::jac_fevals`]).

@@ -3,6 +3,7 @@
 pub mod dop853;
 pub mod dopri5;
 pub mod gauss;
+pub mod radau5;
 pub mod rk4;
 pub mod symplectic;
 pub mod tsit5;
