@@ -339,15 +339,23 @@ impl LatexPrinter<'_> {
 
     fn term(&self, id: Id) -> (bool, String) {
         let f = fraction(self.pool, id);
-        let num = self.factors(&f.num);
-        let num = if num.is_empty() { "1".to_string() } else { num };
         if f.den.is_empty() {
-            return (f.negative, num);
+            let num = self.factors(&f.num);
+            return (
+                f.negative,
+                if num.is_empty() { "1".to_string() } else { num },
+            );
         }
-        (
-            f.negative,
-            format!("\\frac{{{num}}}{{{}}}", self.factors(&f.den)),
-        )
+        // Inside \frac a lone sum needs no parentheses.
+        let side = |fs: &[Factor]| -> String {
+            match fs {
+                [] => "1".to_string(),
+                [Factor::Power(b, e)] if e.is_one() => self.expr(*b),
+                _ => self.factors(fs),
+            }
+        };
+        let (n, d) = (side(&f.num), side(&f.den));
+        (f.negative, format!("\\frac{{{n}}}{{{d}}}"))
     }
 
     fn factors(&self, fs: &[Factor]) -> String {

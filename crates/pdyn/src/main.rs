@@ -1,1 +1,50 @@
-fn main() {}
+//! `pdyn`: the command-line front end. Thin by design: parse arguments, call the library,
+//! print. Every error becomes a message and a non-zero exit code here, and only here.
+
+mod expr_cmd;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Analyze the motion of systems of particles.
+#[derive(Parser, Debug)]
+#[command(name = "pdyn", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Simplify an expression (Pythagorean identity, common factors, collected terms).
+    Simplify(expr_cmd::SimplifyArgs),
+    /// Differentiate an expression with respect to a symbol, or in time (`--wrt t`).
+    Diff(expr_cmd::DiffArgs),
+    /// Solve equations that are linear in the chosen unknowns, exactly.
+    Solve(expr_cmd::SolveArgs),
+    /// Evaluate an expression numerically.
+    Eval(expr_cmd::EvalArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Simplify(a) => expr_cmd::simplify(a),
+        Command::Diff(a) => expr_cmd::diff(a),
+        Command::Solve(a) => expr_cmd::solve(a),
+        Command::Eval(a) => expr_cmd::eval(a),
+    };
+    match result {
+        Ok(out) => {
+            print!("{out}");
+            ExitCode::SUCCESS
+        }
+        Err(msg) => {
+            eprint!("{msg}");
+            if !msg.ends_with('\n') {
+                eprintln!();
+            }
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,320 @@
+//! Expression commands: `simplify`, `diff`, `solve`, `eval`.
+
+use clap::{Args, ValueEnum};
+use pdyn_expr::{ExprError, FreeScope, Id, Pool, Program, Value};
+use serde_json::json;
+
+/// Output notation for expressions.
+#[derive(Clone, Copy, Debug, Default, ValueEnum)]
+pub enum Format {
+    /// Plain text that pdyn parses back.
+    #[default]
+    Text,
+    /// LaTeX (math mode).
+    Latex,
+    /// A Rust f64 expression.
+    Rust,
+}
+
+/// Options shared by the expression commands.
+#[derive(Args, Debug, Clone)]
+pub struct Common {
+    /// Names that are functions of time (also inferred from `x'` and `x(t)`), comma separated.
+    #[arg(long, value_delimiter = ',')]
+    coords: Vec<String>,
+    /// Names declared strictly positive (lets `sqrt(m^2)` become `m`), comma separated.
+    #[arg(long, value_delimiter = ',')]
+    positive: Vec<String>,
+    /// Output notation.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
+    /// Machine-readable output.
+    #[arg(long)]
+    json: bool,
+}
+
+/// `pdyn simplify`.
+#[derive(Args, Debug)]
+pub struct SimplifyArgs {
+    /// The expression, e.g. "sin(x)^2 + cos(x)^2" or a vector "[a, b, c]".
+    #[arg(allow_hyphen_values = true)]
+    expr: String,
+    /// Expand products and powers instead of simplifying.
+    #[arg(long)]
+    expand: bool,
+    #[command(flatten)]
+    common: Common,
+}
+
+/// `pdyn diff`.
+#[derive(Args, Debug)]
+pub struct DiffArgs {
+    /// The expression, e.g. "[R*cos(th(t)), R*sin(th(t)), 0]".
+    #[arg(allow_hyphen_values = true)]
+    expr: String,
+    /// Variable: a symbol, a coordinate rate such as `x'`, or `t` for the total time derivative.
+    #[arg(long, default_value = "t")]
+    wrt: String,
+    /// Number of times to differentiate.
+    #[arg(short = 'n', long, default_value_t = 1)]
+    times: usize,
+    /// Simplify the result.
+    #[arg(long)]
+    simplify: bool,
+    #[command(flatten)]
+    common: Common,
+}
+
+/// `pdyn solve`.
+#[derive(Args, Debug)]
+pub struct SolveArgs {
+    /// Equations `lhs = rhs` (or `lhs == rhs`), one per argument. An equation starting with
+    /// `-` goes after `--`: `pdyn solve --for T,N -- "-T*cos(a) = m*x"`.
+    #[arg(required = true)]
+    equations: Vec<String>,
+    /// Unknowns to solve for, comma separated.
+    #[arg(long = "for", value_delimiter = ',', required = true)]
+    unknowns: Vec<String>,
+    #[command(flatten)]
+    common: Common,
+}
+
+/// `pdyn eval`.
+#[derive(Args, Debug)]
+pub struct EvalArgs {
+    /// The expression.
+    #[arg(allow_hyphen_values = true)]
+    expr: String,
+    /// Values, e.g. `--at x=1,y=2.5`.
+    #[arg(long, value_delimiter = ',')]
+    at: Vec<String>,
+    #[command(flatten)]
+    common: Common,
+}
+
+fn scope(c: &Common) -> FreeScope {
+    let mut s = FreeScope::with_coordinates(c.coords.iter().map(String::as_str));
+    s.positive = c.positive.iter().cloned().collect();
+    s
+}
+
+fn located(e: ExprError, src: &str, origin: &str) -> String {
+    e.render(src, origin)
+}
+
+fn parse(pool: &mut Pool, src: &str, c: &Common, origin: &str) -> Result<Value, String> {
+    let ast = pdyn_expr::syntax::parse(src).map_err(|e| located(e, src, origin))?;
+    let mut sc = scope(c);
+    sc.learn(&ast);
+    pdyn_expr::lower::lower(pool, &ast, &mut sc).map_err(|e| located(e, src, origin))
+}
+
+fn show(pool: &Pool, id: Id, f: Format) -> String {
+    match f {
+        Format::Text => pool.to_text(id),
+        Format::Latex => pool.to_latex(id),
+        Format::Rust => pool.to_rust(id, &|p, n| p.rust_leaf_name(n)),
+    }
+}
+
+fn show_value(pool: &Pool, v: Value, f: Format) -> String {
+    match v {
+        Value::Scalar(s) => show(pool, s, f),
+        Value::Vector(c) => {
+            let parts: Vec<String> = c.iter().map(|&x| show(pool, x, f)).collect();
+            match f {
+                Format::Latex => format!(
+                    "\\begin{{bmatrix}} {} \\end{{bmatrix}}",
+                    parts.join(" \\\\ ")
+                ),
+                _ => format!("[{}]", parts.join(", ")),
+            }
+        }
+    }
+}
+
+fn value_json(pool: &Pool, v: Value) -> serde_json::Value {
+    let one = |x: Id| json!({"text": pool.to_text(x), "latex": pool.to_latex(x)});
+    match v {
+        Value::Scalar(s) => one(s),
+        Value::Vector(c) => json!(c.iter().map(|&x| one(x)).collect::<Vec<_>>()),
+    }
+}
+
+/// `pdyn simplify EXPR`.
+pub fn simplify(a: SimplifyArgs) -> Result<String, String> {
+    let mut pool = Pool::new();
+    let v = parse(&mut pool, &a.expr, &a.common, "<expr>")?;
+    let r = v.map(|x| {
+        let e = pool.expand(x);
+        if a.expand {
+            e
+        } else {
+            pool.simplify(e)
+        }
+    });
+    Ok(if a.common.json {
+        format!(
+            "{}\n",
+            json!({"input": a.expr, "result": value_json(&pool, r)})
+        )
+    } else {
+        format!("{}\n", show_value(&pool, r, a.common.format))
+    })
+}
+
+/// `pdyn diff EXPR --wrt VAR`.
+pub fn diff(a: DiffArgs) -> Result<String, String> {
+    let mut pool = Pool::new();
+    let v = parse(&mut pool, &a.expr, &a.common, "<expr>")?;
+    let var = if a.wrt == "t" {
+        None
+    } else {
+        match parse(&mut pool, &a.wrt, &a.common, "--wrt")? {
+            Value::Scalar(s) if is_leaf(&pool, s) => Some(s),
+            _ => {
+                return Err(format!(
+                    "--wrt: `{}` is not a variable; use a symbol, a coordinate (x, x', x'') or t",
+                    a.wrt
+                ))
+            }
+        }
+    };
+    let mut r = v;
+    for _ in 0..a.times {
+        r = r.map(|x| match var {
+            None => pool.dt(x),
+            Some(w) => pool.diff(x, w),
+        });
+    }
+    if a.simplify {
+        r = r.map(|x| pool.simplify(x));
+    }
+    Ok(if a.common.json {
+        format!(
+            "{}\n",
+            json!({"input": a.expr, "wrt": a.wrt, "times": a.times, "result": value_json(&pool, r)})
+        )
+    } else {
+        format!("{}\n", show_value(&pool, r, a.common.format))
+    })
+}
+
+fn is_leaf(pool: &Pool, id: Id) -> bool {
+    matches!(
+        pool.node(id),
+        pdyn_expr::Node::Sym(_) | pdyn_expr::Node::Coord(..) | pdyn_expr::Node::Time
+    )
+}
+
+/// `pdyn solve EQ... --for X,Y`.
+pub fn solve(a: SolveArgs) -> Result<String, String> {
+    let mut pool = Pool::new();
+    let mut sc = scope(&a.common);
+    let mut eqs = Vec::new();
+    for (i, src) in a.equations.iter().enumerate() {
+        let origin = format!("<equation {}>", i + 1);
+        let (l, r) =
+            pdyn_expr::syntax::parse_equation(src).map_err(|e| located(e, src, &origin))?;
+        sc.learn(&l);
+        if let Some(r) = &r {
+            sc.learn(r);
+        }
+        let v = pool
+            .parse_equation_in(src, &mut sc)
+            .map_err(|e| located(e, src, &origin))?;
+        match v {
+            Value::Scalar(s) => eqs.push(s),
+            Value::Vector(c) => eqs.extend(c.into_iter().filter(|&x| x != Pool::ZERO)),
+        }
+    }
+    let mut unknowns = Vec::new();
+    for u in &a.unknowns {
+        match parse(&mut pool, u, &a.common, "--for")? {
+            Value::Scalar(s) if is_leaf(&pool, s) => unknowns.push(s),
+            _ => return Err(format!("--for: `{u}` is not a variable name")),
+        }
+    }
+    let sys = pool.linear_system(&eqs, &unknowns).map_err(|e| match e {
+        pdyn_expr::linsolve::LinearError::NotLinear { equation, unknown } => format!(
+            "equation {} is not linear in `{}`: its coefficient depends on an unknown",
+            equation + 1,
+            pool.to_text(unknown)
+        ),
+        other => other.to_string(),
+    })?;
+    let sol = pool.solve_linear(&sys).map_err(|e| match e {
+        pdyn_expr::linsolve::LinearError::Underdetermined { free } => {
+            let names: Vec<String> = free.iter().map(|&f| pool.to_text(f)).collect();
+            format!(
+                "the equations do not determine {}: add an equation (a constraint?) involving them",
+                names.join(", ")
+            )
+        }
+        other => other.to_string(),
+    })?;
+    if a.common.json {
+        let m: serde_json::Map<String, serde_json::Value> = a
+            .unknowns
+            .iter()
+            .zip(&sol)
+            .map(|(u, &s)| (u.clone(), value_json(&pool, Value::Scalar(s))))
+            .collect();
+        return Ok(format!("{}\n", json!({"solution": m})));
+    }
+    let mut out = String::new();
+    for (u, &s) in a.unknowns.iter().zip(&sol) {
+        out += &format!("{u} = {}\n", show(&pool, s, a.common.format));
+    }
+    Ok(out)
+}
+
+/// `pdyn eval EXPR --at x=1,y=2`.
+pub fn eval(a: EvalArgs) -> Result<String, String> {
+    let mut pool = Pool::new();
+    let v = parse(&mut pool, &a.expr, &a.common, "<expr>")?;
+    let mut inputs = Vec::new();
+    let mut values = Vec::new();
+    for kv in &a.at {
+        let (k, val) = kv
+            .split_once('=')
+            .ok_or_else(|| format!("--at: expected name=value, got `{kv}`"))?;
+        let x = match parse(&mut pool, k.trim(), &a.common, "--at")? {
+            Value::Scalar(s) if is_leaf(&pool, s) => s,
+            _ => return Err(format!("--at: `{k}` is not a variable name")),
+        };
+        let num = match parse(&mut pool, val.trim(), &a.common, "--at")? {
+            Value::Scalar(s) => pool.simplify(s),
+            Value::Vector(_) => return Err(format!("--at: `{val}` is not a number")),
+        };
+        let prog =
+            Program::compile(&mut pool, &[], &[num]).map_err(|e| format!("--at {k}: {e}"))?;
+        let mut ws = prog.workspace();
+        let mut out = [0.0];
+        prog.eval(&[], &mut ws, &mut out);
+        inputs.push(x);
+        values.push(out[0]);
+    }
+    let outs: Vec<Id> = match v {
+        Value::Scalar(s) => vec![s],
+        Value::Vector(c) => c.to_vec(),
+    };
+    let prog = Program::compile(&mut pool, &inputs, &outs)
+        .map_err(|e| format!("{e}; give it a value with --at"))?;
+    let mut ws = prog.workspace();
+    let mut out = vec![0.0; outs.len()];
+    prog.eval(&values, &mut ws, &mut out);
+    Ok(if a.common.json {
+        format!("{}\n", json!({"input": a.expr, "value": out}))
+    } else if out.len() == 1 {
+        format!("{}\n", out[0])
+    } else {
+        format!(
+            "[{}]\n",
+            out.iter()
+                .map(|x| x.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    })
+}
