@@ -5,7 +5,10 @@ use crate::Solution;
 use std::fmt;
 
 /// Where a numerical failure happened: time, state, and the partial solution.
-#[derive(Debug, Clone, PartialEq)]
+///
+/// Its `Debug` output summarises the partial solution (number of outputs, statistics) instead
+/// of printing every state.
+#[derive(Clone, PartialEq)]
 pub struct FailurePoint {
     /// Time of the last accepted state.
     pub t: f64,
@@ -13,6 +16,24 @@ pub struct FailurePoint {
     pub y: Vec<f64>,
     /// Everything computed up to `t` (outputs, events, statistics).
     pub partial: Box<Solution>,
+}
+
+impl fmt::Debug for FailurePoint {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("FailurePoint")
+            .field("t", &self.t)
+            .field("y", &self.y)
+            .field(
+                "partial",
+                &format_args!(
+                    "Solution {{ {} outputs, {} events, stats: {:?} }}",
+                    self.partial.len(),
+                    self.partial.events.len(),
+                    self.partial.stats
+                ),
+            )
+            .finish()
+    }
 }
 
 /// Errors of the solvers.
