@@ -377,65 +377,60 @@ impl Program {
     #[inline]
     pub fn eval(&self, inputs: &[f64], ws: &mut [f64], out: &mut [f64]) {
         let n = self.n_inputs;
-        ws[..n].copy_from_slice(&inputs[..n]);
         let start = n + self.consts.len();
-        let (done, temps) = ws.split_at_mut(start);
-        let temps = &mut temps[..self.instrs.len()];
+        assert!(
+            inputs.len() >= n && ws.len() >= start + self.instrs.len(),
+            "Program::eval: inputs or workspace too short"
+        );
+        ws[..n].copy_from_slice(&inputs[..n]);
+        let regs = ws.as_mut_ptr();
         for (k, ins) in self.instrs.iter().enumerate() {
-            let get = |r: u32, done: &[f64], temps: &[f64]| -> f64 {
-                let r = r as usize;
-                if r < start {
-                    done[r]
-                } else {
-                    temps[r - start]
-                }
-            };
-            let a = get(ins.a, done, temps);
-            let v = match ins.op {
-                Op::Neg => -a,
-                Op::Sqrt => a.sqrt(),
-                Op::Sin => a.sin(),
-                Op::Cos => a.cos(),
-                Op::Tan => a.tan(),
-                Op::Asin => a.asin(),
-                Op::Acos => a.acos(),
-                Op::Atan => a.atan(),
-                Op::Sinh => a.sinh(),
-                Op::Cosh => a.cosh(),
-                Op::Tanh => a.tanh(),
-                Op::Exp => a.exp(),
-                Op::Ln => a.ln(),
-                Op::Abs => a.abs(),
-                Op::Sign => {
-                    if a > 0.0 {
-                        1.0
-                    } else if a < 0.0 {
-                        -1.0
-                    } else {
-                        a * 0.0 // 0 for 0, NaN for NaN
+            // SAFETY: `compile` only emits operands that are inputs, constants or earlier
+            // temporaries, so `ins.a`, `ins.b` < `start + k` <= ws.len() (checked above), and the
+            // destination `start + k` is in bounds. `Powi` stores an exponent, not a register,
+            // in `b`, and never reads it as one.
+            unsafe {
+                let a = *regs.add(ins.a as usize);
+                let reg_b = || *regs.add(ins.b as usize);
+                let v = match ins.op {
+                    Op::Add => a + reg_b(),
+                    Op::Sub => a - reg_b(),
+                    Op::Mul => a * reg_b(),
+                    Op::Div => a / reg_b(),
+                    Op::Neg => -a,
+                    Op::Sqrt => a.sqrt(),
+                    Op::Powi => a.powi(ins.b as i32),
+                    Op::Powf => a.powf(reg_b()),
+                    Op::Sin => a.sin(),
+                    Op::Cos => a.cos(),
+                    Op::Tan => a.tan(),
+                    Op::Asin => a.asin(),
+                    Op::Acos => a.acos(),
+                    Op::Atan => a.atan(),
+                    Op::Atan2 => a.atan2(reg_b()),
+                    Op::Sinh => a.sinh(),
+                    Op::Cosh => a.cosh(),
+                    Op::Tanh => a.tanh(),
+                    Op::Exp => a.exp(),
+                    Op::Ln => a.ln(),
+                    Op::Abs => a.abs(),
+                    Op::Sign => {
+                        if a > 0.0 {
+                            1.0
+                        } else if a < 0.0 {
+                            -1.0
+                        } else {
+                            a * 0.0 // 0 for 0, NaN for NaN
+                        }
                     }
-                }
-                Op::Powi => a.powi(ins.b as i32),
-                _ => {
-                    let b = get(ins.b, done, temps);
-                    match ins.op {
-                        Op::Add => a + b,
-                        Op::Sub => a - b,
-                        Op::Mul => a * b,
-                        Op::Div => a / b,
-                        Op::Powf => a.powf(b),
-                        Op::Atan2 => a.atan2(b),
-                        Op::Min => a.min(b),
-                        Op::Max => a.max(b),
-                        _ => f64::NAN,
-                    }
-                }
-            };
-            temps[k] = v;
+                    Op::Min => a.min(reg_b()),
+                    Op::Max => a.max(reg_b()),
+                };
+                *regs.add(start + k) = v;
+            }
         }
         for (o, &r) in out.iter_mut().zip(&self.outputs) {
-            let r = r as usize;
-            *o = if r < start { done[r] } else { temps[r - start] };
+            *o = ws[r as usize];
         }
     }
 }
