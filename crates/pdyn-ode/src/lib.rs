@@ -1,6 +1,58 @@
-//! Integrators for ordinary differential equations.
+//! Integrators for ordinary differential equations: adaptive explicit Runge–Kutta pairs, a
+//! stiff implicit solver, symplectic and geometric methods; events, dense output, typed errors.
 //!
-//! pdyn-ode integrates any Rust function: it knows nothing of symbols.
+//! pdyn-ode integrates any Rust function: it knows nothing of symbols and depends on no other
+//! pdyn crate.
+//!
+//! # Quick start
+//! ```
+//! use pdyn_ode::{solve, FnSystem, Method, Options};
+//! // y'' = −y as a first-order system
+//! let osc = FnSystem::new(2, |_t, y: &[f64], f: &mut [f64]| {
+//!     f[0] = y[1];
+//!     f[1] = -y[0];
+//! });
+//! let opts = Options { rtol: 1e-10.into(), atol: 1e-12.into(), ..Default::default() };
+//! let sol = solve(Method::Dop853, &osc, (0.0, 10.0), &[1.0, 0.0], &opts).unwrap();
+//! let (_, y) = sol.last().unwrap();
+//! assert!((y[0] - 10f64.cos()).abs() < 1e-9);
+//! println!("{} accepted steps, {} f-evaluations", sol.stats.accepted, sol.stats.fevals);
+//! ```
+//!
+//! # Layout
+//! | file | what |
+//! |---|---|
+//! | `problem.rs` | [`OdeSystem`] (`M y' = f(t, y)` in place, optional Jacobian and mass matrix), [`SecondOrderSystem`] (`q'' = a(t, q, q')`, `separable` flag), closure wrappers, [`MassInverse`] |
+//! | `options.rs` | [`Options`] (`rtol`, `atol`, `h0`, `max_step`, `max_steps`, `t_eval`, …) with documented defaults |
+//! | `solution.rs` | [`Solution`] (output times and states, [`Stats`], [`EventHit`]s) |
+//! | `error.rs` | [`OdeError`]: typed failures carrying `t`, the state and the partial solution |
+//! | `controller.rs` | the shared PI step-size controller and initial-step estimate (Hairer) |
+//! | `events.rs` | [`Event`]s and the shared locator (Brent's method on the dense output), output at `t_eval` |
+//! | `explicit.rs`, `fixed.rs` | drivers shared by the explicit adaptive pairs, and by the fixed-step methods |
+//! | `tableau.rs` | Butcher tableaus as data; order-condition checker over rooted trees |
+//! | `linalg.rs` | dense real/complex LU with partial pivoting (decsol.f), allocation-free |
+//! | `methods/dopri5.rs` | **DOPRI5**, Dormand & Prince 1980: 5(4), FSAL, 4th-order dense output, stiffness detection (MATLAB `ode45`) |
+//! | `methods/tsit5.rs` | **Tsit5**, Tsitouras 2011: 5(4), FSAL, 4th-order dense output |
+//! | `methods/dop853.rs` | **DOP853**, Prince & Dormand 1981 / Hairer: 8(5,3), 7th-order dense output |
+//! | `methods/rk4.rs` | **RK4**, Kutta 1901: classical order 4, fixed step |
+//! | `methods/radau5.rs` | **Radau5**, Hairer & Wanner 1996: Radau IIA order 5, stiff, mass matrices / index-1 DAEs |
+//! | `methods/symplectic.rs` | **Velocity Verlet** (Verlet 1967), **Yoshida 4** (Yoshida 1990), **Kahan–Li 6 / 8** (Kahan & Li 1997): explicit symplectic, fixed step |
+//! | `methods/gauss.rs` | **Gauss–Legendre 4 / 6** (Butcher 1964): implicit symplectic for any Hamiltonian, fixed step |
+//!
+//! `Method::Auto` runs DOPRI5 and switches to Radau5 when DOPRI5's stiffness detector fires.
+//! [`Method::all`], [`Method::name`] and [`Method::doc`] list the methods with their
+//! descriptions (for `--method help`).
+//!
+//! # Conventions
+//! * Tolerances: a step is accepted when the RMS over components of
+//!   `err_i / (atol_i + rtol_i · max(|y0_i|, |y1_i|))` is ≤ 1. Defaults `rtol = 1e-6`,
+//!   `atol = 1e-9` (tighter than MATLAB's 1e-3 / 1e-6).
+//! * Statistics are counted like Hairer's Fortran codes, so that published counts can be
+//!   compared exactly (tests reproduce dopri5.f on Arenstorf, dop853.f on Van der Pol and
+//!   radau5.f on Robertson).
+//! * No allocation inside a step: each solve allocates its workspaces once. Outputs are pushed
+//!   to the [`Solution`] (amortised growth).
+//! * Fixed-step methods take `N = ⌈|tf − t0| / h0⌉` equal steps of size `(tf − t0)/N`.
 #![warn(missing_docs)]
 // Numerical kernels index several arrays with one index; iterator chains would obscure the math.
 #![allow(clippy::needless_range_loop)]
@@ -24,8 +76,8 @@ pub use error::{FailurePoint, OdeError};
 pub use events::{DenseOutput, Event};
 pub use options::{Options, StiffnessAction, Tolerance};
 pub use problem::{
-    FirstOrderForm, FnSecondOrder, FnSystem, FnSystemWithJacobian, MassKind, OdeSystem,
-    SecondOrderSystem,
+    FirstOrderForm, FnSecondOrder, FnSystem, FnSystemWithJacobian, MassInverse, MassKind,
+    OdeSystem, SecondOrderSystem,
 };
 pub use solution::{Direction, EventHit, Solution, Stats, Status};
 
@@ -212,17 +264,29 @@ pub fn solve_with_events<S: OdeSystem + ?Sized>(
     opts: &Options,
     events: &[Event<'_>],
 ) -> Result<Solution, OdeError> {
-    let (t0, tf) = t_span;
     if method.needs_second_order() {
         return Err(error::invalid(format!(
             "{method} integrates second-order separable systems: use solve_second_order"
         )));
     }
-    if sys.mass_kind() != MassKind::Identity && method != Method::Radau5 {
-        return Err(error::invalid(format!(
-            "{method} does not support a mass matrix (use radau5)"
-        )));
+    let mass = sys.mass_kind();
+    if mass == MassKind::StateDependent || (mass == MassKind::Constant && method != Method::Radau5)
+    {
+        return dispatch(method, &MassInverse::new(sys), t_span, y0, opts, events);
     }
+    dispatch(method, sys, t_span, y0, opts, events)
+}
+
+/// Runs `method` on a system whose mass matrix the method supports.
+fn dispatch<S: OdeSystem + ?Sized>(
+    method: Method,
+    sys: &S,
+    t_span: (f64, f64),
+    y0: &[f64],
+    opts: &Options,
+    events: &[Event<'_>],
+) -> Result<Solution, OdeError> {
+    let (t0, tf) = t_span;
     let n = sys.dim();
     let act = opts.on_stiffness;
     match method {

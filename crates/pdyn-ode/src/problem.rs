@@ -207,3 +207,50 @@ impl<S: SecondOrderSystem + ?Sized> OdeSystem for FirstOrderForm<'_, S> {
         self.0.accel(t, q, v, dv);
     }
 }
+
+/// The explicit form `y' = M(t, y)⁻¹ f(t, y)` of a system with a nonsingular mass matrix.
+///
+/// Each evaluation factorises `M(t, y)` (dense LU, workspace allocated once) and solves for
+/// `y'`. The solvers apply it automatically to methods that need `M = I` and to Radau5 when
+/// `M` depends on the state; a singular `M` yields NaN derivatives, which the solvers report
+/// as [`crate::OdeError::NonFinite`] (use Radau5 with a constant `M` for DAEs).
+pub struct MassInverse<'a, S: ?Sized> {
+    sys: &'a S,
+    work: std::cell::RefCell<(crate::linalg::Lu, Vec<f64>)>,
+}
+
+impl<'a, S: OdeSystem + ?Sized> MassInverse<'a, S> {
+    /// Wraps `sys`.
+    pub fn new(sys: &'a S) -> Self {
+        let n = sys.dim();
+        MassInverse {
+            sys,
+            work: std::cell::RefCell::new((crate::linalg::Lu::new(n), vec![0.0; n * n])),
+        }
+    }
+}
+
+impl<S: OdeSystem + ?Sized> OdeSystem for MassInverse<'_, S> {
+    fn dim(&self) -> usize {
+        self.sys.dim()
+    }
+
+    fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
+        let n = self.sys.dim();
+        self.sys.rhs(t, y, dydt);
+        let mut guard = self.work.borrow_mut();
+        let (lu, m) = &mut *guard;
+        self.sys.mass_matrix(t, y, m);
+        let a = lu.matrix_mut();
+        for i in 0..n {
+            for j in 0..n {
+                a[i + j * n] = m[i * n + j];
+            }
+        }
+        if lu.factor().is_err() {
+            dydt.fill(f64::NAN);
+            return;
+        }
+        lu.solve_in_place(dydt);
+    }
+}

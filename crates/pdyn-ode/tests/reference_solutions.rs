@@ -189,3 +189,27 @@ fn radau5_with_finite_difference_jacobian_on_stiff_van_der_pol() {
     );
     assert!(max_err(&y, &VDP_STIFF_Y2) < 1e-4, "{y:?}");
 }
+
+#[test]
+fn state_dependent_mass_matrix() {
+    // (1 + y²) y' = −y (1 + y²)  ⇔  y' = −y: exact e^{−t}.
+    struct S;
+    impl OdeSystem for S {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs(&self, _t: f64, y: &[f64], f: &mut [f64]) {
+            f[0] = -y[0] * (1.0 + y[0] * y[0]);
+        }
+        fn mass_kind(&self) -> MassKind {
+            MassKind::StateDependent
+        }
+        fn mass_matrix(&self, _t: f64, y: &[f64], m: &mut [f64]) {
+            m[0] = 1.0 + y[0] * y[0];
+        }
+    }
+    for m in [Method::Dopri5, Method::Radau5] {
+        let y = end(m, &S, 2.0, &[1.5], &Options::with_tol(1e-10));
+        assert!((y[0] - 1.5 * (-2.0f64).exp()).abs() < 1e-8, "{m}: {y:?}");
+    }
+}

@@ -1,7 +1,8 @@
 //! **Radau5** — the 3-stage Radau IIA implicit Runge–Kutta method of order 5, with the
 //! algorithm of Hairer & Wanner's RADAU5 code. Implicit, adaptive, L-stable, for stiff
 //! problems and for `M y' = f(t, y)` with a constant (possibly singular: index-1 DAE) mass
-//! matrix. Not symplectic.
+//! matrix (a state-dependent, nonsingular `M(t, y)` is handled through
+//! [`crate::MassInverse`]). Not symplectic.
 //!
 //! E. Hairer, G. Wanner, *Solving Ordinary Differential Equations II: Stiff and
 //! Differential-Algebraic Problems*, 2nd ed., Springer 1996, §IV.8 (radau5.f).
