@@ -1,0 +1,1 @@
+//! Kinematics of a particle (issue 7, in progress).
