@@ -283,23 +283,70 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
 }
 
 /// `out_j = y_j + h Σ_m a_m k_{m,j}` over the nonzero `a_m` (stage-major `k`).
+///
+/// The sum is accumulated stage by stage over whole vectors (vectorisable inner loops) but per
+/// component in the same order as the Fortran codes, `((a_1 k_1 + a_2 k_2) + …)`, then
+/// `y + h·sum`, so results are bit-identical to Hairer's.
 #[inline(always)]
 pub(crate) fn stage_input(y: &[f64], k: &[f64], n: usize, a_row: &[f64], h: f64, out: &mut [f64]) {
+    let out = &mut out[..n];
+    let y = &y[..n];
     if a_row.len() == 1 {
         // `y + (h a21) k1`, in the order of the Fortran codes.
         let ha = h * a_row[0];
-        for j in 0..n {
-            out[j] = y[j] + ha * k[j];
+        for ((o, &yj), &kj) in out.iter_mut().zip(y).zip(&k[..n]) {
+            *o = yj + ha * kj;
         }
         return;
     }
-    for j in 0..n {
-        let mut acc = 0.0;
-        for (m, &a) in a_row.iter().enumerate() {
-            if a != 0.0 {
-                acc += a * k[m * n + j];
+    let mut first = true;
+    for (m, &a) in a_row.iter().enumerate() {
+        if a == 0.0 {
+            continue;
+        }
+        let km = &k[m * n..(m + 1) * n];
+        if first {
+            for (o, &kj) in out.iter_mut().zip(km) {
+                *o = a * kj;
+            }
+            first = false;
+        } else {
+            for (o, &kj) in out.iter_mut().zip(km) {
+                *o += a * kj;
             }
         }
-        out[j] = y[j] + h * acc;
+    }
+    if first {
+        out.copy_from_slice(y);
+        return;
+    }
+    for (o, &yj) in out.iter_mut().zip(y) {
+        *o = yj + h * *o;
+    }
+}
+
+/// `out_j = Σ_m w_m k_{m,j}` over the nonzero `w_m`, accumulated in stage order.
+#[inline(always)]
+pub(crate) fn combine(k: &[f64], n: usize, w: &[f64], out: &mut [f64]) {
+    let out = &mut out[..n];
+    let mut first = true;
+    for (m, &a) in w.iter().enumerate() {
+        if a == 0.0 {
+            continue;
+        }
+        let km = &k[m * n..(m + 1) * n];
+        if first {
+            for (o, &kj) in out.iter_mut().zip(km) {
+                *o = a * kj;
+            }
+            first = false;
+        } else {
+            for (o, &kj) in out.iter_mut().zip(km) {
+                *o += a * kj;
+            }
+        }
+    }
+    if first {
+        out.fill(0.0);
     }
 }

@@ -20,7 +20,7 @@
 
 use crate::controller::Controller;
 use crate::events::DenseOutput;
-use crate::explicit::{stage_input, ExplicitRk};
+use crate::explicit::{combine, stage_input, ExplicitRk};
 use crate::problem::OdeSystem;
 use crate::solution::Stats;
 use crate::tableau::Tableau;
@@ -397,6 +397,8 @@ pub(crate) struct Dop853 {
     n: usize,
     k: Vec<f64>,
     y1: Vec<f64>,
+    bsum: Vec<f64>,
+    e5: Vec<f64>,
     cont: Vec<f64>,
     t_old: f64,
     h: f64,
@@ -433,6 +435,8 @@ impl ExplicitRk for Dop853 {
             n,
             k: vec![0.0; 16 * n],
             y1: vec![0.0; n],
+            bsum: vec![0.0; n],
+            e5: vec![0.0; n],
             cont: vec![0.0; 8 * n],
             t_old: 0.0,
             h: 1.0,
@@ -468,17 +472,13 @@ impl ExplicitRk for Dop853 {
             sys.rhs(t + h, &self.y1, &mut rest[..n]);
         }
         stats.fevals += 11;
+        combine(&self.k, n, &B, &mut self.bsum);
+        combine(&self.k, n, &ER, &mut self.e5);
         let k = &self.k;
         let (mut err, mut err2) = (0.0, 0.0);
         for i in 0..n {
-            let mut bsum = 0.0;
-            let mut e5 = 0.0;
-            for m in 0..12 {
-                if B[m] != 0.0 {
-                    bsum += B[m] * k[m * n + i];
-                    e5 += ER[m] * k[m * n + i];
-                }
-            }
+            let bsum = self.bsum[i];
+            let e5 = self.e5[i];
             y_new[i] = y[i] + h * bsum;
             let sk = atol[i] + rtol[i] * y[i].abs().max(y_new[i].abs());
             let e3 = bsum - BHH[0] * k[i] - BHH[1] * k[8 * n + i] - BHH[2] * k[11 * n + i];
@@ -541,6 +541,10 @@ impl ExplicitRk for Dop853 {
         }
         self.y1 = ys;
         stats.fevals += 3;
+        for (r, d) in D.iter().enumerate() {
+            let (_, row) = self.cont.split_at_mut((4 + r) * n);
+            combine(&self.k, n, d, &mut row[..n]);
+        }
         let k = &self.k;
         for i in 0..n {
             let ydiff = y_new[i] - y[i];
@@ -549,14 +553,8 @@ impl ExplicitRk for Dop853 {
             self.cont[n + i] = ydiff;
             self.cont[2 * n + i] = bspl;
             self.cont[3 * n + i] = ydiff - h * k[12 * n + i] - bspl;
-            for (r, d) in D.iter().enumerate() {
-                let mut acc = 0.0;
-                for m in 0..16 {
-                    if d[m] != 0.0 {
-                        acc += d[m] * k[m * n + i];
-                    }
-                }
-                self.cont[(4 + r) * n + i] = h * acc;
+            for r in 4..8 {
+                self.cont[r * n + i] *= h;
             }
         }
     }

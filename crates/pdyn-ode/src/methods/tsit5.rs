@@ -12,7 +12,7 @@
 
 use crate::controller::Controller;
 use crate::events::DenseOutput;
-use crate::explicit::{stage_input, ExplicitRk};
+use crate::explicit::{combine, stage_input, ExplicitRk};
 use crate::problem::OdeSystem;
 use crate::solution::Stats;
 use crate::tableau::Tableau;
@@ -138,6 +138,7 @@ pub(crate) struct Tsit5 {
     n: usize,
     k: Vec<f64>,
     ysti: Vec<f64>,
+    e: Vec<f64>,
     y0: Vec<f64>,
     t_old: f64,
     h: f64,
@@ -179,6 +180,7 @@ impl ExplicitRk for Tsit5 {
             n,
             k: vec![0.0; 7 * n],
             ysti: vec![0.0; n],
+            e: vec![0.0; n],
             y0: vec![0.0; n],
             t_old: 0.0,
             h: 1.0,
@@ -214,14 +216,10 @@ impl ExplicitRk for Tsit5 {
             sys.rhs(t + h, y_new, &mut rest[..n]);
         }
         stats.fevals += 6;
-        let k = &self.k;
+        combine(&self.k, n, &E, &mut self.e);
         let mut err = 0.0;
         for i in 0..n {
-            let mut e = 0.0;
-            for m in 0..7 {
-                e += E[m] * k[m * n + i];
-            }
-            e *= h;
+            let e = self.e[i] * h;
             let sk = atol[i] + rtol[i] * y[i].abs().max(y_new[i].abs());
             err += (e / sk) * (e / sk);
         }
