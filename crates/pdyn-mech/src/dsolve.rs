@@ -1,1 +1,0 @@
-//! Closed-form solution of linear ODEs with constant coefficients (issue 7, in progress).

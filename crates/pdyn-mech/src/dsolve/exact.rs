@@ -1,0 +1,639 @@
+//! The exact solver for one coordinate: roots by the quadratic formula (after exact rational
+//! roots), particular solutions by undetermined coefficients, constants from the initial
+//! conditions. See the module documentation of [`super`] for the mathematics.
+
+use super::linear::{forcing_groups, ForcingGroup, LinearOde};
+use super::roots::rational_roots;
+use super::{
+    no_closed_form, Case, ClosedForm, Condition, DsolveError, InitialCondition, Method, Relation,
+};
+use pdyn_expr::{Func, Id, Node, Number, Pool};
+
+/// Part of the homogeneous solution contributed by a root (or a pair of roots).
+#[derive(Clone, Copy, Debug)]
+enum Mode {
+    /// `t^j e^{rate t}`, `j < mult`.
+    Exp { rate: Id, mult: usize },
+    /// `e^{rate t} cosh(freq t)`, `e^{rate t} sinh(freq t)`: the real pair `rate ± freq`.
+    Hyperbolic { rate: Id, freq: Id },
+    /// `t^j e^{rate t} cos(freq t)`, `t^j e^{rate t} sin(freq t)`: the pair `rate ± i freq`.
+    Oscillatory { rate: Id, freq: Id, mult: usize },
+}
+
+/// Exact solution of a single equation, `Ok(None)` when its characteristic polynomial needs
+/// numeric roots (degree ≥ 3 without enough rational roots).
+pub(crate) fn solve_scalar(
+    pool: &mut Pool,
+    ode: &LinearOde,
+    ics: &[InitialCondition],
+    t0: Id,
+    first_constant: usize,
+) -> Result<Option<ClosedForm>, DsolveError> {
+    let a = &ode.coeffs[0][0];
+    let n = ode.orders[0];
+    if n == 0 {
+        return Err(DsolveError::Invalid(format!(
+            "the equation has no derivative of `{}`: it is algebraic, solve it with `pdyn solve`",
+            pool.name(ode.coords[0])
+        )));
+    }
+    let lead = a[n];
+    // Monic characteristic polynomial.
+    let c: Vec<Id> = a
+        .iter()
+        .map(|&ak| {
+            let q = pool.div(ak, lead);
+            pool.simplify(q)
+        })
+        .collect();
+    let forcing = pool.div(ode.forcing[0], lead);
+    let forcing = pool.expand(forcing);
+    let groups = forcing_groups(pool, &[forcing])?;
+
+    let mut cases_modes: Vec<(Option<Condition>, Vec<Mode>)> = Vec::new();
+    let exact: Option<Vec<pdyn_expr::Rational>> = c
+        .iter()
+        .map(|&x| pool.as_num(x).and_then(|n| n.as_rational()))
+        .collect();
+    let mut base_modes = Vec::new();
+    let rest: Vec<Id> = if let Some(rc) = exact {
+        let (roots, rest) = rational_roots(&rc);
+        for (r, m) in roots {
+            let rate = pool.num(Number::Rat(r));
+            base_modes.push(Mode::Exp { rate, mult: m });
+        }
+        rest.iter().map(|&r| pool.num(Number::Rat(r))).collect()
+    } else {
+        // Remove the root λ = 0 (equations missing the lowest derivatives).
+        let mut k = 0;
+        while k < c.len() - 1 && c[k] == Pool::ZERO {
+            k += 1;
+        }
+        if k > 0 {
+            base_modes.push(Mode::Exp {
+                rate: Pool::ZERO,
+                mult: k,
+            });
+        }
+        c[k..].to_vec()
+    };
+    match rest.len() {
+        0 | 1 => cases_modes.push((None, base_modes)),
+        2 => {
+            // Monic up to a constant: rest[1] λ + rest[0].
+            let q = pool.div(rest[0], rest[1]);
+            let q = pool.neg(q);
+            let rate = pool.simplify(q);
+            let mut m = base_modes;
+            push_exp(&mut m, rate, 1);
+            cases_modes.push((None, m));
+        }
+        3 => {
+            let (c1, c0) = {
+                let c1 = pool.div(rest[1], rest[2]);
+                let c0 = pool.div(rest[0], rest[2]);
+                (pool.simplify(c1), pool.simplify(c0))
+            };
+            for (cond, modes) in quadratic_modes(pool, c1, c0) {
+                let mut m = base_modes.clone();
+                m.extend(modes);
+                cases_modes.push((cond, m));
+            }
+        }
+        _ => {
+            if c.iter().all(|&x| pool.as_num(x).is_some()) {
+                return Ok(None);
+            }
+            // Symbolic coefficients: the numeric solver would ask for values, but say why here.
+            let params = symbols_of(pool, &c);
+            return Err(no_closed_form(format!(
+                "the characteristic polynomial has degree {} with symbolic coefficients ({}) and does not factor by this method; give numeric values",
+                rest.len() - 1,
+                params
+            )));
+        }
+    }
+
+    let t = pool.time();
+    let mut cases = Vec::new();
+    for (cond, modes) in cases_modes {
+        let mut particular = Pool::ZERO;
+        for g in &groups {
+            let m = resonance(pool, &modes, g.rate, g.freq);
+            let yp = particular_solution(pool, &c, g, m)?;
+            particular = pool.add2(particular, yp);
+        }
+        let basis = basis_functions(pool, &modes, t);
+        let roots = describe_roots(pool, &modes);
+        let (solution, constants) =
+            fit_constants(pool, &basis, particular, ics, ode, t0, first_constant)?;
+        cases.push(Case {
+            condition: cond,
+            solution: vec![solution],
+            roots,
+            constants,
+        });
+    }
+    Ok(Some(ClosedForm {
+        coords: ode.coords.clone(),
+        cases,
+        method: Method::Exact,
+        residual: None,
+    }))
+}
+
+fn symbols_of(pool: &Pool, es: &[Id]) -> String {
+    let mut names: Vec<String> = Vec::new();
+    for n in pool.topo_order(es) {
+        if let Node::Sym(s) = pool.node(n) {
+            let name = pool.name(*s).to_string();
+            if !names.contains(&name) {
+                names.push(name);
+            }
+        }
+    }
+    names.join(", ")
+}
+
+fn push_exp(modes: &mut Vec<Mode>, rate: Id, mult: usize) {
+    for m in modes.iter_mut() {
+        if let Mode::Exp { rate: r, mult: k } = m {
+            if *r == rate {
+                *k += mult;
+                return;
+            }
+        }
+    }
+    modes.push(Mode::Exp { rate, mult });
+}
+
+/// The sign of `e`, when it can be decided.
+pub(crate) fn sign_of(pool: &mut Pool, e: Id) -> Option<Relation> {
+    if e == Pool::ZERO {
+        return Some(Relation::Zero);
+    }
+    if let Some(n) = pool.as_num(e) {
+        return Some(if n.is_positive() {
+            Relation::Positive
+        } else if n.is_negative() {
+            Relation::Negative
+        } else {
+            Relation::Zero
+        });
+    }
+    if let Some(v) = const_value(pool, e) {
+        if v.abs() > 1e-12 * (1.0 + v.abs()) {
+            return Some(if v > 0.0 {
+                Relation::Positive
+            } else {
+                Relation::Negative
+            });
+        }
+    }
+    for form in [e, pool.simplify(e), pool.expand(e)] {
+        if pool.is_positive(form) {
+            return Some(Relation::Positive);
+        }
+        let ne = pool.neg(form);
+        if pool.is_positive(ne) {
+            return Some(Relation::Negative);
+        }
+    }
+    None
+}
+
+/// Numeric value of an expression free of symbols (π, √2...).
+pub(crate) fn const_value(pool: &mut Pool, e: Id) -> Option<f64> {
+    if pool.any_node(e, &|n| {
+        matches!(n, Node::Sym(_) | Node::Coord(..) | Node::Time)
+    }) {
+        return None;
+    }
+    let prog = pdyn_expr::Program::compile(pool, &[], &[e]).ok()?;
+    let mut ws = prog.workspace();
+    let mut out = [0.0];
+    prog.eval(&[], &mut ws, &mut out);
+    out[0].is_finite().then_some(out[0])
+}
+
+/// Drops positive factors from a product, so that `4 wn^2 (zeta^2 - 1)` reads `zeta^2 - 1`.
+fn essential_sign_factor(pool: &mut Pool, e: Id) -> Id {
+    let s = pool.simplify(e);
+    match pool.node(s).clone() {
+        Node::Mul(fs) => {
+            let mut neg = false;
+            let mut keep = Vec::new();
+            for f in fs.iter() {
+                if let Some(n) = pool.as_num(*f) {
+                    neg ^= n.is_negative();
+                } else if !pool.is_positive(*f) {
+                    keep.push(*f);
+                }
+            }
+            let k = pool.mul(&keep);
+            if neg {
+                pool.neg(k)
+            } else {
+                k
+            }
+        }
+        Node::Add(_) => {
+            // Divide out positive common factors while that shortens the expression:
+            // `wn^2 zeta^2 - wn^2` becomes `zeta^2 - 1`.
+            let mut cur = pool.expand(s);
+            for _ in 0..8 {
+                let first = match pool.node(cur) {
+                    Node::Add(ts) => ts[0],
+                    _ => break,
+                };
+                let cands: Vec<Id> = match pool.node(first) {
+                    Node::Mul(fs) => fs.to_vec(),
+                    _ => vec![first],
+                };
+                let size = pool.tree_size(cur, usize::MAX);
+                let mut improved = false;
+                for f in cands {
+                    if pool.as_num(f).is_some() || !pool.is_positive(f) {
+                        continue;
+                    }
+                    let q = pool.div(cur, f);
+                    let q = pool.expand(q);
+                    if pool.tree_size(q, size) < size {
+                        cur = q;
+                        improved = true;
+                        break;
+                    }
+                }
+                if !improved {
+                    break;
+                }
+            }
+            match pool.add_content(cur) {
+                Some((c, prim)) if c.is_positive() => prim,
+                Some((_, prim)) => pool.neg(prim),
+                None => cur,
+            }
+        }
+        _ => s,
+    }
+}
+
+/// Modes of `λ² + c1 λ + c0`, one set per sign of the discriminant when it is unknown.
+fn quadratic_modes(pool: &mut Pool, c1: Id, c0: Id) -> Vec<(Option<Condition>, Vec<Mode>)> {
+    let half = pool.num(Number::ratio(-1, 2));
+    let rate = pool.mul2(half, c1);
+    let rate = pool.simplify(rate);
+    let c1sq = pool.powi(c1, 2);
+    let quarter = pool.num(Number::ratio(1, 4));
+    let q = pool.mul2(quarter, c1sq);
+    let disc = pool.sub(q, c0);
+    let disc = pool.expand(disc);
+    let disc = pool.simplify(disc);
+    let modes_for = |pool: &mut Pool, rel: Relation| -> Vec<Mode> {
+        match rel {
+            Relation::Zero => vec![Mode::Exp { rate, mult: 2 }],
+            Relation::Positive => {
+                // A perfect square gives two rational exponentials.
+                if let Some(r) = pool
+                    .as_num(disc)
+                    .and_then(|n| n.as_rational())
+                    .and_then(|r| r.exact_root(2))
+                {
+                    let rn = pool.num(Number::Rat(r));
+                    let r1 = pool.add2(rate, rn);
+                    let r2 = pool.sub(rate, rn);
+                    return vec![
+                        Mode::Exp { rate: r1, mult: 1 },
+                        Mode::Exp { rate: r2, mult: 1 },
+                    ];
+                }
+                let f = pool.sqrt(disc);
+                let freq = pool.simplify(f);
+                vec![Mode::Hyperbolic { rate, freq }]
+            }
+            Relation::Negative => {
+                let nd = pool.neg(disc);
+                let f = pool.sqrt(nd);
+                let freq = pool.simplify(f);
+                vec![Mode::Oscillatory {
+                    rate,
+                    freq,
+                    mult: 1,
+                }]
+            }
+        }
+    };
+    match sign_of(pool, disc) {
+        Some(rel) => vec![(None, modes_for(pool, rel))],
+        None => {
+            let key = essential_sign_factor(pool, disc);
+            [Relation::Negative, Relation::Zero, Relation::Positive]
+                .into_iter()
+                .map(|rel| {
+                    (
+                        Some(Condition {
+                            expr: key,
+                            relation: rel,
+                        }),
+                        modes_for(pool, rel),
+                    )
+                })
+                .collect()
+        }
+    }
+}
+
+/// Multiplicity of `rate + i freq` among the characteristic roots.
+fn resonance(pool: &mut Pool, modes: &[Mode], rate: Id, freq: Id) -> usize {
+    let mut m = 0;
+    for &mode in modes {
+        match mode {
+            Mode::Exp { rate: r, mult } if freq == Pool::ZERO && pool.provably_equal(r, rate) => {
+                m += mult;
+            }
+            Mode::Hyperbolic { rate: r, freq: f } if freq == Pool::ZERO => {
+                let r1 = pool.add2(r, f);
+                let r2 = pool.sub(r, f);
+                if pool.provably_equal(r1, rate) || pool.provably_equal(r2, rate) {
+                    m += 1;
+                }
+            }
+            Mode::Oscillatory {
+                rate: r,
+                freq: f,
+                mult,
+            } if freq != Pool::ZERO
+                && pool.provably_equal(r, rate)
+                && pool.provably_equal(f, freq) =>
+            {
+                m += mult;
+            }
+            _ => {}
+        }
+    }
+    m
+}
+
+fn exp_of(pool: &mut Pool, rate: Id, t: Id) -> Id {
+    let u = pool.mul2(rate, t);
+    pool.call(Func::Exp, &[u])
+}
+
+fn basis_functions(pool: &mut Pool, modes: &[Mode], t: Id) -> Vec<Id> {
+    let mut out = Vec::new();
+    for &mode in modes {
+        match mode {
+            Mode::Exp { rate, mult } => {
+                let e = exp_of(pool, rate, t);
+                for j in 0..mult {
+                    let tj = pool.powi(t, j as i64);
+                    out.push(pool.mul2(tj, e));
+                }
+            }
+            Mode::Hyperbolic { rate, freq } => {
+                let e = exp_of(pool, rate, t);
+                let u = pool.mul2(freq, t);
+                for f in [Func::Cosh, Func::Sinh] {
+                    let h = pool.call(f, &[u]);
+                    out.push(pool.mul2(e, h));
+                }
+            }
+            Mode::Oscillatory { rate, freq, mult } => {
+                let e = exp_of(pool, rate, t);
+                let u = pool.mul2(freq, t);
+                for j in 0..mult {
+                    let tj = pool.powi(t, j as i64);
+                    for f in [Func::Cos, Func::Sin] {
+                        let h = pool.call(f, &[u]);
+                        out.push(pool.mul(&[tj, e, h]));
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+fn describe_roots(pool: &mut Pool, modes: &[Mode]) -> Vec<String> {
+    let mut out = Vec::new();
+    let times = |m: usize| {
+        if m > 1 {
+            format!(" (×{m})")
+        } else {
+            String::new()
+        }
+    };
+    for &mode in modes {
+        match mode {
+            Mode::Exp { rate, mult } => out.push(format!("{}{}", pool.to_text(rate), times(mult))),
+            Mode::Hyperbolic { rate, freq } => {
+                let r = if rate == Pool::ZERO {
+                    String::new()
+                } else {
+                    format!("{} ", pool.to_text(rate))
+                };
+                out.push(format!("{r}± {}", pool.to_text(freq)));
+            }
+            Mode::Oscillatory { rate, freq, mult } => {
+                let r = if rate == Pool::ZERO {
+                    String::new()
+                } else {
+                    format!("{} ", pool.to_text(rate))
+                };
+                out.push(format!("{r}± i*{}{}", pool.to_text(freq), times(mult)));
+            }
+        }
+    }
+    out
+}
+
+fn binomial(n: usize, k: usize) -> i64 {
+    let mut r: i64 = 1;
+    for i in 0..k {
+        r = r * (n - i) as i64 / (i + 1) as i64;
+    }
+    r
+}
+
+/// Particular solution for one forcing group by undetermined coefficients, `m` the multiplicity
+/// of `rate + i freq` as a characteristic root (monic coefficients `c`).
+fn particular_solution(
+    pool: &mut Pool,
+    c: &[Id],
+    g: &ForcingGroup,
+    m: usize,
+) -> Result<Id, DsolveError> {
+    let t = pool.time();
+    let n = c.len() - 1;
+    let a = g.rate;
+    // L[e^{at} w] = e^{at} Σ_i s_i w^(i), s_i = Σ_{k≥i} c_k C(k,i) a^(k-i).
+    let mut s = Vec::with_capacity(n + 1);
+    for i in 0..=n {
+        let mut terms = Vec::new();
+        for (k, &ck) in c.iter().enumerate().skip(i) {
+            let b = pool.int(binomial(k, i));
+            let ap = pool.powi(a, (k - i) as i64);
+            terms.push(pool.mul(&[b, ck, ap]));
+        }
+        let si = pool.add(&terms);
+        s.push(pool.expand(si));
+    }
+    let deg = g.degree();
+    let oscillating = g.freq != Pool::ZERO;
+    let u = pool.mul2(g.freq, t);
+    let (cos_bt, sin_bt) = if oscillating {
+        (pool.call(Func::Cos, &[u]), pool.call(Func::Sin, &[u]))
+    } else {
+        (Pool::ONE, Pool::ZERO)
+    };
+    let mut unknowns = Vec::new();
+    let mut trial_terms = Vec::new();
+    for j in 0..=deg {
+        let tj = pool.powi(t, (j + m) as i64);
+        let p = pool.symbol(&format!("__dsolve_p{j}"), false);
+        let p = pool.sym(p);
+        unknowns.push(p);
+        trial_terms.push(pool.mul(&[p, tj, cos_bt]));
+        if oscillating {
+            let q = pool.symbol(&format!("__dsolve_q{j}"), false);
+            let q = pool.sym(q);
+            unknowns.push(q);
+            trial_terms.push(pool.mul(&[q, tj, sin_bt]));
+        }
+    }
+    let w = pool.add(&trial_terms);
+    let mut lw = Vec::new();
+    let mut d = w;
+    for (i, &si) in s.iter().enumerate() {
+        if i > 0 {
+            d = pool.dt(d);
+        }
+        lw.push(pool.mul2(si, d));
+    }
+    let mut target = Vec::new();
+    for (j, &pj) in g.cos[0].iter().enumerate() {
+        let tj = pool.powi(t, j as i64);
+        target.push(pool.mul(&[pj, tj, cos_bt]));
+    }
+    for (j, &qj) in g.sin[0].iter().enumerate() {
+        let tj = pool.powi(t, j as i64);
+        target.push(pool.mul(&[qj, tj, sin_bt]));
+    }
+    let lhs = pool.add(&lw);
+    let rhs = pool.add(&target);
+    let resid = pool.sub(lhs, rhs);
+    let resid = pool.expand(resid);
+    // Coefficients of t^j cos(bt) and t^j sin(bt) must vanish.
+    let cs = pool.symbol("__dsolve_cos", false);
+    let cs = pool.sym(cs);
+    let ss = pool.symbol("__dsolve_sin", false);
+    let ss = pool.sym(ss);
+    let mut parts = vec![resid];
+    if oscillating {
+        let r = pool.subs1(resid, cos_bt, cs);
+        let r = pool.subs1(r, sin_bt, ss);
+        if pool.contains(r, u) {
+            return Err(no_closed_form(
+                "the particular solution could not be separated into sine and cosine parts",
+            ));
+        }
+        parts = vec![pool.diff(r, cs), pool.diff(r, ss)];
+    }
+    let mut eqs = Vec::new();
+    for part in parts {
+        let mut p = part;
+        let mut fact = 1i64;
+        for j in 0..=(deg + m + n) {
+            if j > 0 {
+                fact *= j as i64;
+                p = pool.diff(p, t);
+            }
+            let at0 = pool.subs1(p, t, Pool::ZERO);
+            if at0 != Pool::ZERO {
+                let f = pool.int(fact);
+                let e = pool.div(at0, f);
+                eqs.push(pool.expand(e));
+            }
+            if p == Pool::ZERO {
+                break;
+            }
+        }
+    }
+    let sys = pool
+        .linear_system(&eqs, &unknowns)
+        .map_err(|e| DsolveError::Invalid(format!("particular solution: {e}")))?;
+    let sol = pool.solve_linear(&sys).map_err(|e| {
+        no_closed_form(format!(
+            "undetermined coefficients failed for the forcing with rate {} and frequency {} ({e})",
+            pool.to_text(g.rate),
+            pool.to_text(g.freq)
+        ))
+    })?;
+    let mut yp = w;
+    for (&u, &v) in unknowns.iter().zip(&sol) {
+        yp = pool.subs1(yp, u, v);
+    }
+    let e = exp_of(pool, a, t);
+    Ok(pool.mul2(e, yp))
+}
+
+/// `y = Σ C_i φ_i + y_p` with the constants fixed by the initial conditions (all of them or
+/// none: without conditions the constants stay as `C1, C2, ...`).
+fn fit_constants(
+    pool: &mut Pool,
+    basis: &[Id],
+    particular: Id,
+    ics: &[InitialCondition],
+    ode: &LinearOde,
+    t0: Id,
+    first_constant: usize,
+) -> Result<(Id, Vec<Id>), DsolveError> {
+    let t = pool.time();
+    let consts: Vec<Id> = (first_constant..first_constant + basis.len())
+        .map(|i| {
+            let s = pool.symbol(&format!("C{i}"), false);
+            pool.sym(s)
+        })
+        .collect();
+    let mut terms: Vec<Id> = consts
+        .iter()
+        .zip(basis)
+        .map(|(&c, &b)| pool.mul2(c, b))
+        .collect();
+    terms.push(particular);
+    let general = pool.add(&terms);
+    if ics.is_empty() {
+        let e = pool.expand(general);
+        return Ok((pool.simplify(e), consts));
+    }
+    let n = ode.orders[0];
+    if ics.len() != n {
+        return Err(DsolveError::Invalid(format!(
+            "{} initial condition(s) given, the equation needs {n} (`{}` and its derivatives up to order {}), or none",
+            ics.len(),
+            pool.name(ode.coords[0]),
+            n - 1
+        )));
+    }
+    let mut eqs = Vec::new();
+    for ic in ics {
+        let d = pool.dt_n(general, ic.order as usize);
+        let at = pool.subs1(d, t, t0);
+        let e = pool.sub(at, ic.value);
+        eqs.push(pool.expand(e));
+    }
+    let sys = pool
+        .linear_system(&eqs, &consts)
+        .map_err(|e| DsolveError::Invalid(format!("initial conditions: {e}")))?;
+    let sol = pool.solve_linear(&sys).map_err(|e| {
+        DsolveError::Invalid(format!(
+            "the initial conditions do not determine the solution ({e})"
+        ))
+    })?;
+    let mut y = general;
+    for (&c, &v) in consts.iter().zip(&sol) {
+        y = pool.subs1(y, c, v);
+    }
+    let y = pool.expand(y);
+    Ok((pool.simplify(y), Vec::new()))
+}

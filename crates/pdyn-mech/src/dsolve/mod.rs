@@ -1,0 +1,330 @@
+//! Closed-form solution of linear ODEs with constant coefficients, and the 1-D integration
+//! rules of straight-line motion (Bower, *Dynamics*, 3.1.3 and 3.3.2).
+//!
+//! # The mathematics
+//!
+//! A system `Σ_k A_k q^(k)(t) = f(t)` (square, constant matrices `A_k`) has the solution
+//! `q = q_h + q_p`. Every component of `q_h` is a quasi-polynomial built on the roots `λ` of the
+//! characteristic polynomial `χ(λ) = det Σ_k A_k λ^k`: a root of multiplicity `m` contributes
+//! `t^j e^{λt}`, `j < m`; a complex pair `α ± iβ` contributes `t^j e^{αt} cos βt` and
+//! `t^j e^{αt} sin βt`. The forcing is split into groups `e^{at} P(t) cos bt + e^{at} Q(t) sin bt`
+//! (polynomial, exponential, sine/cosine and their products); by superposition each group has a
+//! particular solution of the same form with polynomials of degree `deg P + m`, where `m` is the
+//! multiplicity of `a + ib` as a root of `χ` (`m > 0` is resonance).
+//!
+//! Two solvers implement this:
+//! - **exact** (one coordinate, characteristic polynomial of degree ≤ 2 after removing exact
+//!   rational roots; symbolic parameters allowed). Roots by the quadratic formula on the monic
+//!   polynomial `λ² + c₁λ + c₀`: with `α = -c₁/2` and `Δ = c₁²/4 - c₀`, the homogeneous basis is
+//!   `e^{αt}{cosh, sinh}(√Δ t)` for `Δ > 0` (plain exponentials when `√Δ` is rational),
+//!   `e^{αt}{1, t}` for `Δ = 0` and `e^{αt}{cos, sin}(√-Δ t)` for `Δ < 0`. When the sign of a
+//!   symbolic `Δ` is unknown (the damped oscillator with symbolic `ζ`), every case is returned
+//!   with its condition. The particular solution is found by undetermined coefficients after the
+//!   exponential shift `L[e^{at} w] = e^{at} Σ_k c_k (D + a)^k w`, and the constants from the
+//!   initial conditions by exact linear solution.
+//! - **numeric** (systems, or numeric equations whose characteristic polynomial has irrational
+//!   roots of degree ≥ 3): `χ` is interpolated from `det Σ A_k λ^k` at points on a circle, its
+//!   roots found by the Aberth–Ehrlich iteration, polished by Newton's method and grouped into
+//!   multiple roots and conjugate pairs; the coefficients of every coordinate on the
+//!   quasi-polynomial basis then follow from one least-squares solve of the equations projected on
+//!   the basis (the basis is closed under `d/dt`) together with the initial conditions, and the
+//!   residual is checked.
+//!
+//! Anything else (a coefficient that depends on `t` or on the coordinates, forcing that is not a
+//! sum of such products) is answered with [`DsolveError::NoClosedForm`], which suggests
+//! `pdyn run`. Every step has a fixed work bound, so every call returns in bounded time.
+
+mod exact;
+mod linear;
+mod numeric;
+pub mod quad;
+mod roots;
+pub mod rules;
+
+use pdyn_expr::{Id, Node, Pool, Program, SymId};
+use std::fmt;
+
+pub use linear::{analyze, LinearOde};
+
+/// One initial condition: `coord^(order)(time) = value`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct InitialCondition {
+    /// The coordinate.
+    pub coord: SymId,
+    /// Derivative order (0 for the value, 1 for the rate...).
+    pub order: u8,
+    /// The value.
+    pub value: Id,
+}
+
+/// A relation between an expression and zero, stating when a case applies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Relation {
+    /// `expr > 0`.
+    Positive,
+    /// `expr = 0`.
+    Zero,
+    /// `expr < 0`.
+    Negative,
+}
+
+/// The condition under which a [`Case`] applies: `expr (relation) 0`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Condition {
+    /// The expression whose sign decides.
+    pub expr: Id,
+    /// Its sign in this case.
+    pub relation: Relation,
+}
+
+/// How the solution was obtained.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// Exact symbolic solution.
+    Exact,
+    /// Exact form with floating-point roots and coefficients (numeric eigen-decomposition).
+    Numeric,
+}
+
+/// One solution, valid under its condition.
+#[derive(Clone, Debug)]
+pub struct Case {
+    /// When it applies (`None`: always).
+    pub condition: Option<Condition>,
+    /// One expression in `t` per coordinate, in the order of [`ClosedForm::coords`].
+    pub solution: Vec<Id>,
+    /// Human-readable characteristic roots, e.g. `-zeta*wn ± wn*sqrt(1 - zeta^2)*i`.
+    pub roots: Vec<String>,
+    /// Arbitrary constants left in the solution (`C1`, `C2`...) when initial conditions are
+    /// missing.
+    pub constants: Vec<Id>,
+}
+
+/// Closed-form solution of a linear constant-coefficient system.
+#[derive(Clone, Debug)]
+pub struct ClosedForm {
+    /// The coordinates, in the order of each case's `solution`.
+    pub coords: Vec<SymId>,
+    /// The cases (one, unless the form depends on the sign of a symbolic quantity).
+    pub cases: Vec<Case>,
+    /// How it was obtained.
+    pub method: Method,
+    /// For [`Method::Numeric`]: the relative residual of the least-squares fit (a check).
+    pub residual: Option<f64>,
+}
+
+impl ClosedForm {
+    /// The only case's solution, when there is exactly one case.
+    pub fn unique(&self) -> Option<&[Id]> {
+        match self.cases.as_slice() {
+            [c] => Some(&c.solution),
+            _ => None,
+        }
+    }
+
+    /// Compiles case `case` into a program with inputs `[t, params...]` and outputs
+    /// `[q_1, q_1', q_2, q_2', ...]` (each coordinate and its rate).
+    pub fn compile(
+        &self,
+        pool: &mut Pool,
+        case: usize,
+        params: &[Id],
+    ) -> Result<Program, DsolveError> {
+        let c = self.cases.get(case).ok_or_else(|| {
+            DsolveError::Invalid(format!("no case {case} ({} cases)", self.cases.len()))
+        })?;
+        let t = pool.time();
+        let mut inputs = vec![t];
+        inputs.extend_from_slice(params);
+        let mut outs = Vec::new();
+        for &q in &c.solution {
+            outs.push(q);
+            outs.push(pool.dt(q));
+        }
+        Program::compile(pool, &inputs, &outs).map_err(|e| DsolveError::Invalid(e.to_string()))
+    }
+}
+
+/// Why no closed form was produced.
+#[derive(Clone, Debug, PartialEq)]
+pub enum DsolveError {
+    /// Outside the method: non-linear, variable coefficients, unsupported forcing...
+    NoClosedForm(String),
+    /// The input is malformed (unknown coordinate, inconsistent initial conditions...).
+    Invalid(String),
+}
+
+/// The advice attached to every "no closed form" answer.
+pub const USE_RUN: &str = "no closed form by this method; use `pdyn run` to integrate numerically";
+
+impl fmt::Display for DsolveError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            DsolveError::NoClosedForm(why) => write!(f, "{why}: {USE_RUN}"),
+            DsolveError::Invalid(why) => write!(f, "{why}"),
+        }
+    }
+}
+
+impl std::error::Error for DsolveError {}
+
+pub(crate) fn no_closed_form(why: impl Into<String>) -> DsolveError {
+    DsolveError::NoClosedForm(why.into())
+}
+
+/// Solves `equations` (each meaning `= 0`, linear with constant coefficients in the
+/// coordinates `coords` and their derivatives) with initial conditions at `t = 0`.
+///
+/// `initial` pairs a coordinate leaf (`x`, `x'`, `x''`...) with its value. Missing conditions
+/// leave arbitrary constants `C1, C2, ...` (exact solver only).
+pub fn solve_system(
+    pool: &mut Pool,
+    equations: &[Id],
+    coords: &[SymId],
+    initial: &[(Id, Id)],
+) -> Result<ClosedForm, DsolveError> {
+    let mut ics = Vec::with_capacity(initial.len());
+    for &(lhs, value) in initial {
+        match pool.node(lhs) {
+            Node::Coord(s, k) => ics.push(InitialCondition {
+                coord: *s,
+                order: *k,
+                value,
+            }),
+            _ => {
+                return Err(DsolveError::Invalid(format!(
+                    "initial condition `{} = {}`: the left side must be a coordinate or one of its rates",
+                    pool.to_text(lhs),
+                    pool.to_text(value)
+                )))
+            }
+        }
+    }
+    solve_with(pool, equations, coords, &ics, Pool::ZERO)
+}
+
+/// Like [`solve_system`], with initial conditions given at time `t0`.
+pub fn solve_with(
+    pool: &mut Pool,
+    equations: &[Id],
+    coords: &[SymId],
+    initial: &[InitialCondition],
+    t0: Id,
+) -> Result<ClosedForm, DsolveError> {
+    let ode = analyze(pool, equations, coords)?;
+    for ic in initial {
+        let Some(j) = coords.iter().position(|&c| c == ic.coord) else {
+            return Err(DsolveError::Invalid(format!(
+                "initial condition on `{}`, which is not a coordinate of the equations",
+                pool.name(ic.coord)
+            )));
+        };
+        if ic.order as usize >= ode.orders[j].max(1) {
+            return Err(DsolveError::Invalid(format!(
+                "initial condition on `{}{}`: the equations are of order {} in `{}`, so give its derivatives below order {}",
+                pool.name(ic.coord),
+                "'".repeat(ic.order as usize),
+                ode.orders[j],
+                pool.name(ic.coord),
+                ode.orders[j]
+            )));
+        }
+    }
+    for (i, a) in initial.iter().enumerate() {
+        if initial[..i]
+            .iter()
+            .any(|b| b.coord == a.coord && b.order == a.order)
+        {
+            return Err(DsolveError::Invalid(format!(
+                "two initial conditions on `{}{}`",
+                pool.name(a.coord),
+                "'".repeat(a.order as usize)
+            )));
+        }
+    }
+    if coords.len() == 1 {
+        if let Some(cf) = exact::solve_scalar(pool, &ode, initial, t0, 1)? {
+            return Ok(cf);
+        }
+    } else if let Some(cf) = solve_uncoupled(pool, &ode, initial, t0)? {
+        return Ok(cf);
+    }
+    // Roots not exact, or a coupled system: the numeric solver.
+    numeric::solve_numeric(pool, &ode, initial, t0)
+}
+
+/// Most cases kept when uncoupled equations each split into cases.
+const MAX_CASES: usize = 27;
+
+/// A system whose equations each involve one coordinate (the projectile: `x'' = 0`,
+/// `y'' = -g`) is solved one equation at a time by the exact solver, so symbols are allowed.
+fn solve_uncoupled(
+    pool: &mut Pool,
+    ode: &LinearOde,
+    initial: &[InitialCondition],
+    t0: Id,
+) -> Result<Option<ClosedForm>, DsolveError> {
+    let n = ode.coords.len();
+    let mut owner = vec![usize::MAX; n];
+    for i in 0..n {
+        let involved: Vec<usize> = (0..n)
+            .filter(|&j| ode.coeffs[i][j].iter().any(|&a| a != Pool::ZERO))
+            .collect();
+        match involved.as_slice() {
+            [j] if owner[*j] == usize::MAX => owner[*j] = i,
+            _ => return Ok(None),
+        }
+    }
+    let mut cases: Vec<Case> = vec![Case {
+        condition: None,
+        solution: Vec::new(),
+        roots: Vec::new(),
+        constants: Vec::new(),
+    }];
+    for (j, &i) in owner.iter().enumerate() {
+        let sub = LinearOde {
+            coords: vec![ode.coords[j]],
+            orders: vec![ode.orders[j]],
+            coeffs: vec![vec![ode.coeffs[i][j].clone()]],
+            forcing: vec![ode.forcing[i]],
+        };
+        let ics: Vec<InitialCondition> = initial
+            .iter()
+            .filter(|ic| ic.coord == ode.coords[j])
+            .copied()
+            .collect();
+        let first = 1 + cases[0].constants.len();
+        let Some(cf) = exact::solve_scalar(pool, &sub, &ics, t0, first)? else {
+            return Ok(None);
+        };
+        if cases.len() * cf.cases.len() > MAX_CASES
+            || (cf.cases.len() > 1 && cases.iter().any(|c| c.condition.is_some()))
+        {
+            return Ok(None);
+        }
+        let mut next = Vec::new();
+        for c in &cases {
+            for sc in &cf.cases {
+                let mut solution = c.solution.clone();
+                solution.extend_from_slice(&sc.solution);
+                let mut roots = c.roots.clone();
+                roots.extend(sc.roots.iter().cloned());
+                let mut constants = c.constants.clone();
+                constants.extend_from_slice(&sc.constants);
+                next.push(Case {
+                    condition: c.condition.or(sc.condition),
+                    solution,
+                    roots,
+                    constants,
+                });
+            }
+        }
+        cases = next;
+    }
+    Ok(Some(ClosedForm {
+        coords: ode.coords.clone(),
+        cases,
+        method: Method::Exact,
+        residual: None,
+    }))
+}

@@ -1,0 +1,1 @@
+//! The 1-D rules of straight-line motion (section 3.1.3).
