@@ -402,7 +402,7 @@ impl Pool {
         n
     }
 
-    /// Canonical order of expressions: numbers, constants, `t`, symbols by name, coordinates
+    /// Canonical order of expressions: numbers, constants, symbols by name, `t`, coordinates
     /// by name then derivative order, then compound nodes. Powers sort with their base so that
     /// `a^2*b` keeps `a` before `b`. Deterministic: depends only on structure and names.
     pub fn order(&self, a: Id, b: Id) -> Ordering {
@@ -474,8 +474,8 @@ impl Pool {
         match node {
             Node::Num(_) => 0,
             Node::Const(_) => 1,
-            Node::Time => 2,
-            Node::Sym(_) => 3,
+            Node::Sym(_) => 2,
+            Node::Time => 3,
             Node::Coord(..) => 4,
             Node::Call(..) => 5,
             Node::Pow(..) => 6,

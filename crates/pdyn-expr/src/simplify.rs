@@ -72,7 +72,14 @@ impl Pool {
                 self.mul(&fs)
             }
             Node::Pow(b, x) => {
-                let b = self.simplify_args(b);
+                // Under a fractional or symbolic power the base becomes an atom of the rational
+                // form, so it must be simplified on its own (sqrt(sin^2 + cos^2) = 1).
+                let integer = self.as_num(x).and_then(|n| n.as_integer()).is_some();
+                let b = if integer {
+                    self.simplify_args(b)
+                } else {
+                    self.simplify(b)
+                };
                 let x = self.simplify(x);
                 self.pow(b, x)
             }

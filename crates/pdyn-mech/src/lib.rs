@@ -3,9 +3,18 @@
 //! The textbook's procedure (Bower, *Dynamics*, ch. 3), automated on top of `pdyn-expr`:
 //! - [`kinematics`]: position → velocity, acceleration, normal–tangential and polar components,
 //!   radius of curvature;
+//! - [`model`]: model files (TOML) → particles, coordinates, loads, reactions, constraints;
+//! - [`derive`]: F = ma (and ΣM = 0 for massless frames), constraints at acceleration level,
+//!   eliminated to `q'' = f(q, q', t)` with the reactions as functions of state;
 //! - [`dsolve`]: closed-form solutions of linear constant-coefficient equations of motion, and
 //!   the 1-D integration rules of section 3.1.3.
 #![warn(missing_docs)]
 
+pub mod derive;
 pub mod dsolve;
 pub mod kinematics;
+pub mod model;
+pub mod units;
+
+pub use derive::{derive, Derivation, DeriveError, DeriveOptions};
+pub use model::{load, load_file, Model, ModelError};

@@ -1,6 +1,7 @@
 //! `pdyn`: the command-line front end. Thin by design: parse arguments, call the library,
 //! print. Every error becomes a message and a non-zero exit code here, and only here.
 
+mod derive_cmd;
 mod expr_cmd;
 
 use clap::{Parser, Subcommand};
@@ -24,6 +25,8 @@ enum Command {
     Solve(expr_cmd::SolveArgs),
     /// Evaluate an expression numerically.
     Eval(expr_cmd::EvalArgs),
+    /// Derive the equations of motion of a model file.
+    Derive(derive_cmd::DeriveArgs),
 }
 
 fn main() -> ExitCode {
@@ -33,6 +36,7 @@ fn main() -> ExitCode {
         Command::Diff(a) => expr_cmd::diff(a),
         Command::Solve(a) => expr_cmd::solve(a),
         Command::Eval(a) => expr_cmd::eval(a),
+        Command::Derive(a) => derive_cmd::run(a),
     };
     match result {
         Ok(out) => {

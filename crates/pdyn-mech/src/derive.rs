@@ -1,0 +1,548 @@
+//! Derivation of the equations of motion (chapter 3.3.1, steps 2–7).
+//!
+//! For every particle: `r` (from the model), `v = dr/dt`, `a = dv/dt` by the chain rule; the
+//! resultant force `F` of every load on it (and on the massless frame carrying it). Then
+//! - **Newton form**: `m a − F = 0`, three components per particle (identically zero ones
+//!   dropped); `ΣM = 0` about the particle for each massless frame; `d²f/dt² = 0` for each
+//!   constraint `f(q, t) = 0`. Unknowns: the free coordinates' second derivatives and every
+//!   reaction. The equations are linear in them: `A x = b`, solved exactly when small
+//!   (so `q'' = …` and the reactions print as formulas), numerically at evaluation time
+//!   otherwise.
+//! - **Projected (Kane) form**: `Σ_p (m_p a_p − F_p)·∂r_p/∂q_j = 0` for each free coordinate
+//!   `q_j`, i.e. `M(q) q'' = f(q, q', t)` with `M_jk = Σ_p m_p ∂r_p/∂q_j·∂r_p/∂q_k`. Workless
+//!   reactions (rod tensions, normal forces of fixed smooth guides) drop out, so they need not be
+//!   declared; it is the form used when the Newton equations outnumber their unknowns.
+
+use crate::model::{CoordinateKind, Model, Target};
+use pdyn_expr::linsolve::{LinearError, LinearSystem};
+use pdyn_expr::{vector, Id, Pool};
+use rustc_hash::FxHashMap;
+
+/// Which set of equations to build.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Form {
+    /// Newton's equations when they are square, the projected form when they outnumber the
+    /// unknowns (undeclared workless reactions).
+    #[default]
+    Auto,
+    /// F = m a per particle, reactions as unknowns.
+    Newton,
+    /// `M(q) q'' = f`, reactions eliminated by projection.
+    Projected,
+}
+
+/// Knobs of [`derive`].
+#[derive(Clone, Debug)]
+pub struct DeriveOptions {
+    /// Which equations to build. Default: [`Form::Auto`].
+    pub form: Form,
+    /// Largest number of unknowns eliminated symbolically; larger systems are solved
+    /// numerically when evaluated. Default: 6.
+    pub symbolic_limit: usize,
+    /// Simplify printed expressions (velocities, forces, solutions). Default: true.
+    pub simplify: bool,
+}
+
+impl Default for DeriveOptions {
+    fn default() -> Self {
+        DeriveOptions {
+            form: Form::Auto,
+            symbolic_limit: 6,
+            simplify: true,
+        }
+    }
+}
+
+/// A model whose equations cannot be formed or solved.
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct DeriveError {
+    /// What is wrong, naming the coordinates, reactions or equations involved.
+    pub message: String,
+    /// What to do about it.
+    pub help: Option<String>,
+}
+
+impl std::fmt::Display for DeriveError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.message)?;
+        if let Some(h) = &self.help {
+            write!(f, "\n  = help: {h}")?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for DeriveError {}
+
+fn derr(message: impl Into<String>, help: impl Into<String>) -> DeriveError {
+    DeriveError {
+        message: message.into(),
+        help: Some(help.into()),
+    }
+}
+
+/// Position, velocity, acceleration and resultant force of one particle.
+#[derive(Clone, Debug)]
+pub struct ParticleKinematics {
+    /// Name.
+    pub name: String,
+    /// Mass.
+    pub mass: Id,
+    /// Position.
+    pub r: [Id; 3],
+    /// Velocity.
+    pub v: [Id; 3],
+    /// Acceleration.
+    pub a: [Id; 3],
+    /// Resultant force (including loads on its massless frame).
+    pub force: [Id; 3],
+}
+
+/// One scalar equation `lhs = rhs`.
+#[derive(Clone, Debug)]
+pub struct Equation {
+    /// Where it comes from: `sat: F = ma, x`, `bike: ΣM = 0, z`, `constraint yA + yB = c`.
+    pub label: String,
+    /// Left side (e.g. `m*x''`).
+    pub lhs: Id,
+    /// Right side (e.g. the force component).
+    pub rhs: Id,
+}
+
+/// What an unknown is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UnknownKind {
+    /// Second derivative of the free coordinate with this index in [`Model::coordinates`].
+    Acceleration(usize),
+    /// The reaction with this index in [`Model::reactions`].
+    Reaction(usize),
+}
+
+/// An unknown of the linear system.
+#[derive(Clone, Debug)]
+pub struct Unknown {
+    /// Printed name (`x''`, `N`).
+    pub name: String,
+    /// The leaf expression.
+    pub id: Id,
+    /// Acceleration or reaction.
+    pub kind: UnknownKind,
+}
+
+/// The equations of motion of a model, ready to print or compile.
+#[derive(Clone, Debug)]
+pub struct Derivation {
+    /// The form actually used.
+    pub form: Form,
+    /// Per particle kinematics and forces.
+    pub particles: Vec<ParticleKinematics>,
+    /// The equations (Newton or projected), `lhs = rhs`.
+    pub equations: Vec<Equation>,
+    /// Unknowns, in column order of `system`.
+    pub unknowns: Vec<Unknown>,
+    /// `A x = b` in the unknowns, entries functions of state and time.
+    pub system: LinearSystem,
+    /// Exact solution, one simplified expression per unknown, when the system was small.
+    pub solution: Option<Vec<Id>>,
+    /// Indices (into [`Model::coordinates`]) of the free coordinates, in state order.
+    pub free: Vec<usize>,
+    /// State leaves `w = [q_1..q_n, q_1'..q_n']`.
+    pub state: Vec<Id>,
+    /// Printable names of the state entries.
+    pub state_names: Vec<String>,
+    /// Notes for the user (form chosen and why).
+    pub notes: Vec<String>,
+}
+
+impl Derivation {
+    /// `q''` of each free coordinate, when solved exactly.
+    pub fn accelerations(&self) -> Option<Vec<Id>> {
+        let sol = self.solution.as_ref()?;
+        Some(
+            self.unknowns
+                .iter()
+                .zip(sol)
+                .filter(|(u, _)| matches!(u.kind, UnknownKind::Acceleration(_)))
+                .map(|(_, &s)| s)
+                .collect(),
+        )
+    }
+
+    /// `(name, expression)` of each reaction, when solved exactly.
+    pub fn reactions(&self) -> Option<Vec<(String, Id)>> {
+        let sol = self.solution.as_ref()?;
+        Some(
+            self.unknowns
+                .iter()
+                .zip(sol)
+                .filter(|(u, _)| matches!(u.kind, UnknownKind::Reaction(_)))
+                .map(|(u, &s)| (u.name.clone(), s))
+                .collect(),
+        )
+    }
+}
+
+fn simp(p: &mut Pool, e: Id, on: bool) -> Id {
+    if on && p.tree_size(e, 4001) <= 4000 {
+        p.simplify(e)
+    } else {
+        e
+    }
+}
+
+/// Derives the equations of motion of `model` (its pool grows with the new expressions).
+pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, DeriveError> {
+    let free: Vec<usize> = model
+        .coordinates
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| matches!(c.kind, CoordinateKind::Free { .. }))
+        .map(|(i, _)| i)
+        .collect();
+    let p = &mut model.pool;
+    let q: Vec<Id> = free
+        .iter()
+        .map(|&i| p.coord(model.coordinates[i].sym, 0))
+        .collect();
+    let qd: Vec<Id> = free
+        .iter()
+        .map(|&i| p.coord(model.coordinates[i].sym, 1))
+        .collect();
+    let qdd: Vec<Id> = free
+        .iter()
+        .map(|&i| p.coord(model.coordinates[i].sym, 2))
+        .collect();
+    let mut state = q.clone();
+    state.extend(&qd);
+    let mut state_names: Vec<String> = free
+        .iter()
+        .map(|&i| model.coordinates[i].name.clone())
+        .collect();
+    state_names.extend(
+        free.iter()
+            .map(|&i| format!("{}'", model.coordinates[i].name)),
+    );
+
+    // Kinematics and resultant forces.
+    let mut parts = Vec::with_capacity(model.particles.len());
+    for (i, pt) in model.particles.iter().enumerate() {
+        let r = pt.position;
+        let v = r.map(|c| p.dt(c));
+        let a = v.map(|c| p.dt(c));
+        let mut f = [Pool::ZERO; 3];
+        for load in &model.loads {
+            let on_it = match &load.target {
+                Target::Particle(j) => *j == i,
+                Target::Frame { frame, .. } => model.frames[*frame].particle == i,
+            };
+            if on_it {
+                f = vector::add(p, f, load.force);
+            }
+        }
+        parts.push(ParticleKinematics {
+            name: pt.name.clone(),
+            mass: pt.mass,
+            r,
+            v,
+            a,
+            force: f,
+        });
+    }
+
+    // Newton's equations, frame moments, constraints.
+    let axes = ["x", "y", "z"];
+    let mut newton: Vec<Equation> = Vec::new();
+    for pk in &parts {
+        for (c, axis) in axes.iter().enumerate() {
+            let lhs = p.mul2(pk.mass, pk.a[c]);
+            if lhs == Pool::ZERO && pk.force[c] == Pool::ZERO {
+                continue;
+            }
+            newton.push(Equation {
+                label: format!("{}: F = ma, {axis}", pk.name),
+                lhs,
+                rhs: pk.force[c],
+            });
+        }
+    }
+    for (j, fr) in model.frames.iter().enumerate() {
+        let rp = parts[fr.particle].r;
+        let mut m = [Pool::ZERO; 3];
+        for load in &model.loads {
+            if let Target::Frame { frame, at } = &load.target {
+                if *frame == j {
+                    let arm = vector::sub(p, *at, rp);
+                    let mo = vector::cross(p, arm, load.force);
+                    m = vector::add(p, m, mo);
+                }
+            }
+        }
+        for (c, &mc) in m.iter().enumerate() {
+            if mc != Pool::ZERO {
+                newton.push(Equation {
+                    label: format!(
+                        "{}: ΣM = 0 about {}, {}",
+                        fr.name, model.particles[fr.particle].name, axes[c]
+                    ),
+                    lhs: Pool::ZERO,
+                    rhs: mc,
+                });
+            }
+        }
+    }
+    let mut constraint_eqs = Vec::new();
+    for c in &model.constraints {
+        let acc = p.dt_n(c.equation, 2);
+        constraint_eqs.push(Equation {
+            label: format!("constraint {} (differentiated twice)", c.label),
+            lhs: acc,
+            rhs: Pool::ZERO,
+        });
+    }
+
+    let reaction_unknowns: Vec<Unknown> = model
+        .reactions
+        .iter()
+        .enumerate()
+        .map(|(k, r)| Unknown {
+            name: r.name.clone(),
+            id: r.id,
+            kind: UnknownKind::Reaction(k),
+        })
+        .collect();
+    let acc_unknowns: Vec<Unknown> = free
+        .iter()
+        .zip(&qdd)
+        .map(|(&i, &id)| Unknown {
+            name: format!("{}''", model.coordinates[i].name),
+            id,
+            kind: UnknownKind::Acceleration(i),
+        })
+        .collect();
+
+    let n_newton = newton.len() + constraint_eqs.len();
+    let n_unknowns = acc_unknowns.len() + reaction_unknowns.len();
+    let mut notes = Vec::new();
+    let form = match opts.form {
+        Form::Auto
+            if n_newton > n_unknowns && model.constraints.is_empty() && model.frames.is_empty() =>
+        {
+            notes.push(format!(
+                "Newton's equations ({n_newton}) outnumber their unknowns ({n_unknowns}): the undeclared \
+                 reactions are taken as workless and eliminated by projection (Kane's method)"
+            ));
+            Form::Projected
+        }
+        Form::Auto => Form::Newton,
+        other => other,
+    };
+
+    let (equations, unknowns) = match form {
+        Form::Projected => {
+            if !model.constraints.is_empty() || !model.frames.is_empty() {
+                return Err(derr(
+                    "the projected form needs independent coordinates: this model has constraints or massless frames",
+                    "use the Newton form (--form newton)",
+                ));
+            }
+            let eqs = projected(
+                p,
+                &parts,
+                &qd,
+                &qdd,
+                &free,
+                &model.coordinates,
+                &model.reactions,
+            )?;
+            // Reactions that survive projection do work: they stay unknown and need equations.
+            let mut unk: Vec<Unknown> = acc_unknowns;
+            for ru in reaction_unknowns {
+                if eqs
+                    .iter()
+                    .any(|e| p.contains(e.rhs, ru.id) || p.contains(e.lhs, ru.id))
+                {
+                    unk.push(ru);
+                }
+            }
+            (eqs, unk)
+        }
+        _ => {
+            let mut eqs = newton;
+            eqs.extend(constraint_eqs);
+            let mut unk = acc_unknowns;
+            unk.extend(reaction_unknowns);
+            (eqs, unk)
+        }
+    };
+
+    // Residuals `lhs - rhs`, the linear system, and a check of equations without unknowns.
+    let unknown_ids: Vec<Id> = unknowns.iter().map(|u| u.id).collect();
+    let mut kept = Vec::new();
+    let mut residuals = Vec::new();
+    for e in equations {
+        let r = p.sub(e.lhs, e.rhs);
+        if unknown_ids.iter().any(|&u| p.contains(r, u)) {
+            residuals.push(r);
+            kept.push(e);
+        } else if !p.provably_equal(r, Pool::ZERO) {
+            return Err(derr(
+                format!(
+                    "equation `{}` involves no unknown and does not hold: {} = {}",
+                    e.label,
+                    p.to_text(e.lhs),
+                    p.to_text(e.rhs)
+                ),
+                "a force is missing from the free body diagram: declare the reaction that balances it ([[forces]] kind = \"reaction\")",
+            ));
+        }
+    }
+    let equations = kept;
+    for u in &unknowns {
+        if !residuals.iter().any(|&r| p.contains(r, u.id)) {
+            return Err(derr(
+                format!("no equation involves `{}`", u.name),
+                match u.kind {
+                    UnknownKind::Acceleration(_) => "the coordinate does not move any particle: use it in a position, or remove it",
+                    UnknownKind::Reaction(_) => "the reaction acts on nothing that moves: check its `on` and `direction`",
+                },
+            ));
+        }
+    }
+    if residuals.len() < unknowns.len() {
+        let names: Vec<&str> = unknowns.iter().map(|u| u.name.as_str()).collect();
+        return Err(derr(
+            format!(
+                "{} equations for {} unknowns ({})",
+                residuals.len(),
+                unknowns.len(),
+                names.join(", ")
+            ),
+            "look for constraints that relate the coordinates ([[constraints]]), or fewer unknown reactions (chapter 3.3.1, step 7)",
+        ));
+    }
+    let system = p.linear_system(&residuals, &unknown_ids).map_err(|e| match e {
+        LinearError::NotLinear { equation, unknown } => derr(
+            format!(
+                "equation `{}` is not linear in `{}`",
+                equations[equation].label,
+                p.to_text(unknown)
+            ),
+            "forces may depend on positions and velocities but not on accelerations or products of reactions",
+        ),
+        other => derr(other.to_string(), "check the model's forces"),
+    })?;
+
+    let solution = if unknowns.len() <= opts.symbolic_limit || residuals.len() > unknowns.len() {
+        match p.solve_linear(&system) {
+            Ok(sol) => Some(sol.into_iter().map(|s| simp(p, s, opts.simplify)).collect()),
+            Err(LinearError::Underdetermined { free }) => {
+                let names: Vec<String> = free.iter().map(|&f| p.to_text(f)).collect();
+                return Err(derr(
+                    format!("the equations do not determine {}", names.join(", ")),
+                    "the system is singular: look for a missing constraint or a reaction with no independent equation",
+                ));
+            }
+            Err(LinearError::Inconsistent { equation }) => {
+                return Err(derr(
+                    format!(
+                        "equation `{}` contradicts the others",
+                        equations[equation].label
+                    ),
+                    "more equations than unknowns: a reaction may be missing",
+                ));
+            }
+            Err(_) => None,
+        }
+    } else {
+        None
+    };
+
+    for pk in parts.iter_mut() {
+        pk.v = pk.v.map(|c| simp(p, c, opts.simplify));
+        pk.a = pk.a.map(|c| simp(p, c, opts.simplify));
+        pk.force = pk.force.map(|c| simp(p, c, opts.simplify));
+    }
+    let equations = equations
+        .into_iter()
+        .map(|e| Equation {
+            lhs: simp(p, e.lhs, opts.simplify),
+            rhs: simp(p, e.rhs, opts.simplify),
+            label: e.label,
+        })
+        .collect();
+
+    Ok(Derivation {
+        form,
+        particles: parts,
+        equations,
+        unknowns,
+        system,
+        solution,
+        free,
+        state,
+        state_names,
+        notes,
+    })
+}
+
+/// Kane's equations: for each free coordinate, Σ_p (m a − F)·∂r/∂q_j, written as
+/// `Σ_k M_jk q_k'' = f_j`.
+fn projected(
+    p: &mut Pool,
+    parts: &[ParticleKinematics],
+    qd: &[Id],
+    qdd: &[Id],
+    free: &[usize],
+    coordinates: &[crate::model::Coordinate],
+    reactions: &[crate::model::Reaction],
+) -> Result<Vec<Equation>, DeriveError> {
+    let n = qd.len();
+    // Partial velocities ∂v/∂q_j' = ∂r/∂q_j.
+    let jac: Vec<Vec<[Id; 3]>> = parts
+        .iter()
+        .map(|pk| (0..n).map(|j| pk.v.map(|c| p.diff(c, qd[j]))).collect())
+        .collect();
+    let zero_acc: FxHashMap<Id, Id> = qdd.iter().map(|&a| (a, Pool::ZERO)).collect();
+    let mut eqs = Vec::with_capacity(n);
+    for j in 0..n {
+        let mut lhs_terms = Vec::new();
+        let mut rhs_terms = Vec::new();
+        for (pi, pk) in parts.iter().enumerate() {
+            let jj = jac[pi][j];
+            if jj.iter().all(|&c| c == Pool::ZERO) {
+                continue;
+            }
+            for (k, &acc) in qdd.iter().enumerate() {
+                let jk = jac[pi][k];
+                let d = vector::dot(p, jj, jk);
+                if d != Pool::ZERO {
+                    lhs_terms.push(p.mul(&[pk.mass, d, acc]));
+                }
+            }
+            // Generalized force minus the velocity-dependent part of m a.
+            let a0 = pk.a.map(|c| p.subs(c, &zero_acc));
+            let ma0 = vector::scale(p, pk.mass, a0);
+            let net = vector::sub(p, pk.force, ma0);
+            rhs_terms.push(vector::dot(p, net, jj));
+        }
+        let lhs = p.add(&lhs_terms);
+        let rhs = p.add(&rhs_terms);
+        // Reactions that do no work in this direction vanish only after simplification.
+        let mut rhs = rhs;
+        for r in reactions {
+            if p.contains(rhs, r.id) {
+                let c = p.diff(rhs, r.id);
+                if p.provably_equal(c, Pool::ZERO) {
+                    rhs = p.subs1(rhs, r.id, Pool::ZERO);
+                }
+            }
+        }
+        eqs.push(Equation {
+            label: format!("projection on {}", coordinates[free[j]].name),
+            lhs,
+            rhs,
+        });
+    }
+    Ok(eqs)
+}

@@ -1,0 +1,92 @@
+//! The model file as written: TOML tables deserialised with their byte spans, before any name
+//! is resolved. Every field is optional here; [`super::load`] checks what each kind needs and
+//! reports what is missing at the right place.
+
+use indexmap::IndexMap;
+use serde::Deserialize;
+use toml::Spanned;
+
+/// A value with its span: a number, or a string holding an expression or a quantity.
+pub type Sv = Spanned<toml::Value>;
+/// A name with its span.
+pub type Name = Spanned<String>;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(dead_code)] // `name`, `description` are read through serde only
+pub struct RawModel {
+    pub name: Option<String>,
+    pub description: Option<String>,
+    /// Uniform gravitational acceleration vector, applied to every particle.
+    pub gravity: Option<Sv>,
+    #[serde(default)]
+    pub parameters: IndexMap<Name, Sv>,
+    #[serde(default)]
+    pub coordinates: IndexMap<Name, Sv>,
+    #[serde(default)]
+    pub definitions: IndexMap<Name, Sv>,
+    #[serde(default)]
+    pub points: IndexMap<Name, Sv>,
+    #[serde(default)]
+    pub particles: IndexMap<Name, Spanned<RawParticle>>,
+    #[serde(default)]
+    pub frames: IndexMap<Name, Spanned<RawFrame>>,
+    #[serde(default)]
+    pub forces: Vec<Spanned<RawForce>>,
+    #[serde(default)]
+    pub constraints: Vec<Spanned<RawConstraint>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawParticle {
+    pub mass: Option<Sv>,
+    pub position: Option<Sv>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawFrame {
+    /// The particle the massless frame carries; moments are taken about it.
+    pub particle: Option<Name>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawConstraint {
+    pub equation: Option<Sv>,
+    pub name: Option<Name>,
+}
+
+/// One `[[forces]]` entry; which fields apply depends on `kind`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawForce {
+    pub kind: Option<Name>,
+    pub name: Option<Name>,
+    pub on: Option<Name>,
+    pub at: Option<Sv>,
+    pub to: Option<Name>,
+    pub between: Option<Spanned<Vec<Name>>>,
+    pub force: Option<Sv>,
+    pub direction: Option<Sv>,
+    pub k: Option<Sv>,
+    pub l0: Option<Sv>,
+    pub length: Option<Sv>,
+    pub c: Option<Sv>,
+    pub coefficient: Option<Sv>,
+    pub rho: Option<Sv>,
+    pub cd: Option<Sv>,
+    pub area: Option<Sv>,
+    pub wind: Option<Sv>,
+    pub strength: Option<Sv>,
+    pub potential: Option<Sv>,
+    pub mu: Option<Sv>,
+    pub normal: Option<Sv>,
+    pub tangent: Option<Sv>,
+    pub mode: Option<Name>,
+    pub opposes: Option<Sv>,
+    pub surface_velocity: Option<Sv>,
+    pub normal_force: Option<Name>,
+    pub friction_force: Option<Name>,
+}

@@ -1,0 +1,172 @@
+//! `pdyn derive MODEL`: the equations of motion of a model file, as the chapter writes them.
+
+use clap::{Args, ValueEnum};
+use pdyn_expr::{Id, Pool};
+use pdyn_mech::derive::{Form, UnknownKind};
+use pdyn_mech::{derive, DeriveOptions};
+use serde_json::json;
+use std::path::PathBuf;
+
+/// Which equations to derive.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum FormArg {
+    /// Newton's equations, or the projected form when undeclared reactions make them outnumber the unknowns.
+    Auto,
+    /// F = ma per particle with reactions as unknowns.
+    Newton,
+    /// M(q) q'' = f (Kane): workless reactions eliminated.
+    Projected,
+}
+
+/// `pdyn derive`.
+#[derive(Args, Debug)]
+pub struct DeriveArgs {
+    /// The model file (TOML), e.g. examples/satellite.toml.
+    model: PathBuf,
+    /// Print expressions in LaTeX.
+    #[arg(long)]
+    latex: bool,
+    /// Machine-readable output.
+    #[arg(long)]
+    json: bool,
+    /// Which equations to build.
+    #[arg(long, value_enum, default_value_t = FormArg::Auto)]
+    form: FormArg,
+    /// Largest system eliminated symbolically (larger ones are solved numerically when run).
+    #[arg(long, default_value_t = 6)]
+    symbolic_limit: usize,
+}
+
+/// Loads a model file and renders any error with its location.
+pub fn load(path: &std::path::Path) -> Result<pdyn_mech::Model, String> {
+    let source = std::fs::read_to_string(path)
+        .map_err(|e| format!("{}: error: cannot read the model file: {e}", path.display()))?;
+    pdyn_mech::load(&source, &path.display().to_string()).map_err(|e| e.render(&source))
+}
+
+/// `pdyn derive MODEL`.
+pub fn run(a: DeriveArgs) -> Result<String, String> {
+    let mut model = load(&a.model)?;
+    let opts = DeriveOptions {
+        form: match a.form {
+            FormArg::Auto => Form::Auto,
+            FormArg::Newton => Form::Newton,
+            FormArg::Projected => Form::Projected,
+        },
+        symbolic_limit: a.symbolic_limit,
+        ..DeriveOptions::default()
+    };
+    let d = derive(&mut model, &opts).map_err(|e| format!("{}: error: {e}", model.origin))?;
+    let p = &model.pool;
+    let show = |id: Id| -> String {
+        if a.latex {
+            p.to_latex(id)
+        } else {
+            p.to_text(id)
+        }
+    };
+    let vec3 = |v: [Id; 3]| -> String {
+        let parts: Vec<String> = v.iter().map(|&c| show(c)).collect();
+        if a.latex {
+            format!(
+                "\\begin{{bmatrix}} {} \\end{{bmatrix}}",
+                parts.join(" \\\\ ")
+            )
+        } else {
+            format!("[{}]", parts.join(", "))
+        }
+    };
+    if a.json {
+        return Ok(format!("{}\n", to_json(&model, &d, p)));
+    }
+    let mut out = format!("{}\n\n", model.name);
+    out += "Coordinates:\n";
+    for c in &model.coordinates {
+        match &c.kind {
+            pdyn_mech::model::CoordinateKind::Free { initial, rate } => {
+                out += &format!(
+                    "  {} (unknown): {0}(0) = {initial}, {0}'(0) = {rate}\n",
+                    c.name
+                )
+            }
+            pdyn_mech::model::CoordinateKind::Prescribed { expr } => {
+                out += &format!("  {} = {} (prescribed)\n", c.name, show(*expr))
+            }
+        }
+    }
+    out += "\nParticles:\n";
+    for pk in &d.particles {
+        out += &format!("  {} (mass {})\n", pk.name, show(pk.mass));
+        out += &format!("    r = {}\n", vec3(pk.r));
+        out += &format!("    v = {}\n", vec3(pk.v));
+        out += &format!("    a = {}\n", vec3(pk.a));
+        out += &format!("    F = {}\n", vec3(pk.force));
+    }
+    let title = match d.form {
+        Form::Projected => "Equations of motion (projected on the coordinates, M q'' = f)",
+        _ => "Equations of motion (F = ma, component by component)",
+    };
+    out += &format!("\n{title}:\n");
+    for e in &d.equations {
+        out += &format!("  {}:\n    {} = {}\n", e.label, show(e.lhs), show(e.rhs));
+    }
+    for n in &d.notes {
+        out += &format!("  note: {n}\n");
+    }
+    let names: Vec<&str> = d.unknowns.iter().map(|u| u.name.as_str()).collect();
+    out += &format!("\nUnknowns: {}\n", names.join(", "));
+    match &d.solution {
+        Some(sol) => {
+            out += "\nSolved:\n";
+            for (u, &s) in d.unknowns.iter().zip(sol) {
+                out += &format!("  {} = {}\n", u.name, show(s));
+            }
+            out += &format!(
+                "\nFirst-order system, w = [{}]:\n",
+                d.state_names.join(", ")
+            );
+            let n = d.free.len();
+            for i in 0..n {
+                out += &format!("  d/dt {} = {}\n", d.state_names[i], d.state_names[n + i]);
+            }
+            for (u, &s) in d.unknowns.iter().zip(sol) {
+                if let UnknownKind::Acceleration(_) = u.kind {
+                    out += &format!("  d/dt {}' = {}\n", u.name.trim_end_matches('\''), show(s));
+                }
+            }
+        }
+        None => {
+            out += &format!(
+                "\nThe {}×{} linear system A x = b is solved numerically at each evaluation \
+                 (more than {} unknowns).\n",
+                d.system.rows(),
+                d.system.cols(),
+                a.symbolic_limit
+            );
+        }
+    }
+    Ok(out)
+}
+
+fn to_json(model: &pdyn_mech::Model, d: &pdyn_mech::Derivation, p: &Pool) -> serde_json::Value {
+    let e = |id: Id| json!({"text": p.to_text(id), "latex": p.to_latex(id)});
+    let v = |x: [Id; 3]| json!(x.iter().map(|&c| e(c)).collect::<Vec<_>>());
+    json!({
+        "model": model.name,
+        "form": format!("{:?}", d.form).to_lowercase(),
+        "coordinates": model.coordinates.iter().map(|c| match &c.kind {
+            pdyn_mech::model::CoordinateKind::Free { initial, rate } =>
+                json!({"name": c.name, "kind": "unknown", "initial": initial, "rate": rate}),
+            pdyn_mech::model::CoordinateKind::Prescribed { expr } =>
+                json!({"name": c.name, "kind": "prescribed", "expr": e(*expr)}),
+        }).collect::<Vec<_>>(),
+        "particles": d.particles.iter().map(|pk| json!({
+            "name": pk.name, "mass": e(pk.mass), "r": v(pk.r), "v": v(pk.v), "a": v(pk.a), "force": v(pk.force),
+        })).collect::<Vec<_>>(),
+        "equations": d.equations.iter().map(|q| json!({"label": q.label, "lhs": e(q.lhs), "rhs": e(q.rhs)})).collect::<Vec<_>>(),
+        "unknowns": d.unknowns.iter().map(|u| u.name.clone()).collect::<Vec<_>>(),
+        "solution": d.solution.as_ref().map(|s| d.unknowns.iter().zip(s).map(|(u, &x)| json!({"unknown": u.name, "expr": e(x)})).collect::<Vec<_>>()),
+        "state": d.state_names,
+        "notes": d.notes,
+    })
+}
