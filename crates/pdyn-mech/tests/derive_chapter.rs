@@ -1,0 +1,194 @@
+//! Derived equations of the chapter's systems match the chapter's (examples/ hold the models).
+
+use pdyn_expr::{FreeScope, Id, Pool, Program};
+use pdyn_mech::derive::UnknownKind;
+use pdyn_mech::model::CoordinateKind;
+use pdyn_mech::{derive, load, DeriveOptions, Model};
+
+fn example(name: &str) -> Model {
+    let path = format!("{}/../../examples/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+    let src = std::fs::read_to_string(&path).unwrap();
+    match load(&src, &path) {
+        Ok(m) => m,
+        Err(e) => panic!("{}", e.render(&src)),
+    }
+}
+
+/// Solved expression for the unknown named `name`.
+fn solved(m: &mut Model, name: &str) -> Id {
+    let d = derive(m, &DeriveOptions::default()).unwrap();
+    let sol = d.solution.as_ref().expect("solved symbolically");
+    let k = d.unknowns.iter().position(|u| u.name == name).unwrap();
+    sol[k]
+}
+
+/// Parses `expected` with the model's free coordinates as functions of time.
+fn same(m: &mut Model, got: Id, expected: &str) {
+    let coords: Vec<String> = m
+        .coordinates
+        .iter()
+        .filter(|c| matches!(c.kind, CoordinateKind::Free { .. }))
+        .map(|c| c.name.clone())
+        .collect();
+    let mut scope = FreeScope::with_coordinates(coords.iter().map(String::as_str));
+    let p = &mut m.pool;
+    let e = p.parse_in(expected, &mut scope).unwrap().scalar().unwrap();
+    assert!(
+        p.provably_equal(got, e),
+        "got {}, expected {expected}",
+        p.to_text(got)
+    );
+}
+
+#[test]
+fn suspension_3_3_2_example_2() {
+    let mut m = example("suspension");
+    let x = solved(&mut m, "x''");
+    same(&mut m, x, "-(g + k*(x - L0)/m)");
+    let r = solved(&mut m, "R");
+    assert_eq!(r, Pool::ZERO);
+}
+
+#[test]
+fn rotating_rod_pushing_block_3_3_2_example_3() {
+    let mut m = example("rotating_rod_block");
+    let r = solved(&mut m, "r''");
+    // r'' + 2 mu omega r' - omega^2 r = 0
+    same(&mut m, r, "-2*mu*omega*r' + omega^2*r");
+    let n = solved(&mut m, "N");
+    same(&mut m, n, "2*m*omega*r'");
+}
+
+#[test]
+fn projectile_with_drag_3_3_3_example_1() {
+    let mut m = example("projectile_drag");
+    let v = "sqrt(x'^2 + y'^2 + z'^2)";
+    let x = solved(&mut m, "x''");
+    same(&mut m, x, &format!("-c*{v}*x'"));
+    let z = solved(&mut m, "z''");
+    same(&mut m, z, &format!("-g - c*{v}*z'"));
+}
+
+#[test]
+fn satellite_3_3_3_example_2() {
+    let mut m = example("satellite");
+    let x = solved(&mut m, "x''");
+    same(&mut m, x, "-GM*x/(x^2 + y^2)^(3/2)");
+    let y = solved(&mut m, "y''");
+    same(&mut m, y, "-GM*y/(x^2 + y^2)^(3/2)");
+}
+
+#[test]
+fn building_3_3_3_example_3_keeps_gravity_on_the_first_floor() {
+    let mut m = example("building");
+    let y1 = solved(&mut m, "y1''");
+    // The chapter's derivation (its MATLAB listing drops the -g):
+    same(
+        &mut m,
+        y1,
+        "-g - 2*k/m*(y1 - d0*sin(omega*t) - L) + 2*k/m*(y2 - y1 - L)",
+    );
+    let y2 = solved(&mut m, "y2''");
+    same(&mut m, y2, "-g - 2*k/m*(y2 - y1 - L)");
+}
+
+#[test]
+fn pulley_3_2_example_4_reports_the_tension() {
+    let mut m = example("pulley");
+    let t = solved(&mut m, "T");
+    same(&mut m, t, "2*mA*mB*g/(mA + mB)");
+    let a = solved(&mut m, "yA''");
+    same(&mut m, a, "g*(mB - mA)/(mA + mB)");
+}
+
+/// Independent hand derivation of an n-link chain (Lagrange): with μ_jk = Σ_{p ≥ max(j,k)} m_p,
+/// Σ_k μ_jk l_j l_k [cos(q_j - q_k) q_k'' + sin(q_j - q_k) q_k'^2] + g l_j sin(q_j) Σ_{p≥j} m_p = 0.
+fn chain_accelerations(m: &[f64], l: &[f64], q: &[f64], qd: &[f64], g: f64) -> Vec<f64> {
+    let n = m.len();
+    let mu = |j: usize, k: usize| -> f64 { m[j.max(k)..].iter().sum() };
+    let mut a = vec![vec![0.0; n + 1]; n];
+    for j in 0..n {
+        let mut rhs = -g * l[j] * q[j].sin() * mu(j, j);
+        for k in 0..n {
+            a[j][k] = mu(j, k) * l[j] * l[k] * (q[j] - q[k]).cos();
+            rhs -= mu(j, k) * l[j] * l[k] * (q[j] - q[k]).sin() * qd[k] * qd[k];
+        }
+        a[j][n] = rhs;
+    }
+    // Gaussian elimination with partial pivoting.
+    for c in 0..n {
+        let piv = (c..n)
+            .max_by(|&i, &k| a[i][c].abs().total_cmp(&a[k][c].abs()))
+            .unwrap();
+        a.swap(c, piv);
+        for i in c + 1..n {
+            let f = a[i][c] / a[c][c];
+            for k in c..=n {
+                a[i][k] -= f * a[c][k];
+            }
+        }
+    }
+    let mut x = vec![0.0; n];
+    for i in (0..n).rev() {
+        let s: f64 = (i + 1..n).map(|k| a[i][k] * x[k]).sum();
+        x[i] = (a[i][n] - s) / a[i][i];
+    }
+    x
+}
+
+fn check_chain(n: usize) {
+    let mut model = example(&format!("pendulum_chain_{n}"));
+    let d = derive(&mut model, &DeriveOptions::default()).unwrap();
+    let acc = d
+        .accelerations()
+        .expect("small chains are solved symbolically");
+    assert!(d
+        .unknowns
+        .iter()
+        .all(|u| matches!(u.kind, UnknownKind::Acceleration(_))));
+    let mut inputs = d.state.clone();
+    inputs.extend(model.parameters.iter().map(|p| p.id));
+    let prog = Program::compile(&mut model.pool, &inputs, &acc).unwrap();
+    let mut ws = prog.workspace();
+    let param = |name: &str| {
+        model
+            .parameters
+            .iter()
+            .find(|p| p.name == name)
+            .unwrap()
+            .value
+    };
+    let masses: Vec<f64> = (1..=n).map(|i| param(&format!("m{i}"))).collect();
+    let lengths: Vec<f64> = (1..=n).map(|i| param(&format!("l{i}"))).collect();
+    let g = param("g");
+    let mut seed = 7u64;
+    let mut rnd = || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
+        ((seed >> 11) as f64 / (1u64 << 53) as f64) * 4.0 - 2.0
+    };
+    for _ in 0..20 {
+        let q: Vec<f64> = (0..n).map(|_| rnd()).collect();
+        let qd: Vec<f64> = (0..n).map(|_| rnd()).collect();
+        let mut input: Vec<f64> = q.iter().chain(&qd).copied().collect();
+        input.extend(model.parameters.iter().map(|p| p.value));
+        let mut out = vec![0.0; n];
+        prog.eval(&input, &mut ws, &mut out);
+        let expected = chain_accelerations(&masses, &lengths, &q, &qd, g);
+        for (o, e) in out.iter().zip(&expected) {
+            assert!(
+                (o - e).abs() < 1e-9 * (1.0 + e.abs()),
+                "n={n}: {out:?} vs {expected:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn two_link_chain_matches_hand_derivation() {
+    check_chain(2);
+}
+
+#[test]
+fn three_link_chain_matches_hand_derivation() {
+    check_chain(3);
+}
