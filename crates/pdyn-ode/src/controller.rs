@@ -114,7 +114,13 @@ impl PiState {
     pub(crate) fn propose(&mut self, err: f64, h: f64) -> (bool, f64) {
         let fac11 = err.powf(self.expo1);
         if err <= 1.0 {
-            let fac = fac11 / self.facold.powf(self.beta);
+            // x^0 = 1 exactly: skip the power for the I-controller (β = 0, DOP853).
+            let pi = if self.beta == 0.0 {
+                1.0
+            } else {
+                self.facold.powf(self.beta)
+            };
+            let fac = fac11 / pi;
             let fac = self.facc2.max(self.facc1.min(fac / self.safe));
             self.facold = err.max(1e-4);
             (true, h / fac)

@@ -187,6 +187,7 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
     let mut nstep = 0usize;
     let (mut iasti, mut nonsti) = (0usize, 0usize);
     let nstiff = opts.stiffness_check_interval.max(1);
+    let mut stiff_countdown = nstiff;
     let mut nonfinite_in_row = 0usize;
     loop {
         if nstep >= opts.max_steps {
@@ -223,8 +224,13 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
             sol.stats.accepted += 1;
             let t_new = if last { tf } else { t + h };
             rk.on_accept(sys, t_new, &y_new, &mut sol.stats);
-            // Hairer's stiffness detection.
-            if sol.stats.accepted % nstiff == 0 || iasti > 0 {
+            // Hairer's stiffness detection (every `nstiff` accepted steps, or while suspected).
+            stiff_countdown -= 1;
+            let check = stiff_countdown == 0;
+            if check {
+                stiff_countdown = nstiff;
+            }
+            if check || iasti > 0 {
                 let hlamb = rk.stiffness(h, &y_new);
                 if hlamb > M::STIFF_THRESHOLD {
                     nonsti = 0;
@@ -299,6 +305,19 @@ pub(crate) fn stage_input(y: &[f64], k: &[f64], n: usize, a_row: &[f64], h: f64,
         }
         return;
     }
+    if n < SMALL {
+        // Few components: one pass per component (less loop overhead).
+        for j in 0..n {
+            let mut acc = 0.0;
+            for (m, &a) in a_row.iter().enumerate() {
+                if a != 0.0 {
+                    acc += a * k[m * n + j];
+                }
+            }
+            out[j] = y[j] + h * acc;
+        }
+        return;
+    }
     let mut first = true;
     for (m, &a) in a_row.iter().enumerate() {
         if a == 0.0 {
@@ -324,6 +343,9 @@ pub(crate) fn stage_input(y: &[f64], k: &[f64], n: usize, a_row: &[f64], h: f64,
         *o = yj + h * *o;
     }
 }
+
+/// Below this dimension the stage sums run component by component.
+const SMALL: usize = 16;
 
 /// `out_j = Σ_m w_m k_{m,j}` over the nonzero `w_m`, accumulated in stage order.
 #[inline(always)]

@@ -20,7 +20,7 @@
 
 use crate::controller::Controller;
 use crate::events::DenseOutput;
-use crate::explicit::{stage_input, ExplicitRk};
+use crate::explicit::ExplicitRk;
 use crate::problem::OdeSystem;
 use crate::solution::Stats;
 use crate::tableau::Tableau;
@@ -174,36 +174,66 @@ impl ExplicitRk for Dopri5 {
         rtol: &[f64],
         stats: &mut Stats,
     ) -> f64 {
+        // The stages written out as in dopri5.f (same summation order, so the same rounding),
+        // with the tableau constants folded in by the compiler.
         let n = self.n;
         let a = &TABLEAU.a;
         let c = &TABLEAU.c;
         let xph = t + h;
-        for s in 1..5 {
-            stage_input(y, &self.k, n, &a[s][..s], h, &mut self.ysti);
-            let (done, rest) = self.k.split_at_mut(s * n);
-            let _ = done;
-            sys.rhs(t + c[s] * h, &self.ysti, &mut rest[..n]);
+        let (y, y_new, atol, rtol) = (&y[..n], &mut y_new[..n], &atol[..n], &rtol[..n]);
+        let ys = &mut self.ysti[..n];
+        let (k1, r) = self.k.split_at_mut(n);
+        let (k2, r) = r.split_at_mut(n);
+        let (k3, r) = r.split_at_mut(n);
+        let (k4, r) = r.split_at_mut(n);
+        let (k5, r) = r.split_at_mut(n);
+        let (k6, k7) = r.split_at_mut(n);
+        let k7 = &mut k7[..n];
+        let ha21 = h * a[1][0];
+        for i in 0..n {
+            ys[i] = y[i] + ha21 * k1[i];
         }
-        stage_input(y, &self.k, n, &a[5][..5], h, &mut self.ysti);
-        {
-            let (_, rest) = self.k.split_at_mut(5 * n);
-            sys.rhs(xph, &self.ysti, &mut rest[..n]);
+        sys.rhs(t + c[1] * h, ys, k2);
+        for i in 0..n {
+            ys[i] = y[i] + h * (a[2][0] * k1[i] + a[2][1] * k2[i]);
         }
-        stage_input(y, &self.k, n, &a[6][..6], h, y_new);
-        {
-            let (_, rest) = self.k.split_at_mut(6 * n);
-            sys.rhs(xph, y_new, &mut rest[..n]);
+        sys.rhs(t + c[2] * h, ys, k3);
+        for i in 0..n {
+            ys[i] = y[i] + h * (a[3][0] * k1[i] + a[3][1] * k2[i] + a[3][2] * k3[i]);
         }
+        sys.rhs(t + c[3] * h, ys, k4);
+        for i in 0..n {
+            ys[i] =
+                y[i] + h * (a[4][0] * k1[i] + a[4][1] * k2[i] + a[4][2] * k3[i] + a[4][3] * k4[i]);
+        }
+        sys.rhs(t + c[4] * h, ys, k5);
+        for i in 0..n {
+            ys[i] = y[i]
+                + h * (a[5][0] * k1[i]
+                    + a[5][1] * k2[i]
+                    + a[5][2] * k3[i]
+                    + a[5][3] * k4[i]
+                    + a[5][4] * k5[i]);
+        }
+        sys.rhs(xph, ys, k6);
+        for i in 0..n {
+            y_new[i] = y[i]
+                + h * (a[6][0] * k1[i]
+                    + a[6][2] * k3[i]
+                    + a[6][3] * k4[i]
+                    + a[6][4] * k5[i]
+                    + a[6][5] * k6[i]);
+        }
+        sys.rhs(xph, y_new, k7);
         stats.fevals += 6;
-        let k = &self.k;
         let mut err = 0.0;
         for i in 0..n {
-            let e = (E[0] * k[i]
-                + E[2] * k[2 * n + i]
-                + E[3] * k[3 * n + i]
-                + E[4] * k[4 * n + i]
-                + E[5] * k[5 * n + i]
-                + E[6] * k[6 * n + i])
+            let e = (E[0] * k1[i]
+                + E[2] * k3[i]
+                + E[3] * k4[i]
+                + E[4] * k5[i]
+                + E[5] * k6[i]
+                + E[6] * k7[i])
                 * h;
             let sk = atol[i] + rtol[i] * y[i].abs().max(y_new[i].abs());
             err += (e / sk) * (e / sk);
