@@ -417,6 +417,56 @@ impl DenseOutput for Dop853 {
     }
 }
 
+impl Dop853 {
+    /// One step; `N > 0` fixes the dimension at compile time (`N = 0`: use `self.n`).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn attempt_n<S: OdeSystem + ?Sized, const N: usize>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        y_new: &mut [f64],
+        atol: &[f64],
+        rtol: &[f64],
+        stats: &mut Stats,
+    ) -> f64 {
+        let n = if N > 0 { N } else { self.n };
+        let a = &TABLEAU.a;
+        let c = &TABLEAU.c;
+        for s in 1..11 {
+            stage_input(y, &self.k, n, &a[s][..s], h, &mut self.y1);
+            let (_, rest) = self.k.split_at_mut(s * n);
+            sys.rhs(t + c[s] * h, &self.y1, &mut rest[..n]);
+        }
+        stage_input(y, &self.k, n, &a[11][..11], h, &mut self.y1);
+        {
+            let (_, rest) = self.k.split_at_mut(11 * n);
+            sys.rhs(t + h, &self.y1, &mut rest[..n]);
+        }
+        stats.fevals += 11;
+        combine(&self.k, n, &B, &mut self.bsum);
+        combine(&self.k, n, &ER, &mut self.e5);
+        let k = &self.k;
+        let (mut err, mut err2) = (0.0, 0.0);
+        for i in 0..n {
+            let bsum = self.bsum[i];
+            let e5 = self.e5[i];
+            y_new[i] = y[i] + h * bsum;
+            let sk = atol[i] + rtol[i] * y[i].abs().max(y_new[i].abs());
+            let e3 = bsum - BHH[0] * k[i] - BHH[1] * k[8 * n + i] - BHH[2] * k[11 * n + i];
+            err2 += (e3 / sk) * (e3 / sk);
+            err += (e5 / sk) * (e5 / sk);
+        }
+        let mut deno = err + 0.01 * err2;
+        if deno <= 0.0 {
+            deno = 1.0;
+        }
+        h.abs() * err * (1.0 / (n as f64 * deno)).sqrt()
+    }
+}
+
 impl ExplicitRk for Dop853 {
     const METHOD: Method = Method::Dop853;
     const ORDER: i32 = 8;
@@ -458,38 +508,17 @@ impl ExplicitRk for Dop853 {
         rtol: &[f64],
         stats: &mut Stats,
     ) -> f64 {
-        let n = self.n;
-        let a = &TABLEAU.a;
-        let c = &TABLEAU.c;
-        for s in 1..11 {
-            stage_input(y, &self.k, n, &a[s][..s], h, &mut self.y1);
-            let (_, rest) = self.k.split_at_mut(s * n);
-            sys.rhs(t + c[s] * h, &self.y1, &mut rest[..n]);
+        // Small systems get loops of compile-time length (unrolled, vectorised); the
+        // arithmetic is the same in every variant.
+        match self.n {
+            1 => self.attempt_n::<S, 1>(sys, t, y, h, y_new, atol, rtol, stats),
+            2 => self.attempt_n::<S, 2>(sys, t, y, h, y_new, atol, rtol, stats),
+            3 => self.attempt_n::<S, 3>(sys, t, y, h, y_new, atol, rtol, stats),
+            4 => self.attempt_n::<S, 4>(sys, t, y, h, y_new, atol, rtol, stats),
+            6 => self.attempt_n::<S, 6>(sys, t, y, h, y_new, atol, rtol, stats),
+            8 => self.attempt_n::<S, 8>(sys, t, y, h, y_new, atol, rtol, stats),
+            _ => self.attempt_n::<S, 0>(sys, t, y, h, y_new, atol, rtol, stats),
         }
-        stage_input(y, &self.k, n, &a[11][..11], h, &mut self.y1);
-        {
-            let (_, rest) = self.k.split_at_mut(11 * n);
-            sys.rhs(t + h, &self.y1, &mut rest[..n]);
-        }
-        stats.fevals += 11;
-        combine(&self.k, n, &B, &mut self.bsum);
-        combine(&self.k, n, &ER, &mut self.e5);
-        let k = &self.k;
-        let (mut err, mut err2) = (0.0, 0.0);
-        for i in 0..n {
-            let bsum = self.bsum[i];
-            let e5 = self.e5[i];
-            y_new[i] = y[i] + h * bsum;
-            let sk = atol[i] + rtol[i] * y[i].abs().max(y_new[i].abs());
-            let e3 = bsum - BHH[0] * k[i] - BHH[1] * k[8 * n + i] - BHH[2] * k[11 * n + i];
-            err2 += (e3 / sk) * (e3 / sk);
-            err += (e5 / sk) * (e5 / sk);
-        }
-        let mut deno = err + 0.01 * err2;
-        if deno <= 0.0 {
-            deno = 1.0;
-        }
-        h.abs() * err * (1.0 / (n as f64 * deno)).sqrt()
     }
 
     fn on_accept<S: OdeSystem + ?Sized>(

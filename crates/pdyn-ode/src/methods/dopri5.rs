@@ -135,35 +135,11 @@ impl DenseOutput for Dopri5 {
     }
 }
 
-impl ExplicitRk for Dopri5 {
-    const METHOD: Method = Method::Dopri5;
-    const ORDER: i32 = 5;
-    const STIFF_THRESHOLD: f64 = 3.25;
-
-    fn default_controller() -> Controller {
-        Controller::dopri5()
-    }
-
-    fn alpha(c: &Controller) -> f64 {
-        0.2 - c.beta * 0.75
-    }
-
-    fn new(n: usize) -> Self {
-        Dopri5 {
-            n,
-            k: vec![0.0; 7 * n],
-            ysti: vec![0.0; n],
-            cont: vec![0.0; 5 * n],
-            t_old: 0.0,
-            h: 1.0,
-        }
-    }
-
-    fn f_start(&mut self) -> &mut [f64] {
-        &mut self.k[..self.n]
-    }
-
-    fn attempt<S: OdeSystem + ?Sized>(
+impl Dopri5 {
+    /// One step; `N > 0` fixes the dimension at compile time (`N = 0`: use `self.n`).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn attempt_n<S: OdeSystem + ?Sized, const N: usize>(
         &mut self,
         sys: &S,
         t: f64,
@@ -176,7 +152,7 @@ impl ExplicitRk for Dopri5 {
     ) -> f64 {
         // The stages written out as in dopri5.f (same summation order, so the same rounding),
         // with the tableau constants folded in by the compiler.
-        let n = self.n;
+        let n = if N > 0 { N } else { self.n };
         let a = &TABLEAU.a;
         let c = &TABLEAU.c;
         let xph = t + h;
@@ -239,6 +215,59 @@ impl ExplicitRk for Dopri5 {
             err += (e / sk) * (e / sk);
         }
         (err / n as f64).sqrt()
+    }
+}
+
+impl ExplicitRk for Dopri5 {
+    const METHOD: Method = Method::Dopri5;
+    const ORDER: i32 = 5;
+    const STIFF_THRESHOLD: f64 = 3.25;
+
+    fn default_controller() -> Controller {
+        Controller::dopri5()
+    }
+
+    fn alpha(c: &Controller) -> f64 {
+        0.2 - c.beta * 0.75
+    }
+
+    fn new(n: usize) -> Self {
+        Dopri5 {
+            n,
+            k: vec![0.0; 7 * n],
+            ysti: vec![0.0; n],
+            cont: vec![0.0; 5 * n],
+            t_old: 0.0,
+            h: 1.0,
+        }
+    }
+
+    fn f_start(&mut self) -> &mut [f64] {
+        &mut self.k[..self.n]
+    }
+
+    fn attempt<S: OdeSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        y_new: &mut [f64],
+        atol: &[f64],
+        rtol: &[f64],
+        stats: &mut Stats,
+    ) -> f64 {
+        // Small systems get loops of compile-time length (unrolled, vectorised); the
+        // arithmetic is the same in every variant.
+        match self.n {
+            1 => self.attempt_n::<S, 1>(sys, t, y, h, y_new, atol, rtol, stats),
+            2 => self.attempt_n::<S, 2>(sys, t, y, h, y_new, atol, rtol, stats),
+            3 => self.attempt_n::<S, 3>(sys, t, y, h, y_new, atol, rtol, stats),
+            4 => self.attempt_n::<S, 4>(sys, t, y, h, y_new, atol, rtol, stats),
+            6 => self.attempt_n::<S, 6>(sys, t, y, h, y_new, atol, rtol, stats),
+            8 => self.attempt_n::<S, 8>(sys, t, y, h, y_new, atol, rtol, stats),
+            _ => self.attempt_n::<S, 0>(sys, t, y, h, y_new, atol, rtol, stats),
+        }
     }
 
     fn on_accept<S: OdeSystem + ?Sized>(&mut self, _: &S, _: f64, _: &[f64], _: &mut Stats) {}

@@ -162,6 +162,46 @@ impl DenseOutput for Tsit5 {
     }
 }
 
+impl Tsit5 {
+    /// One step; `N > 0` fixes the dimension at compile time (`N = 0`: use `self.n`).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn attempt_n<S: OdeSystem + ?Sized, const N: usize>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        y_new: &mut [f64],
+        atol: &[f64],
+        rtol: &[f64],
+        stats: &mut Stats,
+    ) -> f64 {
+        let n = if N > 0 { N } else { self.n };
+        let a = &TABLEAU.a;
+        let c = &TABLEAU.c;
+        for s in 1..6 {
+            stage_input(y, &self.k, n, &a[s][..s], h, &mut self.ysti);
+            let (_, rest) = self.k.split_at_mut(s * n);
+            sys.rhs(t + c[s] * h, &self.ysti, &mut rest[..n]);
+        }
+        stage_input(y, &self.k, n, &a[6][..6], h, y_new);
+        {
+            let (_, rest) = self.k.split_at_mut(6 * n);
+            sys.rhs(t + h, y_new, &mut rest[..n]);
+        }
+        stats.fevals += 6;
+        combine(&self.k, n, &E, &mut self.e);
+        let mut err = 0.0;
+        for i in 0..n {
+            let e = self.e[i] * h;
+            let sk = atol[i] + rtol[i] * y[i].abs().max(y_new[i].abs());
+            err += (e / sk) * (e / sk);
+        }
+        (err / n as f64).sqrt()
+    }
+}
+
 impl ExplicitRk for Tsit5 {
     const METHOD: Method = Method::Tsit5;
     const ORDER: i32 = 5;
@@ -202,28 +242,17 @@ impl ExplicitRk for Tsit5 {
         rtol: &[f64],
         stats: &mut Stats,
     ) -> f64 {
-        let n = self.n;
-        let a = &TABLEAU.a;
-        let c = &TABLEAU.c;
-        for s in 1..6 {
-            stage_input(y, &self.k, n, &a[s][..s], h, &mut self.ysti);
-            let (_, rest) = self.k.split_at_mut(s * n);
-            sys.rhs(t + c[s] * h, &self.ysti, &mut rest[..n]);
+        // Small systems get loops of compile-time length (unrolled, vectorised); the
+        // arithmetic is the same in every variant.
+        match self.n {
+            1 => self.attempt_n::<S, 1>(sys, t, y, h, y_new, atol, rtol, stats),
+            2 => self.attempt_n::<S, 2>(sys, t, y, h, y_new, atol, rtol, stats),
+            3 => self.attempt_n::<S, 3>(sys, t, y, h, y_new, atol, rtol, stats),
+            4 => self.attempt_n::<S, 4>(sys, t, y, h, y_new, atol, rtol, stats),
+            6 => self.attempt_n::<S, 6>(sys, t, y, h, y_new, atol, rtol, stats),
+            8 => self.attempt_n::<S, 8>(sys, t, y, h, y_new, atol, rtol, stats),
+            _ => self.attempt_n::<S, 0>(sys, t, y, h, y_new, atol, rtol, stats),
         }
-        stage_input(y, &self.k, n, &a[6][..6], h, y_new);
-        {
-            let (_, rest) = self.k.split_at_mut(6 * n);
-            sys.rhs(t + h, y_new, &mut rest[..n]);
-        }
-        stats.fevals += 6;
-        combine(&self.k, n, &E, &mut self.e);
-        let mut err = 0.0;
-        for i in 0..n {
-            let e = self.e[i] * h;
-            let sk = atol[i] + rtol[i] * y[i].abs().max(y_new[i].abs());
-            err += (e / sk) * (e / sk);
-        }
-        (err / n as f64).sqrt()
     }
 
     fn on_accept<S: OdeSystem + ?Sized>(&mut self, _: &S, _: f64, _: &[f64], _: &mut Stats) {}
