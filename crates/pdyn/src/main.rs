@@ -2,6 +2,7 @@
 //! print. Every error becomes a message and a non-zero exit code here, and only here.
 
 mod derive_cmd;
+mod dsolve_cmd;
 mod expr_cmd;
 
 use clap::{Parser, Subcommand};
@@ -27,6 +28,8 @@ enum Command {
     Eval(expr_cmd::EvalArgs),
     /// Derive the equations of motion of a model file.
     Derive(derive_cmd::DeriveArgs),
+    /// Solve linear constant-coefficient ODEs and systems in closed form, and the 1-D motion rules.
+    Dsolve(dsolve_cmd::DsolveArgs),
 }
 
 fn main() -> ExitCode {
@@ -37,6 +40,7 @@ fn main() -> ExitCode {
         Command::Solve(a) => expr_cmd::solve(a),
         Command::Eval(a) => expr_cmd::eval(a),
         Command::Derive(a) => derive_cmd::run(a),
+        Command::Dsolve(a) => dsolve_cmd::run(a),
     };
     match result {
         Ok(out) => {

@@ -307,14 +307,12 @@ fn quadratic_modes(pool: &mut Pool, c1: Id, c0: Id) -> Vec<(Option<Condition>, V
                         Mode::Exp { rate: r2, mult: 1 },
                     ];
                 }
-                let f = pool.sqrt(disc);
-                let freq = pool.simplify(f);
+                let freq = nice_sqrt(pool, disc);
                 vec![Mode::Hyperbolic { rate, freq }]
             }
             Relation::Negative => {
                 let nd = pool.neg(disc);
-                let f = pool.sqrt(nd);
-                let freq = pool.simplify(f);
+                let freq = nice_sqrt(pool, nd);
                 vec![Mode::Oscillatory {
                     rate,
                     freq,
@@ -440,7 +438,7 @@ fn describe_roots(pool: &mut Pool, modes: &[Mode]) -> Vec<String> {
                 } else {
                     format!("{} ", pool.to_text(rate))
                 };
-                out.push(format!("{r}± i*{}{}", pool.to_text(freq), times(mult)));
+                out.push(format!("{r}± {}*i{}", pool.to_text(freq), times(mult)));
             }
         }
     }
@@ -630,10 +628,60 @@ fn fit_constants(
             "the initial conditions do not determine the solution ({e})"
         ))
     })?;
-    let mut y = general;
-    for (&c, &v) in consts.iter().zip(&sol) {
-        y = pool.subs1(y, c, v);
+    // Collected on the basis: `x0 e^{-ζωt} cos(ωd t) + (v0 + ζω x0)/ωd e^{-ζωt} sin(ωd t)`.
+    let mut terms = Vec::with_capacity(basis.len() + 1);
+    for (&phi, &v) in basis.iter().zip(&sol) {
+        let v = pool.expand(v);
+        let v = pool.simplify(v);
+        terms.push(pool.mul2(v, phi));
     }
-    let y = pool.expand(y);
-    Ok((pool.simplify(y), Vec::new()))
+    let yp = pool.expand(particular);
+    terms.push(pool.simplify(yp));
+    Ok((pool.add(&terms), Vec::new()))
+}
+
+/// `sqrt(d)` with positive square factors taken out: `sqrt(wn^2 - wn^2 zeta^2)` becomes
+/// `wn sqrt(1 - zeta^2)`.
+pub(crate) fn nice_sqrt(pool: &mut Pool, d: Id) -> Id {
+    let mut cur = pool.expand(d);
+    let mut outside = Vec::new();
+    for _ in 0..8 {
+        let first = match pool.node(cur) {
+            Node::Add(ts) => ts[0],
+            _ => break,
+        };
+        let cands: Vec<Id> = match pool.node(first) {
+            Node::Mul(fs) => fs.to_vec(),
+            _ => vec![first],
+        };
+        let size = pool.tree_size(cur, usize::MAX);
+        let mut improved = false;
+        for f in cands {
+            if pool.as_num(f).is_some() || !pool.is_positive(f) {
+                continue;
+            }
+            let q = pool.div(cur, f);
+            let q = pool.expand(q);
+            if pool.tree_size(q, size) < size {
+                cur = q;
+                outside.push(f);
+                improved = true;
+                break;
+            }
+        }
+        if !improved {
+            break;
+        }
+    }
+    let inner = pool.simplify(cur);
+    let mut factors: Vec<Id> = outside.iter().map(|&f| pool.sqrt(f)).collect();
+    factors.push(pool.sqrt(inner));
+    let r = pool.mul(&factors);
+    let plain = pool.sqrt(d);
+    let plain = pool.simplify(plain);
+    if pool.tree_size(r, usize::MAX) <= pool.tree_size(plain, usize::MAX) {
+        r
+    } else {
+        plain
+    }
 }

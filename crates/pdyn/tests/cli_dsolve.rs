@@ -1,0 +1,181 @@
+//! `pdyn dsolve` end to end: the chapter's closed forms, JSON, LaTeX, and refusals.
+
+use std::process::Command;
+
+fn pdyn(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_pdyn"))
+        .args(args)
+        .output()
+        .expect("run pdyn");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn suspension_prints_the_chapter_form() {
+    let (ok, out, err) = pdyn(&[
+        "dsolve",
+        "m*x'' = -k*(x - L0) - m*g",
+        "--ic",
+        "x(0)=L, x'(0)=0",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        out.starts_with("x(t) = L0 - g*m/k + cos(sqrt(k)*t/sqrt(m))*(L - L0 + g*m/k)\n"),
+        "{out}"
+    );
+    assert!(out.contains("assuming m, k, L0, g > 0"), "{out}");
+}
+
+#[test]
+fn rotating_rod_prints_sinh_form() {
+    let (ok, out, err) = pdyn(&[
+        "dsolve",
+        "r'' + 2*mu*omega*r' - omega^2*r = 0",
+        "--ic",
+        "r(0)=0, r'(0)=V",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        out.starts_with(
+            "r(t) = V*sinh(omega*t*sqrt(1 + mu^2))*exp(-mu*omega*t)/(omega*sqrt(1 + mu^2))\n"
+        ),
+        "{out}"
+    );
+}
+
+#[test]
+fn damped_oscillator_cases_and_numeric_choice() {
+    let (ok, out, err) = pdyn(&[
+        "dsolve",
+        "x'' + 2*zeta*wn*x' + wn^2*x = 0",
+        "--ic",
+        "x(0)=x0, x'(0)=v0",
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("case zeta^2 < 1:"), "{out}");
+    assert!(out.contains("case zeta^2 = 1:"), "{out}");
+    assert!(out.contains("case zeta^2 > 1:"), "{out}");
+    assert!(out.contains("wn*sqrt(1 - zeta^2)"), "{out}");
+    let (ok, out, err) = pdyn(&[
+        "dsolve",
+        "x'' + 2*zeta*wn*x' + wn^2*x = 0",
+        "--ic",
+        "x(0)=1, x'(0)=0",
+        "--set",
+        "zeta=2,wn=1",
+    ]);
+    assert!(ok, "{err}");
+    assert!(!out.contains("case"), "{out}");
+    assert!(out.contains("sinh") || out.contains("exp"), "{out}");
+}
+
+#[test]
+fn kremlin_stone_range_from_at_values() {
+    let (ok, out, err) = pdyn(&[
+        "dsolve",
+        "x'' = 0",
+        "y'' = -g",
+        "--ic",
+        "x(0)=0, x'(0)=V*cos(alpha), y(0)=h, y'(0)=V*sin(alpha)",
+        "--set",
+        "g=9.81,V=25*0.44704,alpha=pi/4,h=71",
+        "--at",
+        "4.694",
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+    let vals = &v["cases"][0]["at"][0]["values"];
+    let x = vals[0].as_f64().unwrap();
+    let y = vals[2].as_f64().unwrap();
+    assert!(y.abs() < 0.05, "lands at t = 4.694 s: y = {y}");
+    assert!((x - 37.1).abs() < 0.05, "range {x}");
+    assert_eq!(v["method"], "exact");
+}
+
+#[test]
+fn latex_output() {
+    let (ok, out, err) = pdyn(&[
+        "dsolve",
+        "x'' + 4*x = 0",
+        "--ic",
+        "x(0)=1, x'(0)=0",
+        "--format",
+        "latex",
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("\\cos"), "{out}");
+}
+
+#[test]
+fn system_goes_numeric_and_reports_residual() {
+    let (ok, out, err) = pdyn(&[
+        "dsolve",
+        "2*x1'' = -300*x1 + 100*(x2 - x1)",
+        "x2'' = -100*(x2 - x1)",
+        "--ic",
+        "x1(0)=0.1, x1'(0)=0, x2(0)=0, x2'(0)=0",
+        "--at",
+        "0",
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("relative residual"), "{out}");
+    assert!(out.contains("t = 0: x1 = 0.1"), "{out}");
+}
+
+#[test]
+fn refusals_are_clear_and_located() {
+    let (ok, _, err) = pdyn(&["dsolve", "x'' + sin(x) = 0", "--ic", "x(0)=1, x'(0)=0"]);
+    assert!(!ok);
+    assert!(err.contains("no closed form by this method"), "{err}");
+    assert!(err.contains("pdyn run"), "{err}");
+    let (ok, _, err) = pdyn(&["dsolve", "x'' + t*x = 0"]);
+    assert!(!ok);
+    assert!(err.contains("variable coefficient"), "{err}");
+    let (ok, _, err) = pdyn(&["dsolve", "x'' + 2*x' + = 0"]);
+    assert!(!ok);
+    assert!(err.contains("<equation 1>:1:14"), "{err}");
+    let (ok, _, err) = pdyn(&["dsolve", "x'' + x = 0", "--ic", "x(0)=1, y(0)=2"]);
+    assert!(!ok);
+    assert!(err.contains("`y` does not appear"), "{err}");
+    let (ok, _, err) = pdyn(&["dsolve", "x'' + x = 0", "--ic", "x(0)=1, x'(0)="]);
+    assert!(!ok);
+    assert!(err.contains("no value"), "{err}");
+}
+
+#[test]
+fn rules_closed_and_quadrature() {
+    let (ok, out, err) = pdyn(&[
+        "dsolve",
+        "--rule",
+        "a(v) = -c*v^2",
+        "--ic",
+        "x(0)=0, v(0)=v0",
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("t(v) ="), "{out}");
+    let (ok, out, err) = pdyn(&[
+        "dsolve",
+        "--rule",
+        "a(t) = exp(-t^2)",
+        "--at",
+        "1",
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+    let val = v["quantities"][0]["at"][0]["value"].as_f64().unwrap();
+    assert!((val - 0.746_824_132_812_427).abs() < 1e-10);
+    assert!(v["quantities"][0]["closed_form"].is_null());
+}
+
+#[test]
+fn help_is_available() {
+    let (ok, out, _) = pdyn(&["dsolve", "--help"]);
+    assert!(ok);
+    assert!(out.contains("--ic") && out.contains("--rule"), "{out}");
+}
