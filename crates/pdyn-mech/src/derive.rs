@@ -338,6 +338,8 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
         other => other,
     };
 
+    // In the projected form without working reactions, `M` and `f` are built directly.
+    let mut direct: Option<LinearSystem> = None;
     let (equations, unknowns) = match form {
         Form::Projected => {
             if !model.constraints.is_empty() || !model.frames.is_empty() {
@@ -346,7 +348,7 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
                     "use the Newton form (--form newton)",
                 ));
             }
-            let eqs = projected(
+            let (eqs, mass, forcing) = projected(
                 p,
                 &parts,
                 &qd,
@@ -358,12 +360,16 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
             // Reactions that survive projection do work: they stay unknown and need equations.
             let mut unk: Vec<Unknown> = acc_unknowns;
             for ru in reaction_unknowns {
-                if eqs
-                    .iter()
-                    .any(|e| p.contains(e.rhs, ru.id) || p.contains(e.lhs, ru.id))
-                {
+                if eqs.iter().any(|e| p.contains(e.rhs, ru.id)) {
                     unk.push(ru);
                 }
+            }
+            if unk.len() == qdd.len() {
+                direct = Some(LinearSystem {
+                    unknowns: qdd.clone(),
+                    a: mass,
+                    b: forcing,
+                });
             }
             (eqs, unk)
         }
@@ -376,64 +382,13 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
         }
     };
 
-    // Residuals `lhs - rhs`, the linear system, and a check of equations without unknowns.
-    let unknown_ids: Vec<Id> = unknowns.iter().map(|u| u.id).collect();
-    let mut kept = Vec::new();
-    let mut residuals = Vec::new();
-    for e in equations {
-        let r = p.sub(e.lhs, e.rhs);
-        if unknown_ids.iter().any(|&u| p.contains(r, u)) {
-            residuals.push(r);
-            kept.push(e);
-        } else if !p.provably_equal(r, Pool::ZERO) {
-            return Err(derr(
-                format!(
-                    "equation `{}` involves no unknown and does not hold: {} = {}",
-                    e.label,
-                    p.to_text(e.lhs),
-                    p.to_text(e.rhs)
-                ),
-                "a force is missing from the free body diagram: declare the reaction that balances it ([[forces]] kind = \"reaction\")",
-            ));
-        }
-    }
-    let equations = kept;
-    for u in &unknowns {
-        if !residuals.iter().any(|&r| p.contains(r, u.id)) {
-            return Err(derr(
-                format!("no equation involves `{}`", u.name),
-                match u.kind {
-                    UnknownKind::Acceleration(_) => "the coordinate does not move any particle: use it in a position, or remove it",
-                    UnknownKind::Reaction(_) => "the reaction acts on nothing that moves: check its `on` and `direction`",
-                },
-            ));
-        }
-    }
-    if residuals.len() < unknowns.len() {
-        let names: Vec<&str> = unknowns.iter().map(|u| u.name.as_str()).collect();
-        return Err(derr(
-            format!(
-                "{} equations for {} unknowns ({})",
-                residuals.len(),
-                unknowns.len(),
-                names.join(", ")
-            ),
-            "look for constraints that relate the coordinates ([[constraints]]), or fewer unknown reactions (chapter 3.3.1, step 7)",
-        ));
-    }
-    let system = p.linear_system(&residuals, &unknown_ids).map_err(|e| match e {
-        LinearError::NotLinear { equation, unknown } => derr(
-            format!(
-                "equation `{}` is not linear in `{}`",
-                equations[equation].label,
-                p.to_text(unknown)
-            ),
-            "forces may depend on positions and velocities but not on accelerations or products of reactions",
-        ),
-        other => derr(other.to_string(), "check the model's forces"),
-    })?;
+    let (equations, system) = match direct {
+        Some(sys) => (equations, sys),
+        None => linear_form(p, equations, &unknowns)?,
+    };
+    let residual_count = system.rows();
 
-    let solution = if unknowns.len() <= opts.symbolic_limit || residuals.len() > unknowns.len() {
+    let solution = if unknowns.len() <= opts.symbolic_limit || residual_count > unknowns.len() {
         match p.solve_linear(&system) {
             Ok(sol) => Some(sol.into_iter().map(|s| simp(p, s, opts.simplify)).collect()),
             Err(LinearError::Underdetermined { free }) => {
@@ -486,8 +441,79 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
     })
 }
 
-/// Kane's equations: for each free coordinate, Σ_p (m a − F)·∂r/∂q_j, written as
-/// `Σ_k M_jk q_k'' = f_j`.
+/// Checks the equations (each involves an unknown, or holds identically; every unknown
+/// appears; enough equations) and writes them as `A x = b`.
+fn linear_form(
+    p: &mut Pool,
+    equations: Vec<Equation>,
+    unknowns: &[Unknown],
+) -> Result<(Vec<Equation>, LinearSystem), DeriveError> {
+    let unknown_ids: Vec<Id> = unknowns.iter().map(|u| u.id).collect();
+    let mut kept = Vec::new();
+    let mut residuals = Vec::new();
+    for e in equations {
+        let r = p.sub(e.lhs, e.rhs);
+        if unknown_ids.iter().any(|&u| p.contains(r, u)) {
+            residuals.push(r);
+            kept.push(e);
+        } else if !p.provably_equal(r, Pool::ZERO) {
+            return Err(derr(
+                format!(
+                    "equation `{}` involves no unknown and does not hold: {} = {}",
+                    e.label,
+                    p.to_text(e.lhs),
+                    p.to_text(e.rhs)
+                ),
+                "a force is missing from the free body diagram: declare the reaction that balances it ([[forces]] kind = \"reaction\")",
+            ));
+        }
+    }
+    let equations = kept;
+    for u in unknowns {
+        if !residuals.iter().any(|&r| p.contains(r, u.id)) {
+            return Err(derr(
+                format!("no equation involves `{}`", u.name),
+                match u.kind {
+                    UnknownKind::Acceleration(_) => "the coordinate does not move any particle: use it in a position, or remove it",
+                    UnknownKind::Reaction(_) => "the reaction acts on nothing that moves: check its `on` and `direction`",
+                },
+            ));
+        }
+    }
+    if residuals.len() < unknowns.len() {
+        let names: Vec<&str> = unknowns.iter().map(|u| u.name.as_str()).collect();
+        return Err(derr(
+            format!(
+                "{} equations for {} unknowns ({})",
+                residuals.len(),
+                unknowns.len(),
+                names.join(", ")
+            ),
+            "look for constraints that relate the coordinates ([[constraints]]), or fewer unknown reactions (chapter 3.3.1, step 7)",
+        ));
+    }
+    let system = p.linear_system(&residuals, &unknown_ids).map_err(|e| match e {
+        LinearError::NotLinear { equation, unknown } => derr(
+            format!(
+                "equation `{}` is not linear in `{}`",
+                equations[equation].label,
+                p.to_text(unknown)
+            ),
+            "forces may depend on positions and velocities but not on accelerations or products of reactions",
+        ),
+        other => derr(other.to_string(), "check the model's forces"),
+    })?;
+    Ok((equations, system))
+}
+
+/// Kane's equations: for each free coordinate `q_j`, `Σ_p (m_p a_p − F_p)·∂r_p/∂q_j = 0`,
+/// written as `Σ_k M_jk q_k'' = f_j`. Returns the printable equations, `M` (row-major) and `f`.
+///
+/// `M_jk = Σ_p m_p ∂r_p/∂q_j·∂r_p/∂q_k` is assembled by grouping particles whose partial
+/// velocities give the same dot product (in a chain, every particle below both links), so the
+/// entry is `(Σ m_p) * dot` rather than a sum of `n` products: the work stays O(n³) in cheap
+/// symbol additions and the expressions O(n²).
+#[allow(clippy::type_complexity)]
 fn projected(
     p: &mut Pool,
     parts: &[ParticleKinematics],
@@ -496,7 +522,7 @@ fn projected(
     free: &[usize],
     coordinates: &[crate::model::Coordinate],
     reactions: &[crate::model::Reaction],
-) -> Result<Vec<Equation>, DeriveError> {
+) -> Result<(Vec<Equation>, Vec<Id>, Vec<Id>), DeriveError> {
     let n = qd.len();
     // Partial velocities ∂v/∂q_j' = ∂r/∂q_j.
     let jac: Vec<Vec<[Id; 3]>> = parts
@@ -504,32 +530,61 @@ fn projected(
         .map(|pk| (0..n).map(|j| pk.v.map(|c| p.diff(c, qd[j]))).collect())
         .collect();
     let zero_acc: FxHashMap<Id, Id> = qdd.iter().map(|&a| (a, Pool::ZERO)).collect();
-    let mut eqs = Vec::with_capacity(n);
-    for j in 0..n {
-        let mut lhs_terms = Vec::new();
-        let mut rhs_terms = Vec::new();
-        for (pi, pk) in parts.iter().enumerate() {
-            let jj = jac[pi][j];
-            if jj.iter().all(|&c| c == Pool::ZERO) {
-                continue;
-            }
-            for (k, &acc) in qdd.iter().enumerate() {
-                let jk = jac[pi][k];
-                let d = vector::dot(p, jj, jk);
+    // Mass matrix: (j, k) → dot product → masses.
+    let mut groups: Vec<FxHashMap<Id, Vec<Id>>> = vec![FxHashMap::default(); n * n];
+    let mut dots: FxHashMap<([Id; 3], [Id; 3]), Id> = FxHashMap::default();
+    let mut forcing_terms: Vec<Vec<Id>> = vec![Vec::new(); n];
+    for (pi, pk) in parts.iter().enumerate() {
+        let nz: Vec<usize> = (0..n)
+            .filter(|&j| jac[pi][j].iter().any(|&c| c != Pool::ZERO))
+            .collect();
+        for (a_i, &j) in nz.iter().enumerate() {
+            for &k in &nz[a_i..] {
+                let key = (jac[pi][j], jac[pi][k]);
+                let d = match dots.get(&key) {
+                    Some(&d) => d,
+                    None => {
+                        let d = vector::dot(p, key.0, key.1);
+                        dots.insert(key, d);
+                        d
+                    }
+                };
                 if d != Pool::ZERO {
-                    lhs_terms.push(p.mul(&[pk.mass, d, acc]));
+                    groups[j * n + k].entry(d).or_default().push(pk.mass);
                 }
             }
-            // Generalized force minus the velocity-dependent part of m a.
-            let a0 = pk.a.map(|c| p.subs(c, &zero_acc));
-            let ma0 = vector::scale(p, pk.mass, a0);
-            let net = vector::sub(p, pk.force, ma0);
-            rhs_terms.push(vector::dot(p, net, jj));
         }
-        let lhs = p.add(&lhs_terms);
-        let rhs = p.add(&rhs_terms);
+        if nz.is_empty() {
+            continue;
+        }
+        // Generalized force minus the velocity-dependent part of m a.
+        let a0 = pk.a.map(|c| p.subs(c, &zero_acc));
+        let ma0 = vector::scale(p, pk.mass, a0);
+        let net = vector::sub(p, pk.force, ma0);
+        for &j in &nz {
+            forcing_terms[j].push(vector::dot(p, net, jac[pi][j]));
+        }
+    }
+    let mut mass = vec![Pool::ZERO; n * n];
+    for j in 0..n {
+        for k in j..n {
+            let mut terms = Vec::new();
+            let mut g: Vec<(Id, Vec<Id>)> = groups[j * n + k].drain().collect();
+            g.sort_by_key(|(d, _)| *d);
+            for (d, ms) in g {
+                let total = p.add(&ms);
+                terms.push(p.mul2(total, d));
+            }
+            let m = p.add(&terms);
+            mass[j * n + k] = m;
+            mass[k * n + j] = m;
+        }
+    }
+    let mut forcing = Vec::with_capacity(n);
+    let mut eqs = Vec::with_capacity(n);
+    for j in 0..n {
+        let mut rhs = p.add(&forcing_terms[j]);
         // Reactions that do no work in this direction vanish only after simplification.
-        let mut rhs = rhs;
         for r in reactions {
             if p.contains(rhs, r.id) {
                 let c = p.diff(rhs, r.id);
@@ -538,11 +593,14 @@ fn projected(
                 }
             }
         }
+        let lhs_terms: Vec<Id> = (0..n).map(|k| p.mul2(mass[j * n + k], qdd[k])).collect();
+        let lhs = p.add(&lhs_terms);
+        forcing.push(rhs);
         eqs.push(Equation {
             label: format!("projection on {}", coordinates[free[j]].name),
             lhs,
             rhs,
         });
     }
-    Ok(eqs)
+    Ok((eqs, mass, forcing))
 }
