@@ -15,8 +15,10 @@ struct Problem {
 /// Parses equations and `name(0)=value` / `name'(0)=value` initial conditions.
 fn problem(eqs: &[&str], ics: &[(&str, &str)], positive: &[&str]) -> Problem {
     let mut pool = Pool::new();
-    let mut scope = FreeScope::default();
-    scope.positive = positive.iter().map(|s| s.to_string()).collect();
+    let mut scope = FreeScope {
+        positive: positive.iter().map(|s| s.to_string()).collect(),
+        ..Default::default()
+    };
     for e in eqs {
         let (l, r) = pdyn_expr::syntax::parse_equation(e).unwrap();
         scope.learn(&l);

@@ -5,8 +5,10 @@ use pdyn_expr::{Pool, Program};
 use pdyn_mech::dsolve::rules::{antiderivative, evaluate, solve_rule, Given};
 
 fn law(pool: &mut Pool, src: &str, positive: &[&str]) -> pdyn_expr::Id {
-    let mut scope = pdyn_expr::FreeScope::default();
-    scope.positive = positive.iter().map(|s| s.to_string()).collect();
+    let mut scope = pdyn_expr::FreeScope {
+        positive: positive.iter().map(|s| s.to_string()).collect(),
+        ..Default::default()
+    };
     match pool.parse_in(src, &mut scope).unwrap() {
         pdyn_expr::Value::Scalar(s) => s,
         _ => panic!(),

@@ -513,8 +513,10 @@ fn run_rule(a: &DsolveArgs, rule: &str) -> Result<String, String> {
         .into_iter()
         .filter(|n| n != indep && n != "t" && n != "pi" && n != "e" && !a.signed.contains(n))
         .collect();
-    let mut scope = FreeScope::default();
-    scope.positive = params.iter().cloned().collect();
+    let mut scope = FreeScope {
+        positive: params.iter().cloned().collect(),
+        ..Default::default()
+    };
     let law = match pdyn_expr::lower::lower(&mut pool, &ast, &mut scope)
         .map_err(|e| e.render(src, "--rule"))?
     {
