@@ -397,8 +397,6 @@ pub(crate) struct Dop853 {
     n: usize,
     k: Vec<f64>,
     y1: Vec<f64>,
-    bsum: Vec<f64>,
-    e5: Vec<f64>,
     cont: Vec<f64>,
     t_old: f64,
     h: f64,
@@ -435,28 +433,124 @@ impl Dop853 {
         let n = if N > 0 { N } else { self.n };
         let a = &TABLEAU.a;
         let c = &TABLEAU.c;
-        for s in 1..11 {
-            stage_input(y, &self.k, n, &a[s][..s], h, &mut self.y1);
-            let (_, rest) = self.k.split_at_mut(s * n);
-            sys.rhs(t + c[s] * h, &self.y1, &mut rest[..n]);
+        let (y, y_new, atol, rtol) = (&y[..n], &mut y_new[..n], &atol[..n], &rtol[..n]);
+        let ys = &mut self.y1[..n];
+        let (k1, r) = self.k.split_at_mut(n);
+        let (k2, r) = r.split_at_mut(n);
+        let (k3, r) = r.split_at_mut(n);
+        let (k4, r) = r.split_at_mut(n);
+        let (k5, r) = r.split_at_mut(n);
+        let (k6, r) = r.split_at_mut(n);
+        let (k7, r) = r.split_at_mut(n);
+        let (k8, r) = r.split_at_mut(n);
+        let (k9, r) = r.split_at_mut(n);
+        let (k10, r) = r.split_at_mut(n);
+        let (k11, r) = r.split_at_mut(n);
+        let k12 = &mut r[..n];
+        let ha21 = h * a[1][0];
+        for i in 0..n {
+            ys[i] = y[i] + ha21 * k1[i];
         }
-        stage_input(y, &self.k, n, &a[11][..11], h, &mut self.y1);
-        {
-            let (_, rest) = self.k.split_at_mut(11 * n);
-            sys.rhs(t + h, &self.y1, &mut rest[..n]);
+        sys.rhs(t + c[1] * h, ys, k2);
+        for i in 0..n {
+            ys[i] = y[i] + h * (a[2][0] * k1[i] + a[2][1] * k2[i]);
         }
+        sys.rhs(t + c[2] * h, ys, k3);
+        for i in 0..n {
+            ys[i] = y[i] + h * (a[3][0] * k1[i] + a[3][2] * k3[i]);
+        }
+        sys.rhs(t + c[3] * h, ys, k4);
+        for i in 0..n {
+            ys[i] = y[i] + h * (a[4][0] * k1[i] + a[4][2] * k3[i] + a[4][3] * k4[i]);
+        }
+        sys.rhs(t + c[4] * h, ys, k5);
+        for i in 0..n {
+            ys[i] = y[i] + h * (a[5][0] * k1[i] + a[5][3] * k4[i] + a[5][4] * k5[i]);
+        }
+        sys.rhs(t + c[5] * h, ys, k6);
+        for i in 0..n {
+            ys[i] =
+                y[i] + h * (a[6][0] * k1[i] + a[6][3] * k4[i] + a[6][4] * k5[i] + a[6][5] * k6[i]);
+        }
+        sys.rhs(t + c[6] * h, ys, k7);
+        for i in 0..n {
+            ys[i] = y[i]
+                + h * (a[7][0] * k1[i]
+                    + a[7][3] * k4[i]
+                    + a[7][4] * k5[i]
+                    + a[7][5] * k6[i]
+                    + a[7][6] * k7[i]);
+        }
+        sys.rhs(t + c[7] * h, ys, k8);
+        for i in 0..n {
+            ys[i] = y[i]
+                + h * (a[8][0] * k1[i]
+                    + a[8][3] * k4[i]
+                    + a[8][4] * k5[i]
+                    + a[8][5] * k6[i]
+                    + a[8][6] * k7[i]
+                    + a[8][7] * k8[i]);
+        }
+        sys.rhs(t + c[8] * h, ys, k9);
+        for i in 0..n {
+            ys[i] = y[i]
+                + h * (a[9][0] * k1[i]
+                    + a[9][3] * k4[i]
+                    + a[9][4] * k5[i]
+                    + a[9][5] * k6[i]
+                    + a[9][6] * k7[i]
+                    + a[9][7] * k8[i]
+                    + a[9][8] * k9[i]);
+        }
+        sys.rhs(t + c[9] * h, ys, k10);
+        for i in 0..n {
+            ys[i] = y[i]
+                + h * (a[10][0] * k1[i]
+                    + a[10][3] * k4[i]
+                    + a[10][4] * k5[i]
+                    + a[10][5] * k6[i]
+                    + a[10][6] * k7[i]
+                    + a[10][7] * k8[i]
+                    + a[10][8] * k9[i]
+                    + a[10][9] * k10[i]);
+        }
+        sys.rhs(t + c[10] * h, ys, k11);
+        for i in 0..n {
+            ys[i] = y[i]
+                + h * (a[11][0] * k1[i]
+                    + a[11][3] * k4[i]
+                    + a[11][4] * k5[i]
+                    + a[11][5] * k6[i]
+                    + a[11][6] * k7[i]
+                    + a[11][7] * k8[i]
+                    + a[11][8] * k9[i]
+                    + a[11][9] * k10[i]
+                    + a[11][10] * k11[i]);
+        }
+        sys.rhs(t + h, ys, k12);
         stats.fevals += 11;
-        combine(&self.k, n, &B, &mut self.bsum);
-        combine(&self.k, n, &ER, &mut self.e5);
-        let k = &self.k;
         let (mut err, mut err2) = (0.0, 0.0);
         for i in 0..n {
-            let bsum = self.bsum[i];
-            let e5 = self.e5[i];
-            y_new[i] = y[i] + h * bsum;
+            let b = B[0] * k1[i]
+                + B[5] * k6[i]
+                + B[6] * k7[i]
+                + B[7] * k8[i]
+                + B[8] * k9[i]
+                + B[9] * k10[i]
+                + B[10] * k11[i]
+                + B[11] * k12[i];
+            y_new[i] = y[i] + h * b;
             let sk = atol[i] + rtol[i] * y[i].abs().max(y_new[i].abs());
-            let e3 = bsum - BHH[0] * k[i] - BHH[1] * k[8 * n + i] - BHH[2] * k[11 * n + i];
+            let e3 = b - BHH[0] * k1[i] - BHH[1] * k9[i] - BHH[2] * k12[i];
             err2 += (e3 / sk) * (e3 / sk);
+            let e5 = ER[0] * k1[i]
+                + ER[5] * k6[i]
+                + ER[6] * k7[i]
+                + ER[7] * k8[i]
+                + ER[8] * k9[i]
+                + ER[9] * k10[i]
+                + ER[10] * k11[i]
+                + ER[11] * k12[i];
             err += (e5 / sk) * (e5 / sk);
         }
         let mut deno = err + 0.01 * err2;
@@ -485,8 +579,6 @@ impl ExplicitRk for Dop853 {
             n,
             k: vec![0.0; 16 * n],
             y1: vec![0.0; n],
-            bsum: vec![0.0; n],
-            e5: vec![0.0; n],
             cont: vec![0.0; 8 * n],
             t_old: 0.0,
             h: 1.0,
