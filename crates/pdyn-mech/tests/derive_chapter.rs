@@ -192,3 +192,13 @@ fn two_link_chain_matches_hand_derivation() {
 fn three_link_chain_matches_hand_derivation() {
     check_chain(3);
 }
+
+#[test]
+fn bicycle_on_a_massless_frame_3_2_example_3() {
+    let mut m = example("bicycle");
+    let na = solved(&mut m, "N_A");
+    // N_A = W (L - d - mu h)/(L - mu h): the bike tips (N_A = 0) when mu > (L - d)/h.
+    same(&mut m, na, "m*g*(L - d - mu*h)/(L - mu*h)");
+    let a = solved(&mut m, "x''");
+    same(&mut m, a, "-mu*g*d/(L - mu*h)");
+}

@@ -55,3 +55,38 @@ fn bad_input_is_located_and_exits_nonzero() {
     assert!(!ok);
     assert!(err.contains("`b` has no value"), "{err}");
 }
+
+#[test]
+fn derive_prints_the_chapter_equations_and_json() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/");
+    let (ok, out, err) = pdyn(&["derive", &format!("{root}pulley.toml")]);
+    assert!(ok, "{err}");
+    assert!(out.contains("T = 2*g*mA*mB/(mA + mB)"), "{out}");
+    let (ok, out, err) = pdyn(&["derive", &format!("{root}building.toml"), "--json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("valid JSON");
+    assert_eq!(v["state"][0], "y1");
+    assert_eq!(v["unknowns"][1], "y2''");
+}
+
+#[test]
+fn derive_reports_located_model_errors() {
+    let dir = std::env::temp_dir().join(format!("pdyn-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.toml");
+    std::fs::write(
+        &path,
+        "[parameters]\nm = 1\n\n[coordinates]\nx = { initial = 0, rate = 0 }\n\n[particles.a]\nmass = \"m\"\nposition = \"[x, sn(x), 0]\"\n",
+    )
+    .unwrap();
+    let (ok, _, err) = pdyn(&["derive", path.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(
+        err.contains("bad.toml:9:17: error: unknown function `sn`"),
+        "{err}"
+    );
+    assert!(err.contains("did you mean `sin`?"), "{err}");
+    let (ok, _, err) = pdyn(&["derive", "/nonexistent/model.toml"]);
+    assert!(!ok);
+    assert!(err.contains("cannot read the model file"), "{err}");
+}
