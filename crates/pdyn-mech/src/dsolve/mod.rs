@@ -44,6 +44,7 @@ pub mod rules;
 use pdyn_expr::{Id, Node, Pool, Program, SymId};
 use std::fmt;
 
+pub(crate) use exact::nice_sqrt;
 pub use linear::{analyze, LinearOde};
 
 /// One initial condition: `coord^(order)(time) = value`.
