@@ -1,9 +1,11 @@
-//! Work–precision data for pdyn-ode against the Rust crate `ode_solvers` (a port of Hairer's
-//! dopri5/dop853): final-time error against a reference, f-evaluations and wall time, on
+//! Work–precision data for pdyn-ode against the Rust crates `ode_solvers` (a port of Hairer's
+//! dopri5/dop853) and `differential-equations` (0.2.0, DOPRI5/DOP853): final-time error
+//! against a reference, f-evaluations and wall time, on
 //! Arenstorf (4 eqs) and Pleiades (28 eqs); plus a long velocity-Verlet Kepler run.
 //! Output: CSV lines `problem,impl,method,tol,error,fevals,seconds` on stdout.
 use ode_solvers::{dop853::Dop853, dopri5::Dopri5, OutputType, SVector, System};
 use pdyn_ode::{solve, solve_second_order, FnSecondOrder, FnSystem, Method, Options};
+use nalgebra::SVector as DeVec;
 use std::time::Instant;
 
 const MU: f64 = 0.012277471;
@@ -56,6 +58,31 @@ const PLEI_Y3: [f64; 28] = [
     0.5952396354208710, -3.741244961234010, 0.3773459685750630, 0.9386858869551073,
     0.3667922227200571, -0.3474046353808490, 2.344915448180937, -1.947020434263292,
 ];
+
+struct DeAren;
+impl differential_equations::ode::ODE<f64, DeVec<f64, 4>> for DeAren {
+    fn diff(&self, _t: f64, y: &DeVec<f64, 4>, dy: &mut DeVec<f64, 4>) {
+        arenstorf(y.as_slice(), dy.as_mut_slice());
+    }
+}
+struct DePlei;
+impl differential_equations::ode::ODE<f64, DeVec<f64, 28>> for DePlei {
+    fn diff(&self, _t: f64, y: &DeVec<f64, 28>, dy: &mut DeVec<f64, 28>) {
+        pleiades(y.as_slice(), dy.as_mut_slice());
+    }
+}
+
+/// Runs a `differential-equations` method; returns (final error, f-evaluations).
+macro_rules! de_run {
+    ($method:expr, $sys:expr, $t1:expr, $y0:expr, $reference:expr) => {{
+        let mut m = $method;
+        let sol = differential_equations::ode::ODEProblem::new($sys, 0.0, $t1, $y0)
+            .solve(&mut m)
+            .unwrap();
+        let (_, y) = sol.last().unwrap();
+        (max_err(y.as_slice(), &$reference), sol.evals)
+    }};
+}
 
 struct OsAren;
 impl System<f64, SVector<f64, 4>> for OsAren {
@@ -133,6 +160,22 @@ fn main() {
             (max_err(st.y_out().last().unwrap().as_slice(), &PLEI_Y3), stats.num_eval)
         });
         println!("pleiades,ode_solvers,dop853,{tol:e},{e:e},{nf},{s:e}");
+        // differential-equations
+        use differential_equations::prelude::{DOP853, DOPRI5};
+        let dy0 = DeVec::<f64, 4>::from_row_slice(&AREN_Y0);
+        let dp0 = DeVec::<f64, 28>::from_row_slice(&PLEI_Y0);
+        let (s, (e, nf)) =
+            time(|| de_run!(DOPRI5::new().rtol(tol).atol(tol), DeAren, AREN_T, dy0, AREN_Y0));
+        println!("arenstorf,differential_equations,dopri5,{tol:e},{e:e},{nf},{s:e}");
+        let (s, (e, nf)) =
+            time(|| de_run!(DOP853::new().rtol(tol).atol(tol), DeAren, AREN_T, dy0, AREN_Y0));
+        println!("arenstorf,differential_equations,dop853,{tol:e},{e:e},{nf},{s:e}");
+        let (s, (e, nf)) =
+            time(|| de_run!(DOPRI5::new().rtol(tol).atol(tol), DePlei, 3.0, dp0, PLEI_Y3));
+        println!("pleiades,differential_equations,dopri5,{tol:e},{e:e},{nf},{s:e}");
+        let (s, (e, nf)) =
+            time(|| de_run!(DOP853::new().rtol(tol).atol(tol), DePlei, 3.0, dp0, PLEI_Y3));
+        println!("pleiades,differential_equations,dop853,{tol:e},{e:e},{nf},{s:e}");
     }
     // Robertson to 1e11 with Radau5 (reference: Bari test set).
     let rober = pdyn_ode::FnSystemWithJacobian::new(
