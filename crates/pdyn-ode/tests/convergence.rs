@@ -119,3 +119,43 @@ fn print_tables() {
         println!("{line}");
     }
 }
+
+/// Radau5 cannot be run with a fixed step through the public options (its Newton tolerance is
+/// tied to `rtol`), so its order is measured from work–precision: over a sweep of tolerances
+/// the global error must fall like `N^{-5}` in the number of steps `N` (least-squares slope
+/// of log error against log N over rtol = atol = 1e-8 … 1e-13, within ±0.5 of −5: adaptive
+/// step sequences make this measurement noisier than the fixed-step ones above).
+#[test]
+fn radau5_work_precision_slope_is_order_5() {
+    let q0 = [1.0 - E, 0.0];
+    let v0 = [0.0, ((1.0 + E) / (1.0 - E)).sqrt()];
+    let exact = [q0[0], q0[1], v0[0], v0[1]];
+    let mut pts = Vec::new();
+    for k in 0..6 {
+        let tol = 10f64.powf(-8.0 - k as f64);
+        let sol = solve_second_order(
+            Method::Radau5,
+            &kepler(),
+            (0.0, 2.0 * PI),
+            &q0,
+            &v0,
+            &Options::with_tol(tol),
+        )
+        .unwrap();
+        let (_, y) = sol.last().unwrap();
+        let err = y
+            .iter()
+            .zip(exact)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        pts.push(((sol.stats.accepted as f64).ln(), err.ln()));
+    }
+    let n = pts.len() as f64;
+    let (sx, sy) = pts.iter().fold((0.0, 0.0), |(a, b), p| (a + p.0, b + p.1));
+    let (mx, my) = (sx / n, sy / n);
+    let num: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let den: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let slope = num / den;
+    eprintln!("radau5 work-precision slope {slope:.3}");
+    assert!((slope + 5.0).abs() <= 0.5, "slope {slope:.3}: {pts:?}");
+}
