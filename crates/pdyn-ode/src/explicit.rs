@@ -88,6 +88,9 @@ pub(crate) fn setup<S: OdeSystem + ?Sized>(
     opts: &Options,
 ) -> Result<Setup, OdeError> {
     let n = sys.dim();
+    if n == 0 {
+        return Err(invalid("the system has no components"));
+    }
     if y0.len() != n {
         return Err(invalid(format!(
             "y0 has {} components, the system {n}",

@@ -109,7 +109,10 @@ pub enum Method {
     Radau5,
     /// DOPRI5 while the problem is non-stiff, switching to Radau5 for the rest of the
     /// integration when DOPRI5's stiffness detector fires (checked every
-    /// [`Options::stiffness_check_interval`] accepted steps).
+    /// [`Options::stiffness_check_interval`] accepted steps, then 15 positive checks in a row).
+    /// The switch restarts from the last accepted DOPRI5 state with Radau5's own first step;
+    /// statistics are summed; the occurrence count of `terminal(n)` events restarts at the
+    /// switch; [`Stats::stiffness_detected_at`] records where it happened.
     Auto,
 }
 

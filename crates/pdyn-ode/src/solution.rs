@@ -108,7 +108,7 @@ impl Solution {
         self.t.is_empty()
     }
 
-    /// State at output `k`.
+    /// State at output `k` (panics if `k >= self.len()`, like slice indexing).
     pub fn y_at(&self, k: usize) -> &[f64] {
         &self.y[k * self.n..(k + 1) * self.n]
     }

@@ -203,3 +203,10 @@ fn zero_length_interval_returns_initial_point() {
         assert_eq!(sol.y, vec![1.0, 2.0]);
     }
 }
+
+#[test]
+fn empty_system_is_invalid() {
+    let sys = FnSystem::new(0, |_t, _y: &[f64], _f: &mut [f64]| {});
+    let r = solve(Method::Dopri5, &sys, (0.0, 1.0), &[], &Options::default());
+    assert!(is_invalid(r));
+}
