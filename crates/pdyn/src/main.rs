@@ -4,6 +4,9 @@
 mod derive_cmd;
 mod dsolve_cmd;
 mod expr_cmd;
+mod kin_cmd;
+mod plots;
+mod run_cmd;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -28,8 +31,12 @@ enum Command {
     Eval(expr_cmd::EvalArgs),
     /// Derive the equations of motion of a model file.
     Derive(derive_cmd::DeriveArgs),
+    /// Simulate a model file: integrate, check conservation laws, write CSV/JSON/plots.
+    Run(run_cmd::RunArgs),
     /// Solve linear constant-coefficient ODEs and systems in closed form, and the 1-D motion rules.
     Dsolve(dsolve_cmd::DsolveArgs),
+    /// Kinematics of a particle: velocity, acceleration, normal-tangential and polar components.
+    Kin(kin_cmd::KinArgs),
 }
 
 fn main() -> ExitCode {
@@ -40,7 +47,20 @@ fn main() -> ExitCode {
         Command::Solve(a) => expr_cmd::solve(a),
         Command::Eval(a) => expr_cmd::eval(a),
         Command::Derive(a) => derive_cmd::run(a),
+        Command::Run(a) => match run_cmd::run(a) {
+            Ok((out, err, ok)) => {
+                print!("{out}");
+                eprint!("{err}");
+                return if ok {
+                    ExitCode::SUCCESS
+                } else {
+                    ExitCode::from(1)
+                };
+            }
+            Err(e) => Err(e),
+        },
         Command::Dsolve(a) => dsolve_cmd::run(a),
+        Command::Kin(a) => kin_cmd::run(a),
     };
     match result {
         Ok(out) => {

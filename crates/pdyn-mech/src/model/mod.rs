@@ -9,6 +9,7 @@
 
 mod forces;
 pub(crate) mod raw;
+pub mod spec;
 
 use crate::units::{looks_like_quantity, parse_quantity};
 use pdyn_expr::error::{render_diagnostic, suggest};
@@ -212,6 +213,8 @@ pub struct Model {
     /// True when every force has a potential or is a reaction (energy is then conserved
     /// unless something is prescribed as a function of time).
     pub conservative: bool,
+    /// `[simulate]`, `[[events]]`, `[monitors]`, `[sweep]`.
+    pub run: spec::RunSpec,
 }
 
 /// Name resolution for expressions in a model file.
@@ -647,7 +650,11 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
         constraints.push(Constraint { label, equation: e });
     }
 
+    let params = ld.params.clone();
+    let run = spec::read(&mut ld, &raw, &params)?;
+
     Ok(Model {
+        run,
         name: raw.name.clone().unwrap_or_else(|| origin.to_string()),
         origin: origin.to_string(),
         source: source.to_string(),

@@ -35,6 +35,60 @@ pub struct RawModel {
     pub forces: Vec<Spanned<RawForce>>,
     #[serde(default)]
     pub constraints: Vec<Spanned<RawConstraint>>,
+    pub simulate: Option<Spanned<RawSimulate>>,
+    #[serde(default)]
+    pub events: Vec<Spanned<RawEvent>>,
+    #[serde(default)]
+    pub monitors: IndexMap<Name, Sv>,
+    pub sweep: Option<Spanned<RawSweep>>,
+}
+
+/// `[simulate]`: how `pdyn run` integrates (command-line options override it).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSimulate {
+    pub t_end: Option<Sv>,
+    pub method: Option<Name>,
+    pub rtol: Option<Sv>,
+    pub atol: Option<Sv>,
+    pub dt: Option<Sv>,
+    pub h0: Option<Sv>,
+    pub max_step: Option<Sv>,
+    pub max_steps: Option<Spanned<i64>>,
+    pub points: Option<Spanned<i64>>,
+    pub output_dt: Option<Sv>,
+    pub drift_tolerance: Option<Sv>,
+}
+
+/// `[[events]]`: a zero crossing of `when`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawEvent {
+    pub name: Option<Name>,
+    pub when: Option<Sv>,
+    pub direction: Option<Name>,
+    pub terminal: Option<Spanned<toml::Value>>,
+}
+
+/// `[sweep]`: runs over parameter values, with response measures.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSweep {
+    pub parameter: Option<Name>,
+    pub values: Option<Spanned<Vec<toml::Value>>>,
+    pub from: Option<Sv>,
+    pub to: Option<Sv>,
+    pub steps: Option<Spanned<i64>>,
+    #[serde(default)]
+    pub measures: IndexMap<Name, Spanned<RawMeasure>>,
+}
+
+/// A response measure of a sweep: a statistic of an expression over each run.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawMeasure {
+    pub of: Option<Sv>,
+    pub stat: Option<Name>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -1,0 +1,335 @@
+//! What `pdyn run` needs from a model file besides the mechanics: `[simulate]` settings,
+//! `[[events]]`, `[monitors]` and `[sweep]`, resolved into numbers and expressions. The
+//! integrator itself is chosen and driven by the `pdyn` crate; this module only reads and checks.
+
+use super::raw::{RawModel, Sv};
+use super::{Loader, ModelError};
+use pdyn_expr::error::suggest;
+use pdyn_expr::{Id, Value};
+use std::ops::Range;
+
+/// `[simulate]`. Every field is optional; command-line options override it.
+#[derive(Clone, Debug, Default)]
+pub struct SimulateSpec {
+    /// End time.
+    pub t_end: Option<f64>,
+    /// Method name as written, with its span (checked by the runner).
+    pub method: Option<(String, Range<usize>)>,
+    /// Relative tolerance.
+    pub rtol: Option<f64>,
+    /// Absolute tolerance.
+    pub atol: Option<f64>,
+    /// Step of the fixed-step methods (or first step of the adaptive ones).
+    pub dt: Option<f64>,
+    /// Largest step.
+    pub max_step: Option<f64>,
+    /// Step limit.
+    pub max_steps: Option<usize>,
+    /// Output at this many equally spaced times (instead of every step).
+    pub points: Option<usize>,
+    /// Output every `output_dt` (instead of every step).
+    pub output_dt: Option<f64>,
+    /// Relative drift of a conserved quantity above which a run warns.
+    pub drift_tolerance: Option<f64>,
+}
+
+/// Which zero crossings of an event function count.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Crossing {
+    /// From negative to positive.
+    Rising,
+    /// From positive to negative.
+    Falling,
+    /// Both.
+    Both,
+}
+
+/// An `[[events]]` entry: `when` crosses zero.
+#[derive(Clone, Debug)]
+pub struct EventSpec {
+    /// Name used in reports.
+    pub name: String,
+    /// The event function (of `t`, coordinates, rates, parameters; may use reactions).
+    pub when: Id,
+    /// Crossing direction.
+    pub direction: Crossing,
+    /// Stop at the n-th occurrence (`terminal = true` is 1).
+    pub terminal: Option<usize>,
+}
+
+/// A named expression evaluated along the trajectory.
+#[derive(Clone, Debug)]
+pub struct Monitor {
+    /// Name (a CSV column).
+    pub name: String,
+    /// The expression.
+    pub expr: Id,
+}
+
+/// A statistic of an expression over one run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stat {
+    /// Largest value.
+    Max,
+    /// Smallest value.
+    Min,
+    /// Largest absolute value.
+    MaxAbs,
+    /// Largest minus smallest.
+    PeakToPeak,
+    /// Value at the end.
+    Final,
+    /// Time average (trapezoidal).
+    Mean,
+    /// Root mean square over time.
+    Rms,
+}
+
+impl Stat {
+    const NAMES: [(&'static str, Stat); 7] = [
+        ("max", Stat::Max),
+        ("min", Stat::Min),
+        ("max_abs", Stat::MaxAbs),
+        ("peak_to_peak", Stat::PeakToPeak),
+        ("final", Stat::Final),
+        ("mean", Stat::Mean),
+        ("rms", Stat::Rms),
+    ];
+    /// The name used in model files.
+    pub fn name(self) -> &'static str {
+        Stat::NAMES
+            .iter()
+            .find(|(_, s)| *s == self)
+            .map_or("?", |(n, _)| n)
+    }
+}
+
+/// A response measure of a sweep.
+#[derive(Clone, Debug)]
+pub struct Measure {
+    /// Name (a column of the sweep table).
+    pub name: String,
+    /// The expression.
+    pub of: Id,
+    /// The statistic.
+    pub stat: Stat,
+}
+
+/// `[sweep]`: one parameter over a list of values.
+#[derive(Clone, Debug)]
+pub struct SweepSpec {
+    /// Index of the swept parameter in [`super::Model::parameters`].
+    pub parameter: usize,
+    /// Its values.
+    pub values: Vec<f64>,
+    /// What to record from each run.
+    pub measures: Vec<Measure>,
+}
+
+/// Everything `pdyn run` reads from the model file.
+#[derive(Clone, Debug, Default)]
+pub struct RunSpec {
+    /// `[simulate]`.
+    pub simulate: SimulateSpec,
+    /// `[[events]]`.
+    pub events: Vec<EventSpec>,
+    /// `[monitors]`.
+    pub monitors: Vec<Monitor>,
+    /// `[sweep]`.
+    pub sweep: Option<SweepSpec>,
+}
+
+fn number(ld: &mut Loader, sv: &Sv, what: &str) -> Result<f64, ModelError> {
+    let id = ld.scalar(sv, what)?;
+    ld.constant(id, sv.span(), what)
+}
+
+fn positive(ld: &mut Loader, sv: &Option<Sv>, what: &str) -> Result<Option<f64>, ModelError> {
+    let Some(sv) = sv else { return Ok(None) };
+    let x = number(ld, sv, what)?;
+    if x <= 0.0 {
+        return Err(ld.err(sv.span(), format!("{what} must be positive, it is {x}")));
+    }
+    Ok(Some(x))
+}
+
+pub(super) fn read(
+    ld: &mut Loader,
+    raw: &RawModel,
+    parameters: &[super::Parameter],
+) -> Result<RunSpec, ModelError> {
+    let mut spec = RunSpec::default();
+    if let Some(s) = &raw.simulate {
+        let r = s.get_ref();
+        let sim = &mut spec.simulate;
+        sim.t_end = match &r.t_end {
+            Some(sv) => Some(number(ld, sv, "`t_end`")?),
+            None => None,
+        };
+        sim.method = r.method.as_ref().map(|m| (m.get_ref().clone(), m.span()));
+        sim.rtol = positive(ld, &r.rtol, "`rtol`")?;
+        sim.atol = positive(ld, &r.atol, "`atol`")?;
+        sim.dt = positive(ld, &r.dt, "`dt`")?.or(positive(ld, &r.h0, "`h0`")?);
+        sim.max_step = positive(ld, &r.max_step, "`max_step`")?;
+        sim.output_dt = positive(ld, &r.output_dt, "`output_dt`")?;
+        sim.drift_tolerance = positive(ld, &r.drift_tolerance, "`drift_tolerance`")?;
+        for (field, v, dst) in [
+            ("max_steps", &r.max_steps, &mut sim.max_steps),
+            ("points", &r.points, &mut sim.points),
+        ] {
+            if let Some(v) = v {
+                if *v.get_ref() < 2 {
+                    return Err(ld.err(v.span(), format!("`{field}` must be at least 2")));
+                }
+                *dst = Some(*v.get_ref() as usize);
+            }
+        }
+    }
+    for se in &raw.events {
+        let e = se.get_ref();
+        let name = e.name.as_ref().map_or_else(
+            || format!("event {}", spec.events.len() + 1),
+            |n| n.get_ref().clone(),
+        );
+        let Some(w) = &e.when else {
+            return Err(ld
+                .err(se.span(), format!("event `{name}` has no `when`"))
+                .help("when = \"z\" stops or records when z crosses zero"));
+        };
+        let when = ld.scalar(w, "`when`")?;
+        let direction = match e
+            .direction
+            .as_ref()
+            .map(|d| (d.get_ref().as_str(), d.span()))
+        {
+            None | Some(("both", _)) => Crossing::Both,
+            Some(("rising", _)) | Some(("up", _)) => Crossing::Rising,
+            Some(("falling", _)) | Some(("down", _)) => Crossing::Falling,
+            Some((other, span)) => {
+                return Err(ld
+                    .err(span, format!("unknown direction `{other}`"))
+                    .help("direction is \"rising\", \"falling\" or \"both\""))
+            }
+        };
+        let terminal = match &e.terminal {
+            None => None,
+            Some(t) => match t.get_ref() {
+                toml::Value::Boolean(true) => Some(1),
+                toml::Value::Boolean(false) => None,
+                toml::Value::Integer(n) if *n >= 1 => Some(*n as usize),
+                _ => return Err(ld.err(
+                    t.span(),
+                    "`terminal` is true, false, or the number of occurrences after which to stop",
+                )),
+            },
+        };
+        spec.events.push(EventSpec {
+            name,
+            when,
+            direction,
+            terminal,
+        });
+    }
+    for (name, sv) in &raw.monitors {
+        let v = ld.value(sv)?;
+        match v {
+            Value::Scalar(expr) => spec.monitors.push(Monitor {
+                name: name.get_ref().clone(),
+                expr,
+            }),
+            Value::Vector(c) => {
+                for (axis, &expr) in ["x", "y", "z"].iter().zip(&c) {
+                    spec.monitors.push(Monitor {
+                        name: format!("{}.{axis}", name.get_ref()),
+                        expr,
+                    });
+                }
+            }
+        }
+    }
+    if let Some(ss) = &raw.sweep {
+        let s = ss.get_ref();
+        let Some(pn) = &s.parameter else {
+            return Err(ld
+                .err(ss.span(), "a sweep needs `parameter`")
+                .help("parameter = \"omega\""));
+        };
+        let Some(pi) = parameters.iter().position(|p| &p.name == pn.get_ref()) else {
+            let mut e = ld.err(pn.span(), format!("`{}` is not a parameter", pn.get_ref()));
+            if let Some(s) = suggest(pn.get_ref(), parameters.iter().map(|p| p.name.as_str())) {
+                e = e.help(format!("did you mean `{s}`?"));
+            }
+            return Err(e);
+        };
+        let values = if let Some(vals) = &s.values {
+            let mut out = Vec::new();
+            for v in vals.get_ref() {
+                match v {
+                    toml::Value::Integer(i) => out.push(*i as f64),
+                    toml::Value::Float(f) => out.push(*f),
+                    _ => return Err(ld.err(vals.span(), "`values` must be a list of numbers")),
+                }
+            }
+            out
+        } else {
+            let (Some(from), Some(to), Some(steps)) = (&s.from, &s.to, &s.steps) else {
+                return Err(ld
+                    .err(
+                        ss.span(),
+                        "a sweep needs `values = [...]`, or `from`, `to` and `steps`",
+                    )
+                    .help("e.g. from = 1, to = 30, steps = 300"));
+            };
+            let a = number(ld, from, "`from`")?;
+            let b = number(ld, to, "`to`")?;
+            let n = *steps.get_ref();
+            if n < 2 {
+                return Err(ld.err(steps.span(), "`steps` must be at least 2"));
+            }
+            (0..n)
+                .map(|k| a + (b - a) * k as f64 / (n - 1) as f64)
+                .collect()
+        };
+        if values.is_empty() {
+            return Err(ld.err(ss.span(), "the sweep has no values"));
+        }
+        let mut measures = Vec::new();
+        for (name, sm) in &s.measures {
+            let m = sm.get_ref();
+            let Some(of) = &m.of else {
+                return Err(ld.err(
+                    sm.span(),
+                    format!("measure `{}` needs `of`", name.get_ref()),
+                ));
+            };
+            let of_id = ld.scalar(of, "`of`")?;
+            let stat = match &m.stat {
+                None => Stat::MaxAbs,
+                Some(st) => match Stat::NAMES.iter().find(|(n, _)| n == st.get_ref()) {
+                    Some((_, s)) => *s,
+                    None => {
+                        let names: Vec<&str> = Stat::NAMES.iter().map(|(n, _)| *n).collect();
+                        let mut e =
+                            ld.err(st.span(), format!("unknown statistic `{}`", st.get_ref()));
+                        e = match suggest(st.get_ref(), names.iter().copied()) {
+                            Some(s) => e.help(format!("did you mean `{s}`?")),
+                            None => e.help(format!("statistics: {}", names.join(", "))),
+                        };
+                        return Err(e);
+                    }
+                },
+            };
+            measures.push(Measure {
+                name: name.get_ref().clone(),
+                of: of_id,
+                stat,
+            });
+        }
+        spec.sweep = Some(SweepSpec {
+            parameter: pi,
+            values,
+            measures,
+        });
+    }
+    Ok(spec)
+}

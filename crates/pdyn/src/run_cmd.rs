@@ -1,0 +1,193 @@
+//! `pdyn run MODEL`: simulate a model file.
+
+use clap::Args;
+use pdyn::output::{summary, write_csv};
+use pdyn::sim::{self, RunSettings, DEFAULT_DRIFT_TOLERANCE};
+use std::path::PathBuf;
+
+/// `pdyn run`.
+#[derive(Args, Debug, Clone)]
+pub struct RunArgs {
+    /// The model file (TOML), e.g. examples/satellite.toml.
+    pub model: PathBuf,
+    /// Integration method (`auto`, `dopri5`/`ode45`, `tsit5`, `dop853`, `radau5`, `rk4`,
+    /// `symplectic`, `verlet`, `yoshida4`, `kahanli6`, `kahanli8`, `gauss4`, `gauss6`);
+    /// `--method help` lists them with their papers.
+    #[arg(long)]
+    pub method: Option<String>,
+    /// Relative tolerance (default 1e-6).
+    #[arg(long)]
+    pub rtol: Option<f64>,
+    /// Absolute tolerance (default 1e-9).
+    #[arg(long)]
+    pub atol: Option<f64>,
+    /// End time (overrides [simulate] t_end).
+    #[arg(long = "t-end", alias = "t_end")]
+    pub t_end: Option<f64>,
+    /// Fixed step (symplectic and RK4 methods), or first step.
+    #[arg(long)]
+    pub dt: Option<f64>,
+    /// Largest step.
+    #[arg(long = "max-step", alias = "max_step")]
+    pub max_step: Option<f64>,
+    /// Step limit.
+    #[arg(long = "max-steps", alias = "max_steps")]
+    pub max_steps: Option<usize>,
+    /// Output at this many equally spaced times (default: every step).
+    #[arg(long)]
+    pub points: Option<usize>,
+    /// Output every OUTPUT_DT (default: every step).
+    #[arg(long = "output-dt", alias = "t_eval_dt")]
+    pub output_dt: Option<f64>,
+    /// Warn when a conserved quantity drifts more than this (relative; default 5e-3).
+    #[arg(long = "drift-tolerance")]
+    pub drift_tolerance: Option<f64>,
+    /// Directory for trajectory.csv and summary.json (and plots with --plot).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Write plots (SVG and PNG) into --out.
+    #[arg(long)]
+    pub plot: bool,
+    /// Print the JSON summary instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Merges `[simulate]` and the command line.
+pub fn settings(model: &pdyn_mech::Model, a: &RunArgs) -> Result<RunSettings, String> {
+    let s = &model.run.simulate;
+    let t_end = a.t_end.or(s.t_end).ok_or_else(|| {
+        format!(
+            "{}: error: no end time: add t_end = ... under [simulate] or pass --t-end",
+            model.origin
+        )
+    })?;
+    let method = match &a.method {
+        Some(m) => m.clone(),
+        None => match &s.method {
+            Some((m, span)) => {
+                if sim::method_by_name(m).is_none() {
+                    let e = pdyn_mech::ModelError::new(
+                        &model.origin,
+                        span.clone(),
+                        format!("unknown method `{m}`"),
+                    )
+                    .help("run `pdyn run --method help` for the list");
+                    return Err(e.render(&model.source));
+                }
+                m.clone()
+            }
+            None => "auto".to_string(),
+        },
+    };
+    Ok(RunSettings {
+        method,
+        t_end,
+        rtol: a.rtol.or(s.rtol),
+        atol: a.atol.or(s.atol),
+        dt: a.dt.or(s.dt),
+        max_step: a.max_step.or(s.max_step),
+        max_steps: a.max_steps.or(s.max_steps),
+        points: a.points.or(s.points),
+        output_dt: a.output_dt.or(s.output_dt),
+        drift_tolerance: a
+            .drift_tolerance
+            .or(s.drift_tolerance)
+            .unwrap_or(DEFAULT_DRIFT_TOLERANCE),
+    })
+}
+
+/// `pdyn run MODEL`. Returns (stdout text, stderr text, success).
+pub fn run(a: RunArgs) -> Result<(String, String, bool), String> {
+    if a.method.as_deref() == Some("help") {
+        return Ok((sim::methods_help(), String::new(), true));
+    }
+    let mut model = crate::derive_cmd::load(&a.model)?;
+    let set = settings(&model, &a)?;
+    let prep = sim::prepare(&mut model)?;
+    let res = sim::run(&prep, &set).map_err(|e| format!("{}: error: {e}", model.origin))?;
+    let mut err = String::new();
+    for w in &res.warnings {
+        err += &format!("warning: {w}\n");
+    }
+    if let Some(f) = &res.failure {
+        err += &format!("{}: error: {f}\n", model.origin);
+    }
+    let sum = summary(&res, &model.name, &prep.state_names);
+    if let Some(dir) = &a.out {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        let csv = dir.join("trajectory.csv");
+        write_csv(&res, &csv).map_err(|e| format!("cannot write {}: {e}", csv.display()))?;
+        let js = dir.join("summary.json");
+        std::fs::write(&js, format!("{sum:#}\n"))
+            .map_err(|e| format!("cannot write {}: {e}", js.display()))?;
+        if a.plot {
+            crate::plots::write_run_plots(&model, &prep, &res, dir)?;
+        }
+    } else if a.plot {
+        return Err("--plot needs --out DIR to write the images into".into());
+    }
+    let out = if a.json {
+        format!("{sum:#}\n")
+    } else {
+        text_report(&model, &res, &set, a.out.as_ref())
+    };
+    Ok((out, err, res.failure.is_none()))
+}
+
+fn text_report(
+    model: &pdyn_mech::Model,
+    res: &sim::RunResult,
+    set: &RunSettings,
+    out: Option<&PathBuf>,
+) -> String {
+    let mut s = format!("{}\n", model.name);
+    s += &format!(
+        "method {}, t = 0..{}, {} accepted / {} rejected steps, {} f-evaluations, {} output rows\n",
+        res.method,
+        set.t_end,
+        res.stats.accepted,
+        res.stats.rejected,
+        res.stats.fevals,
+        res.rows.len()
+    );
+    if let Some(last) = res.rows.last() {
+        s += "\nfinal values:\n";
+        for (c, v) in res.columns.iter().zip(last) {
+            s += &format!("  {c:<20} {v:.10e}\n");
+        }
+    }
+    if !res.events.is_empty() {
+        s += "\nevents:\n";
+        for e in &res.events {
+            s += &format!(
+                "  {:<16} t = {:.12e} ({})\n",
+                e.name,
+                e.t,
+                if e.rising { "rising" } else { "falling" }
+            );
+        }
+    }
+    if !res.monitors.is_empty() {
+        s += "\nconserved quantities:\n";
+        for m in &res.monitors {
+            let ok = m.drift <= set.drift_tolerance;
+            s += &format!(
+                "  {:<20} initial {:.10e}, drift {:.3e} ({}) {}\n",
+                m.name,
+                m.initial,
+                m.drift,
+                if m.relative { "relative" } else { "absolute" },
+                if ok { "ok" } else { "DRIFTING" }
+            );
+        }
+    }
+    if let Some(dir) = out {
+        s += &format!(
+            "\nwrote {}/trajectory.csv and summary.json\n",
+            dir.display()
+        );
+    }
+    s
+}
