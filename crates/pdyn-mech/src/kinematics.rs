@@ -373,6 +373,22 @@ fn project(
     }
 }
 
+/// `|e|` distributed over products and integer powers (`|R^2 θ'^3| = R^2 |θ'|^3`), so that it
+/// cancels against `|θ'|^3` from the speed.
+fn abs_of(pool: &mut Pool, e: Id) -> Id {
+    match pool.node(e).clone() {
+        Node::Mul(fs) => {
+            let parts: Vec<Id> = fs.iter().map(|&f| abs_of(pool, f)).collect();
+            pool.mul(&parts)
+        }
+        Node::Pow(b, x) if pool.as_num(x).and_then(|n| n.as_integer()).is_some() => {
+            let ab = abs_of(pool, b);
+            pool.pow(ab, x)
+        }
+        _ => pool.call(Func::Abs, &[e]),
+    }
+}
+
 /// Normal–tangential quantities from `r, v, a` (functions of `t`).
 fn nt(
     pool: &mut Pool,
@@ -392,11 +408,17 @@ fn nt(
         simp(pool, d)
     };
     let vxa = cross(pool, v, a);
-    let vxa2 = {
+    let vxa = simp3(pool, vxa);
+    let nonzero: Vec<Id> = vxa.iter().copied().filter(|&c| c != Pool::ZERO).collect();
+    let vxa_norm = if let [only] = nonzero.as_slice() {
+        // Planar motion: |v × a| is |(v × a)_z|, no square root of a square.
+        let c = simp(pool, *only);
+        abs_of(pool, c)
+    } else {
         let d = dot(pool, vxa, vxa);
-        simp(pool, d)
+        let vxa2 = simp(pool, d);
+        crate::dsolve::nice_sqrt(pool, vxa2)
     };
-    let vxa_norm = crate::dsolve::nice_sqrt(pool, vxa2);
     let tangent = {
         let tv = v.map(|c| pool.div(c, speed));
         simp3(pool, tv)

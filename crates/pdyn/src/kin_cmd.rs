@@ -1,0 +1,682 @@
+//! `pdyn kin`: kinematics of a particle from its position (Cartesian or polar) or its path and
+//! speed: velocity, acceleration, normal–tangential and polar components, curvature, values at
+//! instants and maxima over a range.
+
+use crate::dsolve_cmd::split_top;
+use clap::{Args, ValueEnum};
+use pdyn_expr::syntax::Ast;
+use pdyn_expr::{Binding, FreeScope, Id, Node, Number, Pool, Program, Scope, Value};
+use pdyn_mech::kinematics::{analyze, maximize, solve_time, Kinematics, Motion, Quantity};
+use serde_json::json;
+
+/// Output notation for expressions.
+#[derive(Clone, Copy, Debug, Default, ValueEnum, PartialEq, Eq)]
+pub enum Format {
+    /// Plain text that pdyn parses back.
+    #[default]
+    Text,
+    /// LaTeX (math mode).
+    Latex,
+}
+
+/// `pdyn kin`.
+#[derive(Args, Debug)]
+#[command(after_help = "Examples:
+  pdyn kin \"[R*cos(omega*t), R*sin(omega*t), 0]\"
+  pdyn kin --polar \"r = t/sqrt(pi), theta = t^2\" --at theta=pi
+  pdyn kin --path \"y = A*sin(2*pi*x/L)\" --speed V --max \"norm(a)\" --over x=0..L
+  pdyn kin --path \"x = R*cos(s), y = R*sin(s)\" --param s --speed \"k*t\" --at \"s=pi, t=2\"")]
+pub struct KinArgs {
+    /// Cartesian position `[x, y, z]` as functions of `t` (or of coordinates written `x(t)`).
+    #[arg(allow_hyphen_values = true)]
+    position: Option<String>,
+    /// Cylindrical-polar position: `r = ..., theta = ..., z = ...` (z optional).
+    #[arg(long, allow_hyphen_values = true)]
+    polar: Option<String>,
+    /// A planar path: `y = f(x)`, or `x = ..., y = ...` in the parameter given by --param.
+    #[arg(long, allow_hyphen_values = true)]
+    path: Option<String>,
+    /// The parameter of a parametric path.
+    #[arg(long, default_value = "s")]
+    param: String,
+    /// Speed along the path (a constant or a function of t).
+    #[arg(long, default_value = "V", allow_hyphen_values = true)]
+    speed: String,
+    /// Evaluate at an instant: `t=2`, `theta=pi` (solves for t), `x=L/4` (path position),
+    /// several assignments separated by commas. Repeat for several instants.
+    #[arg(long, allow_hyphen_values = true)]
+    at: Vec<String>,
+    /// Parameter values, e.g. `--set A=2,L=50`.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    set: Vec<String>,
+    /// A scalar to maximise over --over, in the names printed (`norm(a)`, `a_n`, `speed`...).
+    #[arg(long, allow_hyphen_values = true)]
+    max: Option<String>,
+    /// The range for --max: `x=0..L` or `t=0..10`.
+    #[arg(long, allow_hyphen_values = true)]
+    over: Option<String>,
+    /// Parameters that may be negative; every other parameter is assumed positive.
+    #[arg(long, value_delimiter = ',')]
+    signed: Vec<String>,
+    /// Output notation.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
+    /// Machine-readable output.
+    #[arg(long)]
+    json: bool,
+}
+
+fn show(pool: &Pool, id: Id, f: Format) -> String {
+    match f {
+        Format::Text => pool.to_text(id),
+        Format::Latex => pool.to_latex(id),
+    }
+}
+
+fn show_q(pool: &Pool, q: Quantity, f: Format) -> String {
+    match q {
+        Quantity::Scalar(s) => show(pool, s, f),
+        Quantity::Vector(v) => {
+            let parts: Vec<String> = v.iter().map(|&c| show(pool, c, f)).collect();
+            match f {
+                Format::Latex => format!(
+                    "\\begin{{bmatrix}} {} \\end{{bmatrix}}",
+                    parts.join(" \\\\ ")
+                ),
+                Format::Text => format!("[{}]", parts.join(", ")),
+            }
+        }
+    }
+}
+
+fn json_q(pool: &Pool, q: Quantity) -> serde_json::Value {
+    let one = |x: Id| json!({"text": pool.to_text(x), "latex": pool.to_latex(x)});
+    match q {
+        Quantity::Scalar(s) => one(s),
+        Quantity::Vector(v) => json!(v.iter().map(|&c| one(c)).collect::<Vec<_>>()),
+    }
+}
+
+fn idents(ast: &Ast, out: &mut Vec<String>) {
+    match ast {
+        Ast::Ident { name, .. } => {
+            if !out.contains(name) {
+                out.push(name.clone())
+            }
+        }
+        Ast::Num { .. } => {}
+        Ast::Neg { expr, .. } | Ast::Prime { expr, .. } | Ast::Component { expr, .. } => {
+            idents(expr, out)
+        }
+        Ast::Binary { lhs, rhs, .. } => {
+            idents(lhs, out);
+            idents(rhs, out);
+        }
+        Ast::Call { args, .. } => args.iter().for_each(|a| idents(a, out)),
+        Ast::Vector { items, .. } => items.iter().for_each(|a| idents(a, out)),
+    }
+}
+
+/// Parses `src` as a scalar with `scope`; errors carry the location.
+fn scalar(pool: &mut Pool, src: &str, scope: &mut dyn Scope, origin: &str) -> Result<Id, String> {
+    match pool
+        .parse_in(src, scope)
+        .map_err(|e| e.render(src, origin))?
+    {
+        Value::Scalar(s) => Ok(s),
+        Value::Vector(_) => Err(format!("{origin}: `{src}` is a vector, expected a scalar")),
+    }
+}
+
+/// `name = expr` items of a comma-separated list.
+fn assignments(s: &str, origin: &str) -> Result<Vec<(String, String)>, String> {
+    split_top(s)
+        .into_iter()
+        .map(|item| {
+            let (k, v) = item
+                .split_once('=')
+                .ok_or_else(|| format!("{origin}: expected `name = value`, got `{item}`"))?;
+            let k = k.trim().to_string();
+            if k.is_empty() || !k.chars().all(|c| c.is_alphanumeric() || c == '_') {
+                return Err(format!("{origin}: `{k}` is not a name"));
+            }
+            Ok((k, v.trim().to_string()))
+        })
+        .collect()
+}
+
+/// Names bound to the kinematic quantities, other names free (parameters).
+struct KinScope {
+    named: Vec<(String, Value)>,
+    free: FreeScope,
+}
+
+impl Scope for KinScope {
+    fn resolve(&mut self, pool: &mut Pool, name: &str) -> Option<Binding> {
+        if let Some((_, v)) = self.named.iter().find(|(n, _)| n == name) {
+            return Some(Binding::Value(*v));
+        }
+        self.free.resolve(pool, name)
+    }
+    fn names(&self) -> Vec<String> {
+        self.named.iter().map(|(n, _)| n.clone()).collect()
+    }
+}
+
+/// The motion, its input names (for `--at theta=pi`), and the independent variable's name.
+struct Input {
+    motion: Motion,
+    inputs: Vec<(String, Id)>,
+    variable: String,
+}
+
+fn read_input(a: &KinArgs, pool: &mut Pool, scope: &mut FreeScope) -> Result<Input, String> {
+    let given = [a.position.is_some(), a.polar.is_some(), a.path.is_some()]
+        .iter()
+        .filter(|&&b| b)
+        .count();
+    if given != 1 {
+        return Err(
+            "give exactly one of: a position \"[x, y, z]\", --polar \"r = ..., theta = ...\", or --path \"y = f(x)\""
+                .into(),
+        );
+    }
+    if let Some(src) = &a.position {
+        let v = pool
+            .parse_in(src, scope)
+            .map_err(|e| e.render(src, "<position>"))?;
+        let Value::Vector(r) = v else {
+            return Err(format!(
+                "<position>: `{src}` is a scalar; write the position as a vector [x, y, z]"
+            ));
+        };
+        return Ok(Input {
+            motion: Motion::Cartesian(r),
+            inputs: vec![("x".into(), r[0]), ("y".into(), r[1]), ("z".into(), r[2])],
+            variable: "t".into(),
+        });
+    }
+    if let Some(src) = &a.polar {
+        let (mut r, mut th, mut z) = (None, None, Pool::ZERO);
+        for (k, v) in assignments(src, "--polar")? {
+            let e = scalar(pool, &v, scope, "--polar")?;
+            match k.as_str() {
+                "r" => r = Some(e),
+                "theta" | "th" => th = Some(e),
+                "z" => z = e,
+                other => {
+                    return Err(format!(
+                        "--polar: unknown component `{other}` (use r, theta, z)"
+                    ))
+                }
+            }
+        }
+        let (Some(r), Some(th)) = (r, th) else {
+            return Err("--polar: give both r = ... and theta = ...".into());
+        };
+        return Ok(Input {
+            motion: Motion::Polar { r, theta: th, z },
+            inputs: vec![("r".into(), r), ("theta".into(), th), ("z".into(), z)],
+            variable: "t".into(),
+        });
+    }
+    let src = a.path.as_deref().unwrap_or_default();
+    let items = assignments(src, "--path")?;
+    let speed = scalar(pool, &a.speed, scope, "--speed")?;
+    match items.as_slice() {
+        [(k, v)] if k == "y" => {
+            let y = scalar(pool, v, scope, "--path")?;
+            let x = pool.var("x");
+            Ok(Input {
+                motion: Motion::Path {
+                    x,
+                    y,
+                    parameter: x,
+                    speed,
+                },
+                inputs: vec![("y".into(), y)],
+                variable: "x".into(),
+            })
+        }
+        [(k1, v1), (k2, v2)] if k1 == "x" && k2 == "y" => {
+            let x = scalar(pool, v1, scope, "--path")?;
+            let y = scalar(pool, v2, scope, "--path")?;
+            let p = pool.var(&a.param);
+            if !pool.contains(x, p) && !pool.contains(y, p) {
+                return Err(format!(
+                    "--path: neither x nor y depends on the parameter `{}` (set it with --param)",
+                    a.param
+                ));
+            }
+            Ok(Input {
+                motion: Motion::Path {
+                    x,
+                    y,
+                    parameter: p,
+                    speed,
+                },
+                inputs: vec![("x".into(), x), ("y".into(), y)],
+                variable: a.param.clone(),
+            })
+        }
+        _ => Err("--path: write `y = f(x)` or `x = f(s), y = g(s)`".into()),
+    }
+}
+
+fn numeric(pool: &mut Pool, e: Id) -> Option<f64> {
+    if pool.any_node(e, &|n| {
+        matches!(n, Node::Sym(_) | Node::Coord(..) | Node::Time)
+    }) {
+        return None;
+    }
+    let prog = Program::compile(pool, &[], &[e]).ok()?;
+    let mut ws = prog.workspace();
+    let mut o = [0.0];
+    prog.eval(&[], &mut ws, &mut o);
+    Some(o[0])
+}
+
+fn subs_all(pool: &mut Pool, e: Id, map: &[(Id, Id)]) -> Id {
+    map.iter().fold(e, |acc, &(k, v)| pool.subs1(acc, k, v))
+}
+
+fn tidy(pool: &mut Pool, e: Id) -> Id {
+    let x = pool.expand(e);
+    pool.simplify(x)
+}
+
+/// `pdyn kin ...`.
+pub fn run(a: KinArgs) -> Result<String, String> {
+    let mut pool = Pool::new();
+    // Parameters: every plain name except t, the path variable and the quantity names.
+    let mut names = Vec::new();
+    for src in [&a.position, &a.polar, &a.path]
+        .into_iter()
+        .flatten()
+        .chain(a.path.is_some().then_some(&a.speed))
+    {
+        for item in split_top(src) {
+            let rhs = item
+                .split_once('=')
+                .map_or(item.as_str(), |(_, r)| r)
+                .trim();
+            if let Ok(ast) = pdyn_expr::syntax::parse(rhs) {
+                idents(&ast, &mut names);
+            }
+        }
+    }
+    let mut scope = FreeScope::default();
+    for src in [&a.position, &a.polar, &a.path].into_iter().flatten() {
+        for item in split_top(src) {
+            let rhs = item
+                .split_once('=')
+                .map_or(item.as_str(), |(_, r)| r)
+                .trim();
+            if let Ok(ast) = pdyn_expr::syntax::parse(rhs) {
+                scope.learn(&ast);
+            }
+        }
+    }
+    let path_var = if a
+        .path
+        .as_deref()
+        .is_some_and(|p| p.trim_start().starts_with('y'))
+    {
+        "x".to_string()
+    } else {
+        a.param.clone()
+    };
+    let params: Vec<String> = names
+        .into_iter()
+        .filter(|n| {
+            n != "t"
+                && n != "pi"
+                && n != "e"
+                && !(a.path.is_some() && *n == path_var)
+                && !scope.coordinates.contains(n)
+                && !a.signed.contains(n)
+        })
+        .collect();
+    scope.positive = params.iter().cloned().collect();
+    let input = read_input(&a, &mut pool, &mut scope)?;
+    let k = analyze(&mut pool, input.motion).map_err(|e| e.to_string())?;
+    // --set values.
+    let mut set = Vec::new();
+    for (name, v) in a
+        .set
+        .iter()
+        .map(|kv| assignments(kv, "--set"))
+        .collect::<Result<Vec<_>, _>>()?
+        .into_iter()
+        .flatten()
+    {
+        let val = scalar(&mut pool, &v, &mut scope, "--set")?;
+        let sym = pool.var(&name);
+        set.push((sym, val));
+    }
+    let named: Vec<(&'static str, Quantity)> = k.named();
+    let mut out = String::new();
+    let mut js = serde_json::Map::new();
+    if !a.json {
+        for (name, q) in &named {
+            out += &format!("{name} = {}\n", show_q(&pool, *q, a.format));
+        }
+    } else {
+        let m: serde_json::Map<String, serde_json::Value> = named
+            .iter()
+            .map(|(n, q)| (n.to_string(), json_q(&pool, *q)))
+            .collect();
+        js.insert("variable".into(), json!(input.variable));
+        js.insert("quantities".into(), serde_json::Value::Object(m));
+    }
+    // Instants.
+    let mut instants_json = Vec::new();
+    for spec in &a.at {
+        let (header, values) = instant(&mut pool, &k, &input, &named, &set, spec, &mut scope)?;
+        if a.json {
+            let vals: serde_json::Map<String, serde_json::Value> = values
+                .iter()
+                .map(|(n, q, nums)| {
+                    (
+                        n.to_string(),
+                        json!({"exact": json_q(&pool, *q), "value": nums}),
+                    )
+                })
+                .collect();
+            instants_json.push(json!({"at": spec, "resolved": header, "values": vals}));
+        } else {
+            out += &format!("at {header}:\n");
+            for (n, q, nums) in &values {
+                let num_text = match nums {
+                    Some(v) if v.len() == 1 => format!("  ≈ {}", v[0]),
+                    Some(v) => format!(
+                        "  ≈ [{}]",
+                        v.iter().map(f64::to_string).collect::<Vec<_>>().join(", ")
+                    ),
+                    None => String::new(),
+                };
+                out += &format!("  {n} = {}{num_text}\n", show_q(&pool, *q, a.format));
+            }
+        }
+    }
+    if a.json && !a.at.is_empty() {
+        js.insert("at".into(), json!(instants_json));
+    }
+    // Maximum.
+    if let Some(expr) = &a.max {
+        let over = a
+            .over
+            .as_deref()
+            .ok_or("--max needs a range: --over x=0..L (or t=0..T)")?;
+        let (text, j) = maximum(
+            &mut pool, &k, &input, &named, &set, expr, over, &mut scope, a.format,
+        )?;
+        if a.json {
+            js.insert("max".into(), j);
+        } else {
+            out += &text;
+        }
+    } else if a.over.is_some() {
+        return Err("--over is the range of --max; give --max too".into());
+    }
+    let assumed: Vec<&String> = params
+        .iter()
+        .filter(|p| !set.iter().any(|&(s, _)| pool.to_text(s) == **p))
+        .collect();
+    if a.json {
+        js.insert("assumed_positive".into(), json!(assumed));
+        return Ok(format!("{}\n", serde_json::Value::Object(js)));
+    }
+    if !assumed.is_empty() {
+        out += &format!(
+            "assuming {} > 0 (use --signed NAME for a parameter that may be negative)\n",
+            assumed
+                .iter()
+                .map(|s| s.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    Ok(out)
+}
+
+type InstantValues = Vec<(&'static str, Quantity, Option<Vec<f64>>)>;
+
+/// Resolves one `--at` spec and evaluates every quantity there.
+fn instant(
+    pool: &mut Pool,
+    k: &Kinematics,
+    input: &Input,
+    named: &[(&'static str, Quantity)],
+    set: &[(Id, Id)],
+    spec: &str,
+    scope: &mut FreeScope,
+) -> Result<(String, InstantValues), String> {
+    let t = pool.time();
+    let mut map: Vec<(Id, Id)> = set.to_vec();
+    let mut header = Vec::new();
+    for (name, v) in assignments(spec, "--at")? {
+        let val = scalar(pool, &v, scope, "--at")?;
+        let val = subs_all(pool, val, set);
+        if name == "t" {
+            map.push((t, val));
+            header.push(format!("t = {}", pool.to_text(val)));
+        } else if name == input.variable {
+            let var = k.variable;
+            map.push((var, val));
+            header.push(format!("{name} = {}", pool.to_text(val)));
+        } else if let Some(&(_, e)) = input.inputs.iter().find(|(n, _)| *n == name) {
+            if k.variable != t {
+                return Err(format!(
+                    "--at: for a path, give the position along it (`{} = ...`) and, if the speed varies, `t = ...`",
+                    input.variable
+                ));
+            }
+            let e = subs_all(pool, e, set);
+            let (exact, tv) = solve_time(pool, e, val).map_err(|e| format!("--at {spec}: {e}"))?;
+            let tt = match exact {
+                Some(x) => x,
+                None => pool.num(Number::Float(tv)),
+            };
+            header.push(format!(
+                "{name} = {} (t = {}{})",
+                pool.to_text(val),
+                pool.to_text(tt),
+                if exact.is_some() {
+                    format!(" ≈ {tv}")
+                } else {
+                    String::new()
+                }
+            ));
+            map.push((t, tt));
+        } else {
+            return Err(format!(
+                "--at: `{name}` is not t, {} or a component of the input ({})",
+                input.variable,
+                input
+                    .inputs
+                    .iter()
+                    .map(|(n, _)| n.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
+    }
+    let mut values = Vec::new();
+    for (n, q) in named {
+        let ev = |pool: &mut Pool, e: Id| {
+            let s = subs_all(pool, e, &map);
+            tidy(pool, s)
+        };
+        let (q2, nums) = match *q {
+            Quantity::Scalar(s) => {
+                let x = ev(pool, s);
+                let v = numeric(pool, x).map(|v| vec![v]);
+                (Quantity::Scalar(x), v)
+            }
+            Quantity::Vector(v) => {
+                let x = v.map(|c| ev(pool, c));
+                let nums: Option<Vec<f64>> = x.iter().map(|&c| numeric(pool, c)).collect();
+                (Quantity::Vector(x), nums)
+            }
+        };
+        values.push((*n, q2, nums));
+    }
+    Ok((header.join(", "), values))
+}
+
+/// Deterministic pseudo-random positive values for parameter trials.
+fn trial_values(n: usize, seed: u64) -> Vec<f64> {
+    let mut s = seed;
+    (0..n)
+        .map(|_| {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            0.5 + 2.5 * (s % 100_000) as f64 / 100_000.0
+        })
+        .collect()
+}
+
+/// A close small-denominator fraction of `x` in [0, 1].
+fn small_fraction(x: f64) -> Option<(i64, i64)> {
+    for q in 1..=24i64 {
+        let p = (x * q as f64).round();
+        if (x - p / q as f64).abs() < 1e-7 {
+            return Some((p as i64, q));
+        }
+    }
+    None
+}
+
+#[allow(clippy::too_many_arguments)] // the command's state, passed once
+fn maximum(
+    pool: &mut Pool,
+    k: &Kinematics,
+    input: &Input,
+    named: &[(&'static str, Quantity)],
+    set: &[(Id, Id)],
+    expr: &str,
+    over: &str,
+    scope: &mut FreeScope,
+    format: Format,
+) -> Result<(String, serde_json::Value), String> {
+    let mut ks = KinScope {
+        named: named
+            .iter()
+            .map(|(n, q)| {
+                (
+                    n.to_string(),
+                    match q {
+                        Quantity::Scalar(s) => Value::Scalar(*s),
+                        Quantity::Vector(v) => Value::Vector(*v),
+                    },
+                )
+            })
+            .collect(),
+        free: scope.clone(),
+    };
+    let f = scalar(pool, expr, &mut ks, "--max")?;
+    let (var_name, range) = over
+        .split_once('=')
+        .ok_or_else(|| format!("--over: expected `x=0..L`, got `{over}`"))?;
+    let var_name = var_name.trim();
+    let (lo_s, hi_s) = range
+        .split_once("..")
+        .ok_or_else(|| format!("--over: expected `lo..hi`, got `{range}`"))?;
+    let var = if var_name == "t" {
+        pool.time()
+    } else if var_name == input.variable {
+        k.variable
+    } else {
+        return Err(format!(
+            "--over: the range must be in t or {} (got `{var_name}`)",
+            input.variable
+        ));
+    };
+    let lo = scalar(pool, lo_s.trim(), scope, "--over")?;
+    let hi = scalar(pool, hi_s.trim(), scope, "--over")?;
+    let f = subs_all(pool, f, set);
+    let f = tidy(pool, f);
+    let (lo, hi) = (subs_all(pool, lo, set), subs_all(pool, hi, set));
+    // Remaining symbols (parameters without values).
+    let mut free: Vec<Id> = Vec::new();
+    for n in pool.topo_order(&[f, lo, hi]) {
+        if matches!(pool.node(n), Node::Sym(_) | Node::Time) && n != var && !free.contains(&n) {
+            free.push(n);
+        }
+    }
+    if free.contains(&pool.time()) {
+        return Err(format!(
+            "--max: `{expr}` also depends on t; give t a value (--set is for parameters) or maximise over t"
+        ));
+    }
+    let run_trial = |pool: &mut Pool, vals: &[f64]| -> Result<(f64, f64, f64, f64), String> {
+        let map: Vec<(Id, Id)> = free
+            .iter()
+            .zip(vals)
+            .map(|(&s, &v)| (s, pool.num(Number::Float(v))))
+            .collect();
+        let fs = subs_all(pool, f, &map);
+        let l = subs_all(pool, lo, &map);
+        let h = subs_all(pool, hi, &map);
+        let (lv, hv) = match (numeric(pool, l), numeric(pool, h)) {
+            (Some(a), Some(b)) => (a, b),
+            _ => return Err("--over: the range bounds are not numbers".into()),
+        };
+        let ext = maximize(pool, fs, var, lv, hv).map_err(|e| e.to_string())?;
+        Ok((ext.at, ext.value, lv, hv))
+    };
+    if free.is_empty() {
+        let (at, value, _, _) = run_trial(pool, &[])?;
+        let text = format!("max {expr} over {over}: {value} at {var_name} = {at}\n");
+        return Ok((text, json!({"expr": expr, "value": value, "at": at})));
+    }
+    // Symbolic parameters: locate the maximum for random values; when it sits at the same
+    // simple fraction of the range every time, evaluate the expression exactly there and
+    // check it against a third trial.
+    let t1 = run_trial(pool, &trial_values(free.len(), 0x1234_5678_9abc_def1))?;
+    let t2 = run_trial(pool, &trial_values(free.len(), 0x0fed_cba9_8765_4321))?;
+    let frac = |t: (f64, f64, f64, f64)| (t.0 - t.2) / (t.3 - t.2);
+    let names: Vec<String> = free.iter().map(|&s| pool.to_text(s)).collect();
+    let fail = || {
+        format!(
+            "--max: the location of the maximum depends on {}; give values with --set",
+            names.join(", ")
+        )
+    };
+    let (p, q) = match (small_fraction(frac(t1)), small_fraction(frac(t2))) {
+        (Some(a), Some(b)) if a == b => a,
+        _ => return Err(fail()),
+    };
+    let width = pool.sub(hi, lo);
+    let pq = pool.num(Number::ratio(p, q));
+    let off = pool.mul2(pq, width);
+    let at = pool.add2(lo, off);
+    let at = tidy(pool, at);
+    let value = pool.subs1(f, var, at);
+    let value = tidy(pool, value);
+    let check_vals = trial_values(free.len(), 0x5555_aaaa_3333_cccc);
+    let t3 = run_trial(pool, &check_vals)?;
+    let map: Vec<(Id, Id)> = free
+        .iter()
+        .zip(&check_vals)
+        .map(|(&s, &v)| (s, pool.num(Number::Float(v))))
+        .collect();
+    let vs = subs_all(pool, value, &map);
+    let v3 = numeric(pool, vs).ok_or_else(fail)?;
+    if (v3 - t3.1).abs() > 1e-8 * (1.0 + t3.1.abs()) {
+        return Err(fail());
+    }
+    let text = format!(
+        "max {expr} over {over}: {} at {var_name} = {}\n  (location found numerically for random values of {} and checked on a third set)\n",
+        show(pool, value, format),
+        show(pool, at, format),
+        names.join(", ")
+    );
+    Ok((
+        text,
+        json!({"expr": expr, "value": {"text": pool.to_text(value), "latex": pool.to_latex(value)},
+               "at": {"text": pool.to_text(at), "latex": pool.to_latex(at)}}),
+    ))
+}
