@@ -39,12 +39,41 @@ use crate::linalg::{Lu, LuComplex};
 use crate::options::Options;
 use crate::problem::{MassKind, OdeSystem};
 use crate::solution::{Solution, Status};
+use crate::tableau::Tableau;
 use crate::Method;
 
 /// One-line description for `--method help`.
 pub const DOC: &str = "Radau IIA order 5, implicit adaptive (RADAU5 algorithm: simplified \
 Newton, Jacobian reuse, predictive step control); L-stable, for stiff problems and constant \
 mass matrices (index-1 DAEs). Hairer & Wanner 1996.";
+
+const SQ6: f64 = 2.449489742783178098197284074705891391965947480656670128432692567; // √6
+
+/// The Radau IIA tableau (order 5, stage order 3, stiffly accurate: `b` is the last row of
+/// `a`). The solver works with its transformed form (the `T`, `T⁻¹` matrices and the
+/// eigenvalues `γ`, `α ± iβ` of `A⁻¹` below); this is the reference the tests check them
+/// against.
+pub const TABLEAU: Tableau<3> = Tableau {
+    a: [
+        [
+            (88.0 - 7.0 * SQ6) / 360.0,
+            (296.0 - 169.0 * SQ6) / 1800.0,
+            (-2.0 + 3.0 * SQ6) / 225.0,
+        ],
+        [
+            (296.0 + 169.0 * SQ6) / 1800.0,
+            (88.0 + 7.0 * SQ6) / 360.0,
+            (-2.0 - 3.0 * SQ6) / 225.0,
+        ],
+        [(16.0 - SQ6) / 36.0, (16.0 + SQ6) / 36.0, 1.0 / 9.0],
+    ],
+    b: [(16.0 - SQ6) / 36.0, (16.0 + SQ6) / 36.0, 1.0 / 9.0],
+    b_hat: None,
+    c: [(4.0 - SQ6) / 10.0, (4.0 + SQ6) / 10.0, 1.0],
+    order: 5,
+    embedded_order: 0,
+    fsal: false,
+};
 
 /// RADAU5's unit roundoff.
 const UROUND: f64 = 1e-16;
@@ -633,30 +662,51 @@ mod tests {
     use super::*;
     use crate::tableau::order_residual;
 
+    fn mul3(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+        let mut c = [[0.0; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                c[i][j] = (0..3).map(|k| a[i][k] * b[k][j]).sum();
+            }
+        }
+        c
+    }
+
+    fn inv3(a: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+        let det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+            - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+            + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+        let mut r = [[0.0; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                let (i1, i2) = ((j + 1) % 3, (j + 2) % 3);
+                let (j1, j2) = ((i + 1) % 3, (i + 2) % 3);
+                r[i][j] = (a[i1][j1] * a[i2][j2] - a[i1][j2] * a[i2][j1]) / det;
+            }
+        }
+        r
+    }
+
     #[test]
     fn radau_iia_tableau_has_order_5_and_t_inverts_ti() {
-        let s6 = 6f64.sqrt();
-        let a = vec![
-            vec![
-                (88.0 - 7.0 * s6) / 360.0,
-                (296.0 - 169.0 * s6) / 1800.0,
-                (-2.0 + 3.0 * s6) / 225.0,
-            ],
-            vec![
-                (296.0 + 169.0 * s6) / 1800.0,
-                (88.0 + 7.0 * s6) / 360.0,
-                (-2.0 - 3.0 * s6) / 225.0,
-            ],
-            vec![(16.0 - s6) / 36.0, (16.0 + s6) / 36.0, 1.0 / 9.0],
-        ];
-        let b = a[2].clone();
+        let a = TABLEAU.a_rows();
+        assert!(TABLEAU.row_sum_residual() < 1e-15);
+        assert!(order_residual(&a, &TABLEAU.b, 5) < 1e-14);
+        assert!(order_residual(&a, &TABLEAU.b, 6) > 1e-6);
         let k = Consts::new();
-        let c = [k.c1, k.c2, 1.0];
+        assert!((TABLEAU.c[0] - k.c1).abs() < 1e-16 && (TABLEAU.c[1] - k.c2).abs() < 1e-16);
+        // T⁻¹ A⁻¹ T = diag(γ, [[α, −β], [β, α]]) (radau5.f's transformation)
+        let ainv = inv3(&TABLEAU.a);
+        let t = [[T11, T12, T13], [T21, T22, T23], [T31, 1.0, 0.0]];
+        let ti = [[TI11, TI12, TI13], [TI21, TI22, TI23], [TI31, TI32, TI33]];
+        let m = mul3(&ti, &mul3(&ainv, &t));
+        let (g, al, be) = (k.u1, k.alph, k.beta);
+        let want = [[g, 0.0, 0.0], [0.0, al, -be], [0.0, be, al]];
         for i in 0..3 {
-            assert!((a[i].iter().sum::<f64>() - c[i]).abs() < 1e-15);
+            for j in 0..3 {
+                assert!((m[i][j] - want[i][j]).abs() < 1e-12, "{m:?}");
+            }
         }
-        assert!(order_residual(&a, &b, 5) < 1e-14);
-        assert!(order_residual(&a, &b, 6) > 1e-6);
         let t = [[T11, T12, T13], [T21, T22, T23], [T31, 1.0, 0.0]];
         let ti = [[TI11, TI12, TI13], [TI21, TI22, TI23], [TI31, TI32, TI33]];
         for i in 0..3 {
