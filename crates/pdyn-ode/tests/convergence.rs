@@ -105,21 +105,6 @@ fn gauss6_is_order_6() {
     check(Method::Gauss6, 50);
 }
 
-#[test]
-#[ignore = "exploration: prints error tables"]
-fn print_tables() {
-    for m in Method::all() {
-        let mut line = format!("{m:10}");
-        let mut prev = f64::NAN;
-        for n in [25, 50, 100, 200, 400, 800, 1600] {
-            let e = error_after_one_period(*m, n);
-            line += &format!(" {n}:{e:.1e}({:.2})", (prev / e).log2());
-            prev = e;
-        }
-        println!("{line}");
-    }
-}
-
 /// Radau5 cannot be run with a fixed step through the public options (its Newton tolerance is
 /// tied to `rtol`), so its order is measured from work–precision: over a sweep of tolerances
 /// the global error must fall like `N^{-5}` in the number of steps `N` (least-squares slope
