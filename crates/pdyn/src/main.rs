@@ -7,6 +7,7 @@ mod expr_cmd;
 mod kin_cmd;
 mod plots;
 mod run_cmd;
+mod sweep_cmd;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -33,6 +34,8 @@ enum Command {
     Derive(derive_cmd::DeriveArgs),
     /// Simulate a model file: integrate, check conservation laws, write CSV/JSON/plots.
     Run(run_cmd::RunArgs),
+    /// Run a model's [sweep] over parameter values in parallel and tabulate response measures.
+    Sweep(sweep_cmd::SweepArgs),
     /// Solve linear constant-coefficient ODEs and systems in closed form, and the 1-D motion rules.
     Dsolve(dsolve_cmd::DsolveArgs),
     /// Kinematics of a particle: velocity, acceleration, normal-tangential and polar components.
@@ -47,6 +50,18 @@ fn main() -> ExitCode {
         Command::Solve(a) => expr_cmd::solve(a),
         Command::Eval(a) => expr_cmd::eval(a),
         Command::Derive(a) => derive_cmd::run(a),
+        Command::Sweep(a) => match sweep_cmd::run(a) {
+            Ok((out, err, ok)) => {
+                print!("{out}");
+                eprint!("{err}");
+                return if ok {
+                    ExitCode::SUCCESS
+                } else {
+                    ExitCode::from(1)
+                };
+            }
+            Err(e) => Err(e),
+        },
         Command::Run(a) => match run_cmd::run(a) {
             Ok((out, err, ok)) => {
                 print!("{out}");

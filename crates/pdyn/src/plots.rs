@@ -12,3 +12,13 @@ pub fn write_run_plots(
 ) -> Result<(), String> {
     Err("plots are not available in this build yet".into())
 }
+
+/// Writes the sweep's response plot into `dir` (not yet available).
+pub fn write_sweep_plot(
+    _model: &pdyn_mech::Model,
+    _res: &pdyn::sim::sweep::SweepResult,
+    _peaks: &[(String, Vec<(f64, f64)>)],
+    _dir: &Path,
+) -> Result<(), String> {
+    Err("plots are not available in this build yet".into())
+}

@@ -215,6 +215,9 @@ pub struct Model {
     pub conservative: bool,
     /// `[simulate]`, `[[events]]`, `[monitors]`, `[sweep]`.
     pub run: spec::RunSpec,
+    /// `(coordinate index, initial value, initial rate)` as expressions of the parameters, so
+    /// that a sweep over a parameter recomputes the initial conditions that depend on it.
+    pub initial_exprs: Vec<(usize, Id, Id)>,
 }
 
 /// Name resolution for expressions in a model file.
@@ -418,6 +421,7 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
     }
 
     let mut coordinates = Vec::new();
+    let mut initial_exprs = Vec::new();
     for (name, sv) in &raw.coordinates {
         let n = name.get_ref();
         let kind = match sv.get_ref() {
@@ -448,7 +452,7 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
                         Value::Vector(_) => return Err(ld.err(sv.span(), "a coordinate is a scalar")),
                     }
                 } else {
-                    let num = |ld: &mut Loader, key: &str| -> Result<f64, ModelError> {
+                    let num = |ld: &mut Loader, key: &str| -> Result<(f64, Id), ModelError> {
                         let Some(v) = t.get(key) else {
                             let hint = if key == "rate" {
                                 format!("give `{n}`'s initial rate d{n}/dt, e.g. rate = 0 if it starts at rest")
@@ -468,7 +472,8 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
                             }
                         };
                         let x = if looks_like_quantity(&text) {
-                            parse_quantity(&text).map_err(|e| ld.err(sv.span(), format!("in `{key}`: {}", e.message)))?
+                            let q = parse_quantity(&text).map_err(|e| ld.err(sv.span(), format!("in `{key}`: {}", e.message)))?;
+                            (q, ld.pool.num(Number::Float(q)))
                         } else {
                             let ast = pdyn_expr::syntax::parse(&text)
                                 .map_err(|e| ld.err(sv.span(), format!("in `{key}`: {}", e.message)))?;
@@ -477,12 +482,13 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
                             let Value::Scalar(id) = v else {
                                 return Err(ld.err(sv.span(), format!("`{key}` must be a scalar")));
                             };
-                            ld.constant(id, sv.span(), &format!("`{key}` of `{n}`"))?
+                            (ld.constant(id, sv.span(), &format!("`{key}` of `{n}`"))?, id)
                         };
                         Ok(x)
                     };
-                    let initial = num(&mut ld, "initial")?;
-                    let rate = num(&mut ld, "rate")?;
+                    let (initial, initial_expr) = num(&mut ld, "initial")?;
+                    let (rate, rate_expr) = num(&mut ld, "rate")?;
+                    initial_exprs.push((coordinates.len(), initial_expr, rate_expr));
                     CoordinateKind::Free { initial, rate }
                 }
             }
@@ -655,6 +661,7 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
 
     Ok(Model {
         run,
+        initial_exprs,
         name: raw.name.clone().unwrap_or_else(|| origin.to_string()),
         origin: origin.to_string(),
         source: source.to_string(),

@@ -11,6 +11,7 @@
 //! linear momentum components when the resultant moment or force vanishes identically.
 
 pub mod compiled;
+pub mod sweep;
 
 use compiled::{depends_on_time, CompiledModel, Observer};
 use pdyn_expr::{vector, Id, Pool};
@@ -66,6 +67,26 @@ pub struct Prepared {
     pub measures: Option<Observer>,
     /// Notes from the derivation.
     pub notes: Vec<String>,
+    /// Initial state as a function of the parameters (for sweeps).
+    pub initial_conditions: Observer,
+    /// Parameter names, in model order.
+    pub parameter_names: Vec<String>,
+}
+
+impl Prepared {
+    /// A copy with parameter `index` set to `value` (initial conditions recomputed).
+    pub fn with_parameter(&self, index: usize, value: f64) -> Prepared {
+        let mut p = self.clone();
+        let mut params = p.system.parameters();
+        if let Some(x) = params.get_mut(index) {
+            *x = value;
+        }
+        p.system.set_parameters(&params);
+        let mut y0 = vec![0.0; p.y0.len()];
+        p.initial_conditions.eval(&params, &mut y0);
+        p.y0 = y0;
+        p
+    }
 }
 
 /// A recorded event.
@@ -178,15 +199,23 @@ pub fn prepare(model: &mut Model) -> Result<Prepared, String> {
         total_force = vector::add(p, total_force, pk.force);
     }
     let small = |p: &mut Pool, e: Id| p.tree_size(e, 2001) < 2000;
+    // In the projected form some reactions were never declared (a pendulum's pivot): the
+    // forces we know are not all the forces, so momentum balances cannot be checked.
+    let all_forces_known = d.form != pdyn_mech::derive::Form::Projected;
     for (c, axis) in ["x", "y", "z"].iter().enumerate() {
-        if h[c] != Pool::ZERO && small(p, moment[c]) && p.provably_equal(moment[c], Pool::ZERO) {
+        if all_forces_known
+            && h[c] != Pool::ZERO
+            && small(p, moment[c])
+            && p.provably_equal(moment[c], Pool::ZERO)
+        {
             names.push(format!("angular_momentum.{axis}"));
             exprs.push(h[c]);
             conserved.push(true);
         }
     }
     for (c, axis) in ["x", "y", "z"].iter().enumerate() {
-        if momentum[c] != Pool::ZERO
+        if all_forces_known
+            && momentum[c] != Pool::ZERO
             && small(p, total_force[c])
             && p.provably_equal(total_force[c], Pool::ZERO)
         {
@@ -236,6 +265,19 @@ pub fn prepare(model: &mut Model) -> Result<Prepared, String> {
         None => None,
     };
 
+    let param_ids: Vec<Id> = model.parameters.iter().map(|q| q.id).collect();
+    let mut ic_exprs = Vec::new();
+    let mut ic_rates = Vec::new();
+    for &i in &d.free {
+        if let Some(&(_, e, r)) = model.initial_exprs.iter().find(|(k, _, _)| *k == i) {
+            ic_exprs.push(e);
+            ic_rates.push(r);
+        }
+    }
+    ic_exprs.extend(ic_rates);
+    let ic_names = d.state_names.clone();
+    let initial_conditions = Observer::new(&mut model.pool, &param_ids, ic_names, &ic_exprs)
+        .map_err(|e| format!("{}: error: initial conditions: {e}", model.origin))?;
     let mut y0 = Vec::new();
     let mut rates = Vec::new();
     for &i in &d.free {
@@ -255,6 +297,8 @@ pub fn prepare(model: &mut Model) -> Result<Prepared, String> {
         events,
         measures,
         notes: d.notes.clone(),
+        initial_conditions,
+        parameter_names: model.parameters.iter().map(|q| q.name.clone()).collect(),
     })
 }
 

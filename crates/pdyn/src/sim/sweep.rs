@@ -1,0 +1,199 @@
+//! Parameter sweeps: one run per value of a parameter, in parallel on all cores (rayon), with a
+//! progress bar (indicatif, on stderr when it is a terminal). A failed run is recorded with its
+//! message; it does not stop the others.
+
+use super::{run, Prepared, RunSettings};
+use indicatif::{ProgressBar, ProgressStyle};
+use pdyn_mech::model::spec::{Stat, SweepSpec};
+use rayon::prelude::*;
+
+/// Results of a sweep: one row per parameter value.
+#[derive(Clone, Debug)]
+pub struct SweepResult {
+    /// Swept parameter.
+    pub parameter: String,
+    /// Its values.
+    pub values: Vec<f64>,
+    /// Measure names (`name` of each `[sweep.measures]` entry).
+    pub measures: Vec<String>,
+    /// `table[k][j]`: measure `j` of the run at `values[k]` (NaN when the run failed).
+    pub table: Vec<Vec<f64>>,
+    /// `(value, message)` of the runs that failed or warned.
+    pub problems: Vec<(f64, String)>,
+    /// Wall time, seconds.
+    pub seconds: f64,
+    /// Threads used.
+    pub threads: usize,
+}
+
+/// Applies a statistic to a time series.
+pub fn statistic(stat: Stat, t: &[f64], x: &[f64]) -> f64 {
+    if x.is_empty() {
+        return f64::NAN;
+    }
+    match stat {
+        Stat::Max => x.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        Stat::Min => x.iter().copied().fold(f64::INFINITY, f64::min),
+        Stat::MaxAbs => x.iter().fold(0.0, |m, v| m.max(v.abs())),
+        Stat::PeakToPeak => statistic(Stat::Max, t, x) - statistic(Stat::Min, t, x),
+        Stat::Final => x[x.len() - 1],
+        Stat::Mean | Stat::Rms => {
+            let span = t[t.len() - 1] - t[0];
+            if x.len() < 2 || span <= 0.0 {
+                return if stat == Stat::Mean { x[0] } else { x[0].abs() };
+            }
+            let f = |v: f64| if stat == Stat::Mean { v } else { v * v };
+            let integral: f64 = (1..x.len())
+                .map(|k| 0.5 * (f(x[k]) + f(x[k - 1])) * (t[k] - t[k - 1]))
+                .sum();
+            if stat == Stat::Mean {
+                integral / span
+            } else {
+                (integral / span).sqrt()
+            }
+        }
+    }
+}
+
+/// Runs the sweep.
+pub fn sweep(
+    prep: &Prepared,
+    set: &RunSettings,
+    spec: &SweepSpec,
+    stats: &[Stat],
+    progress: bool,
+) -> SweepResult {
+    let start = std::time::Instant::now();
+    let bar = if progress {
+        let b = ProgressBar::new(spec.values.len() as u64);
+        if let Ok(style) = ProgressStyle::with_template(
+            "{spinner} sweep [{bar:40}] {pos}/{len} runs, {per_sec}, eta {eta}",
+        ) {
+            b.set_style(style.progress_chars("=> "));
+        }
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+    let measures = prep.measures.clone();
+    let n_meas = measures.as_ref().map_or(0, |m| m.len());
+    let results: Vec<(Vec<f64>, Option<String>)> = spec
+        .values
+        .par_iter()
+        // Each worker owns a copy (the compiled programs keep per-call scratch space).
+        .map_with(prep.clone(), |base, &v| {
+            let p = base.with_parameter(spec.parameter, v);
+            let out = match run(&p, set) {
+                Err(e) => (vec![f64::NAN; n_meas], Some(e)),
+                Ok(res) => {
+                    let mut problem = res.failure.clone();
+                    if problem.is_none() && !res.warnings.is_empty() {
+                        problem = Some(res.warnings.join("; "));
+                    }
+                    let mut vals = vec![f64::NAN; n_meas];
+                    if let Some(m) = &p.measures {
+                        let n = p.system.n;
+                        let mut series = vec![Vec::with_capacity(res.rows.len()); n_meas];
+                        let mut ts = Vec::with_capacity(res.rows.len());
+                        let mut input = Vec::new();
+                        let mut out = vec![0.0; n_meas];
+                        for row in &res.rows {
+                            p.system
+                                .observation_input(row[0], &row[1..1 + 2 * n], &mut input);
+                            m.eval(&input, &mut out);
+                            ts.push(row[0]);
+                            for (s, &o) in series.iter_mut().zip(&out) {
+                                s.push(o);
+                            }
+                        }
+                        for (j, s) in series.iter().enumerate() {
+                            vals[j] = statistic(stats[j], &ts, s);
+                        }
+                    }
+                    (vals, problem)
+                }
+            };
+            bar.inc(1);
+            out
+        })
+        .collect();
+    bar.finish_and_clear();
+    let mut table = Vec::with_capacity(results.len());
+    let mut problems = Vec::new();
+    for (&v, (vals, prob)) in spec.values.iter().zip(results) {
+        table.push(vals);
+        if let Some(p) = prob {
+            problems.push((v, p));
+        }
+    }
+    SweepResult {
+        parameter: prep
+            .parameter_names
+            .get(spec.parameter)
+            .cloned()
+            .unwrap_or_default(),
+        values: spec.values.clone(),
+        measures: measures.map(|m| m.names.clone()).unwrap_or_default(),
+        table,
+        problems,
+        seconds: start.elapsed().as_secs_f64(),
+        threads: rayon::current_num_threads(),
+    }
+}
+
+/// Local maxima of `y(x)` that stand above their neighbourhood: the resonance peaks of a
+/// frequency sweep. Returned as `(x, y)`, refined by a parabola through the three samples.
+pub fn peaks(x: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
+    let mut out = Vec::new();
+    let max = y
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max);
+    for k in 1..y.len().saturating_sub(1) {
+        let (a, b, c) = (y[k - 1], y[k], y[k + 1]);
+        if b > a && b >= c && b > 0.05 * max {
+            let denom = a - 2.0 * b + c;
+            let shift = if denom.abs() > 0.0 {
+                0.5 * (a - c) / denom
+            } else {
+                0.0
+            };
+            let h = x[k + 1] - x[k];
+            out.push((x[k] + shift.clamp(-1.0, 1.0) * h, b));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn statistics_of_a_sine() {
+        let t: Vec<f64> = (0..=1000)
+            .map(|k| k as f64 * 2.0 * std::f64::consts::PI / 1000.0)
+            .collect();
+        let x: Vec<f64> = t.iter().map(|v| v.sin()).collect();
+        assert!((statistic(Stat::MaxAbs, &t, &x) - 1.0).abs() < 1e-4);
+        assert!(statistic(Stat::Mean, &t, &x).abs() < 1e-12);
+        assert!((statistic(Stat::Rms, &t, &x) - 0.5f64.sqrt()).abs() < 1e-5);
+        assert!((statistic(Stat::PeakToPeak, &t, &x) - 2.0).abs() < 1e-4);
+    }
+
+    #[test]
+    fn peaks_are_refined() {
+        let x: Vec<f64> = (0..100).map(|k| k as f64 * 0.1).collect();
+        let y: Vec<f64> = x
+            .iter()
+            .map(|v| {
+                1.0 / (1.0 + 50.0 * (v - 3.333).powi(2)) + 0.5 / (1.0 + 50.0 * (v - 7.0).powi(2))
+            })
+            .collect();
+        let p = peaks(&x, &y);
+        assert_eq!(p.len(), 2);
+        assert!((p[0].0 - 3.333).abs() < 0.02, "{p:?}");
+        assert!((p[1].0 - 7.0).abs() < 0.02, "{p:?}");
+    }
+}
