@@ -60,7 +60,7 @@ pub fn run(a: SweepArgs) -> Result<(String, String, bool), String> {
     if let Some(dir) = &a.run.out {
         std::fs::create_dir_all(dir)
             .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-        let mut csv = format!("{}", res.parameter);
+        let mut csv = res.parameter.clone();
         for m in &res.measures {
             csv += &format!(",{m}");
         }
