@@ -1,0 +1,254 @@
+//! Sizes, margins, ranges and ticks of a 2-D figure: everything decided
+//! before drawing, as pure functions.
+
+use std::ops::Range;
+
+use crate::font::text_size;
+use crate::ticks::{ticks, Ticks};
+use crate::{clean2, Figure, Marker, PlotError};
+
+/// Fraction of the data span added on each side of an axis.
+pub(crate) const PAD: f64 = 0.04;
+
+/// Font sizes, line widths and spacings for an image (or panel) of a given
+/// size, in device pixels.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Theme {
+    pub title: f64,
+    pub label: f64,
+    pub tick: f64,
+    pub legend: f64,
+    pub note: f64,
+    pub line: u32,
+    pub point: u32,
+    pub tick_len: i32,
+    pub gap: u32,
+    /// Device pixels per logical pixel (2 for supersampled PNG).
+    pub dpr: f64,
+}
+
+impl Theme {
+    /// The theme of a `w`×`h` (logical pixels) image drawn at `dpr` device
+    /// pixels per logical pixel.
+    pub fn new((w, h): (u32, u32), dpr: f64) -> Theme {
+        let fit = (w as f64 / 1000.0).min(h as f64 / 700.0);
+        let f = (0.55 + 0.45 * fit).clamp(0.7, 1.6);
+        let s = f * dpr;
+        Theme {
+            title: 24.0 * s,
+            label: 19.0 * s,
+            tick: 16.0 * s,
+            legend: 16.0 * s,
+            note: 14.0 * s,
+            line: (2.0 * dpr).round().max(1.0) as u32,
+            point: (3.0 * s).round().max(1.0) as u32,
+            tick_len: (5.0 * s).round() as i32,
+            gap: (8.0 * s).round() as u32,
+            dpr,
+        }
+    }
+}
+
+/// Where everything goes on a 2-D figure drawn at a given pixel size.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layout {
+    /// Horizontal data range spanned by the plotting area.
+    pub x_range: Range<f64>,
+    /// Vertical data range spanned by the plotting area.
+    pub y_range: Range<f64>,
+    /// Width and height in pixels of the plotting area (inside the axes).
+    pub plot_size: (u32, u32),
+    pub(crate) x_ticks: Ticks,
+    pub(crate) y_ticks: Ticks,
+    /// Height of the title strip.
+    pub(crate) title_h: u32,
+    /// Height of the label area below the plot, width of the one left of it.
+    pub(crate) x_area: u32,
+    pub(crate) y_area: u32,
+    /// Margins around the chart: top, bottom, left, right.
+    pub(crate) margin: [u32; 4],
+}
+
+/// Widens `lo..hi` by [`PAD`] of its span on each side; a degenerate range
+/// (a constant) gets ±10 % of its value (±1 around zero).
+pub(crate) fn padded(lo: f64, hi: f64) -> Range<f64> {
+    let span = hi - lo;
+    let scale = lo.abs().max(hi.abs());
+    if span <= scale * 1e-12 || span <= f64::MIN_POSITIVE {
+        let d = if scale > 0.0 { 0.1 * scale } else { 1.0 };
+        return (lo - d)..(hi + d);
+    }
+    (lo - PAD * span)..(hi + PAD * span)
+}
+
+/// The data ranges of `fig` before any aspect correction: the bounds of
+/// all finite points and finite markers, widened by 4 % of the span on
+/// each side (a constant gets ±10 %).
+pub fn data_ranges(fig: &Figure) -> Result<(Range<f64>, Range<f64>), PlotError> {
+    let clean = clean2(fig)?;
+    let mut bx = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut by = (f64::INFINITY, f64::NEG_INFINITY);
+    let add = |b: &mut (f64, f64), v: f64| {
+        if v.is_finite() {
+            b.0 = b.0.min(v);
+            b.1 = b.1.max(v);
+        }
+    };
+    for s in &clean {
+        for &(x, y) in s.runs.iter().flatten() {
+            add(&mut bx, x);
+            add(&mut by, y);
+        }
+    }
+    for m in &fig.markers {
+        match *m {
+            Marker::VLine { x, .. } => add(&mut bx, x),
+            Marker::HLine { y, .. } => add(&mut by, y),
+            Marker::Point { x, y, .. } if x.is_finite() && y.is_finite() => {
+                add(&mut bx, x);
+                add(&mut by, y);
+            }
+            Marker::Point { .. } => {}
+        }
+    }
+    Ok((padded(bx.0, bx.1), padded(by.0, by.1)))
+}
+
+/// Widens one of the ranges, about its centre, so that both axes have the
+/// same data units per pixel on a plotting area of `plot_px` = (width,
+/// height) pixels:
+/// `(x.end - x.start) / width == (y.end - y.start) / height`.
+pub fn equal_aspect_ranges(
+    x: Range<f64>,
+    y: Range<f64>,
+    plot_px: (u32, u32),
+) -> (Range<f64>, Range<f64>) {
+    let (w, h) = (plot_px.0.max(1) as f64, plot_px.1.max(1) as f64);
+    let (sx, sy) = (x.end - x.start, y.end - y.start);
+    let (ux, uy) = (sx / w, sy / h);
+    if ux > uy {
+        let c = 0.5 * (y.start + y.end);
+        let half = 0.5 * ux * h;
+        (x, (c - half)..(c + half))
+    } else {
+        let c = 0.5 * (x.start + x.end);
+        let half = 0.5 * uy * w;
+        ((c - half)..(c + half), y)
+    }
+}
+
+fn max_width(labels: &[String], px: f64) -> u32 {
+    labels.iter().map(|l| text_size(l, px).0).max().unwrap_or(0)
+}
+
+/// The layout of `fig` drawn at `size` pixels (as [`crate::save`] does at
+/// [`crate::DEFAULT_SIZE`]): ranges, ticks and the size of the plotting
+/// area. With `equal_aspect`, the ranges satisfy
+/// `x_range span / plot width == y_range span / plot height`.
+pub fn layout(fig: &Figure, size: (u32, u32)) -> Result<Layout, PlotError> {
+    crate::font::ensure()?;
+    layout_with(fig, size, &Theme::new(size, 1.0))
+}
+
+/// [`layout`] for a device size `size` (device pixels) and theme.
+pub(crate) fn layout_with(fig: &Figure, size: (u32, u32), th: &Theme) -> Result<Layout, PlotError> {
+    let (xr0, yr0) = data_ranges(fig)?;
+    let (w, h) = size;
+    let gap = th.gap;
+    let title_h = if fig.title.trim().is_empty() {
+        gap
+    } else {
+        text_size(&fig.title, th.title).1 + 2 * gap
+    };
+    let tick_h = text_size("0123456789", th.tick).1.max(1);
+    let label_h = |s: &str| {
+        if s.trim().is_empty() {
+            0
+        } else {
+            text_size(s, th.label).1 + gap
+        }
+    };
+    // plotters puts tick labels 2 × tick length away from the axis.
+    let label_dist = 2 * th.tick_len.max(0) as u32;
+    let x_area = label_dist + tick_h + label_h(&fig.x_label) + gap;
+    let top = (tick_h / 2 + gap / 2).max(gap);
+    let bottom = gap;
+    let left = gap;
+    let mut right = 3 * gap;
+    let plot_h = h.saturating_sub(title_h + top + bottom + x_area).max(1);
+
+    let n_y = ((plot_h as f64 / (tick_h as f64 * 3.2)) as usize).clamp(2, 10);
+    let mut y_area =
+        label_dist + text_size("\u{2212}0.00", th.tick).0 + label_h(&fig.y_label) + gap;
+    for iter in 0..8 {
+        let plot_w = w.saturating_sub(left + right + y_area).max(1);
+        let (xr, yr) = if fig.equal_aspect {
+            equal_aspect_ranges(xr0.clone(), yr0.clone(), (plot_w, plot_h))
+        } else {
+            (xr0.clone(), yr0.clone())
+        };
+        let y_ticks = ticks(&yr, n_y);
+        // As many x ticks as fit with generous gaps between labels.
+        let mut n_x = 10usize;
+        let mut x_ticks = ticks(&xr, n_x);
+        for _ in 0..8 {
+            let lw = max_width(&x_ticks.labels, th.tick) as f64 + 2.5 * tick_h as f64;
+            let fit = ((plot_w as f64 / lw) as usize).clamp(2, 10);
+            if x_ticks.values.len() <= fit || n_x <= 2 {
+                break;
+            }
+            n_x = fit.min(n_x - 1);
+            x_ticks = ticks(&xr, n_x);
+        }
+        let new_y_area =
+            label_dist + max_width(&y_ticks.labels, th.tick) + label_h(&fig.y_label) + gap;
+        let last_w = x_ticks.labels.last().map_or(0, |l| text_size(l, th.tick).0);
+        let new_right = (last_w / 2 + gap).max(3 * gap);
+        if (new_y_area == y_area && new_right == right) || iter == 7 {
+            return Ok(Layout {
+                x_range: xr,
+                y_range: yr,
+                plot_size: (plot_w, plot_h),
+                x_ticks,
+                y_ticks,
+                title_h,
+                x_area,
+                y_area,
+                margin: [top, bottom, left, right],
+            });
+        }
+        // Grow only after the first rounds so that the loop terminates.
+        if iter < 2 {
+            y_area = new_y_area;
+            right = new_right;
+        } else {
+            y_area = y_area.max(new_y_area);
+            right = right.max(new_right);
+        }
+    }
+    Err(PlotError::render("layout did not converge"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn padding() {
+        let r = padded(0.0, 10.0);
+        assert!((r.start + 0.4).abs() < 1e-12 && (r.end - 10.4).abs() < 1e-12);
+        assert_eq!(padded(0.0, 0.0), -1.0..1.0);
+        let r = padded(5.0, 5.0);
+        assert!((r.start - 4.5).abs() < 1e-12 && (r.end - 5.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn equal_aspect_widens_the_short_side() {
+        let (x, y) = equal_aspect_ranges(-1.0..1.0, -1.0..1.0, (800, 400));
+        assert_eq!(y, -1.0..1.0);
+        assert!((x.start + 2.0).abs() < 1e-12 && (x.end - 2.0).abs() < 1e-12);
+        let (x, y) = equal_aspect_ranges(0.0..10.0, 0.0..1.0, (500, 500));
+        assert_eq!(x, 0.0..10.0);
+        assert!((y.start + 4.5).abs() < 1e-12 && (y.end - 5.5).abs() < 1e-12);
+    }
+}
