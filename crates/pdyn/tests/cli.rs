@@ -90,3 +90,116 @@ fn derive_reports_located_model_errors() {
     assert!(!ok);
     assert!(err.contains("cannot read the model file"), "{err}");
 }
+
+fn tempdir(tag: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("pdyn-cli-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn run_warns_loudly_and_writes_csv_and_json() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/");
+    let out = tempdir("run");
+    let (ok, stdout, err) = pdyn(&[
+        "run",
+        &format!("{root}satellite_ode45.toml"),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(err.contains("warning: energy should be conserved"), "{err}");
+    assert!(stdout.contains("DRIFTING"), "{stdout}");
+    let csv = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
+    assert!(
+        csv.starts_with("t,x,y,x',y',sat.x,sat.y,energy,angular_momentum.z\n"),
+        "{}",
+        &csv[..80]
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["ok"], true);
+    assert!(!summary["warnings"].as_array().unwrap().is_empty());
+    // The same model at rtol 1e-5: no warning.
+    let (ok, _, err) = pdyn(&[
+        "run",
+        &format!("{root}satellite_ode45.toml"),
+        "--rtol",
+        "1e-5",
+        "--atol",
+        "1e-9",
+    ]);
+    assert!(ok && !err.contains("warning"), "{err}");
+}
+
+#[test]
+fn run_reports_a_failed_integration_with_time_and_state_and_keeps_the_data() {
+    let dir = tempdir("fail");
+    let model = dir.join("radial_fall.toml");
+    std::fs::write(
+        &model,
+        "name = \"radial fall into the attracting centre\"\n[parameters]\nGM = 1.0\n\n\
+         [coordinates]\nx = { initial = 1.0, rate = 0.0 }\ny = { initial = 0.0, rate = 0.0 }\n\n\
+         [particles.p]\nmass = 1\nposition = \"[x, y, 0]\"\n\n[points]\nO = \"[0, 0, 0]\"\n\n\
+         [[forces]]\nkind = \"inverse_square\"\non = \"p\"\nto = \"O\"\nstrength = \"GM\"\n\n\
+         [simulate]\nt_end = 10\nmethod = \"dopri5\"\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let (ok, _, err) = pdyn(&[
+        "run",
+        model.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok, "the fall reaches r = 0");
+    assert!(err.contains("integration failed at t = "), "{err}");
+    assert!(err.contains("state: x = "), "{err}");
+    let csv = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
+    assert!(csv.lines().count() > 10, "partial results are kept");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["ok"], false);
+}
+
+#[test]
+fn run_rejects_bad_settings_clearly() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/");
+    let (ok, _, err) = pdyn(&["run", &format!("{root}satellite.toml"), "--method", "ode99"]);
+    assert!(!ok);
+    assert!(err.contains("unknown method `ode99`"), "{err}");
+    let (ok, _, err) = pdyn(&[
+        "run",
+        &format!("{root}satellite.toml"),
+        "--method",
+        "verlet",
+    ]);
+    assert!(!ok);
+    assert!(err.contains("--dt"), "{err}");
+    let (ok, out, _) = pdyn(&["run", &format!("{root}satellite.toml"), "--method", "help"]);
+    assert!(ok);
+    assert!(out.contains("dopri5") && out.contains("Dormand"), "{out}");
+    let (ok, _, err) = pdyn(&[
+        "run",
+        &format!("{root}projectile_drag.toml"),
+        "--method",
+        "verlet",
+        "--dt",
+        "0.01",
+    ]);
+    assert!(!ok);
+    assert!(err.contains("depend on velocities"), "{err}");
+}
+
+#[test]
+fn sweep_prints_the_resonances() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/");
+    let (ok, out, err) = pdyn(&["sweep", &format!("{root}building.toml"), "--json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let peaks = v["measures"][0]["peaks"].as_array().unwrap();
+    assert_eq!(peaks.len(), 2);
+    assert!((peaks[0]["at"].as_f64().unwrap() - 8.74).abs() < 0.1);
+    assert!((peaks[1]["at"].as_f64().unwrap() - 22.88).abs() < 0.1);
+}

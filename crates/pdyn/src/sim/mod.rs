@@ -45,6 +45,35 @@ pub struct RunSettings {
     pub drift_tolerance: f64,
 }
 
+impl RunSettings {
+    /// Settings from a model's `[simulate]` (method `auto` unless given); `t_end` is required.
+    pub fn from_spec(s: &pdyn_mech::model::spec::SimulateSpec) -> Result<RunSettings, String> {
+        Ok(RunSettings {
+            method: s
+                .method
+                .as_ref()
+                .map_or("auto".to_string(), |m| m.0.clone()),
+            t_end: s
+                .t_end
+                .ok_or("no end time: add t_end = ... under [simulate]")?,
+            rtol: s.rtol,
+            atol: s.atol,
+            dt: s.dt,
+            max_step: s.max_step,
+            max_steps: s.max_steps,
+            points: s.points,
+            output_dt: s.output_dt,
+            drift_tolerance: s.drift_tolerance.unwrap_or(DEFAULT_DRIFT_TOLERANCE),
+        })
+    }
+
+    /// The value of column `name` in the last row of a result.
+    pub fn final_value(res: &RunResult, name: &str) -> Option<f64> {
+        let j = res.columns.iter().position(|c| c == name)?;
+        res.rows.last().map(|r| r[j])
+    }
+}
+
 /// Default [`RunSettings::drift_tolerance`].
 pub const DEFAULT_DRIFT_TOLERANCE: f64 = 5e-3;
 
@@ -360,6 +389,9 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, String> {
     opts.max_step = set.max_step;
     if let Some(m) = set.max_steps {
         opts.max_steps = m;
+    } else if let (true, Some(dt)) = (fixed, set.dt) {
+        // A fixed-step run takes exactly t_end/dt steps: that is what was asked for.
+        opts.max_steps = opts.max_steps.max((set.t_end / dt).ceil() as usize + 10);
     }
     let t_end = set.t_end;
     if let Some(npts) = set.points {

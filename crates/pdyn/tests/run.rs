@@ -1,0 +1,190 @@
+//! `pdyn run` and `pdyn sweep` on the chapter's examples (library API).
+
+use pdyn::sim::{self, RunSettings};
+use pdyn_mech::Model;
+
+fn example(name: &str) -> Model {
+    let path = format!("{}/../../examples/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+    let src = std::fs::read_to_string(&path).unwrap();
+    pdyn_mech::load(&src, &path).unwrap_or_else(|e| panic!("{}", e.render(&src)))
+}
+
+fn run_example(name: &str, tweak: impl FnOnce(&mut RunSettings)) -> (Model, sim::RunResult) {
+    let mut m = example(name);
+    let mut set = RunSettings::from_spec(&m.run.simulate).unwrap();
+    tweak(&mut set);
+    let prep = sim::prepare(&mut m).unwrap();
+    let res = sim::run(&prep, &set).unwrap();
+    (m, res)
+}
+
+fn last(res: &sim::RunResult, col: &str) -> f64 {
+    RunSettings::final_value(res, col)
+        .unwrap_or_else(|| panic!("no column {col}: {:?}", res.columns))
+}
+
+#[test]
+fn projectile_with_drag_state_at_5_seconds() {
+    let (_, res) = run_example("projectile_drag", |_| {});
+    assert!(res.failure.is_none());
+    let expected = [
+        ("x", 2.7309863f64),
+        ("y", 2.7309863),
+        ("z", -15.7308060),
+        ("x'", 1.3833e-4),
+        ("y'", 1.3833e-4),
+        ("z'", -4.4294469),
+    ];
+    for (c, e) in expected {
+        let v = last(&res, c);
+        // The reference values are printed to 8 significant digits (5 for the tiny rates).
+        let tol = if e.abs() < 1e-3 { 5e-8 } else { 6e-8 * e.abs() };
+        assert!((v - e).abs() < tol, "{c} = {v}, expected {e}");
+    }
+    assert_eq!(last(&res, "t"), 5.0);
+}
+
+#[test]
+fn satellite_warns_at_ode45_settings_and_not_at_rtol_1e5() {
+    let (_, loose) = run_example("satellite_ode45", |_| {});
+    assert!(
+        loose
+            .warnings
+            .iter()
+            .any(|w| w.contains("energy should be conserved")),
+        "{:?}",
+        loose.warnings
+    );
+    let energy = loose.monitors.iter().find(|m| m.name == "energy").unwrap();
+    assert!(
+        energy.drift > 0.1,
+        "ode45 settings drift a lot: {}",
+        energy.drift
+    );
+
+    let (_, tight) = run_example("satellite", |_| {});
+    assert!(tight.warnings.is_empty(), "{:?}", tight.warnings);
+    let (xi, yi) = (
+        tight.columns.iter().position(|c| c == "x").unwrap(),
+        tight.columns.iter().position(|c| c == "y").unwrap(),
+    );
+    let worst = tight
+        .rows
+        .iter()
+        .map(|r| ((r[xi] * r[xi] + r[yi] * r[yi]).sqrt() - 1.0).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-3, "radius strays by {worst}");
+    assert_eq!(last(&tight, "t"), 100.0);
+}
+
+#[test]
+fn symplectic_satellite_keeps_energy_bounded_over_ten_thousand_orbits() {
+    let orbits = 1e4;
+    let (_, res) = run_example("satellite", |s| {
+        s.method = "symplectic".into();
+        s.dt = Some(0.05);
+        s.t_end = orbits * 2.0 * std::f64::consts::PI;
+        s.points = Some(2001);
+    });
+    assert!(res.failure.is_none(), "{:?}", res.failure);
+    let e = res.columns.iter().position(|c| c == "energy").unwrap();
+    let e0 = res.rows[0][e];
+    let drift = |rows: &[Vec<f64>]| {
+        rows.iter()
+            .map(|r| ((r[e] - e0) / e0).abs())
+            .fold(0.0, f64::max)
+    };
+    let half = drift(&res.rows[..1000]);
+    let whole = drift(&res.rows);
+    assert!(whole < 1e-5, "energy error {whole}");
+    // Bounded: the second half of the run does not make it worse in any significant way.
+    assert!(
+        whole < 1.5 * half,
+        "secular growth: first half {half}, whole {whole}"
+    );
+    assert!(res.warnings.is_empty(), "{:?}", res.warnings);
+}
+
+#[test]
+fn kremlin_stone_range_from_the_terminal_event() {
+    let (m, res) = run_example("kremlin_stone", |_| {});
+    let par = |n: &str| m.parameters.iter().find(|p| p.name == n).unwrap().value;
+    let (g, h, v0, th) = (par("g"), par("H"), par("v0"), par("theta"));
+    let vz = v0 * th.sin();
+    let t_hit = (vz + (vz * vz + 2.0 * g * h).sqrt()) / g;
+    let range = v0 * th.cos() * t_hit;
+    assert_eq!(res.events.len(), 1);
+    let ev = &res.events[0];
+    assert_eq!(ev.name, "hits the ground");
+    assert!(
+        ((ev.t - t_hit) / t_hit).abs() < 1e-10,
+        "t = {} vs {t_hit}",
+        ev.t
+    );
+    assert!(
+        ((ev.state[0] - range) / range).abs() < 1e-8,
+        "D = {} vs {range}",
+        ev.state[0]
+    );
+    assert!((range - 37.1).abs() < 0.05, "about 37.1 m: {range}");
+    // Terminal: the solution stops exactly at the event.
+    assert_eq!(last(&res, "t"), ev.t);
+}
+
+#[test]
+fn nanoparticle_apex_is_kt_over_mg() {
+    let (m, res) = run_example("nanoparticle", |_| {});
+    let par = |n: &str| m.parameters.iter().find(|p| p.name == n).unwrap().value;
+    let h = par("kB") * par("T") / (par("m") * par("g"));
+    let ev = &res.events[0];
+    assert!(
+        ((ev.state[0] - h) / h).abs() < 1e-8,
+        "apex {} vs kT/mg = {h}",
+        ev.state[0]
+    );
+    assert!((h - 0.01).abs() < 0.005, "about 10 mm: {h}");
+}
+
+#[test]
+fn building_sweep_finds_the_natural_frequencies() {
+    let mut m = example("building");
+    let set = RunSettings::from_spec(&m.run.simulate).unwrap();
+    let spec = m.run.sweep.clone().unwrap();
+    let stats: Vec<_> = spec.measures.iter().map(|x| x.stat).collect();
+    let prep = sim::prepare(&mut m).unwrap();
+    let res = sim::sweep::sweep(&prep, &set, &spec, &stats, false);
+    assert!(res.problems.is_empty(), "{:?}", res.problems);
+    let y: Vec<f64> = res.table.iter().map(|r| r[0]).collect();
+    let peaks = sim::sweep::peaks(&res.values, &y);
+    let resolution = res.values[1] - res.values[0];
+    // k = 100, m = 1: omega^2 = (k/m)(3 -+ sqrt(5))
+    let w1 = (100.0f64 * (3.0 - 5f64.sqrt())).sqrt();
+    let w2 = (100.0f64 * (3.0 + 5f64.sqrt())).sqrt();
+    assert_eq!(peaks.len(), 2, "{peaks:?}");
+    assert!((peaks[0].0 - w1).abs() < resolution, "{peaks:?} vs {w1}");
+    assert!((peaks[1].0 - w2).abs() < resolution, "{peaks:?} vs {w2}");
+    assert!((w1 - 8.74).abs() < 0.01 && (w2 - 22.88).abs() < 0.01);
+}
+
+#[test]
+fn prescribed_and_constrained_models_run() {
+    let (_, res) = run_example("rotating_rod_block", |_| {});
+    assert!(res.failure.is_none());
+    // r(t) = V e^{-mu w t} sinh(sqrt(1+mu^2) w t)/(w sqrt(1+mu^2)) with V = 1, w = 2, mu = 0.3
+    let (v, w, mu, t) = (1.0f64, 2.0f64, 0.3f64, 2.0f64);
+    let s = (1.0 + mu * mu).sqrt();
+    let exact = v * (-mu * w * t).exp() * (s * w * t).sinh() / (w * s);
+    assert!(
+        (last(&res, "r") - exact).abs() < 1e-6 * exact,
+        "{} vs {exact}",
+        last(&res, "r")
+    );
+    // N = 2 m w r' is reported as a column.
+    let n = last(&res, "N");
+    assert!((n - 2.0 * w * last(&res, "r'")).abs() < 1e-9 * n.abs());
+    let (_, res) = run_example("pulley", |_| {});
+    let t = last(&res, "T");
+    assert!((t - 2.0 * 2.0 * 1.0 * 9.81 / 3.0).abs() < 1e-12);
+    let e = res.monitors.iter().find(|m| m.name == "energy").unwrap();
+    assert!(e.drift < 1e-6);
+}
