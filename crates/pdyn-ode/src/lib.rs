@@ -34,6 +34,7 @@
 //! | `methods/dopri5.rs` | **DOPRI5**, Dormand & Prince 1980: 5(4), FSAL, 4th-order dense output, stiffness detection (MATLAB `ode45`) |
 //! | `methods/tsit5.rs` | **Tsit5**, Tsitouras 2011: 5(4), FSAL, 4th-order dense output |
 //! | `methods/dop853.rs` | **DOP853**, Prince & Dormand 1981 / Hairer: 8(5,3), 7th-order dense output |
+//! | `methods/vern9.rs` | **Vern9**, Verner 2010: 9(8), for very tight tolerances (cubic Hermite dense output) |
 //! | `methods/rk4.rs` | **RK4**, Kutta 1901: classical order 4, fixed step |
 //! | `methods/radau5.rs` | **Radau5**, Hairer & Wanner 1996: Radau IIA order 5, stiff, mass matrices / index-1 DAEs |
 //! | `methods/symplectic.rs` | **Velocity Verlet** (Verlet 1967), **Yoshida 4** (Yoshida 1990), **Kahan–Li 6 / 8** (Kahan & Li 1997): explicit symplectic, fixed step |
@@ -91,6 +92,8 @@ pub enum Method {
     Tsit5,
     /// Dormand–Prince 8(5,3) ([`methods::dop853`]), adaptive.
     Dop853,
+    /// Verner 9(8) ([`methods::vern9`]), adaptive.
+    Vern9,
     /// Classical Runge–Kutta 4 ([`methods::rk4`]), fixed step.
     Rk4,
     /// Velocity Verlet ([`methods::symplectic`]), fixed step, symplectic, order 2.
@@ -136,6 +139,7 @@ impl Method {
             Method::Dopri5,
             Method::Tsit5,
             Method::Dop853,
+            Method::Vern9,
             Method::Rk4,
             Method::VelocityVerlet,
             Method::Yoshida4,
@@ -154,6 +158,7 @@ impl Method {
             Method::Dopri5 => "dopri5",
             Method::Tsit5 => "tsit5",
             Method::Dop853 => "dop853",
+            Method::Vern9 => "vern9",
             Method::Rk4 => "rk4",
             Method::VelocityVerlet => "verlet",
             Method::Yoshida4 => "yoshida4",
@@ -173,6 +178,7 @@ impl Method {
             Method::Dopri5 => dopri5::DOC,
             Method::Tsit5 => tsit5::DOC,
             Method::Dop853 => dop853::DOC,
+            Method::Vern9 => vern9::DOC,
             Method::Rk4 => rk4::DOC,
             Method::VelocityVerlet => symplectic::DOC_VERLET,
             Method::Yoshida4 => symplectic::DOC_YOSHIDA4,
@@ -190,6 +196,7 @@ impl Method {
         match self {
             Method::Dopri5 | Method::Tsit5 | Method::Radau5 | Method::Auto => 5,
             Method::Dop853 | Method::KahanLi8 => 8,
+            Method::Vern9 => 9,
             Method::Rk4 | Method::Yoshida4 | Method::Gauss4 => 4,
             Method::VelocityVerlet => 2,
             Method::KahanLi6 | Method::Gauss6 => 6,
@@ -199,7 +206,7 @@ impl Method {
     /// Kind of method.
     pub fn kind(self) -> MethodKind {
         match self {
-            Method::Dopri5 | Method::Tsit5 | Method::Dop853 => MethodKind::Adaptive,
+            Method::Dopri5 | Method::Tsit5 | Method::Dop853 | Method::Vern9 => MethodKind::Adaptive,
             Method::Rk4 => MethodKind::FixedStep,
             Method::Radau5 | Method::Auto => MethodKind::Stiff,
             Method::VelocityVerlet
@@ -301,6 +308,9 @@ fn dispatch<S: OdeSystem + ?Sized>(
         }
         Method::Dop853 => {
             explicit::integrate::<methods::dop853::Dop853, S>(sys, t0, tf, y0, opts, events, act)
+        }
+        Method::Vern9 => {
+            explicit::integrate::<methods::vern9::Vern9, S>(sys, t0, tf, y0, opts, events, act)
         }
         Method::Rk4 => fixed::integrate_fixed(
             method,

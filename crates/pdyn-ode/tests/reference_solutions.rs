@@ -18,6 +18,7 @@ fn pleiades_explicit_methods() {
         (Method::Dopri5, 1e-10, 1e-7),
         (Method::Tsit5, 1e-10, 1e-7),
         (Method::Dop853, 1e-12, 1e-9),
+        (Method::Vern9, 1e-12, 1e-9),
     ] {
         let y = end(m, &pleiades(), 3.0, &PLEI_Y0, &Options::with_tol(tol));
         let e = max_err(&y, &PLEI_Y3);

@@ -7,3 +7,4 @@ pub mod radau5;
 pub mod rk4;
 pub mod symplectic;
 pub mod tsit5;
+pub mod vern9;
