@@ -39,7 +39,7 @@ impl Theme {
             label: 19.0 * s,
             tick: 16.0 * s,
             legend: 16.0 * s,
-            note: 14.0 * s,
+            note: 15.0 * s,
             line: (2.0 * dpr).round().max(1.0) as u32,
             point: (3.0 * s).round().max(1.0) as u32,
             tick_len: (5.0 * s).round() as i32,
@@ -137,6 +137,90 @@ pub fn equal_aspect_ranges(
     }
 }
 
+/// Placement of the label of a vertical-line marker: row 0 is at the top
+/// of the plot, `right` tells on which side of the line the text goes.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct VLabel<'a> {
+    pub text: &'a str,
+    pub px: f64,
+    pub right: bool,
+    pub row: usize,
+}
+
+/// Height of one row of vertical-line labels.
+pub(crate) fn vline_row_height(th: &Theme) -> f64 {
+    text_size("Ag", th.note).1 as f64 + 1.5 * th.gap as f64
+}
+
+/// Places the labels of the vertical-line markers of `fig` in rows at the
+/// top of a plotting area `plot_w` pixels wide showing `x_range`: to the
+/// right of its line unless that leaves the plot or crosses another marker
+/// line and the left side does not; in the first row where it overlaps no
+/// other label.
+pub(crate) fn vline_labels<'a>(
+    fig: &'a Figure,
+    x_range: &Range<f64>,
+    plot_w: u32,
+    th: &Theme,
+) -> Vec<VLabel<'a>> {
+    let pw = plot_w as f64;
+    let gap = th.gap as f64;
+    let to_px =
+        |x: f64| crate::ticks::map_linear(x, x_range.start, x_range.end, (0, plot_w as i32));
+    let lines: Vec<f64> = fig
+        .markers
+        .iter()
+        .filter_map(|m| match m {
+            Marker::VLine { x, .. } if x.is_finite() => Some(to_px(*x)),
+            _ => None,
+        })
+        .collect();
+    let mut rows: Vec<Vec<(f64, f64)>> = Vec::new();
+    let mut out = Vec::new();
+    for m in &fig.markers {
+        let Marker::VLine { x, label } = m else {
+            continue;
+        };
+        let text = label.trim();
+        if !x.is_finite() || text.is_empty() {
+            continue;
+        }
+        let px = to_px(*x);
+        let tw = text_size(text, th.note).0 as f64;
+        let span = |right: bool| {
+            if right {
+                (px, px + gap / 2.0 + tw)
+            } else {
+                (px - gap / 2.0 - tw, px)
+            }
+        };
+        let clear = |(a, b): (f64, f64)| {
+            a >= 0.0
+                && b + gap <= pw
+                && !lines
+                    .iter()
+                    .any(|&o| (o - px).abs() > 0.5 && o > a - gap && o < b + gap)
+        };
+        let right = clear(span(true)) || (!clear(span(false)) && px + gap / 2.0 + tw + gap <= pw);
+        let (x0, x1) = span(right);
+        let row = rows
+            .iter()
+            .position(|r| r.iter().all(|&(a, b)| x1 + gap < a || x0 > b + gap))
+            .unwrap_or(rows.len());
+        if row == rows.len() {
+            rows.push(Vec::new());
+        }
+        rows[row].push((x0, x1));
+        out.push(VLabel {
+            text,
+            px,
+            right,
+            row,
+        });
+    }
+    out
+}
+
 fn max_width(labels: &[String], px: f64) -> u32 {
     labels.iter().map(|l| text_size(l, px).0).max().unwrap_or(0)
 }
@@ -182,10 +266,24 @@ pub(crate) fn layout_with(fig: &Figure, size: (u32, u32), th: &Theme) -> Result<
         label_dist + text_size("\u{2212}0.00", th.tick).0 + label_h(&fig.y_label) + gap;
     for iter in 0..8 {
         let plot_w = w.saturating_sub(left + right + y_area).max(1);
-        let (xr, yr) = if fig.equal_aspect {
-            equal_aspect_ranges(xr0.clone(), yr0.clone(), (plot_w, plot_h))
+        // Room at the top for the labels of vertical-line markers.
+        let n_rows = vline_labels(fig, &xr0, plot_w, th)
+            .iter()
+            .map(|l| l.row + 1)
+            .max()
+            .unwrap_or(0);
+        let yr1 = if n_rows > 0 {
+            let room =
+                ((n_rows as f64 * vline_row_height(th) + gap as f64) / plot_h as f64).min(0.5);
+            let top = yr0.start + (yr0.end - yr0.start) / (1.0 - room);
+            yr0.start..top
         } else {
-            (xr0.clone(), yr0.clone())
+            yr0.clone()
+        };
+        let (xr, yr) = if fig.equal_aspect {
+            equal_aspect_ranges(xr0.clone(), yr1, (plot_w, plot_h))
+        } else {
+            (xr0.clone(), yr1)
         };
         let y_ticks = ticks(&yr, n_y);
         // As many x ticks as fit with generous gaps between labels.

@@ -5,7 +5,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::font::{desc, text_size};
-use crate::layout::{layout_with, Layout, Theme};
+use crate::layout::{layout_with, vline_labels, vline_row_height, Layout, Theme};
 use crate::output;
 use crate::ticks::{map_linear, Axis, Ticks};
 use crate::{clean2, Figure, Marker, PlotError, Style};
@@ -31,7 +31,7 @@ pub(crate) const GRID: RGBColor = RGBColor(222, 222, 222);
 pub(crate) const MARK: RGBColor = RGBColor(80, 80, 80);
 
 /// Supersampling factor of PNG output.
-const SUPERSAMPLE: u32 = 2;
+const SUPERSAMPLE: u32 = 3;
 /// Largest image accepted, in pixels per side.
 const MAX_SIDE: u32 = 20_000;
 
@@ -102,11 +102,10 @@ pub(crate) fn png(figs: &[Figure], cols: usize, panel: (u32, u32)) -> Result<Vec
     crate::font::ensure()?;
     let (w, h, cols) = image_size(figs, cols, panel)?;
     // Keep the drawing buffer below ~100 MB.
-    let ss = if (w as u64 * h as u64) * 4 <= 33_000_000 {
-        SUPERSAMPLE
-    } else {
-        1
-    };
+    let ss = (1..=SUPERSAMPLE)
+        .rev()
+        .find(|s| w as u64 * h as u64 * u64::from(s * s) * 3 <= 100_000_000)
+        .unwrap_or(1);
     let dev = (w * ss, h * ss);
     let mut buf = vec![255u8; dev.0 as usize * dev.1 as usize * 3];
     {
@@ -295,7 +294,7 @@ fn draw_figure<DB: DrawingBackend>(
         let color = PALETTE[i % PALETTE.len()];
         let line_style = color.stroke_width(th.line);
         for run in &s.runs {
-            let pts = thin(run, &lay, if line { 0.5 } else { 1.0 } * dpr);
+            let pts = thin(run, &lay, (0.7 * dpr).max(0.5));
             let px: Vec<(f64, f64)> = pts.iter().map(|&p| to_px(&lay, p)).collect();
             samples_along(&px, 4.0 * dpr, &mut samples);
             if line && pts.len() >= 2 {
@@ -359,7 +358,7 @@ fn note<DB: DrawingBackend>(
             (rect.0 as i32, rect.1 as i32),
             (rect.2 as i32, rect.3 as i32),
         ],
-        WHITE.mix(0.8).filled(),
+        WHITE.mix(0.9).filled(),
     ))
     .map_err(err)?;
     let style = desc(th.note)
@@ -411,42 +410,24 @@ fn draw_markers<DB: DrawingBackend>(
     let (pw, ph) = (lay.plot_size.0 as f64, lay.plot_size.1 as f64);
     let gap = th.gap as f64;
     let text_h = text_size("Ag", th.note).1 as f64;
-    let row_h = text_h + 1.5 * gap;
     let mut boxes = Vec::new();
-    // Vertical line labels go in rows at the top, each row left to right
-    // without overlap.
-    let mut row_end: Vec<f64> = Vec::new();
+    // Labels are drawn after all lines so that no line crosses a label.
+    let mut pending: Vec<(&str, (f64, f64), (HPos, VPos))> = Vec::new();
+    for l in vline_labels(fig, &lay.x_range, lay.plot_size.0, th) {
+        let y = gap + l.row as f64 * vline_row_height(th);
+        let (ax, hp) = if l.right {
+            (l.px + gap / 2.0, HPos::Left)
+        } else {
+            (l.px - gap / 2.0, HPos::Right)
+        };
+        pending.push((l.text, (ax, y), (hp, VPos::Top)));
+    }
     for m in &fig.markers {
         match m {
-            Marker::VLine { x, label } if x.is_finite() => {
+            Marker::VLine { x, .. } if x.is_finite() => {
                 let (px, _) = to_px(lay, (*x, lay.y_range.start));
                 dashed(pa, (px, 0.0), (px, ph), th)?;
                 samples_along(&[(px, 0.0), (px, ph)], 8.0 * th.dpr, samples);
-                if label.trim().is_empty() {
-                    continue;
-                }
-                let tw = text_size(label.trim(), th.note).0 as f64;
-                let right_side = px + gap / 2.0 + tw + gap <= pw;
-                let (x0, x1) = if right_side {
-                    (px, px + gap / 2.0 + tw)
-                } else {
-                    (px - gap / 2.0 - tw, px)
-                };
-                let row = row_end
-                    .iter()
-                    .position(|&e| x0 > e + gap)
-                    .unwrap_or(row_end.len());
-                if row == row_end.len() {
-                    row_end.push(f64::NEG_INFINITY);
-                }
-                row_end[row] = x1;
-                let y = gap + row as f64 * row_h;
-                let (ax, hp) = if right_side {
-                    (px + gap / 2.0, HPos::Left)
-                } else {
-                    (px - gap / 2.0, HPos::Right)
-                };
-                boxes.push(note(pa, label.trim(), (ax, y), (hp, VPos::Top), th)?);
             }
             Marker::HLine { y, label } if y.is_finite() => {
                 let (_, py) = to_px(lay, (lay.x_range.start, *y));
@@ -458,13 +439,7 @@ fn draw_markers<DB: DrawingBackend>(
                     } else {
                         (py + gap / 2.0, VPos::Top)
                     };
-                    boxes.push(note(
-                        pa,
-                        label.trim(),
-                        (pw - gap, ay),
-                        (HPos::Right, vp),
-                        th,
-                    )?);
+                    pending.push((label.trim(), (pw - gap, ay), (HPos::Right, vp)));
                 }
             }
             Marker::Point { x, y, label } if x.is_finite() && y.is_finite() => {
@@ -494,11 +469,14 @@ fn draw_markers<DB: DrawingBackend>(
                     } else {
                         (py + off / 2.0, VPos::Top)
                     };
-                    boxes.push(note(pa, label.trim(), (hp.0, vp.0), (hp.1, vp.1), th)?);
+                    pending.push((label.trim(), (hp.0, vp.0), (hp.1, vp.1)));
                 }
             }
             _ => {}
         }
+    }
+    for (text, at, anchor) in pending {
+        boxes.push(note(pa, text, at, anchor, th)?);
     }
     Ok(boxes)
 }

@@ -42,7 +42,7 @@ pub(crate) fn png(fig: &Figure3, size: (u32, u32)) -> Result<Vec<u8>, PlotError>
     crate::font::ensure()?;
     check_size(size)?;
     clean3(fig)?;
-    let ss = 2;
+    let ss = 3;
     let dev = (size.0 * ss, size.1 * ss);
     let mut buf = vec![255u8; dev.0 as usize * dev.1 as usize * 3];
     {
@@ -116,7 +116,11 @@ fn draw3<DB: DrawingBackend>(
     let spans = [rx.end - rx.start, ry.end - ry.start, rz.end - rz.start];
     let longest = spans.iter().cloned().fold(0.0, f64::max);
     let base = cw.min(ch) * 0.8;
-    let side = |s: f64| (base * (s / longest).clamp(0.4, 1.0)).round() as i32;
+    // plotters maps data to integer "3-D pixels" before projecting: work at
+    // PRECISION times the size and scale the projection down to match, so
+    // curves don't wobble.
+    const PRECISION: f64 = 16.0;
+    let side = |s: f64| (PRECISION * base * (s / longest).clamp(0.4, 1.0)).round() as i32;
     chart.set_3d_pixel_range((side(spans[0]), side(spans[2]), side(spans[1])));
     // Fit the projected box into the area, leaving room for the labels.
     let corners: Vec<P3> = [rx.start, rx.end]
@@ -150,6 +154,7 @@ fn draw3<DB: DrawingBackend>(
     chart.with_projection(|mut p| {
         p.yaw = YAW;
         p.pitch = PITCH;
+        p.scale = 1.0 / PRECISION;
         p.into_matrix()
     });
     let bb = project_bbox(&chart);
@@ -161,7 +166,7 @@ fn draw3<DB: DrawingBackend>(
     chart.with_projection(|mut p| {
         p.yaw = YAW;
         p.pitch = PITCH;
-        p.scale = scale;
+        p.scale = scale / PRECISION;
         p.into_matrix()
     });
 
@@ -223,7 +228,7 @@ fn draw3<DB: DrawingBackend>(
     let n_for = |a: P3, b: P3| {
         let (pa, pb) = (to_px(a), to_px(b));
         let len = ((pa.0 - pb.0).powi(2) + (pa.1 - pb.1).powi(2)).sqrt();
-        ((len / (90.0 * th.dpr)) as usize).clamp(3, 7)
+        ((len / (80.0 * th.dpr)) as usize).clamp(4, 8)
     };
     let tx = ticks(&rx, n_for((rx.start, y_front, z0), (rx.end, y_front, z0)));
     let ty = ticks(&ry, n_for((x_front, ry.start, z0), (x_front, ry.end, z0)));
