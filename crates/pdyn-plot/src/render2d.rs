@@ -172,6 +172,9 @@ fn thin(run: &[(f64, f64)], lay: &Layout, min_px: f64) -> Vec<(f64, f64)> {
     out
 }
 
+/// Horizontal and vertical anchoring of a text.
+type Anchor = (HPos, VPos);
+
 /// A rectangle in plotting-area pixels: x0, y0, x1, y1.
 type Rect = (f64, f64, f64, f64);
 
@@ -412,7 +415,7 @@ fn draw_markers<DB: DrawingBackend>(
     let text_h = text_size("Ag", th.note).1 as f64;
     let mut boxes = Vec::new();
     // Labels are drawn after all lines so that no line crosses a label.
-    let mut pending: Vec<(&str, (f64, f64), (HPos, VPos))> = Vec::new();
+    let mut pending: Vec<(&str, (f64, f64), Anchor)> = Vec::new();
     for l in vline_labels(fig, &lay.x_range, lay.plot_size.0, th) {
         let y = gap + l.row as f64 * vline_row_height(th);
         let (ax, hp) = if l.right {
