@@ -124,7 +124,7 @@ fn main() {
     let aren = FnSystem::new(4, |_t, y: &[f64], f: &mut [f64]| arenstorf(y, f));
     let plei = FnSystem::new(28, |_t, y: &[f64], f: &mut [f64]| pleiades(y, f));
     for &tol in &tols {
-        for m in [Method::Dopri5, Method::Tsit5, Method::Dop853] {
+        for m in [Method::Dopri5, Method::Tsit5, Method::Dop853, Method::Vern9] {
             let o = Options::with_tol(tol);
             let (s, sol) = time(|| solve(m, &aren, (0.0, AREN_T), &AREN_Y0, &o).unwrap());
             let e = max_err(sol.last().unwrap().1, &AREN_Y0);
