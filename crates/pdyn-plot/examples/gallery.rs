@@ -124,6 +124,62 @@ fn grid() -> Vec<Figure> {
     ]
 }
 
+/// An inclined circular orbit and a precessing one, in 3-D.
+fn orbit3d() -> Figure3 {
+    let th = linspace(0.0, 6.0 * PI, 3000);
+    let inc: f64 = 0.5;
+    let circ = Series3::new(
+        "inclined circle",
+        th.iter().map(|t| 7000.0 * t.cos()).collect(),
+        th.iter().map(|t| 7000.0 * t.sin() * inc.cos()).collect(),
+        th.iter().map(|t| 7000.0 * t.sin() * inc.sin()).collect(),
+    );
+    let prec = Series3::new(
+        "precessing",
+        th.iter().map(|t| 9000.0 * (t + 0.1 * t).cos()).collect(),
+        th.iter()
+            .map(|t| 9000.0 * (t * 1.1).sin() * (0.2 * t).cos())
+            .collect(),
+        th.iter()
+            .map(|t| 9000.0 * (t * 1.1).sin() * (0.2 * t).sin())
+            .collect(),
+    );
+    Figure3 {
+        title: "Satellite orbits".into(),
+        labels: ["x [km]".into(), "y [km]".into(), "z [km]".into()],
+        series: vec![circ, prec],
+    }
+}
+
+/// A scatter of Poincaré-section points.
+fn poincare() -> Figure {
+    let (mut x, mut y) = (vec![], vec![]);
+    let (mut q, mut p) = (0.1f64, 0.0f64);
+    for _ in 0..3000 {
+        p += 0.9 * q.sin();
+        q += p;
+        x.push(q.rem_euclid(2.0 * PI));
+        y.push(p);
+    }
+    let (mut x2, mut y2) = (vec![], vec![]);
+    let (mut q, mut p) = (3.0f64, 1.0f64);
+    for _ in 0..3000 {
+        p += 0.9 * q.sin();
+        q += p;
+        x2.push(q.rem_euclid(2.0 * PI));
+        y2.push(p);
+    }
+    Figure {
+        title: "Standard map, K = 0.9".into(),
+        x_label: "q [rad]".into(),
+        y_label: "p".into(),
+        series: vec![Series::new("orbit A", x, y), Series::new("orbit B", x2, y2)],
+        style: Style::Points,
+        markers: vec![Marker::point(PI, 0.0, "fixed point")],
+        ..Default::default()
+    }
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dir = PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| ".".into()));
     std::fs::create_dir_all(&dir)?;
@@ -132,6 +188,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         save(&history(), &dir.join(format!("history.{ext}")))?;
         save3(&trajectory(), &dir.join(format!("trajectory3d.{ext}")))?;
         save_grid(&grid(), 2, &dir.join(format!("grid.{ext}")))?;
+        save3(&orbit3d(), &dir.join(format!("orbit3d.{ext}")))?;
+        save(&poincare(), &dir.join(format!("poincare.{ext}")))?;
     }
     println!("wrote to {}", dir.display());
     Ok(())

@@ -221,6 +221,17 @@ pub(crate) fn vline_labels<'a>(
     out
 }
 
+/// `px`, or a smaller size (down to 55 %) at which `text` fits in `max_w`
+/// pixels.
+pub(crate) fn fit_font(text: &str, px: f64, max_w: f64) -> f64 {
+    let tw = text_size(text.trim(), px).0 as f64;
+    if tw > max_w && tw > 0.0 {
+        (px * max_w / tw).max(0.55 * px)
+    } else {
+        px
+    }
+}
+
 fn max_width(labels: &[String], px: f64) -> u32 {
     labels.iter().map(|l| text_size(l, px).0).max().unwrap_or(0)
 }
@@ -242,7 +253,8 @@ pub(crate) fn layout_with(fig: &Figure, size: (u32, u32), th: &Theme) -> Result<
     let title_h = if fig.title.trim().is_empty() {
         gap
     } else {
-        text_size(&fig.title, th.title).1 + 2 * gap
+        let px = fit_font(&fig.title, th.title, w as f64 - 2.0 * gap as f64);
+        text_size(&fig.title, px).1 + 2 * gap
     };
     let tick_h = text_size("0123456789", th.tick).1.max(1);
     let label_h = |s: &str| {
@@ -338,6 +350,56 @@ mod tests {
         assert_eq!(padded(0.0, 0.0), -1.0..1.0);
         let r = padded(5.0, 5.0);
         assert!((r.start - 4.5).abs() < 1e-12 && (r.end - 5.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn vline_labels_avoid_lines_and_each_other() {
+        crate::font::ensure().unwrap();
+        let th = Theme::new((1000, 700), 1.0);
+        let fig = Figure {
+            markers: vec![
+                Marker::vline(3.0, "kick"),
+                Marker::vline(3.3, "contact"),
+                Marker::vline(3.5, "second contact"),
+                Marker::vline(9.9, "end"),
+                Marker::vline(f64::NAN, "skipped"),
+                Marker::vline(5.0, ""),
+            ],
+            ..Default::default()
+        };
+        let l = vline_labels(&fig, &(0.0..10.0), 800, &th);
+        let names: Vec<_> = l.iter().map(|l| l.text).collect();
+        assert_eq!(names, ["kick", "contact", "second contact", "end"]);
+        // "kick" goes left: to its right is the "contact" line.
+        assert!(!l[0].right && l[0].row == 0);
+        // "end" would leave the plot on the right.
+        assert!(!l[3].right);
+        // Labels in one row don't overlap.
+        let span = |v: &VLabel| {
+            let w = text_size(v.text, th.note).0 as f64 + th.gap as f64 / 2.0;
+            if v.right {
+                (v.px, v.px + w)
+            } else {
+                (v.px - w, v.px)
+            }
+        };
+        for a in &l {
+            for b in &l {
+                if a != b && a.row == b.row {
+                    let (sa, sb) = (span(a), span(b));
+                    assert!(sa.1 < sb.0 || sb.1 < sa.0, "{a:?} overlaps {b:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn long_titles_shrink() {
+        crate::font::ensure().unwrap();
+        let long = "a very long title ".repeat(10);
+        let px = fit_font(&long, 24.0, 500.0);
+        assert!((0.55 * 24.0..24.0).contains(&px));
+        assert_eq!(fit_font("short", 24.0, 500.0), 24.0);
     }
 
     #[test]

@@ -367,6 +367,11 @@ pub fn grid_to_svg(figs: &[Figure], cols: usize) -> Result<String, PlotError> {
     render2d::svg(figs, cols, PANEL_SIZE)
 }
 
+/// The PNG file contents of a grid of panels (see [`save_grid`]).
+pub fn grid_to_png(figs: &[Figure], cols: usize) -> Result<Vec<u8>, PlotError> {
+    render2d::png(figs, cols, PANEL_SIZE)
+}
+
 /// Saves a 3-D figure to `path` at [`DEFAULT_SIZE`]; the format comes from
 /// the extension (`.svg` or `.png`).
 pub fn save3(fig: &Figure3, path: &Path) -> Result<(), PlotError> {
@@ -381,6 +386,11 @@ pub fn save3(fig: &Figure3, path: &Path) -> Result<(), PlotError> {
 /// The SVG document of a 3-D figure at [`DEFAULT_SIZE`].
 pub fn to_svg3(fig: &Figure3) -> Result<String, PlotError> {
     render3d::svg(fig, DEFAULT_SIZE)
+}
+
+/// The PNG file contents of a 3-D figure at [`DEFAULT_SIZE`].
+pub fn to_png3(fig: &Figure3) -> Result<Vec<u8>, PlotError> {
+    render3d::png(fig, DEFAULT_SIZE)
 }
 
 /// A series after validation: its label for the legend and its finite

@@ -5,7 +5,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::font::{desc, text_size};
-use crate::layout::{layout_with, vline_labels, vline_row_height, Layout, Theme};
+use crate::layout::{fit_font, layout_with, vline_labels, vline_row_height, Layout, Theme};
 use crate::output;
 use crate::ticks::{map_linear, Axis, Ticks};
 use crate::{clean2, Figure, Marker, PlotError, Style};
@@ -237,7 +237,8 @@ fn draw_figure<DB: DrawingBackend>(
 
     let (title_area, rest) = area.split_vertically(lay.title_h);
     if !fig.title.trim().is_empty() {
-        let style = desc(th.title)
+        let px = fit_font(&fig.title, th.title, w as f64 - 2.0 * th.gap as f64);
+        let style = desc(px)
             .color(&INK)
             .pos(Pos::new(HPos::Center, VPos::Center));
         title_area
@@ -267,7 +268,12 @@ fn draw_figure<DB: DrawingBackend>(
     let xfmt = |v: &f64| tick_label(&lay.x_ticks, *v);
     let yfmt = |v: &f64| tick_label(&lay.y_ticks, *v);
     let tick_font = desc(th.tick).color(&INK);
-    let label_font = desc(th.label).color(&INK);
+    let label_px = fit_font(&fig.x_label, th.label, lay.plot_size.0 as f64).min(fit_font(
+        &fig.y_label,
+        th.label,
+        lay.plot_size.1 as f64,
+    ));
+    let label_font = desc(label_px).color(&INK);
     {
         let mut mesh = chart.configure_mesh();
         mesh.x_labels(lay.x_ticks.values.len())

@@ -10,7 +10,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::FontTransform;
 
 use crate::font::{desc, text_size};
-use crate::layout::{padded, Theme};
+use crate::layout::{fit_font, padded, Theme};
 use crate::output;
 use crate::render2d::{check_size, draw_legend, err, samples_along, GRID, INK, MARK, PALETTE};
 use crate::ticks::{ticks, Ticks};
@@ -81,14 +81,15 @@ fn draw3<DB: DrawingBackend>(
     root.fill(&WHITE).map_err(err)?;
     let (w, _) = root.dim_in_pixel();
     let gap = th.gap as f64;
+    let title_px = fit_font(&fig.title, th.title, w as f64 - 2.0 * gap);
     let title_h = if fig.title.trim().is_empty() {
         th.gap
     } else {
-        text_size(&fig.title, th.title).1 + 2 * th.gap
+        text_size(&fig.title, title_px).1 + 2 * th.gap
     };
     let (title_area, rest) = root.split_vertically(title_h);
     if !fig.title.trim().is_empty() {
-        let style = desc(th.title)
+        let style = desc(title_px)
             .color(&INK)
             .pos(Pos::new(HPos::Center, VPos::Center));
         title_area

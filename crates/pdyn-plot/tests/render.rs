@@ -5,8 +5,9 @@ use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
 use pdyn_plot::{
-    equal_aspect_ranges, grid_to_svg, layout, save, save3, save_grid, save_with_size, to_png,
-    to_svg, to_svg3, Figure, Figure3, Marker, PlotError, Series, Series3, Style, DEFAULT_SIZE,
+    equal_aspect_ranges, grid_to_png, grid_to_svg, layout, save, save3, save_grid, save_with_size,
+    to_png, to_png3, to_svg, to_svg3, Figure, Figure3, Marker, PlotError, Series, Series3, Style,
+    DEFAULT_SIZE,
 };
 
 /// A fresh directory under the system temp dir, removed on drop.
@@ -176,6 +177,11 @@ fn figure3_svg_and_png() {
     );
     assert_eq!(png_size(&read(&dir.path("t.png"))), DEFAULT_SIZE);
     assert_svg(&to_svg3(&fig).unwrap(), &["Projectile"]);
+    assert_eq!(png_size(&to_png3(&fig).unwrap()), DEFAULT_SIZE);
+    // A single series: no legend.
+    let mut one = fig.clone();
+    one.series.truncate(1);
+    assert!(!to_svg3(&one).unwrap().contains(">\nball\n<"));
 }
 
 #[test]
@@ -203,6 +209,10 @@ fn grid_svg_and_png() {
         (2 * pdyn_plot::PANEL_SIZE.0, 3 * pdyn_plot::PANEL_SIZE.1)
     );
     assert!(grid_to_svg(&figs[..1], 3).unwrap().contains("panel a"));
+    assert_eq!(
+        png_size(&grid_to_png(&figs[..3], 3).unwrap()),
+        (3 * pdyn_plot::PANEL_SIZE.0, pdyn_plot::PANEL_SIZE.1)
+    );
 }
 
 /// The pixel bounding box of the first polyline of the given colour.
@@ -324,6 +334,15 @@ fn long_series_give_small_svg() {
     };
     let svg = to_svg(&fig).unwrap();
     assert!(svg.len() < 400_000, "SVG is {} bytes", svg.len());
+}
+
+#[test]
+fn long_texts_still_render() {
+    let mut fig = history();
+    fig.title = "A title that is much too long for the figure ".repeat(4);
+    fig.y_label = "a y label that is longer than the axis is high ".repeat(3);
+    save_with_size(&fig, &TempDir::new("long").path("l.png"), (300, 200)).unwrap();
+    assert!(to_svg(&fig).unwrap().contains("much too long"));
 }
 
 #[test]
