@@ -180,6 +180,39 @@ fn poincare() -> Figure {
     }
 }
 
+/// Amplitude response of a damped oscillator for three dampings, with the
+/// resonance peaks marked (what `pdyn sweep` plots).
+fn resonance() -> Figure {
+    let w = linspace(0.0, 3.0, 600);
+    let mut series = Vec::new();
+    let mut markers = Vec::new();
+    for zeta in [0.05f64, 0.15, 0.4] {
+        let a: Vec<f64> = w
+            .iter()
+            .map(|w| 1.0 / ((1.0 - w * w).powi(2) + (2.0 * zeta * w).powi(2)).sqrt())
+            .collect();
+        let (i, peak) = a
+            .iter()
+            .enumerate()
+            .fold((0, 0.0), |b, (i, &v)| if v > b.1 { (i, v) } else { b });
+        markers.push(Marker::point(
+            w[i],
+            peak,
+            format!("{peak:.1} at {:.2}", w[i]),
+        ));
+        series.push(Series::new(format!("ζ = {zeta}"), w.clone(), a));
+    }
+    Figure {
+        title: "Frequency response of a building storey (long titles shrink to fit the width)"
+            .into(),
+        x_label: "forcing frequency ω/ω₀".into(),
+        y_label: "amplitude ratio X/X_st".into(),
+        series,
+        markers,
+        ..Default::default()
+    }
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dir = PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| ".".into()));
     std::fs::create_dir_all(&dir)?;
@@ -190,6 +223,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         save_grid(&grid(), 2, &dir.join(format!("grid.{ext}")))?;
         save3(&orbit3d(), &dir.join(format!("orbit3d.{ext}")))?;
         save(&poincare(), &dir.join(format!("poincare.{ext}")))?;
+        save(&resonance(), &dir.join(format!("resonance.{ext}")))?;
+        pdyn_plot::save_with_size(&history(), &dir.join(format!("small.{ext}")), (400, 300))?;
     }
     println!("wrote to {}", dir.display());
     Ok(())

@@ -242,11 +242,40 @@ fn max_width(labels: &[String], px: f64) -> u32 {
 /// `x_range span / plot width == y_range span / plot height`.
 pub fn layout(fig: &Figure, size: (u32, u32)) -> Result<Layout, PlotError> {
     crate::font::ensure()?;
-    layout_with(fig, size, &Theme::new(size, 1.0))
+    layout_with(fig, size, &Theme::new(size, 1.0), &Floors::default())
 }
 
-/// [`layout`] for a device size `size` (device pixels) and theme.
-pub(crate) fn layout_with(fig: &Figure, size: (u32, u32), th: &Theme) -> Result<Layout, PlotError> {
+/// Lower bounds for the sizes of a layout, so that the panels of a grid
+/// line up: title height and x label area per row, y label area and right
+/// margin per column.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(crate) struct Floors {
+    pub title_h: u32,
+    pub x_area: u32,
+    pub y_area: u32,
+    pub right: u32,
+}
+
+impl Layout {
+    /// The sizes of this layout, as floors.
+    pub(crate) fn floors(&self) -> Floors {
+        Floors {
+            title_h: self.title_h,
+            x_area: self.x_area,
+            y_area: self.y_area,
+            right: self.margin[3],
+        }
+    }
+}
+
+/// [`layout`] for a device size `size` (device pixels) and theme, with
+/// lower bounds for the sizes of its parts.
+pub(crate) fn layout_with(
+    fig: &Figure,
+    size: (u32, u32),
+    th: &Theme,
+    floors: &Floors,
+) -> Result<Layout, PlotError> {
     let (xr0, yr0) = data_ranges(fig)?;
     let (w, h) = size;
     let gap = th.gap;
@@ -255,7 +284,8 @@ pub(crate) fn layout_with(fig: &Figure, size: (u32, u32), th: &Theme) -> Result<
     } else {
         let px = fit_font(&fig.title, th.title, w as f64 - 2.0 * gap as f64);
         text_size(&fig.title, px).1 + 2 * gap
-    };
+    }
+    .max(floors.title_h);
     let tick_h = text_size("0123456789", th.tick).1.max(1);
     let label_h = |s: &str| {
         if s.trim().is_empty() {
@@ -266,16 +296,17 @@ pub(crate) fn layout_with(fig: &Figure, size: (u32, u32), th: &Theme) -> Result<
     };
     // plotters puts tick labels 2 × tick length away from the axis.
     let label_dist = 2 * th.tick_len.max(0) as u32;
-    let x_area = label_dist + tick_h + label_h(&fig.x_label) + gap;
+    let x_area = (label_dist + tick_h + label_h(&fig.x_label) + gap).max(floors.x_area);
     let top = (tick_h / 2 + gap / 2).max(gap);
     let bottom = gap;
     let left = gap;
-    let mut right = 3 * gap;
+    let mut right = (3 * gap).max(floors.right);
     let plot_h = h.saturating_sub(title_h + top + bottom + x_area).max(1);
 
     let n_y = ((plot_h as f64 / (tick_h as f64 * 3.2)) as usize).clamp(2, 10);
     let mut y_area =
-        label_dist + text_size("\u{2212}0.00", th.tick).0 + label_h(&fig.y_label) + gap;
+        (label_dist + text_size("\u{2212}0.00", th.tick).0 + label_h(&fig.y_label) + gap)
+            .max(floors.y_area);
     for iter in 0..8 {
         let plot_w = w.saturating_sub(left + right + y_area).max(1);
         // Room at the top for the labels of vertical-line markers.
@@ -311,9 +342,10 @@ pub(crate) fn layout_with(fig: &Figure, size: (u32, u32), th: &Theme) -> Result<
             x_ticks = ticks(&xr, n_x);
         }
         let new_y_area =
-            label_dist + max_width(&y_ticks.labels, th.tick) + label_h(&fig.y_label) + gap;
+            (label_dist + max_width(&y_ticks.labels, th.tick) + label_h(&fig.y_label) + gap)
+                .max(floors.y_area);
         let last_w = x_ticks.labels.last().map_or(0, |l| text_size(l, th.tick).0);
-        let new_right = (last_w / 2 + gap).max(3 * gap);
+        let new_right = (last_w / 2 + gap).max(3 * gap).max(floors.right);
         if (new_y_area == y_area && new_right == right) || iter == 7 {
             return Ok(Layout {
                 x_range: xr,

@@ -5,7 +5,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::font::{desc, text_size};
-use crate::layout::{fit_font, layout_with, vline_labels, vline_row_height, Layout, Theme};
+use crate::layout::{fit_font, layout_with, vline_labels, vline_row_height, Floors, Layout, Theme};
 use crate::output;
 use crate::ticks::{map_linear, Axis, Ticks};
 use crate::{clean2, Figure, Marker, PlotError, Style};
@@ -126,8 +126,30 @@ fn draw_grid<DB: DrawingBackend>(
     root.fill(&WHITE).map_err(PlotError::render)?;
     let rows = (figs.len() as u32).div_ceil(cols);
     let panels = root.split_evenly((rows as usize, cols as usize));
-    for (fig, area) in figs.iter().zip(panels.iter()) {
-        draw_figure(area, fig, th)?;
+    // Line the panels up: common title height and x label area per row,
+    // common y label area and right margin per column.
+    let natural = figs
+        .iter()
+        .zip(panels.iter())
+        .map(|(fig, area)| {
+            Ok(layout_with(fig, area.dim_in_pixel(), th, &Floors::default())?.floors())
+        })
+        .collect::<Result<Vec<Floors>, PlotError>>()?;
+    let cols = cols as usize;
+    for (i, (fig, area)) in figs.iter().zip(panels.iter()).enumerate() {
+        let (r, c) = (i / cols, i % cols);
+        let mut f = Floors::default();
+        for (j, n) in natural.iter().enumerate() {
+            if j / cols == r {
+                f.title_h = f.title_h.max(n.title_h);
+                f.x_area = f.x_area.max(n.x_area);
+            }
+            if j % cols == c {
+                f.y_area = f.y_area.max(n.y_area);
+                f.right = f.right.max(n.right);
+            }
+        }
+        draw_figure(area, fig, th, &f)?;
     }
     Ok(())
 }
@@ -229,10 +251,11 @@ fn draw_figure<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     fig: &Figure,
     th: &Theme,
+    floors: &Floors,
 ) -> Result<(), PlotError> {
     let clean = clean2(fig)?;
     let (w, _h) = area.dim_in_pixel();
-    let lay = layout_with(fig, area.dim_in_pixel(), th)?;
+    let lay = layout_with(fig, area.dim_in_pixel(), th, floors)?;
     let dpr = th.dpr;
 
     let (title_area, rest) = area.split_vertically(lay.title_h);
@@ -241,11 +264,20 @@ fn draw_figure<DB: DrawingBackend>(
         let style = desc(px)
             .color(&INK)
             .pos(Pos::new(HPos::Center, VPos::Center));
+        // Centred over the plotting area, but kept inside the image.
+        let tw = text_size(fig.title.trim(), px).0 as f64;
+        let cx = (lay.margin[2] + lay.y_area) as f64 + lay.plot_size.0 as f64 / 2.0;
+        let half = tw / 2.0 + th.gap as f64;
+        let cx = if w as f64 >= 2.0 * half {
+            cx.clamp(half, w as f64 - half)
+        } else {
+            w as f64 / 2.0
+        };
         title_area
             .draw_text(
                 fig.title.trim(),
                 &style,
-                (w as i32 / 2, lay.title_h as i32 / 2 + th.gap as i32 / 2),
+                (cx as i32, lay.title_h as i32 / 2 + th.gap as i32 / 2),
             )
             .map_err(err)?;
     }
