@@ -191,39 +191,13 @@ fn simp(p: &mut Pool, e: Id, on: bool) -> Id {
     }
 }
 
-/// Derives the equations of motion of `model` (its pool grows with the new expressions).
-pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, DeriveError> {
-    let free: Vec<usize> = model
-        .coordinates
-        .iter()
-        .enumerate()
-        .filter(|(_, c)| matches!(c.kind, CoordinateKind::Free { .. }))
-        .map(|(i, _)| i)
-        .collect();
+/// Every particle's kinematics and resultant force, Newton's equations `m a = F` (components
+/// that are identically `0 = 0` dropped) with the frames' `ΣM = 0`, and the constraints
+/// differentiated twice. Shared by [`derive`] and `pdyn forces`.
+pub fn newton_equations(
+    model: &mut Model,
+) -> (Vec<ParticleKinematics>, Vec<Equation>, Vec<Equation>) {
     let p = &mut model.pool;
-    let q: Vec<Id> = free
-        .iter()
-        .map(|&i| p.coord(model.coordinates[i].sym, 0))
-        .collect();
-    let qd: Vec<Id> = free
-        .iter()
-        .map(|&i| p.coord(model.coordinates[i].sym, 1))
-        .collect();
-    let qdd: Vec<Id> = free
-        .iter()
-        .map(|&i| p.coord(model.coordinates[i].sym, 2))
-        .collect();
-    let mut state = q.clone();
-    state.extend(&qd);
-    let mut state_names: Vec<String> = free
-        .iter()
-        .map(|&i| model.coordinates[i].name.clone())
-        .collect();
-    state_names.extend(
-        free.iter()
-            .map(|&i| format!("{}'", model.coordinates[i].name)),
-    );
-
     // Kinematics and resultant forces.
     let mut parts = Vec::with_capacity(model.particles.len());
     for (i, pt) in model.particles.iter().enumerate() {
@@ -300,6 +274,45 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
             rhs: Pool::ZERO,
         });
     }
+
+    (parts, newton, constraint_eqs)
+}
+
+/// Derives the equations of motion of `model` (its pool grows with the new expressions).
+pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, DeriveError> {
+    let free: Vec<usize> = model
+        .coordinates
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| matches!(c.kind, CoordinateKind::Free { .. }))
+        .map(|(i, _)| i)
+        .collect();
+    let p = &mut model.pool;
+    let q: Vec<Id> = free
+        .iter()
+        .map(|&i| p.coord(model.coordinates[i].sym, 0))
+        .collect();
+    let qd: Vec<Id> = free
+        .iter()
+        .map(|&i| p.coord(model.coordinates[i].sym, 1))
+        .collect();
+    let qdd: Vec<Id> = free
+        .iter()
+        .map(|&i| p.coord(model.coordinates[i].sym, 2))
+        .collect();
+    let mut state = q.clone();
+    state.extend(&qd);
+    let mut state_names: Vec<String> = free
+        .iter()
+        .map(|&i| model.coordinates[i].name.clone())
+        .collect();
+    state_names.extend(
+        free.iter()
+            .map(|&i| format!("{}'", model.coordinates[i].name)),
+    );
+
+    let (mut parts, newton, constraint_eqs) = newton_equations(model);
+    let p = &mut model.pool;
 
     let reaction_unknowns: Vec<Unknown> = model
         .reactions

@@ -170,6 +170,18 @@ pub struct Constraint {
     pub equation: Id,
 }
 
+/// A quantity to solve for (thrust, bank angle, ...), with a search range if it enters
+/// nonlinearly.
+#[derive(Clone, Debug)]
+pub struct UnknownQuantity {
+    /// Name.
+    pub name: String,
+    /// Its symbol's expression.
+    pub id: Id,
+    /// Search interval.
+    pub range: Option<(f64, f64)>,
+}
+
 /// A potential energy term of a conservative force, for energy monitors.
 #[derive(Clone, Debug)]
 pub struct PotentialTerm {
@@ -215,6 +227,13 @@ pub struct Model {
     pub conservative: bool,
     /// `[simulate]`, `[[events]]`, `[monitors]`, `[sweep]`.
     pub run: spec::RunSpec,
+    /// Quantities to solve for in `pdyn forces` (`[unknowns]`).
+    pub unknowns: Vec<UnknownQuantity>,
+    /// Accelerations given for free coordinates (`acceleration = ...`): a state with known
+    /// accelerations at an instant.
+    pub known_accelerations: Vec<(usize, Id)>,
+    /// Design criteria (`[[checks]]`).
+    pub checks: Vec<spec::CheckSpec>,
     /// `(coordinate index, initial value, initial rate)` as expressions of the parameters, so
     /// that a sweep over a parameter recomputes the initial conditions that depend on it.
     pub initial_exprs: Vec<(usize, Id, Id)>,
@@ -257,7 +276,7 @@ impl Loader<'_> {
         ModelError::new(self.origin, span, msg)
     }
 
-    fn declare(
+    pub(crate) fn declare(
         &mut self,
         name: &str,
         span: Range<usize>,
@@ -314,7 +333,7 @@ impl Loader<'_> {
         }
     }
 
-    fn located(&self, e: ExprError, offset: usize) -> ModelError {
+    pub(crate) fn located(&self, e: ExprError, offset: usize) -> ModelError {
         let e = e.offset(offset);
         ModelError {
             origin: self.origin.to_string(),
@@ -420,8 +439,43 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
         });
     }
 
+    // Unknown quantities of `pdyn forces` are symbols without values.
+    let mut unknowns = Vec::new();
+    for (name, su) in &raw.unknowns {
+        let s = ld.pool.symbol(name.get_ref(), false);
+        let id = ld.pool.sym(s);
+        ld.declare(
+            name.get_ref(),
+            name.span(),
+            "unknown",
+            Binding::Value(Value::Scalar(id)),
+        )?;
+        let range = match &su.get_ref().range {
+            None => None,
+            Some(r) => {
+                if r.get_ref().len() != 2 {
+                    return Err(ld.err(r.span(), "`range` is [low, high]"));
+                }
+                let lo = ld.scalar(&r.get_ref()[0], "a range bound")?;
+                let lo = ld.constant(lo, r.span(), "a range bound")?;
+                let hi = ld.scalar(&r.get_ref()[1], "a range bound")?;
+                let hi = ld.constant(hi, r.span(), "a range bound")?;
+                if !(lo < hi) {
+                    return Err(ld.err(r.span(), format!("empty range [{lo}, {hi}]")));
+                }
+                Some((lo, hi))
+            }
+        };
+        unknowns.push(UnknownQuantity {
+            name: name.get_ref().clone(),
+            id,
+            range,
+        });
+    }
+
     let mut coordinates = Vec::new();
     let mut initial_exprs = Vec::new();
+    let mut known_accelerations = Vec::new();
     for (name, sv) in &raw.coordinates {
         let n = name.get_ref();
         let kind = match sv.get_ref() {
@@ -432,7 +486,7 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
             toml::Value::Table(t) => {
                 let get = |k: &str| t.get(k);
                 for key in t.keys() {
-                    if !["initial", "rate", "prescribed"].contains(&key.as_str()) {
+                    if !["initial", "rate", "prescribed", "acceleration"].contains(&key.as_str()) {
                         return Err(ld
                             .err(sv.span(), format!("unknown key `{key}` in coordinate `{n}`"))
                             .help("a coordinate is { initial = ..., rate = ... } or a prescribed \"f(t)\""));
@@ -489,6 +543,22 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
                     let (initial, initial_expr) = num(&mut ld, "initial")?;
                     let (rate, rate_expr) = num(&mut ld, "rate")?;
                     initial_exprs.push((coordinates.len(), initial_expr, rate_expr));
+                    if let Some(acc) = t.get("acceleration") {
+                        let text = match acc {
+                            toml::Value::String(s) => s.clone(),
+                            toml::Value::Integer(i) => i.to_string(),
+                            toml::Value::Float(f) => format!("{f:e}"),
+                            other => return Err(ld.err(sv.span(), format!("`acceleration` must be a number or an expression, found {}", other.type_str()))),
+                        };
+                        let ast = pdyn_expr::syntax::parse(&text)
+                            .map_err(|e| ld.err(sv.span(), format!("in `acceleration`: {}", e.message)))?;
+                        let v = lower(&mut ld.pool, &ast, &mut ld.scope)
+                            .map_err(|e| ld.err(sv.span(), format!("in `acceleration` of `{n}`: {}", e.message)).help(e.help.unwrap_or_default()))?;
+                        let Value::Scalar(id) = v else {
+                            return Err(ld.err(sv.span(), "`acceleration` must be a scalar"));
+                        };
+                        known_accelerations.push((coordinates.len(), id));
+                    }
                     CoordinateKind::Free { initial, rate }
                 }
             }
@@ -659,9 +729,14 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
     let params = ld.params.clone();
     let run = spec::read(&mut ld, &raw, &params)?;
 
+    let checks = spec::read_checks(&mut ld, &raw)?;
+
     Ok(Model {
         run,
         initial_exprs,
+        unknowns,
+        known_accelerations,
+        checks,
         name: raw.name.clone().unwrap_or_else(|| origin.to_string()),
         origin: origin.to_string(),
         source: source.to_string(),

@@ -41,6 +41,31 @@ pub struct RawModel {
     #[serde(default)]
     pub monitors: IndexMap<Name, Sv>,
     pub sweep: Option<Spanned<RawSweep>>,
+    #[serde(default)]
+    pub unknowns: IndexMap<Name, Spanned<RawUnknown>>,
+    #[serde(default)]
+    pub checks: Vec<Spanned<RawCheck>>,
+}
+
+/// `[unknowns]`: a quantity to solve for in `pdyn forces` (thrust, bank angle...).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawUnknown {
+    /// Search interval for a nonlinear unknown, `[lo, hi]` (expressions allowed).
+    pub range: Option<Spanned<Vec<Sv>>>,
+}
+
+/// `[[checks]]`: a design criterion solved for a parameter.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawCheck {
+    pub name: Option<Name>,
+    pub condition: Option<Sv>,
+    pub solve_for: Option<Name>,
+    pub range: Option<Spanned<Vec<Sv>>>,
+    pub over: Option<Name>,
+    pub from: Option<Sv>,
+    pub to: Option<Sv>,
 }
 
 /// `[simulate]`: how `pdyn run` integrates (command-line options override it).

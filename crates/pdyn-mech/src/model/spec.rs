@@ -139,6 +139,102 @@ pub struct RunSpec {
     pub sweep: Option<SweepSpec>,
 }
 
+/// A `[[checks]]` entry: `condition` (an equation) solved for a parameter, possibly over a
+/// range of a coordinate or parameter (the worst case is reported).
+#[derive(Clone, Debug)]
+pub struct CheckSpec {
+    /// Name (`slip`, `tip`, ...).
+    pub name: String,
+    /// The condition as `lhs - rhs` (meaning `= 0`), as written (may contain `abs`).
+    pub condition: Id,
+    /// The text of the condition.
+    pub text: String,
+    /// Index of the parameter to solve for.
+    pub solve_for: usize,
+    /// Search interval for that parameter.
+    pub range: Option<(f64, f64)>,
+    /// A name to vary (a parameter or prescribed coordinate's parameter... any symbol) and its
+    /// interval: the critical value is reported where it is smallest.
+    pub over: Option<(Id, String, f64, f64)>,
+}
+
+pub(super) fn read_checks(ld: &mut Loader, raw: &RawModel) -> Result<Vec<CheckSpec>, ModelError> {
+    let mut out = Vec::new();
+    for sc in &raw.checks {
+        let c = sc.get_ref();
+        let name = c.name.as_ref().map_or_else(
+            || format!("check {}", out.len() + 1),
+            |n| n.get_ref().clone(),
+        );
+        let Some(cond) = &c.condition else {
+            return Err(ld
+                .err(sc.span(), format!("check `{name}` has no `condition`"))
+                .help("condition = \"abs(T) = mu*N\" (slip), \"N_A = 0\" (tip), ..."));
+        };
+        let (text, off) = ld.expr_text(cond)?;
+        let v = ld
+            .pool
+            .parse_equation_in(&text, &mut ld.scope)
+            .map_err(|e| ld.located(e, off))?;
+        let Value::Scalar(condition) = v else {
+            return Err(ld.err(cond.span(), "a condition must be a scalar equation"));
+        };
+        let Some(sf) = &c.solve_for else {
+            return Err(ld
+                .err(
+                    sc.span(),
+                    format!("check `{name}` needs `solve_for`, the parameter to find"),
+                )
+                .help("e.g. solve_for = \"omega\""));
+        };
+        let Some(pi) = ld.params.iter().position(|p| &p.name == sf.get_ref()) else {
+            let mut e = ld.err(sf.span(), format!("`{}` is not a parameter", sf.get_ref()));
+            if let Some(s) = suggest(sf.get_ref(), ld.params.iter().map(|p| p.name.as_str())) {
+                e = e.help(format!("did you mean `{s}`?"));
+            }
+            return Err(e);
+        };
+        let range = match &c.range {
+            None => None,
+            Some(r) if r.get_ref().len() == 2 => {
+                let a = number(ld, &r.get_ref()[0], "a range bound")?;
+                let b = number(ld, &r.get_ref()[1], "a range bound")?;
+                Some((a.min(b), a.max(b)))
+            }
+            Some(r) => return Err(ld.err(r.span(), "`range` is [low, high]")),
+        };
+        let over = match &c.over {
+            None => None,
+            Some(o) => {
+                let sym = ld.pool.find_symbol(o.get_ref());
+                let Some(sym) = sym else {
+                    return Err(ld.err(o.span(), format!("unknown name `{}`", o.get_ref())));
+                };
+                let (Some(from), Some(to)) = (&c.from, &c.to) else {
+                    return Err(ld.err(o.span(), "`over` needs `from` and `to`"));
+                };
+                let a = number(ld, from, "`from`")?;
+                let b = number(ld, to, "`to`")?;
+                let id = if ld.params.iter().any(|p| &p.name == o.get_ref()) {
+                    ld.pool.sym(sym)
+                } else {
+                    ld.pool.coord(sym, 0)
+                };
+                Some((id, o.get_ref().clone(), a, b))
+            }
+        };
+        out.push(CheckSpec {
+            name,
+            condition,
+            text,
+            solve_for: pi,
+            range,
+            over,
+        });
+    }
+    Ok(out)
+}
+
 fn number(ld: &mut Loader, sv: &Sv, what: &str) -> Result<f64, ModelError> {
     let id = ld.scalar(sv, what)?;
     ld.constant(id, sv.span(), what)
