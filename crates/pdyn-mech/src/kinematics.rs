@@ -66,6 +66,10 @@ pub struct PolarComponents {
     pub velocity: [Id; 3],
     /// Acceleration: `(a_r, a_θ, a_z)`.
     pub acceleration: [Id; 3],
+    /// Unit tangent: `(t·e_r, t·e_θ, t·k)`.
+    pub tangent: [Id; 3],
+    /// Unit normal: `(n·e_r, n·e_θ, n·k)`.
+    pub normal: [Id; 3],
 }
 
 /// Everything [`analyze`] derives, simplified.
@@ -118,6 +122,8 @@ impl Kinematics {
             ("r_polar", V(self.polar.position)),
             ("v_polar", V(self.polar.velocity)),
             ("a_polar", V(self.polar.acceleration)),
+            ("tangent_polar", V(self.polar.tangent)),
+            ("normal_polar", V(self.polar.normal)),
         ]
     }
 }
@@ -163,6 +169,19 @@ fn simp(pool: &mut Pool, e: Id) -> Id {
 
 /// Derives the kinematic quantities of `motion`.
 pub fn analyze(pool: &mut Pool, motion: Motion) -> Result<Kinematics, KinError> {
+    let mut k = analyze_motion(pool, motion)?;
+    // Basis conversion (i, j, k) -> (e_r, e_θ, k) of the unit vectors.
+    let comps = |pool: &mut Pool, w: [Id; 3], e_r: [Id; 3], e_t: [Id; 3]| -> [Id; 3] {
+        let c_r = dot(pool, w, e_r);
+        let c_t = dot(pool, w, e_t);
+        simp3(pool, [c_r, c_t, w[2]])
+    };
+    k.polar.tangent = comps(pool, k.tangent, k.polar.e_r, k.polar.e_theta);
+    k.polar.normal = comps(pool, k.normal, k.polar.e_r, k.polar.e_theta);
+    Ok(k)
+}
+
+fn analyze_motion(pool: &mut Pool, motion: Motion) -> Result<Kinematics, KinError> {
     match motion {
         Motion::Cartesian(r) => {
             let t = pool.time();
@@ -233,6 +252,8 @@ pub fn analyze(pool: &mut Pool, motion: Motion) -> Result<Kinematics, KinError> 
                 position: simp3(pool, [r, Pool::ZERO, z]),
                 velocity: simp3(pool, [r1, v_theta, z1]),
                 acceleration: simp3(pool, [a_r, a_theta, z2]),
+                tangent: [Pool::ZERO; 3],
+                normal: [Pool::ZERO; 3],
             };
             Ok(nt(pool, t, pos, v, a, polar))
         }
@@ -370,6 +391,8 @@ fn project(
         position: comps(pool, r),
         velocity: comps(pool, v),
         acceleration: comps(pool, a),
+        tangent: [Pool::ZERO; 3],
+        normal: [Pool::ZERO; 3],
     }
 }
 
@@ -465,6 +488,25 @@ fn nt(
         a_n,
         polar,
     }
+}
+
+/// Tidies a magnitude: square roots in a product lose their positive square factors
+/// (`2 sqrt(π² R² T⁴ + 4π⁴ R² T⁴)/T⁴` becomes `2π R sqrt(1 + 4π²)/T²`), then simplifies.
+pub fn tidy_magnitude(pool: &mut Pool, e: Id) -> Id {
+    let half = pool.num(pdyn_expr::Number::ratio(1, 2));
+    let factors: Vec<Id> = match pool.node(e) {
+        Node::Mul(fs) => fs.to_vec(),
+        _ => vec![e],
+    };
+    let parts: Vec<Id> = factors
+        .into_iter()
+        .map(|f| match pool.node(f).clone() {
+            Node::Pow(b, x) if x == half => crate::dsolve::nice_sqrt(pool, b),
+            _ => f,
+        })
+        .collect();
+    let m = pool.mul(&parts);
+    pool.simplify(m)
 }
 
 /// The first `t ≥ 0` with `expr(t) = target` (`expr` a function of `t` only, `target` a

@@ -111,8 +111,8 @@ fn no_elementary_antiderivative_uses_quadrature_with_error_estimate() {
 }
 
 #[test]
-fn spring_position_law_time_by_nested_quadrature() {
-    // a = -4x, x0 = 0, v0 = 2: x = sin(2t), so t(1/2) = asin(1/2)/2 = pi/12.
+fn spring_position_law_time_in_closed_form() {
+    // a = -4x, x0 = 0, v0 = 2: x = sin(2t), so t(x) = asin(x)/2 and t(1/2) = pi/12.
     let mut pool = Pool::new();
     let a = law(&mut pool, "-4*x", &[]);
     let v0 = pool.int(2);
@@ -120,13 +120,28 @@ fn spring_position_law_time_by_nested_quadrature() {
     let vsq = sol.quantities[0].closed.unwrap();
     let expect = pool.parse_scalar("4 - 4*x^2").unwrap();
     assert!(pool.provably_equal(vsq, expect), "{}", pool.to_text(vsq));
+    let t_x = sol.quantities[1].closed.expect("asin form");
+    assert_eq!(pool.to_text(t_x), "asin(x)/2");
     let est = evaluate(&mut pool, &sol.quantities[1], 0.5).unwrap();
-    assert!(
-        (est.value - std::f64::consts::PI / 12.0).abs() < 1e-8,
-        "{est:?}"
-    );
-    // Beyond the amplitude the particle never arrives.
-    assert!(evaluate(&mut pool, &sol.quantities[1], 1.5).is_err());
+    assert!((est.value - std::f64::consts::PI / 12.0).abs() < 1e-14);
+}
+
+#[test]
+fn quartic_position_law_time_by_nested_quadrature() {
+    // a = -4x^3, v0 = 2: v^2 = 4 - 2x^4, t(x) = ∫ dx/sqrt(4 - 2x^4) is elliptic (no
+    // elementary form); reference values from mpmath.quad.
+    let mut pool = Pool::new();
+    let a = law(&mut pool, "-4*x^3", &[]);
+    let v0 = pool.int(2);
+    let sol = solve_rule(&mut pool, Given::AccelerationOfPosition, a, Pool::ZERO, v0).unwrap();
+    assert!(sol.quantities[1].closed.is_none());
+    for (x, reference) in [(0.5, 0.250_791_609_849_273), (1.0, 0.532_515_451_849_903)] {
+        let est = evaluate(&mut pool, &sol.quantities[1], x).unwrap();
+        assert!((est.value - reference).abs() < 1e-9, "{est:?}");
+        assert!(est.error < 1e-6, "{est:?}");
+    }
+    // Beyond the turning point 2^(1/4) the particle never arrives.
+    assert!(evaluate(&mut pool, &sol.quantities[1], 1.3).is_err());
 }
 
 #[test]

@@ -656,6 +656,7 @@ fn maximum(
     let at = tidy(pool, at);
     let value = pool.subs1(f, var, at);
     let value = tidy(pool, value);
+    let value = pdyn_mech::kinematics::tidy_magnitude(pool, value);
     let check_vals = trial_values(free.len(), 0x5555_aaaa_3333_cccc);
     let t3 = run_trial(pool, &check_vals)?;
     let map: Vec<(Id, Id)> = free

@@ -408,6 +408,12 @@ fn integrate_rec(pool: &mut Pool, e: Id, var: Id, steps: &mut usize, depth: usiz
                     return Some(f);
                 }
             }
+            let minus_half = pool.num(Number::ratio(-1, 2));
+            if x == minus_half {
+                if let Some(f) = inverse_sqrt_quadratic(pool, b, var) {
+                    return Some(f);
+                }
+            }
             // Power reduction: sin(u)^2 = (1 - cos 2u)/2, cos(u)^2 = (1 + cos 2u)/2.
             if x == pool.int(2) {
                 if let Node::Call(f @ (Func::Sin | Func::Cos), args) = pool.node(b).clone() {
@@ -460,6 +466,44 @@ fn elementary(pool: &mut Pool, f: Func, u: Id) -> Option<Id> {
         Func::Cosh => pool.call(Func::Sinh, &[u]),
         _ => return None,
     })
+}
+
+/// `∫ dx/sqrt(p + q x^2)` for `p > 0`: `asin(x sqrt(-q/p))/sqrt(-q)` when `q < 0`,
+/// `log(sqrt(q) x + sqrt(p + q x^2))/sqrt(q)` when `q > 0`.
+fn inverse_sqrt_quadratic(pool: &mut Pool, b: Id, var: Id) -> Option<Id> {
+    let d1 = pool.diff(b, var);
+    let d2 = pool.diff(d1, var);
+    if !free_of(pool, d2, var) || pool.subs1(d1, var, Pool::ZERO) != Pool::ZERO {
+        return None;
+    }
+    let half = pool.num(Number::ratio(1, 2));
+    let q = pool.mul2(half, d2);
+    let q = pool.simplify(q);
+    let p = pool.subs1(b, var, Pool::ZERO);
+    let p = pool.simplify(p);
+    if sign_of(pool, p)? != Relation::Positive {
+        return None;
+    }
+    match sign_of(pool, q)? {
+        Relation::Negative => {
+            let nq = pool.neg(q);
+            let r = pool.div(nq, p);
+            let k = pool.sqrt(r);
+            let arg = pool.mul2(var, k);
+            let a = pool.call(Func::Asin, &[arg]);
+            let s = pool.sqrt(nq);
+            Some(pool.div(a, s))
+        }
+        Relation::Positive => {
+            let sq = pool.sqrt(q);
+            let lin = pool.mul2(sq, var);
+            let root = pool.sqrt(b);
+            let sum = pool.add2(lin, root);
+            let l = pool.call(Func::Log, &[sum]);
+            Some(pool.div(l, sq))
+        }
+        Relation::Zero => None,
+    }
 }
 
 /// `∫ dx/(p + q x^2)` when the signs of `p`, `q` are known.
