@@ -34,12 +34,20 @@ pub(crate) const MARK: RGBColor = RGBColor(80, 80, 80);
 const SUPERSAMPLE: u32 = 3;
 /// Largest image accepted, in pixels per side.
 const MAX_SIDE: u32 = 20_000;
+/// Largest image accepted, in pixels (the PNG drawing buffer is at most
+/// 3 bytes per pixel times the supersampling factor squared).
+const MAX_PIXELS: u64 = 40_000_000;
 
 pub(crate) fn check_size((w, h): (u32, u32)) -> Result<(), PlotError> {
-    if w < 200 || h < 150 || w > MAX_SIDE || h > MAX_SIDE {
+    if w < 200
+        || h < 150
+        || w > MAX_SIDE
+        || h > MAX_SIDE
+        || u64::from(w) * u64::from(h) > MAX_PIXELS
+    {
         return Err(PlotError::InvalidArgument {
             message: format!(
-                "image size {w}×{h} pixels: each panel needs at least 200×150, and the image at most {MAX_SIDE} per side"
+                "image size {w}×{h} pixels: each panel needs at least 200×150, and the image at most {MAX_SIDE} pixels per side and {MAX_PIXELS} pixels in all"
             ),
         });
     }

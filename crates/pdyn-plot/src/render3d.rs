@@ -295,8 +295,23 @@ fn draw3<DB: DrawingBackend>(
         ),
     ];
     let axis_style = INK.stroke_width(th.dpr.round() as u32);
+    // The x and y axes meet at the front corner: labels of both there would
+    // collide, so neither is written close to it.
+    let corner = to_px((x_front, y_front, z0));
     for (a, b, t, k, title) in axes {
-        draw_axis(root, &to_px, a, b, t, k, title, centre, th, axis_style)?;
+        let avoid = if k < 2 { Some(corner) } else { None };
+        draw_axis(
+            root,
+            &to_px,
+            (a, b),
+            t,
+            k,
+            title,
+            centre,
+            avoid,
+            th,
+            axis_style,
+        )?;
     }
 
     // Curves: shadow on the floor, the curve, start (ring) and end (dot).
@@ -384,18 +399,19 @@ fn draw3<DB: DrawingBackend>(
 }
 
 /// Draws one axis of the 3-D box along the edge `a`–`b` (data space):
-/// the edge, tick marks and labels pointing away from the box centre, and
-/// the axis title beyond them (the vertical axis' title rotated).
+/// the edge, tick marks and labels pointing away from the box centre
+/// (none near `avoid`), and the axis title beyond them (the vertical axis'
+/// title rotated).
 #[allow(clippy::too_many_arguments)]
 fn draw_axis<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     to_px: &dyn Fn(P3) -> (f64, f64),
-    a: P3,
-    b: P3,
+    (a, b): (P3, P3),
     t: &Ticks,
     k: usize,
     title: &str,
     centre: (f64, f64),
+    avoid: Option<(f64, f64)>,
     th: &Theme,
     style: ShapeStyle,
 ) -> Result<(), PlotError> {
@@ -441,6 +457,11 @@ fn draw_axis<DB: DrawingBackend>(
         let q1 = (q.0 + out.0 * tick, q.1 + out.1 * tick);
         root.draw(&PathElement::new(vec![rel(q), rel(q1)], style))
             .map_err(err)?;
+        if let Some(c) = avoid {
+            if ((q.0 - c.0).powi(2) + (q.1 - c.1).powi(2)).sqrt() < 2.5 * th.tick {
+                continue;
+            }
+        }
         let q2 = (q.0 + out.0 * 2.0 * tick, q.1 + out.1 * 2.0 * tick);
         root.draw_text(label, &font, rel(q2)).map_err(err)?;
         let (tw, tht) = text_size(label, th.tick);

@@ -324,6 +324,52 @@ fn degenerate_data_renders() {
 }
 
 #[test]
+fn degenerate_3d_data_renders() {
+    let flat = Series3::new(
+        "planar",
+        vec![0.0, 1.0, 0.0],
+        vec![0.0, 0.0, 1.0],
+        vec![0.0; 3],
+    );
+    let point = Series3::new("point", vec![2.0], vec![2.0], vec![2.0]);
+    let gappy = Series3::new(
+        "gappy",
+        vec![0.0, f64::NAN, 1.0, 2.0],
+        vec![1e12, 1e12, f64::INFINITY, 2e12],
+        vec![-1e-9, 0.0, 1e-9, 2e-9],
+    );
+    for s in [flat, point, gappy] {
+        let fig = Figure3 {
+            title: s.label.clone(),
+            series: vec![s],
+            ..Default::default()
+        };
+        to_svg3(&fig).unwrap();
+        png_size(&to_png3(&fig).unwrap());
+    }
+}
+
+#[test]
+fn renders_from_many_threads() {
+    std::thread::scope(|sc| {
+        let handles: Vec<_> = (0..4)
+            .map(|i| {
+                sc.spawn(move || {
+                    let mut fig = history();
+                    fig.title = format!("thread {i}");
+                    (to_svg(&fig).unwrap(), to_png(&fig).unwrap())
+                })
+            })
+            .collect();
+        for (i, h) in handles.into_iter().enumerate() {
+            let (svg, png) = h.join().unwrap();
+            assert!(svg.contains(&format!("thread {i}")));
+            png_size(&png);
+        }
+    });
+}
+
+#[test]
 fn long_series_give_small_svg() {
     let n = 200_000;
     let t = linspace(0.0, 100.0, n);
@@ -430,10 +476,12 @@ fn errors_not_panics() {
         save_grid(&[good.clone(), fig(vec![])], 2, &png),
         Err(PlotError::NoSeries { .. })
     ));
-    assert!(matches!(
-        save_with_size(&good, &png, (10, 10)),
-        Err(PlotError::InvalidArgument { .. })
-    ));
+    for size in [(10, 10), (0, 500), (20_000, 20_000), (100_000, 300)] {
+        assert!(matches!(
+            save_with_size(&good, &png, size),
+            Err(PlotError::InvalidArgument { .. })
+        ));
+    }
 
     // 3-D.
     let mut t3 = trajectory();
