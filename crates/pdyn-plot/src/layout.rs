@@ -238,7 +238,9 @@ fn max_width(labels: &[String], px: f64) -> u32 {
 
 /// The layout of `fig` drawn at `size` pixels (as [`crate::save`] does at
 /// [`crate::DEFAULT_SIZE`]): ranges, ticks and the size of the plotting
-/// area. With `equal_aspect`, the ranges satisfy
+/// area. The ranges are [`data_ranges`], raised at the top when labels of
+/// markers need room there, then (with `equal_aspect`) widened by
+/// [`equal_aspect_ranges`] so that
 /// `x_range span / plot width == y_range span / plot height`.
 pub fn layout(fig: &Figure, size: (u32, u32)) -> Result<Layout, PlotError> {
     crate::font::ensure()?;
@@ -323,6 +325,20 @@ pub(crate) fn layout_with(
         } else {
             yr0.clone()
         };
+        // Room above labelled points for their labels.
+        let off = (th.point as f64 * 2.2).round() + gap as f64 / 2.0;
+        let need = (off + text_size("Ag", th.note).1 as f64 + gap as f64 / 2.0) / plot_h as f64;
+        let mut y_top = yr1.end;
+        if need < 0.5 {
+            for m in &fig.markers {
+                if let Marker::Point { x, y, label } = m {
+                    if x.is_finite() && y.is_finite() && !label.trim().is_empty() {
+                        y_top = y_top.max((y - need * yr1.start) / (1.0 - need));
+                    }
+                }
+            }
+        }
+        let yr1 = yr1.start..y_top;
         let (xr, yr) = if fig.equal_aspect {
             equal_aspect_ranges(xr0.clone(), yr1, (plot_w, plot_h))
         } else {
