@@ -96,13 +96,28 @@ pub(crate) fn image_size(
 pub(crate) fn svg(figs: &[Figure], cols: usize, panel: (u32, u32)) -> Result<String, PlotError> {
     crate::font::ensure()?;
     let (w, h, cols) = image_size(figs, cols, panel)?;
+    let dev = (w * SVG_SCALE, h * SVG_SCALE);
     let mut s = String::new();
     {
-        let root = SVGBackend::with_string(&mut s, (w, h)).into_drawing_area();
-        draw_grid(&root, figs, cols, &Theme::new(panel, 1.0))?;
+        let root = SVGBackend::with_string(&mut s, dev).into_drawing_area();
+        draw_grid(&root, figs, cols, &Theme::new(panel, SVG_SCALE as f64))?;
         root.present().map_err(PlotError::render)?;
     }
-    Ok(s)
+    Ok(svg_display_size(s, dev, (w, h)))
+}
+
+/// SVGs are drawn at this many units per pixel: plotters writes integer
+/// coordinates, and a finer grid keeps curves smooth.
+pub(crate) const SVG_SCALE: u32 = 4;
+
+/// Sets the displayed size of an SVG drawn at `dev` units to `size`
+/// pixels (the viewBox keeps the drawing units).
+pub(crate) fn svg_display_size(s: String, dev: (u32, u32), size: (u32, u32)) -> String {
+    let from = format!("<svg width=\"{}\" height=\"{}\" ", dev.0, dev.1);
+    match s.strip_prefix(&from) {
+        Some(rest) => format!("<svg width=\"{}\" height=\"{}\" {rest}", size.0, size.1),
+        None => s,
+    }
 }
 
 /// PNG of `figs` as a grid of `panel`-sized panels, supersampled.
@@ -372,12 +387,26 @@ fn draw_figure<DB: DrawingBackend>(
 
     // Frame around the plotting area.
     let (iw, ih) = (lay.plot_size.0 as i32, lay.plot_size.1 as i32);
-    pa.draw(&Rectangle::new(
-        [(0, 0), (iw - 1, ih - 1)],
+    outline(
+        &pa,
+        (0, 0, iw - 1, ih - 1),
         INK.stroke_width(dpr.round() as u32),
-    ))
-    .map_err(err)?;
+    )?;
     Ok(())
+}
+
+/// A rectangle's outline as a closed path (the SVG backend ignores the
+/// stroke width of rectangles).
+fn outline<DB: DrawingBackend>(
+    pa: &DrawingArea<DB, Shift>,
+    (x0, y0, x1, y1): (i32, i32, i32, i32),
+    style: ShapeStyle,
+) -> Result<(), PlotError> {
+    pa.draw(&PathElement::new(
+        vec![(x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)],
+        style,
+    ))
+    .map_err(err)
 }
 
 /// Draws text with a translucent white box behind it; returns the box.
@@ -566,11 +595,11 @@ pub(crate) fn draw_legend<DB: DrawingBackend>(
         WHITE.mix(0.88).filled(),
     ))
     .map_err(err)?;
-    pa.draw(&Rectangle::new(
-        [(x0, y0), (r.2 as i32, r.3 as i32)],
+    outline(
+        pa,
+        (x0, y0, r.2 as i32, r.3 as i32),
         RGBColor(170, 170, 170).stroke_width(th.dpr.round() as u32),
-    ))
-    .map_err(err)?;
+    )?;
     let font = desc(th.legend)
         .color(&INK)
         .pos(Pos::new(HPos::Left, VPos::Center));

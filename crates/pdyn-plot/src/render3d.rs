@@ -12,7 +12,10 @@ use plotters::style::FontTransform;
 use crate::font::{desc, text_size};
 use crate::layout::{fit_font, padded, Theme};
 use crate::output;
-use crate::render2d::{check_size, draw_legend, err, samples_along, GRID, INK, MARK, PALETTE};
+use crate::render2d::{
+    check_size, draw_legend, err, samples_along, svg_display_size, GRID, INK, MARK, PALETTE,
+    SVG_SCALE,
+};
 use crate::ticks::{ticks, Ticks};
 use crate::{clean3, Figure3, PlotError, Style};
 
@@ -29,13 +32,14 @@ pub(crate) fn svg(fig: &Figure3, size: (u32, u32)) -> Result<String, PlotError> 
     crate::font::ensure()?;
     check_size(size)?;
     clean3(fig)?;
+    let dev = (size.0 * SVG_SCALE, size.1 * SVG_SCALE);
     let mut s = String::new();
     {
-        let root = SVGBackend::with_string(&mut s, size).into_drawing_area();
-        draw3(&root, fig, &Theme::new(size, 1.0))?;
+        let root = SVGBackend::with_string(&mut s, dev).into_drawing_area();
+        draw3(&root, fig, &Theme::new(size, SVG_SCALE as f64))?;
         root.present().map_err(err)?;
     }
-    Ok(s)
+    Ok(svg_display_size(s, dev, size))
 }
 
 pub(crate) fn png(fig: &Figure3, size: (u32, u32)) -> Result<Vec<u8>, PlotError> {
