@@ -269,6 +269,27 @@ pub(crate) fn err<E: std::fmt::Display>(e: E) -> PlotError {
     PlotError::render(e)
 }
 
+/// The chart of a layout on the area below the title (its plotting area
+/// is `lay.plot_size`).
+fn build_chart<'a, DB: DrawingBackend>(
+    rest: &'a DrawingArea<DB, Shift>,
+    lay: &Layout,
+) -> Result<ChartContext<'a, DB, Cartesian2d<Axis, Axis>>, PlotError> {
+    let [mt, mb, ml, mr] = lay.margin;
+    ChartBuilder::on(rest)
+        .margin_top(mt)
+        .margin_bottom(mb)
+        .margin_left(ml)
+        .margin_right(mr)
+        .x_label_area_size(lay.x_area)
+        .y_label_area_size(lay.y_area)
+        .build_cartesian_2d(
+            Axis::new(&lay.x_range, &lay.x_ticks),
+            Axis::new(&lay.y_range, &lay.y_ticks),
+        )
+        .map_err(err)
+}
+
 /// Draws one figure into `area`.
 fn draw_figure<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
@@ -305,20 +326,7 @@ fn draw_figure<DB: DrawingBackend>(
             .map_err(err)?;
     }
 
-    let [mt, mb, ml, mr] = lay.margin;
-    let mut chart = ChartBuilder::on(&rest)
-        .margin_top(mt)
-        .margin_bottom(mb)
-        .margin_left(ml)
-        .margin_right(mr)
-        .x_label_area_size(lay.x_area)
-        .y_label_area_size(lay.y_area)
-        .build_cartesian_2d(
-            Axis::new(&lay.x_range, &lay.x_ticks),
-            Axis::new(&lay.y_range, &lay.y_ticks),
-        )
-        .map_err(err)?;
-    debug_assert_eq!(chart.plotting_area().dim_in_pixel(), lay.plot_size);
+    let mut chart = build_chart(&rest, &lay)?;
 
     let xfmt = |v: &f64| tick_label(&lay.x_ticks, *v);
     let yfmt = |v: &f64| tick_label(&lay.y_ticks, *v);
@@ -642,6 +650,49 @@ mod tests {
         let s = [(90.0, 10.0), (10.0, 10.0), (95.0, 90.0)];
         assert_eq!(least_covered(&c, &s, &[]), 3);
         assert_eq!(least_covered(&c, &[], &[(85.0, 5.0, 90.0, 10.0)]), 1);
+    }
+
+    /// The plotting area plotters makes is the one the layout computed
+    /// (the ranges, equal aspect included, are chosen for that size).
+    #[test]
+    fn layout_predicts_the_plotting_area() {
+        crate::font::ensure().unwrap();
+        let fig = |title: &str, xl: &str, yl: &str, scale: f64| Figure {
+            title: title.into(),
+            x_label: xl.into(),
+            y_label: yl.into(),
+            series: vec![crate::Series::new(
+                "s",
+                vec![0.0, scale],
+                vec![-scale, 1e-3],
+            )],
+            markers: vec![Marker::vline(0.5 * scale, "event")],
+            equal_aspect: true,
+            ..Default::default()
+        };
+        let figs = [
+            fig("Title", "t [s]", "x [m]", 1.0),
+            fig("", "", "", 1e-7),
+            fig("A long title that will need shrinking to fit", "x", "", 3e6),
+        ];
+        for size in [(1000, 700), (200, 150), (640, 440), (2000, 300)] {
+            for dpr in [1.0, 3.0] {
+                for f in &figs {
+                    let dev = ((size.0 as f64 * dpr) as u32, (size.1 as f64 * dpr) as u32);
+                    let th = Theme::new(size, dpr);
+                    let lay = layout_with(f, dev, &th, &Floors::default()).unwrap();
+                    let mut s = String::new();
+                    let root = SVGBackend::with_string(&mut s, dev).into_drawing_area();
+                    let (_, rest) = root.split_vertically(lay.title_h);
+                    let chart = build_chart(&rest, &lay).unwrap();
+                    assert_eq!(
+                        chart.plotting_area().dim_in_pixel(),
+                        lay.plot_size,
+                        "{size:?} {dpr}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]
