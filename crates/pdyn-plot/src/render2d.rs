@@ -110,9 +110,11 @@ pub(crate) fn svg(figs: &[Figure], cols: usize, panel: (u32, u32)) -> Result<Str
 /// coordinates, and a finer grid keeps curves smooth.
 pub(crate) const SVG_SCALE: u32 = 4;
 
-/// Sets the displayed size of an SVG drawn at `dev` units to `size`
-/// pixels (the viewBox keeps the drawing units).
-pub(crate) fn svg_display_size(s: String, dev: (u32, u32), size: (u32, u32)) -> String {
+/// Finishes an SVG drawn at `dev` units: displayed at `size` pixels (the
+/// viewBox keeps the drawing units), and without the control characters
+/// XML forbids (they could come from user labels).
+pub(crate) fn svg_display_size(mut s: String, dev: (u32, u32), size: (u32, u32)) -> String {
+    s.retain(|c| !c.is_control() || matches!(c, '\n' | '\t' | '\r'));
     let from = format!("<svg width=\"{}\" height=\"{}\" ", dev.0, dev.1);
     match s.strip_prefix(&from) {
         Some(rest) => format!("<svg width=\"{}\" height=\"{}\" {rest}", size.0, size.1),

@@ -399,6 +399,16 @@ fn long_texts_still_render() {
 }
 
 #[test]
+fn glyphs_missing_from_the_font_do_not_fail() {
+    let mut fig = history();
+    fig.title = "軌道 🚀 ∮ E·dA".into();
+    fig.series[0].label = "\u{0}\t\u{200b}".into();
+    png_size(&to_png(&fig).unwrap());
+    let svg = to_svg(&fig).unwrap();
+    assert!(svg.contains("軌道") && !svg.contains('\u{0}'));
+}
+
+#[test]
 fn text_is_escaped_in_svg() {
     let mut fig = history();
     fig.title = "a < b & c".into();
