@@ -23,7 +23,7 @@ pub(crate) struct Theme {
     pub point: u32,
     pub tick_len: i32,
     pub gap: u32,
-    /// Device pixels per logical pixel (2 for supersampled PNG).
+    /// Device pixels per logical pixel (3 for PNG, 4 for SVG).
     pub dpr: f64,
 }
 

@@ -12,8 +12,14 @@
 //!
 //! The output format is chosen from the file extension (`.svg` or `.png`,
 //! case-insensitive). Text is rendered with an embedded copy of DejaVu Sans,
-//! so nothing depends on system fonts or libraries; PNGs are rendered at
-//! twice their size and downsampled (anti-aliased lines).
+//! so nothing depends on system fonts or libraries. PNGs are drawn at three
+//! times their size and downsampled (anti-aliased lines); SVGs are drawn
+//! on a 4× finer grid and displayed at their size. Long series are thinned
+//! to sub-pixel resolution, so files stay small.
+//!
+//! A legend appears when a figure has more than one series, in the corner
+//! that hides the least data. Colours follow the Okabe–Ito palette (8
+//! colours, then repeated). Rendering is thread-safe.
 //!
 //! Non-finite points (NaN, ±∞) are skipped; a line is broken where they
 //! were. Invalid input gives a [`PlotError`], never a panic.
