@@ -3,6 +3,6 @@
 # 4.694 s, 37.1 m away (g = 9.81).
 pdyn dsolve "x'' = 0" "y'' = -g" --ic "x(0)=0, x'(0)=V*cos(alpha), y(0)=h, y'(0)=V*sin(alpha)"
 pdyn dsolve "x'' = 0" "y'' = -g" --ic "x(0)=0, x'(0)=V*cos(alpha), y(0)=h, y'(0)=V*sin(alpha)" \
-  --set "g=9.81,V=25*0.44704,alpha=pi/4,h=71" --at 4.694
+  --set "g=9.81,V=25*0.44704,alpha=pi/4,h=71" --when "y = 0"
 # Nanoparticle launched upward with kinetic energy kT: highest point kT/(m g) where y' = 0.
-pdyn dsolve "y'' = -g" --ic "y(0)=0, y'(0)=sqrt(2*k*T/m)"
+pdyn dsolve "y'' = -g" --ic "y(0)=0, y'(0)=sqrt(2*k*T/m)" --when "y' = 0"

@@ -99,6 +99,9 @@ pub struct Kinematics {
     pub a_n: Id,
     /// Polar components.
     pub polar: PolarComponents,
+    /// True on a straight line (`v × a ≡ 0`, curvature 0): the normal is undefined (given as
+    /// the zero vector) and the radius of curvature infinite.
+    pub straight: bool,
 }
 
 impl Kinematics {
@@ -215,7 +218,7 @@ fn analyze_motion(pool: &mut Pool, motion: Motion) -> Result<Kinematics, KinErro
                 simp3(pool, [ex, ey, Pool::ZERO])
             };
             let polar = project(pool, r, v, a, e_r, e_theta);
-            Ok(nt(pool, t, r, v, a, polar))
+            nt(pool, t, r, v, a, polar)
         }
         Motion::Polar { r, theta, z } => {
             let t = pool.time();
@@ -255,7 +258,7 @@ fn analyze_motion(pool: &mut Pool, motion: Motion) -> Result<Kinematics, KinErro
                 tangent: [Pool::ZERO; 3],
                 normal: [Pool::ZERO; 3],
             };
-            Ok(nt(pool, t, pos, v, a, polar))
+            nt(pool, t, pos, v, a, polar)
         }
         Motion::Path {
             x,
@@ -306,7 +309,10 @@ fn analyze_motion(pool: &mut Pool, motion: Motion) -> Result<Kinematics, KinErro
                 let k = pool.call(Func::Abs, &[kappa_s]);
                 simp(pool, k)
             };
-            let radius = {
+            let straight = curvature == Pool::ZERO;
+            let radius = if straight {
+                pool.num(pdyn_expr::Number::Float(f64::INFINITY))
+            } else {
                 let r = pool.powi(curvature, -1);
                 simp(pool, r)
             };
@@ -367,6 +373,7 @@ fn analyze_motion(pool: &mut Pool, motion: Motion) -> Result<Kinematics, KinErro
                 a_t,
                 a_n,
                 polar,
+                straight,
             })
         }
     }
@@ -420,11 +427,16 @@ fn nt(
     v: [Id; 3],
     a: [Id; 3],
     polar: PolarComponents,
-) -> Kinematics {
+) -> Result<Kinematics, KinError> {
     let v2 = {
         let d = dot(pool, v, v);
         simp(pool, d)
     };
+    if v2 == Pool::ZERO {
+        return Err(KinError(
+            "the particle does not move (v = 0): there is no tangent, normal or curvature".into(),
+        ));
+    }
     let speed = crate::dsolve::nice_sqrt(pool, v2);
     let va = {
         let d = dot(pool, v, a);
@@ -464,6 +476,24 @@ fn nt(
         let e = pool.div(s3, vxa_norm);
         simp(pool, e)
     };
+    if vxa_norm == Pool::ZERO {
+        let inf = pool.num(pdyn_expr::Number::Float(f64::INFINITY));
+        return Ok(Kinematics {
+            variable: t,
+            position: r,
+            velocity: v,
+            acceleration: a,
+            speed,
+            tangent,
+            normal: [Pool::ZERO; 3],
+            curvature: Pool::ZERO,
+            radius: inf,
+            a_t,
+            a_n: Pool::ZERO,
+            polar,
+            straight: true,
+        });
+    }
     let normal = {
         let den = pool.mul2(speed, vxa_norm);
         let n: [Id; 3] = [0, 1, 2].map(|i| {
@@ -474,7 +504,7 @@ fn nt(
         });
         simp3(pool, n)
     };
-    Kinematics {
+    Ok(Kinematics {
         variable: t,
         position: r,
         velocity: v,
@@ -487,7 +517,8 @@ fn nt(
         a_t,
         a_n,
         polar,
-    }
+        straight: false,
+    })
 }
 
 /// Tidies a magnitude: square roots in a product lose their positive square factors
@@ -511,7 +542,8 @@ pub fn tidy_magnitude(pool: &mut Pool, e: Id) -> Id {
 
 /// The first `t ≥ 0` with `expr(t) = target` (`expr` a function of `t` only, `target` a
 /// number): exact when `expr` is linear in `t` or a monomial `c t^n`, else numeric (scan and
-/// bisection). Returns the exact instant when found, and its value.
+/// bisection). Returns the exact instant when found, and its value (NaN when the exact instant
+/// still involves parameters without values).
 pub fn solve_time(pool: &mut Pool, expr: Id, target: Id) -> Result<(Option<Id>, f64), KinError> {
     let t = pool.time();
     if !pool.contains(expr, t) {
@@ -524,10 +556,11 @@ pub fn solve_time(pool: &mut Pool, expr: Id, target: Id) -> Result<(Option<Id>, 
     let eq = pool.expand(eq);
     let exact = exact_root(pool, eq, expr, target, t);
     if let Some(e) = exact {
-        if let Some(v) = value(pool, e) {
-            if v >= 0.0 {
-                return Ok((Some(e), v));
-            }
+        match value(pool, e) {
+            Some(v) if v >= 0.0 => return Ok((Some(e), v)),
+            Some(_) => {}
+            // Symbolic instant (parameters without values): exact only, value NaN.
+            None => return Ok((Some(e), f64::NAN)),
         }
     }
     let prog = Program::compile(pool, &[t], &[eq]).map_err(|e| {

@@ -44,6 +44,11 @@ pub struct DsolveArgs {
     /// of a rule), e.g. `--at 0,0.5,1`.
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     at: Vec<String>,
+    /// Find the first instant t ≥ 0 where a condition holds, e.g. `--when "y = 0"` (landing)
+    /// or `--when "y' = 0"` (highest point), and print the state there (exactly when the
+    /// instant solves exactly).
+    #[arg(long, allow_hyphen_values = true)]
+    when: Option<String>,
     /// Parameters that may be negative or zero. Every other parameter of the equations is
     /// assumed positive (masses, stiffnesses, lengths), which decides signs of discriminants.
     #[arg(long, value_delimiter = ',')]
@@ -343,11 +348,16 @@ pub fn run(a: DsolveArgs) -> Result<String, String> {
         .collect();
     let times = eval_times(&mut pool, &a.at)?;
     let table = evaluate(&mut pool, &cf, &times)?;
+    let when = match &a.when {
+        Some(w) => Some(when(&mut pool, &cf, w, &mut scope, &set, a.format)?),
+        None => None,
+    };
     if a.json {
-        return Ok(format!(
-            "{}\n",
-            to_json(&pool, &cf, &assumed, &times, &table)
-        ));
+        let mut j = to_json(&pool, &cf, &assumed, &times, &table);
+        if let Some((_, wj)) = &when {
+            j["when"] = wj.clone();
+        }
+        return Ok(format!("{j}\n"));
     }
     let mut out = String::new();
     for (ci, case) in cf.cases.iter().enumerate() {
@@ -382,6 +392,9 @@ pub fn run(a: DsolveArgs) -> Result<String, String> {
             }
         }
     }
+    if let Some((text, _)) = &when {
+        out += text;
+    }
     if cf.method == Method::Numeric {
         out += &format!(
             "(numeric roots and coefficients; relative residual {:.1e})\n",
@@ -395,6 +408,72 @@ pub fn run(a: DsolveArgs) -> Result<String, String> {
         );
     }
     Ok(out)
+}
+
+/// `--when "lhs = rhs"`: the first t ≥ 0 where it holds (for the first case), and the state.
+fn when(
+    pool: &mut Pool,
+    cf: &ClosedForm,
+    src: &str,
+    scope: &mut FreeScope,
+    set: &[(Id, Id)],
+    format: Format,
+) -> Result<(String, serde_json::Value), String> {
+    let eq = match pool
+        .parse_equation_in(src, scope)
+        .map_err(|e| e.render(src, "--when"))?
+    {
+        Value::Scalar(s) => s,
+        Value::Vector(_) => return Err("--when: the condition must be a scalar equation".into()),
+    };
+    let eq = apply_set(pool, eq, set);
+    if cf.cases.len() > 1 {
+        return Err(
+            "--when: the solution has several cases; give the parameters with --set".into(),
+        );
+    }
+    let sol = &cf.cases[0].solution;
+    let mut e = eq;
+    for (j, &c) in cf.coords.iter().enumerate() {
+        for k in (0..=8u8).rev() {
+            let leaf = pool.coord(c, k);
+            if pool.contains(e, leaf) {
+                let d = pool.dt_n(sol[j], k as usize);
+                e = pool.subs1(e, leaf, d);
+            }
+        }
+    }
+    let (exact, tv) = pdyn_mech::kinematics::solve_time(pool, e, Pool::ZERO)
+        .map_err(|err| format!("--when {src}: {err}"))?;
+    let t = pool.time();
+    let tt = match exact {
+        Some(x) => x,
+        None => pool.num(pdyn_expr::Number::Float(tv)),
+    };
+    let mut text = format!("when {src}: t = {}", show(pool, tt, format));
+    if exact.is_some() && tv.is_finite() && pool.as_num(tt).is_none() {
+        text += &format!(" ≈ {tv}");
+    }
+    text += "\n";
+    let mut state = serde_json::Map::new();
+    for (j, &c) in cf.coords.iter().enumerate() {
+        for k in 0..2 {
+            let d = pool.dt_n(sol[j], k);
+            let at = pool.subs1(d, t, tt);
+            let at = pool.expand(at);
+            let at = pool.simplify(at);
+            let name = format!("{}{}", pool.name(c), "'".repeat(k));
+            let num = eval_const(pool, at, &name).ok();
+            let approx = match num {
+                Some(v) if pool.as_num(at).is_none() => format!("  ≈ {v}"),
+                _ => String::new(),
+            };
+            text += &format!("  {name} = {}{approx}\n", show(pool, at, format));
+            state.insert(name, json!({"exact": both(pool, at), "value": num}));
+        }
+    }
+    let tj = json!({"t": tv.is_finite().then_some(tv), "t_exact": exact.map(|x| both(pool, x)), "state": state});
+    Ok((text, tj))
 }
 
 fn eval_times(pool: &mut Pool, at: &[String]) -> Result<Vec<f64>, String> {
@@ -560,8 +639,7 @@ fn run_rule(a: &DsolveArgs, rule: &str) -> Result<String, String> {
     for q in &sol.quantities {
         let mut vals = Vec::new();
         for &s in &points {
-            let v = rules::evaluate(&mut pool, q, s).map_err(|e| e.to_string())?;
-            vals.push(v);
+            vals.push(rules::evaluate(&mut pool, q, s).map_err(|e| e.to_string()));
         }
         evaluated.push(vals);
     }
@@ -574,7 +652,10 @@ fn run_rule(a: &DsolveArgs, rule: &str) -> Result<String, String> {
                 json!({
                     "name": q.name,
                     "closed_form": q.closed.map(|c| both(&pool, c)),
-                    "at": points.iter().zip(vals).map(|(s, v)| json!({"at": s, "value": v.value, "error": v.error})).collect::<Vec<_>>(),
+                    "at": points.iter().zip(vals).map(|(s, v)| match v {
+                        Ok(v) => json!({"at": s, "value": v.value, "error": v.error}),
+                        Err(e) => json!({"at": s, "value": null, "message": e}),
+                    }).collect::<Vec<_>>(),
                 })
             })
             .collect();
@@ -589,13 +670,20 @@ fn run_rule(a: &DsolveArgs, rule: &str) -> Result<String, String> {
             Some(c) => out += &format!("{} = {}\n", q.name, show(&pool, c, a.format)),
             None => {
                 out += &format!(
-                    "{} = {} (no elementary antiderivative found: numerical quadrature)\n",
+                    "{} = {} (no closed form used: numerical quadrature)\n",
                     q.name,
                     q.describe(&pool)
                 )
             }
         }
         for (s, v) in points.iter().zip(vals) {
+            let v = match v {
+                Ok(v) => v,
+                Err(e) => {
+                    out += &format!("  {indep} = {s}: {e}\n");
+                    continue;
+                }
+            };
             if v.error > 0.0 {
                 out += &format!("  {indep} = {s}: {} (± {:.1e})\n", v.value, v.error);
             } else {

@@ -361,12 +361,17 @@ pub fn run(a: KinArgs) -> Result<String, String> {
         for (name, q) in &named {
             out += &format!("{name} = {}\n", show_q(&pool, *q, a.format));
         }
+        if k.straight {
+            out +=
+                "(straight-line motion: the normal is undefined, shown as 0, and R is infinite)\n";
+        }
     } else {
         let m: serde_json::Map<String, serde_json::Value> = named
             .iter()
             .map(|(n, q)| (n.to_string(), json_q(&pool, *q)))
             .collect();
         js.insert("variable".into(), json!(input.variable));
+        js.insert("straight".into(), json!(k.straight));
         js.insert("quantities".into(), serde_json::Value::Object(m));
     }
     // Instants.
@@ -482,7 +487,7 @@ fn instant(
                 "{name} = {} (t = {}{})",
                 pool.to_text(val),
                 pool.to_text(tt),
-                if exact.is_some() {
+                if exact.is_some() && tv.is_finite() && pool.as_num(tt).is_none() {
                     format!(" ≈ {tv}")
                 } else {
                     String::new()

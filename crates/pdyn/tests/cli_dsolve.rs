@@ -179,3 +179,125 @@ fn help_is_available() {
     assert!(ok);
     assert!(out.contains("--ic") && out.contains("--rule"), "{out}");
 }
+
+#[test]
+fn when_finds_the_landing_and_the_highest_point() {
+    // The Kremlin stone: lands 37.1 m away.
+    let (ok, out, err) = pdyn(&[
+        "dsolve",
+        "x'' = 0",
+        "y'' = -g",
+        "--ic",
+        "x(0)=0, x'(0)=V*cos(alpha), y(0)=h, y'(0)=V*sin(alpha)",
+        "--set",
+        "g=9.81,V=25*0.44704,alpha=pi/4,h=71",
+        "--when",
+        "y = 0",
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+    let range = v["when"]["state"]["x"]["value"].as_f64().unwrap();
+    assert!((range - 37.1).abs() < 0.01, "{range}");
+    // The nanoparticle: highest point kT/(mg), exactly.
+    let (ok, out, err) = pdyn(&[
+        "dsolve",
+        "y'' = -g",
+        "--ic",
+        "y(0)=0, y'(0)=sqrt(2*k*T/m)",
+        "--when",
+        "y' = 0",
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("  y = T*k/(g*m)\n"), "{out}");
+}
+
+/// Odd inputs: every one answers (success or a message, exit code 0 or 2), never a panic, and
+/// quickly.
+#[test]
+fn odd_inputs_never_panic_or_hang() {
+    let cases: &[&[&str]] = &[
+        &["dsolve", "x'' = x''"],
+        &["dsolve", "0 = 0"],
+        &["dsolve", "x'' + 0*x = 0"],
+        &["dsolve", "x' = x'^2"],
+        &["dsolve", "x''*x'' = 1"],
+        &["dsolve", "x'' + x = exp(t^2)"],
+        &["dsolve", "x'' + x = t^100"],
+        &["dsolve", "x'' + x = sin(t)*cos(t)"],
+        &["dsolve", "x'' + x = 1", "--ic", "x(t0)=1, x'(t0)=0"],
+        &["dsolve", "x'' + x = 1", "--ic", "x(0)=1, x'(1)=0"],
+        &["dsolve", "x'' + x = 1", "--ic", "x(0)=1, x(0)=2"],
+        &["dsolve", "x'''''''''''''''' + x = 0"],
+        &[
+            "dsolve",
+            "x'''''''''''' + 3*x'''''' + x = cos(t)",
+            "--ic",
+            "x(0)=1",
+        ],
+        &["dsolve", "x'' + a*x''' + b*x' + c*x = 0"],
+        &["dsolve", "x'' + y = 0", "y'' + x' = 0", "--ic", "x(0)=1"],
+        &[
+            "dsolve",
+            "x'' + y'' = 0",
+            "x'' + y'' + y = 0",
+            "--ic",
+            "x(0)=1, x'(0)=0, y(0)=0, y'(0)=0",
+        ],
+        &[
+            "dsolve",
+            "x'' + k*y = 0",
+            "y'' + k*x = 0",
+            "--ic",
+            "x(0)=1, x'(0)=0, y(0)=0, y'(0)=0",
+        ],
+        &["dsolve", "--rule", "a(t) = 1/t", "--at", "1"],
+        &["dsolve", "--rule", "a(q) = 1"],
+        &[
+            "dsolve", "--rule", "a(v) = 0", "--ic", "v(0)=1", "--at", "2",
+        ],
+        &[
+            "dsolve",
+            "--rule",
+            "a(x) = -x",
+            "--ic",
+            "v(0)=1",
+            "--at",
+            "5",
+        ],
+        &["kin", "[t, t, t]", "--at", "t=1"],
+        &["kin", "[1, 2, 3]", "--at", "t=1"],
+        &["kin", "--path", "y = 0", "--at", "x=1"],
+        &[
+            "kin", "--path", "y = x^2", "--max", "a_n", "--over", "x=-1..1",
+        ],
+        &["kin", "--path", "y = x^2", "--max", "a", "--over", "x=0..1"],
+        &[
+            "kin",
+            "--polar",
+            "r = 1, theta = t",
+            "--max",
+            "speed",
+            "--over",
+            "t=1..0",
+        ],
+    ];
+    for args in cases {
+        let start = std::time::Instant::now();
+        let out = Command::new(env!("CARGO_BIN_EXE_pdyn"))
+            .args(*args)
+            .output()
+            .expect("run pdyn");
+        let code = out.status.code();
+        assert!(
+            code == Some(0) || code == Some(2),
+            "{args:?}: exit {code:?}\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(
+            start.elapsed().as_secs_f64() < 20.0,
+            "{args:?} took {:?}",
+            start.elapsed()
+        );
+    }
+}

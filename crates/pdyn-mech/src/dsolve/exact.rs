@@ -438,7 +438,12 @@ fn describe_roots(pool: &mut Pool, modes: &[Mode]) -> Vec<String> {
                 } else {
                     format!("{} ", pool.to_text(rate))
                 };
-                out.push(format!("{r}± {}*i{}", pool.to_text(freq), times(mult)));
+                let f = if freq == Pool::ONE {
+                    "i".to_string()
+                } else {
+                    format!("{}*i", pool.to_text(freq))
+                };
+                out.push(format!("{r}± {f}{}", times(mult)));
             }
         }
     }

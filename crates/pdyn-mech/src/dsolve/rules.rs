@@ -289,6 +289,19 @@ pub fn solve_rule(
 fn definite(pool: &mut Pool, e: Id, var: Id, lo: Id, hi: Id) -> Option<Id> {
     let f = antiderivative(pool, e, var)?;
     let a = pool.subs1(f, var, lo);
+    // An antiderivative singular at the lower limit (log(0), 1/0) means an improper integral:
+    // leave it to quadrature, which reports divergence.
+    if !pool.any_node(a, &|n| {
+        matches!(n, Node::Sym(_) | Node::Time | Node::Coord(..))
+    }) {
+        let prog = Program::compile(pool, &[], &[a]).ok()?;
+        let mut ws = prog.workspace();
+        let mut o = [0.0];
+        prog.eval(&[], &mut ws, &mut o);
+        if !o[0].is_finite() {
+            return None;
+        }
+    }
     let b = pool.subs1(f, var, hi);
     Some(pool.sub(b, a))
 }
@@ -611,6 +624,30 @@ fn substitution(pool: &mut Pool, e: Id, factors: &[Id], var: Id) -> Option<Id> {
 
 /// Evaluates quantity `q` at `s` (all parameters must be numbers by now).
 pub fn evaluate(pool: &mut Pool, q: &Quantity, s: f64) -> Result<Estimate, DsolveError> {
+    let est = evaluate_raw(pool, q, s)?;
+    let var = pool.to_text(q.variable);
+    if !est.value.is_finite() {
+        return Err(DsolveError::Invalid(format!(
+            "{} is not defined at {var} = {s} (a singular integral, or a point the motion does not reach)",
+            q.name
+        )));
+    }
+    if est.error > 1e-6 * (1.0 + est.value.abs()) {
+        return Err(DsolveError::Invalid(format!(
+            "{} at {var} = {s}: quadrature did not converge (estimated error {:.1e}); the integral may diverge",
+            q.name, est.error
+        )));
+    }
+    if q.name == "v(x)^2" && est.value < 0.0 {
+        return Err(DsolveError::Invalid(format!(
+            "v(x)^2 = {} < 0 at x = {s}: the particle turns back before reaching it",
+            est.value
+        )));
+    }
+    Ok(est)
+}
+
+fn evaluate_raw(pool: &mut Pool, q: &Quantity, s: f64) -> Result<Estimate, DsolveError> {
     let need = |e: String| {
         DsolveError::Invalid(format!(
             "{}: {e}; give the parameters values with --set",
