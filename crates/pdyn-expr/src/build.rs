@@ -565,7 +565,14 @@ impl Pool {
                     return self.call(f, &[v, u]);
                 }
             }
-            Func::Acos | Func::Atan2 => {}
+            Func::Atan2 => {
+                // atan2(y, x) = atan(y/x) when x > 0.
+                if self.is_positive(args[1]) {
+                    let q = self.div(u, args[1]);
+                    return self.call(Func::Atan, &[q]);
+                }
+            }
+            Func::Acos => {}
         }
         self.intern(Node::Call(f, args.to_vec().into_boxed_slice()))
     }

@@ -14,6 +14,7 @@ pub mod derive;
 pub mod dsolve;
 pub mod kinematics;
 pub mod model;
+pub mod prescribed;
 pub mod units;
 
 pub use derive::{derive, Derivation, DeriveError, DeriveOptions};

@@ -103,6 +103,7 @@ fn pulley_3_2_example_4_reports_the_tension() {
 
 /// Independent hand derivation of an n-link chain (Lagrange): with μ_jk = Σ_{p ≥ max(j,k)} m_p,
 /// Σ_k μ_jk l_j l_k [cos(q_j - q_k) q_k'' + sin(q_j - q_k) q_k'^2] + g l_j sin(q_j) Σ_{p≥j} m_p = 0.
+#[allow(clippy::needless_range_loop)] // Gaussian elimination reads best with indices
 fn chain_accelerations(m: &[f64], l: &[f64], q: &[f64], qd: &[f64], g: f64) -> Vec<f64> {
     let n = m.len();
     let mu = |j: usize, k: usize| -> f64 { m[j.max(k)..].iter().sum() };

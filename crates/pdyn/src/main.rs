@@ -4,6 +4,7 @@
 mod derive_cmd;
 mod dsolve_cmd;
 mod expr_cmd;
+mod forces_cmd;
 mod kin_cmd;
 mod plots;
 mod run_cmd;
@@ -32,6 +33,8 @@ enum Command {
     Eval(expr_cmd::EvalArgs),
     /// Derive the equations of motion of a model file.
     Derive(derive_cmd::DeriveArgs),
+    /// Forces required by a prescribed motion (reactions, thrust, bank angle) and design checks (slip, tip).
+    Forces(forces_cmd::ForcesArgs),
     /// Simulate a model file: integrate, check conservation laws, write CSV/JSON/plots.
     Run(run_cmd::RunArgs),
     /// Run a model's [sweep] over parameter values in parallel and tabulate response measures.
@@ -50,6 +53,7 @@ fn main() -> ExitCode {
         Command::Solve(a) => expr_cmd::solve(a),
         Command::Eval(a) => expr_cmd::eval(a),
         Command::Derive(a) => derive_cmd::run(a),
+        Command::Forces(a) => forces_cmd::run(a),
         Command::Sweep(a) => match sweep_cmd::run(a) {
             Ok((out, err, ok)) => {
                 print!("{out}");

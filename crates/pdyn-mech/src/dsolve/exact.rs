@@ -127,6 +127,25 @@ pub(crate) fn solve_scalar(
         let roots = describe_roots(pool, &modes);
         let (solution, constants) =
             fit_constants(pool, &basis, particular, ics, ode, t0, first_constant)?;
+        // Critical case at a threshold `s = v`: write the solution with `v` for `s`.
+        let solution = match cond {
+            Some(Condition {
+                expr,
+                relation: Relation::Zero,
+            }) => match pool.node(expr).clone() {
+                Node::Add(ts) if ts.len() == 2 && matches!(pool.node(ts[1]), Node::Sym(_)) => {
+                    let v = pool.neg(ts[0]);
+                    let y = pool.subs1(solution, ts[1], v);
+                    if const_value(pool, y).is_some_and(|x| !x.is_finite()) {
+                        solution
+                    } else {
+                        collect_like(pool, y)
+                    }
+                }
+                _ => solution,
+            },
+            _ => solution,
+        };
         cases.push(Case {
             condition: cond,
             solution: vec![solution],
@@ -200,6 +219,17 @@ pub(crate) fn sign_of(pool: &mut Pool, e: Id) -> Option<Relation> {
         }
     }
     None
+}
+
+/// Re-simplifies a sum term by term (keeps the collected form of [`fit_constants`]).
+fn collect_like(pool: &mut Pool, y: Id) -> Id {
+    match pool.node(y).clone() {
+        Node::Add(ts) => {
+            let parts: Vec<Id> = ts.iter().map(|&t| pool.simplify(t)).collect();
+            pool.add(&parts)
+        }
+        _ => pool.simplify(y),
+    }
 }
 
 /// Numeric value of an expression free of symbols (π, √2...).
@@ -325,20 +355,56 @@ fn quadratic_modes(pool: &mut Pool, c1: Id, c0: Id) -> Vec<(Option<Condition>, V
         Some(rel) => vec![(None, modes_for(pool, rel))],
         None => {
             let key = essential_sign_factor(pool, disc);
+            // `zeta^2 - 1` with zeta > 0 has the sign of `zeta - 1`: state that, and
+            // substitute zeta = 1 in the critical case.
+            let threshold = threshold(pool, key);
+            let expr = match threshold {
+                Some((s, v)) => pool.sub(s, v),
+                None => key,
+            };
             [Relation::Negative, Relation::Zero, Relation::Positive]
                 .into_iter()
                 .map(|rel| {
-                    (
-                        Some(Condition {
-                            expr: key,
-                            relation: rel,
-                        }),
-                        modes_for(pool, rel),
-                    )
+                    let modes = match (rel, threshold) {
+                        (Relation::Zero, Some((s, v))) => {
+                            let r = pool.subs1(rate, s, v);
+                            let r = pool.simplify(r);
+                            vec![Mode::Exp { rate: r, mult: 2 }]
+                        }
+                        _ => modes_for(pool, rel),
+                    };
+                    (Some(Condition { expr, relation: rel }), modes)
                 })
                 .collect()
         }
     }
+}
+
+/// `(s, v)` when `key = c1 s^n + c0` with `s` a positive symbol, `c1 > 0` and `v = (-c0/c1)^(1/n)`
+/// positive: then `key` has the sign of `s - v`.
+fn threshold(pool: &mut Pool, key: Id) -> Option<(Id, Id)> {
+    let Node::Add(ts) = pool.node(key).clone() else {
+        return None;
+    };
+    let [a, b] = ts[..] else { return None };
+    let c0 = pool.as_num(a)?;
+    let (c1, rest) = pool.split_coeff(b);
+    let (base, n) = match pool.node(rest).clone() {
+        Node::Sym(_) => (rest, Number::ONE),
+        Node::Pow(base, e) if matches!(pool.node(base), Node::Sym(_)) => (base, pool.as_num(e)?),
+        _ => return None,
+    };
+    if !pool.is_positive(base) || !c1.is_positive() || !n.is_positive() {
+        return None;
+    }
+    let ratio = c0.neg().mul(c1.recip());
+    if !ratio.is_positive() {
+        return None;
+    }
+    let r = pool.num(ratio);
+    let e = pool.num(n.recip());
+    let v = pool.pow(r, e);
+    Some((base, pool.simplify(v)))
 }
 
 /// Multiplicity of `rate + i freq` among the characteristic roots.

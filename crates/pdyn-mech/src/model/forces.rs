@@ -43,6 +43,7 @@ enum Endpoint {
 }
 
 pub(super) struct Built {
+    pub friction_forces: Vec<String>,
     pub loads: Vec<Load>,
     pub reactions: Vec<Reaction>,
     pub potentials: Vec<PotentialTerm>,
@@ -57,6 +58,7 @@ pub(super) struct ForceBuilder<'a> {
     reactions: Vec<Reaction>,
     potentials: Vec<PotentialTerm>,
     conservative: bool,
+    friction_forces: Vec<String>,
 }
 
 impl<'a> ForceBuilder<'a> {
@@ -73,11 +75,13 @@ impl<'a> ForceBuilder<'a> {
             reactions: Vec::new(),
             potentials: Vec::new(),
             conservative: true,
+            friction_forces: Vec::new(),
         }
     }
 
     pub fn finish(self) -> Built {
         Built {
+            friction_forces: self.friction_forces,
             loads: self.loads,
             reactions: self.reactions,
             potentials: self.potentials,
@@ -520,6 +524,7 @@ impl<'a> ForceBuilder<'a> {
                             .as_ref()
                             .map_or(kind_n.span(), |n| n.span());
                         let t_id = self.reaction(ld, &t_name, span)?;
+                        self.friction_forces.push(t_name.clone());
                         let tforce = vector::scale(&mut ld.pool, t_id, tangent);
                         self.loads.push(Load {
                             label: format!("friction force {t_name}"),

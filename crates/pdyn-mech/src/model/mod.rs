@@ -234,6 +234,8 @@ pub struct Model {
     pub known_accelerations: Vec<(usize, Id)>,
     /// Design criteria (`[[checks]]`).
     pub checks: Vec<spec::CheckSpec>,
+    /// Names of the unknown (sticking) friction forces.
+    pub friction_forces: Vec<String>,
     /// `(coordinate index, initial value, initial rate)` as expressions of the parameters, so
     /// that a sweep over a parameter recomputes the initial conditions that depend on it.
     pub initial_exprs: Vec<(usize, Id, Id)>,
@@ -460,7 +462,7 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
                 let lo = ld.constant(lo, r.span(), "a range bound")?;
                 let hi = ld.scalar(&r.get_ref()[1], "a range bound")?;
                 let hi = ld.constant(hi, r.span(), "a range bound")?;
-                if !(lo < hi) {
+                if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
                     return Err(ld.err(r.span(), format!("empty range [{lo}, {hi}]")));
                 }
                 Some((lo, hi))
@@ -687,6 +689,7 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
         fb.force(&mut ld, f)?;
     }
     let forces::Built {
+        friction_forces,
         loads,
         reactions,
         potentials,
@@ -737,6 +740,7 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
         unknowns,
         known_accelerations,
         checks,
+        friction_forces,
         name: raw.name.clone().unwrap_or_else(|| origin.to_string()),
         origin: origin.to_string(),
         source: source.to_string(),
