@@ -373,7 +373,13 @@ fn quadratic_modes(pool: &mut Pool, c1: Id, c0: Id) -> Vec<(Option<Condition>, V
                         }
                         _ => modes_for(pool, rel),
                     };
-                    (Some(Condition { expr, relation: rel }), modes)
+                    (
+                        Some(Condition {
+                            expr,
+                            relation: rel,
+                        }),
+                        modes,
+                    )
                 })
                 .collect()
         }
