@@ -24,11 +24,33 @@
 //!   initial conditions by exact linear solution.
 //! - **numeric** (systems, or numeric equations whose characteristic polynomial has irrational
 //!   roots of degree ≥ 3): `χ` is interpolated from `det Σ A_k λ^k` at points on a circle, its
-//!   roots found by the Aberth–Ehrlich iteration, polished by Newton's method and grouped into
-//!   multiple roots and conjugate pairs; the coefficients of every coordinate on the
+//!   roots found by the Aberth–Ehrlich iteration (simultaneous Newton with repulsion) and grouped
+//!   into multiple roots and conjugate pairs; the coefficients of every coordinate on the
 //!   quasi-polynomial basis then follow from one least-squares solve of the equations projected on
 //!   the basis (the basis is closed under `d/dt`) together with the initial conditions, and the
 //!   residual is checked.
+//!
+//! # Use from derived equations of motion
+//!
+//! [`solve_system`] takes equations as expressions (each meaning `= 0`), the coordinates and the
+//! initial conditions; the [`ClosedForm`] gives one expression in `t` per coordinate and compiles
+//! to a [`Program`] evaluating each coordinate and its rate:
+//!
+//! ```
+//! use pdyn_expr::Pool;
+//! use pdyn_mech::dsolve::solve_system;
+//! let mut pool = Pool::new();
+//! let eq = pool.parse_scalar("x'' + 4*x").unwrap(); // x'' + 4x = 0
+//! let x = pool.find_symbol("x").unwrap();
+//! let (at0, rate0) = (pool.coord(x, 0), pool.coord(x, 1));
+//! let one = pool.int(1);
+//! let cf = solve_system(&mut pool, &[eq], &[x], &[(at0, one), (rate0, Pool::ZERO)]).unwrap();
+//! assert_eq!(pool.to_text(cf.unique().unwrap()[0]), "cos(2*t)");
+//! let prog = cf.compile(&mut pool, 0, &[]).unwrap(); // inputs [t], outputs [x, x']
+//! let (mut ws, mut out) = (prog.workspace(), [0.0; 2]);
+//! prog.eval(&[0.5], &mut ws, &mut out);
+//! assert!((out[0] - 1f64.cos()).abs() < 1e-15 && (out[1] + 2.0 * 1f64.sin()).abs() < 1e-15);
+//! ```
 //!
 //! Anything else (a coefficient that depends on `t` or on the coordinates, forcing that is not a
 //! sum of such products) is answered with [`DsolveError::NoClosedForm`], which suggests
