@@ -498,3 +498,54 @@ fn inconsistent_input_is_reported() {
     let mut p = problem(&["x'' + y' = 0"], &[], &[]);
     assert!(solve(&mut p).is_err());
 }
+
+#[test]
+fn numeric_path_repeated_and_defective_roots() {
+    // (λ² + 1)² : double complex pair, t cos t and t sin t terms.
+    let mut p = problem(
+        &["x'''' + 2*x'' + x = 0"],
+        &[("x", "1"), ("x'", "0"), ("x''", "0"), ("x'''", "1")],
+        &[],
+    );
+    let cf = solve(&mut p).unwrap();
+    assert_eq!(cf.method, Method::Numeric);
+    let x = cf.cases[0].solution[0];
+    assert!(p.pool.to_text(x).contains("t*"), "{}", p.pool.to_text(x));
+    assert_satisfies(&mut p, &[x], &[]);
+    // A defective first-order system (critical damping): double root -1, one eigenvector.
+    let mut p = problem(&["x' = y", "y' = -x - 2*y"], &[("x", "1"), ("y", "0")], &[]);
+    let cf = solve(&mut p).unwrap();
+    let sol = cf.unique().unwrap().to_vec();
+    assert_satisfies(&mut p, &sol, &[]);
+    assert_same(&mut p.pool, sol[0], "(1 + t)*exp(-t)", &[]);
+    // Resonant forcing in the numeric path.
+    let mut p = problem(
+        &["x' = y", "y' = -x + cos(t)"],
+        &[("x", "0"), ("y", "0")],
+        &[],
+    );
+    let cf = solve(&mut p).unwrap();
+    let sol = cf.unique().unwrap().to_vec();
+    assert_satisfies(&mut p, &sol, &[]);
+    assert_same(&mut p.pool, sol[0], "t*sin(t)/2", &[]);
+}
+
+#[test]
+fn bounded_time_on_large_inputs() {
+    let start = std::time::Instant::now();
+    // 12th-order numeric equation with polynomial-exponential-trig forcing.
+    let mut p = problem(
+        &["x'''''''''''' + 3*x'''''' + x = t^3*exp(-t)*cos(3*t) + t^5"],
+        &[],
+        &[],
+    );
+    let _ = solve(&mut p);
+    // Symbolic 4th order that does not factor: refused quickly.
+    let mut p = problem(&["x'''' + a*x''' + b*x'' + c*x' + d*x = 0"], &[], &[]);
+    assert!(matches!(solve(&mut p), Err(DsolveError::NoClosedForm(_))));
+    assert!(
+        start.elapsed().as_secs_f64() < 20.0,
+        "{:?}",
+        start.elapsed()
+    );
+}

@@ -1,5 +1,5 @@
 //! Polynomial roots: exact rational roots (rational root theorem with exact deflation), and
-//! numeric roots of real polynomials (Aberth–Ehrlich, Newton polish, grouping of multiple roots
+//! numeric roots of real polynomials (Aberth–Ehrlich iteration, grouping of multiple roots
 //! and conjugate pairs).
 
 use pdyn_expr::Rational;
@@ -132,11 +132,47 @@ pub(crate) fn numeric_roots(coeffs: &[f64]) -> Vec<RootGroup> {
             break;
         }
     }
-    group_roots(&mut groups, &z, radius);
+    group_roots(&mut groups, &z, radius, &monic);
     groups
 }
 
-fn group_roots(groups: &mut Vec<RootGroup>, z: &[C64], scale: f64) {
+/// Polishes a root of multiplicity `m` as the simple root of the `(m-1)`-th derivative (a
+/// multiple root is found by the iteration only to about eps^(1/m)).
+fn polish_multiple(monic: &[f64], z0: C64, m: usize) -> C64 {
+    let n = monic.len() - 1;
+    if m <= 1 || m > n {
+        return z0;
+    }
+    let d: Vec<f64> = (0..=n - (m - 1))
+        .map(|k| {
+            let f: f64 = (k + 1..k + m).map(|j| j as f64).product();
+            monic[k + m - 1] * f
+        })
+        .collect();
+    let mut z = z0;
+    for _ in 0..30 {
+        let (p, dp) = eval_with_derivative(&d, z);
+        if dp.abs() == 0.0 {
+            break;
+        }
+        let step = p.div(dp);
+        if !(step.re.is_finite() && step.im.is_finite()) {
+            break;
+        }
+        z = z.sub(step);
+        if step.abs() <= 1e-16 * z.abs().max(1e-300) {
+            break;
+        }
+    }
+    // Keep the polished value only if it stayed in the cluster.
+    if z.sub(z0).abs() <= 1e-3 * z0.abs().max(1e-6) {
+        z
+    } else {
+        z0
+    }
+}
+
+fn group_roots(groups: &mut Vec<RootGroup>, z: &[C64], scale: f64, monic: &[f64]) {
     // Multiple roots are found to about eps^(1/m): group generously, then average.
     let tol = 1e-6 * scale.max(1e-300);
     let mut used = vec![false; z.len()];
@@ -157,7 +193,8 @@ fn group_roots(groups: &mut Vec<RootGroup>, z: &[C64], scale: f64) {
         for &m in &members {
             mean = mean.add(z[m]);
         }
-        found.push((mean.scale(1.0 / members.len() as f64), members.len()));
+        let mean = mean.scale(1.0 / members.len() as f64);
+        found.push((polish_multiple(monic, mean, members.len()), members.len()));
     }
     // Conjugates: keep the one with im > 0; snap tiny imaginary parts to the real axis.
     let mut taken = vec![false; found.len()];
