@@ -1,24 +1,182 @@
-//! Plots of a run (pdyn-plot): written by `pdyn run --plot`.
+//! Plots of runs and sweeps (pdyn-plot): written by `pdyn run --plot` and `pdyn sweep --plot`.
+//!
+//! A run gives `trajectory` (each particle's path: in the plane of motion with equal axes, or in
+//! 3-D), `coordinates` (each coordinate against time, one panel each, events marked) and, when
+//! pdyn monitors conserved quantities, `conservation` (their relative drift against time). A
+//! sweep gives `sweep` (each response measure against the parameter, peaks marked). Each is
+//! written as SVG and PNG.
 
+use pdyn::sim::sweep::SweepResult;
 use pdyn::sim::{Prepared, RunResult};
+use pdyn_plot::{save, save3, save_grid, Figure, Figure3, Marker, Series, Series3};
 use std::path::Path;
 
-/// Writes the run's plots into `dir` (not yet available: pdyn-plot is being built).
-pub fn write_run_plots(
-    _model: &pdyn_mech::Model,
-    _prep: &Prepared,
-    _res: &RunResult,
-    _dir: &Path,
+fn both(
+    dir: &Path,
+    stem: &str,
+    f: impl Fn(&Path) -> Result<(), pdyn_plot::PlotError>,
 ) -> Result<(), String> {
-    Err("plots are not available in this build yet".into())
+    for ext in ["svg", "png"] {
+        let path = dir.join(format!("{stem}.{ext}"));
+        f(&path).map_err(|e| format!("cannot plot {}: {e}", path.display()))?;
+    }
+    Ok(())
 }
 
-/// Writes the sweep's response plot into `dir` (not yet available).
-pub fn write_sweep_plot(
-    _model: &pdyn_mech::Model,
-    _res: &pdyn::sim::sweep::SweepResult,
-    _peaks: &[(String, Vec<(f64, f64)>)],
-    _dir: &Path,
+fn column(res: &RunResult, name: &str) -> Option<Vec<f64>> {
+    let j = res.columns.iter().position(|c| c == name)?;
+    Some(res.rows.iter().map(|r| r[j]).collect())
+}
+
+/// Writes the plots of a run into `dir`.
+pub fn write_run_plots(
+    model: &pdyn_mech::Model,
+    prep: &Prepared,
+    res: &RunResult,
+    dir: &Path,
 ) -> Result<(), String> {
-    Err("plots are not available in this build yet".into())
+    if res.rows.len() < 2 {
+        return Err("too few output points to plot".into());
+    }
+    let t = column(res, "t").unwrap_or_default();
+    let markers: Vec<Marker> = res
+        .events
+        .iter()
+        .map(|e| Marker::vline(e.t, e.name.clone()))
+        .collect();
+
+    // Trajectory: the components that vary.
+    let mut planar = Vec::new();
+    let mut spatial = Vec::new();
+    let mut axes_used = [false; 3];
+    for p in &model.particles {
+        let comps: Vec<Option<Vec<f64>>> = ["x", "y", "z"]
+            .iter()
+            .map(|a| column(res, &format!("{}.{a}", p.name)))
+            .collect();
+        let varies = |c: &Option<Vec<f64>>| {
+            c.as_ref().is_some_and(|v| {
+                let (lo, hi) = v
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                        (a.min(x), b.max(x))
+                    });
+                hi - lo > 1e-12 * (1.0 + hi.abs().max(lo.abs()))
+            })
+        };
+        for (k, c) in comps.iter().enumerate() {
+            axes_used[k] |= varies(c);
+        }
+        let get = |k: usize| comps[k].clone().unwrap_or_else(|| vec![0.0; t.len()]);
+        spatial.push(Series3::new(p.name.clone(), get(0), get(1), get(2)));
+        planar.push((p.name.clone(), [get(0), get(1), get(2)]));
+    }
+    let used: Vec<usize> = (0..3).filter(|&k| axes_used[k]).collect();
+    let names = ["x [m]", "y [m]", "z [m]"];
+    if used.len() == 3 {
+        let fig = Figure3 {
+            title: format!("{}: trajectory", model.name),
+            labels: names.map(String::from),
+            series: spatial,
+        };
+        both(dir, "trajectory", |p| save3(&fig, p))?;
+    } else if used.len() == 2 {
+        let (a, b) = (used[0], used[1]);
+        let fig = Figure {
+            title: format!("{}: trajectory", model.name),
+            x_label: names[a].into(),
+            y_label: names[b].into(),
+            series: planar
+                .iter()
+                .map(|(n, c)| Series::new(n.clone(), c[a].clone(), c[b].clone()))
+                .collect(),
+            equal_aspect: true,
+            ..Default::default()
+        };
+        both(dir, "trajectory", |p| save(&fig, p))?;
+    }
+
+    // Coordinates against time.
+    let n = prep.system.n;
+    let panels: Vec<Figure> = prep.state_names[..n]
+        .iter()
+        .filter_map(|name| {
+            let y = column(res, name)?;
+            Some(Figure {
+                title: name.clone(),
+                x_label: "t [s]".into(),
+                y_label: name.clone(),
+                series: vec![Series::new(name.clone(), t.clone(), y)],
+                markers: markers.clone(),
+                ..Default::default()
+            })
+        })
+        .collect();
+    if !panels.is_empty() {
+        let cols = if panels.len() == 1 { 1 } else { 2 };
+        both(dir, "coordinates", |p| save_grid(&panels, cols, p))?;
+    }
+
+    // Drift of the conserved quantities.
+    let mut series = Vec::new();
+    for m in &res.monitors {
+        if let Some(v) = column(res, &m.name) {
+            let scale = if m.relative { m.initial.abs() } else { 1.0 };
+            let d: Vec<f64> = v.iter().map(|x| (x - m.initial) / scale).collect();
+            let label = if m.relative {
+                format!("({0} - {0}(0))/|{0}(0)|", m.name)
+            } else {
+                format!("{0} - {0}(0)", m.name)
+            };
+            series.push(Series::new(label, t.clone(), d));
+        }
+    }
+    if !series.is_empty() {
+        let fig = Figure {
+            title: format!("Conserved quantities ({}): drift", res.method),
+            x_label: "t [s]".into(),
+            y_label: "drift".into(),
+            series,
+            markers: vec![Marker::hline(0.0, "")],
+            ..Default::default()
+        };
+        both(dir, "conservation", |p| save(&fig, p))?;
+    }
+    Ok(())
+}
+
+/// Writes the sweep's response curves with their peaks into `dir`.
+pub fn write_sweep_plot(
+    model: &pdyn_mech::Model,
+    res: &SweepResult,
+    peaks: &[(String, Vec<(f64, f64)>)],
+    dir: &Path,
+) -> Result<(), String> {
+    let mut series = Vec::new();
+    let mut markers = Vec::new();
+    for (j, name) in res.measures.iter().enumerate() {
+        let y: Vec<f64> = res.table.iter().map(|r| r[j]).collect();
+        series.push(Series::new(name.clone(), res.values.clone(), y));
+        if let Some((_, pk)) = peaks.iter().find(|(n, _)| n == name) {
+            for (x, v) in pk {
+                markers.push(Marker::point(*x, *v, format!("{} = {x:.2}", res.parameter)));
+            }
+        }
+    }
+    if series.is_empty() {
+        return Err("the sweep has no measures to plot: add [sweep.measures]".into());
+    }
+    let fig = Figure {
+        title: format!("{}: response vs {}", model.name, res.parameter),
+        x_label: res.parameter.clone(),
+        y_label: if res.measures.len() == 1 {
+            res.measures[0].clone()
+        } else {
+            "response".into()
+        },
+        series,
+        markers,
+        ..Default::default()
+    };
+    both(dir, "sweep", |p| save(&fig, p))
 }

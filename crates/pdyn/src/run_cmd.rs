@@ -51,6 +51,9 @@ pub struct RunArgs {
     /// Print the JSON summary instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Override parameter values, e.g. `--set omega=8.7,d0=0.05`.
+    #[arg(long, value_delimiter = ',')]
+    pub set: Vec<String>,
 }
 
 /// Merges `[simulate]` and the command line.
@@ -103,7 +106,12 @@ pub fn run(a: RunArgs) -> Result<(String, String, bool), String> {
         return Ok((sim::methods_help(), String::new(), true));
     }
     let mut model = crate::derive_cmd::load(&a.model)?;
-    let set = settings(&model, &a)?;
+    crate::forces_cmd::apply_set(&mut model, &a.set)?;
+    let mut set = settings(&model, &a)?;
+    if a.plot && set.points.is_none() && set.output_dt.is_none() {
+        // Plots read better from evenly spaced dense output than from raw steps.
+        set.points = Some(2001);
+    }
     let prep = sim::prepare(&mut model)?;
     let res = sim::run(&prep, &set).map_err(|e| format!("{}: error: {e}", model.origin))?;
     let mut err = String::new();

@@ -19,6 +19,7 @@ pub struct SweepArgs {
 /// `pdyn sweep MODEL`. Returns (stdout, stderr, success).
 pub fn run(a: SweepArgs) -> Result<(String, String, bool), String> {
     let mut model = crate::derive_cmd::load(&a.run.model)?;
+    crate::forces_cmd::apply_set(&mut model, &a.run.set)?;
     let Some(spec) = model.run.sweep.clone() else {
         return Err(format!(
             "{}: error: the model has no [sweep] table\n  = help: add [sweep] with parameter, values (or from/to/steps) and [sweep.measures]",

@@ -307,16 +307,10 @@ pub fn prepare(model: &mut Model) -> Result<Prepared, String> {
     let ic_names = d.state_names.clone();
     let initial_conditions = Observer::new(&mut model.pool, &param_ids, ic_names, &ic_exprs)
         .map_err(|e| format!("{}: error: initial conditions: {e}", model.origin))?;
-    let mut y0 = Vec::new();
-    let mut rates = Vec::new();
-    for &i in &d.free {
-        if let pdyn_mech::model::CoordinateKind::Free { initial, rate } = model.coordinates[i].kind
-        {
-            y0.push(initial);
-            rates.push(rate);
-        }
-    }
-    y0.extend(rates);
+    // Initial state from the current parameter values (they may have been overridden).
+    let values: Vec<f64> = model.parameters.iter().map(|q| q.value).collect();
+    let mut y0 = vec![0.0; d.state.len()];
+    initial_conditions.eval(&values, &mut y0);
     Ok(Prepared {
         system,
         observer,
