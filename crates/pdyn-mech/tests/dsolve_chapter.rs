@@ -325,6 +325,17 @@ fn forcing_polynomial_exponential_trig_and_resonance() {
         let x = cf.unique().unwrap()[0];
         assert_satisfies(&mut p, &[x], &[]);
     }
+    // Products and powers of sines and cosines are rewritten as sums.
+    for eq in [
+        "x'' + x = sin(t)*cos(t)",
+        "x'' + 4*x = cos(t)^2",
+        "x'' + x' + x = sin(3*t)*sin(t)*exp(-t)",
+    ] {
+        let mut p = problem(&[eq], &[("x", "1"), ("x'", "0")], &[]);
+        let cf = solve(&mut p).unwrap_or_else(|e| panic!("{eq}: {e}"));
+        let x = cf.unique().unwrap()[0];
+        assert_satisfies(&mut p, &[x], &[]);
+    }
     // The resonant response grows like t: x = (sin 2t - 2t cos 2t)/8.
     let mut p = problem(&["x'' + 4*x = sin(2*t)"], &[("x", "0"), ("x'", "0")], &[]);
     let x = solve(&mut p).unwrap().cases[0].solution[0];

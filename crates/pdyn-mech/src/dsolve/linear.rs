@@ -225,10 +225,106 @@ fn unsupported(pool: &Pool, term: Id) -> DsolveError {
     ))
 }
 
+fn trig_arg(pool: &Pool, f: Id) -> Option<(Func, Id)> {
+    match pool.node(f) {
+        Node::Call(g @ (Func::Sin | Func::Cos), args) => Some((*g, args[0])),
+        _ => None,
+    }
+}
+
+/// `A(u) B(v)` for sines and cosines as a sum (product-to-sum identities).
+fn product_to_sum(pool: &mut Pool, a: (Func, Id), b: (Func, Id)) -> Id {
+    let (fa, u) = a;
+    let (fb, v) = b;
+    let diff = pool.sub(u, v);
+    let sum = pool.add2(u, v);
+    let half = pool.num(pdyn_expr::Number::ratio(1, 2));
+    let r = match (fa, fb) {
+        (Func::Sin, Func::Sin) => {
+            let c1 = pool.call(Func::Cos, &[diff]);
+            let c2 = pool.call(Func::Cos, &[sum]);
+            pool.sub(c1, c2)
+        }
+        (Func::Cos, Func::Cos) => {
+            let c1 = pool.call(Func::Cos, &[diff]);
+            let c2 = pool.call(Func::Cos, &[sum]);
+            pool.add2(c1, c2)
+        }
+        (Func::Sin, _) => {
+            let s1 = pool.call(Func::Sin, &[sum]);
+            let s2 = pool.call(Func::Sin, &[diff]);
+            pool.add2(s1, s2)
+        }
+        _ => {
+            let s1 = pool.call(Func::Sin, &[sum]);
+            let s2 = pool.call(Func::Sin, &[diff]);
+            pool.sub(s1, s2)
+        }
+    };
+    pool.mul2(half, r)
+}
+
+/// Rewrites products and small powers of sines and cosines as sums (`sin t cos t =
+/// sin(2t)/2`, `cos² t = (1 + cos 2t)/2`), so each term has at most one trigonometric factor.
+/// Gives up (returns the input) beyond a fixed amount of work.
+fn linearize_trig(pool: &mut Pool, e: Id) -> Id {
+    let mut cur = pool.expand(e);
+    for _ in 0..24 {
+        let terms: Vec<Id> = match pool.node(cur) {
+            Node::Add(ts) => ts.to_vec(),
+            _ => vec![cur],
+        };
+        if terms.len() > 400 {
+            return cur;
+        }
+        let mut changed = false;
+        let mut out = Vec::with_capacity(terms.len());
+        for term in terms {
+            let factors: Vec<Id> = match pool.node(term) {
+                Node::Mul(fs) => fs.to_vec(),
+                _ => vec![term],
+            };
+            let mut trig = Vec::new();
+            let mut other = Vec::new();
+            for f in factors {
+                if let Some(ta) = trig_arg(pool, f) {
+                    trig.push(ta);
+                    continue;
+                }
+                if let Node::Pow(b, n) = pool.node(f).clone() {
+                    let k = pool.as_num(n).and_then(|x| x.as_integer());
+                    if let (Some(ta), Some(k @ 2..=8)) = (trig_arg(pool, b), k) {
+                        trig.extend(std::iter::repeat_n(ta, k as usize));
+                        continue;
+                    }
+                }
+                other.push(f);
+            }
+            if trig.len() >= 2 {
+                let (a, b) = (trig[0], trig[1]);
+                other.push(product_to_sum(pool, a, b));
+                for &(g, u) in &trig[2..] {
+                    other.push(pool.call(g, &[u]));
+                }
+                out.push(pool.mul(&other));
+                changed = true;
+            } else {
+                out.push(term);
+            }
+        }
+        let next = pool.add(&out);
+        cur = pool.expand(next);
+        if !changed {
+            break;
+        }
+    }
+    cur
+}
+
 /// Splits `f(t)` into terms `coeff t^p e^{rate t} cos|sin(freq t)`.
 pub(crate) fn forcing_terms(pool: &mut Pool, f: Id) -> Result<Vec<ForcingTerm>, DsolveError> {
     let f = hyperbolic_to_exp(pool, f);
-    let f = pool.expand(f);
+    let f = linearize_trig(pool, f);
     if f == Pool::ZERO {
         return Ok(Vec::new());
     }

@@ -8,7 +8,9 @@
 //! characteristic polynomial `χ(λ) = det Σ_k A_k λ^k`: a root of multiplicity `m` contributes
 //! `t^j e^{λt}`, `j < m`; a complex pair `α ± iβ` contributes `t^j e^{αt} cos βt` and
 //! `t^j e^{αt} sin βt`. The forcing is split into groups `e^{at} P(t) cos bt + e^{at} Q(t) sin bt`
-//! (polynomial, exponential, sine/cosine and their products); by superposition each group has a
+//! (polynomial, exponential, sine/cosine and their products; products and powers of sines and
+//! cosines are first turned into sums by the product-to-sum identities, `sinh`/`cosh` into
+//! exponentials); by superposition each group has a
 //! particular solution of the same form with polynomials of degree `deg P + m`, where `m` is the
 //! multiplicity of `a + ib` as a root of `χ` (`m > 0` is resonance).
 //!
