@@ -81,7 +81,7 @@ pub fn tree_count(order: usize) -> usize {
     for p in 1..=order {
         let mut out = Vec::new();
         multisets(&orders, p - 1, 0, &mut Vec::new(), &mut out);
-        orders.extend(std::iter::repeat(p).take(out.len()));
+        orders.extend(std::iter::repeat_n(p, out.len()));
     }
     orders.len()
 }

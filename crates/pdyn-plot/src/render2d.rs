@@ -184,7 +184,7 @@ fn tick_label(t: &Ticks, v: f64) -> String {
     let mut best = None;
     for (i, &tv) in t.values.iter().enumerate() {
         let d = (tv - v).abs();
-        if best.map_or(true, |(_, bd)| d < bd) {
+        if best.is_none_or(|(_, bd)| d < bd) {
             best = Some((i, d));
         }
     }
