@@ -293,11 +293,12 @@ fn vehicle_on_a_circular_path_minimum_time() {
 
 #[test]
 fn robotic_manipulator_maximum_extension_rate() {
-    // Arm turning at constant rate omega, extending at constant rate c from r = 0: the gripper
-    // acceleration is (-r omega^2) e_r + (2 c omega) e_theta; at the start (r = 0) only the
-    // Coriolis term acts, so |a| <= a_max needs c <= a_max/(2 omega) (factor 2, not 1).
+    // Arm turning at constant rate omega, gripper extending at constant rate c from r = 0 to
+    // r = R: a = -c t omega^2 e_r + 2 c omega e_theta (the Coriolis term carries the factor 2).
+    // |a|^2 = r^2 omega^4 + 4 c^2 omega^2 grows with r, so the limit |a| <= a_max binds at full
+    // extension: c_max = sqrt(a_max^2 - R^2 omega^4)/(2 omega).
     let mut p = Pool::new();
-    let pos = ["c", "omega", "a_max"];
+    let pos = ["c", "omega", "a_max", "R"];
     let r = parse(&mut p, "c*t", &pos);
     let th = parse(&mut p, "omega*t", &pos);
     let k = analyze(
@@ -310,18 +311,33 @@ fn robotic_manipulator_maximum_extension_rate() {
     )
     .unwrap();
     assert_eq!(p.to_text(k.polar.acceleration[1]), "2*c*omega");
+    assert_eq!(p.to_text(k.polar.acceleration[0]), "-c*omega^2*t");
     let t = p.time();
     let a2 = pdyn_expr::vector::dot(&mut p, k.acceleration, k.acceleration);
-    let a0 = p.subs1(a2, t, Pool::ZERO);
-    let a0 = p.simplify(a0);
-    let expect = parse(&mut p, "4*c^2*omega^2", &pos);
-    assert!(p.provably_equal(a0, expect), "{}", p.to_text(a0));
-    // |a(0)| = a_max  =>  c = a_max/(2 omega).
-    let cmax = parse(&mut p, "a_max/(2*omega)", &pos);
+    let a2 = p.simplify(a2);
+    // At full extension t = R/c.
+    let t_end = parse(&mut p, "R/c", &pos);
+    let a2_end = p.subs1(a2, t, t_end);
+    let expect = parse(&mut p, "R^2*omega^4 + 4*c^2*omega^2", &pos);
+    assert!(p.provably_equal(a2_end, expect), "{}", p.to_text(a2_end));
+    let cmax = parse(&mut p, "sqrt(a_max^2 - R^2*omega^4)/(2*omega)", &pos);
     let cs = p.var("c");
-    let at = p.subs1(a0, cs, cmax);
+    let at = p.subs1(a2_end, cs, cmax);
     let amax2 = parse(&mut p, "a_max^2", &pos);
-    assert!(p.provably_equal(at, amax2));
+    assert!(p.provably_equal(at, amax2), "{}", p.to_text(at));
+    // Numerically (omega = 2, R = 0.5, a_max = 3): the largest |a| over the stroke is at the end
+    // and equals a_max at c = c_max.
+    let (om, rr, am) = (2.0, 0.5, 3.0);
+    let c_val = ((am * am - rr * rr * om * om * om * om) as f64).sqrt() / (2.0 * om);
+    let mut f = p.sqrt(a2);
+    for (name, v) in [("c", c_val), ("omega", om)] {
+        let s = p.var(name);
+        let n = p.num(pdyn_expr::Number::Float(v));
+        f = p.subs1(f, s, n);
+    }
+    let ext = maximize(&mut p, f, t, 0.0, rr / c_val).unwrap();
+    assert!((ext.at - rr / c_val).abs() < 1e-9, "{ext:?}");
+    assert!((ext.value - am).abs() < 1e-9, "{ext:?}");
 }
 
 #[test]
