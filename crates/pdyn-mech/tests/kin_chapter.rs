@@ -192,6 +192,27 @@ fn cartesian_helix_against_finite_differences() {
         let crn = cr.iter().map(|x| x * x).sum::<f64>().sqrt();
         let rr = num(&mut p, k.radius, &[t], &[tt]);
         assert!((rr - vv.powi(3) / crn).abs() < 1e-4 * rr, "{rr}");
+        // n is a unit vector normal to t, and a = a_t t + a_n n.
+        let vec3 = |p: &mut Pool, w: [Id; 3]| -> Vec<f64> {
+            w.iter().map(|&c| num(p, c, &[t], &[tt])).collect()
+        };
+        let (n, tg, acc_e) = (
+            vec3(&mut p, k.normal),
+            vec3(&mut p, k.tangent),
+            vec3(&mut p, k.acceleration),
+        );
+        let (at, an) = (
+            num(&mut p, k.a_t, &[t], &[tt]),
+            num(&mut p, k.a_n, &[t], &[tt]),
+        );
+        close(n.iter().map(|x| x * x).sum::<f64>(), 1.0);
+        close(
+            n.iter().zip(&tg).map(|(x, y)| x * y).sum::<f64>() + 1.0,
+            1.0,
+        );
+        for i in 0..3 {
+            close(acc_e[i], at * tg[i] + an * n[i]);
+        }
     }
 }
 
