@@ -348,8 +348,8 @@ fn robotic_manipulator_maximum_extension_rate() {
     assert!(p.provably_equal(at, amax2), "{}", p.to_text(at));
     // Numerically (omega = 2, R = 0.5, a_max = 3): the largest |a| over the stroke is at the end
     // and equals a_max at c = c_max.
-    let (om, rr, am) = (2.0, 0.5, 3.0);
-    let c_val = ((am * am - rr * rr * om * om * om * om) as f64).sqrt() / (2.0 * om);
+    let (om, rr, am): (f64, f64, f64) = (2.0, 0.5, 3.0);
+    let c_val = (am * am - rr * rr * om * om * om * om).sqrt() / (2.0 * om);
     let mut f = p.sqrt(a2);
     for (name, v) in [("c", c_val), ("omega", om)] {
         let s = p.var(name);
