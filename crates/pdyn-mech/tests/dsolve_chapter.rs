@@ -560,3 +560,32 @@ fn bounded_time_on_large_inputs() {
         start.elapsed()
     );
 }
+
+#[test]
+fn small_symbolic_systems_by_elimination() {
+    // First-order form of the damped oscillator: the three cases, each satisfying the system.
+    let mut p = problem(
+        &["x' = v", "m*v' = -k*x - c*v"],
+        &[("x", "x0"), ("v", "0")],
+        &["m", "k", "c"],
+    );
+    let cf = solve(&mut p).unwrap();
+    assert_eq!(cf.method, Method::Exact);
+    assert_eq!(cf.cases.len(), 3);
+    for (case, c) in cf.cases.clone().iter().zip([1.0, 4.0, 6.0]) {
+        // c^2 - 4 k m with k = 2, m = 2: 1 - 16 < 0, 16 - 16 = 0, 36 - 16 > 0.
+        let params = [("m", 2.0), ("k", 2.0), ("c", c), ("x0", 0.3)];
+        assert_satisfies(&mut p, &case.solution, &params);
+    }
+    // Two free masses joined by a spring: rigid drift plus vibration.
+    let mut p = problem(
+        &["m*x1'' = k*(x2 - x1)", "m*x2'' = k*(x1 - x2) + F*sin(w*t)"],
+        &[("x1", "0"), ("x1'", "V"), ("x2", "0"), ("x2'", "0")],
+        &["m", "k"],
+    );
+    let cf = solve(&mut p).unwrap();
+    assert_eq!(cf.method, Method::Exact);
+    let sol = cf.unique().unwrap().to_vec();
+    let params = [("m", 1.5), ("k", 20.0), ("V", 0.7), ("F", 2.0), ("w", 1.9)];
+    assert_satisfies(&mut p, &sol, &params);
+}

@@ -58,6 +58,7 @@
 //! sum of such products) is answered with [`DsolveError::NoClosedForm`], which suggests
 //! `pdyn run`. Every step has a fixed work bound, so every call returns in bounded time.
 
+mod eliminate;
 mod exact;
 mod linear;
 mod numeric;
@@ -272,6 +273,8 @@ pub fn solve_with(
             return Ok(cf);
         }
     } else if let Some(cf) = solve_uncoupled(pool, &ode, initial, t0)? {
+        return Ok(cf);
+    } else if let Some(cf) = eliminate::solve_by_elimination(pool, &ode, initial, t0)? {
         return Ok(cf);
     }
     // Roots not exact, or a coupled system: the numeric solver.
