@@ -589,3 +589,52 @@ fn small_symbolic_systems_by_elimination() {
     let params = [("m", 1.5), ("k", 20.0), ("V", 0.7), ("F", 2.0), ("w", 1.9)];
     assert_satisfies(&mut p, &sol, &params);
 }
+
+#[test]
+fn undamped_two_dof_symbolic_normal_modes() {
+    // Symmetric chain: modes sqrt(k/m) and sqrt(3k/m), exactly.
+    let mut p = problem(
+        &["m*x1'' = -2*k*x1 + k*x2", "m*x2'' = k*x1 - 2*k*x2"],
+        &[("x1", "a"), ("x1'", "0"), ("x2", "0"), ("x2'", "0")],
+        &["m", "k"],
+    );
+    let cf = solve(&mut p).unwrap();
+    let sol = cf.unique().unwrap().to_vec();
+    assert_same(
+        &mut p.pool,
+        sol[0],
+        "a/2*(cos(sqrt(k/m)*t) + cos(sqrt(3*k/m)*t))",
+        &[("m", 1.3), ("k", 7.0), ("a", 0.2)],
+    );
+    assert_satisfies(&mut p, &sol, &[("m", 1.3), ("k", 7.0), ("a", 0.2)]);
+    // The 2-storey building with symbolic masses and stiffnesses: the physical case (distinct
+    // real frequencies) satisfies the equations; forcing included.
+    let mut p = problem(
+        &[
+            "m1*x1'' = -k1*x1 - k2*(x1 - x2) + F*cos(w*t)",
+            "m2*x2'' = -k2*(x2 - x1)",
+        ],
+        &[("x1", "a"), ("x1'", "0"), ("x2", "0"), ("x2'", "b")],
+        &["m1", "m2", "k1", "k2"],
+    );
+    let cf = solve(&mut p).unwrap();
+    assert_eq!(cf.method, Method::Exact);
+    let physical = cf
+        .cases
+        .iter()
+        .find(|c| c.condition.map(|k| k.relation) == Some(Relation::Positive))
+        .expect("distinct-frequency case")
+        .solution
+        .clone();
+    let params = [
+        ("m1", 2.0),
+        ("m2", 1.5),
+        ("k1", 40.0),
+        ("k2", 30.0),
+        ("F", 3.0),
+        ("w", 2.2),
+        ("a", 0.1),
+        ("b", -0.4),
+    ];
+    assert_satisfies(&mut p, &physical, &params);
+}

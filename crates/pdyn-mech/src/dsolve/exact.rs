@@ -100,6 +100,29 @@ pub(crate) fn solve_scalar(
                 cases_modes.push((cond, m));
             }
         }
+        5 if rest[1] == Pool::ZERO
+            && rest[3] == Pool::ZERO
+            && !c.iter().all(|&x| pool.as_num(x).is_some()) =>
+        {
+            // Biquadratic (undamped two-degree-of-freedom systems): a quadratic in λ².
+            let b = pool.div(rest[2], rest[4]);
+            let b = pool.simplify(b);
+            let c0 = pool.div(rest[0], rest[4]);
+            let c0 = pool.simplify(c0);
+            let Some(cases) = biquadratic_modes(pool, b, c0) else {
+                let params = symbols_of(pool, &c);
+                return Err(no_closed_form(format!(
+                    "the characteristic polynomial λ^4 + ({})λ^2 + {} has coefficients of unknown sign (in {params}); give numeric values",
+                    pool.to_text(b),
+                    pool.to_text(c0)
+                )));
+            };
+            for (cond, modes) in cases {
+                let mut m = base_modes.clone();
+                m.extend(modes);
+                cases_modes.push((cond, m));
+            }
+        }
         _ => {
             if c.iter().all(|&x| pool.as_num(x).is_some()) {
                 return Ok(None);
@@ -411,6 +434,94 @@ fn threshold(pool: &mut Pool, key: Id) -> Option<(Id, Id)> {
     let e = pool.num(n.recip());
     let v = pool.pow(r, e);
     Some((base, pool.simplify(v)))
+}
+
+/// Modes of `λ⁴ + b λ² + c` for `b, c > 0` (`None` when their signs are unknown). With
+/// `Δ = b² - 4c`: `Δ > 0` gives two frequencies `ω = sqrt((b ∓ √Δ)/2)`; `Δ = 0` a double one
+/// `sqrt(b/2)`; `Δ < 0` the roots `±α ± iβ`, `α = sqrt((√c - b/2)/2)`, `β = sqrt((√c + b/2)/2)`.
+fn biquadratic_modes(pool: &mut Pool, b: Id, c: Id) -> Option<Vec<(Option<Condition>, Vec<Mode>)>> {
+    if sign_of(pool, b)? != Relation::Positive || sign_of(pool, c)? != Relation::Positive {
+        return None;
+    }
+    let b2 = pool.powi(b, 2);
+    let four = pool.int(4);
+    let c4 = pool.mul2(four, c);
+    let disc = pool.sub(b2, c4);
+    let disc = pool.expand(disc);
+    let disc = pool.simplify(disc);
+    let half = pool.num(Number::ratio(1, 2));
+    let modes_for = |pool: &mut Pool, rel: Relation| -> Vec<Mode> {
+        match rel {
+            Relation::Positive => {
+                let r = nice_sqrt(pool, disc);
+                let mut out = Vec::new();
+                for sign in [-1, 1] {
+                    let sr = if sign < 0 { pool.neg(r) } else { r };
+                    let s = pool.add2(b, sr);
+                    let s = pool.mul2(half, s);
+                    let f = pool.sqrt(s);
+                    out.push(Mode::Oscillatory {
+                        rate: Pool::ZERO,
+                        freq: pool.simplify(f),
+                        mult: 1,
+                    });
+                }
+                out
+            }
+            Relation::Zero => {
+                let s = pool.mul2(half, b);
+                let f = pool.sqrt(s);
+                vec![Mode::Oscillatory {
+                    rate: Pool::ZERO,
+                    freq: pool.simplify(f),
+                    mult: 2,
+                }]
+            }
+            Relation::Negative => {
+                let rc = pool.sqrt(c);
+                let hb = pool.mul2(half, b);
+                let a_in = pool.sub(rc, hb);
+                let a_in = pool.mul2(half, a_in);
+                let alpha = pool.sqrt(a_in);
+                let alpha = pool.simplify(alpha);
+                let b_in = pool.add2(rc, hb);
+                let b_in = pool.mul2(half, b_in);
+                let beta = pool.sqrt(b_in);
+                let beta = pool.simplify(beta);
+                let nalpha = pool.neg(alpha);
+                vec![
+                    Mode::Oscillatory {
+                        rate: alpha,
+                        freq: beta,
+                        mult: 1,
+                    },
+                    Mode::Oscillatory {
+                        rate: nalpha,
+                        freq: beta,
+                        mult: 1,
+                    },
+                ]
+            }
+        }
+    };
+    Some(match sign_of(pool, disc) {
+        Some(rel) => vec![(None, modes_for(pool, rel))],
+        None => {
+            let key = essential_sign_factor(pool, disc);
+            [Relation::Positive, Relation::Zero, Relation::Negative]
+                .into_iter()
+                .map(|rel| {
+                    (
+                        Some(Condition {
+                            expr: key,
+                            relation: rel,
+                        }),
+                        modes_for(pool, rel),
+                    )
+                })
+                .collect()
+        }
+    })
 }
 
 /// Multiplicity of `rate + i freq` among the characteristic roots.
