@@ -14,7 +14,7 @@
 //! particular solution of the same form with polynomials of degree `deg P + m`, where `m` is the
 //! multiplicity of `a + ib` as a root of `χ` (`m > 0` is resonance).
 //!
-//! Two solvers implement this:
+//! Three solvers implement this:
 //! - **exact** (one coordinate, characteristic polynomial of degree ≤ 2 after removing exact
 //!   rational roots; symbolic parameters allowed). Roots by the quadratic formula on the monic
 //!   polynomial `λ² + c₁λ + c₀`: with `α = -c₁/2` and `Δ = c₁²/4 - c₀`, the homogeneous basis is
@@ -23,7 +23,12 @@
 //!   symbolic `Δ` is unknown (the damped oscillator with symbolic `ζ`), every case is returned
 //!   with its condition. The particular solution is found by undetermined coefficients after the
 //!   exponential shift `L[e^{at} w] = e^{at} Σ_k c_k (D + a)^k w`, and the constants from the
-//!   initial conditions by exact linear solution.
+//!   initial conditions by exact linear solution. A biquadratic `λ⁴ + bλ² + c` (undamped two
+//!   degrees of freedom) is a quadratic in `λ²`, with cases by the sign of `b² - 4c`.
+//! - **elimination** (coupled systems of 2 or 3 coordinates, symbolic coefficients allowed):
+//!   each coordinate obeys `det P(D) q_j = Σ_i adj P(D)_{ji} f_i`; its initial derivatives come
+//!   from the equations solved for the highest derivatives, and the exact solver does the rest.
+//!   Uncoupled equations (the projectile) are solved one by one.
 //! - **numeric** (systems, or numeric equations whose characteristic polynomial has irrational
 //!   roots of degree ≥ 3): `χ` is interpolated from `det Σ A_k λ^k` at points on a circle, its
 //!   roots found by the Aberth–Ehrlich iteration (simultaneous Newton with repulsion) and grouped
