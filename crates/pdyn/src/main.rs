@@ -45,6 +45,26 @@ enum Command {
     Kin(kin_cmd::KinArgs),
 }
 
+/// Ends a command that reports warnings on stderr and may fail after producing output
+/// (exit 1: a run whose integration failed; exit 2: nothing could be done).
+fn finish(result: Result<(String, String, bool), String>) -> ExitCode {
+    match result {
+        Ok((out, err, ok)) => {
+            print!("{out}");
+            eprint!("{err}");
+            if ok {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            }
+        }
+        Err(msg) => {
+            eprintln!("{}", msg.trim_end());
+            ExitCode::from(2)
+        }
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
@@ -54,30 +74,8 @@ fn main() -> ExitCode {
         Command::Eval(a) => expr_cmd::eval(a),
         Command::Derive(a) => derive_cmd::run(a),
         Command::Forces(a) => forces_cmd::run(a),
-        Command::Sweep(a) => match sweep_cmd::run(a) {
-            Ok((out, err, ok)) => {
-                print!("{out}");
-                eprint!("{err}");
-                return if ok {
-                    ExitCode::SUCCESS
-                } else {
-                    ExitCode::from(1)
-                };
-            }
-            Err(e) => Err(e),
-        },
-        Command::Run(a) => match run_cmd::run(a) {
-            Ok((out, err, ok)) => {
-                print!("{out}");
-                eprint!("{err}");
-                return if ok {
-                    ExitCode::SUCCESS
-                } else {
-                    ExitCode::from(1)
-                };
-            }
-            Err(e) => Err(e),
-        },
+        Command::Sweep(a) => return finish(sweep_cmd::run(a)),
+        Command::Run(a) => return finish(run_cmd::run(a)),
         Command::Dsolve(a) => dsolve_cmd::run(a),
         Command::Kin(a) => kin_cmd::run(a),
     };

@@ -163,24 +163,30 @@ impl CompiledModel {
     /// `reactions`. A singular system gives NaN (the integrator then stops and reports it).
     pub fn unknowns(&self, t: f64, y: &[f64], acc: &mut [f64], reactions: &mut [f64]) {
         let s = &mut *self.scratch.borrow_mut();
-        s.input[0] = t;
-        s.input[1..1 + 2 * self.n].copy_from_slice(&y[..2 * self.n]);
-        match &self.engine {
-            Engine::Exact(prog) => prog.eval(&s.input, &mut s.ws, &mut s.out),
-            Engine::Numeric(_) => {
-                if let Some(sys) = s.numeric.as_mut() {
-                    if sys.solve(&s.input, &mut s.out).is_err() {
-                        s.out.iter_mut().for_each(|x| *x = f64::NAN);
-                    }
-                }
-            }
-        }
+        self.solve_into(s, t, &y[..2 * self.n]);
         for (k, slot) in self.slots.iter().enumerate() {
             match slot {
                 Ok(i) => acc[*i] = s.out[k],
                 Err(r) => {
                     if let Some(x) = reactions.get_mut(*r) {
                         *x = s.out[k];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Solves for every unknown at `(t, y)` into `s.out`. A singular system gives NaN, which
+    /// the integrator reports with the time and state.
+    fn solve_into(&self, s: &mut Scratch, t: f64, y: &[f64]) {
+        s.input[0] = t;
+        s.input[1..1 + 2 * self.n].copy_from_slice(y);
+        match &self.engine {
+            Engine::Exact(prog) => prog.eval(&s.input, &mut s.ws, &mut s.out),
+            Engine::Numeric(_) => {
+                if let Some(sys) = s.numeric.as_mut() {
+                    if sys.solve(&s.input, &mut s.out).is_err() {
+                        s.out.iter_mut().for_each(|x| *x = f64::NAN);
                     }
                 }
             }
@@ -209,18 +215,7 @@ impl OdeSystem for CompiledModel {
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
         let n = self.n;
         let s = &mut *self.scratch.borrow_mut();
-        s.input[0] = t;
-        s.input[1..1 + 2 * n].copy_from_slice(y);
-        match &self.engine {
-            Engine::Exact(prog) => prog.eval(&s.input, &mut s.ws, &mut s.out),
-            Engine::Numeric(_) => {
-                if let Some(sys) = s.numeric.as_mut() {
-                    if sys.solve(&s.input, &mut s.out).is_err() {
-                        s.out.iter_mut().for_each(|x| *x = f64::NAN);
-                    }
-                }
-            }
-        }
+        self.solve_into(s, t, y);
         dydt[..n].copy_from_slice(&y[n..]);
         for (k, slot) in self.slots.iter().enumerate() {
             if let Ok(i) = slot {
