@@ -169,8 +169,13 @@ pub struct RunResult {
 
 /// Derives, compiles, and sets up monitors and events.
 pub fn prepare(model: &mut Model) -> Result<Prepared, String> {
-    let d = derive(model, &DeriveOptions::default())
-        .map_err(|e| format!("{}: error: {e}", model.origin))?;
+    prepare_with(model, &DeriveOptions::default())
+}
+
+/// [`prepare`] with explicit derivation options (e.g. `symbolic_limit = 0` to solve `A x = b`
+/// numerically at every evaluation).
+pub fn prepare_with(model: &mut Model, opts: &DeriveOptions) -> Result<Prepared, String> {
+    let d = derive(model, opts).map_err(|e| format!("{}: error: {e}", model.origin))?;
     let system =
         CompiledModel::new(model, &d).map_err(|e| format!("{}: error: {e}", model.origin))?;
     let obs_inputs = system.observation_inputs.clone();
