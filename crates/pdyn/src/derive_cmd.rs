@@ -57,6 +57,11 @@ pub fn run(a: DeriveArgs) -> Result<String, String> {
         ..DeriveOptions::default()
     };
     let d = derive(&mut model, &opts).map_err(|e| format!("{}: error: {e}", model.origin))?;
+    let exact = if d.solution.is_some() {
+        Some(pdyn::sim::exact::closed_form(&mut model))
+    } else {
+        None
+    };
     let p = &model.pool;
     let show = |id: Id| -> String {
         if a.latex {
@@ -144,6 +149,32 @@ pub fn run(a: DeriveArgs) -> Result<String, String> {
                 a.symbolic_limit
             );
         }
+    }
+    match &exact {
+        Some(Ok(ex)) => {
+            out += "\nClosed-form solution (linear with constant coefficients):\n";
+            for (k, case) in ex.closed.cases.iter().enumerate() {
+                if let Some(c) = case.condition {
+                    let rel = match c.relation {
+                        pdyn_mech::dsolve::Relation::Positive => "> 0",
+                        pdyn_mech::dsolve::Relation::Zero => "= 0",
+                        pdyn_mech::dsolve::Relation::Negative => "< 0",
+                    };
+                    let chosen = if k == ex.case {
+                        "  <- applies to the parameter values"
+                    } else {
+                        ""
+                    };
+                    out +=
+                        &format!("  case {} ≠ {}{chosen}\n", show(c.expr), rel).replace(" ≠ ", " ");
+                }
+                for (q, &s) in ex.closed.coords.iter().zip(&case.solution) {
+                    out += &format!("  {}(t) = {}\n", p.name(*q), show(s));
+                }
+            }
+        }
+        Some(Err(why)) => out += &format!("\nNo closed form: {why}.\n"),
+        None => {}
     }
     Ok(out)
 }

@@ -37,6 +37,8 @@ enum Command {
     Forces(forces_cmd::ForcesArgs),
     /// Simulate a model file: integrate, check conservation laws, write CSV/JSON/plots.
     Run(run_cmd::RunArgs),
+    /// Integrate numerically and compare with the closed-form solution (linear models).
+    Check(run_cmd::CheckArgs),
     /// Run a model's [sweep] over parameter values in parallel and tabulate response measures.
     Sweep(sweep_cmd::SweepArgs),
     /// Solve linear constant-coefficient ODEs and systems in closed form, and the 1-D motion rules.
@@ -75,6 +77,7 @@ fn main() -> ExitCode {
         Command::Derive(a) => derive_cmd::run(a),
         Command::Forces(a) => forces_cmd::run(a),
         Command::Sweep(a) => return finish(sweep_cmd::run(a)),
+        Command::Check(a) => return finish(run_cmd::check(a)),
         Command::Run(a) => return finish(run_cmd::run(a)),
         Command::Dsolve(a) => dsolve_cmd::run(a),
         Command::Kin(a) => kin_cmd::run(a),

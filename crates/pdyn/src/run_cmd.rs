@@ -11,7 +11,8 @@ pub struct RunArgs {
     /// The model file (TOML), e.g. examples/satellite.toml.
     pub model: PathBuf,
     /// Integration method (`auto`, `dopri5`/`ode45`, `tsit5`, `dop853`, `radau5`, `rk4`,
-    /// `symplectic`, `verlet`, `yoshida4`, `kahanli6`, `kahanli8`, `gauss4`, `gauss6`);
+    /// `symplectic`, `verlet`, `yoshida4`, `kahanli6`, `kahanli8`, `gauss4`, `gauss6`, or
+    /// `exact`: the closed-form solution when the equations are linear with constant coefficients);
     /// `--method help` lists them with their papers.
     #[arg(long)]
     pub method: Option<String>,
@@ -66,6 +67,7 @@ pub fn settings(model: &pdyn_mech::Model, a: &RunArgs) -> Result<RunSettings, St
         )
     })?;
     let method = match &a.method {
+        Some(m) if m == "exact" => m.clone(),
         Some(m) => m.clone(),
         None => match &s.method {
             Some((m, span)) => {
@@ -112,8 +114,16 @@ pub fn run(a: RunArgs) -> Result<(String, String, bool), String> {
         // Plots read better from evenly spaced dense output than from raw steps.
         set.points = Some(2001);
     }
+    let res = if set.method == "exact" {
+        let exact = sim::exact::closed_form(&mut model)
+            .map_err(|e| format!("{}: error: --method exact: {e}", model.origin))?;
+        let prep = sim::prepare(&mut model)?;
+        sim::exact::run_exact(&prep, &exact, &set)
+    } else {
+        let prep = sim::prepare(&mut model)?;
+        sim::run(&prep, &set).map_err(|e| format!("{}: error: {e}", model.origin))?
+    };
     let prep = sim::prepare(&mut model)?;
-    let res = sim::run(&prep, &set).map_err(|e| format!("{}: error: {e}", model.origin))?;
     let mut err = String::new();
     for w in &res.warnings {
         err += &format!("warning: {w}\n");
@@ -198,4 +208,61 @@ fn text_report(
         );
     }
     s
+}
+
+/// `pdyn check`.
+#[derive(Args, Debug)]
+pub struct CheckArgs {
+    #[command(flatten)]
+    run: RunArgs,
+}
+
+/// `pdyn check MODEL`: integrate numerically and compare with the closed-form solution.
+pub fn check(a: CheckArgs) -> Result<(String, String, bool), String> {
+    let a = a.run;
+    let mut model = crate::derive_cmd::load(&a.model)?;
+    crate::forces_cmd::apply_set(&mut model, &a.set)?;
+    let set = settings(&model, &a)?;
+    let exact = sim::exact::closed_form(&mut model).map_err(|e| {
+        format!(
+            "{}: error: no exact solution to check against: {e}",
+            model.origin
+        )
+    })?;
+    let prep = sim::prepare(&mut model)?;
+    let rep = sim::exact::check(&prep, &exact, &set)
+        .map_err(|e| format!("{}: error: {e}", model.origin))?;
+    let worst = rep
+        .errors
+        .iter()
+        .map(|e| e.1 / e.2.max(1e-300))
+        .fold(0.0, f64::max);
+    if a.json {
+        let v = serde_json::json!({
+            "model": model.name,
+            "method": rep.run.method,
+            "rows": rep.run.rows.len(),
+            "errors": rep.errors.iter().map(|(n, e, s)| serde_json::json!({"name": n, "max_abs_error": e, "max_abs_value": s})).collect::<Vec<_>>(),
+            "max_relative_error": worst,
+        });
+        return Ok((format!("{v:#}\n"), String::new(), rep.run.failure.is_none()));
+    }
+    let mut out = format!(
+        "{}\n{} vs the closed form at {} times (t = 0..{}):\n",
+        model.name,
+        rep.run.method,
+        rep.run.rows.len(),
+        set.t_end
+    );
+    for (n, e, s) in &rep.errors {
+        out += &format!("  {n:<12} max |error| {e:.3e}   (max |value| {s:.3e})\n");
+    }
+    out += &format!("largest error relative to the size of the solution: {worst:.3e}\n");
+    let err = rep
+        .run
+        .failure
+        .clone()
+        .map(|f| format!("{f}\n"))
+        .unwrap_or_default();
+    Ok((out, err, rep.run.failure.is_none()))
 }

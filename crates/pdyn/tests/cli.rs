@@ -203,3 +203,24 @@ fn sweep_prints_the_resonances() {
     assert!((peaks[0]["at"].as_f64().unwrap() - 8.74).abs() < 0.1);
     assert!((peaks[1]["at"].as_f64().unwrap() - 22.88).abs() < 0.1);
 }
+
+#[test]
+fn derive_prints_closed_forms_and_check_compares() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/");
+    let (ok, out, err) = pdyn(&["derive", &format!("{root}rotating_rod_block.toml")]);
+    assert!(ok, "{err}");
+    assert!(out.contains("Closed-form solution"), "{out}");
+    assert!(
+        out.contains(
+            "r(t) = V*sinh(omega*t*sqrt(1 + mu^2))*exp(-mu*omega*t)/(omega*sqrt(1 + mu^2))"
+        ),
+        "{out}"
+    );
+    let (ok, out, err) = pdyn(&["check", &format!("{root}suspension.toml"), "--json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(v["max_relative_error"].as_f64().unwrap() < 1e-6, "{v}");
+    let (ok, _, err) = pdyn(&["run", &format!("{root}satellite.toml"), "--method", "exact"]);
+    assert!(!ok);
+    assert!(err.contains("no closed form"), "{err}");
+}

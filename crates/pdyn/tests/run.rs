@@ -274,3 +274,40 @@ fn analytic_jacobian_matches_finite_differences() {
     assert!(res.failure.is_none());
     assert!(res.stats.jacobians > 0);
 }
+
+/// The 2-storey building's closed form (dsolve on the derived equations) agrees with `pdyn run`.
+#[test]
+fn building_exact_solution_agrees_with_the_integration() {
+    let mut m = example("building");
+    let exact = sim::exact::closed_form(&mut m).unwrap();
+    let prep = sim::prepare(&mut m).unwrap();
+    let mut set = RunSettings::from_spec(&m.run.simulate).unwrap();
+    set.rtol = Some(1e-12);
+    set.atol = Some(1e-12);
+    let rep = sim::exact::check(&prep, &exact, &set).unwrap();
+    for (name, err, size) in &rep.errors {
+        assert!(
+            *err < 1e-8 * size.max(1.0),
+            "{name}: error {err} (size {size})"
+        );
+    }
+    let ex = sim::exact::run_exact(&prep, &exact, &set);
+    assert_eq!(ex.method, "exact");
+    assert_eq!(ex.rows.len(), rep.run.rows.len());
+    // The suspension's closed form is the chapter's.
+    let mut s = example("suspension");
+    let ex = sim::exact::closed_form(&mut s).unwrap();
+    let x = ex.closed.unique().unwrap()[0];
+    let mut scope = pdyn_expr::FreeScope::default();
+    let expected = s
+        .pool
+        .parse_in("(L - L0 + m*g/k)*cos(sqrt(k/m)*t) + L0 - m*g/k", &mut scope)
+        .unwrap()
+        .scalar()
+        .unwrap();
+    assert!(s.pool.provably_equal(x, expected), "{}", s.pool.to_text(x));
+    // Non-linear models say why there is no closed form.
+    let mut sat = example("satellite");
+    let e = sim::exact::closed_form(&mut sat).err().unwrap();
+    assert!(e.contains("use `pdyn run`"), "{e}");
+}

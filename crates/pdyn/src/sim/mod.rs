@@ -11,6 +11,7 @@
 //! linear momentum components when the resultant moment or force vanishes identically.
 
 pub mod compiled;
+pub mod exact;
 pub mod sweep;
 
 use compiled::{depends_on_time, CompiledModel, Observer};
@@ -491,7 +492,7 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, String> {
     Ok(tabulate(prep, &sol, set, failure))
 }
 
-fn tabulate(
+pub(crate) fn tabulate(
     prep: &Prepared,
     sol: &Solution,
     set: &RunSettings,

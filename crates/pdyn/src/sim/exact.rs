@@ -1,0 +1,182 @@
+//! Closed-form solutions of a model's equations (issue 7's `dsolve`, applied to derived
+//! equations): `pdyn derive` prints them, `pdyn run --method exact` evaluates them, and
+//! `pdyn check` compares them with numerical integration.
+
+use super::{tabulate, Prepared, RunResult, RunSettings};
+use pdyn_expr::{Id, Program};
+use pdyn_mech::dsolve::{solve_system, ClosedForm, Relation};
+use pdyn_mech::model::CoordinateKind;
+use pdyn_mech::{derive, DeriveOptions, Model};
+
+/// The closed-form solution of a model, with the case that applies to its parameter values.
+pub struct ExactSolution {
+    /// Every case dsolve found.
+    pub closed: ClosedForm,
+    /// The case that applies to the parameter values.
+    pub case: usize,
+    /// Inputs `[t, parameters]`, outputs `[q1, q1', q2, q2', ...]` for that case.
+    program: Program,
+    /// Number of free coordinates.
+    n: usize,
+}
+
+/// Solves the model's equations of motion in closed form, when they are linear with constant
+/// coefficients. The error says why not otherwise.
+pub fn closed_form(model: &mut Model) -> Result<ExactSolution, String> {
+    let d = derive(model, &DeriveOptions::default()).map_err(|e| e.to_string())?;
+    let acc = d
+        .accelerations()
+        .ok_or("the equations were not solved for the accelerations symbolically")?;
+    let p = &mut model.pool;
+    let n = d.free.len();
+    let mut equations = Vec::with_capacity(n);
+    let mut coords = Vec::with_capacity(n);
+    let mut initial = Vec::with_capacity(2 * n);
+    for (k, &ci) in d.free.iter().enumerate() {
+        let c = &model.coordinates[ci];
+        let qdd = p.coord(c.sym, 2);
+        equations.push(p.sub(qdd, acc[k]));
+        coords.push(c.sym);
+        if let CoordinateKind::Free { .. } = c.kind {
+            if let Some(&(_, ie, re)) = model.initial_exprs.iter().find(|(i, _, _)| *i == ci) {
+                initial.push((p.coord(c.sym, 0), ie));
+                initial.push((p.coord(c.sym, 1), re));
+            }
+        }
+    }
+    let closed = solve_system(p, &equations, &coords, &initial).map_err(|e| e.to_string())?;
+    // With numeric parameter values, the right case is the one whose condition holds.
+    let params: Vec<Id> = model.parameters.iter().map(|q| q.id).collect();
+    let values: Vec<f64> = model.parameters.iter().map(|q| q.value).collect();
+    let mut case = 0;
+    for (k, c) in closed.cases.iter().enumerate() {
+        let Some(cond) = c.condition else {
+            case = k;
+            break;
+        };
+        let prog = Program::compile(p, &params, &[cond.expr]).map_err(|e| e.to_string())?;
+        let mut ws = prog.workspace();
+        let mut out = [0.0];
+        prog.eval(&values, &mut ws, &mut out);
+        let v = out[0];
+        let holds = match cond.relation {
+            Relation::Positive => v > 1e-12,
+            Relation::Negative => v < -1e-12,
+            Relation::Zero => v.abs() <= 1e-12,
+        };
+        if holds {
+            case = k;
+            break;
+        }
+    }
+    let program = closed
+        .compile(p, case, &params)
+        .map_err(|e| e.to_string())?;
+    Ok(ExactSolution {
+        closed,
+        case,
+        program,
+        n,
+    })
+}
+
+impl ExactSolution {
+    /// The state `[q, q']` at time `t` (parameters in model order).
+    pub fn state(&self, t: f64, params: &[f64], ws: &mut Vec<f64>, y: &mut [f64]) {
+        if ws.is_empty() {
+            *ws = self.program.workspace();
+        }
+        let mut input = Vec::with_capacity(1 + params.len());
+        input.push(t);
+        input.extend_from_slice(params);
+        let mut out = vec![0.0; 2 * self.n];
+        self.program.eval(&input, ws, &mut out);
+        for k in 0..self.n {
+            y[k] = out[2 * k];
+            y[self.n + k] = out[2 * k + 1];
+        }
+    }
+}
+
+/// Output times of an exact evaluation or a check: the run's sampling, or 1001 points.
+fn times(set: &RunSettings) -> Vec<f64> {
+    if let Some(dt) = set.output_dt {
+        let steps = (set.t_end / dt).floor() as usize;
+        let mut ts: Vec<f64> = (0..=steps).map(|k| k as f64 * dt).collect();
+        if ts.last().is_some_and(|&l| l < set.t_end * (1.0 - 1e-12)) {
+            ts.push(set.t_end);
+        }
+        return ts;
+    }
+    let n = set.points.unwrap_or(1001).max(2);
+    (0..n)
+        .map(|k| set.t_end * k as f64 / (n - 1) as f64)
+        .collect()
+}
+
+/// `pdyn run --method exact`: the closed form evaluated at the output times, tabulated like
+/// a numerical run (positions, reactions, monitors, drifts).
+pub fn run_exact(prep: &Prepared, exact: &ExactSolution, set: &RunSettings) -> RunResult {
+    let ts = times(set);
+    let params = prep.system.parameters();
+    let n2 = 2 * exact.n;
+    let mut sol = pdyn_ode::Solution {
+        method: pdyn_ode::Method::Auto,
+        n: n2,
+        t: Vec::with_capacity(ts.len()),
+        y: Vec::with_capacity(ts.len() * n2),
+        events: Vec::new(),
+        stats: Default::default(),
+        status: pdyn_ode::Status::Finished,
+    };
+    let mut ws = Vec::new();
+    let mut y = vec![0.0; n2];
+    for &t in &ts {
+        exact.state(t, &params, &mut ws, &mut y);
+        sol.t.push(t);
+        sol.y.extend_from_slice(&y);
+    }
+    let mut res = tabulate(prep, &sol, set, None);
+    res.method = "exact".into();
+    res
+}
+
+/// Largest difference between a numerical run and the closed form, per state component.
+#[derive(Clone, Debug)]
+pub struct CheckReport {
+    /// `(state name, max |numeric - exact|, max |exact|)`.
+    pub errors: Vec<(String, f64, f64)>,
+    /// The numerical run.
+    pub run: RunResult,
+}
+
+/// `pdyn check`: integrates with `set` at the exact solution's sampling and compares.
+pub fn check(
+    prep: &Prepared,
+    exact: &ExactSolution,
+    set: &RunSettings,
+) -> Result<CheckReport, String> {
+    let mut set = set.clone();
+    if set.points.is_none() && set.output_dt.is_none() {
+        set.points = Some(1001);
+    }
+    let run = super::run(prep, &set)?;
+    let params = prep.system.parameters();
+    let n2 = 2 * exact.n;
+    let mut ws = Vec::new();
+    let mut y = vec![0.0; n2];
+    let mut errors: Vec<(String, f64, f64)> = prep
+        .state_names
+        .iter()
+        .map(|s| (s.clone(), 0.0, 0.0))
+        .collect();
+    for row in &run.rows {
+        exact.state(row[0], &params, &mut ws, &mut y);
+        for k in 0..n2 {
+            let e = (row[1 + k] - y[k]).abs();
+            errors[k].1 = errors[k].1.max(e);
+            errors[k].2 = errors[k].2.max(y[k].abs());
+        }
+    }
+    Ok(CheckReport { errors, run })
+}
