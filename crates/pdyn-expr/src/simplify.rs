@@ -50,14 +50,154 @@ impl Pool {
         }
         for expand_trig in [false, true] {
             if let Some(c) = self.rational_form(base, expand_trig) {
-                let cost = self.tree_size(c, best_cost + 1);
-                if cost < best_cost {
-                    best = c;
-                    best_cost = cost;
+                for cand in [c, self.contract_trig(c)] {
+                    let cost = self.tree_size(cand, best_cost + 1);
+                    if cost < best_cost {
+                        best = cand;
+                        best_cost = cost;
+                    }
                 }
             }
         }
         best
+    }
+
+    /// Contracts products of sines and cosines back into angle sums, in every sum of `e`:
+    /// `R cos a cos b ± R sin a sin b = R cos(a ∓ b)`, `R sin a cos b ± R cos a sin b =
+    /// R sin(a ± b)` (the inverse of the expansion used to find cancellations, so that results
+    /// read like `cos(theta - phi)` rather than four products).
+    pub fn contract_trig(&mut self, e: Id) -> Id {
+        let mut done: FxHashMap<Id, Id> = FxHashMap::default();
+        for n in self.topo_order(&[e]) {
+            let get = |x: &Id| done[x];
+            let r = match self.node(n).clone() {
+                Node::Add(ts) => {
+                    let ts: Vec<Id> = ts.iter().map(get).collect();
+                    let s = self.add(&ts);
+                    self.contract_sum(s)
+                }
+                Node::Mul(fs) => {
+                    let fs: Vec<Id> = fs.iter().map(get).collect();
+                    self.mul(&fs)
+                }
+                Node::Pow(b, x) => {
+                    let (b, x) = (get(&b), get(&x));
+                    self.pow(b, x)
+                }
+                Node::Call(f, args) => {
+                    let args: Vec<Id> = args.iter().map(get).collect();
+                    self.call(f, &args)
+                }
+                _ => n,
+            };
+            done.insert(n, r);
+        }
+        done[&e]
+    }
+
+    /// One sum: repeatedly merges a matching pair of terms.
+    fn contract_sum(&mut self, s: Id) -> Id {
+        let mut cur = s;
+        for _ in 0..32 {
+            let Node::Add(ts) = self.node(cur).clone() else {
+                return cur;
+            };
+            if ts.len() > 64 {
+                return cur;
+            }
+            // (term index, coefficient, rest, kind: (first fn, second fn), a, b)
+            let mut views = Vec::new();
+            for (i, &t) in ts.iter().enumerate() {
+                let (c, rest) = self.split_coeff(t);
+                let fs: Vec<Id> = match self.node(rest) {
+                    Node::Mul(fs) => fs.to_vec(),
+                    _ => vec![rest],
+                };
+                let trig: Vec<usize> = (0..fs.len())
+                    .filter(|&k| matches!(self.node(fs[k]), Node::Call(Func::Sin | Func::Cos, _)))
+                    .collect();
+                for x in 0..trig.len() {
+                    for y in x + 1..trig.len() {
+                        let (f1, f2) = (fs[trig[x]], fs[trig[y]]);
+                        let (Node::Call(k1, a1), Node::Call(k2, a2)) =
+                            (self.node(f1).clone(), self.node(f2).clone())
+                        else {
+                            continue;
+                        };
+                        if a1[0] == a2[0] {
+                            continue;
+                        }
+                        let others: Vec<Id> = fs
+                            .iter()
+                            .enumerate()
+                            .filter(|(k, _)| *k != trig[x] && *k != trig[y])
+                            .map(|(_, &f)| f)
+                            .collect();
+                        let r = self.mul(&others);
+                        views.push((i, c, r, k1, a1[0], k2, a2[0]));
+                    }
+                }
+            }
+            let mut merged = None;
+            'search: for (x, v) in views.iter().enumerate() {
+                for w in &views[x + 1..] {
+                    if v.0 == w.0 || v.2 != w.2 {
+                        continue;
+                    }
+                    // Normalise each view to (fn of a, fn of b) with a < b by id.
+                    let norm = |v: &(usize, Number, Id, Func, Id, Func, Id)| {
+                        if v.4 < v.6 {
+                            (v.3, v.4, v.5, v.6)
+                        } else {
+                            (v.5, v.6, v.3, v.4)
+                        }
+                    };
+                    let (p1, a, p2, b) = norm(v);
+                    let (q1, a2, q2, b2) = norm(w);
+                    if (a, b) != (a2, b2) {
+                        continue;
+                    }
+                    use Func::{Cos, Sin};
+                    // The anchor carries the result's coefficient: cos a cos b for a cosine,
+                    // sin a cos b for a sine; `sign` is the other term's coefficient over it.
+                    let (anchor, other, f) = match ((p1, p2), (q1, q2)) {
+                        ((Cos, Cos), (Sin, Sin)) => (v, w, Cos),
+                        ((Sin, Sin), (Cos, Cos)) => (w, v, Cos),
+                        ((Sin, Cos), (Cos, Sin)) => (v, w, Sin),
+                        ((Cos, Sin), (Sin, Cos)) => (w, v, Sin),
+                        _ => continue,
+                    };
+                    let plus = if other.1 == anchor.1 {
+                        true
+                    } else if other.1 == anchor.1.neg() {
+                        false
+                    } else {
+                        continue;
+                    };
+                    // cos a cos b ± sin a sin b = cos(a ∓ b); sin a cos b ± cos a sin b = sin(a ± b)
+                    let sum = if f == Cos { !plus } else { plus };
+                    let (v, w) = (anchor, other);
+                    let arg = if sum { self.add2(a, b) } else { self.sub(a, b) };
+                    let call = self.call(f, &[arg]);
+                    let coef = self.num(v.1);
+                    let term = self.mul(&[coef, v.2, call]);
+                    merged = Some((v.0, w.0, term));
+                    break 'search;
+                }
+            }
+            let Some((i, j, term)) = merged else {
+                return cur;
+            };
+            let mut rest: Vec<Id> = ts
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| *k != i && *k != j)
+                .map(|(_, &t)| t)
+                .collect();
+            rest.push(term);
+            cur = self.add(&rest);
+        }
+        cur
     }
 
     /// Rebuilds `e` with simplified function arguments and power bases/exponents.
@@ -405,6 +545,26 @@ mod tests {
         assert_eq!(simp("(a*b + a*c)/(b + c)"), "a");
         assert_eq!(simp("x^(3/2)/sqrt(x)"), "x");
         assert_eq!(simp("1/x + 1/y - (x + y)/(x*y)"), "0");
+    }
+
+    #[test]
+    fn trig_products_contract_to_angle_sums() {
+        let mut p = Pool::new();
+        for (src, expected) in [
+            ("cos(a)*cos(b) + sin(a)*sin(b)", "cos(a - b)"),
+            ("cos(a)*cos(b) - sin(a)*sin(b)", "cos(a + b)"),
+            ("m*g*sin(a)*cos(b) - m*g*cos(a)*sin(b)", "g*m*sin(a - b)"),
+            ("x + 2*sin(a)*cos(b) + 2*cos(a)*sin(b)", "x + 2*sin(a + b)"),
+        ] {
+            let e = p.parse_scalar(src).unwrap();
+            let c = p.contract_trig(e);
+            assert_eq!(
+                c,
+                p.parse_scalar(expected).unwrap(),
+                "{src} -> {}",
+                p.to_text(c)
+            );
+        }
     }
 
     #[test]
