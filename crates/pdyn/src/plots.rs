@@ -145,21 +145,34 @@ pub fn write_run_plots(
     Ok(())
 }
 
-/// Writes the sweep's response curves with their peaks into `dir`.
+/// Writes the sweep's response curves with their peaks into `dir`: one curve per measure and
+/// per combination of the other swept parameters.
 pub fn write_sweep_plot(
     model: &pdyn_mech::Model,
     res: &SweepResult,
-    peaks: &[(String, Vec<(f64, f64)>)],
+    peaks: &[pdyn::sim::sweep::Peaks],
     dir: &Path,
 ) -> Result<(), String> {
     let mut series = Vec::new();
     let mut markers = Vec::new();
-    for (j, name) in res.measures.iter().enumerate() {
-        let y: Vec<f64> = res.table.iter().map(|r| r[j]).collect();
-        series.push(Series::new(name.clone(), res.values.clone(), y));
-        if let Some((_, pk)) = peaks.iter().find(|(n, _)| n == name) {
-            for (x, v) in pk {
-                markers.push(Marker::point(*x, *v, format!("{} = {x:.2}", res.parameter)));
+    for (sl, pk) in res.slices.iter().zip(peaks) {
+        let suffix = if sl.fixed.is_empty() {
+            String::new()
+        } else {
+            let f: Vec<String> = sl.fixed.iter().map(|(n, v)| format!("{n} = {v}")).collect();
+            format!(" ({})", f.join(", "))
+        };
+        for (j, name) in res.measures.iter().enumerate() {
+            let y: Vec<f64> = sl.table.iter().map(|r| r[j]).collect();
+            series.push(Series::new(
+                format!("{name}{suffix}"),
+                res.values.clone(),
+                y,
+            ));
+            if let Some((_, list)) = pk.iter().find(|(n, _)| n == name) {
+                for (x, v) in list {
+                    markers.push(Marker::point(*x, *v, format!("{} = {x:.2}", res.parameter)));
+                }
             }
         }
     }

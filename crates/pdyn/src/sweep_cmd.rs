@@ -46,32 +46,49 @@ pub fn run(a: SweepArgs) -> Result<(String, String, bool), String> {
         None => sweep::sweep(&prep, &set, &spec, &stats, progress),
     };
     let mut err = String::new();
-    for (v, p) in &res.problems {
-        err += &format!("warning: {} = {v}: {p}\n", res.parameter);
+    for (at, p) in &res.problems {
+        let at: Vec<String> = at.iter().map(|(n, v)| format!("{n} = {v}")).collect();
+        err += &format!("warning: {}: {p}\n", at.join(", "));
     }
-    let peaks: Vec<(String, Vec<(f64, f64)>)> = res
-        .measures
+    // Peaks along the first parameter, per slice and measure.
+    let peaks: Vec<sweep::Peaks> = res
+        .slices
         .iter()
-        .enumerate()
-        .map(|(j, name)| {
-            let y: Vec<f64> = res.table.iter().map(|r| r[j]).collect();
-            (name.clone(), sweep::peaks(&res.values, &y))
+        .map(|sl| {
+            res.measures
+                .iter()
+                .enumerate()
+                .map(|(j, name)| {
+                    let y: Vec<f64> = sl.table.iter().map(|r| r[j]).collect();
+                    (name.clone(), sweep::peaks(&res.values, &y))
+                })
+                .collect()
         })
         .collect();
     if let Some(dir) = &a.run.out {
         std::fs::create_dir_all(dir)
             .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
         let mut csv = res.parameter.clone();
+        if let Some(sl) = res.slices.first() {
+            for (n, _) in &sl.fixed {
+                csv += &format!(",{n}");
+            }
+        }
         for m in &res.measures {
             csv += &format!(",{m}");
         }
         csv.push('\n');
-        for (v, row) in res.values.iter().zip(&res.table) {
-            csv += &format!("{v:.17e}");
-            for x in row {
-                csv += &format!(",{x:.17e}");
+        for sl in &res.slices {
+            for (v, row) in res.values.iter().zip(&sl.table) {
+                csv += &format!("{v:.17e}");
+                for (_, x) in &sl.fixed {
+                    csv += &format!(",{x:.17e}");
+                }
+                for x in row {
+                    csv += &format!(",{x:.17e}");
+                }
+                csv.push('\n');
             }
-            csv.push('\n');
         }
         let path = dir.join("sweep.csv");
         std::fs::write(&path, csv).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
@@ -79,47 +96,72 @@ pub fn run(a: SweepArgs) -> Result<(String, String, bool), String> {
             crate::plots::write_sweep_plot(&model, &res, &peaks, dir)?;
         }
     }
-    let runs_per_s = res.values.len() as f64 / res.seconds.max(1e-9);
+    let runs_per_s = res.runs as f64 / res.seconds.max(1e-9);
+    let fixed_text = |sl: &sweep::Slice| -> String {
+        let f: Vec<String> = sl.fixed.iter().map(|(n, v)| format!("{n} = {v}")).collect();
+        f.join(", ")
+    };
     if a.run.json {
         let v = json!({
             "model": model.name,
             "parameter": res.parameter,
-            "runs": res.values.len(),
+            "runs": res.runs,
             "seconds": res.seconds,
             "runs_per_second": runs_per_s,
             "threads": res.threads,
             "values": res.values,
-            "measures": res.measures.iter().enumerate().map(|(j, m)| json!({
-                "name": m,
-                "values": res.table.iter().map(|r| r[j]).collect::<Vec<_>>(),
-                "peaks": peaks[j].1.iter().map(|(x, y)| json!({"at": x, "value": y})).collect::<Vec<_>>(),
+            "slices": res.slices.iter().zip(&peaks).map(|(sl, pk)| json!({
+                "fixed": sl.fixed.iter().map(|(n, v)| (n.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
+                "measures": res.measures.iter().enumerate().map(|(j, m)| json!({
+                    "name": m,
+                    "values": sl.table.iter().map(|r| r[j]).collect::<Vec<_>>(),
+                    "peaks": pk[j].1.iter().map(|(x, y)| json!({"at": x, "value": y})).collect::<Vec<_>>(),
+                })).collect::<Vec<_>>(),
             })).collect::<Vec<_>>(),
-            "problems": res.problems.iter().map(|(v, p)| json!({"value": v, "message": p})).collect::<Vec<_>>(),
+            "problems": res.problems.iter().map(|(at, p)| json!({
+                "at": at.iter().map(|(n, v)| (n.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
+                "message": p,
+            })).collect::<Vec<_>>(),
         });
         return Ok((format!("{v:#}\n"), err, true));
     }
     let mut out = format!(
-        "{}\nsweep over {} ({} values) in {:.3} s on {} threads: {:.1} runs/s\n",
+        "{}\nsweep over {} ({} runs) in {:.3} s on {} threads: {:.1} runs/s\n",
         model.name,
-        res.parameter,
-        res.values.len(),
+        if res.slices.len() > 1 {
+            format!(
+                "{} x {} combinations of the others",
+                res.parameter,
+                res.slices.len()
+            )
+        } else {
+            res.parameter.clone()
+        },
+        res.runs,
         res.seconds,
         res.threads,
         runs_per_s
     );
-    for (name, pk) in &peaks {
-        let list: Vec<String> = pk
-            .iter()
-            .map(|(x, y)| format!("{} = {x:.4} ({y:.4e})", res.parameter))
-            .collect();
-        out += &format!(
-            "  {name}: peaks at {}\n",
-            if list.is_empty() {
-                "none".to_string()
-            } else {
-                list.join(", ")
-            }
-        );
+    for (sl, pk) in res.slices.iter().zip(&peaks) {
+        let prefix = if sl.fixed.is_empty() {
+            String::new()
+        } else {
+            format!("[{}] ", fixed_text(sl))
+        };
+        for (name, p) in pk {
+            let list: Vec<String> = p
+                .iter()
+                .map(|(x, y)| format!("{} = {x:.4} ({y:.4e})", res.parameter))
+                .collect();
+            out += &format!(
+                "  {prefix}{name}: peaks at {}\n",
+                if list.is_empty() {
+                    "none".to_string()
+                } else {
+                    list.join(", ")
+                }
+            );
+        }
     }
     if let Some(dir) = &a.run.out {
         out += &format!("wrote {}/sweep.csv\n", dir.display());

@@ -154,7 +154,8 @@ fn building_sweep_finds_the_natural_frequencies() {
     let prep = sim::prepare(&mut m).unwrap();
     let res = sim::sweep::sweep(&prep, &set, &spec, &stats, false);
     assert!(res.problems.is_empty(), "{:?}", res.problems);
-    let y: Vec<f64> = res.table.iter().map(|r| r[0]).collect();
+    assert_eq!(res.slices.len(), 1);
+    let y: Vec<f64> = res.slices[0].table.iter().map(|r| r[0]).collect();
     let peaks = sim::sweep::peaks(&res.values, &y);
     let resolution = res.values[1] - res.values[0];
     // k = 100, m = 1: omega^2 = (k/m)(3 -+ sqrt(5))
@@ -310,4 +311,42 @@ fn building_exact_solution_agrees_with_the_integration() {
     let mut sat = example("satellite");
     let e = sim::exact::closed_form(&mut sat).err().unwrap();
     assert!(e.contains("use `pdyn run`"), "{e}");
+}
+
+/// A sweep over two parameters covers the grid: the building is linear, so the response to the
+/// ground amplitude d0 doubles when d0 doubles, at every frequency.
+#[test]
+fn two_parameter_sweep_covers_the_grid() {
+    let path = format!(
+        "{}/../../examples/building.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let src = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace(
+            "from = 2.0\nto = 30.0\nsteps = 281",
+            "values = [5.0, 8.0, 12.0]",
+        )
+        .replace(
+            "[sweep.measures]",
+            "[sweep.also]\nd0 = [0.05, 0.1]\n\n[sweep.measures]",
+        );
+    let mut m =
+        pdyn_mech::load(&src, "building2.toml").unwrap_or_else(|e| panic!("{}", e.render(&src)));
+    let set = RunSettings::from_spec(&m.run.simulate).unwrap();
+    let spec = m.run.sweep.clone().unwrap();
+    let stats: Vec<_> = spec.measures.iter().map(|x| x.stat).collect();
+    let prep = sim::prepare(&mut m).unwrap();
+    let res = sim::sweep::sweep(&prep, &set, &spec, &stats, false);
+    assert_eq!(res.runs, 6);
+    assert_eq!(res.slices.len(), 2);
+    assert_eq!(res.slices[0].fixed, vec![("d0".to_string(), 0.05)]);
+    for k in 0..3 {
+        let (a, b) = (res.slices[0].table[k][0], res.slices[1].table[k][0]);
+        assert!(
+            (b / a - 2.0).abs() < 1e-6,
+            "omega = {}: {a} vs {b}",
+            res.values[k]
+        );
+    }
 }

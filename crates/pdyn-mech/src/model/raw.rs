@@ -106,6 +106,9 @@ pub struct RawSweep {
     pub steps: Option<Spanned<i64>>,
     #[serde(default)]
     pub measures: IndexMap<Name, Spanned<RawMeasure>>,
+    /// More parameters, each a list of values or `{ from, to, steps }`: the runs cover the grid.
+    #[serde(default)]
+    pub also: IndexMap<Name, Sv>,
 }
 
 /// A response measure of a sweep: a statistic of an expression over each run.

@@ -124,6 +124,9 @@ pub struct SweepSpec {
     pub values: Vec<f64>,
     /// What to record from each run.
     pub measures: Vec<Measure>,
+    /// Further parameters and their values (`[sweep.also]`): every combination is run with the
+    /// whole range of the first parameter.
+    pub others: Vec<(usize, Vec<f64>)>,
 }
 
 /// Everything `pdyn run` reads from the model file.
@@ -421,10 +424,67 @@ pub(super) fn read(
                 stat,
             });
         }
+        let mut others = Vec::new();
+        for (name, sv) in &s.also {
+            let Some(k) = parameters.iter().position(|p| &p.name == name.get_ref()) else {
+                let mut e = ld.err(
+                    name.span(),
+                    format!("`{}` is not a parameter", name.get_ref()),
+                );
+                if let Some(sg) =
+                    suggest(name.get_ref(), parameters.iter().map(|p| p.name.as_str()))
+                {
+                    e = e.help(format!("did you mean `{sg}`?"));
+                }
+                return Err(e);
+            };
+            let vals: Vec<f64> = match sv.get_ref() {
+                toml::Value::Array(a) => {
+                    let mut v = Vec::new();
+                    for x in a {
+                        match x {
+                            toml::Value::Integer(i) => v.push(*i as f64),
+                            toml::Value::Float(f) => v.push(*f),
+                            _ => return Err(ld.err(sv.span(), "values must be numbers")),
+                        }
+                    }
+                    v
+                }
+                toml::Value::Table(t) => {
+                    let num = |key: &str| -> Option<f64> {
+                        match t.get(key)? {
+                            toml::Value::Integer(i) => Some(*i as f64),
+                            toml::Value::Float(f) => Some(*f),
+                            _ => None,
+                        }
+                    };
+                    match (num("from"), num("to"), num("steps")) {
+                        (Some(a), Some(b), Some(n)) if n >= 2.0 => {
+                            let n = n as usize;
+                            (0..n)
+                                .map(|k| a + (b - a) * k as f64 / (n - 1) as f64)
+                                .collect()
+                        }
+                        _ => {
+                            return Err(ld.err(
+                                sv.span(),
+                                "a range is { from = ..., to = ..., steps = N } with N >= 2",
+                            ))
+                        }
+                    }
+                }
+                _ => return Err(ld.err(sv.span(), "give a list of values or { from, to, steps }")),
+            };
+            if vals.is_empty() {
+                return Err(ld.err(sv.span(), "no values"));
+            }
+            others.push((k, vals));
+        }
         spec.sweep = Some(SweepSpec {
             parameter: pi,
             values,
             measures,
+            others,
         });
     }
     Ok(spec)

@@ -7,23 +7,35 @@ use indicatif::{ProgressBar, ProgressStyle};
 use pdyn_mech::model::spec::{Stat, SweepSpec};
 use rayon::prelude::*;
 
-/// Results of a sweep: one row per parameter value.
+/// Results of a sweep.
 #[derive(Clone, Debug)]
 pub struct SweepResult {
-    /// Swept parameter.
+    /// The first (fastest varying) parameter.
     pub parameter: String,
     /// Its values.
     pub values: Vec<f64>,
     /// Measure names (`name` of each `[sweep.measures]` entry).
     pub measures: Vec<String>,
-    /// `table[k][j]`: measure `j` of the run at `values[k]` (NaN when the run failed).
-    pub table: Vec<Vec<f64>>,
-    /// `(value, message)` of the runs that failed or warned.
-    pub problems: Vec<(f64, String)>,
+    /// One slice per combination of the other parameters (`[sweep.also]`); a single slice when
+    /// only one parameter is swept.
+    pub slices: Vec<Slice>,
+    /// `(parameter values, message)` of the runs that failed or warned.
+    pub problems: Vec<(Vec<(String, f64)>, String)>,
+    /// Number of runs.
+    pub runs: usize,
     /// Wall time, seconds.
     pub seconds: f64,
     /// Threads used.
     pub threads: usize,
+}
+
+/// The runs over the first parameter with the other parameters fixed.
+#[derive(Clone, Debug)]
+pub struct Slice {
+    /// The other parameters' values (empty for a one-parameter sweep).
+    pub fixed: Vec<(String, f64)>,
+    /// `table[k][j]`: measure `j` of the run at `values[k]` (NaN when the run failed).
+    pub table: Vec<Vec<f64>>,
 }
 
 /// Applies a statistic to a time series.
@@ -55,91 +67,113 @@ pub fn statistic(stat: Stat, t: &[f64], x: &[f64]) -> f64 {
     }
 }
 
-/// Runs the sweep.
-pub fn sweep(
-    prep: &Prepared,
-    set: &RunSettings,
-    spec: &SweepSpec,
-    stats: &[Stat],
-    progress: bool,
-) -> SweepResult {
+/// Runs the sweep: every value of the first parameter for every combination of the others.
+pub fn sweep(prep: &Prepared, set: &RunSettings, spec: &SweepSpec, stats: &[Stat], progress: bool) -> SweepResult {
     let start = std::time::Instant::now();
+    // Combinations of the other parameters (cartesian product).
+    let mut combos: Vec<Vec<(usize, f64)>> = vec![Vec::new()];
+    for (k, vals) in &spec.others {
+        combos = combos
+            .into_iter()
+            .flat_map(|c| {
+                vals.iter().map(move |&v| {
+                    let mut c2 = c.clone();
+                    c2.push((*k, v));
+                    c2
+                })
+            })
+            .collect();
+    }
+    let jobs: Vec<(usize, f64)> = (0..combos.len())
+        .flat_map(|ci| spec.values.iter().map(move |&v| (ci, v)))
+        .collect();
     let bar = if progress {
-        let b = ProgressBar::new(spec.values.len() as u64);
-        if let Ok(style) = ProgressStyle::with_template(
-            "{spinner} sweep [{bar:40}] {pos}/{len} runs, {per_sec}, eta {eta}",
-        ) {
+        let b = ProgressBar::new(jobs.len() as u64);
+        if let Ok(style) = ProgressStyle::with_template("{spinner} sweep [{bar:40}] {pos}/{len} runs, {per_sec}, eta {eta}") {
             b.set_style(style.progress_chars("=> "));
         }
         b
     } else {
         ProgressBar::hidden()
     };
-    let measures = prep.measures.clone();
-    let n_meas = measures.as_ref().map_or(0, |m| m.len());
-    let results: Vec<(Vec<f64>, Option<String>)> = spec
-        .values
+    let n_meas = prep.measures.as_ref().map_or(0, |m| m.len());
+    let results: Vec<(Vec<f64>, Option<String>)> = jobs
         .par_iter()
         // Each worker owns a copy (the compiled programs keep per-call scratch space).
-        .map_with(prep.clone(), |base, &v| {
-            let p = base.with_parameter(spec.parameter, v);
-            let out = match run(&p, set) {
-                Err(e) => (vec![f64::NAN; n_meas], Some(e)),
-                Ok(res) => {
-                    let mut problem = res.failure.clone();
-                    if problem.is_none() && !res.warnings.is_empty() {
-                        problem = Some(res.warnings.join("; "));
-                    }
-                    let mut vals = vec![f64::NAN; n_meas];
-                    if let Some(m) = &p.measures {
-                        let n = p.system.n;
-                        let mut series = vec![Vec::with_capacity(res.rows.len()); n_meas];
-                        let mut ts = Vec::with_capacity(res.rows.len());
-                        let mut input = Vec::new();
-                        let mut out = vec![0.0; n_meas];
-                        for row in &res.rows {
-                            p.system
-                                .observation_input(row[0], &row[1..1 + 2 * n], &mut input);
-                            m.eval(&input, &mut out);
-                            ts.push(row[0]);
-                            for (s, &o) in series.iter_mut().zip(&out) {
-                                s.push(o);
-                            }
-                        }
-                        for (j, s) in series.iter().enumerate() {
-                            vals[j] = statistic(stats[j], &ts, s);
-                        }
-                    }
-                    (vals, problem)
-                }
-            };
+        .map_with(prep.clone(), |base, &(ci, v)| {
+            let mut p = base.with_parameter(spec.parameter, v);
+            for &(k, x) in &combos[ci] {
+                p = p.with_parameter(k, x);
+            }
+            let out = measure_run(&p, set, stats, n_meas);
             bar.inc(1);
             out
         })
         .collect();
     bar.finish_and_clear();
-    let mut table = Vec::with_capacity(results.len());
+    let name = |k: usize| prep.parameter_names.get(k).cloned().unwrap_or_default();
+    let mut slices: Vec<Slice> = combos
+        .iter()
+        .map(|c| Slice {
+            fixed: c.iter().map(|&(k, x)| (name(k), x)).collect(),
+            table: Vec::with_capacity(spec.values.len()),
+        })
+        .collect();
     let mut problems = Vec::new();
-    for (&v, (vals, prob)) in spec.values.iter().zip(results) {
-        table.push(vals);
+    for (&(ci, v), (vals, prob)) in jobs.iter().zip(results) {
+        slices[ci].table.push(vals);
         if let Some(p) = prob {
-            problems.push((v, p));
+            let mut at = vec![(name(spec.parameter), v)];
+            at.extend(slices[ci].fixed.iter().cloned());
+            problems.push((at, p));
         }
     }
     SweepResult {
-        parameter: prep
-            .parameter_names
-            .get(spec.parameter)
-            .cloned()
-            .unwrap_or_default(),
+        parameter: name(spec.parameter),
         values: spec.values.clone(),
-        measures: measures.map(|m| m.names.clone()).unwrap_or_default(),
-        table,
+        measures: prep.measures.as_ref().map(|m| m.names.clone()).unwrap_or_default(),
+        slices,
         problems,
+        runs: jobs.len(),
         seconds: start.elapsed().as_secs_f64(),
         threads: rayon::current_num_threads(),
     }
 }
+
+/// One run and its measures.
+fn measure_run(p: &Prepared, set: &RunSettings, stats: &[Stat], n_meas: usize) -> (Vec<f64>, Option<String>) {
+    let res = match run(p, set) {
+        Err(e) => return (vec![f64::NAN; n_meas], Some(e)),
+        Ok(r) => r,
+    };
+    let mut problem = res.failure.clone();
+    if problem.is_none() && !res.warnings.is_empty() {
+        problem = Some(res.warnings.join("; "));
+    }
+    let mut vals = vec![f64::NAN; n_meas];
+    if let Some(m) = &p.measures {
+        let n = p.system.n;
+        let mut series = vec![Vec::with_capacity(res.rows.len()); n_meas];
+        let mut ts = Vec::with_capacity(res.rows.len());
+        let mut input = Vec::new();
+        let mut out = vec![0.0; n_meas];
+        for row in &res.rows {
+            p.system.observation_input(row[0], &row[1..1 + 2 * n], &mut input);
+            m.eval(&input, &mut out);
+            ts.push(row[0]);
+            for (s, &o) in series.iter_mut().zip(&out) {
+                s.push(o);
+            }
+        }
+        for (j, s) in series.iter().enumerate() {
+            vals[j] = statistic(stats[j], &ts, s);
+        }
+    }
+    (vals, problem)
+}
+
+/// Peaks of each measure along the first parameter: `(measure name, [(at, value)])`.
+pub type Peaks = Vec<(String, Vec<(f64, f64)>)>;
 
 /// Local maxima of `y(x)` that stand above their neighbourhood: the resonance peaks of a
 /// frequency sweep. Returned as `(x, y)`, refined by a parabola through the three samples.
