@@ -68,7 +68,13 @@ pub fn statistic(stat: Stat, t: &[f64], x: &[f64]) -> f64 {
 }
 
 /// Runs the sweep: every value of the first parameter for every combination of the others.
-pub fn sweep(prep: &Prepared, set: &RunSettings, spec: &SweepSpec, stats: &[Stat], progress: bool) -> SweepResult {
+pub fn sweep(
+    prep: &Prepared,
+    set: &RunSettings,
+    spec: &SweepSpec,
+    stats: &[Stat],
+    progress: bool,
+) -> SweepResult {
     let start = std::time::Instant::now();
     // Combinations of the other parameters (cartesian product).
     let mut combos: Vec<Vec<(usize, f64)>> = vec![Vec::new()];
@@ -89,7 +95,9 @@ pub fn sweep(prep: &Prepared, set: &RunSettings, spec: &SweepSpec, stats: &[Stat
         .collect();
     let bar = if progress {
         let b = ProgressBar::new(jobs.len() as u64);
-        if let Ok(style) = ProgressStyle::with_template("{spinner} sweep [{bar:40}] {pos}/{len} runs, {per_sec}, eta {eta}") {
+        if let Ok(style) = ProgressStyle::with_template(
+            "{spinner} sweep [{bar:40}] {pos}/{len} runs, {per_sec}, eta {eta}",
+        ) {
             b.set_style(style.progress_chars("=> "));
         }
         b
@@ -131,7 +139,11 @@ pub fn sweep(prep: &Prepared, set: &RunSettings, spec: &SweepSpec, stats: &[Stat
     SweepResult {
         parameter: name(spec.parameter),
         values: spec.values.clone(),
-        measures: prep.measures.as_ref().map(|m| m.names.clone()).unwrap_or_default(),
+        measures: prep
+            .measures
+            .as_ref()
+            .map(|m| m.names.clone())
+            .unwrap_or_default(),
         slices,
         problems,
         runs: jobs.len(),
@@ -141,7 +153,12 @@ pub fn sweep(prep: &Prepared, set: &RunSettings, spec: &SweepSpec, stats: &[Stat
 }
 
 /// One run and its measures.
-fn measure_run(p: &Prepared, set: &RunSettings, stats: &[Stat], n_meas: usize) -> (Vec<f64>, Option<String>) {
+fn measure_run(
+    p: &Prepared,
+    set: &RunSettings,
+    stats: &[Stat],
+    n_meas: usize,
+) -> (Vec<f64>, Option<String>) {
     let res = match run(p, set) {
         Err(e) => return (vec![f64::NAN; n_meas], Some(e)),
         Ok(r) => r,
@@ -158,7 +175,8 @@ fn measure_run(p: &Prepared, set: &RunSettings, stats: &[Stat], n_meas: usize) -
         let mut input = Vec::new();
         let mut out = vec![0.0; n_meas];
         for row in &res.rows {
-            p.system.observation_input(row[0], &row[1..1 + 2 * n], &mut input);
+            p.system
+                .observation_input(row[0], &row[1..1 + 2 * n], &mut input);
             m.eval(&input, &mut out);
             ts.push(row[0]);
             for (s, &o) in series.iter_mut().zip(&out) {
