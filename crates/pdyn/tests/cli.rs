@@ -198,7 +198,7 @@ fn sweep_prints_the_resonances() {
     let (ok, out, err) = pdyn(&["sweep", &format!("{root}building.toml"), "--json"]);
     assert!(ok, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-    let peaks = v["measures"][0]["peaks"].as_array().unwrap();
+    let peaks = v["slices"][0]["measures"][0]["peaks"].as_array().unwrap();
     assert_eq!(peaks.len(), 2);
     assert!((peaks[0]["at"].as_f64().unwrap() - 8.74).abs() < 0.1);
     assert!((peaks[1]["at"].as_f64().unwrap() - 22.88).abs() < 0.1);
