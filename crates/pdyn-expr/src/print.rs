@@ -15,12 +15,17 @@ enum Factor {
     Power(Id, Number),
     /// `base^exp` with a symbolic exponent.
     Symbolic(Id, Id),
+    /// One square root gathering several positive bases: `sqrt(g*mu/r)` instead of
+    /// `sqrt(g)*sqrt(mu)/sqrt(r)` (index ranges into [`Fraction::roots`]).
+    Root(usize),
 }
 
 struct Fraction {
     negative: bool,
     num: Vec<Factor>,
     den: Vec<Factor>,
+    /// Bases under a merged square root: (numerator bases, denominator bases).
+    roots: Vec<(Vec<Id>, Vec<Id>)>,
 }
 
 fn fraction(p: &Pool, id: Id) -> Fraction {
@@ -28,6 +33,7 @@ fn fraction(p: &Pool, id: Id) -> Fraction {
         negative: false,
         num: Vec::new(),
         den: Vec::new(),
+        roots: Vec::new(),
     };
     let factors: Vec<Id> = match p.node(id) {
         Node::Mul(fs) => fs.to_vec(),
@@ -61,6 +67,29 @@ fn fraction(p: &Pool, id: Id) -> Fraction {
             },
             _ => f.num.push(Factor::Power(x, Number::ONE)),
         }
+    }
+    // Merge square roots of positive bases (safe: sqrt(a)*sqrt(b) = sqrt(a*b) for a, b > 0, and
+    // the parser splits it back the same way).
+    let half = Number::ratio(1, 2);
+    let is_root = |x: &Factor| matches!(x, Factor::Power(b, e) if *e == half && p.is_positive(*b));
+    let count =
+        f.num.iter().filter(|x| is_root(x)).count() + f.den.iter().filter(|x| is_root(x)).count();
+    if count >= 2 {
+        let take = |v: &mut Vec<Factor>| -> Vec<Id> {
+            let bases = v
+                .iter()
+                .filter_map(|x| match x {
+                    Factor::Power(b, e) if *e == half && p.is_positive(*b) => Some(*b),
+                    _ => None,
+                })
+                .collect();
+            v.retain(|x| !is_root(x));
+            bases
+        };
+        let nb = take(&mut f.num);
+        let db = take(&mut f.den);
+        f.roots.push((nb, db));
+        f.num.push(Factor::Root(0));
     }
     f
 }
@@ -158,12 +187,12 @@ impl TextPrinter<'_> {
     /// A term without its sign: (is negative, text).
     fn term(&self, id: Id) -> (bool, String) {
         let f = fraction(self.pool, id);
-        let num = self.factors(&f.num);
+        let num = self.factors(&f.num, &f.roots);
         let num = if num.is_empty() { "1".to_string() } else { num };
         if f.den.is_empty() {
             return (f.negative, num);
         }
-        let den = self.factors(&f.den);
+        let den = self.factors(&f.den, &f.roots);
         let den = if f.den.len() > 1 {
             format!("({den})")
         } else {
@@ -172,8 +201,30 @@ impl TextPrinter<'_> {
         (f.negative, format!("{num}/{den}"))
     }
 
-    fn factors(&self, fs: &[Factor]) -> String {
-        let parts: Vec<String> = fs.iter().map(|f| self.factor(*f)).collect();
+    fn factors(&self, fs: &[Factor], roots: &[(Vec<Id>, Vec<Id>)]) -> String {
+        let parts: Vec<String> = fs
+            .iter()
+            .map(|f| match f {
+                Factor::Root(k) => {
+                    let (nb, db) = &roots[*k];
+                    let list = |v: &[Id]| -> String {
+                        let s: Vec<String> = v.iter().map(|&b| self.wrap(b, 3)).collect();
+                        s.join("*")
+                    };
+                    let n = if nb.is_empty() {
+                        "1".to_string()
+                    } else {
+                        list(nb)
+                    };
+                    match db.len() {
+                        0 => format!("sqrt({n})"),
+                        1 => format!("sqrt({n}/{})", list(db)),
+                        _ => format!("sqrt({n}/({}))", list(db)),
+                    }
+                }
+                _ => self.factor(*f),
+            })
+            .collect();
         parts.join("*")
     }
 
@@ -190,6 +241,7 @@ impl TextPrinter<'_> {
                 };
                 format!("{}^{es}", self.wrap(b, 4))
             }
+            Factor::Root(_) => String::new(),
             Factor::Symbolic(b, e) => {
                 let es = if precedence(p, e) >= 4 && !p.looks_negative(e) {
                     self.expr(e)
@@ -340,7 +392,7 @@ impl LatexPrinter<'_> {
     fn term(&self, id: Id) -> (bool, String) {
         let f = fraction(self.pool, id);
         if f.den.is_empty() {
-            let num = self.factors(&f.num);
+            let num = self.factors(&f.num, &f.roots);
             return (
                 f.negative,
                 if num.is_empty() { "1".to_string() } else { num },
@@ -351,17 +403,39 @@ impl LatexPrinter<'_> {
             match fs {
                 [] => "1".to_string(),
                 [Factor::Power(b, e)] if e.is_one() => self.expr(*b),
-                _ => self.factors(fs),
+                _ => self.factors(fs, &f.roots),
             }
         };
         let (n, d) = (side(&f.num), side(&f.den));
         (f.negative, format!("\\frac{{{n}}}{{{d}}}"))
     }
 
-    fn factors(&self, fs: &[Factor]) -> String {
+    fn factors(&self, fs: &[Factor], roots: &[(Vec<Id>, Vec<Id>)]) -> String {
         let mut s = String::new();
         for (i, f) in fs.iter().enumerate() {
-            let part = self.factor(*f);
+            let part = match f {
+                Factor::Root(k) => {
+                    let (nb, db) = &roots[*k];
+                    let list = |v: &[Id]| -> String {
+                        let parts: Vec<String> = v
+                            .iter()
+                            .map(|&b| self.factor(Factor::Power(b, Number::ONE)))
+                            .collect();
+                        parts.join(" ")
+                    };
+                    let n = if nb.is_empty() {
+                        "1".to_string()
+                    } else {
+                        list(nb)
+                    };
+                    if db.is_empty() {
+                        format!("\\sqrt{{{n}}}")
+                    } else {
+                        format!("\\sqrt{{\\frac{{{n}}}{{{}}}}}", list(db))
+                    }
+                }
+                _ => self.factor(*f),
+            };
             if i > 0 {
                 s += if part.starts_with(|c: char| c.is_ascii_digit()) {
                     " \\cdot "
@@ -408,6 +482,7 @@ impl LatexPrinter<'_> {
                 format!("{}^{{{es}}}", base(b))
             }
             Factor::Symbolic(b, e) => format!("{}^{{{}}}", base(b), self.expr(e)),
+            Factor::Root(_) => String::new(),
         }
     }
 }
@@ -505,6 +580,22 @@ mod tests {
         assert_eq!(text("x''*R"), "R*x''");
         assert_eq!(text("(a+b)^2"), "(a + b)^2");
         assert_eq!(text("2^(-x)"), "2^(-x)");
+    }
+
+    #[test]
+    fn square_roots_of_positive_factors_merge() {
+        let mut p = Pool::new();
+        for n in ["g", "mu", "r"] {
+            let s = p.symbol(n, true);
+            let _ = p.sym(s);
+        }
+        let e = p.parse_scalar("sqrt(g*mu/r)").unwrap();
+        assert_eq!(p.to_text(e), "sqrt(g*mu/r)");
+        assert_eq!(p.parse_scalar("sqrt(g*mu/r)").unwrap(), e);
+        assert_eq!(p.to_latex(e), "\\sqrt{\\frac{g \\mu}{r}}");
+        // Not for symbols of unknown sign: sqrt(a)*sqrt(b) is not sqrt(a*b) for a, b < 0.
+        let e = p.parse_scalar("sqrt(a)*sqrt(b)").unwrap();
+        assert_eq!(p.to_text(e), "sqrt(a)*sqrt(b)");
     }
 
     #[test]

@@ -139,6 +139,18 @@ proptest! {
     }
 
     #[test]
+    fn printed_text_reparses_with_positive_symbols(text in expr_text(false)) {
+        // Declared-positive symbols take other canonical paths (sqrt(a^2) = a, merged roots).
+        let mut pool = Pool::new();
+        let mut scope = FreeScope::with_coordinates(["x"]);
+        scope.positive = ["a".to_string(), "b".to_string()].into_iter().collect();
+        let e = pool.parse_in(&text, &mut scope).unwrap().scalar().unwrap();
+        let printed = pool.to_text(e);
+        let again = pool.parse_in(&printed, &mut scope).unwrap().scalar().unwrap();
+        prop_assert_eq!(again, e, "{} printed as {}", text, printed);
+    }
+
+    #[test]
     fn simplify_and_expand_preserve_values(text in expr_text(false), pt in point()) {
         let mut s = setup();
         let e = parse(&mut s, &text);
