@@ -24,7 +24,7 @@ fn suspension_prints_the_chapter_form() {
     ]);
     assert!(ok, "{err}");
     assert!(
-        out.starts_with("x(t) = L0 - g*m/k + cos(sqrt(k)*t/sqrt(m))*(L - L0 + g*m/k)\n"),
+        out.starts_with("x(t) = L0 - g*m/k + cos(t*sqrt(k/m))*(L - L0 + g*m/k)\n"),
         "{out}"
     );
     assert!(out.contains("assuming m, k, L0, g > 0"), "{out}");
