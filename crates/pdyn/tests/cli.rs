@@ -1,18 +1,7 @@
 //! The `pdyn` binary, end to end.
 
-use std::process::Command;
-
-fn pdyn(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_pdyn"))
-        .args(args)
-        .output()
-        .expect("run pdyn");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+mod common;
+use common::pdyn;
 
 #[test]
 fn solves_the_rotating_bar_example() {

@@ -1,18 +1,8 @@
 //! `pdyn dsolve` end to end: the chapter's closed forms, JSON, LaTeX, and refusals.
 
+mod common;
+use common::pdyn;
 use std::process::Command;
-
-fn pdyn(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_pdyn"))
-        .args(args)
-        .output()
-        .expect("run pdyn");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 #[test]
 fn suspension_prints_the_chapter_form() {
