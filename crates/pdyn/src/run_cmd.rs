@@ -40,6 +40,9 @@ pub struct RunArgs {
     /// Output every OUTPUT_DT (default: every step).
     #[arg(long = "output-dt", alias = "t_eval_dt")]
     pub output_dt: Option<f64>,
+    /// Output exactly at these times, e.g. `--t-eval 0,0.5,1` (SciPy's `t_eval`).
+    #[arg(long = "t-eval", alias = "t_eval", value_delimiter = ',')]
+    pub t_eval: Vec<f64>,
     /// Warn when a conserved quantity drifts more than this (relative; default 5e-3).
     #[arg(long = "drift-tolerance")]
     pub drift_tolerance: Option<f64>,
@@ -95,6 +98,11 @@ pub fn settings(model: &pdyn_mech::Model, a: &RunArgs) -> Result<RunSettings, St
         max_steps: a.max_steps.or(s.max_steps),
         points: a.points.or(s.points),
         output_dt: a.output_dt.or(s.output_dt),
+        t_eval: if a.t_eval.is_empty() {
+            None
+        } else {
+            Some(a.t_eval.clone())
+        },
         drift_tolerance: a
             .drift_tolerance
             .or(s.drift_tolerance)
@@ -110,7 +118,7 @@ pub fn run(a: RunArgs) -> Result<(String, String, bool), String> {
     let mut model = crate::derive_cmd::load(&a.model)?;
     crate::forces_cmd::apply_set(&mut model, &a.set)?;
     let mut set = settings(&model, &a)?;
-    if a.plot && set.points.is_none() && set.output_dt.is_none() {
+    if a.plot && set.points.is_none() && set.output_dt.is_none() && set.t_eval.is_none() {
         // Plots read better from evenly spaced dense output than from raw steps.
         set.points = Some(2001);
     }

@@ -166,6 +166,23 @@ fn run_rejects_bad_settings_clearly() {
     ]);
     assert!(!ok);
     assert!(err.contains("--dt"), "{err}");
+    let (ok, _, err) = pdyn(&["run", &format!("{root}satellite.toml"), "--t-eval", "0,200"]);
+    assert!(!ok);
+    assert!(
+        err.contains("t_eval must be increasing times within [0, 100]"),
+        "{err}"
+    );
+    let (ok, out, err) = pdyn(&[
+        "run",
+        &format!("{root}satellite.toml"),
+        "--t-eval",
+        "0,0.5,1",
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["outputs"], 3);
+    assert_eq!(v["final"]["t"], 1.0);
     let (ok, out, _) = pdyn(&["run", &format!("{root}satellite.toml"), "--method", "help"]);
     assert!(ok);
     assert!(out.contains("dopri5") && out.contains("Dormand"), "{out}");

@@ -100,6 +100,9 @@ impl ExactSolution {
 
 /// Output times of an exact evaluation or a check: the run's sampling, or 1001 points.
 fn times(set: &RunSettings) -> Vec<f64> {
+    if let Some(ts) = &set.t_eval {
+        return ts.clone();
+    }
     if let Some(dt) = set.output_dt {
         let steps = (set.t_end / dt).floor() as usize;
         let mut ts: Vec<f64> = (0..=steps).map(|k| k as f64 * dt).collect();
@@ -157,7 +160,7 @@ pub fn check(
     set: &RunSettings,
 ) -> Result<CheckReport, String> {
     let mut set = set.clone();
-    if set.points.is_none() && set.output_dt.is_none() {
+    if set.points.is_none() && set.output_dt.is_none() && set.t_eval.is_none() {
         set.points = Some(1001);
     }
     let run = super::run(prep, &set)?;

@@ -41,6 +41,8 @@ pub struct RunSettings {
     pub points: Option<usize>,
     /// Output interval.
     pub output_dt: Option<f64>,
+    /// Output exactly at these times (SciPy's `t_eval`), through dense output.
+    pub t_eval: Option<Vec<f64>>,
     /// Relative drift of a conserved quantity that triggers a warning. Default 5e-3 (0.5 %):
     /// DOPRI5 at rtol 1e-3 on the chapter's satellite drifts by 7 (warns), at rtol 1e-5 by 1e-3.
     pub drift_tolerance: f64,
@@ -64,6 +66,7 @@ impl RunSettings {
             max_steps: s.max_steps,
             points: s.points,
             output_dt: s.output_dt,
+            t_eval: None,
             drift_tolerance: s.drift_tolerance.unwrap_or(DEFAULT_DRIFT_TOLERANCE),
         })
     }
@@ -394,7 +397,12 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, String> {
         opts.max_steps = opts.max_steps.max((set.t_end / dt).ceil() as usize + 10);
     }
     let t_end = set.t_end;
-    if let Some(npts) = set.points {
+    if let Some(ts) = &set.t_eval {
+        if ts.iter().any(|&x| !(0.0..=t_end).contains(&x)) || ts.windows(2).any(|w| w[1] <= w[0]) {
+            return Err(format!("t_eval must be increasing times within [0, {t_end}]"));
+        }
+        opts.t_eval = Some(ts.clone());
+    } else if let Some(npts) = set.points {
         opts.t_eval = Some(
             (0..npts)
                 .map(|k| t_end * k as f64 / (npts - 1) as f64)
