@@ -399,7 +399,9 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, String> {
     let t_end = set.t_end;
     if let Some(ts) = &set.t_eval {
         if ts.iter().any(|&x| !(0.0..=t_end).contains(&x)) || ts.windows(2).any(|w| w[1] <= w[0]) {
-            return Err(format!("t_eval must be increasing times within [0, {t_end}]"));
+            return Err(format!(
+                "t_eval must be increasing times within [0, {t_end}]"
+            ));
         }
         opts.t_eval = Some(ts.clone());
     } else if let Some(npts) = set.points {
