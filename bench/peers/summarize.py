@@ -18,7 +18,7 @@ for prob in ["arenstorf", "pleiades"]:
     print(f"\n#### {prob.capitalize()}: time (s), f-evaluations, final error\n")
     cols = ["pdyn/dopri5", "ode_solvers/dopri5", "differential_equations/dopri5", "scipy_solve_ivp/rk45",
             "pdyn/dop853", "ode_solvers/dop853", "differential_equations/dop853",
-            "scipy_ode_fortran/dop853", "scipy_solve_ivp/dop853", "pdyn/tsit5", "pdyn/vern9"]
+            "scipy_ode_fortran/dop853", "scipy_solve_ivp/dop853", "pdyn/tsit5", "diffsol/tsit45", "pdyn/vern9"]
     print("| tol | " + " | ".join(cols) + " |")
     print("|---" * (len(cols) + 1) + "|")
     for tol in sorted({t for (p, t) in data if p == prob}, reverse=True):
@@ -64,7 +64,8 @@ print("Best time over each family's methods at the same final error; ratio = pdy
 print("| problem | error | pdyn best | best Rust peer | ratio | best SciPy | SciPy / pdyn |")
 print("|---|---|---|---|---|---|---|")
 pd = ["pdyn/dopri5", "pdyn/dop853", "pdyn/tsit5", "pdyn/vern9"]
-rust = ["ode_solvers/dopri5", "ode_solvers/dop853", "differential_equations/dopri5", "differential_equations/dop853"]
+rust = ["ode_solvers/dopri5", "ode_solvers/dop853", "differential_equations/dopri5", "differential_equations/dop853",
+        "diffsol/tsit45"]
 sci = ["scipy_solve_ivp/rk45", "scipy_solve_ivp/dop853", "scipy_ode_fortran/dop853"]
 for prob in ["arenstorf", "pleiades"]:
     for err in [1e-2, 1e-4, 1e-6, 1e-8, 1e-10]:
@@ -79,7 +80,7 @@ for prob in ["arenstorf", "pleiades"]:
               f"{f'{ts:.2e} ({ks})' if ts else '–'} | {rs} |")
 
 print("\n#### Robertson to t = 1e11 (atol = 1e-6·rtol): time (s) / f-evaluations / max relative error\n")
-cols = ["pdyn/radau5", "scipy_solve_ivp/radau", "scipy_solve_ivp/bdf", "scipy_solve_ivp/lsoda"]
+cols = ["pdyn/radau5", "diffsol/bdf", "scipy_solve_ivp/radau", "scipy_solve_ivp/bdf", "scipy_solve_ivp/lsoda"]
 print("| rtol | " + " | ".join(cols) + " |")
 print("|---" * (len(cols) + 1) + "|")
 for tol in sorted({t for (p, t) in data if p == "robertson"}, reverse=True):

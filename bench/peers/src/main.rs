@@ -3,16 +3,18 @@
 //! against a reference, f-evaluations and wall time, on
 //! Arenstorf (4 eqs) and Pleiades (28 eqs); plus a long velocity-Verlet Kepler run.
 //! Output: CSV lines `problem,impl,method,tol,error,fevals,seconds` on stdout.
+use nalgebra::SVector as DeVec;
 use ode_solvers::{dop853::Dop853, dopri5::Dopri5, OutputType, SVector, System};
 use pdyn_ode::{solve, solve_second_order, FnSecondOrder, FnSystem, Method, Options};
-use nalgebra::SVector as DeVec;
 use std::time::Instant;
 
-const MU: f64 = 0.012277471;
-const AREN_Y0: [f64; 4] = [0.994, 0.0, 0.0, -2.001_585_106_379_082_5];
-const AREN_T: f64 = 17.065_216_560_157_963;
+mod diffsol_peer;
 
-fn arenstorf(y: &[f64], f: &mut [f64]) {
+const MU: f64 = 0.012277471;
+pub(crate) const AREN_Y0: [f64; 4] = [0.994, 0.0, 0.0, -2.001_585_106_379_082_5];
+pub(crate) const AREN_T: f64 = 17.065_216_560_157_963;
+
+pub(crate) fn arenstorf(y: &[f64], f: &mut [f64]) {
     let mup = 1.0 - MU;
     let r1 = (y[0] + MU) * (y[0] + MU) + y[1] * y[1];
     let r2 = (y[0] - mup) * (y[0] - mup) + y[1] * y[1];
@@ -24,7 +26,7 @@ fn arenstorf(y: &[f64], f: &mut [f64]) {
     f[3] = y[1] - 2.0 * y[2] - mup * y[1] / d1 - MU * y[1] / d2;
 }
 
-fn pleiades(s: &[f64], f: &mut [f64]) {
+pub(crate) fn pleiades(s: &[f64], f: &mut [f64]) {
     let (x, rest) = s.split_at(7);
     let (y, v) = rest.split_at(7);
     f[..14].copy_from_slice(v);
@@ -45,18 +47,39 @@ fn pleiades(s: &[f64], f: &mut [f64]) {
     }
 }
 
-const PLEI_Y0: [f64; 28] = [
+pub(crate) const PLEI_Y0: [f64; 28] = [
     3.0, 3.0, -1.0, -3.0, 2.0, -2.0, 2.0, 3.0, -3.0, 2.0, 0.0, 0.0, -4.0, 4.0, 0.0, 0.0, 0.0, 0.0,
     0.0, 1.75, -1.5, 0.0, 0.0, 0.0, -1.25, 1.0, 0.0, 0.0,
 ];
-const PLEI_Y3: [f64; 28] = [
-    0.3706139143970502, 3.237284092057233, -3.222559032418324, 0.6597091455775310,
-    0.3425581707156584, 1.562172101400631, -0.7003092922212495, -3.943437585517392,
-    -3.271380973972550, 5.225081843456543, -2.590612434977470, 1.198213693392275,
-    -0.2429682344935824, 1.091449240428980, 3.417003806314313, 1.354584501625501,
-    -2.590065597810775, 2.025053734714242, -1.155815100160448, -0.8072988170223021,
-    0.5952396354208710, -3.741244961234010, 0.3773459685750630, 0.9386858869551073,
-    0.3667922227200571, -0.3474046353808490, 2.344915448180937, -1.947020434263292,
+pub(crate) const PLEI_Y3: [f64; 28] = [
+    0.3706139143970502,
+    3.237284092057233,
+    -3.222559032418324,
+    0.6597091455775310,
+    0.3425581707156584,
+    1.562172101400631,
+    -0.7003092922212495,
+    -3.943437585517392,
+    -3.271380973972550,
+    5.225081843456543,
+    -2.590612434977470,
+    1.198213693392275,
+    -0.2429682344935824,
+    1.091449240428980,
+    3.417003806314313,
+    1.354584501625501,
+    -2.590065597810775,
+    2.025053734714242,
+    -1.155815100160448,
+    -0.8072988170223021,
+    0.5952396354208710,
+    -3.741244961234010,
+    0.3773459685750630,
+    0.9386858869551073,
+    0.3667922227200571,
+    -0.3474046353808490,
+    2.344915448180937,
+    -1.947020434263292,
 ];
 
 struct DeAren;
@@ -97,13 +120,16 @@ impl System<f64, SVector<f64, 28>> for OsPlei {
     }
 }
 
-fn max_err(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+pub(crate) fn max_err(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }
 
 /// Minimum wall time of `run` over enough repetitions to fill ~0.3 s (at least 5); the
 /// minimum is the most robust statistic on a shared machine.
-fn time<R>(mut run: impl FnMut() -> R) -> (f64, R) {
+pub(crate) fn time<R>(mut run: impl FnMut() -> R) -> (f64, R) {
     let t = Instant::now();
     let mut r = run();
     let once = t.elapsed().as_secs_f64().max(1e-7);
@@ -128,7 +154,10 @@ fn main() {
             let o = Options::with_tol(tol);
             let (s, sol) = time(|| solve(m, &aren, (0.0, AREN_T), &AREN_Y0, &o).unwrap());
             let e = max_err(sol.last().unwrap().1, &AREN_Y0);
-            println!("arenstorf,pdyn,{m},{tol:e},{e:e},{},{s:e}", sol.stats.fevals);
+            println!(
+                "arenstorf,pdyn,{m},{tol:e},{e:e},{},{s:e}",
+                sol.stats.fevals
+            );
             let (s, sol) = time(|| solve(m, &plei, (0.0, 3.0), &PLEI_Y0, &o).unwrap());
             let e = max_err(sol.last().unwrap().1, &PLEI_Y3);
             println!("pleiades,pdyn,{m},{tol:e},{e:e},{},{s:e}", sol.stats.fevals);
@@ -136,39 +165,133 @@ fn main() {
         // ode_solvers
         let y0 = SVector::<f64, 4>::from_row_slice(&AREN_Y0);
         let (s, (e, nf)) = time(|| {
-            let mut st = Dopri5::from_param(OsAren, 0.0, AREN_T, 0.0, y0, tol, tol, 0.9, 0.04, 0.2, 10.0, AREN_T, 0.0, 10_000_000, 1000, OutputType::Sparse);
+            let mut st = Dopri5::from_param(
+                OsAren,
+                0.0,
+                AREN_T,
+                0.0,
+                y0,
+                tol,
+                tol,
+                0.9,
+                0.04,
+                0.2,
+                10.0,
+                AREN_T,
+                0.0,
+                10_000_000,
+                1000,
+                OutputType::Sparse,
+            );
             let stats = st.integrate().unwrap();
-            (max_err(st.y_out().last().unwrap().as_slice(), &AREN_Y0), stats.num_eval)
+            (
+                max_err(st.y_out().last().unwrap().as_slice(), &AREN_Y0),
+                stats.num_eval,
+            )
         });
         println!("arenstorf,ode_solvers,dopri5,{tol:e},{e:e},{nf},{s:e}");
         let (s, (e, nf)) = time(|| {
-            let mut st = Dop853::from_param(OsAren, 0.0, AREN_T, 0.0, y0, tol, tol, 0.9, 0.0, 0.333, 6.0, AREN_T, 0.0, 10_000_000, 1000, OutputType::Sparse);
+            let mut st = Dop853::from_param(
+                OsAren,
+                0.0,
+                AREN_T,
+                0.0,
+                y0,
+                tol,
+                tol,
+                0.9,
+                0.0,
+                0.333,
+                6.0,
+                AREN_T,
+                0.0,
+                10_000_000,
+                1000,
+                OutputType::Sparse,
+            );
             let stats = st.integrate().unwrap();
-            (max_err(st.y_out().last().unwrap().as_slice(), &AREN_Y0), stats.num_eval)
+            (
+                max_err(st.y_out().last().unwrap().as_slice(), &AREN_Y0),
+                stats.num_eval,
+            )
         });
         println!("arenstorf,ode_solvers,dop853,{tol:e},{e:e},{nf},{s:e}");
         let p0 = SVector::<f64, 28>::from_row_slice(&PLEI_Y0);
         let (s, (e, nf)) = time(|| {
-            let mut st = Dopri5::from_param(OsPlei, 0.0, 3.0, 0.0, p0, tol, tol, 0.9, 0.04, 0.2, 10.0, 3.0, 0.0, 10_000_000, 1000, OutputType::Sparse);
+            let mut st = Dopri5::from_param(
+                OsPlei,
+                0.0,
+                3.0,
+                0.0,
+                p0,
+                tol,
+                tol,
+                0.9,
+                0.04,
+                0.2,
+                10.0,
+                3.0,
+                0.0,
+                10_000_000,
+                1000,
+                OutputType::Sparse,
+            );
             let stats = st.integrate().unwrap();
-            (max_err(st.y_out().last().unwrap().as_slice(), &PLEI_Y3), stats.num_eval)
+            (
+                max_err(st.y_out().last().unwrap().as_slice(), &PLEI_Y3),
+                stats.num_eval,
+            )
         });
         println!("pleiades,ode_solvers,dopri5,{tol:e},{e:e},{nf},{s:e}");
         let (s, (e, nf)) = time(|| {
-            let mut st = Dop853::from_param(OsPlei, 0.0, 3.0, 0.0, p0, tol, tol, 0.9, 0.0, 0.333, 6.0, 3.0, 0.0, 10_000_000, 1000, OutputType::Sparse);
+            let mut st = Dop853::from_param(
+                OsPlei,
+                0.0,
+                3.0,
+                0.0,
+                p0,
+                tol,
+                tol,
+                0.9,
+                0.0,
+                0.333,
+                6.0,
+                3.0,
+                0.0,
+                10_000_000,
+                1000,
+                OutputType::Sparse,
+            );
             let stats = st.integrate().unwrap();
-            (max_err(st.y_out().last().unwrap().as_slice(), &PLEI_Y3), stats.num_eval)
+            (
+                max_err(st.y_out().last().unwrap().as_slice(), &PLEI_Y3),
+                stats.num_eval,
+            )
         });
         println!("pleiades,ode_solvers,dop853,{tol:e},{e:e},{nf},{s:e}");
         // differential-equations
         use differential_equations::prelude::{DOP853, DOPRI5};
         let dy0 = DeVec::<f64, 4>::from_row_slice(&AREN_Y0);
         let dp0 = DeVec::<f64, 28>::from_row_slice(&PLEI_Y0);
-        let (s, (e, nf)) =
-            time(|| de_run!(DOPRI5::new().rtol(tol).atol(tol), DeAren, AREN_T, dy0, AREN_Y0));
+        let (s, (e, nf)) = time(|| {
+            de_run!(
+                DOPRI5::new().rtol(tol).atol(tol),
+                DeAren,
+                AREN_T,
+                dy0,
+                AREN_Y0
+            )
+        });
         println!("arenstorf,differential_equations,dopri5,{tol:e},{e:e},{nf},{s:e}");
-        let (s, (e, nf)) =
-            time(|| de_run!(DOP853::new().rtol(tol).atol(tol), DeAren, AREN_T, dy0, AREN_Y0));
+        let (s, (e, nf)) = time(|| {
+            de_run!(
+                DOP853::new().rtol(tol).atol(tol),
+                DeAren,
+                AREN_T,
+                dy0,
+                AREN_Y0
+            )
+        });
         println!("arenstorf,differential_equations,dop853,{tol:e},{e:e},{nf},{s:e}");
         let (s, (e, nf)) =
             time(|| de_run!(DOPRI5::new().rtol(tol).atol(tol), DePlei, 3.0, dp0, PLEI_Y3));
@@ -177,6 +300,7 @@ fn main() {
             time(|| de_run!(DOP853::new().rtol(tol).atol(tol), DePlei, 3.0, dp0, PLEI_Y3));
         println!("pleiades,differential_equations,dop853,{tol:e},{e:e},{nf},{s:e}");
     }
+    diffsol_peer::run(&tols);
     // Robertson to 1e11 with Radau5 (reference: Bari test set).
     let rober = pdyn_ode::FnSystemWithJacobian::new(
         3,
@@ -199,7 +323,11 @@ fn main() {
             ]);
         },
     );
-    let rref = [0.2083340149701255e-7, 0.8333360770334713e-13, 0.9999999791665050];
+    let rref = [
+        0.2083340149701255e-7,
+        0.8333360770334713e-13,
+        0.9999999791665050,
+    ];
     for &tol in &[1e-4, 1e-6, 1e-8, 1e-10] {
         let o = Options {
             rtol: tol.into(),
@@ -209,8 +337,13 @@ fn main() {
         let (s, sol) =
             time(|| solve(Method::Radau5, &rober, (0.0, 1e11), &[1.0, 0.0, 0.0], &o).unwrap());
         let y = sol.last().unwrap().1;
-        let e = (0..3).map(|i| ((y[i] - rref[i]) / rref[i]).abs()).fold(0.0, f64::max);
-        println!("robertson,pdyn,radau5,{tol:e},{e:e},{},{s:e}", sol.stats.fevals);
+        let e = (0..3)
+            .map(|i| ((y[i] - rref[i]) / rref[i]).abs())
+            .fold(0.0, f64::max);
+        println!(
+            "robertson,pdyn,radau5,{tol:e},{e:e},{},{s:e}",
+            sol.stats.fevals
+        );
     }
     // Long Kepler run: 10^7 velocity-Verlet steps, e = 0.6, 100 steps per period.
     let e: f64 = 0.6;
