@@ -124,6 +124,17 @@ impl Pool {
 
     /// Solves `sys` exactly; returns one simplified expression per unknown.
     pub fn solve_linear(&mut self, sys: &LinearSystem) -> Result<Vec<Id>, LinearError> {
+        self.solve_linear_with(sys, true)
+    }
+
+    /// Like [`Pool::solve_linear`]; with `check_consistency = false`, equations beyond the rank
+    /// are assumed to hold (they are consequences of the others, e.g. F = ma components already
+    /// satisfied by accelerations from the projected equations) instead of being proved zero.
+    pub fn solve_linear_with(
+        &mut self,
+        sys: &LinearSystem,
+        check_consistency: bool,
+    ) -> Result<Vec<Id>, LinearError> {
         let (m, n) = (sys.rows(), sys.cols());
         let mut rf = RationalForm::new(SOLVE_BUDGET, false);
         // Rows of [A | b] as polynomials, each multiplied through by its common denominator.
@@ -192,7 +203,7 @@ impl Pool {
             return Err(LinearError::Underdetermined { free });
         }
         for i in n..m {
-            if !self.poly_is_zero(&rf, &rows[i][n]) {
+            if check_consistency && !self.poly_is_zero(&rf, &rows[i][n]) {
                 return Err(LinearError::Inconsistent {
                     equation: origin[i],
                 });

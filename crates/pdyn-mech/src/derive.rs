@@ -153,6 +153,9 @@ pub struct Derivation {
     pub state_names: Vec<String>,
     /// Notes for the user (form chosen and why).
     pub notes: Vec<String>,
+    /// Declared reactions that the projected form eliminated, recovered from F = m a with the
+    /// accelerations substituted: `(name, expression of the state)`.
+    pub recovered: Vec<(String, Id)>,
 }
 
 impl Derivation {
@@ -312,6 +315,7 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
     );
 
     let (mut parts, newton, constraint_eqs) = newton_equations(model);
+    let newton_all = newton.clone();
     let p = &mut model.pool;
 
     let reaction_unknowns: Vec<Unknown> = model
@@ -440,6 +444,48 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
         })
         .collect();
 
+    // Reactions the projected form dropped, recovered from Newton's equations.
+    let mut recovered = Vec::new();
+    if form == Form::Projected {
+        let dropped: Vec<(String, Id)> = model
+            .reactions
+            .iter()
+            .filter(|r| !unknowns.iter().any(|u| u.id == r.id))
+            .map(|r| (r.name.clone(), r.id))
+            .collect();
+        if let (false, Some(sol)) = (dropped.is_empty(), &solution) {
+            let acc: FxHashMap<Id, Id> = unknowns
+                .iter()
+                .zip(sol)
+                .filter(|(u, _)| matches!(u.kind, UnknownKind::Acceleration(_)))
+                .map(|(u, &s)| (u.id, s))
+                .collect();
+            let ids: Vec<Id> = dropped.iter().map(|d| d.1).collect();
+            let mut residuals: Vec<Id> = Vec::new();
+            for e in &newton_all {
+                let r = p.sub(e.lhs, e.rhs);
+                let r = p.subs(r, &acc);
+                if ids.iter().any(|&u| p.contains(r, u)) {
+                    residuals.push(r);
+                }
+            }
+            if residuals.len() >= ids.len() {
+                if let Ok(sys) = p.linear_system(&residuals, &ids) {
+                    match p.solve_linear_with(&sys, false) {
+                        Ok(vals) => {
+                            for ((name, _), v) in dropped.iter().zip(vals) {
+                                recovered.push((name.clone(), simp(p, v, opts.simplify)));
+                            }
+                        }
+                        Err(_) => notes.push(
+                            "the declared reactions could not be recovered from F = ma".into(),
+                        ),
+                    }
+                }
+            }
+        }
+    }
+
     Ok(Derivation {
         form,
         particles: parts,
@@ -451,6 +497,7 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
         state,
         state_names,
         notes,
+        recovered,
     })
 }
 

@@ -150,6 +150,12 @@ pub fn run(a: DeriveArgs) -> Result<String, String> {
             );
         }
     }
+    if !d.recovered.is_empty() {
+        out += "\nReactions recovered from F = ma (the projected form eliminated them):\n";
+        for (n, e) in &d.recovered {
+            out += &format!("  {n} = {}\n", show(*e));
+        }
+    }
     match &exact {
         Some(Ok(ex)) => {
             out += "\nClosed-form solution (linear with constant coefficients):\n";

@@ -199,7 +199,13 @@ pub fn prepare_with(model: &mut Model, opts: &DeriveOptions) -> Result<Prepared,
     }
     for r in &model.reactions {
         names.push(r.name.clone());
-        exprs.push(r.id);
+        // Reactions the projected form eliminated come back as functions of the state.
+        let e = d
+            .recovered
+            .iter()
+            .find(|(n, _)| *n == r.name)
+            .map_or(r.id, |x| x.1);
+        exprs.push(e);
         conserved.push(false);
     }
     // Conserved quantities.
