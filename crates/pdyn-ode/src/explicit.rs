@@ -297,6 +297,43 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
 /// component in the same order as the Fortran codes, `((a_1 k_1 + a_2 k_2) + …)`, then
 /// `y + h·sum`, so results are bit-identical to Hairer's.
 #[inline(always)]
+/// Hairer's stiffness estimate `ρ = |h| ‖k_s − k_{s−1}‖ / ‖y_{n+1} − y_stage‖` (dopri5.f,
+/// dop853.f): the last two stages were evaluated at nearly the same point, so the quotient
+/// approximates the dominant eigenvalue of the Jacobian times `h`. 0 when the states coincide.
+pub(crate) fn stiffness_ratio(
+    h: f64,
+    k_last: &[f64],
+    k_prev: &[f64],
+    y_new: &[f64],
+    y_stage: &[f64],
+) -> f64 {
+    let (mut num, mut den) = (0.0, 0.0);
+    for i in 0..y_new.len() {
+        let dk = k_last[i] - k_prev[i];
+        let dy = y_new[i] - y_stage[i];
+        num += dk * dk;
+        den += dy * dy;
+    }
+    if den > 0.0 {
+        h.abs() * (num / den).sqrt()
+    } else {
+        0.0
+    }
+}
+
+/// Calls `$self.attempt_n::<S, N>(args)` with `N` the system dimension when it is one of the
+/// listed sizes (loops of compile-time length: unrolled and vectorised), `N = 0` (run-time
+/// length) otherwise. The arithmetic is the same in every variant.
+macro_rules! dispatch_dim {
+    ($self:ident, $S:ty, [$($n:literal),*], $args:tt) => {
+        match $self.n {
+            $($n => $self.attempt_n::<$S, $n> $args,)*
+            _ => $self.attempt_n::<$S, 0> $args,
+        }
+    };
+}
+pub(crate) use dispatch_dim;
+
 pub(crate) fn stage_input(y: &[f64], k: &[f64], n: usize, a_row: &[f64], h: f64, out: &mut [f64]) {
     let out = &mut out[..n];
     let y = &y[..n];

@@ -242,35 +242,25 @@ impl ExplicitRk for Tsit5 {
         rtol: &[f64],
         stats: &mut Stats,
     ) -> f64 {
-        // Small systems get loops of compile-time length (unrolled, vectorised); the
-        // arithmetic is the same in every variant.
-        match self.n {
-            1 => self.attempt_n::<S, 1>(sys, t, y, h, y_new, atol, rtol, stats),
-            2 => self.attempt_n::<S, 2>(sys, t, y, h, y_new, atol, rtol, stats),
-            3 => self.attempt_n::<S, 3>(sys, t, y, h, y_new, atol, rtol, stats),
-            4 => self.attempt_n::<S, 4>(sys, t, y, h, y_new, atol, rtol, stats),
-            6 => self.attempt_n::<S, 6>(sys, t, y, h, y_new, atol, rtol, stats),
-            8 => self.attempt_n::<S, 8>(sys, t, y, h, y_new, atol, rtol, stats),
-            _ => self.attempt_n::<S, 0>(sys, t, y, h, y_new, atol, rtol, stats),
-        }
+        crate::explicit::dispatch_dim!(
+            self,
+            S,
+            [1, 2, 3, 4, 6, 8],
+            (sys, t, y, h, y_new, atol, rtol, stats)
+        )
     }
 
     fn on_accept<S: OdeSystem + ?Sized>(&mut self, _: &S, _: f64, _: &[f64], _: &mut Stats) {}
 
     fn stiffness(&self, h: f64, y_new: &[f64]) -> f64 {
         let n = self.n;
-        let (mut num, mut den) = (0.0, 0.0);
-        for i in 0..n {
-            let dk = self.k[6 * n + i] - self.k[5 * n + i];
-            let dy = y_new[i] - self.ysti[i];
-            num += dk * dk;
-            den += dy * dy;
-        }
-        if den > 0.0 {
-            h.abs() * (num / den).sqrt()
-        } else {
-            0.0
-        }
+        crate::explicit::stiffness_ratio(
+            h,
+            &self.k[6 * n..7 * n],
+            &self.k[5 * n..6 * n],
+            &y_new[..n],
+            &self.ysti[..n],
+        )
     }
 
     fn prepare_dense<S: OdeSystem + ?Sized>(

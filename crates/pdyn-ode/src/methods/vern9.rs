@@ -468,13 +468,12 @@ impl ExplicitRk for Vern9 {
         rtol: &[f64],
         stats: &mut Stats,
     ) -> f64 {
-        match self.n {
-            1 => self.attempt_n::<S, 1>(sys, t, y, h, y_new, atol, rtol, stats),
-            2 => self.attempt_n::<S, 2>(sys, t, y, h, y_new, atol, rtol, stats),
-            4 => self.attempt_n::<S, 4>(sys, t, y, h, y_new, atol, rtol, stats),
-            6 => self.attempt_n::<S, 6>(sys, t, y, h, y_new, atol, rtol, stats),
-            _ => self.attempt_n::<S, 0>(sys, t, y, h, y_new, atol, rtol, stats),
-        }
+        crate::explicit::dispatch_dim!(
+            self,
+            S,
+            [1, 2, 4, 6],
+            (sys, t, y, h, y_new, atol, rtol, stats)
+        )
     }
 
     fn on_accept<S: OdeSystem + ?Sized>(
