@@ -67,32 +67,17 @@ impl Pool {
     /// R sin(a ± b)` (the inverse of the expansion used to find cancellations, so that results
     /// read like `cos(theta - phi)` rather than four products).
     pub fn contract_trig(&mut self, e: Id) -> Id {
-        let mut done: FxHashMap<Id, Id> = FxHashMap::default();
-        for n in self.topo_order(&[e]) {
-            let get = |x: &Id| done[x];
-            let r = match self.node(n).clone() {
-                Node::Add(ts) => {
-                    let ts: Vec<Id> = ts.iter().map(get).collect();
-                    let s = self.add(&ts);
-                    self.contract_sum(s)
+        self.rewrite(
+            e,
+            |_, _| None,
+            |p, r| {
+                if matches!(p.node(r), Node::Add(_)) {
+                    p.contract_sum(r)
+                } else {
+                    r
                 }
-                Node::Mul(fs) => {
-                    let fs: Vec<Id> = fs.iter().map(get).collect();
-                    self.mul(&fs)
-                }
-                Node::Pow(b, x) => {
-                    let (b, x) = (get(&b), get(&x));
-                    self.pow(b, x)
-                }
-                Node::Call(f, args) => {
-                    let args: Vec<Id> = args.iter().map(get).collect();
-                    self.call(f, &args)
-                }
-                _ => n,
-            };
-            done.insert(n, r);
-        }
-        done[&e]
+            },
+        )
     }
 
     /// One sum: repeatedly merges a matching pair of terms.

@@ -11,30 +11,45 @@ impl Pool {
         if map.is_empty() {
             return e;
         }
+        self.rewrite(e, |_, n| map.get(&n).copied(), |_, r| r)
+    }
+
+    /// Bottom-up rewriting shared by the transformations that rebuild an expression: for each
+    /// node (children first), `replace` may give its replacement outright; otherwise the node is
+    /// rebuilt from its rewritten children through the canonical constructors and passed to
+    /// `finish`.
+    pub(crate) fn rewrite(
+        &mut self,
+        e: Id,
+        replace: impl Fn(&Pool, Id) -> Option<Id>,
+        mut finish: impl FnMut(&mut Pool, Id) -> Id,
+    ) -> Id {
         let mut done: FxHashMap<Id, Id> = FxHashMap::default();
         for n in self.topo_order(&[e]) {
-            let r = if let Some(&v) = map.get(&n) {
-                v
-            } else {
-                let get = |x: &Id| done[x];
-                match self.node(n).clone() {
-                    Node::Add(ts) => {
-                        let ts: Vec<Id> = ts.iter().map(get).collect();
-                        self.add(&ts)
-                    }
-                    Node::Mul(fs) => {
-                        let fs: Vec<Id> = fs.iter().map(get).collect();
-                        self.mul(&fs)
-                    }
-                    Node::Pow(b, x) => {
-                        let (b, x) = (get(&b), get(&x));
-                        self.pow(b, x)
-                    }
-                    Node::Call(f, args) => {
-                        let args: Vec<Id> = args.iter().map(get).collect();
-                        self.call(f, &args)
-                    }
-                    _ => n,
+            let r = match replace(self, n) {
+                Some(v) => v,
+                None => {
+                    let get = |x: &Id| done[x];
+                    let rebuilt = match self.node(n).clone() {
+                        Node::Add(ts) => {
+                            let ts: Vec<Id> = ts.iter().map(get).collect();
+                            self.add(&ts)
+                        }
+                        Node::Mul(fs) => {
+                            let fs: Vec<Id> = fs.iter().map(get).collect();
+                            self.mul(&fs)
+                        }
+                        Node::Pow(b, x) => {
+                            let (b, x) = (get(&b), get(&x));
+                            self.pow(b, x)
+                        }
+                        Node::Call(f, args) => {
+                            let args: Vec<Id> = args.iter().map(get).collect();
+                            self.call(f, &args)
+                        }
+                        _ => n,
+                    };
+                    finish(self, rebuilt)
                 }
             };
             done.insert(n, r);
