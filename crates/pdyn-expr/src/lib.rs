@@ -26,6 +26,7 @@
 
 pub mod build;
 pub mod compile;
+mod constant;
 pub mod diff;
 pub mod error;
 pub mod expand;

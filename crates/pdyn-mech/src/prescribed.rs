@@ -72,8 +72,126 @@ pub struct ForcesResult {
     pub instant: Vec<(String, f64)>,
 }
 
-fn err(msg: impl Into<String>) -> String {
-    msg.into()
+/// Why the forces of a prescribed motion could not be found.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum ForcesError {
+    /// An `--at` name that is neither `t` nor a coordinate.
+    UnknownInstantName {
+        /// The name given.
+        name: String,
+        /// The model's coordinates.
+        coordinates: Vec<String>,
+    },
+    /// The model declares no unknown force.
+    NothingToSolve,
+    /// An equation without unknowns that does not hold: a force is missing.
+    EquationFails {
+        /// The equation's label.
+        label: String,
+        /// The unknowns.
+        unknowns: Vec<String>,
+        /// Its two sides, simplified.
+        lhs: String,
+        /// See `lhs`.
+        rhs: String,
+    },
+    /// Unknowns that no equation involves.
+    Unused {
+        /// Their names.
+        unknowns: Vec<String>,
+    },
+    /// Fewer independent equations than unknowns.
+    TooFewEquations {
+        /// Independent equations.
+        equations: usize,
+        /// The unknowns.
+        unknowns: Vec<String>,
+    },
+    /// The equations leave some unknowns free.
+    Underdetermined {
+        /// The free unknowns.
+        free: Vec<String>,
+    },
+    /// An equation contradicts the others.
+    Inconsistent {
+        /// Its label.
+        label: String,
+    },
+    /// A non-linear system without a real root in the unknowns' ranges.
+    NoRealSolution,
+    /// A `[[checks]]` entry needs the forces in closed form; they were found numerically.
+    CheckNeedsClosedForm {
+        /// The check's name.
+        check: String,
+    },
+    /// The linear algebra failed otherwise.
+    Linear(String),
+    /// Something could not be evaluated (a name without a value).
+    Compile {
+        /// What (`check `slip``), or empty.
+        what: String,
+        /// Why.
+        error: pdyn_expr::compile::CompileError,
+    },
+}
+
+impl std::fmt::Display for ForcesError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ForcesError::UnknownInstantName { name, coordinates } => write!(
+                f,
+                "--at {name}: `{name}` is not t or a coordinate (coordinates: {})",
+                coordinates.join(", ")
+            ),
+            ForcesError::NothingToSolve => f.write_str(
+                "nothing to solve for: declare reactions ([[forces]] kind = \"reaction\" or \"friction\") or [unknowns]",
+            ),
+            ForcesError::EquationFails { label, unknowns, lhs, rhs } => write!(
+                f,
+                "`{label}` involves none of the unknowns ({}) and does not hold: {lhs} = {rhs}; a force is missing",
+                unknowns.join(", ")
+            ),
+            ForcesError::Unused { unknowns } => {
+                write!(f, "no equation involves {}", unknowns.join(", "))
+            }
+            ForcesError::TooFewEquations { equations, unknowns } => write!(
+                f,
+                "{equations} independent equations at most for {} unknowns ({}): add an equation (a friction law, a \
+                 constraint) or make one of them known",
+                unknowns.len(),
+                unknowns.join(", ")
+            ),
+            ForcesError::Underdetermined { free } => write!(
+                f,
+                "the equations do not determine {}: more unknowns than independent equations",
+                free.join(", ")
+            ),
+            ForcesError::Inconsistent { label } => write!(
+                f,
+                "`{label}` contradicts the other equations: the prescribed motion is impossible with these forces"
+            ),
+            ForcesError::NoRealSolution => {
+                f.write_str("no real solution found in the unknowns' ranges")
+            }
+            ForcesError::CheckNeedsClosedForm { check } => write!(
+                f,
+                "check `{check}` needs the forces in closed form, and they were only found numerically"
+            ),
+            ForcesError::Linear(e) => f.write_str(e),
+            ForcesError::Compile { what, error } if what.is_empty() => write!(f, "{error}"),
+            ForcesError::Compile { what, error } => write!(f, "{what}: {error}"),
+        }
+    }
+}
+
+impl std::error::Error for ForcesError {}
+
+fn compile_err(error: pdyn_expr::compile::CompileError) -> ForcesError {
+    ForcesError::Compile {
+        what: String::new(),
+        error,
+    }
 }
 
 /// Evaluates expressions numerically given values for leaves.
@@ -83,8 +201,8 @@ struct Env {
 }
 
 impl Env {
-    fn eval(&self, p: &mut Pool, e: &[Id]) -> Result<Vec<f64>, String> {
-        let prog = Program::compile(p, &self.leaves, e).map_err(|x| x.to_string())?;
+    fn eval(&self, p: &mut Pool, e: &[Id]) -> Result<Vec<f64>, ForcesError> {
+        let prog = Program::compile(p, &self.leaves, e).map_err(compile_err)?;
         let mut ws = prog.workspace();
         let mut out = vec![0.0; e.len()];
         prog.eval(&self.values, &mut ws, &mut out);
@@ -93,7 +211,7 @@ impl Env {
 }
 
 /// Solves for the forces of a prescribed motion and evaluates the model's checks.
-pub fn solve_forces(model: &mut Model, opts: &ForcesOptions) -> Result<ForcesResult, String> {
+pub fn solve_forces(model: &mut Model, opts: &ForcesOptions) -> Result<ForcesResult, ForcesError> {
     let mut notes = Vec::new();
     let over_ids: Vec<Id> = model
         .checks
@@ -113,10 +231,10 @@ pub fn solve_forces(model: &mut Model, opts: &ForcesOptions) -> Result<ForcesRes
             at.insert(k.clone(), *v);
         } else {
             let names: Vec<&str> = model.coordinates.iter().map(|c| c.name.as_str()).collect();
-            return Err(err(format!(
-                "--at {k}: `{k}` is not t or a coordinate (coordinates: {})",
-                names.join(", ")
-            )));
+            return Err(ForcesError::UnknownInstantName {
+                name: k.clone(),
+                coordinates: names.iter().map(|s| s.to_string()).collect(),
+            });
         }
     }
     let mut subs: FxHashMap<Id, Id> = FxHashMap::default();
@@ -171,9 +289,7 @@ pub fn solve_forces(model: &mut Model, opts: &ForcesOptions) -> Result<ForcesRes
         unknown_ids.push(*id);
     }
     if unknown_ids.is_empty() {
-        return Err(err(
-            "nothing to solve for: declare reactions ([[forces]] kind = \"reaction\" or \"friction\") or [unknowns]",
-        ));
+        return Err(ForcesError::NothingToSolve);
     }
 
     let mut equations = Vec::new();
@@ -191,19 +307,13 @@ pub fn solve_forces(model: &mut Model, opts: &ForcesOptions) -> Result<ForcesRes
                 rhs: p.simplify(rhs),
             });
         } else if !p.provably_equal(r, Pool::ZERO) {
-            return Err(err(format!(
-                "`{}` involves none of the unknowns ({}) and does not hold: {} = {}; a force is missing",
-                e.label,
-                unknown_names.join(", "),
-                {
-                    let l = p.simplify(e.lhs);
-                    p.to_text(l)
-                },
-                {
-                    let r = p.simplify(e.rhs);
-                    p.to_text(r)
-                }
-            )));
+            let (l, r) = (p.simplify(e.lhs), p.simplify(e.rhs));
+            return Err(ForcesError::EquationFails {
+                label: e.label.clone(),
+                unknowns: unknown_names.iter().map(|s| s.to_string()).collect(),
+                lhs: p.to_text(l),
+                rhs: p.to_text(r),
+            });
         }
     }
     let unused: Vec<&str> = unknown_ids
@@ -213,16 +323,15 @@ pub fn solve_forces(model: &mut Model, opts: &ForcesOptions) -> Result<ForcesRes
         .map(|(_, n)| n.as_str())
         .collect();
     if !unused.is_empty() {
-        return Err(err(format!("no equation involves {}", unused.join(", "))));
+        return Err(ForcesError::Unused {
+            unknowns: unused.iter().map(|s| s.to_string()).collect(),
+        });
     }
     if residuals.len() < unknown_ids.len() {
-        return Err(err(format!(
-            "{} independent equations at most for {} unknowns ({}): add an equation (a friction law, a \
-             constraint) or make one of them known",
-            residuals.len(),
-            unknown_ids.len(),
-            unknown_names.join(", ")
-        )));
+        return Err(ForcesError::TooFewEquations {
+            equations: residuals.len(),
+            unknowns: unknown_names.iter().map(|s| s.to_string()).collect(),
+        });
     }
 
     // Numeric environment: parameters and the varied coordinates' values at the instant.
@@ -252,18 +361,14 @@ pub fn solve_forces(model: &mut Model, opts: &ForcesOptions) -> Result<ForcesRes
             }
             Err(LinearError::Underdetermined { free }) => {
                 let names: Vec<String> = free.iter().map(|&f| p.to_text(f)).collect();
-                return Err(err(format!(
-                    "the equations do not determine {}: more unknowns than independent equations",
-                    names.join(", ")
-                )));
+                return Err(ForcesError::Underdetermined { free: names });
             }
             Err(LinearError::Inconsistent { equation }) => {
-                return Err(err(format!(
-                    "`{}` contradicts the other equations: the prescribed motion is impossible with these forces",
-                    equations[equation].label
-                )))
+                return Err(ForcesError::Inconsistent {
+                    label: equations[equation].label.clone(),
+                })
             }
-            Err(e) => return Err(err(e.to_string())),
+            Err(e) => return Err(ForcesError::Linear(e.to_string())),
         },
         Err(LinearError::NotLinear { .. }) => {
             match polar(p, &residuals, &unknown_ids, &unknown_names, &mut notes)? {
@@ -274,7 +379,11 @@ pub fn solve_forces(model: &mut Model, opts: &ForcesOptions) -> Result<ForcesRes
                     if let Some((ui, ai)) = notes_mirror(&unknown_names, &notes) {
                         let mut m = vals.clone();
                         m[ui] = -m[ui];
-                        m[ai] += if m[ai] > 0.0 { -std::f64::consts::PI } else { std::f64::consts::PI };
+                        m[ai] += if m[ai] > 0.0 {
+                            -std::f64::consts::PI
+                        } else {
+                            std::f64::consts::PI
+                        };
                         all.push(m);
                     }
                     (Some(sol), all)
@@ -294,13 +403,13 @@ pub fn solve_forces(model: &mut Model, opts: &ForcesOptions) -> Result<ForcesRes
                         .collect();
                     let sols = newton_multistart(p, &residuals, &unknown_ids, &ranges, &env)?;
                     if sols.is_empty() {
-                        return Err(err("no real solution found in the unknowns' ranges"));
+                        return Err(ForcesError::NoRealSolution);
                     }
                     (None, sols)
                 }
             }
         }
-        Err(e) => return Err(err(e.to_string())),
+        Err(e) => return Err(ForcesError::Linear(e.to_string())),
     };
 
     let mut checks = Vec::new();
@@ -354,7 +463,7 @@ fn polar(
     unknowns: &[Id],
     names: &[String],
     notes: &mut Vec<String>,
-) -> Result<Option<Vec<Id>>, String> {
+) -> Result<Option<Vec<Id>>, ForcesError> {
     for (ai, &alpha) in unknowns.iter().enumerate() {
         let sin_a = p.call(Func::Sin, &[alpha]);
         let cos_a = p.call(Func::Cos, &[alpha]);
@@ -421,7 +530,7 @@ fn newton_multistart(
     unknowns: &[Id],
     ranges: &[(f64, f64)],
     env: &Env,
-) -> Result<Vec<Vec<f64>>, String> {
+) -> Result<Vec<Vec<f64>>, ForcesError> {
     let n = unknowns.len();
     let m = residuals.len();
     let mut leaves = env.leaves.clone();
@@ -429,7 +538,7 @@ fn newton_multistart(
     let jac = p.jacobian(residuals, unknowns);
     let mut outs = residuals.to_vec();
     outs.extend(jac);
-    let prog = Program::compile(p, &leaves, &outs).map_err(|e| e.to_string())?;
+    let prog = Program::compile(p, &leaves, &outs).map_err(compile_err)?;
     let mut ws = prog.workspace();
     let mut found: Vec<Vec<f64>> = Vec::new();
     let starts = 24;
@@ -641,13 +750,10 @@ fn run_check(
     names: &[String],
     symbolic: Option<&[Id]>,
     instant: &FxHashMap<Id, Id>,
-) -> Result<CheckResult, String> {
+) -> Result<CheckResult, ForcesError> {
     let param = &parameters[c.solve_for];
-    let sol = symbolic.ok_or_else(|| {
-        format!(
-            "check `{}` needs the forces in closed form, and they were only found numerically",
-            c.name
-        )
+    let sol = symbolic.ok_or_else(|| ForcesError::CheckNeedsClosedForm {
+        check: c.name.clone(),
     })?;
     let mut m: FxHashMap<Id, Id> = unknowns.iter().copied().zip(sol.iter().copied()).collect();
     m.extend(instant.iter().map(|(k, v)| (*k, *v)));
@@ -674,8 +780,10 @@ fn run_check(
         .collect();
     let mut outs = vec![cond];
     outs.extend(involved.iter().map(|(_, e)| *e));
-    let prog =
-        Program::compile(p, &leaves, &outs).map_err(|e| format!("check `{}`: {e}", c.name))?;
+    let prog = Program::compile(p, &leaves, &outs).map_err(|error| ForcesError::Compile {
+        what: format!("check `{}`", c.name),
+        error,
+    })?;
     let mut ws = prog.workspace();
     let mut out = vec![0.0; outs.len()];
     let pi = c.solve_for;

@@ -1,6 +1,11 @@
 //! The `pdyn` library behind the command: running models (integration, monitors, events),
-//! sweeps, and output files. The binary (`main.rs`) parses arguments and prints.
+//! sweeps, output files and plots, and the typed [`Error`] every command returns. The binary
+//! (`main.rs`, `cli/`) parses arguments, calls this and the lower crates, and prints.
 #![warn(missing_docs)]
 
+pub mod error;
 pub mod output;
+pub mod plots;
 pub mod sim;
+
+pub use error::{Error, Location};

@@ -1,21 +1,25 @@
 //! `pdyn`: the command-line front end. Thin by design: parse arguments, call the library,
-//! print. Every error becomes a message and a non-zero exit code here, and only here.
+//! print. Every failure becomes a message, a `--json` error object and an exit code here, and
+//! only here (codes: 0 success, 1 numerical failure after partial output, 2 bad input,
+//! 3 internal error — see `pdyn::error`).
 
-mod derive_cmd;
-mod dsolve_cmd;
-mod expr_cmd;
-mod forces_cmd;
-mod kin_cmd;
-mod plots;
-mod run_cmd;
-mod sweep_cmd;
+mod cli;
 
 use clap::{Parser, Subcommand};
+use cli::Outcome;
+use pdyn::Error;
 use std::process::ExitCode;
 
 /// Analyze the motion of systems of particles.
 #[derive(Parser, Debug)]
-#[command(name = "pdyn", version, about, long_about = None)]
+#[command(
+    name = "pdyn",
+    version,
+    about,
+    long_about = None,
+    after_help = "Exit codes: 0 success; 1 a numerical failure after partial output was written; \
+                  2 bad input; 3 an internal error (please report it)."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -24,75 +28,115 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Simplify an expression (Pythagorean identity, common factors, collected terms).
-    Simplify(expr_cmd::SimplifyArgs),
+    Simplify(cli::expr::SimplifyArgs),
     /// Differentiate an expression with respect to a symbol, or in time (`--wrt t`).
-    Diff(expr_cmd::DiffArgs),
+    Diff(cli::expr::DiffArgs),
     /// Solve equations that are linear in the chosen unknowns, exactly.
-    Solve(expr_cmd::SolveArgs),
+    Solve(cli::expr::SolveArgs),
     /// Evaluate an expression numerically.
-    Eval(expr_cmd::EvalArgs),
+    Eval(cli::expr::EvalArgs),
     /// Derive the equations of motion of a model file.
-    Derive(derive_cmd::DeriveArgs),
+    Derive(cli::derive::DeriveArgs),
     /// Forces required by a prescribed motion (reactions, thrust, bank angle) and design checks (slip, tip).
-    Forces(forces_cmd::ForcesArgs),
+    Forces(cli::forces::ForcesArgs),
     /// Simulate a model file: integrate, check conservation laws, write CSV/JSON/plots.
-    Run(run_cmd::RunArgs),
+    Run(cli::run::RunArgs),
     /// Integrate numerically and compare with the closed-form solution (linear models).
-    Check(run_cmd::CheckArgs),
+    Check(cli::run::CheckArgs),
     /// Run a model's [sweep] over parameter values in parallel and tabulate response measures.
-    Sweep(sweep_cmd::SweepArgs),
+    Sweep(cli::sweep::SweepArgs),
     /// Solve linear constant-coefficient ODEs and systems in closed form, and the 1-D motion rules.
-    Dsolve(dsolve_cmd::DsolveArgs),
+    Dsolve(cli::dsolve::DsolveArgs),
     /// Kinematics of a particle: velocity, acceleration, normal-tangential and polar components.
-    Kin(kin_cmd::KinArgs),
+    Kin(cli::kin::KinArgs),
 }
 
-/// Ends a command that reports warnings on stderr and may fail after producing output
-/// (exit 1: a run whose integration failed; exit 2: nothing could be done).
-fn finish(result: Result<(String, String, bool), String>) -> ExitCode {
-    match result {
-        Ok((out, err, ok)) => {
-            print!("{out}");
-            eprint!("{err}");
-            if ok {
-                ExitCode::SUCCESS
-            } else {
-                ExitCode::from(1)
-            }
-        }
-        Err(msg) => {
-            eprintln!("{}", msg.trim_end());
-            ExitCode::from(2)
-        }
+fn dispatch(command: Command) -> Result<Outcome, Error> {
+    let text = |r: Result<String, Error>| r.map(Outcome::text);
+    match command {
+        Command::Simplify(a) => text(cli::expr::simplify(a)),
+        Command::Diff(a) => text(cli::expr::diff(a)),
+        Command::Solve(a) => text(cli::expr::solve(a)),
+        Command::Eval(a) => text(cli::expr::eval(a)),
+        Command::Derive(a) => text(cli::derive::run(a)),
+        Command::Forces(a) => text(cli::forces::run(a)),
+        Command::Run(a) => cli::run::run(a),
+        Command::Check(a) => cli::run::check(a),
+        Command::Sweep(a) => cli::sweep::run(a),
+        Command::Dsolve(a) => text(cli::dsolve::run(a)),
+        Command::Kin(a) => text(cli::kin::run(a)),
     }
 }
 
+/// Whether the command line asks for JSON (decided before parsing, so that even a usage error
+/// answers in JSON).
+fn wants_json() -> bool {
+    std::env::args().skip(1).any(|a| a == "--json")
+}
+
+/// The one place where failures are rendered: the message on stderr, the JSON error object on
+/// stdout with `--json`, and the exit code.
+fn report(error: &Error, json: bool) -> ExitCode {
+    if json {
+        println!("{:#}", error.to_json());
+    }
+    eprintln!("{}", error.to_string().trim_end());
+    ExitCode::from(error.exit_code())
+}
+
+/// Last resort: a bug must not end in a raw backtrace. Print what was being run, and exit 3.
+fn install_panic_hook(json: bool) {
+    std::panic::set_hook(Box::new(move |info| {
+        let args: Vec<String> = std::env::args().collect();
+        let place = info
+            .location()
+            .map(|l| format!(" at {}:{}", l.file(), l.line()))
+            .unwrap_or_default();
+        let what = info
+            .payload()
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| info.payload().downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        let error = Error::Internal {
+            message: format!("{what}{place} (while running `{}`)", args.join(" ")),
+        };
+        report(&error, json);
+        std::process::exit(error.exit_code().into());
+    }));
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
-    let result = match cli.command {
-        Command::Simplify(a) => expr_cmd::simplify(a),
-        Command::Diff(a) => expr_cmd::diff(a),
-        Command::Solve(a) => expr_cmd::solve(a),
-        Command::Eval(a) => expr_cmd::eval(a),
-        Command::Derive(a) => derive_cmd::run(a),
-        Command::Forces(a) => forces_cmd::run(a),
-        Command::Sweep(a) => return finish(sweep_cmd::run(a)),
-        Command::Check(a) => return finish(run_cmd::check(a)),
-        Command::Run(a) => return finish(run_cmd::run(a)),
-        Command::Dsolve(a) => dsolve_cmd::run(a),
-        Command::Kin(a) => kin_cmd::run(a),
-    };
-    match result {
-        Ok(out) => {
-            print!("{out}");
-            ExitCode::SUCCESS
+    let json = wants_json();
+    install_panic_hook(json);
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => {
+            // --help and --version.
+            let _ = e.print();
+            return ExitCode::SUCCESS;
         }
-        Err(msg) => {
-            eprint!("{msg}");
-            if !msg.ends_with('\n') {
-                eprintln!();
+        Err(e) => {
+            if json {
+                let error = Error::argument("", e.to_string().trim_end());
+                println!("{:#}", error.to_json());
             }
-            ExitCode::from(2)
+            let _ = e.print();
+            return ExitCode::from(2);
         }
+    };
+    match dispatch(cli.command) {
+        Ok(outcome) => {
+            print!("{}", outcome.stdout);
+            eprint!("{}", outcome.stderr);
+            match outcome.failure {
+                None => ExitCode::SUCCESS,
+                Some(error) => {
+                    eprintln!("{}", error.to_string().trim_end());
+                    ExitCode::from(error.exit_code())
+                }
+            }
+        }
+        Err(error) => report(&error, json),
     }
 }

@@ -41,9 +41,9 @@ pub fn summary(res: &RunResult, model_name: &str, state_names: &[String]) -> ser
     };
     json!({
         "model": model_name,
-        "method": res.method,
+        "method": res.method.to_string(),
         "ok": res.failure.is_none(),
-        "failure": res.failure,
+        "failure": res.failure.as_ref().map(|f| f.to_string()),
         "final": final_state,
         "events": res.events.iter().map(|e| json!({
             "name": e.name,

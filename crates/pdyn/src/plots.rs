@@ -6,8 +6,9 @@
 //! sweep gives `sweep` (each response measure against the parameter, peaks marked). Each is
 //! written as SVG and PNG.
 
-use pdyn::sim::sweep::SweepResult;
-use pdyn::sim::{Prepared, RunResult};
+use crate::sim::sweep::SweepResult;
+use crate::sim::{Prepared, RunResult};
+use crate::Error;
 use pdyn_plot::{save, save3, save_grid, Figure, Figure3, Marker, Series, Series3};
 use std::path::Path;
 
@@ -15,10 +16,13 @@ fn both(
     dir: &Path,
     stem: &str,
     f: impl Fn(&Path) -> Result<(), pdyn_plot::PlotError>,
-) -> Result<(), String> {
+) -> Result<(), Error> {
     for ext in ["svg", "png"] {
         let path = dir.join(format!("{stem}.{ext}"));
-        f(&path).map_err(|e| format!("cannot plot {}: {e}", path.display()))?;
+        f(&path).map_err(|e| Error::Plot {
+            path: path.clone(),
+            error: e.to_string(),
+        })?;
     }
     Ok(())
 }
@@ -34,9 +38,9 @@ pub fn write_run_plots(
     prep: &Prepared,
     res: &RunResult,
     dir: &Path,
-) -> Result<(), String> {
+) -> Result<(), Error> {
     if res.rows.len() < 2 {
-        return Err("too few output points to plot".into());
+        return Err(Error::argument("--plot", "too few output points to plot"));
     }
     let t = column(res, "t").unwrap_or_default();
     let markers: Vec<Marker> = res
@@ -150,9 +154,9 @@ pub fn write_run_plots(
 pub fn write_sweep_plot(
     model: &pdyn_mech::Model,
     res: &SweepResult,
-    peaks: &[pdyn::sim::sweep::Peaks],
+    peaks: &[crate::sim::sweep::Peaks],
     dir: &Path,
-) -> Result<(), String> {
+) -> Result<(), Error> {
     let mut series = Vec::new();
     let mut markers = Vec::new();
     for (sl, pk) in res.slices.iter().zip(peaks) {
@@ -177,7 +181,10 @@ pub fn write_sweep_plot(
         }
     }
     if series.is_empty() {
-        return Err("the sweep has no measures to plot: add [sweep.measures]".into());
+        return Err(Error::argument(
+            "--plot",
+            "the sweep has no measures to plot: add [sweep.measures]",
+        ));
     }
     let fig = Figure {
         title: format!("{}: response vs {}", model.name, res.parameter),

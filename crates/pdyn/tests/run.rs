@@ -293,7 +293,7 @@ fn building_exact_solution_agrees_with_the_integration() {
         );
     }
     let ex = sim::exact::run_exact(&prep, &exact, &set);
-    assert_eq!(ex.method, "exact");
+    assert_eq!(ex.method, pdyn::sim::Solver::Exact);
     assert_eq!(ex.rows.len(), rep.run.rows.len());
     // The suspension's closed form is the chapter's.
     let mut s = example("suspension");
@@ -310,7 +310,7 @@ fn building_exact_solution_agrees_with_the_integration() {
     // Non-linear models say why there is no closed form.
     let mut sat = example("satellite");
     let e = sim::exact::closed_form(&mut sat).err().unwrap();
-    assert!(e.contains("use `pdyn run`"), "{e}");
+    assert!(e.to_string().contains("use `pdyn run`"), "{e}");
 }
 
 /// A sweep over two parameters covers the grid: the building is linear, so the response to the

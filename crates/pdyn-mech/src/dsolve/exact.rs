@@ -257,16 +257,7 @@ fn collect_like(pool: &mut Pool, y: Id) -> Id {
 
 /// Numeric value of an expression free of symbols (π, √2...).
 pub(crate) fn const_value(pool: &mut Pool, e: Id) -> Option<f64> {
-    if pool.any_node(e, &|n| {
-        matches!(n, Node::Sym(_) | Node::Coord(..) | Node::Time)
-    }) {
-        return None;
-    }
-    let prog = pdyn_expr::Program::compile(pool, &[], &[e]).ok()?;
-    let mut ws = prog.workspace();
-    let mut out = [0.0];
-    prog.eval(&[], &mut ws, &mut out);
-    out[0].is_finite().then_some(out[0])
+    pool.eval_const(e).ok().filter(|v| v.is_finite())
 }
 
 /// Drops positive factors from a product, so that `4 wn^2 (zeta^2 - 1)` reads `zeta^2 - 1`.

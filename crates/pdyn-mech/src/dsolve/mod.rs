@@ -70,12 +70,14 @@ mod numeric;
 pub mod quad;
 mod roots;
 pub mod rules;
+mod when;
 
 use pdyn_expr::{Id, Node, Pool, Program, SymId};
 use std::fmt;
 
 pub(crate) use exact::nice_sqrt;
 pub use linear::{analyze, LinearOde};
+pub use when::{when, StateAt, When};
 
 /// One initial condition: `coord^(order)(time) = value`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -183,6 +185,11 @@ pub enum DsolveError {
     NoClosedForm(String),
     /// The input is malformed (unknown coordinate, inconsistent initial conditions...).
     Invalid(String),
+    /// An instant was asked of a solution with several cases (by the sign of a symbolic
+    /// quantity): the parameters need values first.
+    SeveralCases,
+    /// The instant asked for could not be found.
+    Instant(crate::kinematics::KinError),
 }
 
 /// The advice attached to every "no closed form" answer.
@@ -193,6 +200,10 @@ impl fmt::Display for DsolveError {
         match self {
             DsolveError::NoClosedForm(why) => write!(f, "{why}: {USE_RUN}"),
             DsolveError::Invalid(why) => write!(f, "{why}"),
+            DsolveError::SeveralCases => {
+                f.write_str("the solution has several cases; give the parameters with --set")
+            }
+            DsolveError::Instant(e) => write!(f, "{e}"),
         }
     }
 }

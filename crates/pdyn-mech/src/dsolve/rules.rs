@@ -293,14 +293,9 @@ fn definite(pool: &mut Pool, e: Id, var: Id, lo: Id, hi: Id) -> Option<Id> {
     // leave it to quadrature, which reports divergence.
     if !pool.any_node(a, &|n| {
         matches!(n, Node::Sym(_) | Node::Time | Node::Coord(..))
-    }) {
-        let prog = Program::compile(pool, &[], &[a]).ok()?;
-        let mut ws = prog.workspace();
-        let mut o = [0.0];
-        prog.eval(&[], &mut ws, &mut o);
-        if !o[0].is_finite() {
-            return None;
-        }
+    }) && !pool.eval_const(a).ok()?.is_finite()
+    {
+        return None;
     }
     let b = pool.subs1(f, var, hi);
     Some(pool.sub(b, a))

@@ -312,7 +312,10 @@ impl Observer {
     }
 }
 
-/// True when `e` depends on `t` explicitly.
-pub fn depends_on_time(pool: &Pool, e: Id) -> bool {
-    pool.any_node(e, &|n| matches!(n, Node::Time))
+/// True when every leaf of `e` (symbol, coordinate derivative, `t`) is one of `inputs`: `e`
+/// can then be compiled over them.
+pub fn depends_only_on(pool: &Pool, e: Id, inputs: &[Id]) -> bool {
+    pool.topo_order(&[e]).into_iter().all(|n| {
+        !matches!(pool.node(n), Node::Sym(_) | Node::Coord(..) | Node::Time) || inputs.contains(&n)
+    })
 }

@@ -2,6 +2,7 @@
 //! equations): `pdyn derive` prints them, `pdyn run --method exact` evaluates them, and
 //! `pdyn check` compares them with numerical integration.
 
+use super::ClosedFormError;
 use super::{tabulate, Prepared, RunResult, RunSettings};
 use pdyn_expr::{Id, Program};
 use pdyn_mech::dsolve::{solve_system, ClosedForm, Relation};
@@ -22,11 +23,9 @@ pub struct ExactSolution {
 
 /// Solves the model's equations of motion in closed form, when they are linear with constant
 /// coefficients. The error says why not otherwise.
-pub fn closed_form(model: &mut Model) -> Result<ExactSolution, String> {
-    let d = derive(model, &DeriveOptions::default()).map_err(|e| e.to_string())?;
-    let acc = d
-        .accelerations()
-        .ok_or("the equations were not solved for the accelerations symbolically")?;
+pub fn closed_form(model: &mut Model) -> Result<ExactSolution, ClosedFormError> {
+    let d = derive(model, &DeriveOptions::default()).map_err(ClosedFormError::Derive)?;
+    let acc = d.accelerations().ok_or(ClosedFormError::NotSolved)?;
     let p = &mut model.pool;
     let n = d.free.len();
     let mut equations = Vec::with_capacity(n);
@@ -44,7 +43,7 @@ pub fn closed_form(model: &mut Model) -> Result<ExactSolution, String> {
             }
         }
     }
-    let closed = solve_system(p, &equations, &coords, &initial).map_err(|e| e.to_string())?;
+    let closed = solve_system(p, &equations, &coords, &initial).map_err(ClosedFormError::Dsolve)?;
     // With numeric parameter values, the right case is the one whose condition holds.
     let params: Vec<Id> = model.parameters.iter().map(|q| q.id).collect();
     let values: Vec<f64> = model.parameters.iter().map(|q| q.value).collect();
@@ -54,7 +53,7 @@ pub fn closed_form(model: &mut Model) -> Result<ExactSolution, String> {
             case = k;
             break;
         };
-        let prog = Program::compile(p, &params, &[cond.expr]).map_err(|e| e.to_string())?;
+        let prog = Program::compile(p, &params, &[cond.expr]).map_err(ClosedFormError::Compile)?;
         let mut ws = prog.workspace();
         let mut out = [0.0];
         prog.eval(&values, &mut ws, &mut out);
@@ -71,7 +70,7 @@ pub fn closed_form(model: &mut Model) -> Result<ExactSolution, String> {
     }
     let program = closed
         .compile(p, case, &params)
-        .map_err(|e| e.to_string())?;
+        .map_err(ClosedFormError::Dsolve)?;
     Ok(ExactSolution {
         closed,
         case,
@@ -140,7 +139,7 @@ pub fn run_exact(prep: &Prepared, exact: &ExactSolution, set: &RunSettings) -> R
         sol.y.extend_from_slice(&y);
     }
     let mut res = tabulate(prep, &sol, set, None);
-    res.method = "exact".into();
+    res.method = super::Solver::Exact;
     res
 }
 
@@ -158,7 +157,7 @@ pub fn check(
     prep: &Prepared,
     exact: &ExactSolution,
     set: &RunSettings,
-) -> Result<CheckReport, String> {
+) -> Result<CheckReport, super::SimError> {
     let mut set = set.clone();
     if set.points.is_none() && set.output_dt.is_none() && set.t_eval.is_none() {
         set.points = Some(1001);

@@ -11,14 +11,19 @@
 //! linear momentum components when the resultant moment or force vanishes identically.
 
 pub mod compiled;
+mod error;
 pub mod exact;
 pub mod sweep;
 
-use compiled::{depends_on_time, CompiledModel, Observer};
-use pdyn_expr::{vector, Id, Pool};
+pub use error::{ClosedFormError, RunFailure, SimError};
+
+use compiled::{CompiledModel, Observer};
+use pdyn_expr::{Id, Pool};
+use pdyn_mech::conservation::conserved_quantities;
 use pdyn_mech::model::spec::Crossing;
 use pdyn_mech::{derive, DeriveOptions, Model};
 use pdyn_ode::{Direction, Event, Method, MethodKind, Options, Solution};
+use std::fmt;
 
 /// Settings of one run: the model's `[simulate]` with command-line overrides applied.
 #[derive(Clone, Debug)]
@@ -50,15 +55,13 @@ pub struct RunSettings {
 
 impl RunSettings {
     /// Settings from a model's `[simulate]` (method `auto` unless given); `t_end` is required.
-    pub fn from_spec(s: &pdyn_mech::model::spec::SimulateSpec) -> Result<RunSettings, String> {
+    pub fn from_spec(s: &pdyn_mech::model::spec::SimulateSpec) -> Result<RunSettings, SimError> {
         Ok(RunSettings {
             method: s
                 .method
                 .as_ref()
                 .map_or("auto".to_string(), |m| m.0.clone()),
-            t_end: s
-                .t_end
-                .ok_or("no end time: add t_end = ... under [simulate]")?,
+            t_end: s.t_end.ok_or(SimError::NoEndTime)?,
             rtol: s.rtol,
             atol: s.atol,
             dt: s.dt,
@@ -94,8 +97,8 @@ pub struct Prepared {
     pub state_names: Vec<String>,
     /// Initial state.
     pub y0: Vec<f64>,
-    /// Event functions (over the observation inputs when they need unknowns).
-    pub events: Vec<(String, Observer, bool, Crossing, Option<usize>)>,
+    /// The model's `[[events]]`, compiled.
+    pub events: Vec<PreparedEvent>,
     /// Sweep measures: observer over the same inputs.
     pub measures: Option<Observer>,
     /// Notes from the derivation.
@@ -119,6 +122,40 @@ impl Prepared {
         p.initial_conditions.eval(&params, &mut y0);
         p.y0 = y0;
         p
+    }
+}
+
+/// An `[[events]]` entry compiled for running: `g(t, y)`, whose zeros are the events.
+#[derive(Clone)]
+pub struct PreparedEvent {
+    /// Name.
+    pub name: String,
+    /// `g` over `[t, q, q', parameters]`, or over the observation inputs (with accelerations
+    /// and reactions) when `needs_unknowns`.
+    pub function: Observer,
+    /// Whether `g` needs accelerations or reactions (costlier to evaluate).
+    pub needs_unknowns: bool,
+    /// Which sign changes count.
+    pub direction: Crossing,
+    /// Stop the run at this occurrence.
+    pub terminal: Option<usize>,
+}
+
+/// What produced a run's result.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Solver {
+    /// A pdyn-ode integrator.
+    Ode(Method),
+    /// The closed-form solution, evaluated (`--method exact`).
+    Exact,
+}
+
+impl fmt::Display for Solver {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Solver::Ode(m) => f.write_str(m.name()),
+            Solver::Exact => f.write_str("exact"),
+        }
     }
 }
 
@@ -166,25 +203,54 @@ pub struct RunResult {
     /// Solver statistics.
     pub stats: pdyn_ode::Stats,
     /// The method that produced the result.
-    pub method: String,
+    pub method: Solver,
     /// Why the integration stopped early, with time and state.
-    pub failure: Option<String>,
+    pub failure: Option<RunFailure>,
 }
 
 /// Derives, compiles, and sets up monitors and events.
-pub fn prepare(model: &mut Model) -> Result<Prepared, String> {
+pub fn prepare(model: &mut Model) -> Result<Prepared, SimError> {
     prepare_with(model, &DeriveOptions::default())
 }
 
 /// [`prepare`] with explicit derivation options (e.g. `symbolic_limit = 0` to solve `A x = b`
 /// numerically at every evaluation).
-pub fn prepare_with(model: &mut Model, opts: &DeriveOptions) -> Result<Prepared, String> {
-    let d = derive(model, opts).map_err(|e| format!("{}: error: {e}", model.origin))?;
-    let system =
-        CompiledModel::new(model, &d).map_err(|e| format!("{}: error: {e}", model.origin))?;
-    let obs_inputs = system.observation_inputs.clone();
-    let p = &mut model.pool;
+pub fn prepare_with(model: &mut Model, opts: &DeriveOptions) -> Result<Prepared, SimError> {
+    // The chapter's steps: equations of motion, solved for the accelerations...
+    let d = derive(model, opts).map_err(SimError::Derive)?;
+    // ... as a first-order system the integrators can step...
+    let system = CompiledModel::new(model, &d).map_err(|error| compile_error("", error))?;
+    // ... what to tabulate and which laws the result must obey...
+    let (observer, conserved) = observations(model, &d, &system)?;
+    // ... when to stop or record, what a sweep measures, and where it starts.
+    let events = compile_events(model, &system)?;
+    let measures = compile_measures(model, &system)?;
+    let initial_conditions = compile_initial_conditions(model, &d)?;
+    let values: Vec<f64> = model.parameters.iter().map(|q| q.value).collect();
+    let mut y0 = vec![0.0; d.state.len()];
+    initial_conditions.eval(&values, &mut y0);
+    Ok(Prepared {
+        system,
+        observer,
+        conserved,
+        state_names: d.state_names.clone(),
+        y0,
+        events,
+        measures,
+        notes: d.notes.clone(),
+        initial_conditions,
+        parameter_names: model.parameters.iter().map(|q| q.name.clone()).collect(),
+    })
+}
 
+/// Output columns after `t` and the state — particle positions, reactions (recovered ones in
+/// the projected form), conserved quantities, the model's `[monitors]` — and which of them
+/// must be conserved.
+fn observations(
+    model: &mut Model,
+    d: &pdyn_mech::Derivation,
+    system: &CompiledModel,
+) -> Result<(Observer, Vec<bool>), SimError> {
     let mut names = Vec::new();
     let mut exprs = Vec::new();
     let mut conserved = Vec::new();
@@ -208,107 +274,68 @@ pub fn prepare_with(model: &mut Model, opts: &DeriveOptions) -> Result<Prepared,
         exprs.push(e);
         conserved.push(false);
     }
-    // Conserved quantities.
-    let explicit_time = model
-        .particles
-        .iter()
-        .any(|pt| pt.position.iter().any(|&c| depends_on_time(p, c)))
-        || model
-            .potentials
-            .iter()
-            .any(|v| depends_on_time(p, v.energy));
-    if model.conservative && !explicit_time && !model.potentials.is_empty() {
-        let mut terms = Vec::new();
-        for pk in &d.particles {
-            let v2 = vector::dot(p, pk.v, pk.v);
-            let half = p.num(pdyn_expr::Number::ratio(1, 2));
-            terms.push(p.mul(&[half, pk.mass, v2]));
-        }
-        terms.extend(model.potentials.iter().map(|v| v.energy));
-        names.push("energy".into());
-        exprs.push(p.add(&terms));
+    for c in conserved_quantities(model, d) {
+        names.push(c.name);
+        exprs.push(c.expr);
         conserved.push(true);
-    }
-    let mut h = [Pool::ZERO; 3];
-    let mut moment = [Pool::ZERO; 3];
-    let mut momentum = [Pool::ZERO; 3];
-    let mut total_force = [Pool::ZERO; 3];
-    for pk in &d.particles {
-        let mv = vector::scale(p, pk.mass, pk.v);
-        let hr = vector::cross(p, pk.r, mv);
-        h = vector::add(p, h, hr);
-        let mr = vector::cross(p, pk.r, pk.force);
-        moment = vector::add(p, moment, mr);
-        momentum = vector::add(p, momentum, mv);
-        total_force = vector::add(p, total_force, pk.force);
-    }
-    let small = |p: &mut Pool, e: Id| p.tree_size(e, 2001) < 2000;
-    // In the projected form some reactions were never declared (a pendulum's pivot): the
-    // forces we know are not all the forces, so momentum balances cannot be checked.
-    let all_forces_known = d.form != pdyn_mech::derive::Form::Projected;
-    for (c, axis) in ["x", "y", "z"].iter().enumerate() {
-        if all_forces_known
-            && h[c] != Pool::ZERO
-            && small(p, moment[c])
-            && p.provably_equal(moment[c], Pool::ZERO)
-        {
-            names.push(format!("angular_momentum.{axis}"));
-            exprs.push(h[c]);
-            conserved.push(true);
-        }
-    }
-    for (c, axis) in ["x", "y", "z"].iter().enumerate() {
-        if all_forces_known
-            && momentum[c] != Pool::ZERO
-            && small(p, total_force[c])
-            && p.provably_equal(total_force[c], Pool::ZERO)
-        {
-            names.push(format!("momentum.{axis}"));
-            exprs.push(momentum[c]);
-            conserved.push(true);
-        }
     }
     for m in &model.run.monitors {
         names.push(m.name.clone());
         exprs.push(m.expr);
         conserved.push(false);
     }
-    let observer = Observer::new(p, &obs_inputs, names, &exprs)
-        .map_err(|e| format!("{}: error: {e}", model.origin))?;
+    let observer = Observer::new(&mut model.pool, &system.observation_inputs, names, &exprs)
+        .map_err(|error| compile_error("", error))?;
+    Ok((observer, conserved))
+}
 
+/// The model's `[[events]]`, each over the cheapest inputs it can be evaluated from.
+fn compile_events(
+    model: &mut Model,
+    system: &CompiledModel,
+) -> Result<Vec<PreparedEvent>, SimError> {
+    let p = &mut model.pool;
     let mut events = Vec::new();
     for ev in &model.run.events {
-        // Cheap inputs when the event needs no accelerations or reactions.
-        let (obs, needs_unknowns) =
-            match Observer::new(p, &system.inputs, vec![ev.name.clone()], &[ev.when]) {
-                Ok(o) => (o, false),
-                Err(_) => (
-                    Observer::new(p, &obs_inputs, vec![ev.name.clone()], &[ev.when]).map_err(
-                        |e| format!("{}: error: event `{}`: {e}", model.origin, ev.name),
-                    )?,
-                    true,
-                ),
-            };
-        events.push((
-            ev.name.clone(),
-            obs,
+        let needs_unknowns = !compiled::depends_only_on(p, ev.when, &system.inputs);
+        let inputs = if needs_unknowns {
+            &system.observation_inputs
+        } else {
+            &system.inputs
+        };
+        let function = Observer::new(p, inputs, vec![ev.name.clone()], &[ev.when])
+            .map_err(|error| compile_error(&format!("event `{}`", ev.name), error))?;
+        events.push(PreparedEvent {
+            name: ev.name.clone(),
+            function,
             needs_unknowns,
-            ev.direction,
-            ev.terminal,
-        ));
+            direction: ev.direction,
+            terminal: ev.terminal,
+        });
     }
-    let measures = match &model.run.sweep {
-        Some(s) => {
-            let names = s.measures.iter().map(|m| m.name.clone()).collect();
-            let ex: Vec<Id> = s.measures.iter().map(|m| m.of).collect();
-            Some(
-                Observer::new(p, &obs_inputs, names, &ex)
-                    .map_err(|e| format!("{}: error: sweep measure: {e}", model.origin))?,
-            )
-        }
-        None => None,
-    };
+    Ok(events)
+}
 
+/// The `[sweep.measures]` over the observation inputs.
+fn compile_measures(
+    model: &mut Model,
+    system: &CompiledModel,
+) -> Result<Option<Observer>, SimError> {
+    let Some(s) = &model.run.sweep else {
+        return Ok(None);
+    };
+    let names = s.measures.iter().map(|m| m.name.clone()).collect();
+    let ex: Vec<Id> = s.measures.iter().map(|m| m.of).collect();
+    Observer::new(&mut model.pool, &system.observation_inputs, names, &ex)
+        .map(Some)
+        .map_err(|error| compile_error("sweep measure", error))
+}
+
+/// The initial state `[q(0), q'(0)]` as a function of the parameters (sweeps change them).
+fn compile_initial_conditions(
+    model: &mut Model,
+    d: &pdyn_mech::Derivation,
+) -> Result<Observer, SimError> {
     let param_ids: Vec<Id> = model.parameters.iter().map(|q| q.id).collect();
     let mut ic_exprs = Vec::new();
     let mut ic_rates = Vec::new();
@@ -319,25 +346,20 @@ pub fn prepare_with(model: &mut Model, opts: &DeriveOptions) -> Result<Prepared,
         }
     }
     ic_exprs.extend(ic_rates);
-    let ic_names = d.state_names.clone();
-    let initial_conditions = Observer::new(&mut model.pool, &param_ids, ic_names, &ic_exprs)
-        .map_err(|e| format!("{}: error: initial conditions: {e}", model.origin))?;
-    // Initial state from the current parameter values (they may have been overridden).
-    let values: Vec<f64> = model.parameters.iter().map(|q| q.value).collect();
-    let mut y0 = vec![0.0; d.state.len()];
-    initial_conditions.eval(&values, &mut y0);
-    Ok(Prepared {
-        system,
-        observer,
-        conserved,
-        state_names: d.state_names.clone(),
-        y0,
-        events,
-        measures,
-        notes: d.notes.clone(),
-        initial_conditions,
-        parameter_names: model.parameters.iter().map(|q| q.name.clone()).collect(),
-    })
+    Observer::new(
+        &mut model.pool,
+        &param_ids,
+        d.state_names.clone(),
+        &ic_exprs,
+    )
+    .map_err(|error| compile_error("initial conditions", error))
+}
+
+fn compile_error(what: &str, error: pdyn_expr::compile::CompileError) -> SimError {
+    SimError::Compile {
+        what: what.to_string(),
+        error,
+    }
 }
 
 /// An event function `g(t, y)`.
@@ -367,25 +389,21 @@ pub fn methods_help() -> String {
 }
 
 /// Integrates a prepared model.
-pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, String> {
-    let method = method_by_name(&set.method).ok_or_else(|| {
-        format!(
-            "unknown method `{}`; run `pdyn run --method help` for the list",
-            set.method
-        )
+pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, SimError> {
+    let method = method_by_name(&set.method).ok_or_else(|| SimError::UnknownMethod {
+        name: set.method.clone(),
     })?;
     let fixed = matches!(
         method.kind(),
         MethodKind::FixedStep | MethodKind::Symplectic
     );
     if fixed && set.dt.is_none() {
-        return Err(format!(
-            "method `{}` takes fixed steps: give the step with --dt (or dt = ... in [simulate])",
-            set.method
-        ));
+        return Err(SimError::NeedsStep {
+            method: set.method.clone(),
+        });
     }
     if !(set.t_end.is_finite() && set.t_end > 0.0) {
-        return Err(format!("t_end must be a positive time, got {}", set.t_end));
+        return Err(SimError::InvalidEndTime(set.t_end));
     }
     let mut opts = Options::default();
     if let Some(r) = set.rtol {
@@ -405,9 +423,7 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, String> {
     let t_end = set.t_end;
     if let Some(ts) = &set.t_eval {
         if ts.iter().any(|&x| !(0.0..=t_end).contains(&x)) || ts.windows(2).any(|w| w[1] <= w[0]) {
-            return Err(format!(
-                "t_eval must be increasing times within [0, {t_end}]"
-            ));
+            return Err(SimError::InvalidTEval { t_end });
         }
         opts.t_eval = Some(ts.clone());
     } else if let Some(npts) = set.points {
@@ -430,8 +446,8 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, String> {
     let event_fns: Vec<Box<EventFn<'_>>> = prep
         .events
         .iter()
-        .map(|(_, obs, needs_unknowns, _, _)| {
-            let needs = *needs_unknowns;
+        .map(|ev| {
+            let (obs, needs) = (&ev.function, ev.needs_unknowns);
             let f: Box<EventFn<'_>> = Box::new(move |t: f64, y: &[f64]| {
                 let mut input = Vec::with_capacity(sys.observation_inputs.len());
                 if needs {
@@ -452,14 +468,14 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, String> {
         .events
         .iter()
         .zip(&event_fns)
-        .map(|((_, _, _, dir, term), g)| {
-            let mut e = Event::new(g.as_ref()).direction(match dir {
+        .map(|(ev, g)| {
+            let mut e = Event::new(g.as_ref()).direction(match ev.direction {
                 Crossing::Rising => Direction::Rising,
                 Crossing::Falling => Direction::Falling,
                 Crossing::Both => Direction::Both,
             });
-            if let Some(k) = term {
-                e = e.terminal(*k);
+            if let Some(k) = ev.terminal {
+                e = e.terminal(k);
             }
             e
         })
@@ -467,11 +483,9 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, String> {
 
     let result = if method.kind() == MethodKind::Symplectic {
         if !sys.separable && !matches!(method, Method::Gauss4 | Method::Gauss6) {
-            return Err(format!(
-                "method `{}` needs accelerations that do not depend on velocities; this model's do \
-                 (drag, dampers, friction...): use gauss4/gauss6 or an adaptive method",
-                set.method
-            ));
+            return Err(SimError::NotSeparable {
+                method: set.method.clone(),
+            });
         }
         pdyn_ode::solve_second_order_with_events(
             method,
@@ -489,20 +503,19 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, String> {
         Ok(s) => (s, None),
         Err(e) => match e.failure_point() {
             Some(fp) => {
-                let state: Vec<String> = prep
-                    .state_names
-                    .iter()
-                    .zip(&fp.y)
-                    .map(|(nm, v)| format!("{nm} = {v:.6e}"))
-                    .collect();
-                let msg = format!(
-                    "integration failed at t = {:.9e}: {e}\n  state: {}",
-                    fp.t,
-                    state.join(", ")
-                );
-                ((*fp.partial).clone(), Some(msg))
+                let failure = RunFailure {
+                    t: fp.t,
+                    state: prep
+                        .state_names
+                        .iter()
+                        .cloned()
+                        .zip(fp.y.iter().copied())
+                        .collect(),
+                    error: e.clone(),
+                };
+                ((*fp.partial).clone(), Some(failure))
             }
-            None => return Err(format!("cannot integrate: {e}")),
+            None => return Err(SimError::Integrator(e)),
         },
     };
     Ok(tabulate(prep, &sol, set, failure))
@@ -512,7 +525,7 @@ pub(crate) fn tabulate(
     prep: &Prepared,
     sol: &Solution,
     set: &RunSettings,
-    failure: Option<String>,
+    failure: Option<RunFailure>,
 ) -> RunResult {
     let sys = &prep.system;
     let mut columns = vec!["t".to_string()];
@@ -539,7 +552,7 @@ pub(crate) fn tabulate(
             name: prep
                 .events
                 .get(h.index)
-                .map_or("event".into(), |e| e.0.clone()),
+                .map_or("event".into(), |e| e.name.clone()),
             t: h.t,
             state: h.y.clone(),
             rising: h.direction == Direction::Rising,
@@ -590,7 +603,7 @@ pub(crate) fn tabulate(
         monitors,
         warnings,
         stats: sol.stats.clone(),
-        method: sol.method.name().to_string(),
+        method: Solver::Ode(sol.method),
         failure,
     }
 }

@@ -2,7 +2,7 @@
 //! progress bar (indicatif, on stderr when it is a terminal). A failed run is recorded with its
 //! message; it does not stop the others.
 
-use super::{run, Prepared, RunSettings};
+use super::{run, Prepared, RunFailure, RunSettings, SimError};
 use indicatif::{ProgressBar, ProgressStyle};
 use pdyn_mech::model::spec::{Stat, SweepSpec};
 use rayon::prelude::*;
@@ -19,14 +19,36 @@ pub struct SweepResult {
     /// One slice per combination of the other parameters (`[sweep.also]`); a single slice when
     /// only one parameter is swept.
     pub slices: Vec<Slice>,
-    /// `(parameter values, message)` of the runs that failed or warned.
-    pub problems: Vec<(Vec<(String, f64)>, String)>,
+    /// `(parameter values, problem)` of the runs that failed or warned.
+    pub problems: Vec<(Vec<(String, f64)>, RunProblem)>,
     /// Number of runs.
     pub runs: usize,
     /// Wall time, seconds.
     pub seconds: f64,
     /// Threads used.
     pub threads: usize,
+}
+
+/// What went wrong with one run of a sweep (the others go on).
+#[derive(Clone, Debug)]
+#[non_exhaustive]
+pub enum RunProblem {
+    /// The run could not start.
+    NotRun(SimError),
+    /// The integration stopped early.
+    Stopped(RunFailure),
+    /// It finished with warnings (a drifting conserved quantity...).
+    Warnings(Vec<String>),
+}
+
+impl std::fmt::Display for RunProblem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RunProblem::NotRun(e) => write!(f, "{e}"),
+            RunProblem::Stopped(e) => write!(f, "{e}"),
+            RunProblem::Warnings(w) => f.write_str(&w.join("; ")),
+        }
+    }
 }
 
 /// The runs over the first parameter with the other parameters fixed.
@@ -105,7 +127,7 @@ pub fn sweep(
         ProgressBar::hidden()
     };
     let n_meas = prep.measures.as_ref().map_or(0, |m| m.len());
-    let results: Vec<(Vec<f64>, Option<String>)> = jobs
+    let results: Vec<(Vec<f64>, Option<RunProblem>)> = jobs
         .par_iter()
         // Each worker owns a copy (the compiled programs keep per-call scratch space).
         .map_with(prep.clone(), |base, &(ci, v)| {
@@ -158,14 +180,14 @@ fn measure_run(
     set: &RunSettings,
     stats: &[Stat],
     n_meas: usize,
-) -> (Vec<f64>, Option<String>) {
+) -> (Vec<f64>, Option<RunProblem>) {
     let res = match run(p, set) {
-        Err(e) => return (vec![f64::NAN; n_meas], Some(e)),
+        Err(e) => return (vec![f64::NAN; n_meas], Some(RunProblem::NotRun(e))),
         Ok(r) => r,
     };
-    let mut problem = res.failure.clone();
+    let mut problem = res.failure.clone().map(RunProblem::Stopped);
     if problem.is_none() && !res.warnings.is_empty() {
-        problem = Some(res.warnings.join("; "));
+        problem = Some(RunProblem::Warnings(res.warnings.clone()));
     }
     let mut vals = vec![f64::NAN; n_meas];
     if let Some(m) = &p.measures {

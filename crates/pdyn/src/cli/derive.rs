@@ -1,6 +1,8 @@
 //! `pdyn derive MODEL`: the equations of motion of a model file, as the chapter writes them.
 
+use super::load_model;
 use clap::{Args, ValueEnum};
+use pdyn::Error;
 use pdyn_expr::{Id, Pool};
 use pdyn_mech::derive::{Form, UnknownKind};
 use pdyn_mech::{derive, DeriveOptions};
@@ -37,16 +39,9 @@ pub struct DeriveArgs {
     symbolic_limit: usize,
 }
 
-/// Loads a model file and renders any error with its location.
-pub fn load(path: &std::path::Path) -> Result<pdyn_mech::Model, String> {
-    let source = std::fs::read_to_string(path)
-        .map_err(|e| format!("{}: error: cannot read the model file: {e}", path.display()))?;
-    pdyn_mech::load(&source, &path.display().to_string()).map_err(|e| e.render(&source))
-}
-
 /// `pdyn derive MODEL`.
-pub fn run(a: DeriveArgs) -> Result<String, String> {
-    let mut model = load(&a.model)?;
+pub fn run(a: DeriveArgs) -> Result<String, Error> {
+    let mut model = load_model(&a.model)?;
     let opts = DeriveOptions {
         form: match a.form {
             FormArg::Auto => Form::Auto,
@@ -56,7 +51,10 @@ pub fn run(a: DeriveArgs) -> Result<String, String> {
         symbolic_limit: a.symbolic_limit,
         ..DeriveOptions::default()
     };
-    let d = derive(&mut model, &opts).map_err(|e| format!("{}: error: {e}", model.origin))?;
+    let d = derive(&mut model, &opts).map_err(|error| Error::Derive {
+        origin: model.origin.clone(),
+        error,
+    })?;
     let exact = if d.solution.is_some() {
         Some(pdyn::sim::exact::closed_form(&mut model))
     } else {

@@ -1,22 +1,13 @@
 //! `pdyn dsolve`: closed-form solution of linear constant-coefficient ODEs and systems, and the
 //! 1-D rules of straight-line motion (`--rule "a(v) = -c*v^2"`).
 
-use clap::{Args, ValueEnum};
-use pdyn_expr::syntax::Ast;
-use pdyn_expr::{FreeScope, Id, Node, Pool, Program, SymId, Value};
+use super::{both, idents, split_top, subs_all, Format};
+use clap::Args;
+use pdyn::Error;
+use pdyn_expr::{FreeScope, Id, Node, Pool, SymId, Value};
 use pdyn_mech::dsolve::rules::{self, Given};
 use pdyn_mech::dsolve::{solve_with, ClosedForm, InitialCondition, Method, Relation};
 use serde_json::json;
-
-/// Output notation for expressions.
-#[derive(Clone, Copy, Debug, Default, ValueEnum, PartialEq, Eq)]
-pub enum Format {
-    /// Plain text that pdyn parses back.
-    #[default]
-    Text,
-    /// LaTeX (math mode).
-    Latex,
-}
 
 /// `pdyn dsolve`.
 #[derive(Args, Debug)]
@@ -62,58 +53,7 @@ pub struct DsolveArgs {
 }
 
 fn show(pool: &Pool, id: Id, f: Format) -> String {
-    match f {
-        Format::Text => pool.to_text(id),
-        Format::Latex => pool.to_latex(id),
-    }
-}
-
-fn both(pool: &Pool, id: Id) -> serde_json::Value {
-    json!({"text": pool.to_text(id), "latex": pool.to_latex(id)})
-}
-
-/// Names used as plain identifiers in `ast` (candidates for parameters).
-fn idents(ast: &Ast, out: &mut Vec<String>) {
-    match ast {
-        Ast::Ident { name, .. } => {
-            if !out.contains(name) {
-                out.push(name.clone())
-            }
-        }
-        Ast::Num { .. } => {}
-        Ast::Neg { expr, .. } | Ast::Prime { expr, .. } | Ast::Component { expr, .. } => {
-            idents(expr, out)
-        }
-        Ast::Binary { lhs, rhs, .. } => {
-            idents(lhs, out);
-            idents(rhs, out);
-        }
-        Ast::Call { args, .. } => args.iter().for_each(|a| idents(a, out)),
-        Ast::Vector { items, .. } => items.iter().for_each(|a| idents(a, out)),
-    }
-}
-
-/// Splits at top-level commas (not inside parentheses or brackets).
-pub(crate) fn split_top(s: &str) -> Vec<String> {
-    let mut out = Vec::new();
-    let mut depth = 0i32;
-    let mut cur = String::new();
-    for ch in s.chars() {
-        match ch {
-            '(' | '[' => depth += 1,
-            ')' | ']' => depth -= 1,
-            _ => {}
-        }
-        if ch == ',' && depth == 0 {
-            out.push(std::mem::take(&mut cur));
-        } else {
-            cur.push(ch);
-        }
-    }
-    if !cur.trim().is_empty() {
-        out.push(cur);
-    }
-    out.into_iter().map(|p| p.trim().to_string()).collect()
+    f.show(pool, id)
 }
 
 /// One parsed initial condition: name, derivative order, time text, value text.
@@ -124,10 +64,10 @@ struct RawIc {
     value: String,
 }
 
-fn parse_ic(item: &str) -> Result<RawIc, String> {
-    let (lhs, value) = item
-        .split_once('=')
-        .ok_or_else(|| format!("--ic: expected `x(0)=value`, got `{item}`"))?;
+fn parse_ic(item: &str) -> Result<RawIc, Error> {
+    let (lhs, value) = item.split_once('=').ok_or_else(|| {
+        Error::argument("--ic", format!("--ic: expected `x(0)=value`, got `{item}`"))
+    })?;
     let lhs = lhs.trim();
     let (head, time) = match lhs.find('(') {
         Some(p) if lhs.ends_with(')') => (&lhs[..p], lhs[p + 1..lhs.len() - 1].trim()),
@@ -141,12 +81,16 @@ fn parse_ic(item: &str) -> Result<RawIc, String> {
         .is_some_and(|c| c.is_alphabetic() || c == '_')
         && name.chars().all(|c| c.is_alphanumeric() || c == '_');
     if !ok {
-        return Err(format!(
-            "--ic: `{lhs}` is not of the form `x(0)`, `x'(0)` or `x''(t0)`"
+        return Err(Error::argument(
+            "--ic",
+            format!("--ic: `{lhs}` is not of the form `x(0)`, `x'(0)` or `x''(t0)`"),
         ));
     }
     if value.trim().is_empty() {
-        return Err(format!("--ic: `{item}` has no value after `=`"));
+        return Err(Error::argument(
+            "--ic",
+            format!("--ic: `{item}` has no value after `=`"),
+        ));
     }
     Ok(RawIc {
         name: name.to_string(),
@@ -157,36 +101,31 @@ fn parse_ic(item: &str) -> Result<RawIc, String> {
 }
 
 /// Parsed `--set` values: (symbol expression, value expression).
-fn parse_set(pool: &mut Pool, set: &[String]) -> Result<Vec<(Id, Id)>, String> {
+fn parse_set(pool: &mut Pool, set: &[String]) -> Result<Vec<(Id, Id)>, Error> {
     let mut out = Vec::new();
     for kv in set {
-        let (k, v) = kv
-            .split_once('=')
-            .ok_or_else(|| format!("--set: expected name=value, got `{kv}`"))?;
+        let (k, v) = kv.split_once('=').ok_or_else(|| {
+            Error::argument("--set", format!("--set: expected name=value, got `{kv}`"))
+        })?;
         let k = k.trim();
         if !k.chars().all(|c| c.is_alphanumeric() || c == '_') || k.is_empty() {
-            return Err(format!("--set: `{k}` is not a parameter name"));
+            return Err(Error::argument(
+                "--set",
+                format!("--set: `{k}` is not a parameter name"),
+            ));
         }
         let val = pool
             .parse_scalar(v.trim())
-            .map_err(|e| e.render(v.trim(), "--set"))?;
+            .map_err(|e| Error::expr("--set", v.trim(), e))?;
         let sym = pool.var(k);
         out.push((sym, val));
     }
     Ok(out)
 }
 
-fn apply_set(pool: &mut Pool, e: Id, set: &[(Id, Id)]) -> Id {
-    set.iter().fold(e, |acc, &(k, v)| pool.subs1(acc, k, v))
-}
-
-fn eval_const(pool: &mut Pool, e: Id, what: &str) -> Result<f64, String> {
-    let prog = Program::compile(pool, &[], &[e])
-        .map_err(|err| format!("{what}: {err}; give it a value with --set"))?;
-    let mut ws = prog.workspace();
-    let mut out = [0.0];
-    prog.eval(&[], &mut ws, &mut out);
-    Ok(out[0])
+fn eval_const(pool: &mut Pool, e: Id, what: &str) -> Result<f64, Error> {
+    pool.eval_const(e)
+        .map_err(|err| Error::argument(what, format!("{what}: {err}; give it a value with --set")))
 }
 
 fn relation_text(pool: &Pool, expr: Id, rel: Relation, f: Format) -> String {
@@ -207,17 +146,21 @@ fn relation_text(pool: &Pool, expr: Id, rel: Relation, f: Format) -> String {
 }
 
 /// `pdyn dsolve EQUATIONS --ic ...` or `pdyn dsolve --rule ...`.
-pub fn run(a: DsolveArgs) -> Result<String, String> {
+pub fn run(a: DsolveArgs) -> Result<String, Error> {
     if let Some(rule) = &a.rule {
         if !a.equations.is_empty() {
-            return Err("give either equations or --rule, not both".into());
+            return Err(Error::argument(
+                "",
+                "give either equations or --rule, not both",
+            ));
         }
         return run_rule(&a, rule);
     }
     if a.equations.is_empty() {
-        return Err(
-            "no equation given; e.g. pdyn dsolve \"x'' + x = 0\" --ic \"x(0)=1, x'(0)=0\"".into(),
-        );
+        return Err(Error::argument(
+            "",
+            "no equation given; e.g. pdyn dsolve \"x'' + x = 0\" --ic \"x(0)=1, x'(0)=0\"",
+        ));
     }
     let mut pool = Pool::new();
     // Pass 1: learn coordinates and parameter names.
@@ -225,7 +168,8 @@ pub fn run(a: DsolveArgs) -> Result<String, String> {
     let mut asts = Vec::new();
     for (i, src) in a.equations.iter().enumerate() {
         let origin = format!("<equation {}>", i + 1);
-        let (l, r) = pdyn_expr::syntax::parse_equation(src).map_err(|e| e.render(src, &origin))?;
+        let (l, r) =
+            pdyn_expr::syntax::parse_equation(src).map_err(|e| Error::expr(&origin, src, e))?;
         scope.learn(&l);
         if let Some(r) = &r {
             scope.learn(r);
@@ -266,7 +210,7 @@ pub fn run(a: DsolveArgs) -> Result<String, String> {
         let origin = format!("<equation {}>", i + 1);
         let v = pool
             .parse_equation_in(src, &mut scope)
-            .map_err(|e| e.render(src, &origin))?;
+            .map_err(|e| Error::expr(&origin, src, e))?;
         match v {
             Value::Scalar(s) => eqs.push(s),
             Value::Vector(c) => eqs.extend(c.into_iter().filter(|&x| x != Pool::ZERO)),
@@ -284,59 +228,74 @@ pub fn run(a: DsolveArgs) -> Result<String, String> {
         }
     }
     if coords.is_empty() {
-        return Err(
-            "the equations contain no coordinate: write the unknown function as x', x'' or x(t)"
-                .into(),
-        );
+        return Err(Error::argument(
+            "",
+            "the equations contain no coordinate: write the unknown function as x', x'' or x(t)",
+        ));
     }
     let set = parse_set(&mut pool, &a.set)?;
-    let eqs: Vec<Id> = eqs.iter().map(|&e| apply_set(&mut pool, e, &set)).collect();
+    let eqs: Vec<Id> = eqs.iter().map(|&e| subs_all(&mut pool, e, &set)).collect();
     let mut t0: Option<(String, Id)> = None;
     let mut initial = Vec::new();
     for ic in &ics {
         let coord = pool.symbol(&ic.name, false);
         if !coords.contains(&coord) {
-            return Err(format!(
-                "--ic: `{}` does not appear in the equations (coordinates: {})",
-                ic.name,
-                coords
-                    .iter()
-                    .map(|&c| pool.name(c).to_string())
-                    .collect::<Vec<_>>()
-                    .join(", ")
+            return Err(Error::argument(
+                "--ic",
+                format!(
+                    "--ic: `{}` does not appear in the equations (coordinates: {})",
+                    ic.name,
+                    coords
+                        .iter()
+                        .map(|&c| pool.name(c).to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
             ));
         }
         let time = pool
             .parse_in(&ic.time, &mut scope)
-            .map_err(|e| e.render(&ic.time, "--ic"))?;
+            .map_err(|e| Error::expr("--ic", &ic.time, e))?;
         let Value::Scalar(time) = time else {
-            return Err(format!("--ic: the time `{}` is a vector", ic.time));
+            return Err(Error::argument(
+                "--ic",
+                format!("--ic: the time `{}` is a vector", ic.time),
+            ));
         };
-        let time = apply_set(&mut pool, time, &set);
+        let time = subs_all(&mut pool, time, &set);
         match &t0 {
             None => t0 = Some((ic.time.clone(), time)),
             Some((txt, prev)) if *prev != time => {
-                return Err(format!(
-                    "--ic: all initial conditions must be at the same time (`{txt}` and `{}`)",
-                    ic.time
+                return Err(Error::argument(
+                    "--ic",
+                    format!(
+                        "--ic: all initial conditions must be at the same time (`{txt}` and `{}`)",
+                        ic.time
+                    ),
                 ))
             }
             _ => {}
         }
         let v = pool
             .parse_in(&ic.value, &mut scope)
-            .map_err(|e| e.render(&ic.value, "--ic"))?;
+            .map_err(|e| Error::expr("--ic", &ic.value, e))?;
         let Value::Scalar(v) = v else {
-            return Err(format!("--ic: the value `{}` is a vector", ic.value));
+            return Err(Error::argument(
+                "--ic",
+                format!("--ic: the value `{}` is a vector", ic.value),
+            ));
         };
         initial.push(InitialCondition {
             coord,
             order: ic.order,
-            value: apply_set(&mut pool, v, &set),
+            value: subs_all(&mut pool, v, &set),
         });
     }
     let t0 = t0.map_or(Pool::ZERO, |(_, id)| id);
-    let cf = solve_with(&mut pool, &eqs, &coords, &initial, t0).map_err(|e| e.to_string())?;
+    let cf = solve_with(&mut pool, &eqs, &coords, &initial, t0).map_err(|error| Error::Dsolve {
+        context: String::new(),
+        error,
+    })?;
     let assumed: Vec<String> = params
         .iter()
         .filter(|p| {
@@ -410,7 +369,7 @@ pub fn run(a: DsolveArgs) -> Result<String, String> {
     Ok(out)
 }
 
-/// `--when "lhs = rhs"`: the first t ≥ 0 where it holds (for the first case), and the state.
+/// `--when "lhs = rhs"`: parsed here, found by [`pdyn_mech::dsolve::when`], printed here.
 fn when(
     pool: &mut Pool,
     cf: &ClosedForm,
@@ -418,85 +377,76 @@ fn when(
     scope: &mut FreeScope,
     set: &[(Id, Id)],
     format: Format,
-) -> Result<(String, serde_json::Value), String> {
+) -> Result<(String, serde_json::Value), Error> {
     let eq = match pool
         .parse_equation_in(src, scope)
-        .map_err(|e| e.render(src, "--when"))?
+        .map_err(|e| Error::expr("--when", src, e))?
     {
         Value::Scalar(s) => s,
-        Value::Vector(_) => return Err("--when: the condition must be a scalar equation".into()),
-    };
-    let eq = apply_set(pool, eq, set);
-    if cf.cases.len() > 1 {
-        return Err(
-            "--when: the solution has several cases; give the parameters with --set".into(),
-        );
-    }
-    let sol = &cf.cases[0].solution;
-    let mut e = eq;
-    for (j, &c) in cf.coords.iter().enumerate() {
-        for k in (0..=8u8).rev() {
-            let leaf = pool.coord(c, k);
-            if pool.contains(e, leaf) {
-                let d = pool.dt_n(sol[j], k as usize);
-                e = pool.subs1(e, leaf, d);
-            }
+        Value::Vector(_) => {
+            return Err(Error::argument(
+                "--when",
+                "--when: the condition must be a scalar equation",
+            ))
         }
-    }
-    let (exact, tv) = pdyn_mech::kinematics::solve_time(pool, e, Pool::ZERO)
-        .map_err(|err| format!("--when {src}: {err}"))?;
-    let t = pool.time();
-    let tt = match exact {
-        Some(x) => x,
-        None => pool.num(pdyn_expr::Number::Float(tv)),
     };
-    let mut text = format!("when {src}: t = {}", show(pool, tt, format));
-    if exact.is_some() && tv.is_finite() && pool.as_num(tt).is_none() {
-        text += &format!(" ≈ {tv}");
+    let eq = subs_all(pool, eq, set);
+    let found = pdyn_mech::dsolve::when(pool, cf, eq).map_err(|error| {
+        let context = match error {
+            pdyn_mech::dsolve::DsolveError::SeveralCases => "--when".to_string(),
+            _ => format!("--when {src}"),
+        };
+        Error::Dsolve { context, error }
+    })?;
+    let mut text = format!("when {src}: t = {}", show(pool, found.t, format));
+    if found.exact && found.value.is_finite() && pool.as_num(found.t).is_none() {
+        text += &format!(" ≈ {}", found.value);
     }
     text += "\n";
     let mut state = serde_json::Map::new();
-    for (j, &c) in cf.coords.iter().enumerate() {
-        for k in 0..2 {
-            let d = pool.dt_n(sol[j], k);
-            let at = pool.subs1(d, t, tt);
-            let at = pool.expand(at);
-            let at = pool.simplify(at);
-            let name = format!("{}{}", pool.name(c), "'".repeat(k));
-            let num = eval_const(pool, at, &name).ok();
-            let approx = match num {
-                Some(v) if pool.as_num(at).is_none() => format!("  ≈ {v}"),
-                _ => String::new(),
-            };
-            text += &format!("  {name} = {}{approx}\n", show(pool, at, format));
-            state.insert(name, json!({"exact": both(pool, at), "value": num}));
-        }
+    for s in &found.state {
+        let approx = match s.value {
+            Some(v) if pool.as_num(s.exact).is_none() => format!("  ≈ {v}"),
+            _ => String::new(),
+        };
+        text += &format!("  {} = {}{approx}\n", s.name, show(pool, s.exact, format));
+        state.insert(
+            s.name.clone(),
+            json!({"exact": both(pool, s.exact), "value": s.value}),
+        );
     }
-    let tj = json!({"t": tv.is_finite().then_some(tv), "t_exact": exact.map(|x| both(pool, x)), "state": state});
+    let tj = json!({
+        "t": found.value.is_finite().then_some(found.value),
+        "t_exact": found.exact.then(|| both(pool, found.t)),
+        "state": state,
+    });
     Ok((text, tj))
 }
 
-fn eval_times(pool: &mut Pool, at: &[String]) -> Result<Vec<f64>, String> {
+fn eval_times(pool: &mut Pool, at: &[String]) -> Result<Vec<f64>, Error> {
     at.iter()
         .map(|s| {
             let e = pool
                 .parse_scalar(s.trim())
-                .map_err(|e| e.render(s.trim(), "--at"))?;
+                .map_err(|e| Error::expr("--at", s.trim(), e))?;
             eval_const(pool, e, &format!("--at {s}"))
         })
         .collect()
 }
 
 /// Per case, per time: `[q1, q1', q2, q2', ...]`.
-fn evaluate(pool: &mut Pool, cf: &ClosedForm, times: &[f64]) -> Result<Vec<Vec<Vec<f64>>>, String> {
+fn evaluate(pool: &mut Pool, cf: &ClosedForm, times: &[f64]) -> Result<Vec<Vec<Vec<f64>>>, Error> {
     if times.is_empty() {
         return Ok(Vec::new());
     }
     let mut all = Vec::new();
     for ci in 0..cf.cases.len() {
-        let prog = cf
-            .compile(pool, ci, &[])
-            .map_err(|e| format!("--at: {e}; give the parameters values with --set"))?;
+        let prog = cf.compile(pool, ci, &[]).map_err(|e| {
+            Error::argument(
+                "--at",
+                format!("--at: {e}; give the parameters values with --set"),
+            )
+        })?;
         let mut ws = prog.workspace();
         let mut rows = Vec::new();
         for &t in times {
@@ -567,24 +517,25 @@ fn to_json(
 }
 
 /// `pdyn dsolve --rule "a(v) = ..."`.
-fn run_rule(a: &DsolveArgs, rule: &str) -> Result<String, String> {
+fn run_rule(a: &DsolveArgs, rule: &str) -> Result<String, Error> {
     let (lhs, rhs) = rule
         .split_once('=')
-        .ok_or_else(|| format!("--rule: expected `a(t) = ...`, `v(t) = ...`, `a(v) = ...` or `a(x) = ...`, got `{rule}`"))?;
+        .ok_or_else(|| Error::argument("--rule", format!("--rule: expected `a(t) = ...`, `v(t) = ...`, `a(v) = ...` or `a(x) = ...`, got `{rule}`")))?;
     let given = match lhs.replace(' ', "").as_str() {
         "a(t)" => Given::AccelerationOfTime,
         "v(t)" => Given::VelocityOfTime,
         "a(v)" => Given::AccelerationOfSpeed,
         "a(x)" => Given::AccelerationOfPosition,
         other => {
-            return Err(format!(
-                "--rule: the left side `{other}` must be a(t), v(t), a(v) or a(x)"
+            return Err(Error::argument(
+                "--rule",
+                format!("--rule: the left side `{other}` must be a(t), v(t), a(v) or a(x)"),
             ))
         }
     };
     let mut pool = Pool::new();
     let src = rhs.trim();
-    let ast = pdyn_expr::syntax::parse(src).map_err(|e| e.render(src, "--rule"))?;
+    let ast = pdyn_expr::syntax::parse(src).map_err(|e| Error::expr("--rule", src, e))?;
     let mut names = Vec::new();
     idents(&ast, &mut names);
     let indep = given.variable();
@@ -597,13 +548,18 @@ fn run_rule(a: &DsolveArgs, rule: &str) -> Result<String, String> {
         ..Default::default()
     };
     let law = match pdyn_expr::lower::lower(&mut pool, &ast, &mut scope)
-        .map_err(|e| e.render(src, "--rule"))?
+        .map_err(|e| Error::expr("--rule", src, e))?
     {
         Value::Scalar(s) => s,
-        Value::Vector(_) => return Err("--rule: the law must be a scalar".into()),
+        Value::Vector(_) => {
+            return Err(Error::argument(
+                "--rule",
+                "--rule: the law must be a scalar",
+            ))
+        }
     };
     let set = parse_set(&mut pool, &a.set)?;
-    let law = apply_set(&mut pool, law, &set);
+    let law = subs_all(&mut pool, law, &set);
     let mut x0 = Pool::ZERO;
     let mut v0 = Pool::ZERO;
     let mut seen = Vec::new();
@@ -611,29 +567,32 @@ fn run_rule(a: &DsolveArgs, rule: &str) -> Result<String, String> {
         for item in split_top(s) {
             let ic = parse_ic(&item)?;
             if ic.time != "0" {
-                return Err(format!(
-                    "--ic: the rules start at t = 0 (got `{}`)",
-                    ic.time
+                return Err(Error::argument(
+                    "--ic",
+                    format!("--ic: the rules start at t = 0 (got `{}`)", ic.time),
                 ));
             }
             let v = pool
                 .parse_scalar(&ic.value)
-                .map_err(|e| e.render(&ic.value, "--ic"))?;
-            let v = apply_set(&mut pool, v, &set);
+                .map_err(|e| Error::expr("--ic", &ic.value, e))?;
+            let v = subs_all(&mut pool, v, &set);
             match (ic.name.as_str(), ic.order) {
                 ("x", 0) => x0 = v,
                 ("v", 0) | ("x", 1) => v0 = v,
                 _ => {
-                    return Err(format!(
-                        "--ic: the rules take x(0) and v(0), not `{}`",
-                        item.trim()
+                    return Err(Error::argument(
+                        "--ic",
+                        format!("--ic: the rules take x(0) and v(0), not `{}`", item.trim()),
                     ))
                 }
             }
             seen.push(ic.name);
         }
     }
-    let sol = rules::solve_rule(&mut pool, given, law, x0, v0).map_err(|e| e.to_string())?;
+    let sol = rules::solve_rule(&mut pool, given, law, x0, v0).map_err(|error| Error::Dsolve {
+        context: String::new(),
+        error,
+    })?;
     let points = eval_times(&mut pool, &a.at)?;
     let mut evaluated = Vec::new();
     for q in &sol.quantities {

@@ -20,11 +20,17 @@
 //! `a = (dV/dt) t + V² κ_s (-y', x')/g`, so `a_t = dV/dt` and `a_n = V² |κ_s|`.
 //!
 //! [`maximize`] finds the largest value of a quantity over a range numerically (dense sampling
-//! and golden-section refinement).
+//! and golden-section refinement); [`maximum`] does it for a quantity with symbolic parameters
+//! (`extremum.rs`).
 
 use pdyn_expr::vector::{cross, dot};
 use pdyn_expr::{Func, Id, Node, Pool, Program};
-use std::fmt;
+
+mod error;
+mod extremum;
+
+pub use error::KinError;
+pub use extremum::{maximize, maximum, Extremum, Maximum};
 
 /// How the motion is given.
 #[derive(Clone, Copy, Debug)]
@@ -140,18 +146,6 @@ pub enum Quantity {
     Vector([Id; 3]),
 }
 
-/// Why the kinematics could not be derived or evaluated.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct KinError(pub String);
-
-impl fmt::Display for KinError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for KinError {}
-
 fn simp3(pool: &mut Pool, v: [Id; 3]) -> [Id; 3] {
     v.map(|c| {
         let e = pool.expand(c);
@@ -190,9 +184,7 @@ fn analyze_motion(pool: &mut Pool, motion: Motion) -> Result<Kinematics, KinErro
             let t = pool.time();
             for c in r {
                 if pool.any_node(c, &|n| matches!(n, Node::Coord(_, k) if *k > 0)) {
-                    return Err(KinError(
-                        "give the position itself, without rates (x', y'...)".into(),
-                    ));
+                    return Err(KinError::RatesInPosition);
                 }
             }
             let v = r.map(|c| pool.dt(c));
@@ -267,10 +259,9 @@ fn analyze_motion(pool: &mut Pool, motion: Motion) -> Result<Kinematics, KinErro
             speed,
         } => {
             if !matches!(pool.node(parameter), Node::Sym(_)) {
-                return Err(KinError(format!(
-                    "the path parameter `{}` must be a plain name",
-                    pool.to_text(parameter)
-                )));
+                return Err(KinError::PathParameterNotAName {
+                    parameter: pool.to_text(parameter),
+                });
             }
             let (x1, y1) = (pool.diff(x, parameter), pool.diff(y, parameter));
             let (x2, y2) = (pool.diff(x1, parameter), pool.diff(y1, parameter));
@@ -281,9 +272,7 @@ fn analyze_motion(pool: &mut Pool, motion: Motion) -> Result<Kinematics, KinErro
                 simp(pool, s)
             };
             if g2 == Pool::ZERO {
-                return Err(KinError(
-                    "the path does not move with its parameter (x' = y' = 0)".into(),
-                ));
+                return Err(KinError::PathDoesNotMove);
             }
             let g = pool.sqrt(g2);
             let tangent = {
@@ -433,9 +422,7 @@ fn nt(
         simp(pool, d)
     };
     if v2 == Pool::ZERO {
-        return Err(KinError(
-            "the particle does not move (v = 0): there is no tangent, normal or curvature".into(),
-        ));
+        return Err(KinError::NoMotion);
     }
     let speed = crate::dsolve::nice_sqrt(pool, v2);
     let va = {
@@ -547,10 +534,9 @@ pub fn tidy_magnitude(pool: &mut Pool, e: Id) -> Id {
 pub fn solve_time(pool: &mut Pool, expr: Id, target: Id) -> Result<(Option<Id>, f64), KinError> {
     let t = pool.time();
     if !pool.contains(expr, t) {
-        return Err(KinError(format!(
-            "`{}` does not change with t",
-            pool.to_text(expr)
-        )));
+        return Err(KinError::ConstantInTime {
+            expr: pool.to_text(expr),
+        });
     }
     let eq = pool.sub(expr, target);
     let eq = pool.expand(eq);
@@ -563,10 +549,9 @@ pub fn solve_time(pool: &mut Pool, expr: Id, target: Id) -> Result<(Option<Id>, 
             None => return Ok((Some(e), f64::NAN)),
         }
     }
-    let prog = Program::compile(pool, &[t], &[eq]).map_err(|e| {
-        KinError(format!(
-            "cannot locate the instant: {e}; give the parameters values with --set"
-        ))
+    let prog = Program::compile(pool, &[t], &[eq]).map_err(|e| KinError::NotEvaluable {
+        expr: String::new(),
+        reason: e.to_string(),
     })?;
     let mut ws = prog.workspace();
     let mut f = |x: f64| {
@@ -604,11 +589,11 @@ pub fn solve_time(pool: &mut Pool, expr: Id, target: Id) -> Result<(Option<Id>, 
         flo = fhi;
         h *= 1.001;
     }
-    Err(KinError(format!(
-        "`{}` never reaches {} for t between 0 and {lo:.3e}",
-        pool.to_text(expr),
-        pool.to_text(target)
-    )))
+    Err(KinError::NeverReaches {
+        expr: pool.to_text(expr),
+        target: pool.to_text(target),
+        t_max: lo,
+    })
 }
 
 fn exact_root(pool: &mut Pool, eq: Id, expr: Id, target: Id, t: Id) -> Option<Id> {
@@ -645,96 +630,5 @@ fn exact_root(pool: &mut Pool, eq: Id, expr: Id, target: Id, t: Id) -> Option<Id
 }
 
 fn value(pool: &mut Pool, e: Id) -> Option<f64> {
-    let prog = Program::compile(pool, &[], &[e]).ok()?;
-    let mut ws = prog.workspace();
-    let mut o = [0.0];
-    prog.eval(&[], &mut ws, &mut o);
-    o[0].is_finite().then_some(o[0])
-}
-
-/// Result of [`maximize`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Extremum {
-    /// Where the maximum is.
-    pub at: f64,
-    /// The maximum value.
-    pub value: f64,
-}
-
-/// Largest value of `f(var)` for `var` in `[lo, hi]` (every other leaf must be a number by
-/// now): dense sampling, then golden-section refinement around the best sample. Among equal
-/// maxima the first is returned.
-pub fn maximize(pool: &mut Pool, f: Id, var: Id, lo: f64, hi: f64) -> Result<Extremum, KinError> {
-    if !(lo.is_finite() && hi.is_finite() && hi > lo) {
-        return Err(KinError(format!("empty or invalid range {lo}..{hi}")));
-    }
-    let prog = Program::compile(pool, &[var], &[f]).map_err(|e| {
-        KinError(format!(
-            "cannot evaluate `{}`: {e}; give the parameters values with --set",
-            pool.to_text(f)
-        ))
-    })?;
-    let mut ws = prog.workspace();
-    let mut eval = |x: f64| {
-        let mut o = [0.0];
-        prog.eval(&[x], &mut ws, &mut o);
-        if o[0].is_finite() {
-            o[0]
-        } else {
-            f64::NEG_INFINITY
-        }
-    };
-    const N: usize = 2000;
-    let mut best = (lo, eval(lo));
-    let samples: Vec<(f64, f64)> = (0..=N)
-        .map(|k| {
-            let x = lo + (hi - lo) * k as f64 / N as f64;
-            (x, eval(x))
-        })
-        .collect();
-    for &(x, y) in &samples {
-        if y > best.1 + 1e-12 * best.1.abs() {
-            best = (x, y);
-        }
-    }
-    if best.1 == f64::NEG_INFINITY {
-        return Err(KinError(format!(
-            "`{}` is not finite anywhere in the range",
-            pool.to_text(f)
-        )));
-    }
-    let h = (hi - lo) / N as f64;
-    let (mut a, mut b) = ((best.0 - h).max(lo), (best.0 + h).min(hi));
-    let gr = 0.5 * (5f64.sqrt() - 1.0);
-    let mut c = b - gr * (b - a);
-    let mut d = a + gr * (b - a);
-    let (mut fc, mut fd) = (eval(c), eval(d));
-    for _ in 0..200 {
-        if fc >= fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - gr * (b - a);
-            fc = eval(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + gr * (b - a);
-            fd = eval(d);
-        }
-        if (b - a).abs() <= 1e-15 * (1.0 + a.abs()) {
-            break;
-        }
-    }
-    let x = 0.5 * (a + b);
-    let fx = eval(x);
-    Ok(if fx >= best.1 {
-        Extremum { at: x, value: fx }
-    } else {
-        Extremum {
-            at: best.0,
-            value: best.1,
-        }
-    })
+    pool.eval_const(e).ok().filter(|v| v.is_finite())
 }

@@ -1,9 +1,12 @@
 //! `pdyn run MODEL`: simulate a model file.
 
+use super::{load_model, set_parameters, Outcome};
 use clap::Args;
 use pdyn::output::{summary, write_csv};
-use pdyn::sim::{self, RunSettings, DEFAULT_DRIFT_TOLERANCE};
-use std::path::PathBuf;
+use pdyn::sim::{self, RunSettings, SimError, DEFAULT_DRIFT_TOLERANCE};
+use pdyn::Error;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// `pdyn run`.
 #[derive(Args, Debug, Clone)]
@@ -61,27 +64,28 @@ pub struct RunArgs {
 }
 
 /// Merges `[simulate]` and the command line.
-pub fn settings(model: &pdyn_mech::Model, a: &RunArgs) -> Result<RunSettings, String> {
+pub fn settings(model: &pdyn_mech::Model, a: &RunArgs) -> Result<RunSettings, Error> {
     let s = &model.run.simulate;
-    let t_end = a.t_end.or(s.t_end).ok_or_else(|| {
-        format!(
-            "{}: error: no end time: add t_end = ... under [simulate] or pass --t-end",
-            model.origin
-        )
-    })?;
+    let t_end = a
+        .t_end
+        .or(s.t_end)
+        .ok_or_else(|| sim_error(model, "", SimError::NoEndTime))?;
     let method = match &a.method {
         Some(m) if m == "exact" => m.clone(),
         Some(m) => m.clone(),
         None => match &s.method {
             Some((m, span)) => {
                 if sim::method_by_name(m).is_none() {
-                    let e = pdyn_mech::ModelError::new(
+                    let error = pdyn_mech::ModelError::new(
                         &model.origin,
                         span.clone(),
                         format!("unknown method `{m}`"),
                     )
                     .help("run `pdyn run --method help` for the list");
-                    return Err(e.render(&model.source));
+                    return Err(Error::Model {
+                        error,
+                        source: model.source.as_str().into(),
+                    });
                 }
                 m.clone()
             }
@@ -110,56 +114,80 @@ pub fn settings(model: &pdyn_mech::Model, a: &RunArgs) -> Result<RunSettings, St
     })
 }
 
-/// `pdyn run MODEL`. Returns (stdout text, stderr text, success).
-pub fn run(a: RunArgs) -> Result<(String, String, bool), String> {
-    if a.method.as_deref() == Some("help") {
-        return Ok((sim::methods_help(), String::new(), true));
+/// A simulation error located in the model file, with what was being attempted.
+pub(crate) fn sim_error(model: &pdyn_mech::Model, context: &'static str, error: SimError) -> Error {
+    Error::Sim {
+        origin: model.origin.clone(),
+        context,
+        error,
     }
-    let mut model = crate::derive_cmd::load(&a.model)?;
-    crate::forces_cmd::apply_set(&mut model, &a.set)?;
+}
+
+pub(crate) fn io_error(path: &Path, action: &'static str, e: std::io::Error) -> Error {
+    Error::Io {
+        path: path.to_path_buf(),
+        action,
+        error: Arc::new(e),
+    }
+}
+
+/// `pdyn run MODEL`.
+pub fn run(a: RunArgs) -> Result<Outcome, Error> {
+    if a.method.as_deref() == Some("help") {
+        return Ok(Outcome::text(sim::methods_help()));
+    }
+    let mut model = load_model(&a.model)?;
+    set_parameters(&mut model, &a.set)?;
     let mut set = settings(&model, &a)?;
     if a.plot && set.points.is_none() && set.output_dt.is_none() && set.t_eval.is_none() {
         // Plots read better from evenly spaced dense output than from raw steps.
         set.points = Some(2001);
     }
+    let prep = sim::prepare(&mut model).map_err(|e| sim_error(&model, "", e))?;
     let res = if set.method == "exact" {
         let exact = sim::exact::closed_form(&mut model)
-            .map_err(|e| format!("{}: error: --method exact: {e}", model.origin))?;
-        let prep = sim::prepare(&mut model)?;
+            .map_err(|e| sim_error(&model, "--method exact: ", SimError::NoClosedForm(e)))?;
         sim::exact::run_exact(&prep, &exact, &set)
     } else {
-        let prep = sim::prepare(&mut model)?;
-        sim::run(&prep, &set).map_err(|e| format!("{}: error: {e}", model.origin))?
+        sim::run(&prep, &set).map_err(|e| sim_error(&model, "", e))?
     };
-    let prep = sim::prepare(&mut model)?;
-    let mut err = String::new();
+    let mut stderr = String::new();
     for w in &res.warnings {
-        err += &format!("warning: {w}\n");
+        stderr += &format!("warning: {w}\n");
     }
-    if let Some(f) = &res.failure {
-        err += &format!("{}: error: {f}\n", model.origin);
+    let failure = res.failure.clone().map(|failure| Error::Integration {
+        origin: model.origin.clone(),
+        failure,
+    });
+    let mut sum = summary(&res, &model.name, &prep.state_names);
+    if let Some(f) = &failure {
+        sum["error"] = f.to_json()["error"].clone();
     }
-    let sum = summary(&res, &model.name, &prep.state_names);
     if let Some(dir) = &a.out {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(|e| io_error(dir, "create", e))?;
         let csv = dir.join("trajectory.csv");
-        write_csv(&res, &csv).map_err(|e| format!("cannot write {}: {e}", csv.display()))?;
+        write_csv(&res, &csv).map_err(|e| io_error(&csv, "write", e))?;
         let js = dir.join("summary.json");
-        std::fs::write(&js, format!("{sum:#}\n"))
-            .map_err(|e| format!("cannot write {}: {e}", js.display()))?;
+        std::fs::write(&js, format!("{sum:#}\n")).map_err(|e| io_error(&js, "write", e))?;
         if a.plot {
-            crate::plots::write_run_plots(&model, &prep, &res, dir)?;
+            pdyn::plots::write_run_plots(&model, &prep, &res, dir)?;
         }
     } else if a.plot {
-        return Err("--plot needs --out DIR to write the images into".into());
+        return Err(Error::argument(
+            "--plot",
+            "--plot needs --out DIR to write the images into",
+        ));
     }
-    let out = if a.json {
+    let stdout = if a.json {
         format!("{sum:#}\n")
     } else {
         text_report(&model, &res, &set, a.out.as_ref())
     };
-    Ok((out, err, res.failure.is_none()))
+    Ok(Outcome {
+        stdout,
+        stderr,
+        failure,
+    })
 }
 
 fn text_report(
@@ -226,20 +254,20 @@ pub struct CheckArgs {
 }
 
 /// `pdyn check MODEL`: integrate numerically and compare with the closed-form solution.
-pub fn check(a: CheckArgs) -> Result<(String, String, bool), String> {
+pub fn check(a: CheckArgs) -> Result<Outcome, Error> {
     let a = a.run;
-    let mut model = crate::derive_cmd::load(&a.model)?;
-    crate::forces_cmd::apply_set(&mut model, &a.set)?;
+    let mut model = load_model(&a.model)?;
+    set_parameters(&mut model, &a.set)?;
     let set = settings(&model, &a)?;
     let exact = sim::exact::closed_form(&mut model).map_err(|e| {
-        format!(
-            "{}: error: no exact solution to check against: {e}",
-            model.origin
+        sim_error(
+            &model,
+            "no exact solution to check against: ",
+            SimError::NoClosedForm(e),
         )
     })?;
-    let prep = sim::prepare(&mut model)?;
-    let rep = sim::exact::check(&prep, &exact, &set)
-        .map_err(|e| format!("{}: error: {e}", model.origin))?;
+    let prep = sim::prepare(&mut model).map_err(|e| sim_error(&model, "", e))?;
+    let rep = sim::exact::check(&prep, &exact, &set).map_err(|e| sim_error(&model, "", e))?;
     let worst = rep
         .errors
         .iter()
@@ -248,12 +276,20 @@ pub fn check(a: CheckArgs) -> Result<(String, String, bool), String> {
     if a.json {
         let v = serde_json::json!({
             "model": model.name,
-            "method": rep.run.method,
+            "method": rep.run.method.to_string(),
             "rows": rep.run.rows.len(),
             "errors": rep.errors.iter().map(|(n, e, s)| serde_json::json!({"name": n, "max_abs_error": e, "max_abs_value": s})).collect::<Vec<_>>(),
             "max_relative_error": worst,
         });
-        return Ok((format!("{v:#}\n"), String::new(), rep.run.failure.is_none()));
+        let failure = rep.run.failure.clone().map(|failure| Error::Integration {
+            origin: model.origin.clone(),
+            failure,
+        });
+        return Ok(Outcome {
+            stdout: format!("{v:#}\n"),
+            stderr: String::new(),
+            failure,
+        });
     }
     let mut out = format!(
         "{}\n{} vs the closed form at {} times (t = 0..{}):\n",
@@ -266,11 +302,13 @@ pub fn check(a: CheckArgs) -> Result<(String, String, bool), String> {
         out += &format!("  {n:<12} max |error| {e:.3e}   (max |value| {s:.3e})\n");
     }
     out += &format!("largest error relative to the size of the solution: {worst:.3e}\n");
-    let err = rep
-        .run
-        .failure
-        .clone()
-        .map(|f| format!("{f}\n"))
-        .unwrap_or_default();
-    Ok((out, err, rep.run.failure.is_none()))
+    let failure = rep.run.failure.clone().map(|failure| Error::Integration {
+        origin: model.origin.clone(),
+        failure,
+    });
+    Ok(Outcome {
+        stdout: out,
+        stderr: String::new(),
+        failure,
+    })
 }

@@ -1,20 +1,10 @@
 //! Expression commands: `simplify`, `diff`, `solve`, `eval`.
 
-use clap::{Args, ValueEnum};
-use pdyn_expr::{ExprError, FreeScope, Id, Pool, Program, Value};
+use super::Format;
+use clap::Args;
+use pdyn::Error;
+use pdyn_expr::{FreeScope, Id, Pool, Program, Value};
 use serde_json::json;
-
-/// Output notation for expressions.
-#[derive(Clone, Copy, Debug, Default, ValueEnum)]
-pub enum Format {
-    /// Plain text that pdyn parses back.
-    #[default]
-    Text,
-    /// LaTeX (math mode).
-    Latex,
-    /// A Rust f64 expression.
-    Rust,
-}
 
 /// Options shared by the expression commands.
 #[derive(Args, Debug, Clone)]
@@ -98,51 +88,33 @@ fn scope(c: &Common) -> FreeScope {
     s
 }
 
-fn located(e: ExprError, src: &str, origin: &str) -> String {
-    e.render(src, origin)
-}
-
-fn parse(pool: &mut Pool, src: &str, c: &Common, origin: &str) -> Result<Value, String> {
-    let ast = pdyn_expr::syntax::parse(src).map_err(|e| located(e, src, origin))?;
+fn parse(pool: &mut Pool, src: &str, c: &Common, origin: &str) -> Result<Value, Error> {
+    let ast = pdyn_expr::syntax::parse(src).map_err(|e| Error::expr(origin, src, e))?;
     let mut sc = scope(c);
     sc.learn(&ast);
-    pdyn_expr::lower::lower(pool, &ast, &mut sc).map_err(|e| located(e, src, origin))
+    pdyn_expr::lower::lower(pool, &ast, &mut sc).map_err(|e| Error::expr(origin, src, e))
 }
 
 fn show(pool: &Pool, id: Id, f: Format) -> String {
-    match f {
-        Format::Text => pool.to_text(id),
-        Format::Latex => pool.to_latex(id),
-        Format::Rust => pool.to_rust(id, &|p, n| p.rust_leaf_name(n)),
-    }
+    f.show(pool, id)
 }
 
 fn show_value(pool: &Pool, v: Value, f: Format) -> String {
     match v {
-        Value::Scalar(s) => show(pool, s, f),
-        Value::Vector(c) => {
-            let parts: Vec<String> = c.iter().map(|&x| show(pool, x, f)).collect();
-            match f {
-                Format::Latex => format!(
-                    "\\begin{{bmatrix}} {} \\end{{bmatrix}}",
-                    parts.join(" \\\\ ")
-                ),
-                _ => format!("[{}]", parts.join(", ")),
-            }
-        }
+        Value::Scalar(s) => f.show(pool, s),
+        Value::Vector(c) => f.show_vector(pool, c),
     }
 }
 
 fn value_json(pool: &Pool, v: Value) -> serde_json::Value {
-    let one = |x: Id| json!({"text": pool.to_text(x), "latex": pool.to_latex(x)});
     match v {
-        Value::Scalar(s) => one(s),
-        Value::Vector(c) => json!(c.iter().map(|&x| one(x)).collect::<Vec<_>>()),
+        Value::Scalar(s) => super::both(pool, s),
+        Value::Vector(c) => json!(c.iter().map(|&x| super::both(pool, x)).collect::<Vec<_>>()),
     }
 }
 
 /// `pdyn simplify EXPR`.
-pub fn simplify(a: SimplifyArgs) -> Result<String, String> {
+pub fn simplify(a: SimplifyArgs) -> Result<String, Error> {
     let mut pool = Pool::new();
     let v = parse(&mut pool, &a.expr, &a.common, "<expr>")?;
     let r = v.map(|x| {
@@ -164,7 +136,7 @@ pub fn simplify(a: SimplifyArgs) -> Result<String, String> {
 }
 
 /// `pdyn diff EXPR --wrt VAR`.
-pub fn diff(a: DiffArgs) -> Result<String, String> {
+pub fn diff(a: DiffArgs) -> Result<String, Error> {
     let mut pool = Pool::new();
     let v = parse(&mut pool, &a.expr, &a.common, "<expr>")?;
     let var = if a.wrt == "t" {
@@ -173,9 +145,12 @@ pub fn diff(a: DiffArgs) -> Result<String, String> {
         match parse(&mut pool, &a.wrt, &a.common, "--wrt")? {
             Value::Scalar(s) if is_leaf(&pool, s) => Some(s),
             _ => {
-                return Err(format!(
+                return Err(Error::argument(
+                    "--wrt",
+                    format!(
                     "--wrt: `{}` is not a variable; use a symbol, a coordinate (x, x', x'') or t",
                     a.wrt
+                ),
                 ))
             }
         }
@@ -208,21 +183,21 @@ fn is_leaf(pool: &Pool, id: Id) -> bool {
 }
 
 /// `pdyn solve EQ... --for X,Y`.
-pub fn solve(a: SolveArgs) -> Result<String, String> {
+pub fn solve(a: SolveArgs) -> Result<String, Error> {
     let mut pool = Pool::new();
     let mut sc = scope(&a.common);
     let mut eqs = Vec::new();
     for (i, src) in a.equations.iter().enumerate() {
         let origin = format!("<equation {}>", i + 1);
         let (l, r) =
-            pdyn_expr::syntax::parse_equation(src).map_err(|e| located(e, src, &origin))?;
+            pdyn_expr::syntax::parse_equation(src).map_err(|e| Error::expr(&origin, src, e))?;
         sc.learn(&l);
         if let Some(r) = &r {
             sc.learn(r);
         }
         let v = pool
             .parse_equation_in(src, &mut sc)
-            .map_err(|e| located(e, src, &origin))?;
+            .map_err(|e| Error::expr(&origin, src, e))?;
         match v {
             Value::Scalar(s) => eqs.push(s),
             Value::Vector(c) => eqs.extend(c.into_iter().filter(|&x| x != Pool::ZERO)),
@@ -232,27 +207,38 @@ pub fn solve(a: SolveArgs) -> Result<String, String> {
     for u in &a.unknowns {
         match parse(&mut pool, u, &a.common, "--for")? {
             Value::Scalar(s) if is_leaf(&pool, s) => unknowns.push(s),
-            _ => return Err(format!("--for: `{u}` is not a variable name")),
+            _ => {
+                return Err(Error::argument(
+                    "--for",
+                    format!("--for: `{u}` is not a variable name"),
+                ))
+            }
         }
     }
-    let sys = pool.linear_system(&eqs, &unknowns).map_err(|e| match e {
-        pdyn_expr::linsolve::LinearError::NotLinear { equation, unknown } => format!(
-            "equation {} is not linear in `{}`: its coefficient depends on an unknown",
-            equation + 1,
-            pool.to_text(unknown)
-        ),
-        other => other.to_string(),
-    })?;
-    let sol = pool.solve_linear(&sys).map_err(|e| match e {
-        pdyn_expr::linsolve::LinearError::Underdetermined { free } => {
-            let names: Vec<String> = free.iter().map(|&f| pool.to_text(f)).collect();
-            format!(
+    let sys = pool
+        .linear_system(&eqs, &unknowns)
+        .map_err(|e| match e {
+            pdyn_expr::linsolve::LinearError::NotLinear { equation, unknown } => format!(
+                "equation {} is not linear in `{}`: its coefficient depends on an unknown",
+                equation + 1,
+                pool.to_text(unknown)
+            ),
+            other => other.to_string(),
+        })
+        .map_err(|message| Error::argument("", message))?;
+    let sol = pool
+        .solve_linear(&sys)
+        .map_err(|e| match e {
+            pdyn_expr::linsolve::LinearError::Underdetermined { free } => {
+                let names: Vec<String> = free.iter().map(|&f| pool.to_text(f)).collect();
+                format!(
                 "the equations do not determine {}: add an equation (a constraint?) involving them",
                 names.join(", ")
             )
-        }
-        other => other.to_string(),
-    })?;
+            }
+            other => other.to_string(),
+        })
+        .map_err(|message| Error::argument("", message))?;
     if a.common.json {
         let m: serde_json::Map<String, serde_json::Value> = a
             .unknowns
@@ -270,25 +256,35 @@ pub fn solve(a: SolveArgs) -> Result<String, String> {
 }
 
 /// `pdyn eval EXPR --at x=1,y=2`.
-pub fn eval(a: EvalArgs) -> Result<String, String> {
+pub fn eval(a: EvalArgs) -> Result<String, Error> {
     let mut pool = Pool::new();
     let v = parse(&mut pool, &a.expr, &a.common, "<expr>")?;
     let mut inputs = Vec::new();
     let mut values = Vec::new();
     for kv in &a.at {
-        let (k, val) = kv
-            .split_once('=')
-            .ok_or_else(|| format!("--at: expected name=value, got `{kv}`"))?;
+        let (k, val) = kv.split_once('=').ok_or_else(|| {
+            Error::argument("--at", format!("--at: expected name=value, got `{kv}`"))
+        })?;
         let x = match parse(&mut pool, k.trim(), &a.common, "--at")? {
             Value::Scalar(s) if is_leaf(&pool, s) => s,
-            _ => return Err(format!("--at: `{k}` is not a variable name")),
+            _ => {
+                return Err(Error::argument(
+                    "--at",
+                    format!("--at: `{k}` is not a variable name"),
+                ))
+            }
         };
         let num = match parse(&mut pool, val.trim(), &a.common, "--at")? {
             Value::Scalar(s) => pool.simplify(s),
-            Value::Vector(_) => return Err(format!("--at: `{val}` is not a number")),
+            Value::Vector(_) => {
+                return Err(Error::argument(
+                    "--at",
+                    format!("--at: `{val}` is not a number"),
+                ))
+            }
         };
-        let prog =
-            Program::compile(&mut pool, &[], &[num]).map_err(|e| format!("--at {k}: {e}"))?;
+        let prog = Program::compile(&mut pool, &[], &[num])
+            .map_err(|e| Error::argument("--at", format!("--at {k}: {e}")))?;
         let mut ws = prog.workspace();
         let mut out = [0.0];
         prog.eval(&[], &mut ws, &mut out);
@@ -300,7 +296,7 @@ pub fn eval(a: EvalArgs) -> Result<String, String> {
         Value::Vector(c) => c.to_vec(),
     };
     let prog = Program::compile(&mut pool, &inputs, &outs)
-        .map_err(|e| format!("{e}; give it a value with --at"))?;
+        .map_err(|e| Error::argument("", format!("{e}; give it a value with --at")))?;
     let mut ws = prog.workspace();
     let mut out = vec![0.0; outs.len()];
     prog.eval(&values, &mut ws, &mut out);

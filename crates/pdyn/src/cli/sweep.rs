@@ -1,8 +1,10 @@
 //! `pdyn sweep MODEL`: the model's `[sweep]`, in parallel, with a progress bar.
 
-use crate::run_cmd::{settings, RunArgs};
+use super::run::{io_error, settings, sim_error, RunArgs};
+use super::{load_model, set_parameters, Outcome};
 use clap::Args;
 use pdyn::sim::{self, sweep};
+use pdyn::Error;
 use serde_json::json;
 use std::io::IsTerminal;
 
@@ -16,18 +18,21 @@ pub struct SweepArgs {
     threads: Option<usize>,
 }
 
-/// `pdyn sweep MODEL`. Returns (stdout, stderr, success).
-pub fn run(a: SweepArgs) -> Result<(String, String, bool), String> {
-    let mut model = crate::derive_cmd::load(&a.run.model)?;
-    crate::forces_cmd::apply_set(&mut model, &a.run.set)?;
+/// `pdyn sweep MODEL`.
+pub fn run(a: SweepArgs) -> Result<Outcome, Error> {
+    let mut model = load_model(&a.run.model)?;
+    set_parameters(&mut model, &a.run.set)?;
     let Some(spec) = model.run.sweep.clone() else {
-        return Err(format!(
-            "{}: error: the model has no [sweep] table\n  = help: add [sweep] with parameter, values (or from/to/steps) and [sweep.measures]",
-            model.origin
+        return Err(Error::argument(
+            &model.origin,
+            format!(
+                "{}: error: the model has no [sweep] table\n  = help: add [sweep] with parameter, values (or from/to/steps) and [sweep.measures]",
+                model.origin
+            ),
         ));
     };
     let set = settings(&model, &a.run)?;
-    let prep = sim::prepare(&mut model)?;
+    let prep = sim::prepare(&mut model).map_err(|e| sim_error(&model, "", e))?;
     let stats: Vec<_> = model
         .run
         .sweep
@@ -39,7 +44,9 @@ pub fn run(a: SweepArgs) -> Result<(String, String, bool), String> {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(n.max(1))
                 .build()
-                .map_err(|e| format!("cannot start {n} threads: {e}"))?;
+                .map_err(|e| {
+                    Error::argument("--threads", format!("cannot start {n} threads: {e}"))
+                })?;
             let owned = prep.clone();
             pool.install(move || sweep::sweep(&owned, &set, &spec, &stats, progress))
         }
@@ -66,8 +73,7 @@ pub fn run(a: SweepArgs) -> Result<(String, String, bool), String> {
         })
         .collect();
     if let Some(dir) = &a.run.out {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(|e| io_error(dir, "create", e))?;
         let mut csv = res.parameter.clone();
         if let Some(sl) = res.slices.first() {
             for (n, _) in &sl.fixed {
@@ -91,9 +97,9 @@ pub fn run(a: SweepArgs) -> Result<(String, String, bool), String> {
             }
         }
         let path = dir.join("sweep.csv");
-        std::fs::write(&path, csv).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        std::fs::write(&path, csv).map_err(|e| io_error(&path, "write", e))?;
         if a.run.plot {
-            crate::plots::write_sweep_plot(&model, &res, &peaks, dir)?;
+            pdyn::plots::write_sweep_plot(&model, &res, &peaks, dir)?;
         }
     }
     let runs_per_s = res.runs as f64 / res.seconds.max(1e-9);
@@ -120,10 +126,14 @@ pub fn run(a: SweepArgs) -> Result<(String, String, bool), String> {
             })).collect::<Vec<_>>(),
             "problems": res.problems.iter().map(|(at, p)| json!({
                 "at": at.iter().map(|(n, v)| (n.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
-                "message": p,
+                "message": p.to_string(),
             })).collect::<Vec<_>>(),
         });
-        return Ok((format!("{v:#}\n"), err, true));
+        return Ok(Outcome {
+            stdout: format!("{v:#}\n"),
+            stderr: err,
+            failure: None,
+        });
     }
     let mut out = format!(
         "{}\nsweep over {} ({} runs) in {:.3} s on {} threads: {:.1} runs/s\n",
@@ -166,5 +176,9 @@ pub fn run(a: SweepArgs) -> Result<(String, String, bool), String> {
     if let Some(dir) = &a.run.out {
         out += &format!("wrote {}/sweep.csv\n", dir.display());
     }
-    Ok((out, err, true))
+    Ok(Outcome {
+        stdout: out,
+        stderr: err,
+        failure: None,
+    })
 }

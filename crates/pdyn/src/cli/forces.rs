@@ -1,6 +1,8 @@
 //! `pdyn forces MODEL`: the forces a prescribed motion requires, and design criteria.
 
+use super::{load_model, numeric_pairs, set_parameters};
 use clap::Args;
+use pdyn::Error;
 use pdyn_expr::{Id, Program};
 use pdyn_mech::prescribed::{solve_forces, ForcesOptions};
 use serde_json::json;
@@ -25,47 +27,17 @@ pub struct ForcesArgs {
     json: bool,
 }
 
-fn pairs(list: &[String], flag: &str) -> Result<Vec<(String, f64)>, String> {
-    list.iter()
-        .map(|kv| {
-            let (k, v) = kv
-                .split_once('=')
-                .ok_or_else(|| format!("{flag}: expected name=value, got `{kv}`"))?;
-            let x: f64 = v
-                .trim()
-                .parse()
-                .map_err(|_| format!("{flag}: `{v}` is not a number (in `{kv}`)"))?;
-            Ok((k.trim().to_string(), x))
-        })
-        .collect()
-}
-
-/// Applies `--set name=value` to a model's parameters.
-pub fn apply_set(model: &mut pdyn_mech::Model, set: &[String]) -> Result<(), String> {
-    for (k, v) in pairs(set, "--set")? {
-        match model.parameters.iter_mut().find(|p| p.name == k) {
-            Some(p) => p.value = v,
-            None => {
-                let names: Vec<&str> = model.parameters.iter().map(|p| p.name.as_str()).collect();
-                return Err(format!(
-                    "--set: `{k}` is not a parameter (parameters: {})",
-                    names.join(", ")
-                ));
-            }
-        }
-    }
-    Ok(())
-}
-
 /// `pdyn forces MODEL`.
-pub fn run(a: ForcesArgs) -> Result<String, String> {
-    let mut model = crate::derive_cmd::load(&a.model)?;
-    apply_set(&mut model, &a.set)?;
+pub fn run(a: ForcesArgs) -> Result<String, Error> {
+    let mut model = load_model(&a.model)?;
+    set_parameters(&mut model, &a.set)?;
     let opts = ForcesOptions {
-        at: pairs(&a.at, "--at")?,
+        at: numeric_pairs(&a.at, "--at")?,
     };
-    let res =
-        solve_forces(&mut model, &opts).map_err(|e| format!("{}: error: {e}", model.origin))?;
+    let res = solve_forces(&mut model, &opts).map_err(|error| Error::Forces {
+        origin: model.origin.clone(),
+        error,
+    })?;
     // Monitors evaluated with the solution: derived quantities such as a load factor.
     let mut derived: Vec<(String, Option<Id>, Vec<f64>)> = Vec::new();
     if !model.run.monitors.is_empty() {

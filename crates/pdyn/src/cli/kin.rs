@@ -2,22 +2,12 @@
 //! speed: velocity, acceleration, normal–tangential and polar components, curvature, values at
 //! instants and maxima over a range.
 
-use crate::dsolve_cmd::split_top;
-use clap::{Args, ValueEnum};
-use pdyn_expr::syntax::Ast;
-use pdyn_expr::{Binding, FreeScope, Id, Node, Number, Pool, Program, Scope, Value};
-use pdyn_mech::kinematics::{analyze, maximize, solve_time, Kinematics, Motion, Quantity};
+use super::{assignments, idents, split_top, subs_all, Format};
+use clap::Args;
+use pdyn::Error;
+use pdyn_expr::{Binding, FreeScope, Id, Number, Pool, Scope, Value};
+use pdyn_mech::kinematics::{analyze, maximum, solve_time, Kinematics, Maximum, Motion, Quantity};
 use serde_json::json;
-
-/// Output notation for expressions.
-#[derive(Clone, Copy, Debug, Default, ValueEnum, PartialEq, Eq)]
-pub enum Format {
-    /// Plain text that pdyn parses back.
-    #[default]
-    Text,
-    /// LaTeX (math mode).
-    Latex,
-}
 
 /// `pdyn kin`.
 #[derive(Args, Debug)]
@@ -67,25 +57,13 @@ pub struct KinArgs {
 }
 
 fn show(pool: &Pool, id: Id, f: Format) -> String {
-    match f {
-        Format::Text => pool.to_text(id),
-        Format::Latex => pool.to_latex(id),
-    }
+    f.show(pool, id)
 }
 
 fn show_q(pool: &Pool, q: Quantity, f: Format) -> String {
     match q {
-        Quantity::Scalar(s) => show(pool, s, f),
-        Quantity::Vector(v) => {
-            let parts: Vec<String> = v.iter().map(|&c| show(pool, c, f)).collect();
-            match f {
-                Format::Latex => format!(
-                    "\\begin{{bmatrix}} {} \\end{{bmatrix}}",
-                    parts.join(" \\\\ ")
-                ),
-                Format::Text => format!("[{}]", parts.join(", ")),
-            }
-        }
+        Quantity::Scalar(s) => f.show(pool, s),
+        Quantity::Vector(v) => f.show_vector(pool, v),
     }
 }
 
@@ -97,52 +75,18 @@ fn json_q(pool: &Pool, q: Quantity) -> serde_json::Value {
     }
 }
 
-fn idents(ast: &Ast, out: &mut Vec<String>) {
-    match ast {
-        Ast::Ident { name, .. } => {
-            if !out.contains(name) {
-                out.push(name.clone())
-            }
-        }
-        Ast::Num { .. } => {}
-        Ast::Neg { expr, .. } | Ast::Prime { expr, .. } | Ast::Component { expr, .. } => {
-            idents(expr, out)
-        }
-        Ast::Binary { lhs, rhs, .. } => {
-            idents(lhs, out);
-            idents(rhs, out);
-        }
-        Ast::Call { args, .. } => args.iter().for_each(|a| idents(a, out)),
-        Ast::Vector { items, .. } => items.iter().for_each(|a| idents(a, out)),
-    }
-}
-
 /// Parses `src` as a scalar with `scope`; errors carry the location.
-fn scalar(pool: &mut Pool, src: &str, scope: &mut dyn Scope, origin: &str) -> Result<Id, String> {
+fn scalar(pool: &mut Pool, src: &str, scope: &mut dyn Scope, origin: &str) -> Result<Id, Error> {
     match pool
         .parse_in(src, scope)
-        .map_err(|e| e.render(src, origin))?
+        .map_err(|e| Error::expr(origin, src, e))?
     {
         Value::Scalar(s) => Ok(s),
-        Value::Vector(_) => Err(format!("{origin}: `{src}` is a vector, expected a scalar")),
+        Value::Vector(_) => Err(Error::argument(
+            "",
+            format!("{origin}: `{src}` is a vector, expected a scalar"),
+        )),
     }
-}
-
-/// `name = expr` items of a comma-separated list.
-fn assignments(s: &str, origin: &str) -> Result<Vec<(String, String)>, String> {
-    split_top(s)
-        .into_iter()
-        .map(|item| {
-            let (k, v) = item
-                .split_once('=')
-                .ok_or_else(|| format!("{origin}: expected `name = value`, got `{item}`"))?;
-            let k = k.trim().to_string();
-            if k.is_empty() || !k.chars().all(|c| c.is_alphanumeric() || c == '_') {
-                return Err(format!("{origin}: `{k}` is not a name"));
-            }
-            Ok((k, v.trim().to_string()))
-        })
-        .collect()
 }
 
 /// Names bound to the kinematic quantities, other names free (parameters).
@@ -170,24 +114,24 @@ struct Input {
     variable: String,
 }
 
-fn read_input(a: &KinArgs, pool: &mut Pool, scope: &mut FreeScope) -> Result<Input, String> {
+fn read_input(a: &KinArgs, pool: &mut Pool, scope: &mut FreeScope) -> Result<Input, Error> {
     let given = [a.position.is_some(), a.polar.is_some(), a.path.is_some()]
         .iter()
         .filter(|&&b| b)
         .count();
     if given != 1 {
-        return Err(
-            "give exactly one of: a position \"[x, y, z]\", --polar \"r = ..., theta = ...\", or --path \"y = f(x)\""
-                .into(),
-        );
+        return Err(Error::argument("", "give exactly one of: a position \"[x, y, z]\", --polar \"r = ..., theta = ...\", or --path \"y = f(x)\""));
     }
     if let Some(src) = &a.position {
         let v = pool
             .parse_in(src, scope)
-            .map_err(|e| e.render(src, "<position>"))?;
+            .map_err(|e| Error::expr("<position>", src, e))?;
         let Value::Vector(r) = v else {
-            return Err(format!(
-                "<position>: `{src}` is a scalar; write the position as a vector [x, y, z]"
+            return Err(Error::argument(
+                "<position>",
+                format!(
+                    "<position>: `{src}` is a scalar; write the position as a vector [x, y, z]"
+                ),
             ));
         };
         return Ok(Input {
@@ -205,14 +149,18 @@ fn read_input(a: &KinArgs, pool: &mut Pool, scope: &mut FreeScope) -> Result<Inp
                 "theta" | "th" => th = Some(e),
                 "z" => z = e,
                 other => {
-                    return Err(format!(
-                        "--polar: unknown component `{other}` (use r, theta, z)"
+                    return Err(Error::argument(
+                        "--polar",
+                        format!("--polar: unknown component `{other}` (use r, theta, z)"),
                     ))
                 }
             }
         }
         let (Some(r), Some(th)) = (r, th) else {
-            return Err("--polar: give both r = ... and theta = ...".into());
+            return Err(Error::argument(
+                "--polar",
+                "--polar: give both r = ... and theta = ...",
+            ));
         };
         return Ok(Input {
             motion: Motion::Polar { r, theta: th, z },
@@ -243,9 +191,12 @@ fn read_input(a: &KinArgs, pool: &mut Pool, scope: &mut FreeScope) -> Result<Inp
             let y = scalar(pool, v2, scope, "--path")?;
             let p = pool.var(&a.param);
             if !pool.contains(x, p) && !pool.contains(y, p) {
-                return Err(format!(
+                return Err(Error::argument(
+                    "--path",
+                    format!(
                     "--path: neither x nor y depends on the parameter `{}` (set it with --param)",
                     a.param
+                ),
                 ));
             }
             Ok(Input {
@@ -259,25 +210,15 @@ fn read_input(a: &KinArgs, pool: &mut Pool, scope: &mut FreeScope) -> Result<Inp
                 variable: a.param.clone(),
             })
         }
-        _ => Err("--path: write `y = f(x)` or `x = f(s), y = g(s)`".into()),
+        _ => Err(Error::argument(
+            "--path",
+            "--path: write `y = f(x)` or `x = f(s), y = g(s)`",
+        )),
     }
 }
 
 fn numeric(pool: &mut Pool, e: Id) -> Option<f64> {
-    if pool.any_node(e, &|n| {
-        matches!(n, Node::Sym(_) | Node::Coord(..) | Node::Time)
-    }) {
-        return None;
-    }
-    let prog = Program::compile(pool, &[], &[e]).ok()?;
-    let mut ws = prog.workspace();
-    let mut o = [0.0];
-    prog.eval(&[], &mut ws, &mut o);
-    Some(o[0])
-}
-
-fn subs_all(pool: &mut Pool, e: Id, map: &[(Id, Id)]) -> Id {
-    map.iter().fold(e, |acc, &(k, v)| pool.subs1(acc, k, v))
+    pool.eval_const(e).ok()
 }
 
 fn tidy(pool: &mut Pool, e: Id) -> Id {
@@ -286,7 +227,7 @@ fn tidy(pool: &mut Pool, e: Id) -> Id {
 }
 
 /// `pdyn kin ...`.
-pub fn run(a: KinArgs) -> Result<String, String> {
+pub fn run(a: KinArgs) -> Result<String, Error> {
     let mut pool = Pool::new();
     // Parameters: every plain name except t, the path variable and the quantity names.
     let mut names = Vec::new();
@@ -339,7 +280,10 @@ pub fn run(a: KinArgs) -> Result<String, String> {
         .collect();
     scope.positive = params.iter().cloned().collect();
     let input = read_input(&a, &mut pool, &mut scope)?;
-    let k = analyze(&mut pool, input.motion).map_err(|e| e.to_string())?;
+    let k = analyze(&mut pool, input.motion).map_err(|error| Error::Kin {
+        context: String::new(),
+        error,
+    })?;
     // --set values.
     let mut set = Vec::new();
     for (name, v) in a
@@ -409,11 +353,10 @@ pub fn run(a: KinArgs) -> Result<String, String> {
     }
     // Maximum.
     if let Some(expr) = &a.max {
-        let over = a
-            .over
-            .as_deref()
-            .ok_or("--max needs a range: --over x=0..L (or t=0..T)")?;
-        let (text, j) = maximum(
+        let over = a.over.as_deref().ok_or_else(|| {
+            Error::argument("--max", "--max needs a range: --over x=0..L (or t=0..T)")
+        })?;
+        let (text, j) = max_over(
             &mut pool, &k, &input, &named, &set, expr, over, &mut scope, a.format,
         )?;
         if a.json {
@@ -422,7 +365,10 @@ pub fn run(a: KinArgs) -> Result<String, String> {
             out += &text;
         }
     } else if a.over.is_some() {
-        return Err("--over is the range of --max; give --max too".into());
+        return Err(Error::argument(
+            "--over",
+            "--over is the range of --max; give --max too",
+        ));
     }
     let assumed: Vec<&String> = params
         .iter()
@@ -456,7 +402,7 @@ fn instant(
     set: &[(Id, Id)],
     spec: &str,
     scope: &mut FreeScope,
-) -> Result<(String, InstantValues), String> {
+) -> Result<(String, InstantValues), Error> {
     let t = pool.time();
     let mut map: Vec<(Id, Id)> = set.to_vec();
     let mut header = Vec::new();
@@ -472,13 +418,16 @@ fn instant(
             header.push(format!("{name} = {}", pool.to_text(val)));
         } else if let Some(&(_, e)) = input.inputs.iter().find(|(n, _)| *n == name) {
             if k.variable != t {
-                return Err(format!(
+                return Err(Error::argument("--at", format!(
                     "--at: for a path, give the position along it (`{} = ...`) and, if the speed varies, `t = ...`",
                     input.variable
-                ));
+                )));
             }
             let e = subs_all(pool, e, set);
-            let (exact, tv) = solve_time(pool, e, val).map_err(|e| format!("--at {spec}: {e}"))?;
+            let (exact, tv) = solve_time(pool, e, val).map_err(|error| Error::Kin {
+                context: format!("--at {spec}"),
+                error,
+            })?;
             let tt = match exact {
                 Some(x) => x,
                 None => pool.num(Number::Float(tv)),
@@ -495,15 +444,18 @@ fn instant(
             ));
             map.push((t, tt));
         } else {
-            return Err(format!(
-                "--at: `{name}` is not t, {} or a component of the input ({})",
-                input.variable,
-                input
-                    .inputs
-                    .iter()
-                    .map(|(n, _)| n.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", ")
+            return Err(Error::argument(
+                "--at",
+                format!(
+                    "--at: `{name}` is not t, {} or a component of the input ({})",
+                    input.variable,
+                    input
+                        .inputs
+                        .iter()
+                        .map(|(n, _)| n.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
             ));
         }
     }
@@ -530,32 +482,10 @@ fn instant(
     Ok((header.join(", "), values))
 }
 
-/// Deterministic pseudo-random positive values for parameter trials.
-fn trial_values(n: usize, seed: u64) -> Vec<f64> {
-    let mut s = seed;
-    (0..n)
-        .map(|_| {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            0.5 + 2.5 * (s % 100_000) as f64 / 100_000.0
-        })
-        .collect()
-}
-
-/// A close small-denominator fraction of `x` in [0, 1].
-fn small_fraction(x: f64) -> Option<(i64, i64)> {
-    for q in 1..=24i64 {
-        let p = (x * q as f64).round();
-        if (x - p / q as f64).abs() < 1e-7 {
-            return Some((p as i64, q));
-        }
-    }
-    None
-}
-
-#[allow(clippy::too_many_arguments)] // the command's state, passed once
-fn maximum(
+/// `--max EXPR --over VAR=LO..HI`: the expression in the names printed, the range parsed, and
+/// the maximum found by [`pdyn_mech::kinematics::maximum`].
+#[allow(clippy::too_many_arguments)] // the command's parsed state, passed once
+fn max_over(
     pool: &mut Pool,
     k: &Kinematics,
     input: &Input,
@@ -565,7 +495,7 @@ fn maximum(
     over: &str,
     scope: &mut FreeScope,
     format: Format,
-) -> Result<(String, serde_json::Value), String> {
+) -> Result<(String, serde_json::Value), Error> {
     let mut ks = KinScope {
         named: named
             .iter()
@@ -582,21 +512,27 @@ fn maximum(
         free: scope.clone(),
     };
     let f = scalar(pool, expr, &mut ks, "--max")?;
-    let (var_name, range) = over
-        .split_once('=')
-        .ok_or_else(|| format!("--over: expected `x=0..L`, got `{over}`"))?;
+    let (var_name, range) = over.split_once('=').ok_or_else(|| {
+        Error::argument("--over", format!("--over: expected `x=0..L`, got `{over}`"))
+    })?;
     let var_name = var_name.trim();
-    let (lo_s, hi_s) = range
-        .split_once("..")
-        .ok_or_else(|| format!("--over: expected `lo..hi`, got `{range}`"))?;
+    let (lo_s, hi_s) = range.split_once("..").ok_or_else(|| {
+        Error::argument(
+            "--over",
+            format!("--over: expected `lo..hi`, got `{range}`"),
+        )
+    })?;
     let var = if var_name == "t" {
         pool.time()
     } else if var_name == input.variable {
         k.variable
     } else {
-        return Err(format!(
-            "--over: the range must be in t or {} (got `{var_name}`)",
-            input.variable
+        return Err(Error::argument(
+            "--over",
+            format!(
+                "--over: the range must be in t or {} (got `{var_name}`)",
+                input.variable
+            ),
         ));
     };
     let lo = scalar(pool, lo_s.trim(), scope, "--over")?;
@@ -604,85 +540,40 @@ fn maximum(
     let f = subs_all(pool, f, set);
     let f = tidy(pool, f);
     let (lo, hi) = (subs_all(pool, lo, set), subs_all(pool, hi, set));
-    // Remaining symbols (parameters without values).
-    let mut free: Vec<Id> = Vec::new();
-    for n in pool.topo_order(&[f, lo, hi]) {
-        if matches!(pool.node(n), Node::Sym(_) | Node::Time) && n != var && !free.contains(&n) {
-            free.push(n);
+    let found = maximum(pool, f, var, lo, hi).map_err(|error| {
+        use pdyn_mech::kinematics::KinError;
+        let context = match error {
+            KinError::DependsOnTime { .. } | KinError::LocationDependsOn { .. } => "--max",
+            _ => "",
+        };
+        Error::Kin {
+            context: context.into(),
+            error,
+        }
+    })?;
+    match found {
+        Maximum::Numeric(e) => {
+            let text = format!(
+                "max {expr} over {over}: {} at {var_name} = {}\n",
+                e.value, e.at
+            );
+            Ok((text, json!({"expr": expr, "value": e.value, "at": e.at})))
+        }
+        Maximum::Exact {
+            at,
+            value,
+            parameters,
+        } => {
+            let text = format!(
+                "max {expr} over {over}: {} at {var_name} = {}\n  (location found numerically for random values of {} and checked on a third set)\n",
+                show(pool, value, format),
+                show(pool, at, format),
+                parameters.join(", ")
+            );
+            Ok((
+                text,
+                json!({"expr": expr, "value": super::both(pool, value), "at": super::both(pool, at)}),
+            ))
         }
     }
-    if free.contains(&pool.time()) {
-        return Err(format!(
-            "--max: `{expr}` also depends on t; give t a value (--set is for parameters) or maximise over t"
-        ));
-    }
-    let run_trial = |pool: &mut Pool, vals: &[f64]| -> Result<(f64, f64, f64, f64), String> {
-        let map: Vec<(Id, Id)> = free
-            .iter()
-            .zip(vals)
-            .map(|(&s, &v)| (s, pool.num(Number::Float(v))))
-            .collect();
-        let fs = subs_all(pool, f, &map);
-        let l = subs_all(pool, lo, &map);
-        let h = subs_all(pool, hi, &map);
-        let (lv, hv) = match (numeric(pool, l), numeric(pool, h)) {
-            (Some(a), Some(b)) => (a, b),
-            _ => return Err("--over: the range bounds are not numbers".into()),
-        };
-        let ext = maximize(pool, fs, var, lv, hv).map_err(|e| e.to_string())?;
-        Ok((ext.at, ext.value, lv, hv))
-    };
-    if free.is_empty() {
-        let (at, value, _, _) = run_trial(pool, &[])?;
-        let text = format!("max {expr} over {over}: {value} at {var_name} = {at}\n");
-        return Ok((text, json!({"expr": expr, "value": value, "at": at})));
-    }
-    // Symbolic parameters: locate the maximum for random values; when it sits at the same
-    // simple fraction of the range every time, evaluate the expression exactly there and
-    // check it against a third trial.
-    let t1 = run_trial(pool, &trial_values(free.len(), 0x1234_5678_9abc_def1))?;
-    let t2 = run_trial(pool, &trial_values(free.len(), 0x0fed_cba9_8765_4321))?;
-    let frac = |t: (f64, f64, f64, f64)| (t.0 - t.2) / (t.3 - t.2);
-    let names: Vec<String> = free.iter().map(|&s| pool.to_text(s)).collect();
-    let fail = || {
-        format!(
-            "--max: the location of the maximum depends on {}; give values with --set",
-            names.join(", ")
-        )
-    };
-    let (p, q) = match (small_fraction(frac(t1)), small_fraction(frac(t2))) {
-        (Some(a), Some(b)) if a == b => a,
-        _ => return Err(fail()),
-    };
-    let width = pool.sub(hi, lo);
-    let pq = pool.num(Number::ratio(p, q));
-    let off = pool.mul2(pq, width);
-    let at = pool.add2(lo, off);
-    let at = tidy(pool, at);
-    let value = pool.subs1(f, var, at);
-    let value = tidy(pool, value);
-    let value = pdyn_mech::kinematics::tidy_magnitude(pool, value);
-    let check_vals = trial_values(free.len(), 0x5555_aaaa_3333_cccc);
-    let t3 = run_trial(pool, &check_vals)?;
-    let map: Vec<(Id, Id)> = free
-        .iter()
-        .zip(&check_vals)
-        .map(|(&s, &v)| (s, pool.num(Number::Float(v))))
-        .collect();
-    let vs = subs_all(pool, value, &map);
-    let v3 = numeric(pool, vs).ok_or_else(fail)?;
-    if (v3 - t3.1).abs() > 1e-8 * (1.0 + t3.1.abs()) {
-        return Err(fail());
-    }
-    let text = format!(
-        "max {expr} over {over}: {} at {var_name} = {}\n  (location found numerically for random values of {} and checked on a third set)\n",
-        show(pool, value, format),
-        show(pool, at, format),
-        names.join(", ")
-    );
-    Ok((
-        text,
-        json!({"expr": expr, "value": {"text": pool.to_text(value), "latex": pool.to_latex(value)},
-               "at": {"text": pool.to_text(at), "latex": pool.to_latex(at)}}),
-    ))
 }

@@ -1,0 +1,144 @@
+//! Which quantities a derived model must conserve — the checks behind the chapter's First Law
+//! of Scientific Computing (3.3.3: "a result that violates a conservation law is wrong").
+//!
+//! - **Energy** `E = Σ ½ mᵢ |vᵢ|² + Σ V`, when every force derives from a potential (or is a
+//!   workless reaction: the model is `conservative`), at least one potential exists, and nothing
+//!   depends explicitly on `t` (no prescribed motion, no time-varying potential).
+//! - **Angular momentum** about the origin, component `c`, `H_c = Σ (rᵢ × mᵢ vᵢ)_c`, when the
+//!   resultant moment `Σ (rᵢ × Fᵢ)_c` is identically zero.
+//! - **Linear momentum**, component `c`, `Σ mᵢ vᵢ_c`, when the resultant force component is
+//!   identically zero.
+//!
+//! Momenta are only checked in Newton's form: in the projected form some reactions were never
+//! declared (a pendulum's pivot), so the known forces are not all the forces. "Identically zero"
+//! is decided by [`Pool::provably_equal`] on expressions below a size bound, so the detection
+//! never blows up; a quantity it cannot prove conserved is simply not monitored.
+
+use crate::derive::{Derivation, Form};
+use crate::Model;
+use pdyn_expr::{vector, Id, Node, Number, Pool};
+
+/// A quantity that the equations of motion conserve, as an expression of the state.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Conserved {
+    /// Column name: `energy`, `angular_momentum.z`, `momentum.x`.
+    pub name: String,
+    /// The quantity.
+    pub expr: Id,
+}
+
+/// Largest expression (in tree nodes) examined when proving a resultant zero.
+const PROOF_SIZE_LIMIT: usize = 2000;
+
+/// True when `e` depends on `t` explicitly.
+pub fn depends_on_time(pool: &Pool, e: Id) -> bool {
+    pool.any_node(e, &|n| matches!(n, Node::Time))
+}
+
+/// The conserved quantities of a derived model (see the module documentation for the rules).
+pub fn conserved_quantities(model: &mut Model, d: &Derivation) -> Vec<Conserved> {
+    let p = &mut model.pool;
+    let mut out = Vec::new();
+    let explicit_time = model
+        .particles
+        .iter()
+        .any(|pt| pt.position.iter().any(|&c| depends_on_time(p, c)))
+        || model
+            .potentials
+            .iter()
+            .any(|v| depends_on_time(p, v.energy));
+    if model.conservative && !explicit_time && !model.potentials.is_empty() {
+        let mut terms = Vec::new();
+        for pk in &d.particles {
+            let v2 = vector::dot(p, pk.v, pk.v);
+            let half = p.num(Number::ratio(1, 2));
+            terms.push(p.mul(&[half, pk.mass, v2]));
+        }
+        terms.extend(model.potentials.iter().map(|v| v.energy));
+        out.push(Conserved {
+            name: "energy".into(),
+            expr: p.add(&terms),
+        });
+    }
+    if d.form == Form::Projected {
+        return out;
+    }
+    let mut h = [Pool::ZERO; 3];
+    let mut moment = [Pool::ZERO; 3];
+    let mut momentum = [Pool::ZERO; 3];
+    let mut total_force = [Pool::ZERO; 3];
+    for pk in &d.particles {
+        let mv = vector::scale(p, pk.mass, pk.v);
+        let hr = vector::cross(p, pk.r, mv);
+        h = vector::add(p, h, hr);
+        let mr = vector::cross(p, pk.r, pk.force);
+        moment = vector::add(p, moment, mr);
+        momentum = vector::add(p, momentum, mv);
+        total_force = vector::add(p, total_force, pk.force);
+    }
+    let vanishes = |p: &mut Pool, e: Id| {
+        p.tree_size(e, PROOF_SIZE_LIMIT + 1) < PROOF_SIZE_LIMIT && p.provably_equal(e, Pool::ZERO)
+    };
+    for (kind, quantity, resultant) in [
+        ("angular_momentum", h, moment),
+        ("momentum", momentum, total_force),
+    ] {
+        for (c, axis) in ["x", "y", "z"].iter().enumerate() {
+            if quantity[c] != Pool::ZERO && vanishes(p, resultant[c]) {
+                out.push(Conserved {
+                    name: format!("{kind}.{axis}"),
+                    expr: quantity[c],
+                });
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{derive, DeriveOptions};
+
+    fn conserved(src: &str) -> Vec<String> {
+        let mut m = crate::load(src, "<test>").unwrap();
+        let d = derive(&mut m, &DeriveOptions::default()).unwrap();
+        conserved_quantities(&mut m, &d)
+            .into_iter()
+            .map(|c| c.name)
+            .collect()
+    }
+
+    const ORBIT: &str = r#"
+name = "orbit"
+[parameters]
+mu = 1
+m = 1
+[coordinates]
+x = { initial = 1, rate = 0 }
+y = { initial = 0, rate = 1 }
+[particles.sat]
+mass = "m"
+position = "[x, y, 0]"
+[points]
+O = "[0, 0, 0]"
+[[forces]]
+kind = "inverse_square"
+on = "sat"
+to = "O"
+strength = "mu*m"
+"#;
+
+    #[test]
+    fn a_central_force_conserves_energy_and_angular_momentum_not_momentum() {
+        assert_eq!(conserved(ORBIT), ["energy", "angular_momentum.z"]);
+    }
+
+    #[test]
+    fn drag_conserves_nothing() {
+        let src =
+            ORBIT.to_string() + "[[forces]]\nkind = \"linear_drag\"\non = \"sat\"\nc = \"c\"\n";
+        let src = src.replace("m = 1\n", "m = 1\nc = 0.1\n");
+        assert_eq!(conserved(&src), Vec::<String>::new());
+    }
+}

@@ -1,0 +1,201 @@
+//! The commands: one module each, doing parse → call the library → print. What the commands
+//! share lives here: the output notation, model loading, `--set`, and argument splitting.
+//!
+//! Every command returns an [`Outcome`] (what to print, and a failure that still produced
+//! output) or a [`pdyn::Error`]; `main` prints and exits.
+
+pub mod derive;
+pub mod dsolve;
+pub mod expr;
+pub mod forces;
+pub mod kin;
+pub mod run;
+pub mod sweep;
+
+use clap::ValueEnum;
+use pdyn::Error;
+use pdyn_expr::syntax::Ast;
+use pdyn_expr::{Id, Pool};
+use std::path::Path;
+use std::sync::Arc;
+
+/// What a command produced.
+#[derive(Debug, Default)]
+pub struct Outcome {
+    /// Printed on stdout.
+    pub stdout: String,
+    /// Printed on stderr (warnings).
+    pub stderr: String,
+    /// A failure after output was produced (an integration that stopped): exit code 1.
+    pub failure: Option<Error>,
+}
+
+impl Outcome {
+    /// Just text on stdout.
+    pub fn text(stdout: String) -> Outcome {
+        Outcome {
+            stdout,
+            ..Outcome::default()
+        }
+    }
+}
+
+/// Output notation for expressions.
+#[derive(Clone, Copy, Debug, Default, ValueEnum, PartialEq, Eq)]
+pub enum Format {
+    /// Plain text that pdyn parses back.
+    #[default]
+    Text,
+    /// LaTeX (math mode).
+    Latex,
+    /// A Rust f64 expression.
+    Rust,
+}
+
+impl Format {
+    /// `id` in this notation.
+    pub fn show(self, pool: &Pool, id: Id) -> String {
+        match self {
+            Format::Text => pool.to_text(id),
+            Format::Latex => pool.to_latex(id),
+            Format::Rust => pool.to_rust(id, &|p, n| p.rust_leaf_name(n)),
+        }
+    }
+
+    /// A 3-vector in this notation (a LaTeX column matrix, or `[x, y, z]`).
+    pub fn show_vector(self, pool: &Pool, v: [Id; 3]) -> String {
+        let parts: Vec<String> = v.iter().map(|&c| self.show(pool, c)).collect();
+        match self {
+            Format::Latex => format!(
+                "\\begin{{bmatrix}} {} \\end{{bmatrix}}",
+                parts.join(" \\\\ ")
+            ),
+            _ => format!("[{}]", parts.join(", ")),
+        }
+    }
+}
+
+/// `{"text": ..., "latex": ...}` for JSON output.
+pub fn both(pool: &Pool, id: Id) -> serde_json::Value {
+    serde_json::json!({"text": pool.to_text(id), "latex": pool.to_latex(id)})
+}
+
+/// Loads a model file; errors keep the file's text so that they can show the offending line.
+pub fn load_model(path: &Path) -> Result<pdyn_mech::Model, Error> {
+    let source = std::fs::read_to_string(path).map_err(|e| Error::Io {
+        path: path.to_path_buf(),
+        action: "read the model file",
+        error: Arc::new(e),
+    })?;
+    pdyn_mech::load(&source, &path.display().to_string()).map_err(|error| Error::Model {
+        error,
+        source: source.into(),
+    })
+}
+
+/// `name=number` pairs of a comma-separated option such as `--at t=0,theta=0.5`.
+pub fn numeric_pairs(list: &[String], flag: &str) -> Result<Vec<(String, f64)>, Error> {
+    list.iter()
+        .map(|kv| {
+            let (k, v) = kv.split_once('=').ok_or_else(|| {
+                Error::argument(flag, format!("{flag}: expected name=value, got `{kv}`"))
+            })?;
+            let x: f64 = v.trim().parse().map_err(|_| {
+                Error::argument(flag, format!("{flag}: `{v}` is not a number (in `{kv}`)"))
+            })?;
+            Ok((k.trim().to_string(), x))
+        })
+        .collect()
+}
+
+/// Applies `--set name=value` (numbers) to a model's parameters.
+pub fn set_parameters(model: &mut pdyn_mech::Model, set: &[String]) -> Result<(), Error> {
+    for (k, v) in numeric_pairs(set, "--set")? {
+        match model.parameters.iter_mut().find(|p| p.name == k) {
+            Some(p) => p.value = v,
+            None => {
+                let names: Vec<&str> = model.parameters.iter().map(|p| p.name.as_str()).collect();
+                return Err(Error::argument(
+                    "--set",
+                    format!(
+                        "--set: `{k}` is not a parameter (parameters: {})",
+                        names.join(", ")
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Splits at top-level commas (not inside parentheses or brackets).
+pub fn split_top(s: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut depth = 0i32;
+    let mut cur = String::new();
+    for ch in s.chars() {
+        match ch {
+            '(' | '[' => depth += 1,
+            ')' | ']' => depth -= 1,
+            _ => {}
+        }
+        if ch == ',' && depth == 0 {
+            out.push(std::mem::take(&mut cur));
+        } else {
+            cur.push(ch);
+        }
+    }
+    if !cur.trim().is_empty() {
+        out.push(cur);
+    }
+    out.into_iter().map(|p| p.trim().to_string()).collect()
+}
+
+/// `name = expr` items of a comma-separated list (`--polar "r = R, theta = t^2"`).
+pub fn assignments(s: &str, origin: &str) -> Result<Vec<(String, String)>, Error> {
+    split_top(s)
+        .into_iter()
+        .map(|item| {
+            let (k, v) = item.split_once('=').ok_or_else(|| {
+                Error::argument(
+                    origin,
+                    format!("{origin}: expected `name = value`, got `{item}`"),
+                )
+            })?;
+            let k = k.trim().to_string();
+            if k.is_empty() || !k.chars().all(|c| c.is_alphanumeric() || c == '_') {
+                return Err(Error::argument(
+                    origin,
+                    format!("{origin}: `{k}` is not a name"),
+                ));
+            }
+            Ok((k, v.trim().to_string()))
+        })
+        .collect()
+}
+
+/// Names used as plain identifiers in `ast` (candidates for parameters), in order.
+pub fn idents(ast: &Ast, out: &mut Vec<String>) {
+    match ast {
+        Ast::Ident { name, .. } => {
+            if !out.contains(name) {
+                out.push(name.clone())
+            }
+        }
+        Ast::Num { .. } => {}
+        Ast::Neg { expr, .. } | Ast::Prime { expr, .. } | Ast::Component { expr, .. } => {
+            idents(expr, out)
+        }
+        Ast::Binary { lhs, rhs, .. } => {
+            idents(lhs, out);
+            idents(rhs, out);
+        }
+        Ast::Call { args, .. } => args.iter().for_each(|a| idents(a, out)),
+        Ast::Vector { items, .. } => items.iter().for_each(|a| idents(a, out)),
+    }
+}
+
+/// Substitutes every `(symbol, value)` pair in turn.
+pub fn subs_all(pool: &mut Pool, e: Id, map: &[(Id, Id)]) -> Id {
+    map.iter().fold(e, |acc, &(k, v)| pool.subs1(acc, k, v))
+}

@@ -1,0 +1,271 @@
+//! [`Error`]: everything that can stop a pdyn command, typed, with where it came from.
+//!
+//! Library functions below return their own error types (`ModelError`, `DeriveError`,
+//! `SimError`, `KinError`, `DsolveError`, `ExprError`...). A command wraps them here with the
+//! context it knows (which file, which argument), so that `main` can render every failure the
+//! same way: a human message on stderr, a JSON object with `--json`, and an exit code:
+//!
+//! | code | meaning |
+//! |---|---|
+//! | 0 | success |
+//! | 1 | a numerical failure after partial output was written (an integration that stopped) |
+//! | 2 | bad input: a file, a model, an option, an expression; nothing was computed |
+//! | 3 | an internal error (a bug): please report it |
+
+use crate::sim::{RunFailure, SimError};
+use pdyn_expr::ExprError;
+use pdyn_mech::dsolve::DsolveError;
+use pdyn_mech::kinematics::KinError;
+use pdyn_mech::prescribed::ForcesError;
+use pdyn_mech::{DeriveError, ModelError};
+use std::fmt;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// Where in the input a problem is: a file or a command-line argument, and a position in it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Location {
+    /// The file name, or the argument (`--set`, `<expression>`).
+    pub file: String,
+    /// 1-based line, when known.
+    pub line: Option<usize>,
+    /// 1-based column (in characters), when known.
+    pub column: Option<usize>,
+}
+
+/// A failure of a pdyn command.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub enum Error {
+    /// A file could not be read or written.
+    Io {
+        /// The file or directory.
+        path: PathBuf,
+        /// What was being done: `read the model file`, `create`, `write`.
+        action: &'static str,
+        /// The operating system's reason.
+        error: Arc<std::io::Error>,
+    },
+    /// A model file that does not load; rendered with the offending line.
+    Model {
+        /// The located problem.
+        error: ModelError,
+        /// The file's text (to show the line).
+        source: Arc<str>,
+    },
+    /// An expression given on the command line that does not parse or has the wrong shape.
+    Expr {
+        /// The argument it came from (`--set`, `<position>`, `--at`...).
+        argument: String,
+        /// The argument's text.
+        text: String,
+        /// The located problem.
+        error: ExprError,
+    },
+    /// A command-line argument with an invalid value or combination.
+    Argument {
+        /// The argument (`--over`, `--set`...), empty when it is about several.
+        argument: String,
+        /// What is wrong and what would be valid.
+        message: String,
+    },
+    /// The equations of motion could not be derived.
+    Derive {
+        /// The model file.
+        origin: String,
+        /// Why.
+        error: DeriveError,
+    },
+    /// The forces of a prescribed motion could not be found.
+    Forces {
+        /// The model file.
+        origin: String,
+        /// Why.
+        error: ForcesError,
+    },
+    /// A model could not be prepared or run.
+    Sim {
+        /// The model file.
+        origin: String,
+        /// What was being attempted (`--method exact: `), or empty.
+        context: &'static str,
+        /// Why.
+        error: SimError,
+    },
+    /// Kinematics could not be derived or evaluated.
+    Kin {
+        /// The argument that asked for it (`--at t=1`, `--max`), or empty.
+        context: String,
+        /// Why.
+        error: KinError,
+    },
+    /// No closed form, or an invalid `dsolve` input.
+    Dsolve {
+        /// The argument that asked for it (`--when y = 0`), or empty.
+        context: String,
+        /// Why.
+        error: DsolveError,
+    },
+    /// A plot could not be drawn or written.
+    Plot {
+        /// The image file.
+        path: PathBuf,
+        /// Why.
+        error: String,
+    },
+    /// An integration stopped before the end (exit code 1). What was computed up to there has
+    /// been written.
+    Integration {
+        /// The model file.
+        origin: String,
+        /// Where and why.
+        failure: RunFailure,
+    },
+    /// A bug in pdyn.
+    Internal {
+        /// What went wrong.
+        message: String,
+    },
+}
+
+impl Error {
+    /// A short machine-readable name of the kind of failure (the `kind` of `--json` errors).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Error::Io { .. } => "io",
+            Error::Model { .. } => "model",
+            Error::Expr { .. } => "expression",
+            Error::Argument { .. } => "argument",
+            Error::Derive { .. } => "derivation",
+            Error::Forces { .. } => "forces",
+            Error::Sim { .. } => "simulation",
+            Error::Kin { .. } => "kinematics",
+            Error::Dsolve { .. } => "dsolve",
+            Error::Plot { .. } => "plot",
+            Error::Integration { .. } => "integration",
+            Error::Internal { .. } => "internal",
+        }
+    }
+
+    /// The process exit code for this failure (see the module documentation).
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Error::Integration { .. } => 1,
+            Error::Internal { .. } => 3,
+            _ => 2,
+        }
+    }
+
+    /// Where the problem is, when it comes from a file or an argument.
+    pub fn location(&self) -> Option<Location> {
+        let at = |file: &str, source: &str, pos: usize| {
+            let (line, column) = pdyn_expr::error::line_col(source, pos);
+            Location {
+                file: file.to_string(),
+                line: Some(line),
+                column: Some(column),
+            }
+        };
+        let file = |f: &str| Location {
+            file: f.to_string(),
+            line: None,
+            column: None,
+        };
+        match self {
+            Error::Model { error, source } => Some(at(&error.origin, source, error.span.start)),
+            Error::Expr {
+                argument,
+                text,
+                error,
+            } => Some(at(argument, text, error.span.start)),
+            Error::Io { path, .. } | Error::Plot { path, .. } => {
+                Some(file(&path.display().to_string()))
+            }
+            Error::Argument { argument, .. } if !argument.is_empty() => Some(file(argument)),
+            Error::Derive { origin, .. }
+            | Error::Forces { origin, .. }
+            | Error::Sim { origin, .. }
+            | Error::Integration { origin, .. } => Some(file(origin)),
+            _ => None,
+        }
+    }
+
+    /// An argument error.
+    pub fn argument(argument: impl Into<String>, message: impl Into<String>) -> Error {
+        Error::Argument {
+            argument: argument.into(),
+            message: message.into(),
+        }
+    }
+
+    /// An expression error in a command-line argument.
+    pub fn expr(argument: &str, text: &str, error: ExprError) -> Error {
+        Error::Expr {
+            argument: argument.to_string(),
+            text: text.to_string(),
+            error,
+        }
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::Io {
+                path,
+                action,
+                error,
+            } if *action == "read the model file" => {
+                write!(f, "{}: error: cannot {action}: {error}", path.display())
+            }
+            Error::Io {
+                path,
+                action,
+                error,
+            } => write!(f, "cannot {action} {}: {error}", path.display()),
+            Error::Model { error, source } => f.write_str(&error.render(source)),
+            Error::Expr {
+                argument,
+                text,
+                error,
+            } => f.write_str(&error.render(text, argument)),
+            Error::Argument { message, .. } => f.write_str(message),
+            Error::Derive { origin, error } => write!(f, "{origin}: error: {error}"),
+            Error::Forces { origin, error } => write!(f, "{origin}: error: {error}"),
+            Error::Sim {
+                origin,
+                context,
+                error,
+            } => write!(f, "{origin}: error: {context}{error}"),
+            Error::Kin { context, error } if context.is_empty() => write!(f, "{error}"),
+            Error::Kin { context, error } => write!(f, "{context}: {error}"),
+            Error::Dsolve { context, error } if context.is_empty() => write!(f, "{error}"),
+            Error::Dsolve { context, error } => write!(f, "{context}: {error}"),
+            Error::Plot { path, error } => write!(f, "cannot plot {}: {error}", path.display()),
+            Error::Integration { origin, failure } => write!(f, "{origin}: error: {failure}"),
+            Error::Internal { message } => write!(
+                f,
+                "internal error — please report it with the command that caused it: {message}"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+impl Error {
+    /// The `--json` form: `{"error": {"kind", "message", "location", "exit_code"}}`.
+    pub fn to_json(&self) -> serde_json::Value {
+        let location = self
+            .location()
+            .map(|l| serde_json::json!({"file": l.file, "line": l.line, "column": l.column}));
+        serde_json::json!({
+            "error": {
+                "kind": self.kind(),
+                "message": self.to_string(),
+                "location": location,
+                "exit_code": self.exit_code(),
+            }
+        })
+    }
+}

@@ -1,0 +1,142 @@
+//! [`SimError`]: why a model could not be prepared or run, and [`RunFailure`]: where an
+//! integration that started stopped early (the partial result is kept).
+
+use pdyn_expr::compile::CompileError;
+use pdyn_mech::dsolve::DsolveError;
+use pdyn_mech::DeriveError;
+use pdyn_ode::OdeError;
+use std::fmt;
+
+/// Why a model could not be prepared for running, or a run could not start.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub enum SimError {
+    /// The equations of motion could not be derived.
+    Derive(DeriveError),
+    /// Something the run needs (equations, an output column, an event, a sweep measure, the
+    /// initial conditions) could not be compiled, e.g. it refers to a name without a value.
+    Compile {
+        /// What was being compiled (`event `hits``, `sweep measure`...); empty for the equations.
+        what: String,
+        /// Why.
+        error: CompileError,
+    },
+    /// A method name that pdyn does not know.
+    UnknownMethod {
+        /// The name given.
+        name: String,
+    },
+    /// A fixed-step method without a step.
+    NeedsStep {
+        /// The method.
+        method: String,
+    },
+    /// No end time in the model or on the command line.
+    NoEndTime,
+    /// An end time that is not a positive finite number.
+    InvalidEndTime(f64),
+    /// `t_eval` not increasing or outside `[0, t_end]`.
+    InvalidTEval {
+        /// The end time.
+        t_end: f64,
+    },
+    /// A symplectic method on accelerations that depend on velocities.
+    NotSeparable {
+        /// The method.
+        method: String,
+    },
+    /// The integrator refused to start (bad options), before any step.
+    Integrator(OdeError),
+    /// No closed-form solution for `--method exact` / `pdyn check`.
+    NoClosedForm(ClosedFormError),
+}
+
+/// Why a model's equations have no closed form here.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub enum ClosedFormError {
+    /// Derivation failed.
+    Derive(DeriveError),
+    /// The accelerations were not solved symbolically (too many unknowns).
+    NotSolved,
+    /// dsolve could not solve them.
+    Dsolve(DsolveError),
+    /// The solution could not be compiled.
+    Compile(CompileError),
+}
+
+impl fmt::Display for ClosedFormError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ClosedFormError::Derive(e) => write!(f, "{e}"),
+            ClosedFormError::NotSolved => {
+                f.write_str("the equations were not solved for the accelerations symbolically")
+            }
+            ClosedFormError::Dsolve(e) => write!(f, "{e}"),
+            ClosedFormError::Compile(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl fmt::Display for SimError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SimError::Derive(e) => write!(f, "{e}"),
+            SimError::Compile { what, error } if what.is_empty() => write!(f, "{error}"),
+            SimError::Compile { what, error } => write!(f, "{what}: {error}"),
+            SimError::UnknownMethod { name } => write!(
+                f,
+                "unknown method `{name}`; run `pdyn run --method help` for the list"
+            ),
+            SimError::NeedsStep { method } => write!(
+                f,
+                "method `{method}` takes fixed steps: give the step with --dt (or dt = ... in [simulate])"
+            ),
+            SimError::NoEndTime => {
+                f.write_str("no end time: add t_end = ... under [simulate] or pass --t-end")
+            }
+            SimError::InvalidEndTime(t) => write!(f, "t_end must be a positive time, got {t}"),
+            SimError::InvalidTEval { t_end } => {
+                write!(f, "t_eval must be increasing times within [0, {t_end}]")
+            }
+            SimError::NotSeparable { method } => write!(
+                f,
+                "method `{method}` needs accelerations that do not depend on velocities; this model's do \
+                 (drag, dampers, friction...): use gauss4/gauss6 or an adaptive method"
+            ),
+            SimError::Integrator(e) => write!(f, "cannot integrate: {e}"),
+            SimError::NoClosedForm(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for SimError {}
+
+/// An integration that stopped before the end: where, in what state, and why. The rows up to
+/// that point are in the [`super::RunResult`].
+#[derive(Debug, Clone)]
+pub struct RunFailure {
+    /// Time of the last accepted state.
+    pub t: f64,
+    /// The state there, named.
+    pub state: Vec<(String, f64)>,
+    /// The integrator's error.
+    pub error: OdeError,
+}
+
+impl fmt::Display for RunFailure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let state: Vec<String> = self
+            .state
+            .iter()
+            .map(|(nm, v)| format!("{nm} = {v:.6e}"))
+            .collect();
+        write!(
+            f,
+            "integration failed at t = {:.9e}: {}\n  state: {}",
+            self.t,
+            self.error,
+            state.join(", ")
+        )
+    }
+}
