@@ -109,6 +109,10 @@ fn install_panic_hook(json: bool) {
 fn main() -> ExitCode {
     let json = wants_json();
     install_panic_hook(json);
+    // For the test of the panic hook: a bug on demand.
+    if std::env::var_os("PDYN_DEBUG_PANIC").is_some() {
+        panic!("PDYN_DEBUG_PANIC is set");
+    }
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) if !e.use_stderr() => {

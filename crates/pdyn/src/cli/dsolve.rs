@@ -52,10 +52,6 @@ pub struct DsolveArgs {
     json: bool,
 }
 
-fn show(pool: &Pool, id: Id, f: Format) -> String {
-    f.show(pool, id)
-}
-
 /// One parsed initial condition: name, derivative order, time text, value text.
 struct RawIc {
     name: String,
@@ -133,9 +129,9 @@ fn relation_text(pool: &Pool, expr: Id, rel: Relation, f: Format) -> String {
     let (lhs, rhs) = match pool.node(expr) {
         Node::Add(ts) if pool.as_num(ts[0]).is_some() && ts.len() == 2 => {
             let c = pool.as_num(ts[0]).unwrap_or(pdyn_expr::Number::ZERO).neg();
-            (show(pool, ts[1], f), c.to_string())
+            (f.show(pool, ts[1]), c.to_string())
         }
-        _ => (show(pool, expr, f), "0".to_string()),
+        _ => (f.show(pool, expr), "0".to_string()),
     };
     let op = match (rel, f) {
         (Relation::Positive, _) => ">",
@@ -331,7 +327,7 @@ pub fn run(a: DsolveArgs) -> Result<String, Error> {
             out += &format!(
                 "{indent}{}(t) = {}\n",
                 pool.name(cf.coords[j]),
-                show(&pool, q, a.format)
+                a.format.show(&pool, q)
             );
         }
         if !case.roots.is_empty() {
@@ -398,7 +394,7 @@ fn when(
         };
         Error::Dsolve { context, error }
     })?;
-    let mut text = format!("when {src}: t = {}", show(pool, found.t, format));
+    let mut text = format!("when {src}: t = {}", format.show(pool, found.t));
     if found.exact && found.value.is_finite() && pool.as_num(found.t).is_none() {
         text += &format!(" ≈ {}", found.value);
     }
@@ -409,7 +405,7 @@ fn when(
             Some(v) if pool.as_num(s.exact).is_none() => format!("  ≈ {v}"),
             _ => String::new(),
         };
-        text += &format!("  {} = {}{approx}\n", s.name, show(pool, s.exact, format));
+        text += &format!("  {} = {}{approx}\n", s.name, format.show(pool, s.exact));
         state.insert(
             s.name.clone(),
             json!({"exact": both(pool, s.exact), "value": s.value}),
@@ -626,7 +622,7 @@ fn run_rule(a: &DsolveArgs, rule: &str) -> Result<String, Error> {
     let mut out = String::new();
     for (q, vals) in sol.quantities.iter().zip(&evaluated) {
         match q.closed {
-            Some(c) => out += &format!("{} = {}\n", q.name, show(&pool, c, a.format)),
+            Some(c) => out += &format!("{} = {}\n", q.name, a.format.show(&pool, c)),
             None => {
                 out += &format!(
                     "{} = {} (no closed form used: numerical quadrature)\n",

@@ -1,6 +1,6 @@
 //! Expression commands: `simplify`, `diff`, `solve`, `eval`.
 
-use super::Format;
+use super::{value_json, Format};
 use clap::Args;
 use pdyn::Error;
 use pdyn_expr::{FreeScope, Id, Pool, Program, Value};
@@ -95,22 +95,8 @@ fn parse(pool: &mut Pool, src: &str, c: &Common, origin: &str) -> Result<Value, 
     pdyn_expr::lower::lower(pool, &ast, &mut sc).map_err(|e| Error::expr(origin, src, e))
 }
 
-fn show(pool: &Pool, id: Id, f: Format) -> String {
-    f.show(pool, id)
-}
-
 fn show_value(pool: &Pool, v: Value, f: Format) -> String {
-    match v {
-        Value::Scalar(s) => f.show(pool, s),
-        Value::Vector(c) => f.show_vector(pool, c),
-    }
-}
-
-fn value_json(pool: &Pool, v: Value) -> serde_json::Value {
-    match v {
-        Value::Scalar(s) => super::both(pool, s),
-        Value::Vector(c) => json!(c.iter().map(|&x| super::both(pool, x)).collect::<Vec<_>>()),
-    }
+    f.show_value(pool, v)
 }
 
 /// `pdyn simplify EXPR`.
@@ -250,7 +236,7 @@ pub fn solve(a: SolveArgs) -> Result<String, Error> {
     }
     let mut out = String::new();
     for (u, &s) in a.unknowns.iter().zip(&sol) {
-        out += &format!("{u} = {}\n", show(&pool, s, a.common.format));
+        out += &format!("{u} = {}\n", a.common.format.show(&pool, s));
     }
     Ok(out)
 }

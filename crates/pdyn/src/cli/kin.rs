@@ -56,23 +56,20 @@ pub struct KinArgs {
     json: bool,
 }
 
-fn show(pool: &Pool, id: Id, f: Format) -> String {
-    f.show(pool, id)
+/// A kinematic quantity as an expression value.
+fn value(q: Quantity) -> Value {
+    match q {
+        Quantity::Scalar(s) => Value::Scalar(s),
+        Quantity::Vector(v) => Value::Vector(v),
+    }
 }
 
 fn show_q(pool: &Pool, q: Quantity, f: Format) -> String {
-    match q {
-        Quantity::Scalar(s) => f.show(pool, s),
-        Quantity::Vector(v) => f.show_vector(pool, v),
-    }
+    f.show_value(pool, value(q))
 }
 
 fn json_q(pool: &Pool, q: Quantity) -> serde_json::Value {
-    let one = |x: Id| json!({"text": pool.to_text(x), "latex": pool.to_latex(x)});
-    match q {
-        Quantity::Scalar(s) => one(s),
-        Quantity::Vector(v) => json!(v.iter().map(|&c| one(c)).collect::<Vec<_>>()),
-    }
+    super::value_json(pool, value(q))
 }
 
 /// Parses `src` as a scalar with `scope`; errors carry the location.
@@ -499,15 +496,7 @@ fn max_over(
     let mut ks = KinScope {
         named: named
             .iter()
-            .map(|(n, q)| {
-                (
-                    n.to_string(),
-                    match q {
-                        Quantity::Scalar(s) => Value::Scalar(*s),
-                        Quantity::Vector(v) => Value::Vector(*v),
-                    },
-                )
-            })
+            .map(|(n, q)| (n.to_string(), value(*q)))
             .collect(),
         free: scope.clone(),
     };
@@ -566,8 +555,8 @@ fn max_over(
         } => {
             let text = format!(
                 "max {expr} over {over}: {} at {var_name} = {}\n  (location found numerically for random values of {} and checked on a third set)\n",
-                show(pool, value, format),
-                show(pool, at, format),
+                format.show(pool, value),
+                format.show(pool, at),
                 parameters.join(", ")
             );
             Ok((

@@ -15,7 +15,7 @@ pub mod sweep;
 use clap::ValueEnum;
 use pdyn::Error;
 use pdyn_expr::syntax::Ast;
-use pdyn_expr::{Id, Pool};
+use pdyn_expr::{Id, Pool, Value};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -72,6 +72,24 @@ impl Format {
             ),
             _ => format!("[{}]", parts.join(", ")),
         }
+    }
+}
+
+impl Format {
+    /// A scalar or a vector in this notation.
+    pub fn show_value(self, pool: &Pool, v: Value) -> String {
+        match v {
+            Value::Scalar(s) => self.show(pool, s),
+            Value::Vector(c) => self.show_vector(pool, c),
+        }
+    }
+}
+
+/// A scalar as `{"text", "latex"}`, a vector as a list of three of them.
+pub fn value_json(pool: &Pool, v: Value) -> serde_json::Value {
+    match v {
+        Value::Scalar(s) => both(pool, s),
+        Value::Vector(c) => serde_json::json!(c.iter().map(|&x| both(pool, x)).collect::<Vec<_>>()),
     }
 }
 

@@ -1,0 +1,145 @@
+//! Exit codes (0 success, 1 numerical failure after partial output, 2 bad input, 3 internal
+//! error) and `--json` on failure: every command prints a JSON error object on stdout with
+//! `error.kind` set, as well as the human message on stderr.
+
+use std::process::Command;
+
+fn root() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// Runs `pdyn ARGS` in the repository root: (exit code, stdout, stderr).
+fn pdyn_env(args: &[&str], env: &[(&str, &str)]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_pdyn"))
+        .args(args)
+        .envs(env.iter().copied())
+        .current_dir(root())
+        .output()
+        .expect("run pdyn");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn pdyn(args: &[&str]) -> (i32, String, String) {
+    pdyn_env(args, &[])
+}
+
+fn json_error(stdout: &str) -> serde_json::Value {
+    let v: serde_json::Value = serde_json::from_str(stdout)
+        .unwrap_or_else(|e| panic!("stdout is not JSON ({e}):\n{stdout}"));
+    v["error"].clone()
+}
+
+#[test]
+fn success_is_zero() {
+    let (code, out, _) = pdyn(&["eval", "sqrt(x^2 + y^2)", "--at", "x=3,y=4"]);
+    assert_eq!((code, out.trim()), (0, "5"));
+}
+
+#[test]
+fn every_command_answers_bad_input_with_exit_2_and_a_json_error() {
+    let broken = std::env::temp_dir().join(format!("pdyn-broken-{}.toml", std::process::id()));
+    std::fs::write(&broken, "name = \"broken\"\n[parameters]\nm = \"2 *\"\n").unwrap();
+    let b = broken.to_str().unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["simplify", "sin(x"], "expression"),
+        (vec!["diff", "x^2", "--wrt", "[x, y]"], "argument"),
+        (vec!["solve", "--for", "x", "x^2 = 4"], "argument"),
+        (vec!["eval", "x + 1"], "argument"),
+        (vec!["derive", b], "model"),
+        (vec!["forces", b], "model"),
+        (vec!["run", b], "model"),
+        (vec!["check", "examples/satellite.toml"], "simulation"),
+        (vec!["sweep", "examples/satellite.toml"], "argument"),
+        (vec!["dsolve", "x'' = -x^2"], "dsolve"),
+        (vec!["kin", "[t, t^2, 0]", "--at", "t=zz(1"], "expression"),
+        (vec!["run", "examples/no_such_model.toml"], "io"),
+        (
+            vec!["run", "examples/satellite.toml", "--method", "rk4"],
+            "simulation",
+        ),
+    ];
+    for (args, kind) in cases {
+        let mut a = args.clone();
+        a.push("--json");
+        let (code, out, err) = pdyn(&a);
+        assert_eq!(code, 2, "{args:?}: exit {code}\n{err}");
+        let e = json_error(&out);
+        assert_eq!(e["kind"], kind, "{args:?}: {e}");
+        assert_eq!(e["exit_code"], 2);
+        assert!(
+            !err.trim().is_empty(),
+            "{args:?}: the human message goes to stderr too"
+        );
+        assert_eq!(
+            e["message"].as_str().unwrap().trim_end(),
+            err.trim_end(),
+            "{args:?}"
+        );
+    }
+    std::fs::remove_file(&broken).ok();
+}
+
+#[test]
+fn model_errors_carry_file_line_and_column_in_json() {
+    let broken = std::env::temp_dir().join(format!("pdyn-located-{}.toml", std::process::id()));
+    std::fs::write(&broken, "name = \"broken\"\n[parameters]\nm = \"2 *\"\n").unwrap();
+    let (code, out, err) = pdyn(&["derive", broken.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 2, "{err}");
+    let loc = &json_error(&out)["location"];
+    assert_eq!(loc["file"], broken.to_str().unwrap());
+    assert_eq!(loc["line"], 3, "{loc}");
+    assert!(loc["column"].as_u64().unwrap() >= 5, "{loc}");
+    std::fs::remove_file(&broken).ok();
+}
+
+#[test]
+fn usage_errors_are_json_too() {
+    let (code, out, _) = pdyn(&["run", "--no-such-flag", "--json"]);
+    assert_eq!(code, 2);
+    assert_eq!(json_error(&out)["kind"], "argument");
+}
+
+#[test]
+fn a_failed_integration_exits_1_with_partial_output_and_a_json_error() {
+    let dir = std::env::temp_dir().join(format!("pdyn-exit1-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = dir.join("radial_fall.toml");
+    std::fs::write(
+        &model,
+        "name = \"radial fall\"\n[parameters]\nGM = 1.0\n[coordinates]\n\
+         x = { initial = 1.0, rate = 0.0 }\ny = { initial = 0.0, rate = 0.0 }\n\
+         [particles.p]\nmass = 1\nposition = \"[x, y, 0]\"\n[points]\nO = \"[0, 0, 0]\"\n\
+         [[forces]]\nkind = \"inverse_square\"\non = \"p\"\nto = \"O\"\nstrength = \"GM\"\n\
+         [simulate]\nt_end = 10\nmethod = \"dopri5\"\n",
+    )
+    .unwrap();
+    let (code, out, err) = pdyn(&["run", model.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 1, "{err}");
+    let summary: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(summary["ok"], false);
+    assert_eq!(summary["error"]["kind"], "integration");
+    assert_eq!(summary["error"]["exit_code"], 1);
+    assert!(
+        summary["final"]["x"].as_f64().unwrap() < 1.0,
+        "partial results are kept"
+    );
+    assert!(err.contains("integration failed at t = "), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn an_internal_error_exits_3_without_a_backtrace() {
+    // A deliberate panic (see `main.rs`) stands for a bug.
+    let (code, out, err) = pdyn_env(
+        &["eval", "1", "--json"],
+        &[("PDYN_DEBUG_PANIC", "1"), ("RUST_BACKTRACE", "1")],
+    );
+    assert_eq!(code, 3, "{err}");
+    assert!(err.contains("internal error"), "{err}");
+    assert!(!err.contains("stack backtrace"), "{err}");
+    assert_eq!(json_error(&out)["kind"], "internal");
+}
