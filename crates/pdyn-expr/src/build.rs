@@ -579,13 +579,8 @@ impl Pool {
 }
 
 fn gcd_i64(a: i64, b: i64) -> i64 {
-    let (mut a, mut b) = (a.unsigned_abs(), b.unsigned_abs());
-    while b != 0 {
-        let r = a % b;
-        a = b;
-        b = r;
-    }
-    a.min(i64::MAX as u64) as i64
+    let g = crate::number::gcd(a.unsigned_abs().into(), b.unsigned_abs().into());
+    g.min(i64::MAX as u128) as i64
 }
 
 #[cfg(test)]

@@ -14,7 +14,9 @@ pub struct Rational {
     den: i64,
 }
 
-fn gcd_u128(mut a: u128, mut b: u128) -> u128 {
+/// Greatest common divisor (Euclid); `gcd(0, 0) = 0`. The one integer gcd of the workspace:
+/// callers with signed values pass `unsigned_abs()`.
+pub fn gcd(mut a: u128, mut b: u128) -> u128 {
     while b != 0 {
         let r = a % b;
         a = b;
@@ -41,7 +43,7 @@ impl Rational {
         if den == 0 {
             return None;
         }
-        let g = gcd_u128(num.unsigned_abs(), den.unsigned_abs()).max(1) as i128;
+        let g = gcd(num.unsigned_abs(), den.unsigned_abs()).max(1) as i128;
         let (mut n, mut d) = (num / g, den / g);
         if d < 0 {
             n = -n;

@@ -672,11 +672,8 @@ pub fn solve_for_parameter(p: &mut Pool, c: Id, x: Id) -> Vec<Id> {
 }
 
 fn gcd(a: i64, b: i64) -> i64 {
-    if b == 0 {
-        a.abs()
-    } else {
-        gcd(b, a % b)
-    }
+    let g = pdyn_expr::number::gcd(a.unsigned_abs().into(), b.unsigned_abs().into());
+    g.min(i64::MAX as u128) as i64
 }
 
 /// `abs(a) - b` (either side) becomes `a^2 - b^2`.

@@ -864,3 +864,157 @@ pub(crate) fn nice_sqrt(pool: &mut Pool, d: Id) -> Id {
         plain
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dsolve::solve_system;
+    use pdyn_expr::{Program, SymId};
+
+    fn setup(positive: &[&str]) -> (Pool, SymId) {
+        let mut p = Pool::new();
+        for s in positive {
+            p.symbol(s, true);
+        }
+        let x = p.symbol("x", false);
+        (p, x)
+    }
+
+    /// Solves `eq = 0` with x(0) = x0, x'(0) = v0 and checks every case numerically: the
+    /// residual of the equation at several times, and the initial conditions.
+    fn solve_and_verify(
+        p: &mut Pool,
+        x: SymId,
+        eq: &str,
+        x0: &str,
+        v0: &str,
+        params: &[(&str, f64)],
+    ) -> ClosedForm {
+        let e = p.parse_scalar(eq).unwrap();
+        let (c0, c1, c2) = (p.coord(x, 0), p.coord(x, 1), p.coord(x, 2));
+        let (a, b) = (p.parse_scalar(x0).unwrap(), p.parse_scalar(v0).unwrap());
+        let cf = solve_system(p, &[e], &[x], &[(c0, a), (c1, b)]).unwrap();
+        let leaves: Vec<Id> = params.iter().map(|(n, _)| p.var(n)).collect();
+        let values: Vec<f64> = params.iter().map(|(_, v)| *v).collect();
+        for case in &cf.cases {
+            // Only the case whose condition holds for these values (e.g. zeta < 1) applies.
+            if let Some(c) = case.condition {
+                let prog = Program::compile(p, &leaves, &[c.expr]).unwrap();
+                let mut ws = prog.workspace();
+                let mut v = [0.0];
+                prog.eval(&values, &mut ws, &mut v);
+                let holds = match c.relation {
+                    Relation::Positive => v[0] > 1e-12,
+                    Relation::Negative => v[0] < -1e-12,
+                    Relation::Zero => v[0].abs() <= 1e-12,
+                };
+                if !holds {
+                    continue;
+                }
+            }
+            let s = case.solution[0];
+            let (s1, s2) = (p.dt(s), p.dt_n(s, 2));
+            let mut map = rustc_hash::FxHashMap::default();
+            map.insert(c0, s);
+            map.insert(c1, s1);
+            map.insert(c2, s2);
+            let residual = p.subs(e, &map);
+            let t = p.time();
+            let mut inputs = vec![t];
+            inputs.extend(&leaves);
+            let prog = Program::compile(p, &inputs, &[residual, s, s1, a, b]).unwrap();
+            let mut ws = prog.workspace();
+            let mut out = [0.0; 5];
+            for k in 0..5 {
+                let mut input = vec![0.37 * k as f64];
+                input.extend(&values);
+                prog.eval(&input, &mut ws, &mut out);
+                assert!(out[0].abs() < 1e-9, "{eq}: residual {} at t = {}", out[0], input[0]);
+                if k == 0 {
+                    assert!((out[1] - out[3]).abs() < 1e-12, "{eq}: x(0)");
+                    assert!((out[2] - out[4]).abs() < 1e-12, "{eq}: x'(0)");
+                }
+            }
+        }
+        cf
+    }
+
+    #[test]
+    fn binomial_coefficients() {
+        assert_eq!(
+            (0..=5).map(|k| binomial(5, k)).collect::<Vec<_>>(),
+            [1, 5, 10, 10, 5, 1]
+        );
+    }
+
+    #[test]
+    fn signs_of_numbers_constants_and_positive_symbols() {
+        let (mut p, _) = setup(&["k", "m"]);
+        let cases = [
+            ("3", Some(Relation::Positive)),
+            ("-2/7", Some(Relation::Negative)),
+            ("pi - 3", Some(Relation::Positive)),
+            ("sqrt(2) - 2", Some(Relation::Negative)),
+            ("k/m + 1", Some(Relation::Positive)),
+            ("-k*m", Some(Relation::Negative)),
+            ("k - m", None),
+        ];
+        for (src, want) in cases {
+            let e = p.parse_scalar(src).unwrap();
+            assert_eq!(sign_of(&mut p, e), want, "{src}");
+        }
+    }
+
+    #[test]
+    fn square_roots_take_positive_squares_outside() {
+        let (mut p, _) = setup(&["wn", "zeta"]);
+        let d = p.parse_scalar("wn^2 - wn^2*zeta^2").unwrap();
+        let s = nice_sqrt(&mut p, d);
+        assert_eq!(p.to_text(s), "wn*sqrt(1 - zeta^2)");
+    }
+
+    #[test]
+    fn distinct_real_repeated_and_complex_roots_satisfy_the_equation() {
+        let (mut p, x) = setup(&[]);
+        solve_and_verify(&mut p, x, "x'' - 3*x' + 2*x", "1", "0", &[]);
+        let cf = solve_and_verify(&mut p, x, "x'' + 2*x' + x", "1", "2", &[]);
+        assert!(p.to_text(cf.cases[0].solution[0]).contains("exp(-t)"));
+        solve_and_verify(&mut p, x, "x'' + 2*x' + 5*x", "0", "1", &[]);
+    }
+
+    #[test]
+    fn forcing_and_resonance_by_undetermined_coefficients() {
+        let (mut p, x) = setup(&[]);
+        // Off resonance, polynomial and exponential forcing.
+        solve_and_verify(&mut p, x, "x'' + x - t^2 - exp(2*t)", "0", "0", &[]);
+        // At resonance the particular solution grows like t sin(2t).
+        let cf = solve_and_verify(&mut p, x, "x'' + 4*x - sin(2*t)", "0", "0", &[]);
+        let text = p.to_text(cf.cases[0].solution[0]);
+        assert!(text.contains("t*cos(2*t)"), "{text}");
+    }
+
+    #[test]
+    fn a_symbolic_damping_ratio_gives_three_verified_cases() {
+        let (mut p, x) = setup(&["wn", "zeta"]);
+        let eq = "x'' + 2*zeta*wn*x' + wn^2*x";
+        for zeta in [0.3, 1.0, 2.5] {
+            let cf = solve_and_verify(
+                &mut p,
+                x,
+                eq,
+                "1",
+                "0",
+                &[("wn", 3.0), ("zeta", zeta)],
+            );
+            assert_eq!(cf.cases.len(), 3, "under-, critically and over-damped");
+        }
+    }
+
+    #[test]
+    fn an_algebraic_equation_is_refused() {
+        let (mut p, x) = setup(&[]);
+        let e = p.parse_scalar("x(t) - 1").unwrap();
+        let err = solve_system(&mut p, &[e], &[x], &[]).unwrap_err();
+        assert!(err.to_string().contains("algebraic"), "{err}");
+    }
+}

@@ -301,15 +301,10 @@ fn to_integers(c: &[Rational]) -> Option<Vec<i128>> {
         .collect()
 }
 
-fn gcd(mut a: i128, mut b: i128) -> i128 {
-    a = a.abs();
-    b = b.abs();
-    while b != 0 {
-        let r = a % b;
-        a = b;
-        b = r;
-    }
-    a.max(1)
+/// gcd, at least 1 (a divisor).
+fn gcd(a: i128, b: i128) -> i128 {
+    let g = pdyn_expr::number::gcd(a.unsigned_abs(), b.unsigned_abs());
+    g.clamp(1, i128::MAX as u128) as i128
 }
 
 /// Positive divisors of `n` (`None` when `n` is too large to enumerate quickly).
