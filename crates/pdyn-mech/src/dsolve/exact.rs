@@ -929,7 +929,12 @@ mod tests {
                 let mut input = vec![0.37 * k as f64];
                 input.extend(&values);
                 prog.eval(&input, &mut ws, &mut out);
-                assert!(out[0].abs() < 1e-9, "{eq}: residual {} at t = {}", out[0], input[0]);
+                assert!(
+                    out[0].abs() < 1e-9,
+                    "{eq}: residual {} at t = {}",
+                    out[0],
+                    input[0]
+                );
                 if k == 0 {
                     assert!((out[1] - out[3]).abs() < 1e-12, "{eq}: x(0)");
                     assert!((out[2] - out[4]).abs() < 1e-12, "{eq}: x'(0)");
@@ -998,14 +1003,7 @@ mod tests {
         let (mut p, x) = setup(&["wn", "zeta"]);
         let eq = "x'' + 2*zeta*wn*x' + wn^2*x";
         for zeta in [0.3, 1.0, 2.5] {
-            let cf = solve_and_verify(
-                &mut p,
-                x,
-                eq,
-                "1",
-                "0",
-                &[("wn", 3.0), ("zeta", zeta)],
-            );
+            let cf = solve_and_verify(&mut p, x, eq, "1", "0", &[("wn", 3.0), ("zeta", zeta)]);
             assert_eq!(cf.cases.len(), 3, "under-, critically and over-damped");
         }
     }
