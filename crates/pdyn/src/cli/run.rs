@@ -3,8 +3,9 @@
 use super::{load_model, set_parameters, Outcome};
 use clap::Args;
 use pdyn::output::{summary, write_csv};
-use pdyn::sim::{self, RunSettings, SimError, DEFAULT_DRIFT_TOLERANCE};
+use pdyn::sim::{self, RunSettings, SimError};
 use pdyn::Error;
+use pdyn_mech::model::spec::SimulateSpec;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -66,52 +67,35 @@ pub struct RunArgs {
 /// Merges `[simulate]` and the command line.
 pub fn settings(model: &pdyn_mech::Model, a: &RunArgs) -> Result<RunSettings, Error> {
     let s = &model.run.simulate;
-    let t_end = a
-        .t_end
-        .or(s.t_end)
-        .ok_or_else(|| sim_error(model, "", SimError::NoEndTime))?;
-    let method = match &a.method {
-        Some(m) if m == "exact" => m.clone(),
-        Some(m) => m.clone(),
-        None => match &s.method {
-            Some((m, span)) => {
-                if sim::method_by_name(m).is_none() {
-                    let error = pdyn_mech::ModelError::new(
-                        &model.origin,
-                        span.clone(),
-                        format!("unknown method `{m}`"),
-                    )
-                    .help("run `pdyn run --method help` for the list");
-                    return Err(Error::Model {
-                        error,
-                        source: model.source.as_str().into(),
-                    });
-                }
-                m.clone()
-            }
-            None => "auto".to_string(),
-        },
+    // A method named in the file is checked here, where its place in the file is known.
+    if let (None, Some((m, span))) = (&a.method, &s.method) {
+        if sim::method_by_name(m).is_none() {
+            let error = pdyn_mech::ModelError::new(
+                &model.origin,
+                span.clone(),
+                format!("unknown method `{m}`"),
+            )
+            .help("run `pdyn run --method help` for the list");
+            return Err(Error::Model {
+                error,
+                source: model.source.as_str().into(),
+            });
+        }
+    }
+    let overrides = SimulateSpec {
+        t_end: a.t_end,
+        method: a.method.clone().map(|m| (m, 0..0)),
+        rtol: a.rtol,
+        atol: a.atol,
+        dt: a.dt,
+        max_step: a.max_step,
+        max_steps: a.max_steps,
+        points: a.points,
+        output_dt: a.output_dt,
+        drift_tolerance: a.drift_tolerance,
     };
-    Ok(RunSettings {
-        method,
-        t_end,
-        rtol: a.rtol.or(s.rtol),
-        atol: a.atol.or(s.atol),
-        dt: a.dt.or(s.dt),
-        max_step: a.max_step.or(s.max_step),
-        max_steps: a.max_steps.or(s.max_steps),
-        points: a.points.or(s.points),
-        output_dt: a.output_dt.or(s.output_dt),
-        t_eval: if a.t_eval.is_empty() {
-            None
-        } else {
-            Some(a.t_eval.clone())
-        },
-        drift_tolerance: a
-            .drift_tolerance
-            .or(s.drift_tolerance)
-            .unwrap_or(DEFAULT_DRIFT_TOLERANCE),
-    })
+    let t_eval = (!a.t_eval.is_empty()).then(|| a.t_eval.clone());
+    RunSettings::resolve(s, &overrides, t_eval).map_err(|e| sim_error(model, "", e))
 }
 
 /// A simulation error located in the model file, with what was being attempted.

@@ -20,7 +20,7 @@ pub use error::{ClosedFormError, RunFailure, SimError};
 use compiled::{CompiledModel, Observer};
 use pdyn_expr::{Id, Pool};
 use pdyn_mech::conservation::conserved_quantities;
-use pdyn_mech::model::spec::Crossing;
+use pdyn_mech::model::spec::{Crossing, SimulateSpec};
 use pdyn_mech::{derive, DeriveOptions, Model};
 use pdyn_ode::{Direction, Event, Method, MethodKind, Options, Solution};
 use std::fmt;
@@ -55,22 +55,37 @@ pub struct RunSettings {
 
 impl RunSettings {
     /// Settings from a model's `[simulate]` (method `auto` unless given); `t_end` is required.
-    pub fn from_spec(s: &pdyn_mech::model::spec::SimulateSpec) -> Result<RunSettings, SimError> {
+    pub fn from_spec(s: &SimulateSpec) -> Result<RunSettings, SimError> {
+        Self::resolve(s, &SimulateSpec::default(), None)
+    }
+
+    /// `[simulate]` of the model file with `overrides` (the command line's options, a Python
+    /// call's keywords) taking precedence field by field, then the defaults.
+    pub fn resolve(
+        file: &SimulateSpec,
+        overrides: &SimulateSpec,
+        t_eval: Option<Vec<f64>>,
+    ) -> Result<RunSettings, SimError> {
+        let (o, s) = (overrides, file);
         Ok(RunSettings {
-            method: s
+            method: o
                 .method
                 .as_ref()
+                .or(s.method.as_ref())
                 .map_or("auto".to_string(), |m| m.0.clone()),
-            t_end: s.t_end.ok_or(SimError::NoEndTime)?,
-            rtol: s.rtol,
-            atol: s.atol,
-            dt: s.dt,
-            max_step: s.max_step,
-            max_steps: s.max_steps,
-            points: s.points,
-            output_dt: s.output_dt,
-            t_eval: None,
-            drift_tolerance: s.drift_tolerance.unwrap_or(DEFAULT_DRIFT_TOLERANCE),
+            t_end: o.t_end.or(s.t_end).ok_or(SimError::NoEndTime)?,
+            rtol: o.rtol.or(s.rtol),
+            atol: o.atol.or(s.atol),
+            dt: o.dt.or(s.dt),
+            max_step: o.max_step.or(s.max_step),
+            max_steps: o.max_steps.or(s.max_steps),
+            points: o.points.or(s.points),
+            output_dt: o.output_dt.or(s.output_dt),
+            t_eval,
+            drift_tolerance: o
+                .drift_tolerance
+                .or(s.drift_tolerance)
+                .unwrap_or(DEFAULT_DRIFT_TOLERANCE),
         })
     }
 
