@@ -143,3 +143,41 @@ fn an_internal_error_exits_3_without_a_backtrace() {
     assert!(!err.contains("stack backtrace"), "{err}");
     assert_eq!(json_error(&out)["kind"], "internal");
 }
+
+#[test]
+fn run_options_are_validated_where_read_and_named() {
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["--dt", "-0.1", "--method", "rk4"],
+            "--dt must be a finite time > 0, got -0.1",
+        ),
+        (&["--points", "0"], "--points must be between 2 and"),
+        (
+            &["--points", "100000000000"],
+            "--points must be between 2 and",
+        ),
+        (
+            &["--output-dt", "0"],
+            "--output-dt must be a finite time > 0",
+        ),
+        (&["--output-dt", "1e-12"], "at most 10000000 output rows"),
+        (
+            &["--rtol", "-1"],
+            "--rtol must be a finite number >= 0, got -1",
+        ),
+        (
+            &["--dt", "1e-15", "--method", "verlet"],
+            "--dt must be at least",
+        ),
+        (&["--t-end", "-3"], "t_end must be a positive time, got -3"),
+        (&["--drift-tolerance", "0"], "--drift-tolerance must be"),
+    ];
+    for (opts, want) in cases {
+        let mut args = vec!["run", "examples/satellite.toml", "--json"];
+        args.extend_from_slice(opts);
+        let (code, out, err) = pdyn(&args);
+        assert_eq!(code, 2, "{opts:?}: {err}");
+        assert!(err.contains(want), "{opts:?}: {err}");
+        assert_eq!(json_error(&out)["kind"], "simulation", "{opts:?}");
+    }
+}

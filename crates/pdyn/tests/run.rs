@@ -152,7 +152,7 @@ fn building_sweep_finds_the_natural_frequencies() {
     let spec = m.run.sweep.clone().unwrap();
     let stats: Vec<_> = spec.measures.iter().map(|x| x.stat).collect();
     let prep = sim::prepare(&mut m).unwrap();
-    let res = sim::sweep::sweep(&prep, &set, &spec, &stats, false);
+    let res = sim::sweep::sweep(&prep, &set, &spec, &stats, false).unwrap();
     assert!(res.problems.is_empty(), "{:?}", res.problems);
     assert_eq!(res.slices.len(), 1);
     let y: Vec<f64> = res.slices[0].table.iter().map(|r| r[0]).collect();
@@ -292,7 +292,7 @@ fn building_exact_solution_agrees_with_the_integration() {
             "{name}: error {err} (size {size})"
         );
     }
-    let ex = sim::exact::run_exact(&prep, &exact, &set);
+    let ex = sim::exact::run_exact(&prep, &exact, &set).unwrap();
     assert_eq!(ex.method, pdyn::sim::Solver::Exact);
     assert_eq!(ex.rows.len(), rep.run.rows.len());
     // The suspension's closed form is the chapter's.
@@ -337,7 +337,7 @@ fn two_parameter_sweep_covers_the_grid() {
     let spec = m.run.sweep.clone().unwrap();
     let stats: Vec<_> = spec.measures.iter().map(|x| x.stat).collect();
     let prep = sim::prepare(&mut m).unwrap();
-    let res = sim::sweep::sweep(&prep, &set, &spec, &stats, false);
+    let res = sim::sweep::sweep(&prep, &set, &spec, &stats, false).unwrap();
     assert_eq!(res.runs, 6);
     assert_eq!(res.slices.len(), 2);
     assert_eq!(res.slices[0].fixed, vec![("d0".to_string(), 0.05)]);

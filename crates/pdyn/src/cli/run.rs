@@ -21,19 +21,19 @@ pub struct RunArgs {
     #[arg(long)]
     pub method: Option<String>,
     /// Relative tolerance (default 1e-6).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub rtol: Option<f64>,
     /// Absolute tolerance (default 1e-9).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub atol: Option<f64>,
     /// End time (overrides [simulate] t_end).
-    #[arg(long = "t-end", alias = "t_end")]
+    #[arg(long = "t-end", alias = "t_end", allow_negative_numbers = true)]
     pub t_end: Option<f64>,
     /// Fixed step (symplectic and RK4 methods), or first step.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub dt: Option<f64>,
     /// Largest step.
-    #[arg(long = "max-step", alias = "max_step")]
+    #[arg(long = "max-step", alias = "max_step", allow_negative_numbers = true)]
     pub max_step: Option<f64>,
     /// Step limit.
     #[arg(long = "max-steps", alias = "max_steps")]
@@ -42,13 +42,18 @@ pub struct RunArgs {
     #[arg(long)]
     pub points: Option<usize>,
     /// Output every OUTPUT_DT (default: every step).
-    #[arg(long = "output-dt", alias = "t_eval_dt")]
+    #[arg(long = "output-dt", alias = "t_eval_dt", allow_negative_numbers = true)]
     pub output_dt: Option<f64>,
     /// Output exactly at these times, e.g. `--t-eval 0,0.5,1` (SciPy's `t_eval`).
-    #[arg(long = "t-eval", alias = "t_eval", value_delimiter = ',')]
+    #[arg(
+        long = "t-eval",
+        alias = "t_eval",
+        value_delimiter = ',',
+        allow_negative_numbers = true
+    )]
     pub t_eval: Vec<f64>,
     /// Warn when a conserved quantity drifts more than this (relative; default 5e-3).
-    #[arg(long = "drift-tolerance")]
+    #[arg(long = "drift-tolerance", allow_negative_numbers = true)]
     pub drift_tolerance: Option<f64>,
     /// Directory for trajectory.csv and summary.json (and plots with --plot).
     #[arg(long)]
@@ -131,7 +136,7 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
     let res = if set.method == "exact" {
         let exact = sim::exact::closed_form(&mut model)
             .map_err(|e| sim_error(&model, "--method exact: ", SimError::NoClosedForm(e)))?;
-        sim::exact::run_exact(&prep, &exact, &set)
+        sim::exact::run_exact(&prep, &exact, &set).map_err(|e| sim_error(&model, "", e))?
     } else {
         sim::run(&prep, &set).map_err(|e| sim_error(&model, "", e))?
     };

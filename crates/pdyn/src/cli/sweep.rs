@@ -51,7 +51,8 @@ pub fn run(a: SweepArgs) -> Result<Outcome, Error> {
             pool.install(move || sweep::sweep(&owned, &set, &spec, &stats, progress))
         }
         None => sweep::sweep(&prep, &set, &spec, &stats, progress),
-    };
+    }
+    .map_err(|e| sim_error(&model, "", e))?;
     let mut err = String::new();
     for (at, p) in &res.problems {
         let at: Vec<String> = at.iter().map(|(n, v)| format!("{n} = {v}")).collect();

@@ -49,6 +49,15 @@ pub enum SimError {
     Integrator(OdeError),
     /// No closed-form solution for `--method exact` / `pdyn check`.
     NoClosedForm(ClosedFormError),
+    /// A run setting outside its valid range (named as on the command line).
+    InvalidOption {
+        /// The option, e.g. `--dt`.
+        option: &'static str,
+        /// The value given.
+        value: String,
+        /// What would be valid.
+        requirement: String,
+    },
 }
 
 /// Why a model's equations have no closed form here.
@@ -106,6 +115,11 @@ impl fmt::Display for SimError {
             ),
             SimError::Integrator(e) => write!(f, "cannot integrate: {e}"),
             SimError::NoClosedForm(e) => write!(f, "{e}"),
+            SimError::InvalidOption {
+                option,
+                value,
+                requirement,
+            } => write!(f, "{option} must be {requirement}, got {value}"),
         }
     }
 }

@@ -97,29 +97,23 @@ impl ExactSolution {
     }
 }
 
-/// Output times of an exact evaluation or a check: the run's sampling, or 1001 points.
-fn times(set: &RunSettings) -> Vec<f64> {
-    if let Some(ts) = &set.t_eval {
-        return ts.clone();
-    }
-    if let Some(dt) = set.output_dt {
-        let steps = (set.t_end / dt).floor() as usize;
-        let mut ts: Vec<f64> = (0..=steps).map(|k| k as f64 * dt).collect();
-        if ts.last().is_some_and(|&l| l < set.t_end * (1.0 - 1e-12)) {
-            ts.push(set.t_end);
-        }
-        return ts;
-    }
-    let n = set.points.unwrap_or(1001).max(2);
-    (0..n)
-        .map(|k| set.t_end * k as f64 / (n - 1) as f64)
-        .collect()
-}
-
 /// `pdyn run --method exact`: the closed form evaluated at the output times, tabulated like
 /// a numerical run (positions, reactions, monitors, drifts).
-pub fn run_exact(prep: &Prepared, exact: &ExactSolution, set: &RunSettings) -> RunResult {
-    let ts = times(set);
+pub fn run_exact(
+    prep: &Prepared,
+    exact: &ExactSolution,
+    set: &RunSettings,
+) -> Result<RunResult, super::SimError> {
+    set.validate()?;
+    // The run's sampling, or 1001 points.
+    let ts = set.output_times().unwrap_or_else(|| {
+        RunSettings {
+            points: Some(1001),
+            ..set.clone()
+        }
+        .output_times()
+        .unwrap_or_default()
+    });
     let params = prep.system.parameters();
     let n2 = 2 * exact.n;
     let mut sol = pdyn_ode::Solution {
@@ -140,7 +134,7 @@ pub fn run_exact(prep: &Prepared, exact: &ExactSolution, set: &RunSettings) -> R
     }
     let mut res = tabulate(prep, &sol, set, None);
     res.method = super::Solver::Exact;
-    res
+    Ok(res)
 }
 
 /// Largest difference between a numerical run and the closed form, per state component.

@@ -96,6 +96,130 @@ impl RunSettings {
     }
 }
 
+/// Largest number of output rows a run may produce (`--points`, `t_end/--output-dt`,
+/// `--t-eval`): 10⁷ rows of a few columns is already gigabytes of CSV.
+pub const MAX_OUTPUT_ROWS: usize = 10_000_000;
+
+/// Largest number of fixed steps a run may be asked to take (`t_end/--dt`).
+pub const MAX_FIXED_STEPS: f64 = 1e10;
+
+impl RunSettings {
+    /// The output times asked for (`t_eval`, `points` or `output_dt`, in that order), or
+    /// `None` for output at every step. Call after [`RunSettings::validate`] (sizes).
+    pub fn output_times(&self) -> Option<Vec<f64>> {
+        let t_end = self.t_end;
+        if let Some(ts) = &self.t_eval {
+            Some(ts.clone())
+        } else if let Some(n) = self.points {
+            Some((0..n).map(|k| t_end * k as f64 / (n - 1) as f64).collect())
+        } else {
+            self.output_dt.map(|dt| {
+                let steps = (t_end / dt).floor() as usize;
+                let mut ts: Vec<f64> = (0..=steps).map(|k| k as f64 * dt).collect();
+                if ts.last().is_some_and(|&l| l < t_end * (1.0 - 1e-12)) {
+                    ts.push(t_end);
+                }
+                ts
+            })
+        }
+    }
+
+    /// Checks every setting against its valid range, naming the option as the command line
+    /// does. Sizes are checked here, before anything is allocated.
+    pub fn validate(&self) -> Result<(), SimError> {
+        let bad = |option: &'static str, value: f64, requirement: &str| {
+            let value = if value != 0.0 && !(1e-4..1e7).contains(&value.abs()) {
+                format!("{value:e}")
+            } else {
+                value.to_string()
+            };
+            Err(SimError::InvalidOption {
+                option,
+                value,
+                requirement: requirement.to_string(),
+            })
+        };
+        if !(self.t_end.is_finite() && self.t_end > 0.0) {
+            return Err(SimError::InvalidEndTime(self.t_end));
+        }
+        for (option, v) in [("--rtol", self.rtol), ("--atol", self.atol)] {
+            if let Some(v) = v {
+                if !(v.is_finite() && v >= 0.0) {
+                    return bad(option, v, "a finite number >= 0");
+                }
+            }
+        }
+        if self.rtol == Some(0.0) && self.atol == Some(0.0) {
+            return bad("--atol", 0.0, "> 0 when --rtol is 0");
+        }
+        for (option, v) in [("--dt", self.dt), ("--max-step", self.max_step)] {
+            if let Some(v) = v {
+                if !(v.is_finite() && v > 0.0) {
+                    return bad(option, v, "a finite time > 0");
+                }
+            }
+        }
+        if let Some(dt) = self.dt {
+            if self.t_end / dt > MAX_FIXED_STEPS {
+                return bad(
+                    "--dt",
+                    dt,
+                    &format!(
+                        "at least t_end/{MAX_FIXED_STEPS:e} = {:e}",
+                        self.t_end / MAX_FIXED_STEPS
+                    ),
+                );
+            }
+        }
+        if let Some(n) = self.points {
+            if !(2..=MAX_OUTPUT_ROWS).contains(&n) {
+                return bad(
+                    "--points",
+                    n as f64,
+                    &format!("between 2 and {MAX_OUTPUT_ROWS}"),
+                );
+            }
+        }
+        if let Some(h) = self.output_dt {
+            if !(h.is_finite() && h > 0.0) {
+                return bad("--output-dt", h, "a finite time > 0");
+            }
+            if self.t_end / h > MAX_OUTPUT_ROWS as f64 {
+                return bad(
+                    "--output-dt",
+                    h,
+                    &format!(
+                        "at least t_end/{MAX_OUTPUT_ROWS} = {:e} (at most {MAX_OUTPUT_ROWS} output rows)",
+                        self.t_end / MAX_OUTPUT_ROWS as f64
+                    ),
+                );
+            }
+        }
+        if let Some(ts) = &self.t_eval {
+            if ts.len() > MAX_OUTPUT_ROWS {
+                return bad(
+                    "--t-eval",
+                    ts.len() as f64,
+                    &format!("at most {MAX_OUTPUT_ROWS} times"),
+                );
+            }
+            if ts.iter().any(|&x| !(0.0..=self.t_end).contains(&x))
+                || ts.windows(2).any(|w| w[1] <= w[0])
+            {
+                return Err(SimError::InvalidTEval { t_end: self.t_end });
+            }
+        }
+        if !(self.drift_tolerance.is_finite() && self.drift_tolerance > 0.0) {
+            return bad(
+                "--drift-tolerance",
+                self.drift_tolerance,
+                "a finite number > 0",
+            );
+        }
+        Ok(())
+    }
+}
+
 /// Default [`RunSettings::drift_tolerance`].
 pub const DEFAULT_DRIFT_TOLERANCE: f64 = 5e-3;
 
@@ -408,6 +532,7 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, SimError> {
     let method = method_by_name(&set.method).ok_or_else(|| SimError::UnknownMethod {
         name: set.method.clone(),
     })?;
+    set.validate()?;
     let fixed = matches!(
         method.kind(),
         MethodKind::FixedStep | MethodKind::Symplectic
@@ -416,9 +541,6 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, SimError> {
         return Err(SimError::NeedsStep {
             method: set.method.clone(),
         });
-    }
-    if !(set.t_end.is_finite() && set.t_end > 0.0) {
-        return Err(SimError::InvalidEndTime(set.t_end));
     }
     let mut opts = Options::default();
     if let Some(r) = set.rtol {
@@ -436,25 +558,7 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, SimError> {
         opts.max_steps = opts.max_steps.max((set.t_end / dt).ceil() as usize + 10);
     }
     let t_end = set.t_end;
-    if let Some(ts) = &set.t_eval {
-        if ts.iter().any(|&x| !(0.0..=t_end).contains(&x)) || ts.windows(2).any(|w| w[1] <= w[0]) {
-            return Err(SimError::InvalidTEval { t_end });
-        }
-        opts.t_eval = Some(ts.clone());
-    } else if let Some(npts) = set.points {
-        opts.t_eval = Some(
-            (0..npts)
-                .map(|k| t_end * k as f64 / (npts - 1) as f64)
-                .collect(),
-        );
-    } else if let Some(dt) = set.output_dt {
-        let steps = (t_end / dt).floor() as usize;
-        let mut ts: Vec<f64> = (0..=steps).map(|k| k as f64 * dt).collect();
-        if ts.last().is_some_and(|&l| l < t_end * (1.0 - 1e-12)) {
-            ts.push(t_end);
-        }
-        opts.t_eval = Some(ts);
-    }
+    opts.t_eval = set.output_times();
 
     let sys = &prep.system;
     let n = sys.n;

@@ -29,6 +29,9 @@ pub struct SweepResult {
     pub threads: usize,
 }
 
+/// Largest number of runs one sweep may ask for (the product of the swept values' counts).
+pub const MAX_SWEEP_RUNS: usize = 10_000_000;
+
 /// What went wrong with one run of a sweep (the others go on).
 #[derive(Clone, Debug)]
 #[non_exhaustive]
@@ -96,7 +99,23 @@ pub fn sweep(
     spec: &SweepSpec,
     stats: &[Stat],
     progress: bool,
-) -> SweepResult {
+) -> Result<SweepResult, SimError> {
+    set.validate()?;
+    // Count the runs before building anything.
+    let runs = spec
+        .others
+        .iter()
+        .try_fold(spec.values.len(), |n, (_, v)| n.checked_mul(v.len()))
+        .filter(|&n| n <= MAX_SWEEP_RUNS);
+    if runs.is_none() {
+        return Err(SimError::InvalidOption {
+            option: "[sweep]",
+            value: "more runs".into(),
+            requirement: format!(
+                "at most {MAX_SWEEP_RUNS} runs (every combination of the swept values)"
+            ),
+        });
+    }
     let start = std::time::Instant::now();
     // Combinations of the other parameters (cartesian product).
     let mut combos: Vec<Vec<(usize, f64)>> = vec![Vec::new()];
@@ -158,7 +177,7 @@ pub fn sweep(
             problems.push((at, p));
         }
     }
-    SweepResult {
+    Ok(SweepResult {
         parameter: name(spec.parameter),
         values: spec.values.clone(),
         measures: prep
@@ -171,7 +190,7 @@ pub fn sweep(
         runs: jobs.len(),
         seconds: start.elapsed().as_secs_f64(),
         threads: rayon::current_num_threads(),
-    }
+    })
 }
 
 /// One run and its measures.
