@@ -209,6 +209,9 @@ impl Pool {
                 });
             }
         }
+        if n == 0 {
+            return Ok(Vec::new());
+        }
         // Fraction-free back substitution: x_i = y_i / det.
         let det = rows[n - 1][n - 1].clone();
         let mut y: Vec<Poly> = vec![Poly::zero(); n];

@@ -79,10 +79,7 @@ fn cases() -> Vec<Vec<String>> {
     for m in &models {
         let rel = format!("examples/{}", m.file_name().unwrap().to_string_lossy());
         let text = std::fs::read_to_string(m).unwrap();
-        // aircraft_turn has no free coordinate: `derive` panicked there before (issue 11).
-        if !rel.contains("aircraft_turn") {
-            cases.push(vec!["derive".into(), rel.clone()]);
-        }
+        cases.push(vec!["derive".into(), rel.clone()]);
         if text.contains("[simulate]") {
             cases.push(vec!["run".into(), rel.clone()]);
         } else {

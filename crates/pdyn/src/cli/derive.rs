@@ -116,6 +116,11 @@ pub fn run(a: DeriveArgs) -> Result<String, Error> {
     for n in &d.notes {
         out += &format!("  note: {n}\n");
     }
+    if d.free.is_empty() {
+        out += "\nEvery coordinate is prescribed: there are no equations of motion to solve. \
+                The forces this motion needs are found by `pdyn forces`.\n";
+        return Ok(out);
+    }
     let names: Vec<&str> = d.unknowns.iter().map(|u| u.name.as_str()).collect();
     out += &format!("\nUnknowns: {}\n", names.join(", "));
     match &d.solution {
