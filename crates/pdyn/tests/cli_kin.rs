@@ -119,3 +119,34 @@ fn errors_are_clear() {
     let (ok, _, _) = pdyn(&["kin", "--help"]);
     assert!(ok);
 }
+
+/// A negative value given with --set contradicts the positivity assumed while deriving: the
+/// derivation is redone without it (issue 11: speed was printed as -6, the tangent against v).
+#[test]
+fn a_negative_rate_given_later_is_not_assumed_positive() {
+    let (ok, out, err) = pdyn(&[
+        "kin",
+        "[R*cos(omega*t), R*sin(omega*t), 0]",
+        "--set",
+        "R=2,omega=-3",
+        "--at",
+        "t=0.5",
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let at = &v["at"][0]["values"];
+    assert_eq!(at["speed"]["value"][0].as_f64().unwrap(), 6.0);
+    let vel: Vec<f64> = (0..3)
+        .map(|i| at["v"]["value"][i].as_f64().unwrap())
+        .collect();
+    let tan: Vec<f64> = (0..3)
+        .map(|i| at["tangent"]["value"][i].as_f64().unwrap())
+        .collect();
+    for i in 0..3 {
+        assert!(
+            (tan[i] - vel[i] / 6.0).abs() < 1e-12,
+            "tangent {tan:?} vs v {vel:?}"
+        );
+    }
+}

@@ -189,6 +189,7 @@ pub fn run(a: DsolveArgs) -> Result<String, Error> {
             idents(r, &mut names);
         }
     }
+    let signed_by_set = super::not_positive_in_set(&a.set);
     let params: Vec<String> = names
         .into_iter()
         .filter(|n| {
@@ -197,6 +198,7 @@ pub fn run(a: DsolveArgs) -> Result<String, Error> {
                 && n != "pi"
                 && n != "e"
                 && !a.signed.contains(n)
+                && !signed_by_set.contains(n)
         })
         .collect();
     scope.positive = params.iter().cloned().collect();
@@ -535,9 +537,17 @@ fn run_rule(a: &DsolveArgs, rule: &str) -> Result<String, Error> {
     let mut names = Vec::new();
     idents(&ast, &mut names);
     let indep = given.variable();
+    let signed_by_set = super::not_positive_in_set(&a.set);
     let params: Vec<String> = names
         .into_iter()
-        .filter(|n| n != indep && n != "t" && n != "pi" && n != "e" && !a.signed.contains(n))
+        .filter(|n| {
+            n != indep
+                && n != "t"
+                && n != "pi"
+                && n != "e"
+                && !a.signed.contains(n)
+                && !signed_by_set.contains(n)
+        })
         .collect();
     let mut scope = FreeScope {
         positive: params.iter().cloned().collect(),

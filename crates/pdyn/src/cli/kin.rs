@@ -264,6 +264,7 @@ pub fn run(a: KinArgs) -> Result<String, Error> {
     } else {
         a.param.clone()
     };
+    let signed_by_set = super::not_positive_in_set(&a.set);
     let params: Vec<String> = names
         .into_iter()
         .filter(|n| {
@@ -273,6 +274,7 @@ pub fn run(a: KinArgs) -> Result<String, Error> {
                 && !(a.path.is_some() && *n == path_var)
                 && !scope.coordinates.contains(n)
                 && !a.signed.contains(n)
+                && !signed_by_set.contains(n)
         })
         .collect();
     scope.positive = params.iter().cloned().collect();

@@ -213,6 +213,30 @@ pub fn idents(ast: &Ast, out: &mut Vec<String>) {
     }
 }
 
+/// Names that `--set` gives a value that is not a positive number (`omega=-3`, `c=0`, or an
+/// expression of other names). Parameters are assumed positive while deriving (it decides
+/// `sqrt(R^2) = R` and the signs of discriminants); a value given later that contradicts or
+/// may contradict the assumption must not inherit results derived under it, so these names
+/// are derived without it, as if given with `--signed`.
+pub fn not_positive_in_set(set: &[String]) -> Vec<String> {
+    let mut out = Vec::new();
+    for item in set.iter().flat_map(|s| split_top(s)) {
+        let Some((name, value)) = item.split_once('=') else {
+            continue;
+        };
+        let mut pool = Pool::new();
+        let positive = pool
+            .parse_scalar(value.trim())
+            .ok()
+            .and_then(|v| pool.eval_const(v).ok())
+            .is_some_and(|v| v > 0.0 && v.is_finite());
+        if !positive {
+            out.push(name.trim().to_string());
+        }
+    }
+    out
+}
+
 /// Substitutes every `(symbol, value)` pair in turn.
 pub fn subs_all(pool: &mut Pool, e: Id, map: &[(Id, Id)]) -> Id {
     map.iter().fold(e, |acc, &(k, v)| pool.subs1(acc, k, v))
