@@ -16,7 +16,7 @@
 
 use crate::derive::{Derivation, Form};
 use crate::Model;
-use pdyn_expr::{vector, Id, Node, Number, Pool};
+use pdyn_expr::{vector, Func, Id, Node, Number, Pool};
 
 /// A quantity that the equations of motion conserve, as an expression of the state.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -25,6 +25,12 @@ pub struct Conserved {
     pub name: String,
     /// The quantity.
     pub expr: Id,
+    /// Its physical scale at a state, the sum of the magnitudes of its parts: `Σ ½ m v² + Σ |V|`
+    /// for energy, `Σ m |r| |v|` for angular momentum, `Σ m |v|` for momentum. A drift is
+    /// measured against this, not against the quantity's own value, which may be zero (a
+    /// pendulum released from the horizontal has E = 0) or tiny by cancellation, at any
+    /// scale of units.
+    pub scale: Id,
 }
 
 /// Largest expression (in tree nodes) examined when proving a resultant zero.
@@ -54,15 +60,29 @@ pub fn conserved_quantities(model: &mut Model, d: &Derivation) -> Vec<Conserved>
             let half = p.num(Number::ratio(1, 2));
             terms.push(p.mul(&[half, pk.mass, v2]));
         }
+        let mut magnitudes = terms.clone();
+        for v in &model.potentials {
+            magnitudes.push(p.call(Func::Abs, &[v.energy]));
+        }
         terms.extend(model.potentials.iter().map(|v| v.energy));
         out.push(Conserved {
             name: "energy".into(),
             expr: p.add(&terms),
+            scale: p.add(&magnitudes),
         });
     }
     if d.form == Form::Projected {
         return out;
     }
+    let (mut linear_scale, mut angular_scale) = (Vec::new(), Vec::new());
+    for pk in &d.particles {
+        let speed = vector::norm(p, pk.v);
+        let r = vector::norm(p, pk.r);
+        linear_scale.push(p.mul(&[pk.mass, speed]));
+        angular_scale.push(p.mul(&[pk.mass, speed, r]));
+    }
+    let linear_scale = p.add(&linear_scale);
+    let angular_scale = p.add(&angular_scale);
     let mut h = [Pool::ZERO; 3];
     let mut moment = [Pool::ZERO; 3];
     let mut momentum = [Pool::ZERO; 3];
@@ -79,15 +99,16 @@ pub fn conserved_quantities(model: &mut Model, d: &Derivation) -> Vec<Conserved>
     let vanishes = |p: &mut Pool, e: Id| {
         p.tree_size(e, PROOF_SIZE_LIMIT + 1) < PROOF_SIZE_LIMIT && p.provably_equal(e, Pool::ZERO)
     };
-    for (kind, quantity, resultant) in [
-        ("angular_momentum", h, moment),
-        ("momentum", momentum, total_force),
+    for (kind, quantity, resultant, scale) in [
+        ("angular_momentum", h, moment, angular_scale),
+        ("momentum", momentum, total_force, linear_scale),
     ] {
         for (c, axis) in ["x", "y", "z"].iter().enumerate() {
             if quantity[c] != Pool::ZERO && vanishes(p, resultant[c]) {
                 out.push(Conserved {
                     name: format!("{kind}.{axis}"),
                     expr: quantity[c],
+                    scale,
                 });
             }
         }

@@ -53,7 +53,7 @@ pub fn summary(res: &RunResult, model_name: &str, state_names: &[String]) -> ser
         })).collect::<Vec<_>>(),
         "monitors": res.monitors.iter().map(|m| json!({
             "name": m.name, "initial": json_num(m.initial), "drift": json_num(m.drift),
-            "relative": m.relative, "conserved": m.conserved,
+            "relative": m.relative, "scale": json_num(m.scale), "conserved": m.conserved,
         })).collect::<Vec<_>>(),
         "stats": {
             "steps": res.stats.steps, "accepted": res.stats.accepted, "rejected": res.stats.rejected,

@@ -125,10 +125,10 @@ pub fn write_run_plots(
     let mut series = Vec::new();
     for m in &res.monitors {
         if let Some(v) = column(res, &m.name) {
-            let scale = if m.relative { m.initial.abs() } else { 1.0 };
+            let scale = if m.relative { m.scale } else { 1.0 };
             let d: Vec<f64> = v.iter().map(|x| (x - m.initial) / scale).collect();
             let label = if m.relative {
-                format!("({0} - {0}(0))/|{0}(0)|", m.name)
+                format!("({0} - {0}(0))/{1:.3e}", m.name, m.scale)
             } else {
                 format!("{0} - {0}(0)", m.name)
             };

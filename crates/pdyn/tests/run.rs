@@ -350,3 +350,80 @@ fn two_parameter_sweep_covers_the_grid() {
         );
     }
 }
+
+fn run_source(src: &str, tweak: impl FnOnce(&mut RunSettings)) -> sim::RunResult {
+    let mut m = pdyn_mech::load(src, "<test>").unwrap_or_else(|e| panic!("{}", e.render(src)));
+    let mut set = RunSettings::from_spec(&m.run.simulate).unwrap();
+    tweak(&mut set);
+    let prep = sim::prepare(&mut m).unwrap();
+    sim::run(&prep, &set).unwrap()
+}
+
+fn energy(res: &sim::RunResult) -> &sim::MonitorReport {
+    res.monitors
+        .iter()
+        .find(|m| m.name == "energy")
+        .expect("energy is monitored")
+}
+
+/// The First Law's safeguard measures drift against the quantity's physical scale, so it
+/// flags the same run at any scale of units (issue 11: a 1e-25 kg satellite spiralling in was
+/// reported "ok").
+#[test]
+fn drift_is_flagged_at_any_scale_of_units() {
+    let satellite = std::fs::read_to_string(format!(
+        "{}/../../examples/satellite_ode45.toml",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let mut drifts = Vec::new();
+    for mass in ["1.0", "1e-25", "1e30"] {
+        let src = satellite.replace("m = 1.0", &format!("m = {mass}"));
+        let res = run_source(&src, |_| {});
+        let e = energy(&res);
+        assert!(e.relative, "{mass}");
+        assert!(
+            !res.warnings.is_empty(),
+            "m = {mass}: the spiral must be flagged"
+        );
+        drifts.push(e.drift);
+    }
+    for d in &drifts {
+        assert!((d / drifts[0] - 1.0).abs() < 1e-6, "scale-free: {drifts:?}");
+    }
+}
+
+/// A pendulum released from the horizontal has E = 0 (datum at the pivot): an accurate run is
+/// not flagged (issue 11: it was reported DRIFTING by 4.8e8), and an inaccurate one is.
+#[test]
+fn zero_initial_energy_is_measured_against_the_motion_s_energy() {
+    let src = r#"
+name = "pendulum released from the horizontal"
+gravity = "[0, -g, 0]"
+[parameters]
+g = 9.81
+m = 2.0
+l = 1.5
+[coordinates]
+q = { initial = 1.5707963267948966, rate = 0.0 }
+[particles.bob]
+mass = "m"
+position = "l*[sin(q), -cos(q), 0]"
+[simulate]
+t_end = 10.0
+rtol = 1e-10
+atol = 1e-12
+"#;
+    let res = run_source(src, |_| {});
+    let e = energy(&res);
+    assert!(e.initial.abs() < 1e-12, "E0 = {}", e.initial);
+    assert!(e.relative && e.scale > 1.0, "scale {}", e.scale);
+    assert!(e.drift < 1e-6, "drift {}", e.drift);
+    assert!(res.warnings.is_empty(), "{:?}", res.warnings);
+    let coarse = run_source(src, |s| {
+        s.rtol = Some(1e-2);
+        s.atol = Some(1e-2);
+    });
+    assert!(energy(&coarse).drift > 5e-3, "{}", energy(&coarse).drift);
+    assert!(!coarse.warnings.is_empty());
+}

@@ -232,6 +232,9 @@ pub struct Prepared {
     pub observer: Observer,
     /// Which observer outputs are conserved quantities (checked for drift).
     pub conserved: Vec<bool>,
+    /// The physical scale of each conserved quantity, in the order they appear among the
+    /// observer outputs (see [`pdyn_mech::conservation::Conserved::scale`]).
+    pub scales: Observer,
     /// Names of the state components.
     pub state_names: Vec<String>,
     /// Initial state.
@@ -318,10 +321,14 @@ pub struct MonitorReport {
     pub name: String,
     /// Value at the first output.
     pub initial: f64,
-    /// `max |Q - Q0|`, divided by `|Q0|` when `relative`.
+    /// `max |Q - Q0|`, divided by `scale` when `relative`.
     pub drift: f64,
-    /// Whether `drift` is relative.
+    /// Whether `drift` is relative to `scale` (false only when the scale is zero: nothing
+    /// moves and nothing acts).
     pub relative: bool,
+    /// The quantity's physical scale over the run: the larger of its value at the start and
+    /// its median along the run (see [`pdyn_mech::conservation::Conserved::scale`]).
+    pub scale: f64,
     /// Whether the quantity should be conserved.
     pub conserved: bool,
 }
@@ -360,7 +367,7 @@ pub fn prepare_with(model: &mut Model, opts: &DeriveOptions) -> Result<Prepared,
     // ... as a first-order system the integrators can step...
     let system = CompiledModel::new(model, &d).map_err(|error| compile_error("", error))?;
     // ... what to tabulate and which laws the result must obey...
-    let (observer, conserved) = observations(model, &d, &system)?;
+    let (observer, conserved, scales) = observations(model, &d, &system)?;
     // ... when to stop or record, what a sweep measures, and where it starts.
     let events = compile_events(model, &system)?;
     let measures = compile_measures(model, &system)?;
@@ -372,6 +379,7 @@ pub fn prepare_with(model: &mut Model, opts: &DeriveOptions) -> Result<Prepared,
         system,
         observer,
         conserved,
+        scales,
         state_names: d.state_names.clone(),
         y0,
         events,
@@ -389,7 +397,7 @@ fn observations(
     model: &mut Model,
     d: &pdyn_mech::Derivation,
     system: &CompiledModel,
-) -> Result<(Observer, Vec<bool>), SimError> {
+) -> Result<(Observer, Vec<bool>, Observer), SimError> {
     let mut names = Vec::new();
     let mut exprs = Vec::new();
     let mut conserved = Vec::new();
@@ -413,7 +421,10 @@ fn observations(
         exprs.push(e);
         conserved.push(false);
     }
+    let (mut scale_names, mut scale_exprs) = (Vec::new(), Vec::new());
     for c in conserved_quantities(model, d) {
+        scale_names.push(c.name.clone());
+        scale_exprs.push(c.scale);
         names.push(c.name);
         exprs.push(c.expr);
         conserved.push(true);
@@ -425,7 +436,14 @@ fn observations(
     }
     let observer = Observer::new(&mut model.pool, &system.observation_inputs, names, &exprs)
         .map_err(|error| compile_error("", error))?;
-    Ok((observer, conserved))
+    let scales = Observer::new(
+        &mut model.pool,
+        &system.observation_inputs,
+        scale_names,
+        &scale_exprs,
+    )
+    .map_err(|error| compile_error("conservation scale", error))?;
+    Ok((observer, conserved, scales))
 }
 
 /// The model's `[[events]]`, each over the cheapest inputs it can be evaluated from.
@@ -640,6 +658,36 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, SimError> {
     Ok(tabulate(prep, &sol, set, failure))
 }
 
+/// The scale of each conserved quantity over a run: the larger of its value at the first
+/// output and its median along the run. The median, not the maximum, so that a run that
+/// goes wrong (a satellite spiralling into the planet, where the kinetic energy grows without
+/// bound) cannot enlarge the yardstick its own error is measured with.
+fn conservation_scales(prep: &Prepared, sol: &Solution) -> Vec<f64> {
+    let n = prep.scales.len();
+    if n == 0 || sol.is_empty() {
+        return vec![f64::NAN; n];
+    }
+    let mut per_quantity = vec![Vec::with_capacity(sol.len()); n];
+    let mut input = Vec::new();
+    let mut out = vec![0.0; n];
+    for k in 0..sol.len() {
+        prep.system
+            .observation_input(sol.t[k], sol.y_at(k), &mut input);
+        prep.scales.eval(&input, &mut out);
+        for (series, &v) in per_quantity.iter_mut().zip(&out) {
+            series.push(v.abs());
+        }
+    }
+    per_quantity
+        .into_iter()
+        .map(|mut v| {
+            let first = v[0];
+            v.sort_by(f64::total_cmp);
+            first.max(v[v.len() / 2])
+        })
+        .collect()
+}
+
 pub(crate) fn tabulate(
     prep: &Prepared,
     sol: &Solution,
@@ -678,6 +726,7 @@ pub(crate) fn tabulate(
         })
         .collect();
     let offset = 1 + prep.state_names.len();
+    let scales = conservation_scales(prep, sol);
     let mut monitors = Vec::new();
     let mut warnings = Vec::new();
     for (j, name) in prep.observer.names.iter().enumerate() {
@@ -692,8 +741,10 @@ pub(crate) fn tabulate(
             .iter()
             .map(|r| (r[offset + j] - first).abs())
             .fold(0.0, f64::max);
-        let relative = first.abs() > 1e-12;
-        let drift = if relative { dev / first.abs() } else { dev };
+        let k = monitors.len();
+        let scale = scales.get(k).copied().unwrap_or(f64::NAN);
+        let relative = scale > 0.0;
+        let drift = if relative { dev / scale } else { dev };
         if drift.is_nan() || drift > set.drift_tolerance {
             let t_last = rows.last().map_or(0.0, |r| r[0]);
             warnings.push(format!(
@@ -709,6 +760,7 @@ pub(crate) fn tabulate(
             initial: first,
             drift,
             relative,
+            scale,
             conserved,
         });
     }
