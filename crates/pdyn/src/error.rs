@@ -121,6 +121,13 @@ pub enum Error {
         /// Where and why.
         failure: RunFailure,
     },
+    /// A result that is NaN or infinite (`1/0`), printed as such (exit code 1).
+    NonFinite {
+        /// What was evaluated.
+        what: String,
+        /// Which components are not finite.
+        components: Vec<usize>,
+    },
     /// A bug in pdyn.
     Internal {
         /// What went wrong.
@@ -143,6 +150,7 @@ impl Error {
             Error::Dsolve { .. } => "dsolve",
             Error::Plot { .. } => "plot",
             Error::Integration { .. } => "integration",
+            Error::NonFinite { .. } => "non_finite",
             Error::Internal { .. } => "internal",
         }
     }
@@ -150,7 +158,7 @@ impl Error {
     /// The process exit code for this failure (see the module documentation).
     pub fn exit_code(&self) -> u8 {
         match self {
-            Error::Integration { .. } => 1,
+            Error::Integration { .. } | Error::NonFinite { .. } => 1,
             Error::Internal { .. } => 3,
             _ => 2,
         }
@@ -243,6 +251,11 @@ impl fmt::Display for Error {
             Error::Dsolve { context, error } => write!(f, "{context}: {error}"),
             Error::Plot { path, error } => write!(f, "cannot plot {}: {error}", path.display()),
             Error::Integration { origin, failure } => write!(f, "{origin}: error: {failure}"),
+            Error::NonFinite { what, components } => write!(
+                f,
+                "error: {what} is not finite (NaN or infinite) in component(s) {components:?}: \
+                 a division by zero or a function outside its domain"
+            ),
             Error::Internal { message } => write!(
                 f,
                 "internal error — please report it with the command that caused it: {message}"

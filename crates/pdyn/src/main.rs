@@ -57,7 +57,7 @@ fn dispatch(command: Command) -> Result<Outcome, Error> {
         Command::Simplify(a) => text(cli::expr::simplify(a)),
         Command::Diff(a) => text(cli::expr::diff(a)),
         Command::Solve(a) => text(cli::expr::solve(a)),
-        Command::Eval(a) => text(cli::expr::eval(a)),
+        Command::Eval(a) => cli::expr::eval(a),
         Command::Derive(a) => text(cli::derive::run(a)),
         Command::Forces(a) => text(cli::forces::run(a)),
         Command::Run(a) => cli::run::run(a),

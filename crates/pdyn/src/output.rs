@@ -65,7 +65,9 @@ pub fn summary(res: &RunResult, model_name: &str, state_names: &[String]) -> ser
     })
 }
 
-fn json_num(x: f64) -> serde_json::Value {
+/// A number for JSON: finite values as numbers, NaN and infinities as the strings `"NaN"`,
+/// `"inf"`, `"-inf"` (JSON has no such numbers; `null` would hide them).
+pub fn json_num(x: f64) -> serde_json::Value {
     if x.is_finite() {
         json!(x)
     } else {

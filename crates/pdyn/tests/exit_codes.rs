@@ -181,3 +181,19 @@ fn run_options_are_validated_where_read_and_named() {
         assert_eq!(json_error(&out)["kind"], "simulation", "{opts:?}");
     }
 }
+
+#[test]
+fn non_finite_results_are_flagged_never_printed_as_if_right() {
+    let (code, out, err) = pdyn(&["eval", "[1/0, 2, log(-1)]", "--json"]);
+    assert_eq!(code, 1, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["value"], serde_json::json!(["inf", 2.0, "NaN"]));
+    assert_eq!(v["non_finite"], serde_json::json!([0, 2]));
+    assert!(err.contains("not finite"), "{err}");
+    // Non-finite inputs are refused where they are read.
+    let (code, _, err) = pdyn(&["eval", "x + 1", "--at", "x=1/0"]);
+    assert_eq!(code, 2, "{err}");
+    let (code, _, err) = pdyn(&["forces", "examples/takeoff.toml", "--set", "m=nan"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("not a finite number"), "{err}");
+}

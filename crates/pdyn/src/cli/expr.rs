@@ -242,7 +242,7 @@ pub fn solve(a: SolveArgs) -> Result<String, Error> {
 }
 
 /// `pdyn eval EXPR --at x=1,y=2`.
-pub fn eval(a: EvalArgs) -> Result<String, Error> {
+pub fn eval(a: EvalArgs) -> Result<super::Outcome, Error> {
     let mut pool = Pool::new();
     let v = parse(&mut pool, &a.expr, &a.common, "<expr>")?;
     let mut inputs = Vec::new();
@@ -274,6 +274,12 @@ pub fn eval(a: EvalArgs) -> Result<String, Error> {
         let mut ws = prog.workspace();
         let mut out = [0.0];
         prog.eval(&[], &mut ws, &mut out);
+        if !out[0].is_finite() {
+            return Err(Error::argument(
+                "--at",
+                format!("--at {k}: `{val}` is not a finite number ({})", out[0]),
+            ));
+        }
         inputs.push(x);
         values.push(out[0]);
     }
@@ -286,8 +292,18 @@ pub fn eval(a: EvalArgs) -> Result<String, Error> {
     let mut ws = prog.workspace();
     let mut out = vec![0.0; outs.len()];
     prog.eval(&values, &mut ws, &mut out);
-    Ok(if a.common.json {
-        format!("{}\n", json!({"input": a.expr, "value": out}))
+    let non_finite: Vec<usize> = (0..out.len()).filter(|&i| !out[i].is_finite()).collect();
+    let failure = (!non_finite.is_empty()).then(|| Error::NonFinite {
+        what: format!("`{}`", a.expr),
+        components: non_finite.clone(),
+    });
+    let stdout = if a.common.json {
+        let value: Vec<serde_json::Value> =
+            out.iter().map(|&x| pdyn::output::json_num(x)).collect();
+        format!(
+            "{}\n",
+            json!({"input": a.expr, "value": value, "non_finite": non_finite})
+        )
     } else if out.len() == 1 {
         format!("{}\n", out[0])
     } else {
@@ -298,5 +314,10 @@ pub fn eval(a: EvalArgs) -> Result<String, Error> {
                 .collect::<Vec<_>>()
                 .join(", ")
         )
+    };
+    Ok(super::Outcome {
+        stdout,
+        stderr: String::new(),
+        failure,
     })
 }

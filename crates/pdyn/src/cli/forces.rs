@@ -2,6 +2,7 @@
 
 use super::{load_model, numeric_pairs, set_parameters};
 use clap::Args;
+use pdyn::output::json_num;
 use pdyn::Error;
 use pdyn_expr::{Id, Program};
 use pdyn_mech::prescribed::{solve_forces, ForcesOptions};
@@ -85,19 +86,19 @@ pub fn run(a: ForcesArgs) -> Result<String, Error> {
         let e = |id: Id| json!({"text": p.to_text(id), "latex": p.to_latex(id)});
         let v = json!({
             "model": model.name,
-            "instant": res.instant.iter().map(|(n, v)| (n.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
+            "instant": res.instant.iter().map(|(n, v)| (n.clone(), json_num(*v))).collect::<serde_json::Map<_, _>>(),
             "equations": res.equations.iter().map(|q| json!({"label": q.label, "lhs": e(q.lhs), "rhs": e(q.rhs)})).collect::<Vec<_>>(),
             "unknowns": res.unknowns,
             "symbolic": res.symbolic.as_ref().map(|s| res.unknowns.iter().zip(s).map(|(n, &x)| (n.clone(), e(x))).collect::<serde_json::Map<_, _>>()),
-            "solutions": res.numeric.iter().map(|s| res.unknowns.iter().zip(s).map(|(n, &x)| (n.clone(), json!(x))).collect::<serde_json::Map<_, _>>()).collect::<Vec<_>>(),
-            "derived": derived.iter().map(|(n, s, v)| json!({"name": n, "expr": s.map(e), "values": v})).collect::<Vec<_>>(),
+            "solutions": res.numeric.iter().map(|s| res.unknowns.iter().zip(s).map(|(n, &x)| (n.clone(), json_num(x))).collect::<serde_json::Map<_, _>>()).collect::<Vec<_>>(),
+            "derived": derived.iter().map(|(n, s, v)| json!({"name": n, "expr": s.map(e), "values": v.iter().map(|&x| json_num(x)).collect::<Vec<_>>()})).collect::<Vec<_>>(),
             "checks": res.checks.iter().map(|c| json!({
                 "name": c.name, "condition": c.condition, "parameter": c.parameter,
                 "symbolic": c.symbolic.iter().map(|&x| e(x)).collect::<Vec<_>>(),
-                "min": c.min.map(|(v, at)| json!({"value": v, "at": at})),
-                "max": c.max.map(|(v, at)| json!({"value": v, "at": at})),
+                "min": c.min.map(|(v, at)| json!({"value": json_num(v), "at": at.map(json_num)})),
+                "max": c.max.map(|(v, at)| json!({"value": json_num(v), "at": at.map(json_num)})),
                 "over": c.over,
-                "forces_at_critical": c.forces_at_critical.iter().map(|(n, v)| (n.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
+                "forces_at_critical": c.forces_at_critical.iter().map(|(n, v)| (n.clone(), json_num(*v))).collect::<serde_json::Map<_, _>>(),
             })).collect::<Vec<_>>(),
             "notes": res.notes.iter().filter(|n| !n.starts_with("polar:")).collect::<Vec<_>>(),
         });

@@ -121,6 +121,12 @@ pub fn numeric_pairs(list: &[String], flag: &str) -> Result<Vec<(String, f64)>, 
             let x: f64 = v.trim().parse().map_err(|_| {
                 Error::argument(flag, format!("{flag}: `{v}` is not a number (in `{kv}`)"))
             })?;
+            if !x.is_finite() {
+                return Err(Error::argument(
+                    flag,
+                    format!("{flag}: `{v}` is not a finite number (in `{kv}`)"),
+                ));
+            }
             Ok((k.trim().to_string(), x))
         })
         .collect()
