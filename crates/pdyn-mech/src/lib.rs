@@ -17,6 +17,7 @@ pub mod kinematics;
 pub mod model;
 pub mod prescribed;
 pub mod units;
+pub mod validity;
 
 pub use derive::{derive, Derivation, DeriveError, DeriveOptions};
 pub use model::{load, load_file, Model, ModelError};

@@ -69,6 +69,15 @@ pub enum Error {
         /// What is wrong and what would be valid.
         message: String,
     },
+    /// A parameter value that breaks a physical requirement (a mass ≤ 0), given by the option.
+    Value {
+        /// The model file.
+        origin: String,
+        /// The option that gave the value (`--set`).
+        option: String,
+        /// What is wrong.
+        error: pdyn_mech::validity::InvalidValue,
+    },
     /// The equations of motion could not be derived.
     Derive {
         /// The model file.
@@ -143,6 +152,7 @@ impl Error {
             Error::Model { .. } => "model",
             Error::Expr { .. } => "expression",
             Error::Argument { .. } => "argument",
+            Error::Value { .. } => "value",
             Error::Derive { .. } => "derivation",
             Error::Forces { .. } => "forces",
             Error::Sim { .. } => "simulation",
@@ -191,6 +201,7 @@ impl Error {
             }
             Error::Argument { argument, .. } if !argument.is_empty() => Some(file(argument)),
             Error::Derive { origin, .. }
+            | Error::Value { origin, .. }
             | Error::Forces { origin, .. }
             | Error::Sim { origin, .. }
             | Error::Integration { origin, .. } => Some(file(origin)),
@@ -239,6 +250,11 @@ impl fmt::Display for Error {
             } => f.write_str(&error.render(text, argument)),
             Error::Argument { message, .. } => f.write_str(message),
             Error::Derive { origin, error } => write!(f, "{origin}: error: {error}"),
+            Error::Value {
+                origin,
+                option,
+                error,
+            } => write!(f, "{origin}: error: {option}: {error}"),
             Error::Forces { origin, error } => write!(f, "{origin}: error: {error}"),
             Error::Sim {
                 origin,

@@ -197,3 +197,19 @@ fn non_finite_results_are_flagged_never_printed_as_if_right() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("not a finite number"), "{err}");
 }
+
+#[test]
+fn a_mass_set_to_a_non_positive_value_is_refused_with_the_particle_named() {
+    for cmd in ["run", "check", "sweep", "forces"] {
+        let model = if cmd == "forces" {
+            "examples/pulley.toml"
+        } else {
+            "examples/building.toml"
+        };
+        let param = if cmd == "forces" { "mA=0" } else { "m=-1" };
+        let (code, out, err) = pdyn(&[cmd, model, "--set", param, "--json"]);
+        assert_eq!(code, 2, "{cmd}: {err}");
+        assert_eq!(json_error(&out)["kind"], "value", "{cmd}");
+        assert!(err.contains("must be finite and > 0"), "{cmd}: {err}");
+    }
+}

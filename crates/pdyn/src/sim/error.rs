@@ -49,6 +49,8 @@ pub enum SimError {
     Integrator(OdeError),
     /// No closed-form solution for `--method exact` / `pdyn check`.
     NoClosedForm(ClosedFormError),
+    /// Parameter values that break a physical requirement (a sweep's run with a mass ≤ 0).
+    InvalidValue(pdyn_mech::validity::InvalidValue),
     /// A run setting outside its valid range (named as on the command line).
     InvalidOption {
         /// The option, e.g. `--dt`.
@@ -115,6 +117,7 @@ impl fmt::Display for SimError {
             ),
             SimError::Integrator(e) => write!(f, "cannot integrate: {e}"),
             SimError::NoClosedForm(e) => write!(f, "{e}"),
+            SimError::InvalidValue(e) => write!(f, "{e}"),
             SimError::InvalidOption {
                 option,
                 value,

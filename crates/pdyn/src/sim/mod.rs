@@ -21,6 +21,7 @@ use compiled::{CompiledModel, Observer};
 use pdyn_expr::{Id, Pool};
 use pdyn_mech::conservation::conserved_quantities;
 use pdyn_mech::model::spec::{Crossing, SimulateSpec};
+use pdyn_mech::validity::ValueChecks;
 use pdyn_mech::{derive, DeriveOptions, Model};
 use pdyn_ode::{Direction, Event, Method, MethodKind, Options, Solution};
 use std::fmt;
@@ -237,6 +238,8 @@ pub struct Prepared {
     pub scales: Observer,
     /// Names of the state components.
     pub state_names: Vec<String>,
+    /// Physical requirements on the parameter values (masses > 0), checked before each run.
+    pub value_checks: Option<ValueChecks>,
     /// Initial state.
     pub y0: Vec<f64>,
     /// The model's `[[events]]`, compiled.
@@ -381,6 +384,7 @@ pub fn prepare_with(model: &mut Model, opts: &DeriveOptions) -> Result<Prepared,
         conserved,
         scales,
         state_names: d.state_names.clone(),
+        value_checks: ValueChecks::compile(model).ok(),
         y0,
         events,
         measures,
@@ -551,6 +555,11 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, SimError> {
         name: set.method.clone(),
     })?;
     set.validate()?;
+    if let Some(checks) = &prep.value_checks {
+        checks
+            .check(&prep.system.parameters())
+            .map_err(SimError::InvalidValue)?;
+    }
     let fixed = matches!(
         method.kind(),
         MethodKind::FixedStep | MethodKind::Symplectic
