@@ -134,7 +134,58 @@ pub fn run_exact(
     }
     let mut res = tabulate(prep, &sol, set, None);
     res.method = super::Solver::Exact;
+    if let Some(w) = verify_against_integration(prep, &sol, set) {
+        res.warnings.push(w);
+    }
     Ok(res)
+}
+
+/// Largest difference, relative to the solution's size, that a closed form may have from a
+/// tight numerical integration before it is reported as untrustworthy.
+pub const EXACT_AGREEMENT: f64 = 1e-6;
+
+/// The First Law applied to closed forms: a formula that is exact in exact arithmetic can lose
+/// every digit in floating point (near a resonance, `F/(ωₙ² − ω²)` multiplies a difference of
+/// nearly equal sines). Integrate with DOP853 at rtol 1e-11 at the same times and compare;
+/// return a warning when they disagree by more than [`EXACT_AGREEMENT`].
+fn verify_against_integration(
+    prep: &Prepared,
+    exact: &pdyn_ode::Solution,
+    set: &RunSettings,
+) -> Option<String> {
+    let check = RunSettings {
+        method: "dop853".into(),
+        rtol: Some(1e-11),
+        atol: Some(1e-12),
+        dt: None,
+        max_step: None,
+        max_steps: None,
+        points: None,
+        output_dt: None,
+        t_eval: Some(exact.t.clone()),
+        ..set.clone()
+    };
+    let run = super::run(prep, &check).ok()?;
+    if run.failure.is_some() || run.rows.len() != exact.len() {
+        return None;
+    }
+    let n2 = exact.n;
+    let mut worst = 0.0f64;
+    for c in 0..n2 {
+        let size = run.rows.iter().map(|r| r[1 + c].abs()).fold(0.0, f64::max);
+        let err = (0..exact.len())
+            .map(|k| (exact.y_at(k)[c] - run.rows[k][1 + c]).abs())
+            .fold(0.0, f64::max);
+        worst = worst.max(err / size.max(1e-300));
+    }
+    (worst > EXACT_AGREEMENT || worst.is_nan()).then(|| {
+        format!(
+            "the closed form differs from a DOP853 integration (rtol 1e-11) by {worst:.3e} relative \
+             to the solution's size: evaluated in floating point it cannot be trusted here (near a \
+             resonance or a repeated root the formula cancels large terms). Use a numerical method \
+             (drop --method exact)."
+        )
+    })
 }
 
 /// Largest difference between a numerical run and the closed form, per state component.
