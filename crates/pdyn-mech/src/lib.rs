@@ -10,6 +10,7 @@
 //!   the 1-D integration rules of section 3.1.3.
 #![warn(missing_docs)]
 
+pub mod algebra;
 pub mod conservation;
 pub mod derive;
 pub mod dsolve;

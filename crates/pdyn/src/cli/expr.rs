@@ -201,42 +201,56 @@ pub fn solve(a: SolveArgs) -> Result<String, Error> {
             }
         }
     }
-    let sys = pool
-        .linear_system(&eqs, &unknowns)
-        .map_err(|e| match e {
-            pdyn_expr::linsolve::LinearError::NotLinear { equation, unknown } => format!(
-                "equation {} is not linear in `{}`: its coefficient depends on an unknown",
-                equation + 1,
-                pool.to_text(unknown)
-            ),
-            other => other.to_string(),
-        })
-        .map_err(|message| Error::argument("", message))?;
-    let sol = pool
-        .solve_linear(&sys)
-        .map_err(|e| match e {
-            pdyn_expr::linsolve::LinearError::Underdetermined { free } => {
-                let names: Vec<String> = free.iter().map(|&f| pool.to_text(f)).collect();
-                format!(
-                "the equations do not determine {}: add an equation (a constraint?) involving them",
-                names.join(", ")
-            )
-            }
-            other => other.to_string(),
-        })
-        .map_err(|message| Error::argument("", message))?;
+    let solutions = match pool.linear_system(&eqs, &unknowns) {
+        // Linear: exact elimination, printed as it always was.
+        Ok(sys) => vec![pool
+            .solve_linear(&sys)
+            .map_err(|e| match e {
+                pdyn_expr::linsolve::LinearError::Underdetermined { free } => {
+                    let names: Vec<String> = free.iter().map(|&f| pool.to_text(f)).collect();
+                    format!(
+                        "the equations do not determine {}: add an equation (a constraint?) involving them",
+                        names.join(", ")
+                    )
+                }
+                other => other.to_string(),
+            })
+            .map_err(|message| Error::argument("", message))?],
+        // Not linear: substitution, the quadratic formula, real roots of polynomials.
+        Err(pdyn_expr::linsolve::LinearError::NotLinear { .. }) => {
+            pdyn_mech::algebra::solve(&mut pool, &eqs, &unknowns).map_err(|error| {
+                Error::argument("", format!("{error}"))
+            })?
+        }
+        Err(e) => return Err(Error::argument("", e.to_string())),
+    };
+    if solutions.is_empty() {
+        return Err(Error::argument("", "no real solution"));
+    }
     if a.common.json {
-        let m: serde_json::Map<String, serde_json::Value> = a
-            .unknowns
-            .iter()
-            .zip(&sol)
-            .map(|(u, &s)| (u.clone(), value_json(&pool, Value::Scalar(s))))
-            .collect();
-        return Ok(format!("{}\n", json!({"solution": m})));
+        let one = |sol: &Vec<Id>| -> serde_json::Map<String, serde_json::Value> {
+            a.unknowns
+                .iter()
+                .zip(sol)
+                .map(|(u, &s)| (u.clone(), value_json(&pool, Value::Scalar(s))))
+                .collect()
+        };
+        return Ok(if solutions.len() == 1 {
+            format!("{}\n", json!({"solution": one(&solutions[0])}))
+        } else {
+            let all: Vec<_> = solutions.iter().map(one).collect();
+            format!("{}\n", json!({"solution": one(&solutions[0]), "solutions": all}))
+        });
     }
     let mut out = String::new();
-    for (u, &s) in a.unknowns.iter().zip(&sol) {
-        out += &format!("{u} = {}\n", a.common.format.show(&pool, s));
+    for (k, sol) in solutions.iter().enumerate() {
+        if solutions.len() > 1 {
+            out += &format!("solution {}:\n", k + 1);
+        }
+        let indent = if solutions.len() > 1 { "  " } else { "" };
+        for (u, &s) in a.unknowns.iter().zip(sol) {
+            out += &format!("{indent}{u} = {}\n", a.common.format.show(&pool, s));
+        }
     }
     Ok(out)
 }
