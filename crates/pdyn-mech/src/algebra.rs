@@ -65,7 +65,11 @@ impl std::error::Error for AlgebraError {}
 pub type Solution = Vec<Id>;
 
 /// Solves `equations` (each `= 0`) for `unknowns`: every solution the rules find.
-pub fn solve(pool: &mut Pool, equations: &[Id], unknowns: &[Id]) -> Result<Vec<Solution>, AlgebraError> {
+pub fn solve(
+    pool: &mut Pool,
+    equations: &[Id],
+    unknowns: &[Id],
+) -> Result<Vec<Solution>, AlgebraError> {
     let mut out = solve_rec(pool, equations, unknowns, 0)?;
     out.truncate(MAX_SOLUTIONS);
     Ok(out)
@@ -89,7 +93,11 @@ fn numerator(pool: &mut Pool, e: Id) -> Id {
     };
     let n = match pool.node(s).clone() {
         Node::Mul(fs) => {
-            let kept: Vec<Id> = fs.iter().copied().filter(|&f| !negative_power(pool, f)).collect();
+            let kept: Vec<Id> = fs
+                .iter()
+                .copied()
+                .filter(|&f| !negative_power(pool, f))
+                .collect();
             pool.mul(&kept)
         }
         _ if negative_power(pool, s) => Pool::ONE,
@@ -308,7 +316,11 @@ pub fn real_roots(coeffs: &[f64]) -> Vec<f64> {
     }
     // Cauchy bound on the roots' magnitude.
     let lead = *c.last().unwrap_or(&1.0);
-    let bound = 1.0 + c[..c.len() - 1].iter().map(|x| (x / lead).abs()).fold(0.0, f64::max);
+    let bound = 1.0
+        + c[..c.len() - 1]
+            .iter()
+            .map(|x| (x / lead).abs())
+            .fold(0.0, f64::max);
     let count = sturm_count(&c, -bound, bound);
     // Isolate by bisection on the Sturm count, then refine each interval by bisection on sign.
     let mut roots = Vec::new();
@@ -322,7 +334,11 @@ fn eval(c: &[f64], x: f64) -> f64 {
 }
 
 fn derivative(c: &[f64]) -> Vec<f64> {
-    c.iter().enumerate().skip(1).map(|(k, &v)| k as f64 * v).collect()
+    c.iter()
+        .enumerate()
+        .skip(1)
+        .map(|(k, &v)| k as f64 * v)
+        .collect()
 }
 
 /// Remainder of `a / b` (ascending coefficients).
@@ -350,14 +366,21 @@ fn sturm_count(c: &[f64], lo: f64, hi: f64) -> usize {
     let mut seq = vec![c.to_vec(), derivative(c)];
     while seq.last().is_some_and(|p| p.len() > 1) {
         let n = seq.len();
-        let r: Vec<f64> = remainder(&seq[n - 2], &seq[n - 1]).iter().map(|x| -x).collect();
+        let r: Vec<f64> = remainder(&seq[n - 2], &seq[n - 1])
+            .iter()
+            .map(|x| -x)
+            .collect();
         if r.iter().all(|&x| x == 0.0) {
             break;
         }
         seq.push(r);
     }
     let changes = |x: f64| {
-        let signs: Vec<f64> = seq.iter().map(|p| eval(p, x)).filter(|v| *v != 0.0).collect();
+        let signs: Vec<f64> = seq
+            .iter()
+            .map(|p| eval(p, x))
+            .filter(|v| *v != 0.0)
+            .collect();
         signs.windows(2).filter(|w| w[0] * w[1] < 0.0).count()
     };
     changes(lo).saturating_sub(changes(hi))

@@ -294,3 +294,43 @@ fn odd_inputs_never_panic_or_hang() {
         );
     }
 }
+
+/// `--when` with symbolic parameters solves the quadratic exactly (issue 11): the Kremlin
+/// stone's flight time from height h is (V sin α + √(V² sin²α + 2 g h))/g.
+#[test]
+fn when_solves_a_symbolic_quadratic_exactly() {
+    let (ok, out, err) = pdyn(&[
+        "dsolve",
+        "x'' = 0",
+        "y'' = -g",
+        "--ic",
+        "x(0)=0, x'(0)=V*cos(alpha), y(0)=h, y'(0)=V*sin(alpha)",
+        "--when",
+        "y = 0",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("when y = 0: t = (V*sin(alpha) + sqrt(V^2*sin(alpha)^2 + 2*g*h))/g"),
+        "{out}"
+    );
+}
+
+/// `pdyn solve` beyond linear systems: the chapter's takeoff kinematics, both roots of a
+/// quadratic.
+#[test]
+fn solve_handles_the_takeoff_kinematics_and_quadratics() {
+    let (ok, out, err) = pdyn(&["solve", "--for", "a,t", "v_t = a*t", "d = a*t^2/2"]);
+    assert!(ok, "{err}");
+    assert_eq!(out, "a = v_t^2/(2*d)\nt = 2*d/v_t\n");
+    let (ok, out, err) = pdyn(&["solve", "--for", "x", "x^2 - 3*x + 2 = 0", "--json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let mut roots: Vec<String> = v["solutions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["x"]["text"].as_str().unwrap().to_string())
+        .collect();
+    roots.sort();
+    assert_eq!(roots, ["1", "2"]);
+}

@@ -143,7 +143,15 @@ fn mutated_examples_never_panic_or_hang() {
             let commands: Vec<Vec<&str>> = if simulates {
                 vec![
                     vec!["derive", p],
-                    vec!["run", p, "--t-end", "0.05", "--max-steps", "20000", "--json"],
+                    vec![
+                        "run",
+                        p,
+                        "--t-end",
+                        "0.05",
+                        "--max-steps",
+                        "20000",
+                        "--json",
+                    ],
                 ]
             } else {
                 vec![vec!["forces", p, "--json"]]

@@ -445,7 +445,9 @@ fn the_closed_form_warns_where_floating_point_ruins_it() {
     assert!(exact_run(9.0).warnings.is_empty());
     let near = exact_run(8.7403);
     assert!(
-        near.warnings.iter().any(|w| w.contains("cannot be trusted")),
+        near.warnings
+            .iter()
+            .any(|w| w.contains("cannot be trusted")),
         "{:?}",
         near.warnings
     );

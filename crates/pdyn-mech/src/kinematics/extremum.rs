@@ -112,14 +112,14 @@ pub fn maximize(pool: &mut Pool, f: Id, var: Id, lo: f64, hi: f64) -> Result<Ext
 }
 
 /// Seeds of the three parameter sets tried by [`maximum`] (fixed, so results are reproducible).
-const TRIAL_SEEDS: [u64; 3] = [
+pub(crate) const TRIAL_SEEDS: [u64; 3] = [
     0x1234_5678_9abc_def1,
     0x0fed_cba9_8765_4321,
     0x5555_aaaa_3333_cccc,
 ];
 
 /// Deterministic pseudo-random positive values in [0.5, 3) for parameter trials (xorshift).
-fn trial_values(n: usize, seed: u64) -> Vec<f64> {
+pub(crate) fn trial_values(n: usize, seed: u64) -> Vec<f64> {
     let mut s = seed;
     (0..n)
         .map(|_| {

@@ -540,7 +540,8 @@ pub fn solve_time(pool: &mut Pool, expr: Id, target: Id) -> Result<(Option<Id>, 
     }
     let eq = pool.sub(expr, target);
     let eq = pool.expand(eq);
-    let exact = exact_root(pool, eq, expr, target, t);
+    let exact =
+        exact_root(pool, eq, expr, target, t).or_else(|| earliest_algebraic_root(pool, eq, t));
     if let Some(e) = exact {
         match value(pool, e) {
             Some(v) if v >= 0.0 => return Ok((Some(e), v)),
@@ -594,6 +595,52 @@ pub fn solve_time(pool: &mut Pool, expr: Id, target: Id) -> Result<(Option<Id>, 
         target: pool.to_text(target),
         t_max: lo,
     })
+}
+
+/// The earliest root `t ≥ 0` of `eq`, with parameters without values, among those
+/// [`crate::algebra::solve`] finds (e.g. both roots of a quadratic): a root is kept when it is
+/// `≥ 0` for three sets of positive trial values, and chosen when it is the earliest in all
+/// three.
+fn earliest_algebraic_root(pool: &mut Pool, eq: Id, t: Id) -> Option<Id> {
+    let roots: Vec<Id> = crate::algebra::solve(pool, &[eq], &[t])
+        .ok()?
+        .into_iter()
+        .filter_map(|s| s.first().copied())
+        .collect();
+    let mut free: Vec<Id> = Vec::new();
+    for n in pool.topo_order(&roots) {
+        if matches!(pool.node(n), Node::Sym(_)) && !free.contains(&n) {
+            free.push(n);
+        }
+    }
+    if free.is_empty() {
+        // All numbers: the root-finder below gives the instant to full precision, and an
+        // exact form such as `sqrt(43531875 + 3903218*sin(pi/4)^2)/...` informs nobody.
+        return None;
+    }
+    let trials: Vec<Vec<f64>> = extremum::TRIAL_SEEDS
+        .iter()
+        .map(|&seed| extremum::trial_values(free.len(), seed))
+        .collect();
+    let mut values = vec![Vec::new(); roots.len()];
+    for vals in &trials {
+        for (k, &r) in roots.iter().enumerate() {
+            let x = free.iter().zip(vals).fold(r, |acc, (&s, &v)| {
+                let num = pool.num(pdyn_expr::Number::Float(v));
+                pool.subs1(acc, s, num)
+            });
+            values[k].push(pool.eval_const(x).unwrap_or(f64::NAN));
+        }
+    }
+    let admissible: Vec<usize> = (0..roots.len())
+        .filter(|&k| values[k].iter().all(|v| v.is_finite() && *v >= -1e-12))
+        .collect();
+    let earliest = admissible.iter().copied().find(|&k| {
+        admissible
+            .iter()
+            .all(|&j| (0..trials.len()).all(|i| values[k][i] <= values[j][i]))
+    })?;
+    Some(roots[earliest])
 }
 
 fn exact_root(pool: &mut Pool, eq: Id, expr: Id, target: Id, t: Id) -> Option<Id> {

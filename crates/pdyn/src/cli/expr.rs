@@ -239,7 +239,10 @@ pub fn solve(a: SolveArgs) -> Result<String, Error> {
             format!("{}\n", json!({"solution": one(&solutions[0])}))
         } else {
             let all: Vec<_> = solutions.iter().map(one).collect();
-            format!("{}\n", json!({"solution": one(&solutions[0]), "solutions": all}))
+            format!(
+                "{}\n",
+                json!({"solution": one(&solutions[0]), "solutions": all})
+            )
         });
     }
     let mut out = String::new();
