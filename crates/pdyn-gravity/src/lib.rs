@@ -30,7 +30,7 @@ pub mod units;
 
 pub use error::{GravityError, Warning};
 pub use forces::Gravity;
-pub use integrators::{Integrator, WhFastParams};
+pub use integrators::{Ias15Params, Integrator, WhFastParams};
 pub use orbit::{Anomaly, Elements, Orbit};
 pub use pdyn_particles::{Particle, Particles, Vec3};
 pub use simulation::{EventParams, Outcome, Primary, Simulation};

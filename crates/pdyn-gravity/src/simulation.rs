@@ -302,14 +302,16 @@ impl Simulation {
         let tol = 1e-12 * t_end.abs().max(self.dt);
         while t_end - self.t > tol {
             let ws = self.workspace.as_mut().expect("created above");
+            let dt_before = self.dt;
             let h = ws.step(
                 &mut self.particles,
                 &mut self.forces,
                 self.t,
-                self.dt,
+                &mut self.dt,
                 t_end - self.t,
+                &mut self.warnings,
             )?;
-            if h == self.dt && ws.is_fixed_step() {
+            if h == dt_before && ws.is_fixed_step() {
                 self.n_fixed += 1;
                 self.t = self.t_origin + self.n_fixed as f64 * self.dt;
             } else {

@@ -1,5 +1,6 @@
 //! Integrators, one per file; each file opens with its method, order and paper.
 
+pub mod ias15;
 pub mod leapfrog;
 pub mod whfast;
 
@@ -8,6 +9,7 @@ use pdyn_particles::Particles;
 use crate::error::{GravityError, Warning};
 use crate::forces::Forces;
 
+pub use ias15::Ias15Params;
 pub use whfast::WhFastParams;
 
 /// The integrator of a [`crate::Simulation`] and its parameters.
@@ -17,6 +19,9 @@ pub enum Integrator {
     /// Wisdom–Holman in Jacobi coordinates with symplectic correctors (fixed step): planetary
     /// systems dominated by one mass.
     WhFast(WhFastParams),
+    /// IAS15, adaptive 15th-order Gauss–Radau (the step given to the simulation is the first
+    /// trial step): close encounters, high eccentricities, machine-precision runs.
+    Ias15(Ias15Params),
     /// Drift–kick–drift leapfrog (fixed step): large `N`, with direct or tree forces.
     Leapfrog,
 }
@@ -31,6 +36,7 @@ impl Default for Integrator {
 #[derive(Debug, Clone)]
 pub(crate) enum Workspace {
     WhFast(whfast::WhFast),
+    Ias15(Box<ias15::Ias15>),
     Leapfrog(leapfrog::Leapfrog),
 }
 
@@ -46,6 +52,9 @@ impl Workspace {
             Integrator::WhFast(params) => {
                 Workspace::WhFast(whfast::WhFast::new(params, p, g, dt, warnings)?)
             }
+            Integrator::Ias15(params) => {
+                Workspace::Ias15(Box::new(ias15::Ias15::new(params, p.len())?))
+            }
             Integrator::Leapfrog => Workspace::Leapfrog(leapfrog::Leapfrog),
         })
     }
@@ -57,10 +66,16 @@ impl Workspace {
         p: &mut Particles,
         f: &mut Forces,
         t: f64,
-        dt: f64,
+        dt: &mut f64,
         h_max: f64,
+        warnings: &mut Vec<Warning>,
     ) -> Result<f64, GravityError> {
+        if let Workspace::Ias15(w) = self {
+            return w.step(p, f, t, dt, h_max, warnings);
+        }
+        let dt = *dt;
         match self {
+            Workspace::Ias15(_) => unreachable!("handled above"),
             Workspace::WhFast(w) => {
                 // A remainder within round-off of dt is a full step (keeps the corrector).
                 if h_max < dt * (1.0 - 1e-9) {
@@ -93,7 +108,7 @@ impl Workspace {
     ) -> Result<(), GravityError> {
         match self {
             Workspace::WhFast(w) => w.synchronize(p, f, t),
-            Workspace::Leapfrog(_) => Ok(()),
+            Workspace::Leapfrog(_) | Workspace::Ias15(_) => Ok(()),
         }
     }
 }
