@@ -24,12 +24,13 @@ pub mod forces;
 pub mod integrators;
 pub mod kepler;
 pub mod orbit;
+pub mod plummer;
 pub mod rng;
 mod simulation;
 pub mod units;
 
 pub use error::{GravityError, Warning};
-pub use forces::Gravity;
+pub use forces::{Gravity, TreeParams};
 pub use integrators::{Ias15Params, Integrator, WhFastParams};
 pub use orbit::{Anomaly, Elements, Orbit};
 pub use pdyn_particles::{Particle, Particles, Vec3};

@@ -103,6 +103,7 @@ impl Simulation {
                 g: units.g(),
                 eps2: 0.0,
                 kind: Gravity::Direct,
+                tree: crate::forces::Octree::new(),
             },
             integrator: Integrator::default(),
             events: EventParams::default(),
@@ -241,6 +242,14 @@ impl Simulation {
 
     /// Chooses the force computation.
     pub fn set_gravity(&mut self, gravity: Gravity) -> Result<(), GravityError> {
+        if let Gravity::Tree(t) = gravity {
+            if !(t.theta.is_finite() && t.theta >= 0.0) {
+                return Err(GravityError::InvalidParameter {
+                    name: "theta",
+                    value: t.theta,
+                });
+            }
+        }
         self.synchronize()?;
         self.forces.kind = gravity;
         self.reset_workspace();
