@@ -27,6 +27,7 @@ pub mod orbit;
 pub mod plummer;
 pub mod rng;
 mod simulation;
+pub mod systems;
 pub mod units;
 
 pub use error::{GravityError, Warning};

@@ -78,6 +78,13 @@ impl Node {
 pub struct Octree {
     nodes: Vec<Node>,
     next: Vec<u32>,
+    /// Scratch arena for the depth-first relayout.
+    spare: Vec<Node>,
+    /// Particles in depth-first leaf order (walks in this order share cached cells).
+    order: Vec<u32>,
+    /// Accelerations by position in `order`.
+    acc: Vec<[f64; 3]>,
+    stack: Vec<(u32, u32)>,
 }
 
 impl Octree {
@@ -114,7 +121,45 @@ impl Octree {
         for i in 0..n {
             self.insert(p, i as u32);
         }
+        self.relayout();
         self.moments(p);
+    }
+
+    /// Renumbers cells in depth-first preorder (children stay after parents, neighbours in
+    /// space become neighbours in memory) and lists the particles in the same order.
+    fn relayout(&mut self) {
+        self.spare.clear();
+        self.order.clear();
+        self.stack.clear();
+        // (old index, new parent index + 1, or 0 for the root); children pushed in reverse
+        // so that they pop in octant order.
+        self.stack.push((0, 0));
+        while let Some((old, parent_plus_oct)) = self.stack.pop() {
+            let new = self.spare.len() as u32;
+            let mut node = self.nodes[old as usize].clone();
+            let children = node.children;
+            node.children = [NONE; 8];
+            self.spare.push(node);
+            if parent_plus_oct != 0 {
+                let parent = (parent_plus_oct >> 3) - 1;
+                let oct = parent_plus_oct & 7;
+                self.spare[parent as usize].children[oct as usize] = new;
+            }
+            if self.nodes[old as usize].leaf {
+                let mut j = self.nodes[old as usize].body;
+                while j != NONE {
+                    self.order.push(j);
+                    j = self.next[j as usize];
+                }
+            }
+            for oct in (0..8u32).rev() {
+                let c = children[oct as usize];
+                if c != NONE {
+                    self.stack.push((c, ((new + 1) << 3) | oct));
+                }
+            }
+        }
+        std::mem::swap(&mut self.nodes, &mut self.spare);
     }
 
     fn octant(c: [f64; 3], r: [f64; 3]) -> usize {
@@ -231,16 +276,18 @@ impl Octree {
     /// accelerations (`eps2`: squared Plummer softening, applied to monopole and direct terms).
     pub fn accelerations(&mut self, p: &mut Particles, g: f64, eps2: f64, params: TreeParams) {
         self.build(p);
+        let mut acc = std::mem::take(&mut self.acc);
+        acc.clear();
+        acc.resize(p.len(), [0.0; 3]);
         let tree = &*self;
         let (x, y, z, m) = (&p.x, &p.y, &p.z, &p.m);
         let theta2 = params.theta * params.theta;
-        p.ax.par_iter_mut()
-            .zip(p.ay.par_iter_mut())
-            .zip(p.az.par_iter_mut())
-            .enumerate()
+        acc.par_iter_mut()
+            .zip(tree.order.par_iter())
             .with_min_len(64)
-            .for_each(|(i, ((ax, ay), az))| {
-                let a = tree.walk(
+            .for_each(|(a, &iu)| {
+                let i = iu as usize;
+                *a = tree.walk(
                     i,
                     [x[i], y[i], z[i]],
                     x,
@@ -251,10 +298,14 @@ impl Octree {
                     theta2,
                     params.quadrupole,
                 );
-                *ax = g * a[0];
-                *ay = g * a[1];
-                *az = g * a[2];
             });
+        for (a, &i) in acc.iter().zip(&self.order) {
+            let i = i as usize;
+            p.ax[i] = g * a[0];
+            p.ay[i] = g * a[1];
+            p.az[i] = g * a[2];
+        }
+        self.acc = acc;
     }
 
     #[allow(clippy::too_many_arguments)]
