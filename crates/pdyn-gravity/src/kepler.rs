@@ -15,12 +15,12 @@
 //! (`r += (f−1) r₀ + g v₀`), which keeps round-off small.
 //!
 //! Robustness (following the strategy Rein & Tamayo 2015 describe for WHFast): for ellipses
-//! `Δt` is first reduced modulo the period; Newton's method starts from a second-order guess
+//! `Δt` is first reduced modulo the period; Halley's method starts from a third-order guess
 //! and stops when an iterate repeats exactly; if it has not converged after a few
 //! iterations, the Laguerre–Conway iteration (Conway 1986), which converges from almost any
 //! start, takes over; bisection on a bracket is the last resort. The Stumpff functions are
-//! evaluated by series after quartering the argument, then the double-angle identities
-//! `c₀(4z) = 2c₀² − 1`, `c₁(4z) = c₀c₁`, `c₂(4z) = c₁²/2`, `c₃(4z) = (c₂ + c₀c₃)/4`.
+//! evaluated by their series for `|z| ≤ 1` and from trigonometric (hyperbolic) closed forms
+//! written without cancellation beyond (see [`stumpff`]).
 
 use std::f64::consts::PI;
 
@@ -41,7 +41,7 @@ const INV_FACT: [f64; 24] = {
 
 /// Stumpff functions `[c₀, c₁, c₂, c₃](z)`, for any finite `z` (`z > 0`: ellipse).
 ///
-/// `|z| ≤ 0.1`: series. Otherwise with `s = √|z|`: `c₀ = cos s`, `c₁ = sin s / s`,
+/// `|z| ≤ 1`: series (6 terms up to `|z| = 0.1`, 9 up to 1; truncation below 1e-18). Otherwise with `s = √|z|`: `c₀ = cos s`, `c₁ = sin s / s`,
 /// `c₂ = 2 sin²(s/2)/z` (no cancellation), hyperbolic functions for `z < 0`; `c₃` by its
 /// series up to `|z| = 4` (where `s − sin s` would cancel) and `(s − sin s)/s³` beyond.
 pub fn stumpff(z: f64) -> [f64; 4] {
@@ -56,7 +56,11 @@ pub fn stumpff(z: f64) -> [f64; 4] {
         (c2, c3)
     };
     if z.abs() <= 0.1 {
-        let (c2, c3) = series(z, 8);
+        let (c2, c3) = series(z, 6);
+        return [1.0 - z * c2, 1.0 - z * c3, c2, c3];
+    }
+    if z.abs() <= 1.0 {
+        let (c2, c3) = series(z, 9);
         return [1.0 - z * c2, 1.0 - z * c3, c2, c3];
     }
     let s = z.abs().sqrt();
@@ -78,7 +82,7 @@ pub fn stumpff(z: f64) -> [f64; 4] {
         )
     };
     let c3 = if z.abs() <= 4.0 {
-        series(z, 10).1
+        series(z, 11).1
     } else {
         c3_closed
     };
@@ -117,14 +121,10 @@ pub fn kepler_drift(
 
     // Reduce dt modulo the period for ellipses: G₁, G₂ are periodic and μG₃ − Δt is too.
     let mut dt = dt;
-    let mut x_period = f64::NAN;
-    if beta > 0.0 {
-        let sb = beta.sqrt();
-        let period = 2.0 * PI * mu / (beta * sb);
-        x_period = 2.0 * PI / sb;
-        if dt.abs() > period {
-            dt -= period * (dt / period).trunc();
-        }
+    // |dt| > P ⇔ dt² β³ > (2πμ)² (no square root on the common path).
+    if beta > 0.0 && dt * dt * beta * beta * beta > 4.0 * PI * PI * mu * mu {
+        let period = 2.0 * PI * mu / (beta * beta.sqrt());
+        dt -= period * (dt / period).trunc();
     }
     let f_of = |xx: f64| -> ([f64; 4], f64, f64, f64) {
         let g = g_functions(beta, xx);
@@ -134,15 +134,16 @@ pub fn kepler_drift(
         (g, f, fp, fpp)
     };
 
-    // Newton from a second-order guess.
+    // Halley's iteration from a third-order guess; stop when an iterate repeats exactly.
     let dtr = dt / r0;
-    let mut xx = dtr * (1.0 - 0.5 * dtr * eta0 / r0);
+    let mut xx = dtr * (1.0 - 0.5 * dtr / r0 * (eta0 - dtr * (eta0 * eta0 / r0 - zeta0 / 3.0)));
     let mut converged = false;
     let mut old1 = f64::NAN;
+    let mut last: Option<(f64, [f64; 4])> = None;
     for _ in 0..12 {
-        let g = g_functions(beta, xx);
-        let s = eta0 * g[1] + zeta0 * g[2];
-        let next = (xx * s - eta0 * g[2] - zeta0 * g[3] + dt) / (r0 + s);
+        let (g, f, fp, fpp) = f_of(xx);
+        last = Some((xx, g));
+        let next = xx - 2.0 * f * fp / (2.0 * fp * fp - f * fpp);
         let old2 = old1;
         old1 = xx;
         xx = next;
@@ -150,7 +151,8 @@ pub fn kepler_drift(
             converged = true;
             break;
         }
-        if !xx.is_finite() || (beta > 0.0 && (xx - old1).abs() > 0.5 * x_period) {
+        // A jump of more than half a period in X (ΔX² β > π²) means divergence.
+        if !xx.is_finite() || (beta > 0.0 && (xx - old1) * (xx - old1) * beta > PI * PI) {
             break;
         }
     }
@@ -202,7 +204,10 @@ pub fn kepler_drift(
         }
         xx = 0.5 * (lo + hi);
     }
-    let g = g_functions(beta, xx);
+    let g = match last {
+        Some((x_last, g)) if x_last == xx => g,
+        _ => g_functions(beta, xx),
+    };
     let rn = r0 + eta0 * g[1] + zeta0 * g[2];
     if !(rn.is_finite() && rn > 0.0) {
         return Err(KeplerFailure);

@@ -85,15 +85,26 @@ fn lane_sum(
         m[..n4].chunks_exact(4),
     );
     for (((cx, cy), cz), cm) in xc.zip(yc).zip(zc).zip(mc) {
+        // Fixed-size views: no bounds checks, so the four lanes become one vector operation.
+        let cx: &[f64; 4] = cx.try_into().expect("chunk of 4");
+        let cy: &[f64; 4] = cy.try_into().expect("chunk of 4");
+        let cz: &[f64; 4] = cz.try_into().expect("chunk of 4");
+        let cm: &[f64; 4] = cm.try_into().expect("chunk of 4");
+        let mut f = [0.0f64; 4];
+        let mut dx = [0.0f64; 4];
+        let mut dy = [0.0f64; 4];
+        let mut dz = [0.0f64; 4];
         for l in 0..4 {
-            let dx = cx[l] - xi;
-            let dy = cy[l] - yi;
-            let dz = cz[l] - zi;
-            let r2 = dx * dx + dy * dy + dz * dz + eps2;
-            let f = cm[l] / (r2 * r2.sqrt());
-            lx[l] += f * dx;
-            ly[l] += f * dy;
-            lz[l] += f * dz;
+            dx[l] = cx[l] - xi;
+            dy[l] = cy[l] - yi;
+            dz[l] = cz[l] - zi;
+            let r2 = dx[l] * dx[l] + dy[l] * dy[l] + dz[l] * dz[l] + eps2;
+            f[l] = cm[l] / (r2 * r2.sqrt());
+        }
+        for l in 0..4 {
+            lx[l] += f[l] * dx[l];
+            ly[l] += f[l] * dy[l];
+            lz[l] += f[l] * dz[l];
         }
     }
     let mut s = [
