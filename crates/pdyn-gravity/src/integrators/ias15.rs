@@ -206,10 +206,12 @@ fn add_cs(p: &mut f64, cs: &mut f64, inp: f64) {
     *p = t;
 }
 
-type Coeffs = [Vec<f64>; 7];
+/// Seven coefficients per coordinate, contiguous: `c[k][j]` is coefficient `j` of
+/// coordinate `k`.
+type Coeffs = Vec<[f64; 7]>;
 
 fn zeros7(n: usize) -> Coeffs {
-    std::array::from_fn(|_| vec![0.0; n])
+    vec![[0.0; 7]; n]
 }
 
 /// IAS15 workspace (all of it allocated once, in [`Ias15::new`]).
@@ -272,24 +274,16 @@ impl Ias15 {
     fn predict(&mut self, ratio: f64, from_saved: bool) {
         let n3 = self.x0.len();
         if ratio > 20.0 {
-            for j in 0..7 {
-                self.e[j].iter_mut().for_each(|v| *v = 0.0);
-                self.b[j].iter_mut().for_each(|v| *v = 0.0);
-            }
+            self.e.iter_mut().for_each(|v| *v = [0.0; 7]);
+            self.b.iter_mut().for_each(|v| *v = [0.0; 7]);
             return;
         }
         let q: [f64; 7] = std::array::from_fn(|j| ratio.powi(j as i32 + 1));
         for idx in 0..n3 {
             let (sb, se): ([f64; 7], [f64; 7]) = if from_saved {
-                (
-                    std::array::from_fn(|k| self.br[k][idx]),
-                    std::array::from_fn(|k| self.er[k][idx]),
-                )
+                (self.br[idx], self.er[idx])
             } else {
-                (
-                    std::array::from_fn(|k| self.b[k][idx]),
-                    std::array::from_fn(|k| self.e[k][idx]),
-                )
+                (self.b[idx], self.e[idx])
             };
             for j in 0..7 {
                 let mut s = 0.0;
@@ -297,8 +291,8 @@ impl Ias15 {
                     s += binom(k + 1, j + 1) * sb[k];
                 }
                 let ej = q[j] * s;
-                self.e[j][idx] = ej;
-                self.b[j][idx] = ej + (sb[j] - se[j]);
+                self.e[idx][j] = ej;
+                self.b[idx][j] = ej + (sb[j] - se[j]);
             }
         }
     }
@@ -350,17 +344,15 @@ impl Ias15 {
             self.a0[k + 1] = p.ay[i];
             self.a0[k + 2] = p.az[i];
         }
-        for j in 0..7 {
-            self.csb[j].iter_mut().for_each(|v| *v = 0.0);
-        }
+        self.csb.iter_mut().for_each(|v| *v = [0.0; 7]);
         // g = D b
         for idx in 0..n3 {
             for j in 0..7 {
-                let mut s = self.b[j][idx];
+                let mut s = self.b[idx][j];
                 for k in j + 1..7 {
-                    s += D_PACKED[tri(k, j)] * self.b[k][idx];
+                    s += D_PACKED[tri(k, j)] * self.b[idx][k];
                 }
-                self.g[j][idx] = s;
+                self.g[idx][j] = s;
             }
         }
 
@@ -388,7 +380,7 @@ impl Ias15 {
                 for i in 0..n {
                     for c in 0..3 {
                         let k = 3 * i + c;
-                        let b = |j: usize| self.b[j][k];
+                        let b = |j: usize| self.b[k][j];
                         let inner = ((((((b(6) * 7.0 * hs / 9.0 + b(5)) * 3.0 * hs / 4.0
                             + b(4))
                             * 5.0
@@ -431,18 +423,18 @@ impl Ias15 {
                     // Newton divided difference: g_j = (…((a_s − a₀)/(h_s − h₀) − g₀)/(h_s − h₁) … − g_{j−1})/(h_s − h_j).
                     let mut gk = (self.at[k] - self.a0[k]) / RR[tri(s, 0)];
                     for m in 0..j {
-                        gk = (gk - self.g[m][k]) / RR[tri(s, m + 1)];
+                        gk = (gk - self.g[k][m]) / RR[tri(s, m + 1)];
                     }
-                    let delta = gk - self.g[j][k];
-                    self.g[j][k] = gk;
+                    let delta = gk - self.g[k][j];
+                    self.g[k][j] = gk;
                     for r in 0..j {
                         add_cs(
-                            &mut self.b[r][k],
-                            &mut self.csb[r][k],
+                            &mut self.b[k][r],
+                            &mut self.csb[k][r],
                             delta * C_PACKED[tri(j, r)],
                         );
                     }
-                    add_cs(&mut self.b[j][k], &mut self.csb[j][k], delta);
+                    add_cs(&mut self.b[k][j], &mut self.csb[k][j], delta);
                     if s == 7 {
                         let ak = self.at[k].abs();
                         if ak.is_normal() && ak > max_a {
@@ -467,7 +459,7 @@ impl Ias15 {
             for i in 0..n {
                 let (mut a0i, mut y2, mut y3, mut y4) = (0.0, 0.0, 0.0, 0.0);
                 for k in 3 * i..3 * i + 3 {
-                    let b = |j: usize| self.b[j][k];
+                    let b = |j: usize| self.b[k][j];
                     a0i += self.a0[k] * self.a0[k];
                     let t2 = self.a0[k] + b(0) + b(1) + b(2) + b(3) + b(4) + b(5) + b(6);
                     y2 += t2 * t2;
@@ -524,7 +516,7 @@ impl Ias15 {
 
         let h2 = dt_done * dt_done;
         for k in 0..n3 {
-            let b = |j: usize| self.b[j][k];
+            let b = |j: usize| self.b[k][j];
             let (x0, csx) = (&mut self.x0[k], &mut self.csx[k]);
             add_cs(x0, csx, b(6) / 72.0 * h2);
             add_cs(x0, csx, b(5) / 56.0 * h2);
@@ -554,10 +546,8 @@ impl Ias15 {
             p.vz[i] = self.v0[3 * i + 2];
         }
         self.dt_last_done = dt_done;
-        for j in 0..7 {
-            self.er[j].copy_from_slice(&self.e[j]);
-            self.br[j].copy_from_slice(&self.b[j]);
-        }
+        self.er.copy_from_slice(&self.e);
+        self.br.copy_from_slice(&self.b);
         self.predict(*dt / dt_done, false);
         Ok(Some(dt_done))
     }

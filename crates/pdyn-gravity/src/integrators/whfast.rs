@@ -30,7 +30,7 @@ use pdyn_particles::Particles;
 
 use crate::error::{GravityError, Warning};
 use crate::forces::Forces;
-use crate::kepler::kepler_drift;
+use crate::kepler::kepler_drift_batch;
 
 /// WHFast parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -95,6 +95,8 @@ pub(crate) struct WhFast {
     jv: Vec<[f64; 3]>,
     ja: Vec<[f64; 3]>,
     eta: Vec<f64>,
+    /// `μᵢ = G ηᵢ` of each Jacobi Kepler problem (index 0 unused).
+    mu: Vec<f64>,
     synchronized: bool,
     dt: f64,
 }
@@ -167,6 +169,7 @@ impl WhFast {
             jr: vec![[0.0; 3]; n],
             jv: vec![[0.0; 3]; n],
             ja: vec![[0.0; 3]; n],
+            mu: eta.iter().map(|e| g * e).collect(),
             eta,
             synchronized: true,
             dt,
@@ -198,11 +201,9 @@ impl WhFast {
         Ok(w)
     }
 
-    fn kepler(&mut self, g: f64, h: f64, t: f64) -> Result<(), GravityError> {
-        for i in 1..self.jr.len() {
-            kepler_drift(g * self.eta[i], &mut self.jr[i], &mut self.jv[i], h)
-                .map_err(|_| GravityError::KeplerNotConverged { t, body: i })?;
-        }
+    fn kepler(&mut self, _g: f64, h: f64, t: f64) -> Result<(), GravityError> {
+        kepler_drift_batch(&self.mu[1..], &mut self.jr[1..], &mut self.jv[1..], h)
+            .map_err(|i| GravityError::KeplerNotConverged { t, body: i + 1 })?;
         for k in 0..3 {
             self.jr[0][k] += h * self.jv[0][k];
         }
