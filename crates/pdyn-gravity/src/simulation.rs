@@ -22,6 +22,12 @@ pub enum Primary {
 }
 
 /// What stopped [`Simulation::integrate`].
+///
+/// Events are checked after every step on the positions the step leaves in the particle
+/// arrays: the end-of-step positions for IAS15 and leapfrog, the mid-step (kick) positions
+/// for WHFast, which keeps Jacobi coordinates between steps. The simulation is synchronised
+/// before `integrate` returns, so [`Simulation::particles`] is the state at the reported time.
+/// Collision detection is a direct `O(N²)` pair test, run only when some radius is positive.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub enum Outcome {
