@@ -514,18 +514,19 @@ impl Ias15 {
         }
         *dt = dt_new;
 
-        let h2 = dt_done * dt_done;
         for k in 0..n3 {
             let b = |j: usize| self.b[k][j];
             let (x0, csx) = (&mut self.x0[k], &mut self.csx[k]);
-            add_cs(x0, csx, b(6) / 72.0 * h2);
-            add_cs(x0, csx, b(5) / 56.0 * h2);
-            add_cs(x0, csx, b(4) / 42.0 * h2);
-            add_cs(x0, csx, b(3) / 30.0 * h2);
-            add_cs(x0, csx, b(2) / 20.0 * h2);
-            add_cs(x0, csx, b(1) / 12.0 * h2);
-            add_cs(x0, csx, b(0) / 6.0 * h2);
-            add_cs(x0, csx, self.a0[k] / 2.0 * h2);
+            // (b/c·Δt)·Δt, not b/c·Δt²: a precomputed Δt² rounds the same way every step of a
+            // fixed step size and biases the error (Rein & Spiegel 2015).
+            add_cs(x0, csx, b(6) / 72.0 * dt_done * dt_done);
+            add_cs(x0, csx, b(5) / 56.0 * dt_done * dt_done);
+            add_cs(x0, csx, b(4) / 42.0 * dt_done * dt_done);
+            add_cs(x0, csx, b(3) / 30.0 * dt_done * dt_done);
+            add_cs(x0, csx, b(2) / 20.0 * dt_done * dt_done);
+            add_cs(x0, csx, b(1) / 12.0 * dt_done * dt_done);
+            add_cs(x0, csx, b(0) / 6.0 * dt_done * dt_done);
+            add_cs(x0, csx, self.a0[k] / 2.0 * dt_done * dt_done);
             add_cs(x0, csx, self.v0[k] * dt_done);
             let (v0, csv) = (&mut self.v0[k], &mut self.csv[k]);
             add_cs(v0, csv, b(6) / 8.0 * dt_done);
