@@ -17,6 +17,24 @@
 //! parallel loop computes each particle's sum in a fixed order on one thread.
 //!
 //! This crate knows nothing of symbols or model files.
+//!
+//! ```
+//! use pdyn_gravity::{Elements, Integrator, Particle, Primary, Simulation, Units, Vec3, WhFastParams};
+//!
+//! // The Sun and a Jupiter-mass planet at 5.2 AU, e = 0.05, in AU, years and solar masses.
+//! let mut sim = Simulation::new(Units::AuYearSolarMass);
+//! sim.add(Particle { mass: 1.0, pos: Vec3::ZERO, vel: Vec3::ZERO })?;
+//! let orbit = Elements { e: 0.05, ..Elements::circular(5.2) };
+//! sim.add_orbit(9.5e-4, &orbit, Primary::Interior)?;
+//! sim.move_to_center_of_mass()?;
+//! sim.set_integrator(Integrator::WhFast(WhFastParams { corrector: 11, ..Default::default() }))?;
+//! sim.set_dt(0.5)?; // years, ≈ P/24
+//! let e0 = sim.energy();
+//! sim.integrate(1000.0)?;
+//! let a = sim.orbit(1, Primary::Interior)?.a;
+//! assert!((a - 5.2).abs() < 1e-9 && ((sim.energy() - e0) / e0).abs() < 1e-12);
+//! # Ok::<(), pdyn_gravity::GravityError>(())
+//! ```
 #![warn(missing_docs)]
 
 pub mod error;
