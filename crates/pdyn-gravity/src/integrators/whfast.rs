@@ -231,9 +231,11 @@ impl WhFast {
                     self.ja[i][c] += k * r[c];
                 }
             }
-            let ratio = norm(self.ja[i]) * r2 / mu;
-            if ratio > worst.0 || ratio.is_nan() {
-                worst = (ratio, i);
+            // (|a_int| r²/μ)², compared squared: no square root per body and step.
+            let a2 = dot(self.ja[i], self.ja[i]);
+            let ratio2 = a2 * r2 * r2 / (mu * mu);
+            if ratio2 > worst.0 || ratio2.is_nan() {
+                worst = (ratio2, i);
             }
             for c in 0..3 {
                 self.jv[i][c] += h * self.ja[i][c];
@@ -242,11 +244,12 @@ impl WhFast {
         for c in 0..3 {
             self.jv[0][c] += h * self.ja[0][c];
         }
-        if worst.0.is_nan() || worst.0 > self.params.close_encounter_ratio {
+        let limit = self.params.close_encounter_ratio;
+        if worst.0.is_nan() || worst.0 > limit * limit {
             return Err(GravityError::CloseEncounter {
                 t,
                 body: worst.1,
-                ratio: worst.0,
+                ratio: worst.0.sqrt(),
             });
         }
         Ok(())
