@@ -229,7 +229,8 @@ fn long_step_warns() {
 }
 
 /// Two planets on crossing orbits meet; WHFast reports the encounter instead of silently
-/// producing garbage.
+/// producing garbage, keeps the state of its last completed step, and IAS15 then integrates
+/// through the encounter conserving energy.
 #[test]
 fn close_encounter_is_reported() {
     let mut sim = Simulation::new(Units::GEqualsOne);
@@ -252,4 +253,12 @@ fn close_encounter_is_reported() {
     let err = sim.integrate(1000.0).unwrap_err();
     assert!(matches!(err, GravityError::CloseEncounter { .. }), "{err}");
     assert!(err.to_string().contains("IAS15"));
+    let t_fail = sim.t();
+    assert!(t_fail > 0.0 && t_fail < 1000.0);
+    sim.set_integrator(Integrator::Ias15(pdyn_gravity::Ias15Params::default()))
+        .unwrap();
+    let e0 = sim.energy();
+    sim.integrate(t_fail + 50.0).unwrap();
+    let de = ((sim.energy() - e0) / e0).abs();
+    assert!(de < 1e-12, "{de:e}");
 }

@@ -94,6 +94,9 @@ pub(crate) struct WhFast {
     jr: Vec<[f64; 3]>,
     jv: Vec<[f64; 3]>,
     ja: Vec<[f64; 3]>,
+    /// Jacobi state before the current step (restored if the step fails).
+    backup_r: Vec<[f64; 3]>,
+    backup_v: Vec<[f64; 3]>,
     eta: Vec<f64>,
     /// `μᵢ = G ηᵢ` of each Jacobi Kepler problem (index 0 unused).
     mu: Vec<f64>,
@@ -169,6 +172,8 @@ impl WhFast {
             jr: vec![[0.0; 3]; n],
             jv: vec![[0.0; 3]; n],
             ja: vec![[0.0; 3]; n],
+            backup_r: vec![[0.0; 3]; n],
+            backup_v: vec![[0.0; 3]; n],
             mu: eta.iter().map(|e| g * e).collect(),
             eta,
             synchronized: true,
@@ -302,8 +307,41 @@ impl WhFast {
         Ok(())
     }
 
-    /// One step of length `self.dt` (fusing the pending half drift).
+    /// Saves the Jacobi state, runs `op`, and restores the state if `op` fails, so that an
+    /// error leaves the integrator at the last completed step.
+    fn transaction(
+        &mut self,
+        p: &mut Particles,
+        f: &mut Forces,
+        op: impl FnOnce(&mut Self, &mut Particles, &mut Forces) -> Result<(), GravityError>,
+    ) -> Result<(), GravityError> {
+        self.backup_r.copy_from_slice(&self.jr);
+        self.backup_v.copy_from_slice(&self.jv);
+        let was_synchronized = self.synchronized;
+        let result = op(self, p, f);
+        if result.is_err() {
+            self.jr.copy_from_slice(&self.backup_r);
+            self.jv.copy_from_slice(&self.backup_v);
+            self.synchronized = was_synchronized;
+            if was_synchronized {
+                self.write_back(p);
+            }
+        }
+        result
+    }
+
+    /// One step of length `self.dt` (fusing the pending half drift); on error the state of
+    /// the last completed step is kept.
     pub fn step(&mut self, p: &mut Particles, f: &mut Forces, t: f64) -> Result<(), GravityError> {
+        self.transaction(p, f, |w, p, f| w.step_inner(p, f, t))
+    }
+
+    fn step_inner(
+        &mut self,
+        p: &mut Particles,
+        f: &mut Forces,
+        t: f64,
+    ) -> Result<(), GravityError> {
         let dt = self.dt;
         if self.synchronized {
             if self.params.corrector > 0 {
@@ -320,6 +358,16 @@ impl WhFast {
     /// One uncorrected drift–kick–drift step of length `h` from a synchronised state (used to
     /// land exactly on an end time), leaving the state synchronised.
     pub fn partial_step(
+        &mut self,
+        p: &mut Particles,
+        f: &mut Forces,
+        t: f64,
+        h: f64,
+    ) -> Result<(), GravityError> {
+        self.transaction(p, f, |w, p, f| w.partial_step_inner(p, f, t, h))
+    }
+
+    fn partial_step_inner(
         &mut self,
         p: &mut Particles,
         f: &mut Forces,
