@@ -136,7 +136,10 @@ fn figure_eight_returns_after_one_period() {
     assert!(diff < 1e-12);
 }
 
-/// IAS15 on the outer Solar System over 1000 years: machine-precision energy.
+/// IAS15 on the outer Solar System over 1000 years: machine-precision energy; and the
+/// osculating Jacobi semi-major axes of Jupiter and Saturn vary by the same ~6e-4 and ~2e-3
+/// as under WHFast (tests/whfast.rs), so that variation is the physics (the Great
+/// Inequality), not integration error.
 #[test]
 fn outer_solar_system_energy() {
     let mut sim = common::outer_solar_system();
@@ -144,11 +147,23 @@ fn outer_solar_system_energy() {
         .unwrap();
     sim.set_dt(10.0).unwrap();
     let e0 = sim.energy();
-    sim.integrate(1000.0 * 365.25).unwrap();
+    let a0 = [1, 2].map(|i| sim.orbit(i, Primary::Interior).unwrap().a);
+    let mut da = [0.0f64; 2];
+    for k in 1..=200 {
+        sim.integrate(1000.0 * 365.25 * k as f64 / 200.0).unwrap();
+        for (j, i) in [1, 2].into_iter().enumerate() {
+            let a = sim.orbit(i, Primary::Interior).unwrap().a;
+            da[j] = da[j].max(((a - a0[j]) / a0[j]).abs());
+        }
+    }
     let de = ((sim.energy() - e0) / e0).abs();
     eprintln!(
-        "outer Solar System, IAS15, 1000 yr: {} steps, |dE/E| {de:.1e}",
-        sim.steps()
+        "outer Solar System, IAS15, 1000 yr: {} steps, |dE/E| {de:.1e}, max |da/a| Jupiter {:.2e}, Saturn {:.2e}",
+        sim.steps(),
+        da[0],
+        da[1]
     );
     assert!(de < 1e-14);
+    assert!(da[0] > 3e-4 && da[0] < 1e-3, "{da:?}");
+    assert!(da[1] > 1e-3 && da[1] < 3e-3, "{da:?}");
 }
