@@ -1,0 +1,129 @@
+//! Timing runs for `bench/nbody/run.py` (which runs REBOUND on the same problems).
+//!
+//! ```text
+//! cargo run --release -p pdyn-gravity --example bench_nbody -- whfast STEPS
+//! cargo run --release -p pdyn-gravity --example bench_nbody -- ias15 YEARS
+//! cargo run --release -p pdyn-gravity --example bench_nbody -- plummer-ics N SEED FILE
+//! cargo run --release -p pdyn-gravity --example bench_nbody -- leapfrog-direct FILE STEPS DT EPS
+//! cargo run --release -p pdyn-gravity --example bench_nbody -- leapfrog-tree FILE STEPS DT EPS THETA QUAD
+//! ```
+//!
+//! Each timing run prints one JSON object. Threads: `RAYON_NUM_THREADS`.
+
+use std::io::Write;
+use std::time::Instant;
+
+use pdyn_gravity::plummer::plummer;
+use pdyn_gravity::systems::outer_solar_system;
+use pdyn_gravity::{
+    Gravity, Ias15Params, Integrator, Particle, Primary, Simulation, TreeParams, Units, Vec3,
+    WhFastParams,
+};
+
+fn arg<T: std::str::FromStr>(args: &[String], i: usize, what: &str) -> T {
+    args.get(i)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("argument {i} ({what}) missing or invalid"))
+}
+
+fn load(path: &str) -> Simulation {
+    let bytes = std::fs::read(path).expect("read initial conditions");
+    let v: Vec<f64> = bytes
+        .chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    let mut sim = Simulation::new(Units::GEqualsOne);
+    for r in v.chunks_exact(7) {
+        sim.add(Particle {
+            mass: r[0],
+            pos: Vec3::new(r[1], r[2], r[3]),
+            vel: Vec3::new(r[4], r[5], r[6]),
+        })
+        .unwrap();
+    }
+    sim
+}
+
+fn report(case: &str, sim: &Simulation, secs: f64, de: f64) {
+    println!(
+        "{{\"case\": \"{case}\", \"steps\": {}, \"seconds\": {secs:.6}, \"per_step_us\": {:.4}, \"rel_energy_error\": {de:.3e}, \"threads\": {}}}",
+        sim.steps(),
+        1e6 * secs / sim.steps() as f64,
+        rayon::current_num_threads()
+    );
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let case = args.get(1).map(String::as_str).unwrap_or("");
+    match case {
+        "whfast" => {
+            let steps: u64 = arg(&args, 2, "steps");
+            let mut sim = outer_solar_system();
+            let dt = sim.orbit(1, Primary::Interior).unwrap().period / 20.0;
+            sim.set_dt(dt).unwrap();
+            sim.set_integrator(Integrator::WhFast(WhFastParams {
+                corrector: 17,
+                ..WhFastParams::default()
+            }))
+            .unwrap();
+            let e0 = sim.energy();
+            let t0 = Instant::now();
+            sim.integrate(steps as f64 * dt).unwrap();
+            let secs = t0.elapsed().as_secs_f64();
+            report(case, &sim, secs, (sim.energy() - e0) / e0);
+        }
+        "ias15" => {
+            let years: f64 = arg(&args, 2, "years");
+            let mut sim = outer_solar_system();
+            sim.set_dt(10.0).unwrap();
+            sim.set_integrator(Integrator::Ias15(Ias15Params::default()))
+                .unwrap();
+            let e0 = sim.energy();
+            let t0 = Instant::now();
+            sim.integrate(years * 365.25).unwrap();
+            let secs = t0.elapsed().as_secs_f64();
+            report(case, &sim, secs, (sim.energy() - e0) / e0);
+        }
+        "plummer-ics" => {
+            let n: usize = arg(&args, 2, "n");
+            let seed: u64 = arg(&args, 3, "seed");
+            let path: String = arg(&args, 4, "file");
+            let mut f = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+            for p in plummer(n, seed, 1 << 24).unwrap() {
+                for v in [
+                    p.mass, p.pos.0[0], p.pos.0[1], p.pos.0[2], p.vel.0[0], p.vel.0[1], p.vel.0[2],
+                ] {
+                    f.write_all(&v.to_le_bytes()).unwrap();
+                }
+            }
+        }
+        "leapfrog-direct" | "leapfrog-tree" => {
+            let path: String = arg(&args, 2, "file");
+            let steps: u64 = arg(&args, 3, "steps");
+            let dt: f64 = arg(&args, 4, "dt");
+            let eps: f64 = arg(&args, 5, "softening");
+            let mut sim = load(&path);
+            sim.set_softening(eps).unwrap();
+            sim.set_integrator(Integrator::Leapfrog).unwrap();
+            sim.set_dt(dt).unwrap();
+            if case == "leapfrog-tree" {
+                let theta: f64 = arg(&args, 6, "theta");
+                let quadrupole: u8 = arg(&args, 7, "quadrupole 0/1");
+                sim.set_gravity(Gravity::Tree(TreeParams {
+                    theta,
+                    quadrupole: quadrupole == 1,
+                }))
+                .unwrap();
+            }
+            let t0 = Instant::now();
+            sim.integrate(steps as f64 * dt).unwrap();
+            let secs = t0.elapsed().as_secs_f64();
+            report(case, &sim, secs, f64::NAN);
+        }
+        _ => {
+            eprintln!("usage: see the file's doc comment");
+            std::process::exit(2);
+        }
+    }
+}

@@ -1,0 +1,4 @@
+//! Initial conditions shared by the integration tests (see `pdyn_gravity::systems`).
+#![allow(dead_code, unused_imports)]
+
+pub use pdyn_gravity::systems::{figure_eight, outer_solar_system, FIGURE_EIGHT_PERIOD};

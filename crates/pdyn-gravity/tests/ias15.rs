@@ -1,0 +1,169 @@
+//! IAS15: machine-precision energy on Kepler orbits, Brouwer's law, the figure-eight.
+
+mod common;
+
+use std::f64::consts::PI;
+
+use pdyn_gravity::{
+    Anomaly, Elements, Ias15Params, Integrator, Particle, Primary, Simulation, Units, Vec3,
+};
+
+fn kepler_at(e: f64, mean_anomaly: f64) -> Simulation {
+    let mut sim = Simulation::new(Units::GEqualsOne);
+    sim.add(Particle {
+        mass: 1.0,
+        pos: Vec3::ZERO,
+        vel: Vec3::ZERO,
+    })
+    .unwrap();
+    let el = Elements {
+        a: 1.0,
+        e,
+        inc: 0.2,
+        Omega: 0.3,
+        omega: 0.4,
+        anomaly: Anomaly::Mean(mean_anomaly),
+    };
+    sim.add_orbit(1e-3, &el, Primary::Interior).unwrap();
+    sim.move_to_center_of_mass().unwrap();
+    sim.set_integrator(Integrator::Ias15(Ias15Params::default()))
+        .unwrap();
+    sim.set_dt(1e-3).unwrap();
+    sim
+}
+
+/// Relative energy error sampled once per orbit over `orbits` orbits.
+fn energy_errors(e: f64, orbits: usize) -> (Vec<f64>, u64) {
+    energy_errors_at(e, 0.0, orbits)
+}
+
+fn energy_errors_at(e: f64, mean_anomaly: f64, orbits: usize) -> (Vec<f64>, u64) {
+    let mut sim = kepler_at(e, mean_anomaly);
+    let period = 2.0 * PI / 1.001f64.sqrt();
+    let e0 = sim.energy();
+    let errs = (1..=orbits)
+        .map(|k| {
+            sim.integrate(k as f64 * period).unwrap();
+            ((sim.energy() - e0) / e0).abs()
+        })
+        .collect();
+    (errs, sim.steps())
+}
+
+/// Two-body orbits e = 0 … 0.99 (m = 1e-3 about 1, G = 1) over 10³ orbits, sampled every
+/// orbit. The step counts equal REBOUND 5.2.2's exactly (same PRS23 controller): 36004,
+/// 52002, 98000, 159999. Max |dE/E|: ours 1.3e-14, 1.1e-14, 2.4e-14, 8.6e-13; REBOUND's
+/// 3.9e-15, 9.5e-15, 2.4e-14, 2.2e-13. The 1e-14 is thus met by neither code for
+/// e ≥ 0.9, and by us only to within a factor 1.3 at e ≤ 0.5.
+#[test]
+fn kepler_energy_error_is_at_machine_precision() {
+    let expected_steps = [36004, 52002, 98000, 159999];
+    let bounds = [2e-14, 2e-14, 4e-14, 1.5e-12];
+    for (k, &e) in [0.0, 0.5, 0.9, 0.99].iter().enumerate() {
+        let (errs, steps) = energy_errors(e, 1000);
+        let max = errs.iter().cloned().fold(0.0, f64::max);
+        eprintln!("e = {e}: {steps} steps, max |dE/E| over 1000 orbits = {max:.2e}");
+        assert_eq!(steps, expected_steps[k]);
+        assert!(max <= bounds[k], "e = {e}: {max:e}");
+    }
+}
+
+/// Brouwer's law: round-off makes the energy error a random walk, `⟨ΔE²⟩ ∝ t`. Over an
+/// ensemble of 6 circular orbits (different starting phases, 10³ orbits each), the RMS error
+/// over orbits 100–1000 is then √10 ≈ 3.2 times that over orbits 10–100; a linear drift
+/// would give ≈ 10. We measure 6.8 (REBOUND 5.2.2 on the same ensemble: 4.9), i.e. growth
+/// between √t and t (≈ t^0.8): some bias remains in our round-off. The test guards against
+/// anything worse (< 8); it does not prove √t.
+#[test]
+fn energy_error_grows_no_faster_than_sqrt_t() {
+    let (mut early, mut late) = (0.0, 0.0);
+    for j in 0..6 {
+        let (errs, _) = energy_errors_at(0.0, 1.0 * j as f64, 1000);
+        early += errs[9..100].iter().map(|x| x * x).sum::<f64>() / 91.0;
+        late += errs[99..1000].iter().map(|x| x * x).sum::<f64>() / 901.0;
+    }
+    let ratio = (late / early).sqrt();
+    eprintln!(
+        "ensemble RMS |dE/E|: orbits 10-100 {:.2e}, 100-1000 {:.2e}, ratio {ratio:.2}",
+        (early / 6.0).sqrt(),
+        (late / 6.0).sqrt()
+    );
+    assert!(ratio < 8.0);
+}
+
+fn figure_eight_after_one_period(epsilon: f64) -> Simulation {
+    let mut sim = common::figure_eight();
+    sim.set_integrator(Integrator::Ias15(Ias15Params {
+        epsilon,
+        ..Ias15Params::default()
+    }))
+    .unwrap();
+    sim.set_dt(1e-3).unwrap();
+    sim.integrate(common::FIGURE_EIGHT_PERIOD).unwrap();
+    sim
+}
+
+/// The figure-eight of Chenciner & Montgomery returns to its initial state after one period
+/// to 3.6e-8 relative: the limit set by the 8 published digits of the initial conditions and
+/// period (REBOUND's IAS15 gives the same 3.586e-8). That the integrator is not the limit is
+/// shown by a run at ε = 1e-12 agreeing with the default run to 1e-12.
+#[test]
+fn figure_eight_returns_after_one_period() {
+    let tight = figure_eight_after_one_period(1e-12);
+    let mut sim = common::figure_eight();
+    sim.set_integrator(Integrator::Ias15(Ias15Params::default()))
+        .unwrap();
+    sim.set_dt(1e-3).unwrap();
+    let start = sim.particles().clone();
+    let e0 = sim.energy();
+    sim.integrate(common::FIGURE_EIGHT_PERIOD).unwrap();
+    let p = sim.particles();
+    let (mut num, mut den) = (0.0, 0.0);
+    for i in 0..3 {
+        num += (p.pos(i) - start.pos(i)).norm2() + (p.vel(i) - start.vel(i)).norm2();
+        den += start.pos(i).norm2() + start.vel(i).norm2();
+    }
+    let rel = (num / den).sqrt();
+    let de = ((sim.energy() - e0) / e0).abs();
+    eprintln!("figure-eight: relative state difference after one period {rel:.2e}, |dE/E| {de:.1e}, {} steps", sim.steps());
+    assert!(rel < 4e-8, "{rel:e}");
+    assert!(de < 1e-14);
+    let q = tight.particles();
+    let diff: f64 = (0..3)
+        .map(|i| (p.pos(i) - q.pos(i)).norm() + (p.vel(i) - q.vel(i)).norm())
+        .sum();
+    eprintln!("figure-eight: eps 1e-9 vs 1e-12 runs differ by {diff:.1e}");
+    assert!(diff < 1e-12);
+}
+
+/// IAS15 on the outer Solar System over 1000 years: machine-precision energy; and the
+/// osculating Jacobi semi-major axes of Jupiter and Saturn vary by the same ~6e-4 and ~2e-3
+/// as under WHFast (tests/whfast.rs), so that variation is the physics (the Great
+/// Inequality), not integration error.
+#[test]
+fn outer_solar_system_energy() {
+    let mut sim = common::outer_solar_system();
+    sim.set_integrator(Integrator::Ias15(Ias15Params::default()))
+        .unwrap();
+    sim.set_dt(10.0).unwrap();
+    let e0 = sim.energy();
+    let a0 = [1, 2].map(|i| sim.orbit(i, Primary::Interior).unwrap().a);
+    let mut da = [0.0f64; 2];
+    for k in 1..=200 {
+        sim.integrate(1000.0 * 365.25 * k as f64 / 200.0).unwrap();
+        for (j, i) in [1, 2].into_iter().enumerate() {
+            let a = sim.orbit(i, Primary::Interior).unwrap().a;
+            da[j] = da[j].max(((a - a0[j]) / a0[j]).abs());
+        }
+    }
+    let de = ((sim.energy() - e0) / e0).abs();
+    eprintln!(
+        "outer Solar System, IAS15, 1000 yr: {} steps, |dE/E| {de:.1e}, max |da/a| Jupiter {:.2e}, Saturn {:.2e}",
+        sim.steps(),
+        da[0],
+        da[1]
+    );
+    assert!(de < 1e-14);
+    assert!(da[0] > 3e-4 && da[0] < 1e-3, "{da:?}");
+    assert!(da[1] > 1e-3 && da[1] < 3e-3, "{da:?}");
+}
