@@ -452,3 +452,42 @@ fn the_closed_form_warns_where_floating_point_ruins_it() {
         near.warnings
     );
 }
+
+/// DOPRI5 forced onto a stiff problem runs out of steps; the failure says why, as dopri5.f
+/// does, and what to use instead (issue 11).
+#[test]
+fn an_explicit_method_stalling_on_a_stiff_problem_says_stiff() {
+    let src = r#"
+name = "Van der Pol, mu = 1000"
+[parameters]
+mu = 1000.0
+[coordinates]
+x = { initial = 2.0, rate = 0.0 }
+[particles.p]
+mass = 1
+position = "[x, 0, 0]"
+[[forces]]
+kind = "applied"
+on = "p"
+force = "[mu*(1 - x^2)*x' - x, 0, 0]"
+[simulate]
+t_end = 3000
+method = "dopri5"
+max_steps = 20000
+"#;
+    let res = run_source(src, |_| {});
+    let f = res.failure.expect("runs out of steps");
+    assert!(f.stiff_at.is_some());
+    let text = f.to_string();
+    assert!(text.contains("stiff") && text.contains("radau5"), "{text}");
+    // And auto (DOPRI5 switching to Radau5) gets through the same span.
+    let res = run_source(src, |s| {
+        s.method = "auto".into();
+        s.t_end = 100.0;
+    });
+    assert!(
+        res.failure.is_none(),
+        "{:?}",
+        res.failure.map(|f| f.to_string())
+    );
+}

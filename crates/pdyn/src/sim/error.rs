@@ -139,6 +139,9 @@ pub struct RunFailure {
     pub state: Vec<(String, f64)>,
     /// The integrator's error.
     pub error: OdeError,
+    /// Where an explicit method's stiffness test fired before the failure (Hairer's test, as
+    /// in `dopri5.f`): the likely reason for running out of steps.
+    pub stiff_at: Option<f64>,
 }
 
 impl fmt::Display for RunFailure {
@@ -154,6 +157,14 @@ impl fmt::Display for RunFailure {
             self.t,
             self.error,
             state.join(", ")
-        )
+        )?;
+        if let Some(at) = self.stiff_at {
+            write!(
+                f,
+                "\n  the problem seems to have become stiff at t = {at:.6e} (the explicit method's \
+                 stiffness test fired): use --method radau5, or --method auto to switch when it does"
+            )?;
+        }
+        Ok(())
     }
 }

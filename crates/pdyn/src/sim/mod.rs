@@ -658,6 +658,7 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, SimError> {
                         .zip(fp.y.iter().copied())
                         .collect(),
                     error: e.clone(),
+                    stiff_at: fp.partial.stats.stiffness_detected_at,
                 };
                 ((*fp.partial).clone(), Some(failure))
             }
