@@ -128,7 +128,7 @@ pub enum Error {
         /// The model file.
         origin: String,
         /// Where and why.
-        failure: RunFailure,
+        failure: Box<RunFailure>,
     },
     /// A result that is NaN or infinite (`1/0`), printed as such (exit code 1).
     NonFinite {

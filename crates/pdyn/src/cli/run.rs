@@ -146,7 +146,7 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
     }
     let failure = res.failure.clone().map(|failure| Error::Integration {
         origin: model.origin.clone(),
-        failure,
+        failure: Box::new(failure),
     });
     let mut sum = summary(&res, &model.name, &prep.state_names);
     if let Some(f) = &failure {
@@ -272,7 +272,7 @@ pub fn check(a: CheckArgs) -> Result<Outcome, Error> {
         });
         let failure = rep.run.failure.clone().map(|failure| Error::Integration {
             origin: model.origin.clone(),
-            failure,
+            failure: Box::new(failure),
         });
         return Ok(Outcome {
             stdout: format!("{v:#}\n"),
@@ -293,7 +293,7 @@ pub fn check(a: CheckArgs) -> Result<Outcome, Error> {
     out += &format!("largest error relative to the size of the solution: {worst:.3e}\n");
     let failure = rep.run.failure.clone().map(|failure| Error::Integration {
         origin: model.origin.clone(),
-        failure,
+        failure: Box::new(failure),
     });
     Ok(Outcome {
         stdout: out,
