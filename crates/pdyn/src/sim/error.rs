@@ -51,6 +51,17 @@ pub enum SimError {
     NoClosedForm(ClosedFormError),
     /// Parameter values that break a physical requirement (a sweep's run with a mass ≤ 0).
     InvalidValue(pdyn_mech::validity::InvalidValue),
+    /// The initial state does not satisfy a constraint.
+    InitialStateViolatesConstraint {
+        /// The constraint's name (or equation).
+        label: String,
+        /// `position` (f = 0) or `velocity` (df/dt = 0).
+        level: &'static str,
+        /// The residual at t = 0.
+        residual: f64,
+        /// The size of the constraint's terms (what the residual is compared with).
+        scale: f64,
+    },
     /// A run setting outside its valid range (named as on the command line).
     InvalidOption {
         /// The option, e.g. `--dt`.
@@ -118,6 +129,17 @@ impl fmt::Display for SimError {
             SimError::Integrator(e) => write!(f, "cannot integrate: {e}"),
             SimError::NoClosedForm(e) => write!(f, "{e}"),
             SimError::InvalidValue(e) => write!(f, "{e}"),
+            SimError::InitialStateViolatesConstraint {
+                label,
+                level,
+                residual,
+                scale,
+            } => write!(
+                f,
+                "the initial state violates constraint `{label}` at the {level} level: its \
+                 residual is {residual:.3e} (its terms are of size {scale:.3e}); give initial \
+                 values and rates that satisfy it"
+            ),
             SimError::InvalidOption {
                 option,
                 value,

@@ -378,6 +378,7 @@ pub fn prepare_with(model: &mut Model, opts: &DeriveOptions) -> Result<Prepared,
     let values: Vec<f64> = model.parameters.iter().map(|q| q.value).collect();
     let mut y0 = vec![0.0; d.state.len()];
     initial_conditions.eval(&values, &mut y0);
+    check_constraints_at_start(model, &system, &y0)?;
     Ok(Prepared {
         system,
         observer,
@@ -392,6 +393,65 @@ pub fn prepare_with(model: &mut Model, opts: &DeriveOptions) -> Result<Prepared,
         initial_conditions,
         parameter_names: model.parameters.iter().map(|q| q.name.clone()).collect(),
     })
+}
+
+/// Relative size of a constraint's residual at t = 0, against its terms, above which the
+/// initial state is refused.
+pub const CONSTRAINT_TOLERANCE: f64 = 1e-8;
+
+/// Every constraint `f(q, t) = 0` and its rate `df/dt = 0` must hold at t = 0: an initial
+/// state off the constraint makes the integrator follow a different motion, and the only
+/// symptom would be a drift warning that blames the tolerance.
+fn check_constraints_at_start(
+    model: &mut Model,
+    system: &CompiledModel,
+    y0: &[f64],
+) -> Result<(), SimError> {
+    if model.constraints.is_empty() {
+        return Ok(());
+    }
+    let p = &mut model.pool;
+    let mut labels = Vec::new();
+    let mut exprs = Vec::new();
+    for c in &model.constraints {
+        for (level, f) in [("position", c.equation), ("velocity", p.dt(c.equation))] {
+            // The size of the terms: |a| + |b| + ... for f = a + b + ...
+            let terms: Vec<Id> = match p.node(f).clone() {
+                pdyn_expr::Node::Add(ts) => ts.to_vec(),
+                _ => vec![f],
+            };
+            let abs: Vec<Id> = terms
+                .iter()
+                .map(|&t| p.call(pdyn_expr::Func::Abs, &[t]))
+                .collect();
+            labels.push((level, c.label.clone()));
+            exprs.push(f);
+            exprs.push(p.add(&abs));
+        }
+    }
+    let names = (0..exprs.len()).map(|k| format!("c{k}")).collect();
+    // A constraint that is not a function of the state (it involves accelerations or
+    // reactions) is not checked here.
+    let Ok(obs) = Observer::new(p, &system.observation_inputs, names, &exprs) else {
+        return Ok(());
+    };
+    let mut input = Vec::new();
+    system.observation_input(0.0, y0, &mut input);
+    let mut out = vec![0.0; exprs.len()];
+    obs.eval(&input, &mut out);
+    for (k, (level, label)) in labels.into_iter().enumerate() {
+        let (residual, scale) = (out[2 * k], out[2 * k + 1]);
+        let holds = residual.abs() <= CONSTRAINT_TOLERANCE * scale;
+        if !holds {
+            return Err(SimError::InitialStateViolatesConstraint {
+                label,
+                level,
+                residual,
+                scale,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Output columns after `t` and the state — particle positions, reactions (recovered ones in
