@@ -51,6 +51,18 @@ pub struct CheckResult {
     /// Unknown forces at the smallest critical value: `(name, value)` (their signs tell which
     /// way a block slides).
     pub forces_at_critical: Vec<(String, f64)>,
+    /// Without `over`: every critical value in the range, ascending (a banked curve has a
+    /// least and a greatest speed), each with the unknown forces there.
+    pub critical: Vec<Critical>,
+}
+
+/// One critical value of a check and the forces there.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Critical {
+    /// The parameter's critical value.
+    pub value: f64,
+    /// Unknown forces there: `(name, value)`.
+    pub forces: Vec<(String, f64)>,
 }
 
 /// What `pdyn forces` found.
@@ -801,6 +813,8 @@ fn run_check(
         prog.eval(&input, &mut ws, out);
     };
     let mut crit: Vec<(f64, Option<f64>)> = Vec::new();
+    // Without `over`, every root in the range; with it, the first root at each sample.
+    let all_roots = over.is_none();
     for ov in samples {
         let grid = 2000;
         let mut prev: Option<(f64, f64)> = None;
@@ -814,6 +828,10 @@ fn run_check(
             }
             if f == 0.0 {
                 crit.push((pv, ov));
+                if all_roots {
+                    prev = None;
+                    continue;
+                }
                 break;
             }
             if let Some((pp, pf)) = prev {
@@ -833,8 +851,18 @@ fn run_check(
                             break;
                         }
                     }
-                    crit.push((0.5 * (a + b), ov));
-                    break;
+                    // A sign change through a pole (a denominator crossing zero) is not a
+                    // root: there |f| grows instead of vanishing.
+                    let root = 0.5 * (a + b);
+                    eval(root, ov, &mut out);
+                    if out[0].abs() > 1e-6 * pf.abs().max(f.abs()) {
+                        prev = Some((pv, f));
+                        continue;
+                    }
+                    crit.push((root, ov));
+                    if !all_roots {
+                        break;
+                    }
                 }
             }
             prev = Some((pv, f));
@@ -842,13 +870,26 @@ fn run_check(
     }
     let min = crit.iter().copied().min_by(|a, b| a.0.total_cmp(&b.0));
     let max = crit.iter().copied().max_by(|a, b| a.0.total_cmp(&b.0));
-    let mut forces_at_critical = Vec::new();
-    if let Some((pv, ov)) = min {
+    let mut forces_at = |pv: f64, ov: Option<f64>| {
         eval(pv, ov, &mut out);
-        for (k, (n, _)) in involved.iter().enumerate() {
-            forces_at_critical.push((n.clone(), out[1 + k]));
-        }
-    }
+        involved
+            .iter()
+            .enumerate()
+            .map(|(k, (n, _))| (n.clone(), out[1 + k]))
+            .collect::<Vec<_>>()
+    };
+    let forces_at_critical = min.map_or(Vec::new(), |(pv, ov)| forces_at(pv, ov));
+    let mut critical: Vec<Critical> = if all_roots {
+        crit.iter()
+            .map(|&(value, _)| Critical {
+                value,
+                forces: forces_at(value, None),
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    critical.sort_by(|a, b| a.value.total_cmp(&b.value));
     Ok(CheckResult {
         name: c.name.clone(),
         condition: c.text.clone(),
@@ -858,5 +899,6 @@ fn run_check(
         max,
         over: over.map(|o| o.1),
         forces_at_critical,
+        critical,
     })
 }

@@ -203,3 +203,22 @@ fn count_mismatch_names_what_is_missing() {
     let e = solve_forces(&mut m2, &ForcesOptions::default()).unwrap_err();
     assert!(e.to_string().contains("no equation involves F_X"), "{e}");
 }
+
+/// A check with two critical values in its range reports both, ascending (issue 11: only the
+/// smallest was reported). Banked curve: V² = g R (sin β ∓ μ cos β)/(cos β ± μ sin β).
+#[test]
+fn banked_curve_reports_the_least_and_the_greatest_speed() {
+    let mut m = example("banked_curve");
+    let res = solve_forces(&mut m, &ForcesOptions::default()).unwrap();
+    let c = &res.checks[0];
+    let (g, r, b, mu) = (9.81f64, 50.0f64, 30f64.to_radians(), 0.2f64);
+    let v_min = (g * r * (b.sin() - mu * b.cos()) / (b.cos() + mu * b.sin())).sqrt();
+    let v_max = (g * r * (b.sin() + mu * b.cos()) / (b.cos() - mu * b.sin())).sqrt();
+    let got: Vec<f64> = c.critical.iter().map(|k| k.value).collect();
+    assert_eq!(got.len(), 2, "{got:?}");
+    assert!((got[0] - v_min).abs() < 1e-9 * v_min, "{got:?} vs {v_min}");
+    assert!((got[1] - v_max).abs() < 1e-9 * v_max, "{got:?} vs {v_max}");
+    // Friction reverses between the two: down the bank at V_min, up at V_max.
+    let t = |k: usize| c.critical[k].forces.iter().find(|f| f.0 == "T").unwrap().1;
+    assert!(t(0) < 0.0 && t(1) > 0.0);
+}

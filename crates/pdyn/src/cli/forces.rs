@@ -99,6 +99,10 @@ pub fn run(a: ForcesArgs) -> Result<String, Error> {
                 "max": c.max.map(|(v, at)| json!({"value": json_num(v), "at": at.map(json_num)})),
                 "over": c.over,
                 "forces_at_critical": c.forces_at_critical.iter().map(|(n, v)| (n.clone(), json_num(*v))).collect::<serde_json::Map<_, _>>(),
+                "critical": c.critical.iter().map(|k| json!({
+                    "value": json_num(k.value),
+                    "forces": k.forces.iter().map(|(n, v)| (n.clone(), json_num(*v))).collect::<serde_json::Map<_, _>>(),
+                })).collect::<Vec<_>>(),
             })).collect::<Vec<_>>(),
             "notes": res.notes.iter().filter(|n| !n.starts_with("polar:")).collect::<Vec<_>>(),
         });
@@ -151,25 +155,35 @@ pub fn run(a: ForcesArgs) -> Result<String, Error> {
             (Some(name), Some(v)) => format!(" at {name} = {v:.6}"),
             _ => String::new(),
         };
+        let sense = |n: &String, v: f64| {
+            if model.friction_forces.contains(n) && v < 0.0 {
+                " (negative: friction acts against the `tangent` it was drawn along; it opposes \
+                 sliding, so the body starts to slide along +tangent)"
+            } else if model.friction_forces.contains(n) && v > 0.0 {
+                " (positive: friction acts along `tangent`; the body starts to slide along -tangent)"
+            } else {
+                ""
+            }
+        };
+        let forces = |out: &mut String, forces: &[(String, f64)]| {
+            for (n, v) in forces {
+                *out += &format!("  at the critical value {n} = {v:.6e}{}\n", sense(n, *v));
+            }
+        };
         match (c.min, c.max, &c.over) {
             (Some((v, o)), Some((w, o2)), Some(_)) => {
                 out += &format!("  smallest critical {} = {v:.6e}{}\n", c.parameter, at(o));
                 out += &format!("  largest critical {} = {w:.6e}{}\n", c.parameter, at(o2));
+                forces(&mut out, &c.forces_at_critical);
             }
-            (Some((v, _)), _, None) => out += &format!("  critical {} = {v:.6e}\n", c.parameter),
+            (Some(_), _, None) => {
+                // Every critical value in the range, each with the forces there.
+                for k in &c.critical {
+                    out += &format!("  critical {} = {:.6e}\n", c.parameter, k.value);
+                    forces(&mut out, &k.forces);
+                }
+            }
             _ => out += &format!("  no critical {} in the search range\n", c.parameter),
-        }
-        for (n, v) in &c.forces_at_critical {
-            let sense = if model.friction_forces.contains(n) && *v < 0.0 {
-                " (negative: friction acts against the `tangent` it was drawn along; it opposes \
-                 sliding, so the body starts to slide along +tangent)"
-                    .to_string()
-            } else if model.friction_forces.contains(n) && *v > 0.0 {
-                " (positive: friction acts along `tangent`; the body starts to slide along -tangent)".to_string()
-            } else {
-                String::new()
-            };
-            out += &format!("  at the critical value {n} = {v:.6e}{sense}\n");
         }
     }
     for n in res.notes.iter().filter(|n| !n.starts_with("polar:")) {
