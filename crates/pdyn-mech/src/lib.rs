@@ -16,6 +16,7 @@ pub mod derive;
 pub mod dsolve;
 pub mod kinematics;
 pub mod model;
+pub mod parameters;
 pub mod prescribed;
 pub mod units;
 pub mod validity;

@@ -398,6 +398,32 @@ pub fn solve_forces(model: &mut Model, opts: &ForcesOptions) -> Result<ForcesRes
                         };
                         all.push(m);
                     }
+                    // Declared ranges (`alpha = { range = [...] }`) are honoured.
+                    let declared: Vec<Option<(f64, f64)>> = unknown_ids
+                        .iter()
+                        .map(|&u| {
+                            model
+                                .unknowns
+                                .iter()
+                                .find(|q| q.id == u)
+                                .and_then(|q| q.range)
+                        })
+                        .collect();
+                    let before = all.len();
+                    all.retain(|s| {
+                        s.iter().zip(&declared).all(|(v, r)| {
+                            r.is_none_or(|(lo, hi)| (lo - 1e-12..=hi + 1e-12).contains(v))
+                        })
+                    });
+                    if all.is_empty() {
+                        return Err(ForcesError::NoRealSolution);
+                    }
+                    if all.len() < before {
+                        notes.push(format!(
+                            "{} solution(s) outside the unknowns' declared ranges left out",
+                            before - all.len()
+                        ));
+                    }
                     (Some(sol), all)
                 }
                 None => {

@@ -150,6 +150,7 @@ pub fn set_parameters(model: &mut pdyn_mech::Model, set: &[String]) -> Result<()
         }
     }
     if !set.is_empty() {
+        pdyn_mech::parameters::refresh_initial_values(model);
         pdyn_mech::validity::check_parameter_values(model).map_err(|error| Error::Value {
             origin: model.origin.clone(),
             option: "--set".into(),
