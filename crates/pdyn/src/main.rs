@@ -51,6 +51,9 @@ enum Command {
     Kin(cli::kin::KinArgs),
 }
 
+/// Stack of the thread that runs a command: 1 GiB of address space.
+const WORKER_STACK: usize = 1 << 30;
+
 fn dispatch(command: Command) -> Result<Outcome, Error> {
     let text = |r: Result<String, Error>| r.map(Outcome::text);
     match command {
@@ -129,7 +132,26 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    match dispatch(cli.command) {
+    // Expressions are trees and the symbolic algorithms recurse over them: a long sum typed on
+    // the command line is a deep tree. The work runs on a thread whose stack is large enough
+    // for any input within the size limits (the memory is reserved, not committed).
+    let worker = std::thread::Builder::new()
+        .name("pdyn".into())
+        .stack_size(WORKER_STACK)
+        .spawn(move || dispatch(cli.command));
+    let result = match worker {
+        Ok(handle) => match handle.join() {
+            Ok(result) => result,
+            // The panic hook has already reported and exited; this is unreachable in practice.
+            Err(_) => Err(Error::Internal {
+                message: "the worker thread panicked".into(),
+            }),
+        },
+        Err(e) => Err(Error::Internal {
+            message: format!("cannot start the worker thread: {e}"),
+        }),
+    };
+    match result {
         Ok(outcome) => {
             print!("{}", outcome.stdout);
             eprint!("{}", outcome.stderr);
