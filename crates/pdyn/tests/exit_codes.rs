@@ -213,3 +213,25 @@ fn a_mass_set_to_a_non_positive_value_is_refused_with_the_particle_named() {
         assert!(err.contains("must be finite and > 0"), "{cmd}: {err}");
     }
 }
+
+#[test]
+fn set_accepts_quantities_with_units_as_model_files_do() {
+    let (code, out, err) = pdyn(&[
+        "forces",
+        "examples/takeoff.toml",
+        "--set",
+        "v_t=150 knot",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let thrust = v["solutions"][0]["F_T"].as_f64().unwrap();
+    let vt = 150.0 * 1852.0 / 3600.0;
+    assert!(
+        (thrust - 15000.0 * vt * vt / 400.0).abs() < 1e-6 * thrust,
+        "{thrust}"
+    );
+    let (code, _, err) = pdyn(&["forces", "examples/takeoff.toml", "--set", "v_t=150 parsec"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("unknown unit `parsec`"), "{err}");
+}

@@ -118,9 +118,24 @@ pub fn numeric_pairs(list: &[String], flag: &str) -> Result<Vec<(String, f64)>, 
             let (k, v) = kv.split_once('=').ok_or_else(|| {
                 Error::argument(flag, format!("{flag}: expected name=value, got `{kv}`"))
             })?;
-            let x: f64 = v.trim().parse().map_err(|_| {
-                Error::argument(flag, format!("{flag}: `{v}` is not a number (in `{kv}`)"))
-            })?;
+            let x: f64 = match v.trim().parse() {
+                Ok(x) => x,
+                // A quantity with units, as in model files: `--set v_t="150 knot"`.
+                Err(_) if pdyn_mech::units::looks_like_quantity(v) => {
+                    pdyn_mech::units::parse_quantity(v).map_err(|e| {
+                        Error::argument(
+                            flag,
+                            format!("{flag}: `{v}`: {} (in `{kv}`)", e.message),
+                        )
+                    })?
+                }
+                Err(_) => {
+                    return Err(Error::argument(
+                        flag,
+                        format!("{flag}: `{v}` is not a number or a quantity such as `150 knot` (in `{kv}`)"),
+                    ))
+                }
+            };
             if !x.is_finite() {
                 return Err(Error::argument(
                     flag,
