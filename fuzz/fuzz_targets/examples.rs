@@ -23,45 +23,9 @@ pub const EXAMPLES: &[(&str, &str)] = &[
     ("window_blind", include_str!("../../examples/window_blind.toml")),
 ];
 
-/// Byte ranges of the values of `key = value` pairs.
-fn value_spans(src: &str) -> Vec<(usize, usize)> {
-    let mut spans = Vec::new();
-    let mut offset = 0;
-    for line in src.split_inclusive('\n') {
-        let t = line.trim_start();
-        if !t.starts_with('#') && !t.starts_with('[') {
-            let b = line.as_bytes();
-            let mut i = 0;
-            while let Some(eq) = line[i..].find('=').map(|k| k + i) {
-                let mut s = eq + 1;
-                while s < b.len() && b[s] == b' ' {
-                    s += 1;
-                }
-                if s >= b.len() {
-                    break;
-                }
-                let e = if b[s] == b'"' {
-                    match line[s + 1..].find('"') {
-                        Some(k) => s + k + 2,
-                        None => break,
-                    }
-                } else {
-                    let mut e = s;
-                    while e < b.len() && !matches!(b[e], b',' | b'}' | b'\n' | b' ' | b'#') {
-                        e += 1;
-                    }
-                    e
-                };
-                if e > s {
-                    spans.push((offset + s, offset + e));
-                }
-                i = e.max(eq + 1);
-            }
-        }
-        offset += line.len();
-    }
-    spans
-}
+#[path = "../../crates/pdyn/tests/common/toml_values.rs"]
+mod toml_values;
+use toml_values::value_spans;
 
 /// `(example name, mutated text)`: byte 0 picks the example, byte 1 the value, the rest
 /// (UTF-8) replaces it. `None` for inputs too short or not UTF-8.

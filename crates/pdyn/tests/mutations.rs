@@ -4,6 +4,10 @@
 //! and `forces`. Each case must end with exit 0, 1 or 2 — never a panic (exit 3, the panic
 //! hook), never a hang (a case still running after `HANG` is killed and reported).
 
+#[path = "common/toml_values.rs"]
+mod toml_values;
+use toml_values::value_spans;
+
 use std::io::Read;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -44,46 +48,6 @@ fn xorshift(s: &mut u64) -> u64 {
     *s ^= *s >> 7;
     *s ^= *s << 17;
     *s
-}
-
-/// Byte ranges of the values in `key = value` lines (a quoted string or a bare token).
-fn value_spans(src: &str) -> Vec<(usize, usize)> {
-    let mut spans = Vec::new();
-    let mut offset = 0;
-    for line in src.split_inclusive('\n') {
-        let t = line.trim_start();
-        if !t.starts_with('#') && !t.starts_with('[') {
-            let mut i = 0;
-            let b = line.as_bytes();
-            while let Some(eq) = line[i..].find('=').map(|k| k + i) {
-                let mut s = eq + 1;
-                while s < b.len() && b[s] == b' ' {
-                    s += 1;
-                }
-                if s >= b.len() {
-                    break;
-                }
-                let e = if b[s] == b'"' {
-                    match line[s + 1..].find('"') {
-                        Some(k) => s + 1 + k + 1,
-                        None => break,
-                    }
-                } else {
-                    let mut e = s;
-                    while e < b.len() && !matches!(b[e], b',' | b'}' | b'\n' | b' ' | b'#') {
-                        e += 1;
-                    }
-                    e
-                };
-                if e > s {
-                    spans.push((offset + s, offset + e));
-                }
-                i = e.max(eq + 1);
-            }
-        }
-        offset += line.len();
-    }
-    spans
 }
 
 /// Runs the binary with a hang guard: Some(exit code), or None when it had to be killed.

@@ -146,6 +146,17 @@ pub enum Quantity {
     Vector([Id; 3]),
 }
 
+/// The unit vector `(x, y, 0)/n` in the plane and its left perpendicular `(-y, x, 0)/n`
+/// (`n = |(x, y)|`): a path's tangent and normal side, or polar `e_r` and `e_θ`.
+fn planar_frame(pool: &mut Pool, x: Id, y: Id, n: Id) -> ([Id; 3], [Id; 3]) {
+    let (a, b) = (pool.div(x, n), pool.div(y, n));
+    let unit = simp3(pool, [a, b, Pool::ZERO]);
+    let ny = pool.neg(y);
+    let (c, d) = (pool.div(ny, n), pool.div(x, n));
+    let left = simp3(pool, [c, d, Pool::ZERO]);
+    (unit, left)
+}
+
 fn simp3(pool: &mut Pool, v: [Id; 3]) -> [Id; 3] {
     v.map(|c| {
         let e = pool.expand(c);
@@ -275,17 +286,7 @@ fn analyze_motion(pool: &mut Pool, motion: Motion) -> Result<Kinematics, KinErro
                 return Err(KinError::PathDoesNotMove);
             }
             let g = pool.sqrt(g2);
-            let tangent = {
-                let a = pool.div(x1, g);
-                let b = pool.div(y1, g);
-                simp3(pool, [a, b, Pool::ZERO])
-            };
-            let left = {
-                let ny = pool.neg(y1);
-                let a = pool.div(ny, g);
-                let b = pool.div(x1, g);
-                simp3(pool, [a, b, Pool::ZERO])
-            };
+            let (tangent, left) = planar_frame(pool, x1, y1, g);
             let kappa_s = {
                 let p1 = pool.mul2(x1, y2);
                 let p2 = pool.mul2(y1, x2);
@@ -337,17 +338,7 @@ fn analyze_motion(pool: &mut Pool, motion: Motion) -> Result<Kinematics, KinErro
                 simp(pool, s)
             };
             let rho = pool.sqrt(rho2);
-            let e_r = {
-                let a = pool.div(x, rho);
-                let b = pool.div(y, rho);
-                simp3(pool, [a, b, Pool::ZERO])
-            };
-            let e_theta = {
-                let ny = pool.neg(y);
-                let a = pool.div(ny, rho);
-                let b = pool.div(x, rho);
-                simp3(pool, [a, b, Pool::ZERO])
-            };
+            let (e_r, e_theta) = planar_frame(pool, x, y, rho);
             let polar = project(pool, position, velocity, acceleration, e_r, e_theta);
             Ok(Kinematics {
                 variable: parameter,
