@@ -117,9 +117,49 @@ fn kernel<'a, P: PairPotential + 'a>(
     i: usize,
     pot: impl Fn(usize) -> (&'a P, f64),
 ) -> PairOut {
+    // Neighbours are taken in blocks of `B`: gathered, then evaluated branch-free (pairs in
+    // the skin shell r_c ≤ r < r_c + δ are evaluated at r_c and masked), which lets the
+    // compiler use packed arithmetic. Each lane sums a fixed subsequence of the list, and the
+    // lanes are added in a fixed order: the result is independent of the thread count.
+    const B: usize = 4;
     let ri = pos[i];
-    let (mut fx, mut fy, mut fz, mut e, mut w) = (0.0, 0.0, 0.0, 0.0, 0.0);
-    for &j in list {
+    let mut acc = [[0.0f64; B]; 5];
+    let mut blocks = list.chunks_exact(B);
+    for blk in &mut blocks {
+        let mut d = [[0.0f64; B]; 3];
+        let mut r2 = [0.0f64; B];
+        let mut rc2 = [0.0f64; B];
+        let mut pp: [Option<&P>; B] = [None; B];
+        for l in 0..B {
+            let j = blk[l] as usize;
+            let q = pos[j];
+            d[0][l] = ri[0] - q[0];
+            d[1][l] = ri[1] - q[1];
+            d[2][l] = ri[2] - q[2];
+            r2[l] = d[0][l] * d[0][l] + d[1][l] * d[1][l] + d[2][l] * d[2][l];
+            let (p, c) = pot(j);
+            pp[l] = Some(p);
+            rc2[l] = c;
+        }
+        for l in 0..B {
+            let inside = r2[l] < rc2[l];
+            let (u, fr) = match pp[l] {
+                Some(p) => p.energy_force(if inside { r2[l] } else { rc2[l] }),
+                None => (0.0, 0.0),
+            };
+            let fr = if inside { fr } else { 0.0 };
+            acc[0][l] += fr * d[0][l];
+            acc[1][l] += fr * d[1][l];
+            acc[2][l] += fr * d[2][l];
+            acc[3][l] += if inside { u } else { 0.0 };
+            acc[4][l] += fr * r2[l];
+        }
+    }
+    let mut t = [0.0f64; 5];
+    for (tk, a) in t.iter_mut().zip(&acc) {
+        *tk = (a[0] + a[1]) + (a[2] + a[3]);
+    }
+    for &j in blocks.remainder() {
         let q = pos[j as usize];
         let dx = ri[0] - q[0];
         let dy = ri[1] - q[1];
@@ -128,16 +168,85 @@ fn kernel<'a, P: PairPotential + 'a>(
         let (p, rc2) = pot(j as usize);
         if r2 < rc2 {
             let (u, fr) = p.energy_force(r2);
-            fx += fr * dx;
-            fy += fr * dy;
-            fz += fr * dz;
-            e += u;
-            w += fr * r2;
+            t[0] += fr * dx;
+            t[1] += fr * dy;
+            t[2] += fr * dz;
+            t[3] += u;
+            t[4] += fr * r2;
         }
     }
     PairOut {
-        f: [fx, fy, fz],
-        e: 0.5 * e,
-        w: 0.5 * w,
+        f: [t[0], t[1], t[2]],
+        e: 0.5 * t[3],
+        w: 0.5 * t[4],
+    }
+}
+
+/// [`kernel`] for one potential: its parameters stay in registers and the blocks vectorise.
+#[inline(always)]
+fn kernel_single<P: PairPotential>(
+    pos: &[[f64; 3]],
+    list: &[u32],
+    i: usize,
+    p: &P,
+    rc2: f64,
+) -> PairOut {
+    const B: usize = 4;
+    let ri = pos[i];
+    let mut acc = [[0.0f64; B]; 5];
+    let mut blocks = list.chunks_exact(B);
+    for blk in &mut blocks {
+        let mut d = [[0.0f64; B]; 3];
+        let mut r2 = [0.0f64; B];
+        for l in 0..B {
+            let q = pos[blk[l] as usize];
+            d[0][l] = ri[0] - q[0];
+            d[1][l] = ri[1] - q[1];
+            d[2][l] = ri[2] - q[2];
+        }
+        for l in 0..B {
+            r2[l] = d[0][l] * d[0][l] + d[1][l] * d[1][l] + d[2][l] * d[2][l];
+        }
+        let mut r2m = [0.0f64; B];
+        for l in 0..B {
+            r2m[l] = if r2[l] < rc2 { r2[l] } else { rc2 };
+        }
+        let (mut u, mut fr) = p.energy_force4(r2m);
+        for l in 0..B {
+            let inside = r2[l] < rc2;
+            u[l] = if inside { u[l] } else { 0.0 };
+            fr[l] = if inside { fr[l] } else { 0.0 };
+        }
+        for l in 0..B {
+            acc[0][l] += fr[l] * d[0][l];
+            acc[1][l] += fr[l] * d[1][l];
+            acc[2][l] += fr[l] * d[2][l];
+            acc[3][l] += u[l];
+            acc[4][l] += fr[l] * r2[l];
+        }
+    }
+    let mut t = [0.0f64; 5];
+    for (tk, a) in t.iter_mut().zip(&acc) {
+        *tk = (a[0] + a[1]) + (a[2] + a[3]);
+    }
+    for &j in blocks.remainder() {
+        let q = pos[j as usize];
+        let dx = ri[0] - q[0];
+        let dy = ri[1] - q[1];
+        let dz = ri[2] - q[2];
+        let r2 = dx * dx + dy * dy + dz * dz;
+        if r2 < rc2 {
+            let (u, fr) = p.energy_force(r2);
+            t[0] += fr * dx;
+            t[1] += fr * dy;
+            t[2] += fr * dz;
+            t[3] += u;
+            t[4] += fr * r2;
+        }
+    }
+    PairOut {
+        f: [t[0], t[1], t[2]],
+        e: 0.5 * t[3],
+        w: 0.5 * t[4],
     }
 }

@@ -292,6 +292,26 @@ impl<P: PairPotential> Simulation<P> {
         self.potential
     }
 
+    /// Number of distinct pairs currently inside their cutoff (a diagnostic, `O(N)` work).
+    pub fn pairs_within_cutoff(&self) -> usize {
+        let rc2 = self.force_field.max_cutoff().powi(2);
+        let pos = &self.nl.pos;
+        (0..self.system.particles.len())
+            .map(|i| {
+                let r = pos[i];
+                self.nl
+                    .neighbors(i)
+                    .iter()
+                    .filter(|&&j| {
+                        let q = pos[j as usize];
+                        (r[0] - q[0]).powi(2) + (r[1] - q[1]).powi(2) + (r[2] - q[2]).powi(2) < rc2
+                    })
+                    .count()
+            })
+            .sum::<usize>()
+            / 2
+    }
+
     /// Forces `mᵢ aᵢ` of particle `i` at the current positions.
     pub fn force(&self, i: usize) -> Vec3 {
         Vec3(self.out[i].f)

@@ -22,6 +22,19 @@ pub trait PairPotential: Send + Sync {
     fn cutoff(&self) -> f64;
     /// `(u, f/r)` at squared distance `r2 < cutoff()²`, where `f/r = −u'(r)/r`.
     fn energy_force(&self, r2: f64) -> (f64, f64);
+
+    /// `(u, f/r)` for four squared distances at once (each `< cutoff()²`). The default calls
+    /// [`PairPotential::energy_force`] four times; kernels override it so that the four lanes
+    /// are computed with packed arithmetic.
+    #[inline(always)]
+    fn energy_force4(&self, r2: [f64; 4]) -> ([f64; 4], [f64; 4]) {
+        let mut u = [0.0; 4];
+        let mut f = [0.0; 4];
+        for l in 0..4 {
+            (u[l], f[l]) = self.energy_force(r2[l]);
+        }
+        (u, f)
+    }
 }
 
 /// The untruncated potential: `(u(r), −u'(r)/r)` at `r² = r2`, for any `r > 0`.
@@ -37,5 +50,9 @@ impl<P: PairPotential + ?Sized> PairPotential for Box<P> {
     #[inline]
     fn energy_force(&self, r2: f64) -> (f64, f64) {
         (**self).energy_force(r2)
+    }
+    #[inline]
+    fn energy_force4(&self, r2: [f64; 4]) -> ([f64; 4], [f64; 4]) {
+        (**self).energy_force4(r2)
     }
 }

@@ -70,6 +70,31 @@ impl<P: RawPair> PairPotential for Truncated<P> {
             (u - self.u_c, fr)
         }
     }
+
+    #[inline(always)]
+    fn energy_force4(&self, r2: [f64; 4]) -> ([f64; 4], [f64; 4]) {
+        // the mode is tested once per block, and the parameters are copied into locals, so
+        // the four lanes vectorise
+        let inner = &self.inner;
+        let (u_c, f_c, rc) = (self.u_c, self.f_c, self.rc);
+        let mut u = [0.0; 4];
+        let mut f = [0.0; 4];
+        if self.mode == CutoffMode::ShiftedForce {
+            for l in 0..4 {
+                let (a, b) = inner.raw(r2[l]);
+                let r = r2[l].sqrt();
+                u[l] = a - u_c + (r - rc) * f_c;
+                f[l] = b - f_c / r;
+            }
+        } else {
+            for l in 0..4 {
+                let (a, b) = inner.raw(r2[l]);
+                u[l] = a - u_c;
+                f[l] = b;
+            }
+        }
+        (u, f)
+    }
 }
 
 #[cfg(test)]
