@@ -92,7 +92,7 @@ impl<P: PairPotential> ForceField<P> {
                 .enumerate()
                 .with_min_len(128)
                 .for_each(|(i, o)| {
-                    *o = kernel(pos, nl.neighbors(i), i, |_| (p, rc2));
+                    *o = kernel_single(pos, nl.neighbors(i), i, p, rc2);
                 });
         } else {
             let nt = self.ntypes;
