@@ -7,9 +7,9 @@
 //! cells of edge `≥ r_s` (counting sort), and each real particle `i` gets the *full* list of
 //! extended indices `j ≠ i` with `|rᵢ − rⱼ| < r_s`, scanning the 27 surrounding cells in a fixed
 //! order. Between builds ghosts follow their owners (`r_g = r_owner + shift`), so the force loop
-//! needs no minimum image. The list stays exact while no particle has moved more than `δ/2`
-//! since the build (two particles approach by at most `δ`); [`NeighborList::needs_rebuild`]
-//! checks that after every drift.
+//! needs no minimum image. The list stays exact while the two largest displacements since
+//! the build add up to at most `δ` (a pair approaches by at most the sum of its two
+//! displacements); [`NeighborList::needs_rebuild`] checks that after every drift.
 
 use crate::{MdError, SimBox};
 use pdyn_particles::Particles;
@@ -90,17 +90,29 @@ impl NeighborList {
         &self.neigh[i * self.stride..i * self.stride + self.count[i] as usize]
     }
 
-    /// Whether some particle moved more than `δ/2` since the last build (or none was made).
+    /// Whether the list may have become inexact: the two largest displacements since the last
+    /// build add up to more than `δ` (two particles approach by at most `dᵢ + dⱼ`), or no build
+    /// was made yet.
     pub fn needs_rebuild(&self, p: &Particles) -> bool {
         if self.x0.len() != p.len() || self.builds == 0 {
             return true;
         }
-        let lim = 0.25 * self.skin * self.skin;
-        (0..p.len()).any(|i| {
+        let (mut d1, mut d2) = (0.0f64, 0.0f64); // largest and second largest squared
+        for i in 0..p.len() {
             let a = self.x0[i];
             let d = [p.x[i] - a[0], p.y[i] - a[1], p.z[i] - a[2]];
-            d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > lim
-        })
+            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            if r2 > d2 || r2.is_nan() {
+                if r2 > d1 || r2.is_nan() {
+                    d2 = d1;
+                    d1 = r2;
+                } else {
+                    d2 = r2;
+                }
+            }
+        }
+        let total = d1.sqrt() + d2.sqrt();
+        total > self.skin || total.is_nan()
     }
 
     /// Copies real positions into the extended array and moves ghosts with their owners.
