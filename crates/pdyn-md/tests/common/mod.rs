@@ -69,3 +69,18 @@ pub fn std(y: &[f64]) -> f64 {
     let m = y.iter().sum::<f64>() / n;
     (y.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / n).sqrt()
 }
+
+/// Standard deviation of the residuals about the least-squares line (fluctuation with any
+/// linear drift removed).
+pub fn detrended_std(x: &[f64], y: &[f64]) -> f64 {
+    let b = slope(x, y);
+    let n = x.len() as f64;
+    let mx = x.iter().sum::<f64>() / n;
+    let my = y.iter().sum::<f64>() / n;
+    let r: Vec<f64> = x
+        .iter()
+        .zip(y)
+        .map(|(a, v)| v - (my + b * (a - mx)))
+        .collect();
+    std(&r)
+}
