@@ -32,6 +32,8 @@ pub struct NeighborList {
     cell_of: Vec<u32>,
     cell_start: Vec<u32>,
     cell_atoms: Vec<u32>,
+    /// Positions in cell order (`cell_pos[k] = pos[cell_atoms[k]]`), scanned contiguously.
+    cell_pos: Vec<[f64; 3]>,
     x0: Vec<[f64; 3]>,
     /// Number of builds so far.
     pub builds: u64,
@@ -206,6 +208,10 @@ impl NeighborList {
                 fill[c as usize] += 1;
             }
         }
+        self.cell_pos.clear();
+        let pos = &self.pos;
+        self.cell_pos
+            .extend(self.cell_atoms.iter().map(|&a| pos[a as usize]));
         // full lists, rebuilt with a larger stride if some particle overflows
         let rs2 = rs * rs;
         self.count.clear();
@@ -215,7 +221,12 @@ impl NeighborList {
                 self.neigh.resize(n * self.stride, 0);
             }
             let stride = self.stride;
-            let (pos, cs, ca) = (&self.pos, &self.cell_start, &self.cell_atoms);
+            let (pos, cs, ca, cp) = (
+                &self.pos,
+                &self.cell_start,
+                &self.cell_atoms,
+                &self.cell_pos,
+            );
             let max = self.neigh[..n * stride]
                 .par_chunks_mut(stride)
                 .zip(self.count.par_iter_mut())
@@ -229,13 +240,11 @@ impl NeighborList {
                         for cy in c[1].saturating_sub(1)..=(c[1] + 1).min(nc[1] - 1) {
                             for cz in c[2].saturating_sub(1)..=(c[2] + 1).min(nc[2] - 1) {
                                 let cell = (cx * nc[1] + cy) * nc[2] + cz;
-                                for &j in &ca[cs[cell] as usize..cs[cell + 1] as usize] {
-                                    if j as usize == i {
-                                        continue;
-                                    }
-                                    let q = pos[j as usize];
+                                let range = cs[cell] as usize..cs[cell + 1] as usize;
+                                for (&j, q) in ca[range.clone()].iter().zip(&cp[range]) {
                                     let d = [ri[0] - q[0], ri[1] - q[1], ri[2] - q[2]];
-                                    if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < rs2 {
+                                    let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                                    if r2 < rs2 && j as usize != i {
                                         if m < stride {
                                             list[m] = j;
                                         }
