@@ -34,6 +34,7 @@ pub struct NeighborList {
     cell_atoms: Vec<u32>,
     /// Positions in cell order (`cell_pos[k] = pos[cell_atoms[k]]`), scanned contiguously.
     cell_pos: Vec<[f64; 3]>,
+    cell_fill: Vec<u32>,
     x0: Vec<[f64; 3]>,
     /// Number of builds so far.
     pub builds: u64,
@@ -201,12 +202,11 @@ impl NeighborList {
         }
         self.cell_atoms.clear();
         self.cell_atoms.resize(self.pos.len(), 0);
-        {
-            let mut fill: Vec<u32> = self.cell_start[..ncell].to_vec();
-            for (a, &c) in self.cell_of.iter().enumerate() {
-                self.cell_atoms[fill[c as usize] as usize] = a as u32;
-                fill[c as usize] += 1;
-            }
+        self.cell_fill.clear();
+        self.cell_fill.extend_from_slice(&self.cell_start[..ncell]);
+        for (a, &c) in self.cell_of.iter().enumerate() {
+            self.cell_atoms[self.cell_fill[c as usize] as usize] = a as u32;
+            self.cell_fill[c as usize] += 1;
         }
         self.cell_pos.clear();
         let pos = &self.pos;
