@@ -48,6 +48,8 @@ for steps in $steps_list; do
     rows+="| pdyn-md | $thr | $steps | $loop | $(python3 -c "print(f'{$setup+$loop:.4f}')") | $(python3 -c "print(f'{$rate:.4g}')") | $(python3 -c "print(f'{$prate/$thr:.4g}')") | $temp | $etot | $press |"$'\n'
   done
 done
+# same initial state in both codes (4,000 atoms, 100 steps): see compare.sh
+cmp_line=$(bash "$here/compare.sh" | tail -1)
 peak=$(python3 -c "
 mhz=float('$mhz'); f='$flags'
 per=16 if ('avx2' in f and 'fma' in f) else 4
@@ -81,6 +83,9 @@ Peak floating-point rate of one core: $peak. One pair interaction in the pdyn-md
 about 25 FLOP (distance 8, LJ energy and force/r 12 with one division, accumulation 5), and
 pdyn-md evaluates every pair twice (full neighbour list, for thread-count-independent results),
 so the sustained rate is ≈ 50 FLOP × pairs/s/core.
+
+Same initial state (pdyn-md writes a LAMMPS data file, LAMMPS reads it and runs the same
+NVE steps; \`bash bench/md/compare.sh\`): $cmp_line.
 
 Notes:
 - pdyn-md rebuilds its list when the two largest displacements since the last build add up
