@@ -1,0 +1,86 @@
+//! Radial distribution function `g(r) = n(r) / (ρ 4π r² Δr)` averaged over particles and
+//! frames, where `n(r)` is the mean number of neighbours in the shell `[r, r + Δr)` (minimum
+//! image, so `r_max ≤ L_min/2`). Uses the exact shell volume `(4π/3)(r₂³ − r₁³)`.
+
+use crate::{MdError, System};
+use std::f64::consts::PI;
+
+/// Histogram accumulator for `g(r)`.
+#[derive(Debug, Clone)]
+pub struct Rdf {
+    r_max: f64,
+    counts: Vec<u64>,
+    frames: u64,
+    norm: f64,
+}
+
+impl Rdf {
+    /// `bins` bins on `[0, r_max)`.
+    pub fn new(r_max: f64, bins: usize) -> Result<Self, MdError> {
+        if !(r_max.is_finite() && r_max > 0.0) {
+            return Err(MdError::InvalidParameter {
+                name: "r_max",
+                value: r_max,
+            });
+        }
+        if bins == 0 || bins > 1 << 24 {
+            return Err(MdError::InvalidParameter {
+                name: "bins",
+                value: bins as f64,
+            });
+        }
+        Ok(Rdf {
+            r_max,
+            counts: vec![0; bins],
+            frames: 0,
+            norm: 0.0,
+        })
+    }
+
+    /// Adds one frame (all pairs, `O(N²)`).
+    pub fn add(&mut self, s: &System) -> Result<(), MdError> {
+        let half = 0.5 * s.sim_box.min_edge();
+        if self.r_max > half {
+            return Err(MdError::InvalidParameter {
+                name: "r_max (> L/2)",
+                value: self.r_max,
+            });
+        }
+        let p = &s.particles;
+        let n = p.len();
+        let nb = self.counts.len();
+        let scale = nb as f64 / self.r_max;
+        for i in 0..n {
+            for j in i + 1..n {
+                let r = s.sim_box.delta(p.pos(i), p.pos(j)).norm();
+                let b = (r * scale) as usize;
+                if b < nb {
+                    self.counts[b] += 2;
+                }
+            }
+        }
+        self.frames += 1;
+        // Σ over frames of N·ρ
+        self.norm += n as f64 * s.density();
+        Ok(())
+    }
+
+    /// Bin centres and `g(r)`.
+    pub fn result(&self) -> (Vec<f64>, Vec<f64>) {
+        let nb = self.counts.len();
+        let dr = self.r_max / nb as f64;
+        let mut r = Vec::with_capacity(nb);
+        let mut g = Vec::with_capacity(nb);
+        for (b, &c) in self.counts.iter().enumerate() {
+            let (r1, r2) = (b as f64 * dr, (b + 1) as f64 * dr);
+            let shell = 4.0 / 3.0 * PI * (r2.powi(3) - r1.powi(3));
+            r.push(0.5 * (r1 + r2));
+            g.push(if self.norm > 0.0 {
+                c as f64 / (self.norm * shell)
+            } else {
+                0.0
+            });
+        }
+        (r, g)
+    }
+}

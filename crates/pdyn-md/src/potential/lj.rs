@@ -1,0 +1,70 @@
+//! Lennard-Jones 12-6: `u(r) = 4ε[(σ/r)¹² − (σ/r)⁶]` (Jones, Proc. R. Soc. A 106, 463 (1924)).
+//!
+//! `f/r = 24ε[2(σ/r)¹² − (σ/r)⁶]/r²`. Long-range (tail) corrections for a plain cutoff `r_c`
+//! at number density `ρ` (Allen & Tildesley §2.8):
+//! `U_tail/N = (8/3)πρεσ³[(1/3)(σ/r_c)⁹ − (σ/r_c)³]`,
+//! `P_tail = (16/3)πρ²εσ³[(2/3)(σ/r_c)⁹ − (σ/r_c)³]`.
+
+use super::{CutoffMode, RawPair, Truncated};
+use std::f64::consts::PI;
+
+/// Lennard-Jones parameters (well depth `ε`, diameter `σ`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LennardJones {
+    /// Well depth ε (energy units).
+    pub epsilon: f64,
+    /// Zero-crossing distance σ (length units).
+    pub sigma: f64,
+    sigma2: f64,
+    eps4: f64,
+    eps24: f64,
+}
+
+impl LennardJones {
+    /// LJ with `ε` and `σ`.
+    pub fn new(epsilon: f64, sigma: f64) -> Self {
+        LennardJones {
+            epsilon,
+            sigma,
+            sigma2: sigma * sigma,
+            eps4: 4.0 * epsilon,
+            eps24: 24.0 * epsilon,
+        }
+    }
+
+    /// Truncated at `rc` with the given cutoff mode.
+    pub fn truncated(self, rc: f64, mode: CutoffMode) -> Truncated<Self> {
+        Truncated::new(self, rc, mode)
+    }
+
+    /// Tail correction to the energy per particle at density `rho` for a plain cutoff `rc`.
+    pub fn energy_tail_per_particle(&self, rho: f64, rc: f64) -> f64 {
+        let s3 = (self.sigma / rc).powi(3);
+        8.0 / 3.0 * PI * rho * self.epsilon * self.sigma.powi(3) * (s3 * s3 * s3 / 3.0 - s3)
+    }
+
+    /// Tail correction to the pressure at density `rho` for a plain cutoff `rc`.
+    pub fn pressure_tail(&self, rho: f64, rc: f64) -> f64 {
+        let s3 = (self.sigma / rc).powi(3);
+        16.0 / 3.0
+            * PI
+            * rho
+            * rho
+            * self.epsilon
+            * self.sigma.powi(3)
+            * (2.0 / 3.0 * s3 * s3 * s3 - s3)
+    }
+}
+
+impl RawPair for LennardJones {
+    #[inline(always)]
+    fn raw(&self, r2: f64) -> (f64, f64) {
+        let inv = 1.0 / r2;
+        let sr2 = self.sigma2 * inv;
+        let sr6 = sr2 * sr2 * sr2;
+        (
+            self.eps4 * sr6 * (sr6 - 1.0),
+            self.eps24 * sr6 * (2.0 * sr6 - 1.0) * inv,
+        )
+    }
+}

@@ -1,0 +1,526 @@
+//! [`System`] (particles, types, box, bonds) and [`Simulation`] (system, force field,
+//! neighbour list, thermostat, velocity-Verlet stepping with failure detection).
+//!
+//! Velocity Verlet (Swope, Andersen, Berens & Wilson, J. Chem. Phys. 76, 637 (1982)):
+//! `v ← v + (h/2) a; x ← x + h v; a ← F(x)/m; v ← v + (h/2) a`. Second order, symplectic and
+//! time-reversible for NVE, so the energy error stays bounded (`O(h²)` fluctuations, no drift).
+//!
+//! Failure detection, every step: a non-finite state, a particle that moves more than
+//! `SimParams::max_displacement` in one step, or (for NVE and Nosé–Hoover, whose conserved
+//! quantity is known) a change of that quantity per particle beyond
+//! `SimParams::max_energy_change` stops the run with `MdError::Unstable`, the step and the
+//! offending particle; the records so far are returned in `RunFailure::partial`.
+
+use crate::bonds::Bond;
+use crate::forces::PairOut;
+use crate::potential::PairPotential;
+use crate::thermostat::Thermostat;
+use crate::{ForceField, MdError, NeighborList, RunFailure, SimBox, ThermoRecord};
+use pdyn_particles::{Particles, Vec3};
+
+/// Particles in a periodic box, with types and bonds.
+#[derive(Debug, Clone)]
+pub struct System {
+    /// Positions (wrapped into the box at every neighbour-list build), velocities, masses.
+    pub particles: Particles,
+    /// Type of each particle (index into the force field's table).
+    pub types: Vec<u32>,
+    /// Periodic box.
+    pub sim_box: SimBox,
+    /// Box lengths removed by wrapping: unwrapped `r = x + image·L`.
+    pub images: Vec<[i32; 3]>,
+    /// Bonds.
+    pub bonds: Vec<Bond>,
+}
+
+impl System {
+    /// Particles of type 0 in `sim_box`, no bonds.
+    pub fn new(particles: Particles, sim_box: SimBox) -> Self {
+        let n = particles.len();
+        System {
+            particles,
+            types: vec![0; n],
+            sim_box,
+            images: vec![[0; 3]; n],
+            bonds: vec![],
+        }
+    }
+
+    /// Sets the type of every particle (lengths must match).
+    pub fn set_types(&mut self, types: Vec<u32>) -> Result<(), MdError> {
+        if types.len() != self.particles.len() {
+            return Err(MdError::IndexOutOfRange {
+                what: "types length",
+                index: types.len(),
+                len: self.particles.len(),
+            });
+        }
+        self.types = types;
+        Ok(())
+    }
+
+    /// Adds a bond between existing particles `i ≠ j`.
+    pub fn add_bond(&mut self, bond: Bond) -> Result<(), MdError> {
+        let n = self.particles.len();
+        for idx in [bond.i, bond.j] {
+            if idx >= n {
+                return Err(MdError::IndexOutOfRange {
+                    what: "bond particle",
+                    index: idx,
+                    len: n,
+                });
+            }
+        }
+        if bond.i == bond.j {
+            return Err(MdError::IndexOutOfRange {
+                what: "bond to itself",
+                index: bond.i,
+                len: n,
+            });
+        }
+        self.bonds.push(bond);
+        Ok(())
+    }
+
+    /// Unwrapped position of particle `i` (continuous across boundaries).
+    pub fn unwrapped(&self, i: usize) -> Vec3 {
+        let l = self.sim_box.l;
+        let m = self.images[i];
+        let p = &self.particles;
+        Vec3::new(
+            p.x[i] + m[0] as f64 * l[0],
+            p.y[i] + m[1] as f64 * l[1],
+            p.z[i] + m[2] as f64 * l[2],
+        )
+    }
+
+    /// Number density `N/V`.
+    pub fn density(&self) -> f64 {
+        self.particles.len() as f64 / self.sim_box.volume()
+    }
+}
+
+/// Run parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimParams {
+    /// Time step (default 0.005 τ, LAMMPS `bench/in.lj`).
+    pub dt: f64,
+    /// Neighbour-list skin δ (default 0.3 σ).
+    pub skin: f64,
+    /// Thermodynamic output every this many steps (default 100; 0 = only at the end).
+    pub thermo_every: u64,
+    /// Boltzmann constant (default 1: reduced LJ units).
+    pub boltzmann: f64,
+    /// Pairs closer than this at the start are refused as overlapping (default 0.7 σ, where
+    /// LJ's pair energy exceeds 250 ε).
+    pub overlap_distance: f64,
+    /// Largest displacement of a particle in one step before the run is declared unstable
+    /// (default 0.5 σ).
+    pub max_displacement: f64,
+    /// Largest change of the conserved quantity per particle since the start of the run
+    /// (NVE, Nosé–Hoover) before the run is declared unstable (default 1.0 ε).
+    pub max_energy_change: f64,
+}
+
+impl Default for SimParams {
+    fn default() -> Self {
+        SimParams {
+            dt: 0.005,
+            skin: 0.3,
+            thermo_every: 100,
+            boltzmann: 1.0,
+            overlap_distance: 0.7,
+            max_displacement: 0.5,
+            max_energy_change: 1.0,
+        }
+    }
+}
+
+/// Thermodynamic records and counters of a run.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RunReport {
+    /// One record every `thermo_every` steps (and at step 0 of the first run).
+    pub records: Vec<ThermoRecord>,
+    /// Neighbour-list builds during the run.
+    pub builds: u64,
+    /// Steps completed.
+    pub steps: u64,
+}
+
+/// Receives thermodynamic records (and the system) during a run.
+pub trait Observer {
+    /// Called at every thermo output.
+    fn observe(&mut self, record: &ThermoRecord, system: &System);
+}
+
+impl<F: FnMut(&ThermoRecord, &System)> Observer for F {
+    fn observe(&mut self, record: &ThermoRecord, system: &System) {
+        self(record, system)
+    }
+}
+
+/// A molecular-dynamics run in progress.
+#[derive(Debug, Clone)]
+pub struct Simulation<P> {
+    /// The particles, box, types and bonds.
+    pub system: System,
+    /// Pair potentials.
+    pub force_field: ForceField<P>,
+    /// Thermostat (or `Thermostat::None`).
+    pub thermostat: Thermostat,
+    /// Parameters.
+    pub params: SimParams,
+    nl: NeighborList,
+    out: Vec<PairOut>,
+    /// Steps taken so far.
+    pub step: u64,
+    potential: f64,
+    virial: f64,
+    e0: Option<f64>,
+}
+
+impl<P: PairPotential> Simulation<P> {
+    /// Checks the set-up (box against cutoff + skin, types, bonds, overlaps) and computes the
+    /// initial forces.
+    pub fn new(
+        system: System,
+        force_field: ForceField<P>,
+        thermostat: Thermostat,
+        params: SimParams,
+    ) -> Result<Self, MdError> {
+        for (name, v) in [
+            ("dt", params.dt),
+            ("boltzmann", params.boltzmann),
+            ("max_displacement", params.max_displacement),
+            ("max_energy_change", params.max_energy_change),
+        ] {
+            crate::thermostat::positive(name, v)?;
+        }
+        let nl = NeighborList::new(force_field.max_cutoff(), params.skin)?;
+        nl.check_box(&system.sim_box)?;
+        let nt = force_field.ntypes();
+        if let Some((i, &t)) = system
+            .types
+            .iter()
+            .enumerate()
+            .find(|(_, &t)| t as usize >= nt)
+        {
+            let _ = i;
+            return Err(MdError::IndexOutOfRange {
+                what: "type",
+                index: t as usize,
+                len: nt,
+            });
+        }
+        let n = system.particles.len();
+        let mut sim = Simulation {
+            system,
+            force_field,
+            thermostat,
+            params,
+            nl,
+            out: vec![PairOut::default(); n],
+            step: 0,
+            potential: 0.0,
+            virial: 0.0,
+            e0: None,
+        };
+        sim.rebuild();
+        sim.check_overlap()?;
+        sim.forces().map_err(|e| e.with_step(0))?;
+        Ok(sim)
+    }
+
+    fn rebuild(&mut self) {
+        let s = &mut self.system;
+        self.nl.build(&mut s.particles, &mut s.images, &s.sim_box);
+    }
+
+    fn check_overlap(&self) -> Result<(), MdError> {
+        let d2 = self.params.overlap_distance.powi(2);
+        let p = &self.system.particles;
+        for i in 0..p.len() {
+            let ri = self.nl.pos[i];
+            for &j in self.nl.neighbors(i) {
+                let q = self.nl.pos[j as usize];
+                let r2 = (ri[0] - q[0]).powi(2) + (ri[1] - q[1]).powi(2) + (ri[2] - q[2]).powi(2);
+                let o = self.nl.owner[j as usize] as usize;
+                if r2 < d2 && o > i {
+                    return Err(MdError::Overlap {
+                        i,
+                        j: o,
+                        distance: r2.sqrt(),
+                        threshold: self.params.overlap_distance,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Pair and bond forces into accelerations; potential energy and virial.
+    fn forces(&mut self) -> Result<(), MdError> {
+        let s = &mut self.system;
+        self.force_field.compute(&self.nl, &s.types, &mut self.out);
+        let (u_b, w_b) = bond_forces(s, &mut self.out)?;
+        let p = &mut s.particles;
+        let (mut u, mut w) = (u_b, w_b);
+        for (i, o) in self.out.iter().enumerate() {
+            let inv_m = if p.m[i] > 0.0 { 1.0 / p.m[i] } else { 0.0 };
+            p.ax[i] = o.f[0] * inv_m;
+            p.ay[i] = o.f[1] * inv_m;
+            p.az[i] = o.f[2] * inv_m;
+            u += o.e;
+            w += o.w;
+        }
+        self.potential = u;
+        self.virial = w;
+        Ok(())
+    }
+
+    /// Degrees of freedom: `3N − 3` (momentum conserved), `3N` under Langevin.
+    pub fn dof(&self) -> f64 {
+        let n = self.system.particles.len();
+        match self.thermostat {
+            Thermostat::Langevin(_) => (3 * n) as f64,
+            _ => (3 * n).saturating_sub(3) as f64,
+        }
+    }
+
+    /// Potential energy at the current positions.
+    pub fn potential_energy(&self) -> f64 {
+        self.potential
+    }
+
+    /// Number of distinct pairs currently inside their cutoff (a diagnostic, `O(N)` work).
+    pub fn pairs_within_cutoff(&self) -> usize {
+        let rc2 = self.force_field.max_cutoff().powi(2);
+        let pos = &self.nl.pos;
+        (0..self.system.particles.len())
+            .map(|i| {
+                let r = pos[i];
+                self.nl
+                    .neighbors(i)
+                    .iter()
+                    .filter(|&&j| {
+                        let q = pos[j as usize];
+                        (r[0] - q[0]).powi(2) + (r[1] - q[1]).powi(2) + (r[2] - q[2]).powi(2) < rc2
+                    })
+                    .count()
+            })
+            .sum::<usize>()
+            / 2
+    }
+
+    /// Forces `mᵢ aᵢ` of particle `i` at the current positions.
+    pub fn force(&self, i: usize) -> Vec3 {
+        Vec3(self.out[i].f)
+    }
+
+    /// Thermodynamic state now.
+    pub fn thermo(&self) -> ThermoRecord {
+        let p = &self.system.particles;
+        let k = p.kinetic_energy();
+        let nf = self.dof();
+        let kb = self.params.boltzmann;
+        let total = k + self.potential;
+        let extra = match &self.thermostat {
+            Thermostat::NoseHooverChain(c) => c.energy(nf, kb),
+            _ => 0.0,
+        };
+        ThermoRecord {
+            step: self.step,
+            time: self.step as f64 * self.params.dt,
+            temperature: if nf > 0.0 { 2.0 * k / (nf * kb) } else { 0.0 },
+            kinetic: k,
+            potential: self.potential,
+            total,
+            pressure: (2.0 * k + self.virial) / (3.0 * self.system.sim_box.volume()),
+            conserved: total + extra,
+        }
+    }
+
+    /// Runs `steps` steps, reporting to `observer` every `params.thermo_every` steps (and at
+    /// the start of the first run). On failure the state is left as it was when detected.
+    pub fn run(
+        &mut self,
+        steps: u64,
+        observer: &mut dyn Observer,
+    ) -> Result<RunReport, RunFailure> {
+        let mut report = RunReport::default();
+        let builds0 = self.nl.builds;
+        let every = self.params.thermo_every;
+        if self.step == 0 {
+            let r = self.thermo();
+            observer.observe(&r, &self.system);
+            report.records.push(r);
+        }
+        let checks_energy = matches!(
+            self.thermostat,
+            Thermostat::None | Thermostat::NoseHooverChain(_)
+        );
+        if self.e0.is_none() {
+            self.e0 = Some(self.thermo().conserved);
+        }
+        for _ in 0..steps {
+            if let Err(error) = self.one_step(checks_energy) {
+                report.builds = self.nl.builds - builds0;
+                return Err(RunFailure {
+                    error,
+                    partial: report,
+                });
+            }
+            report.steps += 1;
+            if every > 0 && self.step % every == 0 {
+                let r = self.thermo();
+                observer.observe(&r, &self.system);
+                report.records.push(r);
+            }
+        }
+        if every == 0 {
+            let r = self.thermo();
+            observer.observe(&r, &self.system);
+            report.records.push(r);
+        }
+        report.builds = self.nl.builds - builds0;
+        Ok(report)
+    }
+
+    fn one_step(&mut self, checks_energy: bool) -> Result<(), MdError> {
+        let h = self.params.dt;
+        let kb = self.params.boltzmann;
+        let nf = self.dof();
+        self.step += 1;
+        let step = self.step;
+        if let Thermostat::NoseHooverChain(c) = &mut self.thermostat {
+            let ke = self.system.particles.kinetic_energy();
+            c.half_step(&mut self.system.particles, h, ke, nf, kb);
+        }
+        let p = &mut self.system.particles;
+        p.kick(0.5 * h);
+        // largest displacement of this step, |v| h
+        let (mut vmax2, mut imax) = (0.0, 0);
+        for i in 0..p.len() {
+            let v2 = p.vx[i] * p.vx[i] + p.vy[i] * p.vy[i] + p.vz[i] * p.vz[i];
+            if v2 > vmax2 || v2.is_nan() {
+                vmax2 = v2;
+                imax = i;
+            }
+        }
+        let disp = vmax2.sqrt() * h;
+        if !within(disp, self.params.max_displacement) {
+            return Err(self.unstable(step, imax, disp));
+        }
+        if let Thermostat::Langevin(l) = &mut self.thermostat {
+            p.drift(0.5 * h);
+            l.ou_step(p, h, kb);
+            p.drift(0.5 * h);
+        } else {
+            p.drift(h);
+        }
+        if self.nl.needs_rebuild(&self.system.particles) {
+            self.rebuild();
+        } else {
+            self.nl.update_ghosts(&self.system.particles);
+        }
+        self.forces().map_err(|e| e.with_step(step))?;
+        let p = &mut self.system.particles;
+        p.kick(0.5 * h);
+        match &mut self.thermostat {
+            Thermostat::NoseHooverChain(c) => {
+                let ke = p.kinetic_energy();
+                c.half_step(p, h, ke, nf, kb);
+            }
+            Thermostat::Berendsen(b) => {
+                let t = 2.0 * p.kinetic_energy() / (nf * kb);
+                b.rescale(p, h, t);
+            }
+            _ => {}
+        }
+        if checks_energy || !self.potential.is_finite() {
+            let e = self.thermo().conserved;
+            let de = (e - self.e0.unwrap_or(e)).abs() / self.system.particles.len().max(1) as f64;
+            if !within(de, self.params.max_energy_change) {
+                let p = &self.system.particles;
+                let atom = p.first_non_finite().unwrap_or_else(|| {
+                    (0..p.len())
+                        .max_by(|&a, &b| p.acc(a).norm2().total_cmp(&p.acc(b).norm2()))
+                        .unwrap_or(0)
+                });
+                let mut err = self.unstable(step, atom, disp);
+                if let MdError::Unstable {
+                    energy_change_per_atom,
+                    ..
+                } = &mut err
+                {
+                    *energy_change_per_atom = de;
+                }
+                return Err(err);
+            }
+        }
+        Ok(())
+    }
+
+    fn unstable(&self, step: u64, atom: usize, displacement: f64) -> MdError {
+        let p = &self.system.particles;
+        let bx = &self.system.sim_box;
+        let neighbor = (0..p.len())
+            .filter(|&j| j != atom)
+            .map(|j| (j, bx.delta(p.pos(atom), p.pos(j)).norm2()))
+            .filter(|(_, d)| d.is_finite())
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(j, _)| j);
+        let e = self.thermo().conserved;
+        MdError::Unstable {
+            step,
+            atom,
+            neighbor,
+            displacement,
+            energy_change_per_atom: (e - self.e0.unwrap_or(e)).abs() / p.len().max(1) as f64,
+        }
+    }
+}
+
+impl MdError {
+    fn with_step(mut self, s: u64) -> Self {
+        if let MdError::BondBroken { step, .. } = &mut self {
+            *step = s;
+        }
+        self
+    }
+}
+
+/// Adds bond forces to `out` (in bond order); returns bond energy and virial.
+pub(crate) fn bond_forces(s: &System, out: &mut [PairOut]) -> Result<(f64, f64), MdError> {
+    let (mut u, mut w) = (0.0, 0.0);
+    let p = &s.particles;
+    for (b, bond) in s.bonds.iter().enumerate() {
+        let d = s.sim_box.delta(p.pos(bond.i), p.pos(bond.j)).0;
+        let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        let Some((e, fr)) = bond.kind.energy_force(r2) else {
+            let max = match bond.kind {
+                crate::BondKind::Fene { r_max, .. } => r_max,
+                _ => f64::INFINITY,
+            };
+            return Err(MdError::BondBroken {
+                step: 0,
+                bond: b,
+                atoms: [bond.i, bond.j],
+                length: r2.sqrt(),
+                max,
+            });
+        };
+        for (k, dk) in d.iter().enumerate() {
+            out[bond.i].f[k] += fr * dk;
+            out[bond.j].f[k] -= fr * dk;
+        }
+        u += e;
+        w += fr * r2;
+    }
+    Ok((u, w))
+}
+
+/// `x ≤ limit`, false for NaN.
+fn within(x: f64, limit: f64) -> bool {
+    x <= limit
+}
