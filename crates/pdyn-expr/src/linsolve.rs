@@ -209,6 +209,10 @@ impl Pool {
                 });
             }
         }
+        if n == 0 {
+            // No unknowns (every coordinate prescribed): nothing to solve.
+            return Ok(Vec::new());
+        }
         // Fraction-free back substitution: x_i = y_i / det.
         let det = rows[n - 1][n - 1].clone();
         let mut y: Vec<Poly> = vec![Poly::zero(); n];
