@@ -193,7 +193,7 @@ fn check_handwritten_chain() {
         let (a, b) = ab.split_at_mut(N * N);
         let mut perm = vec![0; N];
         lu_factor_in_place(a, N, &mut perm).unwrap();
-        lu_solve_in_place(a, N, &perm, b, &mut vec![0.0; N]);
+        lu_solve_in_place(a, N, &perm, b, &mut [0.0; N]);
         b.to_vec()
     };
     let mut derived = vec![0.0; N * N + N];
