@@ -17,8 +17,12 @@ use crate::number::Number;
 use crate::pool::{Func, Id, Node, Pool};
 use rustc_hash::FxHashMap;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Op {
+/// The operation of one [`Instr`]. Unary operations read `a` only; `Powi` reads `a` and takes
+/// its integer exponent from `b` (not a register); every other binary operation reads `a`, `b`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+#[allow(missing_docs)] // the names are the operations
+pub enum Op {
     Add,
     Sub,
     Mul,
@@ -45,12 +49,41 @@ enum Op {
     Max,
 }
 
-/// One instruction: `reg[dst] = op(reg[a], reg[b])`; for `Powi`, `b` holds the exponent.
+impl Op {
+    /// True when the operation reads the register `b` (binary operations except `Powi`).
+    pub fn reads_b(self) -> bool {
+        matches!(
+            self,
+            Op::Add | Op::Sub | Op::Mul | Op::Div | Op::Powf | Op::Atan2 | Op::Min | Op::Max
+        )
+    }
+}
+
+/// One instruction: `reg[dst] = op(reg[a], reg[b])`; for `Powi`, `b` holds the exponent. The
+/// destination of instruction `k` is register [`Program::first_temporary`]` + k`.
 #[derive(Clone, Copy, Debug)]
-struct Instr {
+pub struct Instr {
     op: Op,
     a: u32,
     b: u32,
+}
+
+impl Instr {
+    /// The operation.
+    pub fn op(&self) -> Op {
+        self.op
+    }
+
+    /// The first operand register.
+    pub fn a(&self) -> u32 {
+        self.a
+    }
+
+    /// The second operand register, or for [`Op::Powi`] the exponent (as `i32` bits); unused
+    /// (0) for unary operations.
+    pub fn b(&self) -> u32 {
+        self.b
+    }
 }
 
 /// Why a set of expressions could not be compiled.
@@ -362,6 +395,27 @@ impl Program {
         self.outputs.len()
     }
 
+    /// Read-only view of the instructions, in evaluation order (for code generators such as
+    /// `pdyn-jit`). Registers are laid out `[inputs | constants | temporaries]`.
+    pub fn instructions(&self) -> &[Instr] {
+        &self.instrs
+    }
+
+    /// The constants, held in registers `n_inputs()..n_inputs() + constants().len()`.
+    pub fn constants(&self) -> &[f64] {
+        &self.consts
+    }
+
+    /// The register of each output, in output order.
+    pub fn output_registers(&self) -> &[u32] {
+        &self.outputs
+    }
+
+    /// The register written by instruction 0 (`n_inputs() + constants().len()`).
+    pub fn first_temporary(&self) -> usize {
+        self.n_inputs + self.consts.len()
+    }
+
     /// A register file for [`Program::eval`], with the constants loaded.
     pub fn workspace(&self) -> Vec<f64> {
         let mut w = vec![0.0; self.n_inputs + self.consts.len() + self.instrs.len()];
@@ -481,6 +535,17 @@ impl CompiledLinearSystem {
             perm: vec![0; n],
             work: vec![0.0; n],
         })
+    }
+
+    /// The program computing the entries: `n²` matrix entries row-major, then the `n`
+    /// right-hand sides.
+    pub fn program(&self) -> &Program {
+        &self.program
+    }
+
+    /// Number of unknowns.
+    pub fn n(&self) -> usize {
+        self.n
     }
 
     /// Solves for the unknowns at `inputs`, writing them to `x`.

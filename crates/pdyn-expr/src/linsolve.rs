@@ -210,6 +210,7 @@ impl Pool {
             }
         }
         if n == 0 {
+            // No unknowns (every coordinate prescribed): nothing to solve.
             return Ok(Vec::new());
         }
         // Fraction-free back substitution: x_i = y_i / det.

@@ -1,0 +1,600 @@
+//! # pdyn-jit — native code for compiled right-hand sides
+//!
+//! [`pdyn_expr::Program`] is a flat register program run by an interpreter: each instruction
+//! costs a `match` dispatch and a load/store through the register file. This crate translates
+//! the same instruction list into machine code with Cranelift, so that a compiled right-hand
+//! side runs near the speed of a hand-written Rust closure. `pdyn-expr` stays free of the code
+//! generator: it only exposes a read-only view of a program (instructions, constants, output
+//! registers), and this crate depends on it.
+//!
+//! ## What is emitted, and why results agree bit for bit
+//! One function `extern "C" fn(inputs: *const f64, out: *mut f64)` with a single basic block:
+//! every instruction of the program becomes one SSA value, in the program's order, so the
+//! arithmetic is the same sequence of IEEE operations as the interpreter's (no reassociation,
+//! no fused multiply-add). `+ − × ÷`, negation, `sqrt`, `abs` and `sign` are native
+//! instructions (correctly rounded, like Rust's). Transcendental functions (`sin`, `cos`,
+//! `tan`, `asin`, `acos`, `atan`, `atan2`, `sinh`, `cosh`, `tanh`, `exp`, `ln`, `powf`,
+//! `powi`) and `min`/`max` call `extern "C"` shims that call the same `f64` methods the
+//! interpreter calls, hence the same libm: the JIT and [`Program::eval`] give identical bits
+//! (NaN payloads aside). `min`/`max` go through shims because Rust's NaN-ignoring semantics and
+//! its choice between `+0` and `−0` are not those of Cranelift's `fmin`/`fmax`.
+//!
+//! ## Choosing the engine
+//! [`JitProgram::compile`] fails with [`JitError::Unsupported`] where Cranelift has no backend
+//! for the host. [`Evaluator`] wraps the choice: [`JitMode::Auto`] uses native code when it can
+//! and falls back to the interpreter otherwise; [`JitMode::Off`] always interprets (the CLI
+//! exposes this as `--no-jit`). Both engines have the same `eval(inputs, ws, out)` contract.
+//!
+//! ## Threads
+//! A [`JitProgram`] is `Send + Sync` and cheap to clone (the code is shared behind an `Arc`):
+//! the generated function touches only its arguments and its own stack frame, so any number
+//! of threads may call it at once. The code memory is freed when the last clone is dropped.
+#![warn(missing_docs)]
+
+use cranelift_codegen::ir::condcodes::FloatCC;
+use cranelift_codegen::ir::{types, AbiParam, InstBuilder, MemFlags, Signature, Value};
+use cranelift_codegen::settings::{self, Configurable};
+use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
+use cranelift_jit::{JITBuilder, JITModule};
+use cranelift_module::{default_libcall_names, Linkage, Module};
+use pdyn_expr::compile::{CompiledLinearSystem, Op};
+use pdyn_expr::lu::{lu_factor_in_place, lu_solve_in_place, SingularMatrix};
+use pdyn_expr::Program;
+use std::sync::Arc;
+
+/// Why a program could not be compiled to native code. The interpreter remains usable.
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum JitError {
+    /// Cranelift has no code generator for this host (architecture or OS).
+    Unsupported {
+        /// Cranelift's reason.
+        reason: String,
+    },
+    /// The program uses an operation this crate does not translate (a newer `Op`).
+    UnsupportedOp {
+        /// The operation, printed.
+        op: String,
+    },
+    /// Cranelift rejected the generated function (a bug here, reported rather than panicking).
+    Codegen {
+        /// Cranelift's message.
+        message: String,
+    },
+}
+
+impl std::fmt::Display for JitError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            JitError::Unsupported { reason } => {
+                write!(f, "no native code generator for this platform: {reason}")
+            }
+            JitError::UnsupportedOp { op } => {
+                write!(f, "operation {op} has no native translation")
+            }
+            JitError::Codegen { message } => write!(f, "native code generation failed: {message}"),
+        }
+    }
+}
+
+impl std::error::Error for JitError {}
+
+fn codegen<E: std::fmt::Display>(e: E) -> JitError {
+    JitError::Codegen {
+        message: e.to_string(),
+    }
+}
+
+type RawFn = unsafe extern "C" fn(*const f64, *mut f64);
+
+/// The JIT module owning the code memory; freed on drop.
+struct Code {
+    module: Option<JITModule>,
+    func: RawFn,
+}
+
+impl Drop for Code {
+    fn drop(&mut self) {
+        if let Some(m) = self.module.take() {
+            // SAFETY: `func` points into this module's memory and is only reachable through
+            // this `Code`, which is being dropped: no call can be in flight or follow.
+            unsafe { m.free_memory() };
+        }
+    }
+}
+
+// SAFETY: after `finalize_definitions` the module is never mutated again (only freed, in
+// `Drop`, which has exclusive access). The generated function reads `inputs`, writes `out`
+// and its own stack frame, and calls pure shims: concurrent calls do not interfere.
+unsafe impl Send for Code {}
+// SAFETY: see `Send`; `&Code` only allows calling the finished function.
+unsafe impl Sync for Code {}
+
+/// A [`Program`] translated to native code; see the crate documentation.
+#[derive(Clone)]
+pub struct JitProgram {
+    code: Arc<Code>,
+    n_inputs: usize,
+    n_outputs: usize,
+    len: usize,
+}
+
+impl std::fmt::Debug for JitProgram {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("JitProgram")
+            .field("n_inputs", &self.n_inputs)
+            .field("n_outputs", &self.n_outputs)
+            .field("instructions", &self.len)
+            .finish()
+    }
+}
+
+mod shims {
+    //! `extern "C"` wrappers of the `f64` methods the interpreter calls.
+    macro_rules! unary {
+        ($($name:ident => $m:ident),* $(,)?) => {
+            $(pub extern "C" fn $name(x: f64) -> f64 { x.$m() })*
+        };
+    }
+    unary!(sin => sin, cos => cos, tan => tan, asin => asin, acos => acos, atan => atan,
+           sinh => sinh, cosh => cosh, tanh => tanh, exp => exp, ln => ln);
+    pub extern "C" fn atan2(y: f64, x: f64) -> f64 {
+        y.atan2(x)
+    }
+    pub extern "C" fn powf(x: f64, y: f64) -> f64 {
+        x.powf(y)
+    }
+    pub extern "C" fn powi(x: f64, k: i32) -> f64 {
+        x.powi(k)
+    }
+    pub extern "C" fn min(a: f64, b: f64) -> f64 {
+        a.min(b)
+    }
+    pub extern "C" fn max(a: f64, b: f64) -> f64 {
+        a.max(b)
+    }
+}
+
+fn unary_shim(op: Op) -> Option<extern "C" fn(f64) -> f64> {
+    Some(match op {
+        Op::Sin => shims::sin,
+        Op::Cos => shims::cos,
+        Op::Tan => shims::tan,
+        Op::Asin => shims::asin,
+        Op::Acos => shims::acos,
+        Op::Atan => shims::atan,
+        Op::Sinh => shims::sinh,
+        Op::Cosh => shims::cosh,
+        Op::Tanh => shims::tanh,
+        Op::Exp => shims::exp,
+        Op::Ln => shims::ln,
+        _ => return None,
+    })
+}
+
+fn binary_shim(op: Op) -> Option<extern "C" fn(f64, f64) -> f64> {
+    Some(match op {
+        Op::Atan2 => shims::atan2,
+        Op::Powf => shims::powf,
+        Op::Min => shims::min,
+        Op::Max => shims::max,
+        _ => return None,
+    })
+}
+
+impl JitProgram {
+    /// Translates `prog` to native code for the host.
+    pub fn compile(prog: &Program) -> Result<JitProgram, JitError> {
+        let isa_builder = cranelift_native::builder().map_err(|r| JitError::Unsupported {
+            reason: r.to_string(),
+        })?;
+        let mut flags = settings::builder();
+        flags.set("opt_level", "speed").map_err(codegen)?;
+        flags
+            .set("use_colocated_libcalls", "false")
+            .map_err(codegen)?;
+        flags.set("is_pic", "false").map_err(codegen)?;
+        let isa = isa_builder
+            .finish(settings::Flags::new(flags))
+            .map_err(codegen)?;
+        let mut module = JITModule::new(JITBuilder::with_isa(isa, default_libcall_names()));
+        let ptr = module.target_config().pointer_type();
+        let call_conv = module.isa().default_call_conv();
+
+        let mut ctx = module.make_context();
+        ctx.func.signature.params.push(AbiParam::new(ptr));
+        ctx.func.signature.params.push(AbiParam::new(ptr));
+        let mut fctx = FunctionBuilderContext::new();
+        {
+            let mut b = FunctionBuilder::new(&mut ctx.func, &mut fctx);
+            let block = b.create_block();
+            b.append_block_params_for_function_params(block);
+            b.switch_to_block(block);
+            b.seal_block(block);
+            let (inp, outp) = (b.block_params(block)[0], b.block_params(block)[1]);
+
+            let mut sig1 = Signature::new(call_conv);
+            sig1.params.push(AbiParam::new(types::F64));
+            sig1.returns.push(AbiParam::new(types::F64));
+            let sig1 = b.import_signature(sig1);
+            let mut sig2 = Signature::new(call_conv);
+            sig2.params.push(AbiParam::new(types::F64));
+            sig2.params.push(AbiParam::new(types::F64));
+            sig2.returns.push(AbiParam::new(types::F64));
+            let sig2 = b.import_signature(sig2);
+            let mut sigi = Signature::new(call_conv);
+            sigi.params.push(AbiParam::new(types::F64));
+            sigi.params.push(AbiParam::new(types::I32));
+            sigi.returns.push(AbiParam::new(types::F64));
+            let sigi = b.import_signature(sigi);
+
+            // Registers: inputs loaded on first use, constants materialised on first use,
+            // temporaries are the SSA values of the instructions.
+            let n_in = prog.n_inputs();
+            let consts = prog.constants();
+            let first_temp = prog.first_temporary();
+            let mut regs: Vec<Option<Value>> = vec![None; first_temp + prog.len()];
+            let flags = MemFlags::trusted();
+            let get = |b: &mut FunctionBuilder, regs: &mut Vec<Option<Value>>, r: u32| {
+                let r = r as usize;
+                if let Some(v) = regs[r] {
+                    return v;
+                }
+                let v = if r < n_in {
+                    b.ins().load(types::F64, flags, inp, (8 * r) as i32)
+                } else {
+                    b.ins().f64const(consts[r - n_in])
+                };
+                regs[r] = Some(v);
+                v
+            };
+            for (k, ins) in prog.instructions().iter().enumerate() {
+                let a = get(&mut b, &mut regs, ins.a());
+                let rb = if ins.op().reads_b() {
+                    Some(get(&mut b, &mut regs, ins.b()))
+                } else {
+                    None
+                };
+                let bv = || rb.expect("binary operation reads b");
+                let v = match ins.op() {
+                    Op::Add => b.ins().fadd(a, bv()),
+                    Op::Sub => b.ins().fsub(a, bv()),
+                    Op::Mul => b.ins().fmul(a, bv()),
+                    Op::Div => b.ins().fdiv(a, bv()),
+                    Op::Neg => b.ins().fneg(a),
+                    Op::Sqrt => b.ins().sqrt(a),
+                    Op::Abs => b.ins().fabs(a),
+                    Op::Sign => {
+                        // 1 for a > 0, −1 for a < 0, a·0 otherwise (±0, or NaN for NaN).
+                        let zero = b.ins().f64const(0.0);
+                        let one = b.ins().f64const(1.0);
+                        let minus_one = b.ins().f64const(-1.0);
+                        let gt = b.ins().fcmp(FloatCC::GreaterThan, a, zero);
+                        let lt = b.ins().fcmp(FloatCC::LessThan, a, zero);
+                        let az = b.ins().fmul(a, zero);
+                        let r = b.ins().select(lt, minus_one, az);
+                        b.ins().select(gt, one, r)
+                    }
+                    Op::Powi => {
+                        let f = b.ins().iconst(
+                            ptr,
+                            shims::powi as extern "C" fn(f64, i32) -> f64 as usize as i64,
+                        );
+                        let e = b.ins().iconst(types::I32, ins.b() as i32 as i64);
+                        let call = b.ins().call_indirect(sigi, f, &[a, e]);
+                        b.inst_results(call)[0]
+                    }
+                    op => {
+                        if let Some(s) = unary_shim(op) {
+                            let f = b.ins().iconst(ptr, s as usize as i64);
+                            let call = b.ins().call_indirect(sig1, f, &[a]);
+                            b.inst_results(call)[0]
+                        } else if let Some(s) = binary_shim(op) {
+                            let f = b.ins().iconst(ptr, s as usize as i64);
+                            let call = b.ins().call_indirect(sig2, f, &[a, bv()]);
+                            b.inst_results(call)[0]
+                        } else {
+                            return Err(JitError::UnsupportedOp {
+                                op: format!("{op:?}"),
+                            });
+                        }
+                    }
+                };
+                regs[first_temp + k] = Some(v);
+            }
+            for (i, &r) in prog.output_registers().iter().enumerate() {
+                let v = get(&mut b, &mut regs, r);
+                b.ins().store(flags, v, outp, (8 * i) as i32);
+            }
+            b.ins().return_(&[]);
+            b.finalize();
+        }
+        let id = module
+            .declare_function("pdyn_program", Linkage::Local, &ctx.func.signature)
+            .map_err(codegen)?;
+        module.define_function(id, &mut ctx).map_err(codegen)?;
+        module.clear_context(&mut ctx);
+        module.finalize_definitions().map_err(codegen)?;
+        let raw = module.get_finalized_function(id);
+        // SAFETY: `raw` is the finalized code of a function with exactly this signature,
+        // using the platform's default (C) calling convention.
+        let func = unsafe { std::mem::transmute::<*const u8, RawFn>(raw) };
+        Ok(JitProgram {
+            code: Arc::new(Code {
+                module: Some(module),
+                func,
+            }),
+            n_inputs: prog.n_inputs(),
+            n_outputs: prog.n_outputs(),
+            len: prog.len(),
+        })
+    }
+
+    /// Number of inputs read by [`JitProgram::eval`].
+    pub fn n_inputs(&self) -> usize {
+        self.n_inputs
+    }
+
+    /// Number of outputs written by [`JitProgram::eval`].
+    pub fn n_outputs(&self) -> usize {
+        self.n_outputs
+    }
+
+    /// Number of instructions of the source program.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// True when the source program had no instruction.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Evaluates every output: the same values, bit for bit, as [`Program::eval`] on the
+    /// source program. Needs no workspace and allocates nothing.
+    ///
+    /// # Panics
+    /// If `inputs` is shorter than [`JitProgram::n_inputs`] or `out` shorter than
+    /// [`JitProgram::n_outputs`] (a programming error, not a data error).
+    #[inline]
+    pub fn eval(&self, inputs: &[f64], out: &mut [f64]) {
+        assert!(
+            inputs.len() >= self.n_inputs && out.len() >= self.n_outputs,
+            "JitProgram::eval: inputs or outputs too short"
+        );
+        // SAFETY: the function reads `inputs[..n_inputs]` and writes `out[..n_outputs]`,
+        // both in bounds (checked above); the code is alive while `self.code` is.
+        unsafe { (self.code.func)(inputs.as_ptr(), out.as_mut_ptr()) }
+    }
+}
+
+/// Whether to generate native code. Default: [`JitMode::Auto`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum JitMode {
+    /// Native code where the platform supports it, the interpreter otherwise.
+    #[default]
+    Auto,
+    /// Always the interpreter (the CLI's `--no-jit`).
+    Off,
+}
+
+/// A compiled program run natively or by the interpreter, behind one `eval` contract.
+#[derive(Clone, Debug)]
+#[non_exhaustive]
+pub enum Evaluator {
+    /// Native code.
+    Native(JitProgram),
+    /// The interpreter of [`Program::eval`].
+    Interpreted(Program),
+}
+
+impl Evaluator {
+    /// Chooses the engine for `prog` according to `mode`; with [`JitMode::Auto`], a failure of
+    /// the JIT (unsupported platform, code generation error) falls back to the interpreter.
+    pub fn new(prog: Program, mode: JitMode) -> Evaluator {
+        match mode {
+            JitMode::Off => Evaluator::Interpreted(prog),
+            JitMode::Auto => match JitProgram::compile(&prog) {
+                Ok(j) => Evaluator::Native(j),
+                Err(_) => Evaluator::Interpreted(prog),
+            },
+        }
+    }
+
+    /// True when native code runs.
+    pub fn is_native(&self) -> bool {
+        matches!(self, Evaluator::Native(_))
+    }
+
+    /// A workspace for [`Evaluator::eval`] (empty for native code, which needs none).
+    pub fn workspace(&self) -> Vec<f64> {
+        match self {
+            Evaluator::Native(_) => Vec::new(),
+            Evaluator::Interpreted(p) => p.workspace(),
+        }
+    }
+
+    /// Number of outputs.
+    pub fn n_outputs(&self) -> usize {
+        match self {
+            Evaluator::Native(j) => j.n_outputs(),
+            Evaluator::Interpreted(p) => p.n_outputs(),
+        }
+    }
+
+    /// Evaluates every output, with the contract of [`Program::eval`]; `ws` must come from
+    /// [`Evaluator::workspace`].
+    #[inline]
+    pub fn eval(&self, inputs: &[f64], ws: &mut [f64], out: &mut [f64]) {
+        match self {
+            Evaluator::Native(j) => j.eval(inputs, out),
+            Evaluator::Interpreted(p) => p.eval(inputs, ws, out),
+        }
+    }
+}
+
+/// A [`CompiledLinearSystem`] whose entries `A`, `b` are evaluated by an [`Evaluator`], then
+/// solved by the same in-place LU. Owns its buffers; `solve` allocates nothing.
+#[derive(Clone, Debug)]
+pub struct JitLinearSystem {
+    eval: Evaluator,
+    n: usize,
+    ws: Vec<f64>,
+    ab: Vec<f64>,
+    perm: Vec<usize>,
+    work: Vec<f64>,
+}
+
+impl JitLinearSystem {
+    /// Builds the evaluator of `sys`'s entries according to `mode`.
+    pub fn new(sys: &CompiledLinearSystem, mode: JitMode) -> JitLinearSystem {
+        let n = sys.n();
+        let eval = Evaluator::new(sys.program().clone(), mode);
+        JitLinearSystem {
+            ws: eval.workspace(),
+            eval,
+            n,
+            ab: vec![0.0; n * n + n],
+            perm: vec![0; n],
+            work: vec![0.0; n],
+        }
+    }
+
+    /// True when the entries are evaluated by native code.
+    pub fn is_native(&self) -> bool {
+        self.eval.is_native()
+    }
+
+    /// Solves for the unknowns at `inputs`, writing them to `x` (as
+    /// [`CompiledLinearSystem::solve`], with the same result bits).
+    pub fn solve(&mut self, inputs: &[f64], x: &mut [f64]) -> Result<(), SingularMatrix> {
+        let n = self.n;
+        self.eval.eval(inputs, &mut self.ws, &mut self.ab);
+        let (a, b) = self.ab.split_at_mut(n * n);
+        lu_factor_in_place(a, n, &mut self.perm)?;
+        lu_solve_in_place(a, n, &self.perm, b, &mut self.work);
+        x[..n].copy_from_slice(&b[..n]);
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pdyn_expr::{Id, Pool};
+
+    fn same(a: f64, b: f64) -> bool {
+        a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
+    }
+
+    #[test]
+    fn every_operation_agrees_with_the_interpreter() {
+        let mut p = Pool::new();
+        let (x, y) = (p.var("x"), p.var("y"));
+        let srcs = [
+            "x + y",
+            "x - y",
+            "x*y",
+            "x/y",
+            "-x",
+            "x^2",
+            "x^3",
+            "x^7",
+            "x^(-3)",
+            "x^(3/2)",
+            "x^(5/2)",
+            "x^y",
+            "x^0.3",
+            "sqrt(x)",
+            "sin(x)",
+            "cos(x)",
+            "tan(x)",
+            "asin(x)",
+            "acos(x)",
+            "atan(x)",
+            "atan2(x, y)",
+            "sinh(x)",
+            "cosh(x)",
+            "tanh(x)",
+            "exp(x)",
+            "log(x)",
+            "abs(x)",
+            "sign(x)",
+            "min(x, y)",
+            "max(x, y)",
+            "3",
+            "x",
+        ];
+        let outs: Vec<Id> = srcs.iter().map(|s| p.parse_scalar(s).unwrap()).collect();
+        let prog = Program::compile(&mut p, &[x, y], &outs).unwrap();
+        let jit = JitProgram::compile(&prog).unwrap();
+        let mut ws = prog.workspace();
+        let (mut o1, mut o2) = (vec![0.0; outs.len()], vec![0.0; outs.len()]);
+        let specials = [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            -0.7,
+            2.5,
+            f64::NAN,
+            f64::INFINITY,
+            1e300,
+        ];
+        for &a in &specials {
+            for &b in &specials {
+                prog.eval(&[a, b], &mut ws, &mut o1);
+                jit.eval(&[a, b], &mut o2);
+                for k in 0..outs.len() {
+                    assert!(
+                        same(o1[k], o2[k]),
+                        "{} at ({a}, {b}): {} vs {}",
+                        srcs[k],
+                        o1[k],
+                        o2[k]
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn off_mode_interprets_and_auto_is_native_here() {
+        let mut p = Pool::new();
+        let x = p.var("x");
+        let e = p.parse_scalar("x*x + 1").unwrap();
+        let prog = Program::compile(&mut p, &[x], &[e]).unwrap();
+        let off = Evaluator::new(prog.clone(), JitMode::Off);
+        assert!(!off.is_native());
+        let auto = Evaluator::new(prog, JitMode::Auto);
+        assert!(auto.is_native(), "this test host has a Cranelift backend");
+        let mut out = [0.0];
+        let mut ws = auto.workspace();
+        auto.eval(&[3.0], &mut ws, &mut out);
+        assert_eq!(out[0], 10.0);
+    }
+
+    #[test]
+    fn is_send_and_sync_and_callable_from_threads() {
+        fn assert_send_sync<T: Send + Sync>() {}
+        assert_send_sync::<JitProgram>();
+        let mut p = Pool::new();
+        let x = p.var("x");
+        let e = p.parse_scalar("sin(x)*x").unwrap();
+        let prog = Program::compile(&mut p, &[x], &[e]).unwrap();
+        let jit = JitProgram::compile(&prog).unwrap();
+        std::thread::scope(|s| {
+            for k in 0..4 {
+                let jit = jit.clone();
+                s.spawn(move || {
+                    let mut out = [0.0];
+                    let xk = k as f64 * 0.3;
+                    jit.eval(&[xk], &mut out);
+                    assert_eq!(out[0].to_bits(), (xk.sin() * xk).to_bits());
+                });
+            }
+        });
+    }
+}

@@ -1,0 +1,84 @@
+//! Complexity regression on deterministic counts, not on time: deriving and compiling the
+//! equations `M(q) q'' = f` of an n-link planar pendulum chain is O(n²) in size (M has n²
+//! entries, each O(1) after sharing; f has n entries of O(n) terms). Doubling n from 20 to 40
+//! must therefore multiply the expression nodes created and the compiled instructions by
+//! about 4, and at most 4.5; an O(n³) regression would give about 8.
+
+use pdyn_expr::compile::CompiledLinearSystem;
+use pdyn_expr::Id;
+use pdyn_mech::derive::Form;
+use pdyn_mech::{derive, load, DeriveOptions};
+
+/// The model file of an n-link chain (as `examples/pendulum_chain_3.toml`).
+fn chain_toml(n: usize) -> String {
+    let mut s =
+        String::from("name = \"chain\"\ngravity = \"[0, -g, 0]\"\n\n[parameters]\ng = 9.81\n");
+    for i in 1..=n {
+        s += &format!("m{i} = 1.0\nl{i} = 1.0\n");
+    }
+    s += "\n[coordinates]\n";
+    for i in 1..=n {
+        s += &format!("q{i} = {{ initial = 0.1, rate = 0.0 }}\n");
+    }
+    for i in 1..=n {
+        let pos: Vec<String> = (1..=i)
+            .map(|j| format!("l{j}*[sin(q{j}), -cos(q{j}), 0]"))
+            .collect();
+        s += &format!(
+            "\n[particles.p{i}]\nmass = \"m{i}\"\nposition = \"{}\"\n",
+            pos.join(" + ")
+        );
+    }
+    s
+}
+
+/// Counts for the chain of `n` links: (nodes in the pool after derivation, distinct nodes of
+/// the system's DAG, compiled instructions of `[A | b]`).
+fn counts(n: usize, opts: &DeriveOptions) -> (usize, usize, usize) {
+    let mut m = load(&chain_toml(n), "chain.toml").unwrap();
+    let d = derive(&mut m, opts).unwrap();
+    let created = m.pool.len();
+    let entries: Vec<Id> = d.system.a.iter().chain(&d.system.b).copied().collect();
+    let dag = m.pool.dag_size(&entries);
+    let mut inputs: Vec<Id> = vec![m.pool.time()];
+    inputs.extend(&d.state);
+    inputs.extend(m.parameters.iter().map(|p| p.id));
+    let sys = CompiledLinearSystem::new(&mut m.pool, &d.system, &inputs).unwrap();
+    (created, dag, sys.program().len())
+}
+
+/// The bench's options (`pdyn-mech/benches/chain.rs`): projected form, numeric solve.
+#[test]
+fn chain_derivation_grows_quadratically() {
+    let opts = DeriveOptions {
+        form: Form::Projected,
+        symbolic_limit: 0,
+        simplify: false,
+    };
+    check(&opts);
+}
+
+/// The user's path: `pdyn derive` / `pdyn run` defaults (automatic form, simplified printing).
+#[test]
+fn chain_derivation_with_default_options_grows_quadratically() {
+    check(&DeriveOptions::default());
+}
+
+fn check(opts: &DeriveOptions) {
+    let (c20, d20, i20) = counts(20, opts);
+    let (c40, d40, i40) = counts(40, opts);
+    let ratio = |a: usize, b: usize| b as f64 / a as f64;
+    let (rc, rd, ri) = (ratio(c20, c40), ratio(d20, d40), ratio(i20, i40));
+    eprintln!("n=20: created {c20}, dag {d20}, instructions {i20}");
+    eprintln!("n=40: created {c40}, dag {d40}, instructions {i40}");
+    eprintln!("ratios: created {rc:.3}, dag {rd:.3}, instructions {ri:.3}");
+    assert!(
+        rc <= 4.5,
+        "pool nodes created grow {rc:.3}x from n=20 to 40"
+    );
+    assert!(rd <= 4.5, "system DAG grows {rd:.3}x from n=20 to 40");
+    assert!(
+        ri <= 4.5,
+        "compiled instructions grow {ri:.3}x from n=20 to 40"
+    );
+}
