@@ -41,8 +41,10 @@
 //! | `methods/gauss.rs` | **Gauss–Legendre 4 / 6** (Butcher 1964): implicit symplectic for any Hamiltonian, fixed step |
 //!
 //! `Method::Auto` runs DOPRI5 and switches to Radau5 when DOPRI5's stiffness detector fires.
-//! [`Method::all`], [`Method::name`] and [`Method::doc`] list the methods with their
-//! descriptions (for `--method help`).
+//! [`METHODS`] is the one table describing the methods (name, aliases, order, kind, symplectic
+//! composition weights, description); [`Method::all`], [`Method::name`], [`Method::doc`],
+//! [`Method::order`], [`Method::kind`] and [`Method::from_name`] read it. Only `dispatch`
+//! (which calls each method's generic code) matches on [`Method`].
 //!
 //! # Conventions
 //! * Tolerances: a step is accepted when the RMS over components of
@@ -82,7 +84,8 @@ pub use problem::{
 };
 pub use solution::{Direction, EventHit, Solution, Stats, Status};
 
-/// The integration methods. See [`Method::all`] and [`Method::doc`].
+/// The integration methods. Everything descriptive about a method (name, aliases, order,
+/// kind, documentation) is one row of [`METHODS`]; see [`Method::info`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum Method {
@@ -132,109 +135,176 @@ pub enum MethodKind {
     Symplectic,
 }
 
+/// The description of one integration method: one row of [`METHODS`].
+#[derive(Debug, Clone, Copy)]
+#[non_exhaustive]
+pub struct MethodInfo {
+    /// The method this row describes.
+    pub method: Method,
+    /// Short lowercase name (`dopri5`, `tsit5`, …) printed by `--method help`.
+    pub name: &'static str,
+    /// Other names [`Method::from_name`] accepts (lowercase).
+    pub aliases: &'static [&'static str],
+    /// Nominal order of the propagated solution.
+    pub order: u32,
+    /// Kind of method (adaptive, stiff, fixed step, symplectic).
+    pub kind: MethodKind,
+    /// For explicit symplectic compositions of velocity Verlet: the substep weights. Such a
+    /// method integrates only separable second-order systems
+    /// ([`solve_second_order`]).
+    pub composition: Option<&'static [f64]>,
+    /// One-paragraph description: order, adaptivity, symplecticity, paper.
+    pub doc: &'static str,
+}
+
+impl MethodInfo {
+    /// Whether the method controls its step size from an error estimate.
+    pub fn adaptive(&self) -> bool {
+        matches!(self.kind, MethodKind::Adaptive | MethodKind::Stiff)
+    }
+
+    /// Whether the method is symplectic (for Hamiltonian systems).
+    pub fn symplectic(&self) -> bool {
+        self.kind == MethodKind::Symplectic
+    }
+}
+
+/// Every method, in the order `--method help` lists them. Adding a method: a variant of
+/// [`Method`], a row here, an arm in `dispatch` (which calls the method's generic code).
+pub const METHODS: [MethodInfo; 13] = {
+    use methods::*;
+    const fn row(
+        method: Method,
+        name: &'static str,
+        order: u32,
+        kind: MethodKind,
+        doc: &'static str,
+    ) -> MethodInfo {
+        MethodInfo {
+            method,
+            name,
+            aliases: &[],
+            order,
+            kind,
+            composition: None,
+            doc,
+        }
+    }
+    use MethodKind::{Adaptive, FixedStep, Stiff, Symplectic};
+    [
+        MethodInfo {
+            aliases: &["ode45", "rk45"],
+            ..row(Method::Dopri5, "dopri5", 5, Adaptive, dopri5::DOC)
+        },
+        row(Method::Tsit5, "tsit5", 5, Adaptive, tsit5::DOC),
+        row(Method::Dop853, "dop853", 8, Adaptive, dop853::DOC),
+        row(Method::Vern9, "vern9", 9, Adaptive, vern9::DOC),
+        row(Method::Rk4, "rk4", 4, FixedStep, rk4::DOC),
+        MethodInfo {
+            aliases: &["leapfrog", "velocity-verlet"],
+            composition: Some(&symplectic::VERLET),
+            ..row(
+                Method::VelocityVerlet,
+                "verlet",
+                2,
+                Symplectic,
+                symplectic::DOC_VERLET,
+            )
+        },
+        MethodInfo {
+            composition: Some(&symplectic::YOSHIDA4),
+            ..row(
+                Method::Yoshida4,
+                "yoshida4",
+                4,
+                Symplectic,
+                symplectic::DOC_YOSHIDA4,
+            )
+        },
+        MethodInfo {
+            composition: Some(&symplectic::KAHAN_LI6),
+            ..row(
+                Method::KahanLi6,
+                "kahanli6",
+                6,
+                Symplectic,
+                symplectic::DOC_KAHAN_LI6,
+            )
+        },
+        MethodInfo {
+            composition: Some(&symplectic::KAHAN_LI8),
+            ..row(
+                Method::KahanLi8,
+                "kahanli8",
+                8,
+                Symplectic,
+                symplectic::DOC_KAHAN_LI8,
+            )
+        },
+        row(Method::Gauss4, "gauss4", 4, Symplectic, gauss::DOC_GAUSS4),
+        row(Method::Gauss6, "gauss6", 6, Symplectic, gauss::DOC_GAUSS6),
+        row(Method::Radau5, "radau5", 5, Stiff, radau5::DOC),
+        row(Method::Auto, "auto", 5, Stiff, AUTO_DOC),
+    ]
+};
+
+/// The `method` column of [`METHODS`], for [`Method::all`].
+const ALL: [Method; METHODS.len()] = {
+    let mut all = [Method::Auto; METHODS.len()];
+    let mut i = 0;
+    while i < METHODS.len() {
+        all[i] = METHODS[i].method;
+        i += 1;
+    }
+    all
+};
+
 impl Method {
     /// Every method, in the order `--method help` lists them.
     pub fn all() -> &'static [Method] {
-        &[
-            Method::Dopri5,
-            Method::Tsit5,
-            Method::Dop853,
-            Method::Vern9,
-            Method::Rk4,
-            Method::VelocityVerlet,
-            Method::Yoshida4,
-            Method::KahanLi6,
-            Method::KahanLi8,
-            Method::Gauss4,
-            Method::Gauss6,
-            Method::Radau5,
-            Method::Auto,
-        ]
+        &ALL
+    }
+
+    /// This method's row of [`METHODS`].
+    pub fn info(self) -> &'static MethodInfo {
+        METHODS
+            .iter()
+            .find(|i| i.method == self)
+            .expect("every Method has a row in METHODS")
     }
 
     /// Short lowercase name (`dopri5`, `tsit5`, …), accepted by [`Method::from_name`].
     pub fn name(self) -> &'static str {
-        match self {
-            Method::Dopri5 => "dopri5",
-            Method::Tsit5 => "tsit5",
-            Method::Dop853 => "dop853",
-            Method::Vern9 => "vern9",
-            Method::Rk4 => "rk4",
-            Method::VelocityVerlet => "verlet",
-            Method::Yoshida4 => "yoshida4",
-            Method::KahanLi6 => "kahanli6",
-            Method::KahanLi8 => "kahanli8",
-            Method::Gauss4 => "gauss4",
-            Method::Gauss6 => "gauss6",
-            Method::Radau5 => "radau5",
-            Method::Auto => "auto",
-        }
+        self.info().name
     }
 
     /// One-paragraph description: order, adaptivity, symplecticity, paper.
     pub fn doc(self) -> &'static str {
-        use methods::*;
-        match self {
-            Method::Dopri5 => dopri5::DOC,
-            Method::Tsit5 => tsit5::DOC,
-            Method::Dop853 => dop853::DOC,
-            Method::Vern9 => vern9::DOC,
-            Method::Rk4 => rk4::DOC,
-            Method::VelocityVerlet => symplectic::DOC_VERLET,
-            Method::Yoshida4 => symplectic::DOC_YOSHIDA4,
-            Method::KahanLi6 => symplectic::DOC_KAHAN_LI6,
-            Method::KahanLi8 => symplectic::DOC_KAHAN_LI8,
-            Method::Gauss4 => gauss::DOC_GAUSS4,
-            Method::Gauss6 => gauss::DOC_GAUSS6,
-            Method::Radau5 => radau5::DOC,
-            Method::Auto => AUTO_DOC,
-        }
+        self.info().doc
     }
 
     /// Nominal order of the propagated solution.
     pub fn order(self) -> u32 {
-        match self {
-            Method::Dopri5 | Method::Tsit5 | Method::Radau5 | Method::Auto => 5,
-            Method::Dop853 | Method::KahanLi8 => 8,
-            Method::Vern9 => 9,
-            Method::Rk4 | Method::Yoshida4 | Method::Gauss4 => 4,
-            Method::VelocityVerlet => 2,
-            Method::KahanLi6 | Method::Gauss6 => 6,
-        }
+        self.info().order
     }
 
     /// Kind of method.
     pub fn kind(self) -> MethodKind {
-        match self {
-            Method::Dopri5 | Method::Tsit5 | Method::Dop853 | Method::Vern9 => MethodKind::Adaptive,
-            Method::Rk4 => MethodKind::FixedStep,
-            Method::Radau5 | Method::Auto => MethodKind::Stiff,
-            Method::VelocityVerlet
-            | Method::Yoshida4
-            | Method::KahanLi6
-            | Method::KahanLi8
-            | Method::Gauss4
-            | Method::Gauss6 => MethodKind::Symplectic,
-        }
+        self.info().kind
     }
 
-    /// Parses a name as printed by [`Method::name`] (case-insensitive; `ode45`/`rk45` are
-    /// aliases of `dopri5`, `leapfrog` of `verlet`).
+    /// Parses a name as printed by [`Method::name`] or one of its aliases (case-insensitive;
+    /// `ode45`/`rk45` are aliases of `dopri5`, `leapfrog` of `verlet`).
     pub fn from_name(name: &str) -> Option<Method> {
         let lower = name.to_ascii_lowercase();
-        match lower.as_str() {
-            "ode45" | "rk45" => return Some(Method::Dopri5),
-            "leapfrog" | "velocity-verlet" => return Some(Method::VelocityVerlet),
-            _ => {}
-        }
-        Method::all().iter().copied().find(|m| m.name() == lower)
+        METHODS
+            .iter()
+            .find(|i| i.name == lower || i.aliases.contains(&lower.as_str()))
+            .map(|i| i.method)
     }
 
     fn needs_second_order(self) -> bool {
-        matches!(
-            self,
-            Method::VelocityVerlet | Method::Yoshida4 | Method::KahanLi6 | Method::KahanLi8
-        )
+        self.info().composition.is_some()
     }
 }
 
@@ -466,12 +536,8 @@ pub fn solve_second_order_with_events<S: SecondOrderSystem + ?Sized>(
     let mut y0 = q0.to_vec();
     y0.extend_from_slice(v0);
     let first = FirstOrderForm(sys);
-    let w: &'static [f64] = match method {
-        Method::VelocityVerlet => &methods::symplectic::VERLET,
-        Method::Yoshida4 => &methods::symplectic::YOSHIDA4,
-        Method::KahanLi6 => &methods::symplectic::KAHAN_LI6,
-        Method::KahanLi8 => &methods::symplectic::KAHAN_LI8,
-        _ => return solve_with_events(method, &first, t_span, &y0, opts, events),
+    let Some(w) = method.info().composition else {
+        return solve_with_events(method, &first, t_span, &y0, opts, events);
     };
     if !sys.separable() {
         return Err(error::invalid(format!(
@@ -489,4 +555,42 @@ pub fn solve_second_order_with_events<S: SecondOrderSystem + ?Sized>(
         opts,
         events,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn method_table_has_one_row_per_method_and_unique_names() {
+        for (i, info) in METHODS.iter().enumerate() {
+            assert_eq!(Method::all()[i], info.method);
+            assert_eq!(
+                info.method.info().name,
+                info.name,
+                "{} listed twice",
+                info.name
+            );
+            assert_eq!(Method::from_name(info.name), Some(info.method));
+            assert_eq!(
+                Method::from_name(&info.name.to_uppercase()),
+                Some(info.method)
+            );
+            for alias in info.aliases {
+                assert_eq!(Method::from_name(alias), Some(info.method));
+            }
+            if info.composition.is_some() {
+                assert!(info.symplectic() && !info.adaptive(), "{}", info.name);
+            }
+        }
+        let mut names: Vec<_> = METHODS
+            .iter()
+            .flat_map(|i| std::iter::once(i.name).chain(i.aliases.iter().copied()))
+            .collect();
+        let n = names.len();
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), n, "a name or alias is used twice");
+        assert_eq!(Method::from_name("nope"), None);
+    }
 }

@@ -1,0 +1,38 @@
+//! `reaction`: an unknown force on a body, `name * direction` (one unknown `name`) or, without
+//! `direction`, an unknown vector `(name_x, name_y, name_z)`. Reactions with the same name are
+//! the same unknown. Workless or not: unknown.
+
+use super::{vector, Entry, ForceBuilder, Kind, Load, Loader, ModelError, Pool};
+
+pub(super) const REACTION: Kind = Kind {
+    name: "reaction",
+    fields: "`on`, `name`, optional `direction`",
+    force: "`name * direction` (one unknown), or an unknown vector `name_x, name_y, name_z`",
+    potential: "—",
+    build,
+};
+
+fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelError> {
+    let (target, _) = b.target(ld, e)?;
+    let name = e.need_name(ld, &e.raw.name, "name")?;
+    let force = match &e.raw.direction {
+        Some(d) => {
+            let dir = ld.vector(d, "`direction`")?;
+            let n = b.reaction(ld, name.get_ref(), name.span())?;
+            vector::scale(&mut ld.pool, n, dir)
+        }
+        None => {
+            let mut c = [Pool::ZERO; 3];
+            for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+                c[k] = b.reaction(ld, &format!("{}_{axis}", name.get_ref()), name.span())?;
+            }
+            c
+        }
+    };
+    b.loads.push(Load {
+        label: format!("reaction {}", name.get_ref()),
+        target,
+        force,
+    });
+    Ok(())
+}
