@@ -107,7 +107,8 @@ def test_broken_model_raises_model_error_with_its_line():
 
 
 def test_failing_run_returns_the_partial_solution():
-    sol = pdyn.Model.from_toml(RADIAL_FALL, "radial_fall.toml").run()
+    with pytest.warns(pdyn.DriftWarning):
+        sol = pdyn.Model.from_toml(RADIAL_FALL, "radial_fall.toml").run()
     assert sol.success is False and sol.status == -1
     assert "integration failed" in sol.message or "step" in sol.message
     assert len(sol.t) > 1 and sol.t[-1] < 10
@@ -181,7 +182,8 @@ def test_solve_ivp_compiled_and_callable_agree_and_count_evaluations():
     # nfev is the Rust solver's count: exactly the number of Python calls made.
     assert b.nfev == calls[0]
     assert a.nfev == b.nfev
-    np.testing.assert_allclose(a.y[:, -1], b.y[:, -1], rtol=0, atol=1e-12)
+    # Same steps; the arithmetic differs in rounding only (x^(3/2) compiled vs x**1.5).
+    np.testing.assert_allclose(a.y[:, -1], b.y[:, -1], rtol=0, atol=1e-9)
     # One period: back at the start.
     assert np.max(np.abs(a.y[:, -1] - ARENSTORF_Y0)) < 1e-5
 
@@ -218,7 +220,7 @@ def test_solve_ivp_events_and_scipy_method_names():
 
 def test_solve_ivp_failure_and_python_errors():
     sol = pdyn.solve_ivp(["y0^2"], (0, 2), [1.0])  # blows up at t = 1
-    assert sol.success is False and sol.status == -1 and sol.t[-1] < 1.0 + 1e-6
+    assert sol.success is False and sol.status == -1 and 0.99 < sol.t[-1] < 1.01
     with pytest.raises(ZeroDivisionError):
         pdyn.solve_ivp(lambda t, y: [1 / 0], (0, 1), [0.0])
     with pytest.raises(pdyn.ParameterError):

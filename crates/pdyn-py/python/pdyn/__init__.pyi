@@ -53,7 +53,7 @@ class Derivation:
     form: str
     notes: List[str]
 
-class SweepResult(dict):
+class SweepResult:
     parameter: str
     values: npt.NDArray[np.float64]
     measures: Dict[str, npt.NDArray[np.float64]]

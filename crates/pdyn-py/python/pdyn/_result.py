@@ -218,16 +218,23 @@ class Derivation:
         return "$\\begin{aligned}" + rows + "\\end{aligned}$"
 
 
-class SweepResult(dict):
+class SweepResult:
     """The result of :meth:`pdyn.Model.sweep`: ``parameter`` (name), ``values`` (float64
     array), ``measures`` (name -> float64 array, NaN where a run failed), ``problems``
     (``[(value, message)]``), ``runs``, ``seconds``, ``threads``; :meth:`to_pandas`."""
 
-    def __getattr__(self, name: str) -> Any:
-        try:
-            return self[name]
-        except KeyError as e:
-            raise AttributeError(name) from e
+    def __init__(self, parameter, values, measures, problems, runs, seconds, threads):
+        self.parameter: str = parameter
+        self.values: np.ndarray = values
+        self.measures: Dict[str, np.ndarray] = measures
+        self.problems = problems
+        self.runs: int = runs
+        self.seconds: float = seconds
+        self.threads: int = threads
+
+    def __repr__(self) -> str:
+        return (f"SweepResult({self.parameter!r}, {self.runs} runs, measures "
+                f"{list(self.measures)}, {len(self.problems)} problems, {self.seconds:.3f} s)")
 
     def to_pandas(self):
         """One row per value: the parameter and every measure, as a pandas DataFrame."""
@@ -235,6 +242,6 @@ class SweepResult(dict):
             import pandas as pd
         except ImportError as e:  # pragma: no cover
             raise ImportError("SweepResult.to_pandas() needs pandas: pip install pandas") from e
-        data = {self["parameter"]: self["values"]}
-        data.update(self["measures"])
+        data = {self.parameter: self.values}
+        data.update(self.measures)
         return pd.DataFrame(data)
