@@ -705,6 +705,9 @@ impl<'a> Evaluator<'a> {
     }
 }
 
+/// An event function `g(t, y)`.
+type EventFn<'a> = dyn Fn(f64, &[f64]) -> f64 + 'a;
+
 /// The options of one `solve_ivp` call.
 struct IvpOptions {
     method: Method,
@@ -774,11 +777,11 @@ fn integrate(
             Rhs::Callable(_) => None,
         })
         .collect();
-    let gs: Vec<Box<dyn Fn(f64, &[f64]) -> f64 + '_>> = events
+    let gs: Vec<Box<EventFn<'_>>> = events
         .iter()
         .zip(&event_evals)
         .map(|(e, ev)| {
-            let g: Box<dyn Fn(f64, &[f64]) -> f64 + '_> = match (&e.function, ev) {
+            let g: Box<EventFn<'_>> = match (&e.function, ev) {
                 (Rhs::Compiled(_), Some(ev)) => Box::new(move |t, y| {
                     let mut out = [0.0];
                     ev.eval(t, y, &mut out);

@@ -21,24 +21,33 @@ class OdeResult(dict):
       ``success``;
     * ``nfev``, ``njev``, ``nlu`` -- the Rust solver's counts; ``stats`` has all of them;
     * pdyn's: ``columns`` (every tabulated column of a model run), ``sol["x"]`` (a column by
-      name), ``monitors`` (conserved quantities with their drift), ``warnings``,
+      name; a model's columns take precedence over SciPy's keys, so ``sol["y"]`` is a
+      coordinate ``y`` when there is one, ``sol.y`` always the states), :meth:`column`,
+      ``monitors`` (conserved quantities with their drift), ``warnings``,
       ``method``, :meth:`to_pandas`.
     """
 
     def __getattr__(self, name: str) -> Any:
         try:
-            return self[name]
+            return dict.__getitem__(self, name)
         except KeyError as e:
             raise AttributeError(name) from e
 
     def __getitem__(self, key: str) -> Any:
-        if dict.__contains__(self, key):
-            return dict.__getitem__(self, key)
+        # A model's columns come first: sol["y"] is the coordinate y when the model has one
+        # (sol.y is always SciPy's state matrix).
         cols = dict.get(self, "columns")
         table = dict.get(self, "_table")
         if cols is not None and table is not None and key in cols:
-            return np.ascontiguousarray(table[:, cols.index(key)])
-        raise KeyError(key)
+            return self.column(key)
+        return dict.__getitem__(self, key)
+
+    def column(self, name: str) -> np.ndarray:
+        """The tabulated column ``name`` (see ``columns``) as a float64 array."""
+        cols = dict.get(self, "columns")
+        if cols is None or name not in cols:
+            raise KeyError(f"no column {name!r} (columns: {cols})")
+        return np.ascontiguousarray(dict.__getitem__(self, "_table")[:, cols.index(name)])
 
     def __dir__(self):
         return list(self.keys()) + list(super().__dir__())
