@@ -2,6 +2,7 @@
 
 import json
 import math
+import pathlib
 import subprocess
 import threading
 import time
@@ -266,3 +267,17 @@ def test_sweep_releases_the_gil(examples):
     # With the GIL held the ticker could not run at all while the sweep ran.
     assert t1 - t0 > 0.05, "the sweep is too short to tell"
     assert len(during) >= 10, (len(during), t1 - t0)
+
+
+def test_from_file_error_names_the_file_and_methods_are_listed(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('name = "x"\n[parameters]\nm = 1.0\n[coordinates]\nq = { initial = "m +" }\n')
+    with pytest.raises(pdyn.ModelError) as info:
+        pdyn.Model.from_file(bad)
+    assert info.value.file == str(bad) and info.value.line == 5
+    names = pdyn.methods()
+    assert {"dopri5", "dop853", "radau5", "tsit5", "vern9"} <= set(names)
+    with pytest.raises(pdyn.ParameterError, match="unknown method"):
+        pdyn.Model.from_file(
+            pathlib.Path(__file__).resolve().parents[3] / "examples" / "kremlin_stone.toml"
+        ).run(method="nope")
