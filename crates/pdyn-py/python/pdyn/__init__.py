@@ -1,0 +1,237 @@
+"""pdyn: analyse the motion of systems of particles from Python.
+
+A model file (TOML) -> derived equations of motion -> integration with conservation checks,
+the same engine as the ``pdyn`` command::
+
+    import pdyn
+    m = pdyn.Model.from_file("examples/projectile_drag.toml")
+    sol = m.run(t_end=5.0)            # SciPy-shaped result: sol.t, sol.y (n_states, n_times)
+    sol["z"], sol.columns, sol.monitors
+    d = m.derive()                    # d.equations: [(label, lhs, rhs)] of pdyn.Expr
+    sw = m.sweep("c", numpy.linspace(0.1, 1, 10), measures={"zmin": ("z", "min")})
+
+    # SciPy's solve_ivp, with a compiled right-hand side (no Python in the loop):
+    sol = pdyn.solve_ivp(["y1", "-y0"], (0, 10), [1.0, 0.0], method="DOP853")
+
+Errors: :class:`ModelError` (with ``file``, ``line``, ``column``), :class:`ParameterError`,
+both :class:`PdynError`; a drifting conserved quantity warns with :class:`DriftWarning`.
+A numerical failure returns ``success=False`` with the partial solution, as SciPy does.
+"""
+
+import math
+import os
+from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _pdyn
+from ._errors import DriftWarning, ModelError, ParameterError, PdynError
+from ._result import Derivation, Expr, OdeResult, SweepResult, _from_ivp, _from_run
+
+__version__ = _pdyn.__version__
+
+__all__ = [
+    "Model", "solve_ivp", "methods", "OdeResult", "Derivation", "Expr", "SweepResult",
+    "PdynError", "ModelError", "ParameterError", "DriftWarning", "__version__",
+]
+
+
+def _array1(x, name: str) -> np.ndarray:
+    a = np.ascontiguousarray(np.asarray(x, dtype=np.float64).ravel())
+    if a.ndim != 1:
+        raise ValueError(f"{name} must be one-dimensional")
+    return a
+
+
+def _params(params: Optional[Mapping[str, float]]):
+    if params is None:
+        return None
+    return [(str(k), float(v)) for k, v in params.items()]
+
+
+class Model:
+    """A model (particles, coordinates, forces, ``[simulate]``...) loaded from TOML.
+
+    Build it with :meth:`from_file`, :meth:`from_toml` or :meth:`from_dict`; a model that
+    does not load raises :class:`ModelError` with the file, line and column.
+    """
+
+    __slots__ = ("_m",)
+
+    def __init__(self, inner: "_pdyn.Model"):
+        self._m = inner
+
+    @classmethod
+    def from_file(cls, path: Union[str, "os.PathLike[str]"]) -> "Model":
+        """Loads a model file (TOML, see docs/model-format.md)."""
+        path = os.fspath(path)
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+        return cls(_pdyn.Model.from_toml(text, path))
+
+    @classmethod
+    def from_toml(cls, text: str, origin: str = "<string>") -> "Model":
+        """Loads a model from TOML text; ``origin`` names it in error messages."""
+        return cls(_pdyn.Model.from_toml(text, origin))
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "Model":
+        """Loads a model from a dict laid out as a model file
+        (``{"parameters": {"g": 9.81}, "coordinates": {...}, ...}``)."""
+        return cls(_pdyn.Model.from_dict(d))
+
+    @property
+    def name(self) -> str:
+        """The model's name."""
+        return self._m.name
+
+    @property
+    def source(self) -> str:
+        """The TOML text the model was loaded from."""
+        return self._m.source
+
+    @property
+    def parameters(self) -> Dict[str, float]:
+        """Parameter values in SI units, in file order (a copy: pass ``params=`` to
+        :meth:`run` to change them)."""
+        return dict(self._m.parameters)
+
+    def __repr__(self) -> str:
+        return f"pdyn.Model({self.name!r}, origin={self._m.origin!r})"
+
+    def run(self, t_end: Optional[float] = None, method: Optional[str] = None,
+            rtol: Optional[float] = None, atol: Optional[float] = None,
+            t_eval: Optional[Sequence[float]] = None, max_step: Optional[float] = None,
+            dt: Optional[float] = None, max_steps: Optional[int] = None,
+            points: Optional[int] = None, drift_tolerance: Optional[float] = None,
+            params: Optional[Mapping[str, float]] = None) -> OdeResult:
+        """Integrates the equations of motion, like ``pdyn run``.
+
+        Every argument left ``None`` takes the model's ``[simulate]`` value, then pdyn's
+        default (method ``auto``, rtol 1e-6, atol 1e-9). ``method``: SciPy's names
+        (``"RK45"``, ``"DOP853"``, ``"Radau"``) or pdyn's (:func:`methods`). ``t_eval``:
+        output times within [0, t_end]; ``points``: that many equally spaced outputs;
+        ``dt``: the fixed step (symplectic methods, RK4) or the first step; ``params``:
+        parameter values (checked like ``pdyn run --set``).
+
+        Returns an :class:`OdeResult` (``success=False`` with the partial solution when the
+        integration fails). Warns :class:`DriftWarning` when a conserved quantity drifts
+        more than ``drift_tolerance`` (relative, default 5e-3). The GIL is released while
+        the integration runs.
+        """
+        te = None if t_eval is None else _array1(t_eval, "t_eval")
+        raw = self._m.run(t_end=t_end, method=method, rtol=rtol, atol=atol, t_eval=te,
+                          max_step=max_step, dt=dt, max_steps=max_steps, points=points,
+                          drift_tolerance=drift_tolerance, params=_params(params))
+        return _from_run(raw, list(raw["event_names"]))
+
+    def derive(self) -> Derivation:
+        """The equations of motion (F = ma or the projected form), the unknowns, their exact
+        solution when the system is small, and the first-order system."""
+        return Derivation(self._m.derive())
+
+    def sweep(self, param: str, values: Sequence[float],
+              measures: Optional[Mapping[str, Union[str, Tuple[str, str]]]] = None,
+              t_end: Optional[float] = None, method: Optional[str] = None,
+              rtol: Optional[float] = None, atol: Optional[float] = None,
+              max_step: Optional[float] = None, dt: Optional[float] = None,
+              points: Optional[int] = None, threads: Optional[int] = None,
+              params: Optional[Mapping[str, float]] = None) -> SweepResult:
+        """Runs the model once per value of parameter ``param``, in parallel on all cores
+        (``threads`` to limit), with the GIL released, like ``pdyn sweep``.
+
+        ``measures``: ``{name: (expression, statistic)}`` (statistic: max, min, max_abs,
+        peak_to_peak, final, mean, rms; a bare expression means ``max_abs``), or ``None``
+        for the model's ``[sweep.measures]``. Returns a :class:`SweepResult` with one
+        float64 array per measure (NaN where a run failed; see ``problems``).
+        """
+        ms = None
+        if measures is not None:
+            ms = []
+            for name, spec in measures.items():
+                if isinstance(spec, str):
+                    ms.append((str(name), spec, "max_abs"))
+                else:
+                    of, stat = spec
+                    ms.append((str(name), str(of), str(stat)))
+        raw = self._m.sweep(str(param), _array1(values, "values"), measures=ms, t_end=t_end,
+                            method=method, rtol=rtol, atol=atol, max_step=max_step, dt=dt,
+                            points=points, threads=threads, params=_params(params))
+        return SweepResult(
+            parameter=raw["parameter"], values=raw["values"], measures=dict(raw["measures"]),
+            problems=list(raw["problems"]), runs=raw["runs"], seconds=raw["seconds"],
+            threads=raw["threads"],
+        )
+
+
+def methods() -> Dict[str, str]:
+    """pdyn's integration methods: name -> description (order, adaptivity, paper)."""
+    return dict(_pdyn.methods())
+
+
+def _tol(x, name: str):
+    a = np.asarray(x, dtype=np.float64).ravel()
+    if a.size == 0:
+        raise ValueError(f"{name} is empty")
+    return [float(v) for v in a]
+
+
+def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float, float],
+              y0: Sequence[float], method: str = "DOP853",
+              t_eval: Optional[Sequence[float]] = None, dense_output: bool = False,
+              events: Optional[Any] = None, vectorized: bool = False,
+              args: Optional[Any] = None, rtol: Union[float, Sequence[float]] = 1e-3,
+              atol: Union[float, Sequence[float]] = 1e-6, max_step: float = math.inf,
+              first_step: Optional[float] = None, max_steps: Optional[int] = None,
+              **options: Any) -> OdeResult:
+    """Solves ``y' = fun(t, y)`` with SciPy's signature and result, integrated by pdyn.
+
+    ``fun`` is either a Python callable ``fun(t, y) -> array`` (called with the GIL held for
+    each evaluation), or a list of expression strings in ``t`` and ``y0, y1, ...`` (and the
+    names of ``args`` when it is a dict of numbers), compiled once: no Python in the loop,
+    the GIL released. ``events``: callables with SciPy's ``terminal``/``direction``
+    attributes, or expression strings (a ``(expression, terminal, direction)`` tuple sets
+    them). ``method``: ``"RK45"`` (DOPRI5), ``"DOP853"``, ``"Radau"``, or pdyn's
+    (``"Tsit5"``, ``"Vern9"``, ...; :func:`methods`).
+
+    Returns an :class:`OdeResult`; ``nfev`` is the Rust solver's count (``stats`` has all).
+    A numerical failure returns ``success=False``, ``status=-1`` and the partial solution.
+    ``dense_output`` and ``vectorized`` are not supported (``sol.sol`` is ``None``).
+    """
+    if dense_output:
+        raise NotImplementedError("pdyn.solve_ivp: dense_output is not supported yet; use t_eval")
+    if options:
+        raise TypeError(f"pdyn.solve_ivp: unsupported options {sorted(options)}")
+    t0, tf = (float(t_span[0]), float(t_span[1]))
+    y0a = _array1(y0, "y0")
+    named_args = []
+    if args is not None:
+        if isinstance(args, Mapping):
+            named_args = [(str(k), float(v)) for k, v in args.items()]
+        elif callable(fun):
+            user_fun, extra = fun, tuple(args)
+            fun = lambda t, y: user_fun(t, y, *extra)  # noqa: E731
+        else:
+            raise TypeError("args for expression strings must be a dict {name: value}")
+    ev_list = []
+    if events is not None:
+        if callable(events) or isinstance(events, (str, tuple)):
+            events = [events]
+        for ev in events:
+            if isinstance(ev, tuple):
+                g, terminal, direction = (list(ev) + [False, 0])[:3]
+            else:
+                g = ev
+                terminal = getattr(ev, "terminal", False)
+                direction = getattr(ev, "direction", 0)
+            if isinstance(terminal, bool):
+                term = 1 if terminal else None
+            else:
+                term = int(terminal) if terminal else None
+            ev_list.append((g, term, int(np.sign(direction))))
+    te = None if t_eval is None else _array1(t_eval, "t_eval")
+    raw = _pdyn._solve_ivp(
+        fun, t0, tf, y0a, str(method), te, _tol(rtol, "rtol"), _tol(atol, "atol"),
+        None if math.isinf(max_step) else float(max_step),
+        None if first_step is None else float(first_step), max_steps, ev_list, named_args)
+    return _from_ivp(raw, len(ev_list), len(y0a))

@@ -1,0 +1,35 @@
+"""Exceptions and warnings of pdyn (raised by the Rust part, ``pdyn._pdyn``)."""
+
+from typing import Optional
+
+
+class PdynError(Exception):
+    """Base class of every error pdyn raises."""
+
+
+class ModelError(PdynError, ValueError):
+    """A model that does not load.
+
+    ``str(e)`` is the full report (file:line:column, the offending line, a caret, help);
+    the attributes locate it: ``file``, ``line`` and ``column`` (1-based, ``None`` when
+    unknown) and ``message`` (what is wrong, one line).
+    """
+
+    def __init__(self, text: str, file: str = "", line: Optional[int] = None,
+                 column: Optional[int] = None, message: str = ""):
+        super().__init__(text)
+        self.file = file
+        self.line = line
+        self.column = column
+        self.message = message or text
+
+
+class ParameterError(PdynError, ValueError):
+    """An invalid argument: an unknown parameter or method, a value out of range
+    (a mass <= 0, rtol < 0, t_eval outside [0, t_end]...)."""
+
+
+class DriftWarning(UserWarning):
+    """A quantity that should be conserved (energy, angular momentum) drifted by more than
+    the drift tolerance: the result cannot be trusted (tighten rtol or use a symplectic
+    method)."""

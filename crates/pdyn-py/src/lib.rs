@@ -1,0 +1,1004 @@
+//! `pdyn._pdyn`: the Rust half of the Python package `pdyn` (the pure-Python half, in
+//! `python/pdyn/`, builds result objects, emits warnings and holds the docstrings users read).
+//!
+//! Every function here returns plain Python data (dicts, lists, float64 NumPy arrays) and
+//! raises the exceptions defined in `pdyn._errors`. Errors are typed down to this boundary
+//! ([`pdyn::Error`], [`pdyn_mech::ModelError`], ...) and rendered only here. Integrations run
+//! with the GIL released, except when they must call back into Python.
+#![warn(missing_docs)]
+
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
+use pdyn::sim::{self, sweep, Prepared, RunResult, RunSettings};
+use pdyn::Error;
+use pdyn_expr::{Id, Pool, Program};
+use pdyn_mech::model::spec::SimulateSpec;
+use pdyn_ode::{Direction, Event, FnSystem, Method, Options, Solution, Status};
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use std::cell::RefCell;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+/// Builds an instance of an exception class of `pdyn._errors`.
+fn py_error<'py>(
+    py: Python<'py>,
+    class: &str,
+    make: impl FnOnce(&Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>>,
+) -> PyErr {
+    let made = py
+        .import("pdyn._errors")
+        .and_then(|m| m.getattr(class))
+        .and_then(|c| make(&c));
+    match made {
+        Ok(inst) => PyErr::from_value(inst),
+        Err(e) => e,
+    }
+}
+
+/// `pdyn.PdynError(message)`, or a subclass named by `class`.
+fn pdyn_error(py: Python<'_>, class: &str, message: String) -> PyErr {
+    py_error(py, class, |c| c.call1((message,)))
+}
+
+/// Renders a [`pdyn::Error`]: `ModelError` (with file, line, column) for a model that does not
+/// load, `ParameterError` for a bad parameter value or option, `PdynError` otherwise.
+fn to_py(py: Python<'_>, e: &Error) -> PyErr {
+    match e {
+        Error::Model { error, .. } => {
+            let loc = e.location();
+            let (line, column) = loc.as_ref().map_or((None, None), |l| (l.line, l.column));
+            py_error(py, "ModelError", |c| {
+                c.call1((
+                    e.to_string(),
+                    error.origin.clone(),
+                    line,
+                    column,
+                    error.message.clone(),
+                ))
+            })
+        }
+        Error::Value { .. } | Error::Argument { .. } => {
+            pdyn_error(py, "ParameterError", e.to_string())
+        }
+        Error::Sim {
+            error:
+                sim::SimError::InvalidOption { .. }
+                | sim::SimError::InvalidEndTime(_)
+                | sim::SimError::InvalidTEval { .. }
+                | sim::SimError::UnknownMethod { .. }
+                | sim::SimError::NeedsStep { .. }
+                | sim::SimError::NoEndTime
+                | sim::SimError::InvalidValue(_),
+            ..
+        } => pdyn_error(py, "ParameterError", e.to_string()),
+        _ => pdyn_error(py, "PdynError", e.to_string()),
+    }
+}
+
+/// Runs `f`, turning a panic (a bug in pdyn) into `pdyn.PdynError` instead of unwinding into
+/// the interpreter.
+fn guarded<T>(py: Python<'_>, f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(r) => r,
+        Err(payload) => {
+            let msg = payload
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| payload.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_else(|| "panic".into());
+            Err(pdyn_error(
+                py,
+                "PdynError",
+                format!("internal error in pdyn (please report it): {msg}"),
+            ))
+        }
+    }
+}
+
+/// SciPy's method names (`RK45`, `DOP853`, `Radau`) and pdyn's own (`tsit5`, `vern9`, ...).
+fn method_name(name: &str) -> String {
+    match name.to_ascii_lowercase().as_str() {
+        "rk45" => "dopri5".into(),
+        "radau" => "radau5".into(),
+        other => other.into(),
+    }
+}
+
+/// A model file, loaded (`pdyn.Model` wraps it).
+#[pyclass(module = "pdyn._pdyn", name = "Model", frozen)]
+struct PyModel {
+    model: pdyn_mech::Model,
+}
+
+/// The run settings given from Python (any may be `None`: the model's `[simulate]` applies).
+#[derive(Default)]
+struct Overrides {
+    t_end: Option<f64>,
+    method: Option<String>,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+    t_eval: Option<Vec<f64>>,
+    max_step: Option<f64>,
+    dt: Option<f64>,
+    max_steps: Option<usize>,
+    points: Option<usize>,
+    drift_tolerance: Option<f64>,
+}
+
+impl PyModel {
+    /// The loaded model with `params` applied as `pdyn run --set` applies them.
+    fn with_params(&self, params: Option<Vec<(String, f64)>>) -> Result<pdyn_mech::Model, Error> {
+        let mut model = self.model.clone();
+        let Some(params) = params else {
+            return Ok(model);
+        };
+        for (k, v) in &params {
+            match model.parameters.iter_mut().find(|p| &p.name == k) {
+                Some(p) => p.value = *v,
+                None => {
+                    let names: Vec<&str> = self
+                        .model
+                        .parameters
+                        .iter()
+                        .map(|p| p.name.as_str())
+                        .collect();
+                    return Err(Error::argument(
+                        "params",
+                        format!(
+                            "`{k}` is not a parameter (parameters: {})",
+                            names.join(", ")
+                        ),
+                    ));
+                }
+            }
+        }
+        if !params.is_empty() {
+            pdyn_mech::validity::check_parameter_values(&mut model).map_err(|error| {
+                Error::Value {
+                    origin: model.origin.clone(),
+                    option: "params".into(),
+                    error,
+                }
+            })?;
+        }
+        Ok(model)
+    }
+
+    fn settings(model: &pdyn_mech::Model, o: Overrides) -> Result<RunSettings, Error> {
+        let sim_err = |error| Error::Sim {
+            origin: model.origin.clone(),
+            context: "",
+            error,
+        };
+        let overrides = SimulateSpec {
+            t_end: o.t_end,
+            method: o.method.map(|m| (method_name(&m), 0..0)),
+            rtol: o.rtol,
+            atol: o.atol,
+            dt: o.dt,
+            max_step: o.max_step,
+            max_steps: o.max_steps,
+            points: o.points,
+            output_dt: None,
+            drift_tolerance: o.drift_tolerance,
+        };
+        let mut file = model.run.simulate.clone();
+        if o.t_eval.is_some() || o.points.is_some() {
+            // Explicit output times replace the file's output spacing.
+            file.output_dt = None;
+            file.points = None;
+        }
+        RunSettings::resolve(&file, &overrides, o.t_eval).map_err(sim_err)
+    }
+
+    fn prepare(model: &mut pdyn_mech::Model) -> Result<Prepared, Error> {
+        sim::prepare(model).map_err(|error| Error::Sim {
+            origin: model.origin.clone(),
+            context: "",
+            error,
+        })
+    }
+}
+
+fn load_error(source: &str, error: pdyn_mech::ModelError) -> Error {
+    Error::Model {
+        error,
+        source: source.into(),
+    }
+}
+
+fn f64_array<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
+    PyArray1::from_vec(py, v)
+}
+
+/// A `(rows, cols)` float64 array from a flat row-major vector.
+fn f64_matrix(py: Python<'_>, v: Vec<f64>, rows: usize, cols: usize) -> PyResult<PyObject> {
+    let a = PyArray1::from_vec(py, v);
+    Ok(a.reshape([rows, cols])?.into_any().unbind())
+}
+
+/// A run result as a dict of plain data (the Python layer builds `pdyn.OdeResult`).
+fn run_dict(
+    py: Python<'_>,
+    res: RunResult,
+    n_states: usize,
+    event_names: Vec<String>,
+) -> PyResult<PyObject> {
+    let d = PyDict::new(py);
+    d.set_item("event_names", event_names)?;
+    let rows = res.rows.len();
+    let cols = res.columns.len();
+    let flat: Vec<f64> = res.rows.into_iter().flatten().collect();
+    d.set_item("columns", res.columns)?;
+    d.set_item("table", f64_matrix(py, flat, rows, cols)?)?;
+    d.set_item("n_states", n_states)?;
+    let events = PyList::empty(py);
+    for e in res.events {
+        let k = e.state.len();
+        events.append((e.name, e.t, f64_matrix(py, e.state, 1, k)?, e.rising))?;
+    }
+    d.set_item("events", events)?;
+    let monitors = PyList::empty(py);
+    for m in res.monitors {
+        let md = PyDict::new(py);
+        md.set_item("name", m.name)?;
+        md.set_item("initial", m.initial)?;
+        md.set_item("drift", m.drift)?;
+        md.set_item("relative", m.relative)?;
+        md.set_item("scale", m.scale)?;
+        md.set_item("conserved", m.conserved)?;
+        monitors.append(md)?;
+    }
+    d.set_item("monitors", monitors)?;
+    d.set_item("warnings", res.warnings)?;
+    d.set_item("stats", stats_dict(py, &res.stats)?)?;
+    d.set_item("method", res.method.to_string())?;
+    d.set_item("failure", res.failure.map(|f| f.to_string()))?;
+    Ok(d.into_any().unbind())
+}
+
+fn stats_dict<'py>(py: Python<'py>, s: &pdyn_ode::Stats) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("steps", s.steps)?;
+    d.set_item("accepted", s.accepted)?;
+    d.set_item("rejected", s.rejected)?;
+    d.set_item("fevals", s.fevals)?;
+    d.set_item("jac_fevals", s.jac_fevals)?;
+    d.set_item("jacobians", s.jacobians)?;
+    d.set_item("lu_decompositions", s.lu_decompositions)?;
+    d.set_item("linear_solves", s.linear_solves)?;
+    d.set_item("stiffness_detected_at", s.stiffness_detected_at)?;
+    Ok(d)
+}
+
+/// A Python dict as TOML text (the keys in insertion order).
+fn dict_to_toml(obj: &Bound<'_, PyAny>) -> PyResult<String> {
+    fn value(obj: &Bound<'_, PyAny>, at: &str) -> PyResult<toml::Value> {
+        if let Ok(b) = obj.downcast::<pyo3::types::PyBool>() {
+            return Ok(toml::Value::Boolean(b.is_true()));
+        }
+        if let Ok(i) = obj.downcast::<pyo3::types::PyInt>() {
+            return Ok(toml::Value::Integer(i.extract()?));
+        }
+        if let Ok(f) = obj.downcast::<pyo3::types::PyFloat>() {
+            return Ok(toml::Value::Float(f.value()));
+        }
+        if let Ok(s) = obj.downcast::<pyo3::types::PyString>() {
+            return Ok(toml::Value::String(s.extract::<String>()?));
+        }
+        if let Ok(d) = obj.downcast::<PyDict>() {
+            let mut t = toml::Table::new();
+            for (k, v) in d.iter() {
+                let k: String = k.extract().map_err(|_| {
+                    PyTypeError::new_err(format!("{at}: dictionary keys must be strings"))
+                })?;
+                let sub = value(&v, &format!("{at}.{k}"))?;
+                t.insert(k, sub);
+            }
+            return Ok(toml::Value::Table(t));
+        }
+        if let Ok(seq) = obj.try_iter() {
+            let mut out = Vec::new();
+            for (i, item) in seq.enumerate() {
+                out.push(value(&item?, &format!("{at}[{i}]"))?);
+            }
+            return Ok(toml::Value::Array(out));
+        }
+        // NumPy scalars and other numbers.
+        if let Ok(x) = obj.extract::<f64>() {
+            return Ok(toml::Value::Float(x));
+        }
+        Err(PyTypeError::new_err(format!(
+            "{at}: cannot write a {} into a model (use str, int, float, bool, list or dict)",
+            obj.get_type().name()?
+        )))
+    }
+    match value(obj, "model")? {
+        toml::Value::Table(t) => toml::to_string(&t)
+            .map_err(|e| PyTypeError::new_err(format!("cannot write the model as TOML: {e}"))),
+        _ => Err(PyTypeError::new_err("a model must be a dict")),
+    }
+}
+
+#[pymethods]
+impl PyModel {
+    /// Loads a model from TOML text; `origin` names it in error messages.
+    #[staticmethod]
+    #[pyo3(signature = (text, origin = "<string>"))]
+    fn from_toml(py: Python<'_>, text: &str, origin: &str) -> PyResult<PyModel> {
+        guarded(py, || {
+            pdyn_mech::load(text, origin)
+                .map(|model| PyModel { model })
+                .map_err(|e| to_py(py, &load_error(text, e)))
+        })
+    }
+
+    /// Loads a model from a dict with the layout of a model file.
+    #[staticmethod]
+    fn from_dict(py: Python<'_>, d: &Bound<'_, PyAny>) -> PyResult<PyModel> {
+        let text = dict_to_toml(d)?;
+        Self::from_toml(py, &text, "<dict>")
+    }
+
+    /// The TOML text the model was loaded from.
+    #[getter]
+    fn source(&self) -> String {
+        self.model.source.clone()
+    }
+
+    /// The model's name.
+    #[getter]
+    fn name(&self) -> String {
+        self.model.name.clone()
+    }
+
+    /// The file name used in messages.
+    #[getter]
+    fn origin(&self) -> String {
+        self.model.origin.clone()
+    }
+
+    /// `[(name, value in SI units)]`, in file order.
+    #[getter]
+    fn parameters(&self) -> Vec<(String, f64)> {
+        self.model
+            .parameters
+            .iter()
+            .map(|p| (p.name.clone(), p.value))
+            .collect()
+    }
+
+    /// Integrates the model; returns a dict of plain data (see `pdyn.Model.run`).
+    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, t_eval=None, max_step=None, dt=None, max_steps=None, points=None, drift_tolerance=None, params=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn run(
+        &self,
+        py: Python<'_>,
+        t_end: Option<f64>,
+        method: Option<String>,
+        rtol: Option<f64>,
+        atol: Option<f64>,
+        t_eval: Option<PyReadonlyArray1<'_, f64>>,
+        max_step: Option<f64>,
+        dt: Option<f64>,
+        max_steps: Option<usize>,
+        points: Option<usize>,
+        drift_tolerance: Option<f64>,
+        params: Option<Vec<(String, f64)>>,
+    ) -> PyResult<PyObject> {
+        let t_eval = match t_eval {
+            Some(a) => Some(a.as_slice()?.to_vec()),
+            None => None,
+        };
+        let o = Overrides {
+            t_end,
+            method,
+            rtol,
+            atol,
+            t_eval,
+            max_step,
+            dt,
+            max_steps,
+            points,
+            drift_tolerance,
+        };
+        let outcome = py.allow_threads(|| {
+            catch_unwind(AssertUnwindSafe(
+                || -> Result<(RunResult, usize, Vec<String>), Error> {
+                    let mut model = self.with_params(params)?;
+                    let set = Self::settings(&model, o)?;
+                    let prep = Self::prepare(&mut model)?;
+                    let res = sim::run(&prep, &set).map_err(|error| Error::Sim {
+                        origin: model.origin.clone(),
+                        context: "",
+                        error,
+                    })?;
+                    let names = prep.events.iter().map(|e| e.name.clone()).collect();
+                    Ok((res, prep.state_names.len(), names))
+                },
+            ))
+        });
+        match outcome {
+            Ok(Ok((res, n, names))) => run_dict(py, res, n, names),
+            Ok(Err(e)) => Err(to_py(py, &e)),
+            Err(_) => Err(pdyn_error(
+                py,
+                "PdynError",
+                "internal error in pdyn during the run (please report it)".into(),
+            )),
+        }
+    }
+
+    /// The equations of motion, as text and LaTeX (see `pdyn.Model.derive`).
+    fn derive(&self, py: Python<'_>) -> PyResult<PyObject> {
+        guarded(py, || {
+            let mut model = self.model.clone();
+            let d = pdyn_mech::derive(&mut model, &pdyn_mech::DeriveOptions::default()).map_err(
+                |error| {
+                    to_py(
+                        py,
+                        &Error::Derive {
+                            origin: model.origin.clone(),
+                            error,
+                        },
+                    )
+                },
+            )?;
+            let p: &Pool = &model.pool;
+            let e = |id: Id| (p.to_text(id), p.to_latex(id));
+            let out = PyDict::new(py);
+            let eqs: Vec<_> = d
+                .equations
+                .iter()
+                .map(|q| (q.label.clone(), e(q.lhs), e(q.rhs)))
+                .collect();
+            out.set_item("equations", eqs)?;
+            out.set_item(
+                "unknowns",
+                d.unknowns
+                    .iter()
+                    .map(|u| u.name.clone())
+                    .collect::<Vec<_>>(),
+            )?;
+            out.set_item(
+                "solution",
+                d.solution.as_ref().map(|s| {
+                    d.unknowns
+                        .iter()
+                        .zip(s)
+                        .map(|(u, &x)| (u.name.clone(), e(x)))
+                        .collect::<Vec<_>>()
+                }),
+            )?;
+            out.set_item("state", d.state_names.clone())?;
+            // d/dt q = q' for each free coordinate, then d/dt q' = the solved acceleration.
+            let first_order = d.accelerations().map(|acc| {
+                let n = d.free.len();
+                let mut rows: Vec<(String, (String, String))> = Vec::new();
+                for i in 0..n {
+                    let rate = &d.state_names[n + i];
+                    rows.push((d.state_names[i].clone(), (rate.clone(), rate.clone())));
+                }
+                for (i, &a) in acc.iter().enumerate() {
+                    rows.push((d.state_names[n + i].clone(), e(a)));
+                }
+                rows
+            });
+            out.set_item("first_order", first_order)?;
+            out.set_item("notes", d.notes.clone())?;
+            out.set_item("form", format!("{:?}", d.form).to_lowercase())?;
+            Ok(out.into_any().unbind())
+        })
+    }
+
+    /// Runs the model once per value of `parameter`, in parallel (see `pdyn.Model.sweep`).
+    #[pyo3(signature = (parameter, values, measures=None, t_end=None, method=None, rtol=None, atol=None, max_step=None, dt=None, points=None, threads=None, params=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn sweep(
+        &self,
+        py: Python<'_>,
+        parameter: String,
+        values: PyReadonlyArray1<'_, f64>,
+        measures: Option<Vec<(String, String, String)>>,
+        t_end: Option<f64>,
+        method: Option<String>,
+        rtol: Option<f64>,
+        atol: Option<f64>,
+        max_step: Option<f64>,
+        dt: Option<f64>,
+        points: Option<usize>,
+        threads: Option<usize>,
+        params: Option<Vec<(String, f64)>>,
+    ) -> PyResult<PyObject> {
+        let values = values.as_slice()?.to_vec();
+        // Measures given from Python are written into the model's [sweep] table and the model
+        // reloaded: they are then checked and compiled exactly as a file's measures.
+        let base = match &measures {
+            Some(ms) => {
+                let mut table: toml::Table = toml::from_str(&self.model.source)
+                    .map_err(|e| pdyn_error(py, "PdynError", e.to_string()))?;
+                let mut sw = toml::Table::new();
+                sw.insert("parameter".into(), toml::Value::String(parameter.clone()));
+                sw.insert(
+                    "values".into(),
+                    toml::Value::Array(values.iter().map(|&v| toml::Value::Float(v)).collect()),
+                );
+                let mut mt = toml::Table::new();
+                for (name, of, stat) in ms {
+                    let mut one = toml::Table::new();
+                    one.insert("of".into(), toml::Value::String(of.clone()));
+                    one.insert("stat".into(), toml::Value::String(stat.clone()));
+                    mt.insert(name.clone(), toml::Value::Table(one));
+                }
+                sw.insert("measures".into(), toml::Value::Table(mt));
+                table.insert("sweep".into(), toml::Value::Table(sw));
+                let text = toml::to_string(&table)
+                    .map_err(|e| pdyn_error(py, "PdynError", e.to_string()))?;
+                let origin = format!("{} (with the sweep's measures)", self.model.origin);
+                PyModel {
+                    model: pdyn_mech::load(&text, &origin)
+                        .map_err(|e| to_py(py, &load_error(&text, e)))?,
+                }
+            }
+            None => PyModel {
+                model: self.model.clone(),
+            },
+        };
+        let o = Overrides {
+            t_end,
+            method,
+            rtol,
+            atol,
+            max_step,
+            dt,
+            points,
+            ..Overrides::default()
+        };
+        let outcome = py.allow_threads(|| {
+            catch_unwind(AssertUnwindSafe(|| -> Result<sweep::SweepResult, Error> {
+                let mut model = base.with_params(params)?;
+                let origin = model.origin.clone();
+                let sim_err = |error| Error::Sim {
+                    origin: origin.clone(),
+                    context: "",
+                    error,
+                };
+                let index = model
+                    .parameters
+                    .iter()
+                    .position(|p| p.name == parameter)
+                    .ok_or_else(|| {
+                        Error::argument(
+                            "parameter",
+                            format!("`{parameter}` is not a parameter of the model"),
+                        )
+                    })?;
+                let Some(mut spec) = model.run.sweep.clone() else {
+                    return Err(Error::argument(
+                        "measures",
+                        "the model has no [sweep.measures]: give measures={name: (expression, statistic)}",
+                    ));
+                };
+                spec.parameter = index;
+                spec.values = values;
+                spec.others.clear();
+                let set = Self::settings(&model, o)?;
+                let prep = Self::prepare(&mut model)?;
+                let stats: Vec<_> = spec.measures.iter().map(|m| m.stat).collect();
+                match threads {
+                    Some(n) => {
+                        let pool = rayon_pool(n)?;
+                        pool.install(move || sweep::sweep(&prep, &set, &spec, &stats, false))
+                    }
+                    None => sweep::sweep(&prep, &set, &spec, &stats, false),
+                }
+                .map_err(sim_err)
+            }))
+        });
+        let res = match outcome {
+            Ok(Ok(r)) => r,
+            Ok(Err(e)) => return Err(to_py(py, &e)),
+            Err(_) => {
+                return Err(pdyn_error(
+                    py,
+                    "PdynError",
+                    "internal error in pdyn during the sweep (please report it)".into(),
+                ))
+            }
+        };
+        let d = PyDict::new(py);
+        d.set_item("parameter", res.parameter.clone())?;
+        let nv = res.values.len();
+        d.set_item("values", f64_array(py, res.values.clone()))?;
+        let table = PyDict::new(py);
+        if let Some(sl) = res.slices.first() {
+            for (j, m) in res.measures.iter().enumerate() {
+                let col: Vec<f64> = sl.table.iter().map(|r| r[j]).collect();
+                debug_assert_eq!(col.len(), nv);
+                table.set_item(m, f64_array(py, col))?;
+            }
+        }
+        d.set_item("measures", table)?;
+        let problems: Vec<(f64, String)> = res
+            .problems
+            .iter()
+            .map(|(at, p)| (at.first().map_or(f64::NAN, |x| x.1), p.to_string()))
+            .collect();
+        d.set_item("problems", problems)?;
+        d.set_item("runs", res.runs)?;
+        d.set_item("seconds", res.seconds)?;
+        d.set_item("threads", res.threads)?;
+        Ok(d.into_any().unbind())
+    }
+}
+
+/// A rayon pool with `n` threads (a sweep's `threads=`).
+fn rayon_pool(n: usize) -> Result<rayon::ThreadPool, Error> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n.max(1))
+        .build()
+        .map_err(|e| Error::argument("threads", format!("cannot start {n} threads: {e}")))
+}
+
+/// An event for `solve_ivp`: a Python callable or an expression, with SciPy's attributes.
+struct IvpEvent {
+    function: Rhs,
+    terminal: Option<usize>,
+    direction: Direction,
+}
+
+/// A right-hand side or event function: compiled expressions, or a Python callable.
+enum Rhs {
+    Compiled(Program),
+    Callable(PyObject),
+}
+
+/// Compiles expressions in `t`, `y0..y{n-1}` and the names of `params` into one program
+/// over the inputs `[t, y0.., params..]`.
+fn compile_exprs(exprs: &[String], n: usize, params: &[(String, f64)]) -> Result<Program, String> {
+    let mut pool = Pool::new();
+    let mut outputs = Vec::new();
+    for (i, src) in exprs.iter().enumerate() {
+        let id = pool.parse_scalar(src).map_err(|e| {
+            let (_, col) = pdyn_expr::error::line_col(src, e.span.start);
+            format!("expression {i} (`{src}`), column {col}: {}", e.message)
+        })?;
+        outputs.push(id);
+    }
+    let mut inputs = vec![pool.var("t")];
+    for k in 0..n {
+        inputs.push(pool.var(&format!("y{k}")));
+    }
+    for (name, _) in params {
+        inputs.push(pool.var(name));
+    }
+    Program::compile(&mut pool, &inputs, &outputs).map_err(|e| {
+        format!(
+            "{e} (the expressions may use t, y0..y{}, and the names given in args)",
+            n.saturating_sub(1)
+        )
+    })
+}
+
+/// Evaluates one compiled program with its own registers.
+struct Evaluator<'a> {
+    program: &'a Program,
+    inputs: RefCell<Vec<f64>>,
+    ws: RefCell<Vec<f64>>,
+}
+
+impl<'a> Evaluator<'a> {
+    fn new(program: &'a Program, n: usize, params: &[(String, f64)]) -> Self {
+        let mut inputs = vec![0.0; 1 + n];
+        inputs.extend(params.iter().map(|p| p.1));
+        Evaluator {
+            program,
+            inputs: RefCell::new(inputs),
+            ws: RefCell::new(program.workspace()),
+        }
+    }
+    fn eval(&self, t: f64, y: &[f64], out: &mut [f64]) {
+        let mut inp = self.inputs.borrow_mut();
+        inp[0] = t;
+        inp[1..1 + y.len()].copy_from_slice(y);
+        self.program.eval(&inp, &mut self.ws.borrow_mut(), out);
+    }
+}
+
+/// An event function `g(t, y)`.
+type EventFn<'a> = dyn Fn(f64, &[f64]) -> f64 + 'a;
+
+/// The options of one `solve_ivp` call.
+struct IvpOptions {
+    method: Method,
+    t_span: (f64, f64),
+    y0: Vec<f64>,
+    opts: Options,
+}
+
+/// Integrates with the given right-hand side and events; Python errors raised inside
+/// callbacks are kept in `err` (the solver then sees NaN and stops).
+fn integrate(
+    py: Option<Python<'_>>,
+    rhs: &Rhs,
+    events: &[IvpEvent],
+    params: &[(String, f64)],
+    o: &IvpOptions,
+    err: &RefCell<Option<PyErr>>,
+) -> Result<Solution, pdyn_ode::OdeError> {
+    let n = o.y0.len();
+    let call_py = |f: &PyObject, t: f64, y: &[f64]| -> Option<Vec<f64>> {
+        let py = py?;
+        if err.borrow().is_some() {
+            return None;
+        }
+        let arr = PyArray1::from_slice(py, y);
+        let r = f.call1(py, (t, arr)).and_then(|v| {
+            let v = v.bind(py);
+            // Arrays, lists and scalars (for an event) alike.
+            let np = py.import("numpy")?;
+            let a = np.call_method1("asarray", (v, "float64"))?;
+            let a = a.call_method0("ravel")?;
+            a.extract::<Vec<f64>>()
+        });
+        match r {
+            Ok(v) => Some(v),
+            Err(e) => {
+                *err.borrow_mut() = Some(e);
+                None
+            }
+        }
+    };
+    let evaluator = match rhs {
+        Rhs::Compiled(p) => Some(Evaluator::new(p, n, params)),
+        Rhs::Callable(_) => None,
+    };
+    let f = |t: f64, y: &[f64], dy: &mut [f64]| match (rhs, &evaluator) {
+        (Rhs::Compiled(_), Some(ev)) => ev.eval(t, y, dy),
+        (Rhs::Callable(func), _) => match call_py(func, t, y) {
+            Some(v) if v.len() == dy.len() => dy.copy_from_slice(&v),
+            Some(v) => {
+                if err.borrow().is_none() {
+                    *err.borrow_mut() = Some(PyErr::new::<pyo3::exceptions::PyValueError, _>(
+                        format!("fun returned {} values for {} states", v.len(), dy.len()),
+                    ));
+                }
+                dy.fill(f64::NAN);
+            }
+            None => dy.fill(f64::NAN),
+        },
+        _ => dy.fill(f64::NAN),
+    };
+    let system = FnSystem::new(n, f);
+    let event_evals: Vec<Option<Evaluator<'_>>> = events
+        .iter()
+        .map(|e| match &e.function {
+            Rhs::Compiled(p) => Some(Evaluator::new(p, n, params)),
+            Rhs::Callable(_) => None,
+        })
+        .collect();
+    let gs: Vec<Box<EventFn<'_>>> = events
+        .iter()
+        .zip(&event_evals)
+        .map(|(e, ev)| {
+            let g: Box<EventFn<'_>> = match (&e.function, ev) {
+                (Rhs::Compiled(_), Some(ev)) => Box::new(move |t, y| {
+                    let mut out = [0.0];
+                    ev.eval(t, y, &mut out);
+                    out[0]
+                }),
+                (Rhs::Callable(func), _) => Box::new(move |t, y| {
+                    call_py(func, t, y)
+                        .and_then(|v| v.first().copied())
+                        .unwrap_or(f64::NAN)
+                }),
+                _ => Box::new(|_, _| f64::NAN),
+            };
+            g
+        })
+        .collect();
+    let evs: Vec<Event<'_>> = events
+        .iter()
+        .zip(&gs)
+        .map(|(e, g)| {
+            let mut ev = Event::new(g.as_ref()).direction(e.direction);
+            if let Some(k) = e.terminal {
+                ev = ev.terminal(k);
+            }
+            ev
+        })
+        .collect();
+    pdyn_ode::solve_with_events(o.method, &system, o.t_span, &o.y0, &o.opts, &evs)
+}
+
+/// `solve_ivp`'s Rust part: returns a dict of plain data (`pdyn.solve_ivp` builds the
+/// `OdeResult`). `fun` is a callable `fun(t, y)` or a list of expression strings.
+#[pyfunction]
+#[pyo3(signature = (fun, t0, tf, y0, method, t_eval, rtol, atol, max_step, first_step, max_steps, events, args))]
+#[allow(clippy::too_many_arguments)]
+fn _solve_ivp(
+    py: Python<'_>,
+    fun: &Bound<'_, PyAny>,
+    t0: f64,
+    tf: f64,
+    y0: PyReadonlyArray1<'_, f64>,
+    method: &str,
+    t_eval: Option<PyReadonlyArray1<'_, f64>>,
+    rtol: Vec<f64>,
+    atol: Vec<f64>,
+    max_step: Option<f64>,
+    first_step: Option<f64>,
+    max_steps: Option<usize>,
+    events: Vec<(Bound<'_, PyAny>, Option<usize>, i32)>,
+    args: Vec<(String, f64)>,
+) -> PyResult<PyObject> {
+    let y0 = y0.as_slice()?.to_vec();
+    let n = y0.len();
+    let Some(m) = Method::from_name(&method_name(method)) else {
+        return Err(pdyn_error(
+            py,
+            "ParameterError",
+            format!(
+                "unknown method `{method}`: use RK45, DOP853, Radau or one of pdyn's ({})",
+                Method::all()
+                    .iter()
+                    .map(|m| m.name())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        ));
+    };
+    let to_rhs = |obj: &Bound<'_, PyAny>, what: &str, outputs: Option<usize>| -> PyResult<Rhs> {
+        if obj.is_callable() {
+            return Ok(Rhs::Callable(obj.clone().unbind()));
+        }
+        let exprs: Vec<String> = if let Ok(s) = obj.extract::<String>() {
+            vec![s]
+        } else {
+            obj.extract().map_err(|_| {
+                PyTypeError::new_err(format!(
+                    "{what} must be a callable or a list of expression strings"
+                ))
+            })?
+        };
+        if let Some(k) = outputs {
+            if exprs.len() != k {
+                return Err(pdyn_error(
+                    py,
+                    "ParameterError",
+                    format!("{what} has {} expressions for {k} states", exprs.len()),
+                ));
+            }
+        }
+        compile_exprs(&exprs, n, &args)
+            .map(Rhs::Compiled)
+            .map_err(|e| pdyn_error(py, "ParameterError", format!("{what}: {e}")))
+    };
+    let rhs = to_rhs(fun, "fun", Some(n))?;
+    let mut ivp_events = Vec::new();
+    for (k, (g, terminal, direction)) in events.iter().enumerate() {
+        ivp_events.push(IvpEvent {
+            function: to_rhs(g, &format!("events[{k}]"), Some(1))?,
+            terminal: *terminal,
+            direction: match direction.signum() {
+                1 => Direction::Rising,
+                -1 => Direction::Falling,
+                _ => Direction::Both,
+            },
+        });
+    }
+    let tol = |v: Vec<f64>| -> pdyn_ode::Tolerance {
+        if v.len() == 1 {
+            v[0].into()
+        } else {
+            v.into()
+        }
+    };
+    let mut opts = Options {
+        rtol: tol(rtol),
+        atol: tol(atol),
+        h0: first_step,
+        max_step,
+        ..Options::default()
+    };
+    if let Some(ms) = max_steps {
+        opts.max_steps = ms;
+    }
+    if let Some(te) = t_eval {
+        opts.t_eval = Some(te.as_slice()?.to_vec());
+    }
+    let o = IvpOptions {
+        method: m,
+        t_span: (t0, tf),
+        y0,
+        opts,
+    };
+    let all_compiled = matches!(rhs, Rhs::Compiled(_))
+        && ivp_events
+            .iter()
+            .all(|e| matches!(e.function, Rhs::Compiled(_)));
+    let err = RefCell::new(None);
+    let result = if all_compiled {
+        // No Python in the loop: the GIL is released for the whole integration.
+        let rhs_ref = &rhs;
+        let evs = &ivp_events;
+        let args_ref = &args;
+        let o_ref = &o;
+        py.allow_threads(move || {
+            catch_unwind(AssertUnwindSafe(|| {
+                let err = RefCell::new(None);
+                integrate(None, rhs_ref, evs, args_ref, o_ref, &err)
+            }))
+        })
+    } else {
+        catch_unwind(AssertUnwindSafe(|| {
+            integrate(Some(py), &rhs, &ivp_events, &args, &o, &err)
+        }))
+    };
+    if let Some(e) = err.into_inner() {
+        return Err(e);
+    }
+    let result = result.map_err(|_| {
+        pdyn_error(
+            py,
+            "PdynError",
+            "internal error in pdyn during solve_ivp (please report it)".into(),
+        )
+    })?;
+    let (sol, message, status) = match result {
+        Ok(sol) => {
+            let (msg, status) = match sol.status {
+                Status::Finished => (
+                    "The solver successfully reached the end of the integration interval."
+                        .to_string(),
+                    0,
+                ),
+                Status::TerminalEvent(_) => ("A termination event occurred.".to_string(), 1),
+            };
+            (sol, msg, status)
+        }
+        Err(e) => match e.failure_point() {
+            Some(fp) => ((*fp.partial).clone(), e.to_string(), -1),
+            None => return Err(pdyn_error(py, "ParameterError", e.to_string())),
+        },
+    };
+    let d = PyDict::new(py);
+    let len = sol.len();
+    d.set_item("t", f64_array(py, sol.t.clone()))?;
+    d.set_item("y_rows", f64_matrix(py, sol.y.clone(), len, n)?)?;
+    let hits = PyList::empty(py);
+    for h in &sol.events {
+        hits.append((h.index, h.t, f64_array(py, h.y.clone())))?;
+    }
+    d.set_item("events", hits)?;
+    d.set_item("stats", stats_dict(py, &sol.stats)?)?;
+    d.set_item("message", message)?;
+    d.set_item("status", status)?;
+    d.set_item("method", sol.method.name())?;
+    d.set_item("gil_released", all_compiled)?;
+    Ok(d.into_any().unbind())
+}
+
+/// Names and descriptions of the integration methods.
+#[pyfunction]
+fn methods() -> Vec<(String, String)> {
+    Method::all()
+        .iter()
+        .map(|m| {
+            (
+                m.name().to_string(),
+                m.doc().split_whitespace().collect::<Vec<_>>().join(" "),
+            )
+        })
+        .collect()
+}
+
+/// The Rust half of `pdyn`.
+#[pymodule]
+fn _pdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyModel>()?;
+    m.add_function(wrap_pyfunction!(_solve_ivp, m)?)?;
+    m.add_function(wrap_pyfunction!(methods, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
