@@ -289,6 +289,24 @@ fn polynomial_roots(pool: &mut Pool, e: Id, u: Id) -> Result<Vec<Id>, AlgebraErr
     match numeric {
         Some(coeffs) if coeffs.iter().all(|x| x.is_finite()) => {
             let roots = real_roots(&coeffs);
+            // A root is only reported when the polynomial vanishes there relative to the size
+            // of its terms (floating point fails on extreme coefficients: refuse, never guess).
+            let trustworthy = roots.iter().all(|&r| {
+                let size: f64 = coeffs
+                    .iter()
+                    .enumerate()
+                    .map(|(k, c)| (c * r.powi(k as i32)).abs())
+                    .sum();
+                size.is_finite() && eval(&coeffs, r).abs() <= 1e-9 * size.max(f64::MIN_POSITIVE)
+            });
+            if !trustworthy {
+                return Err(AlgebraError::NoClosedForm {
+                    reason: format!(
+                        "the real roots of this polynomial in {} cannot be found reliably in floating point (coefficients of very different sizes); rescale the unknown",
+                        pool.to_text(u)
+                    ),
+                });
+            }
             Ok(roots
                 .into_iter()
                 .map(|r| pool.num(Number::Float(r)))
@@ -518,6 +536,24 @@ mod tests {
         v.sort_by(f64::total_cmp);
         for (got, want) in v.iter().zip([-2.0, -1.0, 1.0, 2.0]) {
             assert!((got - want).abs() < 1e-12, "{v:?}");
+        }
+    }
+
+    #[test]
+    fn extreme_coefficients_are_refused_not_guessed() {
+        let mut p = setup(&[]);
+        let e = eqs(&mut p, &["x^3 = 1e308*x"]);
+        let x = p.var("x");
+        match solve(&mut p, &e, &[x]) {
+            Err(AlgebraError::NoClosedForm { .. }) => {}
+            Ok(sols) => {
+                // If solved, every root must be right.
+                for s in sols {
+                    let v = p.eval_const(s[0]).unwrap();
+                    assert!(v == 0.0 || (v.abs() / 1e154 - 1.0).abs() < 1e-6, "{v}");
+                }
+            }
+            Err(other) => panic!("{other}"),
         }
     }
 
