@@ -21,6 +21,7 @@ use compiled::{CompiledModel, Observer};
 use pdyn_expr::{Id, Pool};
 use pdyn_mech::conservation::conserved_quantities;
 use pdyn_mech::model::spec::{Crossing, SimulateSpec};
+use pdyn_mech::parameters::DerivedParameters;
 use pdyn_mech::validity::ValueChecks;
 use pdyn_mech::{derive, DeriveOptions, Model};
 use pdyn_ode::{Direction, Event, Method, MethodKind, Options, Solution};
@@ -252,16 +253,23 @@ pub struct Prepared {
     pub initial_conditions: Observer,
     /// Parameter names, in model order.
     pub parameter_names: Vec<String>,
+    /// Parameters defined by others (`m = "4/3*pi*a^3*rho"`), recomputed for each sweep run.
+    pub derived: DerivedParameters,
 }
 
 impl Prepared {
-    /// A copy with parameter `index` set to `value` (initial conditions recomputed).
-    pub fn with_parameter(&self, index: usize, value: f64) -> Prepared {
+    /// A copy with the parameters `(index, value)` set, the derived parameters that depend on
+    /// them and the initial conditions recomputed.
+    pub fn with_parameters(&self, given: &[(usize, f64)]) -> Prepared {
         let mut p = self.clone();
         let mut params = p.system.parameters();
-        if let Some(x) = params.get_mut(index) {
-            *x = value;
+        for &(index, value) in given {
+            if let Some(x) = params.get_mut(index) {
+                *x = value;
+            }
         }
+        let fixed: Vec<usize> = given.iter().map(|g| g.0).collect();
+        p.derived.apply(&mut params, &fixed);
         p.system.set_parameters(&params);
         let mut y0 = vec![0.0; p.y0.len()];
         p.initial_conditions.eval(&params, &mut y0);
@@ -392,6 +400,7 @@ pub fn prepare_with(model: &mut Model, opts: &DeriveOptions) -> Result<Prepared,
         notes: d.notes.clone(),
         initial_conditions,
         parameter_names: model.parameters.iter().map(|q| q.name.clone()).collect(),
+        derived: DerivedParameters::compile(model),
     })
 }
 

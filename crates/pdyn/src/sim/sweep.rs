@@ -150,10 +150,9 @@ pub fn sweep(
         .par_iter()
         // Each worker owns a copy (the compiled programs keep per-call scratch space).
         .map_with(prep.clone(), |base, &(ci, v)| {
-            let mut p = base.with_parameter(spec.parameter, v);
-            for &(k, x) in &combos[ci] {
-                p = p.with_parameter(k, x);
-            }
+            let mut given = vec![(spec.parameter, v)];
+            given.extend_from_slice(&combos[ci]);
+            let p = base.with_parameters(&given);
             let out = measure_run(&p, set, stats, n_meas);
             bar.inc(1);
             out

@@ -1,0 +1,189 @@
+//! The state of reading one model file: the expression pool, the names declared so far and
+//! the parameters' values, with the helpers every table uses to turn a TOML value into an
+//! expression (located errors, unit literals, shape checks, constant evaluation).
+
+use super::raw::Sv;
+use super::{ModelError, Parameter};
+use crate::units::{looks_like_quantity, parse_quantity};
+use pdyn_expr::lower::{lower, Binding, Scope};
+use pdyn_expr::{ExprError, Id, Number, Pool, Program, Value};
+use rustc_hash::FxHashMap;
+use std::ops::Range;
+
+/// Name resolution for expressions in a model file.
+#[derive(Default)]
+pub(crate) struct ModelScope {
+    pub(super) names: FxHashMap<String, (Binding, Range<usize>, &'static str)>,
+    pub(super) order: Vec<String>,
+    pub(super) local: FxHashMap<String, Binding>,
+}
+
+impl Scope for ModelScope {
+    fn resolve(&mut self, _pool: &mut Pool, name: &str) -> Option<Binding> {
+        if let Some((b, _, _)) = self.names.get(name) {
+            return Some(*b);
+        }
+        self.local.get(name).copied()
+    }
+    fn names(&self) -> Vec<String> {
+        let mut v = self.order.clone();
+        v.extend(self.local.keys().cloned());
+        v
+    }
+}
+
+const RESERVED: [&str; 2] = ["t", "pi"];
+
+pub(crate) struct Loader<'a> {
+    pub origin: &'a str,
+    pub source: &'a str,
+    pub pool: Pool,
+    pub scope: ModelScope,
+    pub params: Vec<Parameter>,
+}
+
+impl<'a> Loader<'a> {
+    /// A loader for the file `origin` with text `source`, nothing declared yet.
+    pub fn new(origin: &'a str, source: &'a str) -> Loader<'a> {
+        Loader {
+            origin,
+            source,
+            pool: Pool::new(),
+            scope: ModelScope::default(),
+            params: Vec::new(),
+        }
+    }
+
+    pub fn err(&self, span: Range<usize>, msg: impl Into<String>) -> ModelError {
+        ModelError::new(self.origin, span, msg)
+    }
+
+    pub(crate) fn declare(
+        &mut self,
+        name: &str,
+        span: Range<usize>,
+        what: &'static str,
+        b: Binding,
+    ) -> Result<(), ModelError> {
+        if let Some((_, prev, kind)) = self.scope.names.get(name) {
+            let (line, _) = pdyn_expr::error::line_col(self.source, prev.start);
+            return Err(self
+                .err(span, format!("duplicate name `{name}`: already a {kind} (line {line})"))
+                .help("every parameter, coordinate, definition, point, particle and reaction needs its own name"));
+        }
+        let reserved = (RESERVED.contains(&name) && what != "reaction")
+            || pdyn_expr::Func::from_name(name).is_some()
+            || ["sqrt", "dot", "cross", "norm", "unit"].contains(&name);
+        if reserved || !is_identifier(name) {
+            return Err(self
+                .err(span, format!("`{name}` cannot be used as a {what} name"))
+                .help("names are letters, digits and `_`, not starting with a digit, and not t, pi or a function name"));
+        }
+        self.scope.names.insert(name.to_string(), (b, span, what));
+        self.scope.order.push(name.to_string());
+        Ok(())
+    }
+
+    /// Text of an expression-valued field and the byte offset of that text in the file.
+    pub fn expr_text(&self, sv: &Sv) -> Result<(String, usize), ModelError> {
+        let span = sv.span();
+        match sv.get_ref() {
+            toml::Value::String(s) => {
+                let raw = &self.source[span.start..];
+                let quote = if raw.starts_with("\"\"\"") || raw.starts_with("'''") {
+                    3
+                } else {
+                    1
+                };
+                Ok((s.clone(), span.start + quote))
+            }
+            toml::Value::Integer(_) | toml::Value::Float(_) => {
+                let text = self.source[span.clone()].replace('_', "");
+                let text = if pdyn_expr::lower::literal(&text).is_some() {
+                    text
+                } else {
+                    match sv.get_ref() {
+                        toml::Value::Float(f) => format!("{f:e}"),
+                        other => other.to_string(),
+                    }
+                };
+                Ok((text, span.start))
+            }
+            other => Err(self
+                .err(span, format!("expected a number or an expression in quotes, found a {}", other.type_str()))
+                .help("write numbers plainly (9.81) and expressions in quotes (\"m*g\", \"[x, y, 0]\", \"25 mph\")")),
+        }
+    }
+
+    pub(crate) fn located(&self, e: ExprError, offset: usize) -> ModelError {
+        let e = e.offset(offset);
+        ModelError {
+            origin: self.origin.to_string(),
+            span: e.span,
+            message: e.message,
+            help: e.help,
+        }
+    }
+
+    /// Parses an expression-valued field.
+    pub fn value(&mut self, sv: &Sv) -> Result<Value, ModelError> {
+        let (text, off) = self.expr_text(sv)?;
+        if looks_like_quantity(&text) {
+            let x = parse_quantity(&text).map_err(|e| {
+                let mut me = self.err(e.span.start + off..e.span.end + off, e.message);
+                me.help = e.help;
+                me
+            })?;
+            return Ok(Value::Scalar(self.pool.num(Number::Float(x))));
+        }
+        let ast = pdyn_expr::syntax::parse(&text).map_err(|e| self.located(e, off))?;
+        lower(&mut self.pool, &ast, &mut self.scope).map_err(|e| self.located(e, off))
+    }
+
+    /// Parses a field that must be a scalar.
+    pub fn scalar(&mut self, sv: &Sv, what: &str) -> Result<Id, ModelError> {
+        match self.value(sv)? {
+            Value::Scalar(s) => Ok(s),
+            Value::Vector(_) => Err(self.err(
+                sv.span(),
+                format!("{what} must be a scalar, but this is a vector"),
+            )),
+        }
+    }
+
+    /// Parses a field that must be a vector.
+    pub fn vector(&mut self, sv: &Sv, what: &str) -> Result<[Id; 3], ModelError> {
+        match self.value(sv)? {
+            Value::Vector(v) => Ok(v),
+            Value::Scalar(_) => Err(self
+                .err(
+                    sv.span(),
+                    format!("{what} must be a vector, but this is a scalar"),
+                )
+                .help("write vectors as \"[x, y, z]\" (or \"[x, y]\" in the plane)")),
+        }
+    }
+
+    /// Evaluates an expression that may only involve parameters.
+    pub fn constant(&mut self, e: Id, span: Range<usize>, what: &str) -> Result<f64, ModelError> {
+        let inputs: Vec<Id> = self.params.iter().map(|p| p.id).collect();
+        let values: Vec<f64> = self.params.iter().map(|p| p.value).collect();
+        let prog = Program::compile(&mut self.pool, &inputs, &[e]).map_err(|err| {
+            self.err(span.clone(), format!("{what} must be a number here: {err}"))
+                .help("only parameters (and numbers, pi, units) may appear here")
+        })?;
+        let mut ws = prog.workspace();
+        let mut out = [0.0];
+        prog.eval(&values, &mut ws, &mut out);
+        if !out[0].is_finite() {
+            return Err(self.err(span, format!("{what} evaluates to {}", out[0])));
+        }
+        Ok(out[0])
+    }
+}
+
+fn is_identifier(name: &str) -> bool {
+    let mut chars = name.chars();
+    matches!(chars.next(), Some(c) if c.is_alphabetic() || c == '_')
+        && chars.all(|c| c.is_alphanumeric() || c == '_')
+}

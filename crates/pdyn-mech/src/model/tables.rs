@@ -1,0 +1,439 @@
+//! One method per table of a model file, in the order [`super::load`] reads them: each
+//! declares the names it introduces (so later tables can use them) and returns what it built.
+
+use super::forces;
+use super::loader::Loader;
+use super::raw::{RawModel, Sv};
+use super::{
+    Constraint, Coordinate, CoordinateKind, Frame, ModelError, Parameter, Particle, UnknownQuantity,
+};
+use crate::units::{looks_like_quantity, parse_quantity};
+use pdyn_expr::error::suggest;
+use pdyn_expr::lower::{lower, Binding};
+use pdyn_expr::{Id, Number, Value};
+
+/// What `[coordinates]` declares.
+pub(super) struct Coordinates {
+    pub coordinates: Vec<Coordinate>,
+    /// `(coordinate index, initial value, initial rate)` as expressions of the parameters.
+    pub initial_exprs: Vec<(usize, Id, Id)>,
+    /// `acceleration = ...` given for a free coordinate.
+    pub known_accelerations: Vec<(usize, Id)>,
+}
+
+impl Loader<'_> {
+    /// `[parameters]`: named constants. A parameter written in terms of earlier ones keeps
+    /// that definition, so that it follows them when they change (`--set`, sweeps).
+    pub(super) fn read_parameters(&mut self, raw: &RawModel) -> Result<(), ModelError> {
+        for (name, sv) in &raw.parameters {
+            let id = self.scalar(sv, "a parameter")?;
+            let value = self.constant(id, sv.span(), "a parameter")?;
+            let definition = self.depends_on_parameters(id).then_some(id);
+            let sym = self.pool.symbol(name.get_ref(), value > 0.0);
+            let sid = self.pool.sym(sym);
+            self.declare(
+                name.get_ref(),
+                name.span(),
+                "parameter",
+                Binding::Value(Value::Scalar(sid)),
+            )?;
+            self.params.push(Parameter {
+                name: name.get_ref().clone(),
+                id: sid,
+                value,
+                definition,
+            });
+        }
+        Ok(())
+    }
+
+    /// Whether `e` mentions one of the parameters declared so far.
+    fn depends_on_parameters(&self, e: Id) -> bool {
+        self.params.iter().any(|p| self.pool.contains(e, p.id))
+    }
+
+    /// `[unknowns]`: the quantities of `pdyn forces`, symbols without values.
+    pub(super) fn read_unknowns(
+        &mut self,
+        raw: &RawModel,
+    ) -> Result<Vec<UnknownQuantity>, ModelError> {
+        let mut unknowns = Vec::new();
+        for (name, su) in &raw.unknowns {
+            let s = self.pool.symbol(name.get_ref(), false);
+            let id = self.pool.sym(s);
+            self.declare(
+                name.get_ref(),
+                name.span(),
+                "unknown",
+                Binding::Value(Value::Scalar(id)),
+            )?;
+            let range = match &su.get_ref().range {
+                None => None,
+                Some(r) => {
+                    if r.get_ref().len() != 2 {
+                        return Err(self.err(r.span(), "`range` is [low, high]"));
+                    }
+                    let lo = self.scalar(&r.get_ref()[0], "a range bound")?;
+                    let lo = self.constant(lo, r.span(), "a range bound")?;
+                    let hi = self.scalar(&r.get_ref()[1], "a range bound")?;
+                    let hi = self.constant(hi, r.span(), "a range bound")?;
+                    if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
+                        return Err(self.err(r.span(), format!("empty range [{lo}, {hi}]")));
+                    }
+                    Some((lo, hi))
+                }
+            };
+            unknowns.push(UnknownQuantity {
+                name: name.get_ref().clone(),
+                id,
+                range,
+            });
+        }
+        Ok(unknowns)
+    }
+
+    /// `[coordinates]`: free ones with initial conditions, prescribed ones as functions of t.
+    pub(super) fn read_coordinates(&mut self, raw: &RawModel) -> Result<Coordinates, ModelError> {
+        let mut out = Coordinates {
+            coordinates: Vec::new(),
+            initial_exprs: Vec::new(),
+            known_accelerations: Vec::new(),
+        };
+        for (name, sv) in &raw.coordinates {
+            let n = name.get_ref();
+            let index = out.coordinates.len();
+            let kind = match sv.get_ref() {
+                toml::Value::String(_) => {
+                    let expr = self.scalar(sv, "a prescribed coordinate")?;
+                    CoordinateKind::Prescribed { expr }
+                }
+                toml::Value::Table(t) => self.coordinate_table(n, sv, t, index, &mut out)?,
+                other => {
+                    return Err(self
+                        .err(sv.span(), format!("coordinate `{n}` must be a table or a string, found a {}", other.type_str()))
+                        .help("write `x = { initial = 1.0, rate = 0.0 }` for an unknown coordinate, or `theta = \"omega*t\"` for a prescribed one"))
+                }
+            };
+            let sym = self.pool.symbol(n, false);
+            let binding = match &kind {
+                CoordinateKind::Free { .. } => Binding::Coordinate(sym),
+                CoordinateKind::Prescribed { expr } => Binding::Value(Value::Scalar(*expr)),
+            };
+            self.declare(n, name.span(), "coordinate", binding)?;
+            out.coordinates.push(Coordinate {
+                name: n.clone(),
+                sym,
+                kind,
+            });
+        }
+        Ok(out)
+    }
+
+    /// One coordinate written as a table: `{ initial, rate [, acceleration] }` or
+    /// `{ prescribed = "f(t)" }`.
+    fn coordinate_table(
+        &mut self,
+        n: &str,
+        sv: &Sv,
+        t: &toml::Table,
+        index: usize,
+        out: &mut Coordinates,
+    ) -> Result<CoordinateKind, ModelError> {
+        for key in t.keys() {
+            if !["initial", "rate", "prescribed", "acceleration"].contains(&key.as_str()) {
+                return Err(self
+                    .err(
+                        sv.span(),
+                        format!("unknown key `{key}` in coordinate `{n}`"),
+                    )
+                    .help(
+                        "a coordinate is { initial = ..., rate = ... } or a prescribed \"f(t)\"",
+                    ));
+            }
+        }
+        if let Some(p) = t.get("prescribed") {
+            let text = match p {
+                toml::Value::String(s) => s.clone(),
+                other => other.to_string(),
+            };
+            let ast = pdyn_expr::syntax::parse(&text)
+                .map_err(|e| self.err(sv.span(), format!("in `prescribed`: {}", e.message)))?;
+            let v = lower(&mut self.pool, &ast, &mut self.scope)
+                .map_err(|e| self.err(sv.span(), format!("in `prescribed`: {}", e.message)))?;
+            return match v {
+                Value::Scalar(expr) => Ok(CoordinateKind::Prescribed { expr }),
+                Value::Vector(_) => Err(self.err(sv.span(), "a coordinate is a scalar")),
+            };
+        }
+        let (initial, initial_expr) = self.initial_condition(n, sv, t, "initial")?;
+        let (rate, rate_expr) = self.initial_condition(n, sv, t, "rate")?;
+        out.initial_exprs.push((index, initial_expr, rate_expr));
+        if let Some(acc) = t.get("acceleration") {
+            let text = match acc {
+                toml::Value::String(s) => s.clone(),
+                toml::Value::Integer(i) => i.to_string(),
+                toml::Value::Float(f) => format!("{f:e}"),
+                other => {
+                    return Err(self.err(
+                        sv.span(),
+                        format!(
+                            "`acceleration` must be a number or an expression, found {}",
+                            other.type_str()
+                        ),
+                    ))
+                }
+            };
+            let ast = pdyn_expr::syntax::parse(&text)
+                .map_err(|e| self.err(sv.span(), format!("in `acceleration`: {}", e.message)))?;
+            let v = lower(&mut self.pool, &ast, &mut self.scope).map_err(|e| {
+                self.err(
+                    sv.span(),
+                    format!("in `acceleration` of `{n}`: {}", e.message),
+                )
+                .help(e.help.unwrap_or_default())
+            })?;
+            let Value::Scalar(id) = v else {
+                return Err(self.err(sv.span(), "`acceleration` must be a scalar"));
+            };
+            out.known_accelerations.push((index, id));
+        }
+        Ok(CoordinateKind::Free { initial, rate })
+    }
+
+    /// A coordinate's `initial` or `rate`: its value now and its expression in the parameters.
+    fn initial_condition(
+        &mut self,
+        n: &str,
+        sv: &Sv,
+        t: &toml::Table,
+        key: &str,
+    ) -> Result<(f64, Id), ModelError> {
+        let Some(v) = t.get(key) else {
+            let hint = if key == "rate" {
+                format!("give `{n}`'s initial rate d{n}/dt, e.g. rate = 0 if it starts at rest")
+            } else {
+                format!("give `{n}`'s value at t = 0, e.g. initial = 0")
+            };
+            return Err(self
+                .err(
+                    sv.span(),
+                    format!("coordinate `{n}` has no `{key}` (initial condition)"),
+                )
+                .help(hint));
+        };
+        let text = match v {
+            toml::Value::String(s) => s.clone(),
+            toml::Value::Integer(i) => i.to_string(),
+            toml::Value::Float(f) => format!("{f:e}"),
+            other => {
+                return Err(self.err(
+                    sv.span(),
+                    format!("`{key}` must be a number, found {}", other.type_str()),
+                ))
+            }
+        };
+        if looks_like_quantity(&text) {
+            let q = parse_quantity(&text)
+                .map_err(|e| self.err(sv.span(), format!("in `{key}`: {}", e.message)))?;
+            return Ok((q, self.pool.num(Number::Float(q))));
+        }
+        let ast = pdyn_expr::syntax::parse(&text)
+            .map_err(|e| self.err(sv.span(), format!("in `{key}`: {}", e.message)))?;
+        let v = lower(&mut self.pool, &ast, &mut self.scope).map_err(|e| {
+            self.err(sv.span(), format!("in `{key}` of `{n}`: {}", e.message))
+                .help(e.help.unwrap_or_default())
+        })?;
+        let Value::Scalar(id) = v else {
+            return Err(self.err(sv.span(), format!("`{key}` must be a scalar")));
+        };
+        Ok((
+            self.constant(id, sv.span(), &format!("`{key}` of `{n}`"))?,
+            id,
+        ))
+    }
+
+    /// `[definitions]`: named expressions.
+    pub(super) fn read_definitions(
+        &mut self,
+        raw: &RawModel,
+    ) -> Result<Vec<(String, Value)>, ModelError> {
+        let mut definitions = Vec::new();
+        for (name, sv) in &raw.definitions {
+            let v = self.value(sv)?;
+            self.declare(name.get_ref(), name.span(), "definition", Binding::Value(v))?;
+            definitions.push((name.get_ref().clone(), v));
+        }
+        Ok(definitions)
+    }
+
+    /// `[points]`: named fixed or prescribed positions.
+    pub(super) fn read_points(
+        &mut self,
+        raw: &RawModel,
+    ) -> Result<Vec<(String, [Id; 3])>, ModelError> {
+        let mut points = Vec::new();
+        for (name, sv) in &raw.points {
+            let v = self.vector(sv, &format!("point `{}`", name.get_ref()))?;
+            self.declare(
+                name.get_ref(),
+                name.span(),
+                "point",
+                Binding::Value(Value::Vector(v)),
+            )?;
+            points.push((name.get_ref().clone(), v));
+        }
+        Ok(points)
+    }
+
+    /// `[particles.NAME]`: mass and position; declares `NAME` (the position), `r_NAME` and
+    /// `v_NAME`. A model needs at least one.
+    pub(super) fn read_particles(&mut self, raw: &RawModel) -> Result<Vec<Particle>, ModelError> {
+        let mut particles = Vec::new();
+        for (name, sp) in &raw.particles {
+            let n = name.get_ref();
+            let p = sp.get_ref();
+            let Some(msv) = &p.mass else {
+                return Err(self
+                    .err(name.span(), format!("particle `{n}` has no mass"))
+                    .help("add mass = ... (a number or a parameter)"));
+            };
+            let Some(psv) = &p.position else {
+                return Err(self
+                    .err(name.span(), format!("particle `{n}` has no position"))
+                    .help("add position = \"[x, y, z]\" in terms of the coordinates"));
+            };
+            let mass = self.scalar(msv, "a mass")?;
+            let mv = self.constant(mass, msv.span(), "a mass")?;
+            if mv <= 0.0 {
+                return Err(self
+                    .err(
+                        msv.span(),
+                        format!("the mass of `{n}` must be positive, it is {mv}"),
+                    )
+                    .help("a massless body is a frame: declare it under [frames]"));
+            }
+            let position = self.vector(psv, &format!("the position of `{n}`"))?;
+            let vel = position.map(|c| self.pool.dt(c));
+            for (prefix, v) in [("r_", position), ("v_", vel)] {
+                let key = format!("{prefix}{n}");
+                if !self.scope.names.contains_key(&key) {
+                    self.scope
+                        .local
+                        .insert(key, Binding::Value(Value::Vector(v)));
+                }
+            }
+            self.declare(
+                n,
+                name.span(),
+                "particle",
+                Binding::Value(Value::Vector(position)),
+            )?;
+            particles.push(Particle {
+                name: n.clone(),
+                mass,
+                position,
+            });
+        }
+        if particles.is_empty() {
+            return Err(self
+                .err(0..0, "the model has no particles")
+                .help("add a [particles.NAME] table with mass and position"));
+        }
+        Ok(particles)
+    }
+
+    /// `[frames.NAME]`: massless frames, each carrying one particle.
+    pub(super) fn read_frames(
+        &mut self,
+        raw: &RawModel,
+        particles: &[Particle],
+    ) -> Result<Vec<Frame>, ModelError> {
+        let mut frames = Vec::new();
+        for (name, sf) in &raw.frames {
+            let Some(pn) = &sf.get_ref().particle else {
+                return Err(self
+                    .err(
+                        name.span(),
+                        format!("frame `{}` names no particle", name.get_ref()),
+                    )
+                    .help("add particle = \"NAME\""));
+            };
+            let Some(pi) = particles.iter().position(|p| &p.name == pn.get_ref()) else {
+                let s = suggest(pn.get_ref(), particles.iter().map(|p| p.name.as_str()));
+                let mut e = self.err(pn.span(), format!("unknown particle `{}`", pn.get_ref()));
+                if let Some(s) = s {
+                    e = e.help(format!("did you mean `{s}`?"));
+                }
+                return Err(e);
+            };
+            frames.push(Frame {
+                name: name.get_ref().clone(),
+                particle: pi,
+            });
+        }
+        Ok(frames)
+    }
+
+    /// `gravity` and `[[forces]]`, split into loads; the reactions they introduce become names
+    /// that constraints, events and monitors may use.
+    pub(super) fn read_forces(
+        &mut self,
+        raw: &RawModel,
+        particles: &[Particle],
+        frames: &[Frame],
+        points: &[(String, [Id; 3])],
+    ) -> Result<forces::Built, ModelError> {
+        let gravity = match &raw.gravity {
+            Some(g) => Some(self.vector(g, "gravity")?),
+            None => None,
+        };
+        let mut fb = forces::ForceBuilder::new(particles, frames, points);
+        if let Some(g) = gravity {
+            fb.gravity(self, g);
+        }
+        for f in &raw.forces {
+            fb.force(self, f)?;
+        }
+        let built = fb.finish();
+        for r in &built.reactions {
+            if !self.scope.names.contains_key(&r.name) {
+                self.scope.order.push(r.name.clone());
+                self.scope.names.insert(
+                    r.name.clone(),
+                    (Binding::Value(Value::Scalar(r.id)), 0..0, "reaction"),
+                );
+            }
+        }
+        Ok(built)
+    }
+
+    /// `[[constraints]]`: equations among the coordinates.
+    pub(super) fn read_constraints(
+        &mut self,
+        raw: &RawModel,
+    ) -> Result<Vec<Constraint>, ModelError> {
+        let mut constraints = Vec::new();
+        for sc in &raw.constraints {
+            let c = sc.get_ref();
+            let Some(eq) = &c.equation else {
+                return Err(self
+                    .err(sc.span(), "a constraint has no `equation`")
+                    .help("write equation = \"yA + yB = 2*h\" (a relation among coordinates)"));
+            };
+            let (text, off) = self.expr_text(eq)?;
+            let v = self
+                .pool
+                .parse_equation_in(&text, &mut self.scope)
+                .map_err(|e| self.located(e, off))?;
+            let Value::Scalar(e) = v else {
+                return Err(self.err(eq.span(), "a constraint equation must be scalar"));
+            };
+            let label = c
+                .name
+                .as_ref()
+                .map_or(text.clone(), |n| n.get_ref().clone());
+            constraints.push(Constraint { label, equation: e });
+        }
+        Ok(constraints)
+    }
+}
