@@ -10,77 +10,11 @@ use std::time::Instant;
 
 mod diffsol_peer;
 
-const MU: f64 = 0.012277471;
-pub(crate) const AREN_Y0: [f64; 4] = [0.994, 0.0, 0.0, -2.001_585_106_379_082_5];
-pub(crate) const AREN_T: f64 = 17.065_216_560_157_963;
-
-pub(crate) fn arenstorf(y: &[f64], f: &mut [f64]) {
-    let mup = 1.0 - MU;
-    let r1 = (y[0] + MU) * (y[0] + MU) + y[1] * y[1];
-    let r2 = (y[0] - mup) * (y[0] - mup) + y[1] * y[1];
-    let d1 = r1 * r1.sqrt();
-    let d2 = r2 * r2.sqrt();
-    f[0] = y[2];
-    f[1] = y[3];
-    f[2] = y[0] + 2.0 * y[3] - mup * (y[0] + MU) / d1 - MU * (y[0] - mup) / d2;
-    f[3] = y[1] - 2.0 * y[2] - mup * y[1] / d1 - MU * y[1] / d2;
-}
-
-pub(crate) fn pleiades(s: &[f64], f: &mut [f64]) {
-    let (x, rest) = s.split_at(7);
-    let (y, v) = rest.split_at(7);
-    f[..14].copy_from_slice(v);
-    for i in 0..7 {
-        let (mut ax, mut ay) = (0.0, 0.0);
-        for j in 0..7 {
-            if i != j {
-                let dx = x[j] - x[i];
-                let dy = y[j] - y[i];
-                let r2 = dx * dx + dy * dy;
-                let r3 = r2 * r2.sqrt();
-                ax += (j + 1) as f64 * dx / r3;
-                ay += (j + 1) as f64 * dy / r3;
-            }
-        }
-        f[14 + i] = ax;
-        f[21 + i] = ay;
-    }
-}
-
-pub(crate) const PLEI_Y0: [f64; 28] = [
-    3.0, 3.0, -1.0, -3.0, 2.0, -2.0, 2.0, 3.0, -3.0, 2.0, 0.0, 0.0, -4.0, 4.0, 0.0, 0.0, 0.0, 0.0,
-    0.0, 1.75, -1.5, 0.0, 0.0, 0.0, -1.25, 1.0, 0.0, 0.0,
-];
-pub(crate) const PLEI_Y3: [f64; 28] = [
-    0.3706139143970502,
-    3.237284092057233,
-    -3.222559032418324,
-    0.6597091455775310,
-    0.3425581707156584,
-    1.562172101400631,
-    -0.7003092922212495,
-    -3.943437585517392,
-    -3.271380973972550,
-    5.225081843456543,
-    -2.590612434977470,
-    1.198213693392275,
-    -0.2429682344935824,
-    1.091449240428980,
-    3.417003806314313,
-    1.354584501625501,
-    -2.590065597810775,
-    2.025053734714242,
-    -1.155815100160448,
-    -0.8072988170223021,
-    0.5952396354208710,
-    -3.741244961234010,
-    0.3773459685750630,
-    0.9386858869551073,
-    0.3667922227200571,
-    -0.3474046353808490,
-    2.344915448180937,
-    -1.947020434263292,
-];
+// The problems and their published data come from pdyn-ode itself, so every code here
+// integrates the same right-hand side from the same start.
+pub(crate) use pdyn_ode::problems::{
+    arenstorf_rhs as arenstorf, pleiades_rhs as pleiades, AREN_T, AREN_Y0, PLEI_Y0, PLEI_Y3,
+};
 
 struct DeAren;
 impl differential_equations::ode::ODE<f64, DeVec<f64, 4>> for DeAren {

@@ -92,31 +92,10 @@ fn satellite_handwritten(b: Bencher) {
 }
 
 /// The model file of an n-link planar chain (as `examples/pendulum_chain_3.toml`).
-fn chain_toml(n: usize) -> String {
-    let mut s =
-        String::from("name = \"chain\"\ngravity = \"[0, -g, 0]\"\n\n[parameters]\ng = 9.81\n");
-    for i in 1..=n {
-        s += &format!(
-            "m{i} = {}\nl{i} = {}\n",
-            1.0 + 0.1 * i as f64,
-            0.5 + 0.05 * i as f64
-        );
-    }
-    s += "\n[coordinates]\n";
-    for i in 1..=n {
-        s += &format!("q{i} = {{ initial = 0.1, rate = 0.0 }}\n");
-    }
-    for i in 1..=n {
-        let pos: Vec<String> = (1..=i)
-            .map(|j| format!("l{j}*[sin(q{j}), -cos(q{j}), 0]"))
-            .collect();
-        s += &format!(
-            "\n[particles.p{i}]\nmass = \"m{i}\"\nposition = \"{}\"\n",
-            pos.join(" + ")
-        );
-    }
-    s
-}
+// The chain generator shared with pdyn-mech's tests (unit masses and lengths).
+#[path = "../../pdyn-mech/tests/common/chain.rs"]
+mod chain_model;
+use chain_model::chain_toml;
 
 struct Chain {
     prog: Program,

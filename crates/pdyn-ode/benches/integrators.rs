@@ -6,47 +6,15 @@ use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use pdyn_ode::{solve, solve_second_order, FnSecondOrder, FnSystem, FnSystemWithJacobian};
 use pdyn_ode::{Method, Options};
 
-const MU: f64 = 0.012277471;
-const AREN_Y0: [f64; 4] = [0.994, 0.0, 0.0, -2.001_585_106_379_082_5];
-const AREN_T: f64 = 17.065_216_560_157_963;
+use pdyn_ode::problems::{arenstorf_rhs, pleiades_rhs, AREN_T, AREN_Y0, PLEI_Y0};
 
 fn arenstorf(_t: f64, y: &[f64], f: &mut [f64]) {
-    let mup = 1.0 - MU;
-    let r1 = (y[0] + MU) * (y[0] + MU) + y[1] * y[1];
-    let r2 = (y[0] - mup) * (y[0] - mup) + y[1] * y[1];
-    let d1 = r1 * r1.sqrt();
-    let d2 = r2 * r2.sqrt();
-    f[0] = y[2];
-    f[1] = y[3];
-    f[2] = y[0] + 2.0 * y[3] - mup * (y[0] + MU) / d1 - MU * (y[0] - mup) / d2;
-    f[3] = y[1] - 2.0 * y[2] - mup * y[1] / d1 - MU * y[1] / d2;
+    arenstorf_rhs(y, f)
 }
 
 fn pleiades(_t: f64, s: &[f64], f: &mut [f64]) {
-    let (x, rest) = s.split_at(7);
-    let (y, v) = rest.split_at(7);
-    f[..14].copy_from_slice(v);
-    for i in 0..7 {
-        let (mut ax, mut ay) = (0.0, 0.0);
-        for j in 0..7 {
-            if i != j {
-                let dx = x[j] - x[i];
-                let dy = y[j] - y[i];
-                let r2 = dx * dx + dy * dy;
-                let r3 = r2 * r2.sqrt();
-                ax += (j + 1) as f64 * dx / r3;
-                ay += (j + 1) as f64 * dy / r3;
-            }
-        }
-        f[14 + i] = ax;
-        f[21 + i] = ay;
-    }
+    pleiades_rhs(s, f)
 }
-
-const PLEI_Y0: [f64; 28] = [
-    3.0, 3.0, -1.0, -3.0, 2.0, -2.0, 2.0, 3.0, -3.0, 2.0, 0.0, 0.0, -4.0, 4.0, 0.0, 0.0, 0.0, 0.0,
-    0.0, 1.75, -1.5, 0.0, 0.0, 0.0, -1.25, 1.0, 0.0, 0.0,
-];
 
 fn bench(c: &mut Criterion) {
     let aren = FnSystem::new(4, arenstorf);

@@ -71,6 +71,7 @@ pub mod linalg;
 pub mod methods;
 mod options;
 pub mod problem;
+pub mod problems;
 mod solution;
 pub mod tableau;
 

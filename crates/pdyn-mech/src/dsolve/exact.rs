@@ -282,36 +282,8 @@ fn essential_sign_factor(pool: &mut Pool, e: Id) -> Id {
             }
         }
         Node::Add(_) => {
-            // Divide out positive common factors while that shortens the expression:
             // `wn^2 zeta^2 - wn^2` becomes `zeta^2 - 1`.
-            let mut cur = pool.expand(s);
-            for _ in 0..8 {
-                let first = match pool.node(cur) {
-                    Node::Add(ts) => ts[0],
-                    _ => break,
-                };
-                let cands: Vec<Id> = match pool.node(first) {
-                    Node::Mul(fs) => fs.to_vec(),
-                    _ => vec![first],
-                };
-                let size = pool.tree_size(cur, usize::MAX);
-                let mut improved = false;
-                for f in cands {
-                    if pool.as_num(f).is_some() || !pool.is_positive(f) {
-                        continue;
-                    }
-                    let q = pool.div(cur, f);
-                    let q = pool.expand(q);
-                    if pool.tree_size(q, size) < size {
-                        cur = q;
-                        improved = true;
-                        break;
-                    }
-                }
-                if !improved {
-                    break;
-                }
-            }
+            let (cur, _) = shed_positive_factors(pool, s);
             match pool.add_content(cur) {
                 Some((c, prim)) if c.is_positive() => prim,
                 Some((_, prim)) => pool.neg(prim),
@@ -819,11 +791,11 @@ fn fit_constants(
     Ok((pool.add(&terms), Vec::new()))
 }
 
-/// `sqrt(d)` with positive square factors taken out: `sqrt(wn^2 - wn^2 zeta^2)` becomes
-/// `wn sqrt(1 - zeta^2)`.
-pub(crate) fn nice_sqrt(pool: &mut Pool, d: Id) -> Id {
-    let mut cur = pool.expand(d);
-    let mut outside = Vec::new();
+/// Divides positive factors out of a sum while that shortens it (at most 8 of them, each a
+/// factor of the first term): `wn^2 zeta^2 - wn^2` gives `(zeta^2 - 1, [wn^2])`.
+fn shed_positive_factors(pool: &mut Pool, e: Id) -> (Id, Vec<Id>) {
+    let mut cur = pool.expand(e);
+    let mut shed = Vec::new();
     for _ in 0..8 {
         let first = match pool.node(cur) {
             Node::Add(ts) => ts[0],
@@ -834,24 +806,29 @@ pub(crate) fn nice_sqrt(pool: &mut Pool, d: Id) -> Id {
             _ => vec![first],
         };
         let size = pool.tree_size(cur, usize::MAX);
-        let mut improved = false;
-        for f in cands {
+        let shorter = cands.into_iter().find_map(|f| {
             if pool.as_num(f).is_some() || !pool.is_positive(f) {
-                continue;
+                return None;
             }
             let q = pool.div(cur, f);
             let q = pool.expand(q);
-            if pool.tree_size(q, size) < size {
+            (pool.tree_size(q, size) < size).then_some((f, q))
+        });
+        match shorter {
+            Some((f, q)) => {
                 cur = q;
-                outside.push(f);
-                improved = true;
-                break;
+                shed.push(f);
             }
-        }
-        if !improved {
-            break;
+            None => break,
         }
     }
+    (cur, shed)
+}
+
+/// `sqrt(d)` with positive square factors taken out: `sqrt(wn^2 - wn^2 zeta^2)` becomes
+/// `wn sqrt(1 - zeta^2)`.
+pub(crate) fn nice_sqrt(pool: &mut Pool, d: Id) -> Id {
+    let (cur, outside) = shed_positive_factors(pool, d);
     let inner = pool.simplify(cur);
     let mut factors: Vec<Id> = outside.iter().map(|&f| pool.sqrt(f)).collect();
     factors.push(pool.sqrt(inner));
