@@ -71,8 +71,9 @@ fn satellite_interpreter(b: Bencher) {
 #[divan::bench]
 fn satellite_jit(b: Bencher) {
     let jit = JitProgram::compile(&satellite()).unwrap();
+    let mut ws = jit.workspace();
     b.counter(divan::counter::ItemsCount::new(CALLS))
-        .bench_local(|| euler(|w, out| jit.eval(w, out)));
+        .bench_local(|| euler(|w, out| jit.eval(w, &mut ws, out)));
 }
 
 #[divan::bench]
@@ -204,8 +205,9 @@ fn chain16_mf_jit(b: Bencher) {
     let c = chain();
     let jit = JitProgram::compile(&c.prog).unwrap();
     let mut out = vec![0.0; c.prog.n_outputs()];
+    let mut ws = jit.workspace();
     b.bench_local(|| {
-        jit.eval(black_box(&c.input), &mut out);
+        jit.eval(black_box(&c.input), &mut ws, &mut out);
         black_box(out[0])
     });
 }

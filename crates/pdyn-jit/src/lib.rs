@@ -8,8 +8,11 @@
 //! registers), and this crate depends on it.
 //!
 //! ## What is emitted, and why results agree bit for bit
-//! One function `extern "C" fn(inputs: *const f64, out: *mut f64)` with a single basic block:
-//! every instruction of the program becomes one SSA value, in the program's order, so the
+//! Functions `extern "C" fn(inputs: *const f64, out: *mut f64, spill: *mut f64)`, one per
+//! chunk of 2,048 instructions, each a single basic block, called in order (values a later
+//! chunk needs pass through the `spill` workspace, bits unchanged; one huge block makes
+//! Cranelift's register allocation superlinear): every instruction of the program becomes one
+//! SSA value, in the program's order, so the
 //! arithmetic is the same sequence of IEEE operations as the interpreter's (no reassociation,
 //! no fused multiply-add). `+ − × ÷`, negation, `sqrt`, `abs` and `sign` are native
 //! instructions (correctly rounded, like Rust's). Transcendental functions (`sin`, `cos`,
@@ -85,12 +88,20 @@ fn codegen<E: std::fmt::Display>(e: E) -> JitError {
     }
 }
 
-type RawFn = unsafe extern "C" fn(*const f64, *mut f64);
+/// One chunk of a program: `(inputs, out, spill)`.
+type RawFn = unsafe extern "C" fn(*const f64, *mut f64, *mut f64);
+
+/// Instructions per generated function. Cranelift's register allocator slows down sharply on
+/// one huge basic block (many values live across many calls), so a long program becomes a
+/// sequence of functions of this size that pass the values they share through a spill array.
+/// Measured on the 100-link chain: one function took longer to compile than the whole run.
+const CHUNK: usize = 2048;
 
 /// The JIT module owning the code memory; freed on drop.
 struct Code {
     module: Option<JITModule>,
-    func: RawFn,
+    /// The chunks, called in order.
+    funcs: Vec<RawFn>,
 }
 
 impl Drop for Code {
@@ -117,6 +128,8 @@ pub struct JitProgram {
     n_inputs: usize,
     n_outputs: usize,
     len: usize,
+    /// Values passed between chunks.
+    n_spill: usize,
 }
 
 impl std::fmt::Debug for JitProgram {
@@ -125,8 +138,186 @@ impl std::fmt::Debug for JitProgram {
             .field("n_inputs", &self.n_inputs)
             .field("n_outputs", &self.n_outputs)
             .field("instructions", &self.len)
+            .field("chunks", &self.code.funcs.len())
             .finish()
     }
+}
+
+/// Which values cross from one chunk to a later one, and where they are kept meanwhile.
+struct SpillPlan {
+    chunks: usize,
+    /// Spill slot of each temporary (instruction index), `u32::MAX` when it stays in its chunk.
+    slot: Vec<u32>,
+    n_slots: usize,
+}
+
+impl SpillPlan {
+    fn new(prog: &Program) -> SpillPlan {
+        let len = prog.len();
+        let chunks = len.div_ceil(CHUNK).max(1);
+        let first_temp = prog.first_temporary() as u32;
+        // The last chunk that reads each temporary (outputs are read by the last chunk).
+        let mut last_use = vec![0usize; len];
+        let mut read = |r: u32, chunk: usize| {
+            if r >= first_temp {
+                let k = (r - first_temp) as usize;
+                last_use[k] = last_use[k].max(chunk);
+            }
+        };
+        for (k, ins) in prog.instructions().iter().enumerate() {
+            read(ins.a(), k / CHUNK);
+            if ins.op().reads_b() {
+                read(ins.b(), k / CHUNK);
+            }
+        }
+        for &r in prog.output_registers() {
+            read(r, chunks - 1);
+        }
+        let mut slot = vec![u32::MAX; len];
+        let mut n_slots = 0;
+        for k in 0..len {
+            if last_use[k] > k / CHUNK {
+                slot[k] = n_slots as u32;
+                n_slots += 1;
+            }
+        }
+        SpillPlan {
+            chunks,
+            slot,
+            n_slots,
+        }
+    }
+}
+
+/// Emits chunk `c` of `prog` into `func`: instructions `c*CHUNK ..`, storing the values later
+/// chunks need into the spill array, and (last chunk) the outputs.
+fn emit_chunk(
+    prog: &Program,
+    plan: &SpillPlan,
+    c: usize,
+    ptr: types::Type,
+    call_conv: cranelift_codegen::isa::CallConv,
+    func: &mut cranelift_codegen::ir::Function,
+    fctx: &mut FunctionBuilderContext,
+) -> Result<(), JitError> {
+    let mut b = FunctionBuilder::new(func, fctx);
+    let block = b.create_block();
+    b.append_block_params_for_function_params(block);
+    b.switch_to_block(block);
+    b.seal_block(block);
+    let params = b.block_params(block);
+    let (inp, outp, spill) = (params[0], params[1], params[2]);
+
+    let mut sig1 = Signature::new(call_conv);
+    sig1.params.push(AbiParam::new(types::F64));
+    sig1.returns.push(AbiParam::new(types::F64));
+    let sig1 = b.import_signature(sig1);
+    let mut sig2 = Signature::new(call_conv);
+    sig2.params.push(AbiParam::new(types::F64));
+    sig2.params.push(AbiParam::new(types::F64));
+    sig2.returns.push(AbiParam::new(types::F64));
+    let sig2 = b.import_signature(sig2);
+    let mut sigi = Signature::new(call_conv);
+    sigi.params.push(AbiParam::new(types::F64));
+    sigi.params.push(AbiParam::new(types::I32));
+    sigi.returns.push(AbiParam::new(types::F64));
+    let sigi = b.import_signature(sigi);
+
+    // Registers: inputs loaded on first use, constants materialised on first use, temporaries
+    // of earlier chunks loaded from the spill array on first use, temporaries of this chunk
+    // are the SSA values of its instructions.
+    let n_in = prog.n_inputs();
+    let consts = prog.constants();
+    let first_temp = prog.first_temporary();
+    let mut regs: Vec<Option<Value>> = vec![None; first_temp + prog.len()];
+    let flags = MemFlags::trusted();
+    let get = |b: &mut FunctionBuilder, regs: &mut Vec<Option<Value>>, r: u32| {
+        let r = r as usize;
+        if let Some(v) = regs[r] {
+            return v;
+        }
+        let v = if r < n_in {
+            b.ins().load(types::F64, flags, inp, (8 * r) as i32)
+        } else if r < first_temp {
+            b.ins().f64const(consts[r - n_in])
+        } else {
+            // Defined by an earlier chunk, which spilled it (the plan saw this read).
+            let slot = plan.slot[r - first_temp] as usize;
+            b.ins().load(types::F64, flags, spill, (8 * slot) as i32)
+        };
+        regs[r] = Some(v);
+        v
+    };
+    let start = c * CHUNK;
+    let end = (start + CHUNK).min(prog.len());
+    for (k, ins) in prog.instructions()[start..end].iter().enumerate() {
+        let k = start + k;
+        let a = get(&mut b, &mut regs, ins.a());
+        let rb = if ins.op().reads_b() {
+            Some(get(&mut b, &mut regs, ins.b()))
+        } else {
+            None
+        };
+        let bv = || rb.expect("binary operation reads b");
+        let v = match ins.op() {
+            Op::Add => b.ins().fadd(a, bv()),
+            Op::Sub => b.ins().fsub(a, bv()),
+            Op::Mul => b.ins().fmul(a, bv()),
+            Op::Div => b.ins().fdiv(a, bv()),
+            Op::Neg => b.ins().fneg(a),
+            Op::Sqrt => b.ins().sqrt(a),
+            Op::Abs => b.ins().fabs(a),
+            Op::Sign => {
+                // 1 for a > 0, −1 for a < 0, a·0 otherwise (±0, or NaN for NaN).
+                let zero = b.ins().f64const(0.0);
+                let one = b.ins().f64const(1.0);
+                let minus_one = b.ins().f64const(-1.0);
+                let gt = b.ins().fcmp(FloatCC::GreaterThan, a, zero);
+                let lt = b.ins().fcmp(FloatCC::LessThan, a, zero);
+                let az = b.ins().fmul(a, zero);
+                let r = b.ins().select(lt, minus_one, az);
+                b.ins().select(gt, one, r)
+            }
+            Op::Powi => {
+                let f = b.ins().iconst(
+                    ptr,
+                    shims::powi as extern "C" fn(f64, i32) -> f64 as usize as i64,
+                );
+                let e = b.ins().iconst(types::I32, ins.b() as i32 as i64);
+                let call = b.ins().call_indirect(sigi, f, &[a, e]);
+                b.inst_results(call)[0]
+            }
+            op => {
+                if let Some(s) = unary_shim(op) {
+                    let f = b.ins().iconst(ptr, s as usize as i64);
+                    let call = b.ins().call_indirect(sig1, f, &[a]);
+                    b.inst_results(call)[0]
+                } else if let Some(s) = binary_shim(op) {
+                    let f = b.ins().iconst(ptr, s as usize as i64);
+                    let call = b.ins().call_indirect(sig2, f, &[a, bv()]);
+                    b.inst_results(call)[0]
+                } else {
+                    return Err(JitError::UnsupportedOp {
+                        op: format!("{op:?}"),
+                    });
+                }
+            }
+        };
+        regs[first_temp + k] = Some(v);
+        let slot = plan.slot[k];
+        if slot != u32::MAX {
+            b.ins().store(flags, v, spill, (8 * slot as usize) as i32);
+        }
+    }
+    if c + 1 == plan.chunks {
+        for (i, &r) in prog.output_registers().iter().enumerate() {
+            let v = get(&mut b, &mut regs, r);
+            b.ins().store(flags, v, outp, (8 * i) as i32);
+        }
+    }
+    b.ins().return_(&[]);
+    b.finalize();
+    Ok(())
 }
 
 mod shims {
@@ -201,133 +392,56 @@ impl JitProgram {
         let ptr = module.target_config().pointer_type();
         let call_conv = module.isa().default_call_conv();
 
+        let plan = SpillPlan::new(prog);
+        let mut ids = Vec::new();
         let mut ctx = module.make_context();
-        ctx.func.signature.params.push(AbiParam::new(ptr));
-        ctx.func.signature.params.push(AbiParam::new(ptr));
         let mut fctx = FunctionBuilderContext::new();
-        {
-            let mut b = FunctionBuilder::new(&mut ctx.func, &mut fctx);
-            let block = b.create_block();
-            b.append_block_params_for_function_params(block);
-            b.switch_to_block(block);
-            b.seal_block(block);
-            let (inp, outp) = (b.block_params(block)[0], b.block_params(block)[1]);
-
-            let mut sig1 = Signature::new(call_conv);
-            sig1.params.push(AbiParam::new(types::F64));
-            sig1.returns.push(AbiParam::new(types::F64));
-            let sig1 = b.import_signature(sig1);
-            let mut sig2 = Signature::new(call_conv);
-            sig2.params.push(AbiParam::new(types::F64));
-            sig2.params.push(AbiParam::new(types::F64));
-            sig2.returns.push(AbiParam::new(types::F64));
-            let sig2 = b.import_signature(sig2);
-            let mut sigi = Signature::new(call_conv);
-            sigi.params.push(AbiParam::new(types::F64));
-            sigi.params.push(AbiParam::new(types::I32));
-            sigi.returns.push(AbiParam::new(types::F64));
-            let sigi = b.import_signature(sigi);
-
-            // Registers: inputs loaded on first use, constants materialised on first use,
-            // temporaries are the SSA values of the instructions.
-            let n_in = prog.n_inputs();
-            let consts = prog.constants();
-            let first_temp = prog.first_temporary();
-            let mut regs: Vec<Option<Value>> = vec![None; first_temp + prog.len()];
-            let flags = MemFlags::trusted();
-            let get = |b: &mut FunctionBuilder, regs: &mut Vec<Option<Value>>, r: u32| {
-                let r = r as usize;
-                if let Some(v) = regs[r] {
-                    return v;
-                }
-                let v = if r < n_in {
-                    b.ins().load(types::F64, flags, inp, (8 * r) as i32)
-                } else {
-                    b.ins().f64const(consts[r - n_in])
-                };
-                regs[r] = Some(v);
-                v
-            };
-            for (k, ins) in prog.instructions().iter().enumerate() {
-                let a = get(&mut b, &mut regs, ins.a());
-                let rb = if ins.op().reads_b() {
-                    Some(get(&mut b, &mut regs, ins.b()))
-                } else {
-                    None
-                };
-                let bv = || rb.expect("binary operation reads b");
-                let v = match ins.op() {
-                    Op::Add => b.ins().fadd(a, bv()),
-                    Op::Sub => b.ins().fsub(a, bv()),
-                    Op::Mul => b.ins().fmul(a, bv()),
-                    Op::Div => b.ins().fdiv(a, bv()),
-                    Op::Neg => b.ins().fneg(a),
-                    Op::Sqrt => b.ins().sqrt(a),
-                    Op::Abs => b.ins().fabs(a),
-                    Op::Sign => {
-                        // 1 for a > 0, −1 for a < 0, a·0 otherwise (±0, or NaN for NaN).
-                        let zero = b.ins().f64const(0.0);
-                        let one = b.ins().f64const(1.0);
-                        let minus_one = b.ins().f64const(-1.0);
-                        let gt = b.ins().fcmp(FloatCC::GreaterThan, a, zero);
-                        let lt = b.ins().fcmp(FloatCC::LessThan, a, zero);
-                        let az = b.ins().fmul(a, zero);
-                        let r = b.ins().select(lt, minus_one, az);
-                        b.ins().select(gt, one, r)
-                    }
-                    Op::Powi => {
-                        let f = b.ins().iconst(
-                            ptr,
-                            shims::powi as extern "C" fn(f64, i32) -> f64 as usize as i64,
-                        );
-                        let e = b.ins().iconst(types::I32, ins.b() as i32 as i64);
-                        let call = b.ins().call_indirect(sigi, f, &[a, e]);
-                        b.inst_results(call)[0]
-                    }
-                    op => {
-                        if let Some(s) = unary_shim(op) {
-                            let f = b.ins().iconst(ptr, s as usize as i64);
-                            let call = b.ins().call_indirect(sig1, f, &[a]);
-                            b.inst_results(call)[0]
-                        } else if let Some(s) = binary_shim(op) {
-                            let f = b.ins().iconst(ptr, s as usize as i64);
-                            let call = b.ins().call_indirect(sig2, f, &[a, bv()]);
-                            b.inst_results(call)[0]
-                        } else {
-                            return Err(JitError::UnsupportedOp {
-                                op: format!("{op:?}"),
-                            });
-                        }
-                    }
-                };
-                regs[first_temp + k] = Some(v);
+        for c in 0..plan.chunks {
+            for _ in 0..3 {
+                ctx.func.signature.params.push(AbiParam::new(ptr));
             }
-            for (i, &r) in prog.output_registers().iter().enumerate() {
-                let v = get(&mut b, &mut regs, r);
-                b.ins().store(flags, v, outp, (8 * i) as i32);
-            }
-            b.ins().return_(&[]);
-            b.finalize();
+            emit_chunk(prog, &plan, c, ptr, call_conv, &mut ctx.func, &mut fctx)?;
+            let id = module
+                .declare_function(
+                    &format!("pdyn_chunk{c}"),
+                    Linkage::Local,
+                    &ctx.func.signature,
+                )
+                .map_err(codegen)?;
+            module.define_function(id, &mut ctx).map_err(codegen)?;
+            module.clear_context(&mut ctx);
+            ids.push(id);
         }
-        let id = module
-            .declare_function("pdyn_program", Linkage::Local, &ctx.func.signature)
-            .map_err(codegen)?;
-        module.define_function(id, &mut ctx).map_err(codegen)?;
-        module.clear_context(&mut ctx);
         module.finalize_definitions().map_err(codegen)?;
-        let raw = module.get_finalized_function(id);
-        // SAFETY: `raw` is the finalized code of a function with exactly this signature,
-        // using the platform's default (C) calling convention.
-        let func = unsafe { std::mem::transmute::<*const u8, RawFn>(raw) };
+        let funcs = ids
+            .into_iter()
+            .map(|id| {
+                let raw = module.get_finalized_function(id);
+                // SAFETY: `raw` is the finalized code of a function with exactly this
+                // signature, using the platform's default (C) calling convention.
+                unsafe { std::mem::transmute::<*const u8, RawFn>(raw) }
+            })
+            .collect();
         Ok(JitProgram {
             code: Arc::new(Code {
                 module: Some(module),
-                func,
+                funcs,
             }),
             n_inputs: prog.n_inputs(),
             n_outputs: prog.n_outputs(),
             len: prog.len(),
+            n_spill: plan.n_slots,
         })
+    }
+
+    /// Number of generated functions (programs longer than a chunk are split).
+    pub fn chunks(&self) -> usize {
+        self.code.funcs.len()
+    }
+
+    /// A spill array for [`JitProgram::eval`] (empty for programs of one chunk).
+    pub fn workspace(&self) -> Vec<f64> {
+        vec![0.0; self.n_spill]
     }
 
     /// Number of inputs read by [`JitProgram::eval`].
@@ -351,20 +465,26 @@ impl JitProgram {
     }
 
     /// Evaluates every output: the same values, bit for bit, as [`Program::eval`] on the
-    /// source program. Needs no workspace and allocates nothing.
+    /// source program. `ws` comes from [`JitProgram::workspace`]; allocates nothing.
     ///
     /// # Panics
-    /// If `inputs` is shorter than [`JitProgram::n_inputs`] or `out` shorter than
-    /// [`JitProgram::n_outputs`] (a programming error, not a data error).
+    /// If `inputs` is shorter than [`JitProgram::n_inputs`], `out` shorter than
+    /// [`JitProgram::n_outputs`] or `ws` shorter than the workspace (a programming error, not
+    /// a data error).
     #[inline]
-    pub fn eval(&self, inputs: &[f64], out: &mut [f64]) {
+    pub fn eval(&self, inputs: &[f64], ws: &mut [f64], out: &mut [f64]) {
         assert!(
-            inputs.len() >= self.n_inputs && out.len() >= self.n_outputs,
-            "JitProgram::eval: inputs or outputs too short"
+            inputs.len() >= self.n_inputs
+                && out.len() >= self.n_outputs
+                && ws.len() >= self.n_spill,
+            "JitProgram::eval: inputs, workspace or outputs too short"
         );
-        // SAFETY: the function reads `inputs[..n_inputs]` and writes `out[..n_outputs]`,
-        // both in bounds (checked above); the code is alive while `self.code` is.
-        unsafe { (self.code.func)(inputs.as_ptr(), out.as_mut_ptr()) }
+        for f in &self.code.funcs {
+            // SAFETY: each chunk reads `inputs[..n_inputs]`, reads and writes
+            // `ws[..n_spill]` and writes `out[..n_outputs]`, all in bounds (checked above);
+            // the code is alive while `self.code` is.
+            unsafe { f(inputs.as_ptr(), out.as_mut_ptr(), ws.as_mut_ptr()) }
+        }
     }
 }
 
@@ -407,10 +527,10 @@ impl Evaluator {
         matches!(self, Evaluator::Native(_))
     }
 
-    /// A workspace for [`Evaluator::eval`] (empty for native code, which needs none).
+    /// A workspace for [`Evaluator::eval`].
     pub fn workspace(&self) -> Vec<f64> {
         match self {
-            Evaluator::Native(_) => Vec::new(),
+            Evaluator::Native(j) => j.workspace(),
             Evaluator::Interpreted(p) => p.workspace(),
         }
     }
@@ -428,7 +548,7 @@ impl Evaluator {
     #[inline]
     pub fn eval(&self, inputs: &[f64], ws: &mut [f64], out: &mut [f64]) {
         match self {
-            Evaluator::Native(j) => j.eval(inputs, out),
+            Evaluator::Native(j) => j.eval(inputs, ws, out),
             Evaluator::Interpreted(p) => p.eval(inputs, ws, out),
         }
     }
@@ -546,7 +666,7 @@ mod tests {
         for &a in &specials {
             for &b in &specials {
                 prog.eval(&[a, b], &mut ws, &mut o1);
-                jit.eval(&[a, b], &mut o2);
+                jit.eval(&[a, b], &mut [], &mut o2);
                 for k in 0..outs.len() {
                     assert!(
                         same(o1[k], o2[k]),
@@ -591,7 +711,7 @@ mod tests {
                 s.spawn(move || {
                     let mut out = [0.0];
                     let xk = k as f64 * 0.3;
-                    jit.eval(&[xk], &mut out);
+                    jit.eval(&[xk], &mut [], &mut out);
                     assert_eq!(out[0].to_bits(), (xk.sin() * xk).to_bits());
                 });
             }

@@ -29,12 +29,13 @@ fn same(a: f64, b: f64) -> bool {
 fn check(name: &str, prog: &Program, trials: usize) -> usize {
     let jit = JitProgram::compile(prog).unwrap_or_else(|e| panic!("{name}: {e}"));
     let mut ws = prog.workspace();
+    let mut jws = jit.workspace();
     let (mut o1, mut o2) = (vec![0.0; prog.n_outputs()], vec![1.0; prog.n_outputs()]);
     let mut rng = Rng(0x9E37_79B9_7F4A_7C15 ^ prog.len() as u64);
     for _ in 0..trials {
         let input: Vec<f64> = (0..prog.n_inputs()).map(|_| rng.next()).collect();
         prog.eval(&input, &mut ws, &mut o1);
-        jit.eval(&input, &mut o2);
+        jit.eval(&input, &mut jws, &mut o2);
         for k in 0..o1.len() {
             assert!(
                 same(o1[k], o2[k]),
@@ -168,4 +169,27 @@ fn pendulum_chains_agree_bit_for_bit() {
         assert!(check_model(&format!("chain {n}"), &chain_toml(n), &projected).is_some());
     }
     assert!(check_model("chain 4 exact", &chain_toml(4), &DeriveOptions::default()).is_some());
+}
+
+#[test]
+fn programs_longer_than_one_chunk_are_split_and_still_agree() {
+    let mut m = load(&chain_toml(16), "chain 16").unwrap();
+    let projected = DeriveOptions {
+        form: Form::Projected,
+        symbolic_limit: 0,
+        simplify: false,
+    };
+    let d = derive(&mut m, &projected).unwrap();
+    let all: Vec<Id> = d.system.a.iter().chain(&d.system.b).copied().collect();
+    let inp = inputs(&mut m, &d.state, &all);
+    let sys = CompiledLinearSystem::new(&mut m.pool, &d.system, &inp).unwrap();
+    let jit = JitProgram::compile(sys.program()).unwrap();
+    // The 16-link chain's A and b take several thousand instructions: several chunks, with
+    // values crossing between them through the spill array.
+    assert!(jit.chunks() >= 2, "{jit:?}");
+    assert!(!jit.workspace().is_empty());
+    assert_eq!(
+        check("chain 16 system", sys.program(), 50),
+        50 * (16 * 16 + 16)
+    );
 }

@@ -230,3 +230,19 @@ fn derive_prints_closed_forms_and_check_compares() {
     assert!(!ok);
     assert!(err.contains("no closed form"), "{err}");
 }
+
+#[test]
+fn native_code_and_the_interpreter_give_the_same_run() {
+    // `pendulum_chain_3` solves A x = b numerically (JitLinearSystem), the others run one
+    // exact program; the trajectory CSV of both engines must be identical to the last bit.
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/");
+    for name in ["satellite", "building", "pendulum_chain_3"] {
+        let model = &format!("{root}{name}.toml");
+        let (ok, native, err) = pdyn(&["run", model, "--json", "--t-end", "2"]);
+        assert!(ok, "{model}: {err}");
+        let (ok, interp, err) = pdyn(&["run", model, "--json", "--t-end", "2", "--no-jit"]);
+        assert!(ok, "{model}: {err}");
+        assert_eq!(native, interp, "{model}");
+        assert!(native.contains("\"final\""), "{native}");
+    }
+}

@@ -67,6 +67,27 @@ pub struct RunArgs {
     /// Override parameter values, e.g. `--set omega=8.7,d0=0.05`.
     #[arg(long, value_delimiter = ',')]
     pub set: Vec<String>,
+    /// Evaluate the equations with the interpreter instead of native code (same results,
+    /// slower; for platforms without the JIT or to rule it out).
+    #[arg(long = "no-jit")]
+    pub no_jit: bool,
+}
+
+impl RunArgs {
+    /// Native code unless `--no-jit`.
+    pub fn jit(&self) -> sim::JitMode {
+        if self.no_jit {
+            sim::JitMode::Off
+        } else {
+            sim::JitMode::Auto
+        }
+    }
+}
+
+/// Derives and compiles the model as the options ask.
+pub(crate) fn prepare(model: &mut pdyn_mech::Model, a: &RunArgs) -> Result<sim::Prepared, Error> {
+    sim::prepare_with_jit(model, &pdyn_mech::DeriveOptions::default(), a.jit())
+        .map_err(|e| sim_error(model, "", e))
 }
 
 /// Merges `[simulate]` and the command line.
@@ -132,7 +153,7 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
         // Plots read better from evenly spaced dense output than from raw steps.
         set.points = Some(2001);
     }
-    let prep = sim::prepare(&mut model).map_err(|e| sim_error(&model, "", e))?;
+    let prep = prepare(&mut model, &a)?;
     let res = if set.method == "exact" {
         let exact = sim::exact::closed_form(&mut model)
             .map_err(|e| sim_error(&model, "--method exact: ", SimError::NoClosedForm(e)))?;
@@ -255,7 +276,7 @@ pub fn check(a: CheckArgs) -> Result<Outcome, Error> {
             SimError::NoClosedForm(e),
         )
     })?;
-    let prep = sim::prepare(&mut model).map_err(|e| sim_error(&model, "", e))?;
+    let prep = prepare(&mut model, &a)?;
     let rep = sim::exact::check(&prep, &exact, &set).map_err(|e| sim_error(&model, "", e))?;
     let worst = rep
         .errors

@@ -3,7 +3,7 @@
 use super::run::{io_error, settings, sim_error, RunArgs};
 use super::{load_model, set_parameters, Outcome};
 use clap::Args;
-use pdyn::sim::{self, sweep};
+use pdyn::sim::sweep;
 use pdyn::Error;
 use serde_json::json;
 use std::io::IsTerminal;
@@ -32,7 +32,7 @@ pub fn run(a: SweepArgs) -> Result<Outcome, Error> {
         ));
     };
     let set = settings(&model, &a.run)?;
-    let prep = sim::prepare(&mut model).map_err(|e| sim_error(&model, "", e))?;
+    let prep = super::run::prepare(&mut model, &a.run)?;
     let stats: Vec<_> = model
         .run
         .sweep

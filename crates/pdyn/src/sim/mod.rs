@@ -19,6 +19,7 @@ pub use error::{ClosedFormError, RunFailure, SimError};
 
 use compiled::{CompiledModel, Observer};
 use pdyn_expr::{Id, Pool};
+pub use pdyn_jit::JitMode;
 use pdyn_mech::conservation::conserved_quantities;
 use pdyn_mech::model::spec::{Crossing, SimulateSpec};
 use pdyn_mech::parameters::DerivedParameters;
@@ -373,10 +374,21 @@ pub fn prepare(model: &mut Model) -> Result<Prepared, SimError> {
 /// [`prepare`] with explicit derivation options (e.g. `symbolic_limit = 0` to solve `A x = b`
 /// numerically at every evaluation).
 pub fn prepare_with(model: &mut Model, opts: &DeriveOptions) -> Result<Prepared, SimError> {
+    prepare_with_jit(model, opts, JitMode::Auto)
+}
+
+/// [`prepare_with`], choosing native code or the interpreter for the right-hand side
+/// (`--no-jit` is [`JitMode::Off`]).
+pub fn prepare_with_jit(
+    model: &mut Model,
+    opts: &DeriveOptions,
+    jit: JitMode,
+) -> Result<Prepared, SimError> {
     // The chapter's steps: equations of motion, solved for the accelerations...
     let d = derive(model, opts).map_err(SimError::Derive)?;
     // ... as a first-order system the integrators can step...
-    let system = CompiledModel::new(model, &d).map_err(|error| compile_error("", error))?;
+    let system =
+        CompiledModel::with_jit(model, &d, jit).map_err(|error| compile_error("", error))?;
     // ... what to tabulate and which laws the result must obey...
     let (observer, conserved, scales) = observations(model, &d, &system)?;
     // ... when to stop or record, what a sweep measures, and where it starts.
