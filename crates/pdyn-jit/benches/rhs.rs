@@ -111,6 +111,7 @@ fn chain() -> Chain {
         form: Form::Projected,
         symbolic_limit: 0,
         simplify: false,
+        ..DeriveOptions::default()
     };
     let d = derive(&mut m, &opts).unwrap();
     let mut inputs: Vec<Id> = vec![m.pool.time()];

@@ -94,7 +94,8 @@ type RawFn = unsafe extern "C" fn(*const f64, *mut f64, *mut f64);
 /// Instructions per generated function. Cranelift's register allocator slows down sharply on
 /// one huge basic block (many values live across many calls), so a long program becomes a
 /// sequence of functions of this size that pass the values they share through a spill array.
-/// Measured on the 100-link chain: one function took longer to compile than the whole run.
+/// Measured on the 100-link chain's `A x = b` (user CPU of `pdyn run --t-end 0.001`): 3.5 s of
+/// code generation as one function, 2.2 s as chunks of 2,048 (512 gave the same).
 const CHUNK: usize = 2048;
 
 /// The JIT module owning the code memory; freed on drop.

@@ -165,6 +165,7 @@ fn pendulum_chains_agree_bit_for_bit() {
             form: Form::Projected,
             symbolic_limit: 0,
             simplify: false,
+            ..DeriveOptions::default()
         };
         assert!(check_model(&format!("chain {n}"), &chain_toml(n), &projected).is_some());
     }
@@ -178,6 +179,7 @@ fn programs_longer_than_one_chunk_are_split_and_still_agree() {
         form: Form::Projected,
         symbolic_limit: 0,
         simplify: false,
+        ..DeriveOptions::default()
     };
     let d = derive(&mut m, &projected).unwrap();
     let all: Vec<Id> = d.system.a.iter().chain(&d.system.b).copied().collect();

@@ -22,6 +22,7 @@ fn derive_chain(b: Bencher, n: usize) {
         form: Form::Projected,
         symbolic_limit: 0,
         simplify: false,
+        ..DeriveOptions::default()
     };
     b.bench(|| {
         let mut m = load(black_box(&src), "chain.toml").unwrap();

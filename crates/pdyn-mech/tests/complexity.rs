@@ -35,6 +35,7 @@ fn chain_derivation_grows_quadratically() {
         form: Form::Projected,
         symbolic_limit: 0,
         simplify: false,
+        ..DeriveOptions::default()
     };
     check(&opts);
 }

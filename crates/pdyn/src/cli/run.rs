@@ -86,8 +86,7 @@ impl RunArgs {
 
 /// Derives and compiles the model as the options ask.
 pub(crate) fn prepare(model: &mut pdyn_mech::Model, a: &RunArgs) -> Result<sim::Prepared, Error> {
-    sim::prepare_with_jit(model, &pdyn_mech::DeriveOptions::default(), a.jit())
-        .map_err(|e| sim_error(model, "", e))
+    sim::prepare_with_jit(model, &sim::run_options(), a.jit()).map_err(|e| sim_error(model, "", e))
 }
 
 /// Merges `[simulate]` and the command line.

@@ -368,7 +368,15 @@ pub struct RunResult {
 
 /// Derives, compiles, and sets up monitors and events.
 pub fn prepare(model: &mut Model) -> Result<Prepared, SimError> {
-    prepare_with(model, &DeriveOptions::default())
+    prepare_with(model, &run_options())
+}
+
+/// What a run needs from the derivation: everything but the printed form of the equations.
+pub fn run_options() -> DeriveOptions {
+    DeriveOptions {
+        simplify_printed: false,
+        ..DeriveOptions::default()
+    }
 }
 
 /// [`prepare`] with explicit derivation options (e.g. `symbolic_limit = 0` to solve `A x = b`
