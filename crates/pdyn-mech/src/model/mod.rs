@@ -9,6 +9,7 @@
 
 mod forces;
 pub(crate) mod raw;
+pub mod constants;
 pub mod spec;
 
 use crate::units::{looks_like_quantity, parse_quantity};
