@@ -100,12 +100,19 @@ impl<'a> Constants<'a> {
                         // The element's own place in the file, so an error points into it.
                         let text = &self.ld.source[span.clone()];
                         let quoted = format!("\"{s}\"");
-                        let at = text.find(&quoted).map_or(span.start, |p| span.start + p + 1);
-                        let ast = pdyn_expr::syntax::parse(s).map_err(|e| self.ld.located(e, at))?;
-                        let v = pdyn_expr::lower::lower(&mut self.ld.pool, &ast, &mut self.ld.scope)
-                            .map_err(|e| self.ld.located(e, at))?;
+                        let at = text
+                            .find(&quoted)
+                            .map_or(span.start, |p| span.start + p + 1);
+                        let ast =
+                            pdyn_expr::syntax::parse(s).map_err(|e| self.ld.located(e, at))?;
+                        let v =
+                            pdyn_expr::lower::lower(&mut self.ld.pool, &ast, &mut self.ld.scope)
+                                .map_err(|e| self.ld.located(e, at))?;
                         let Value::Scalar(id) = v else {
-                            return Err(self.err(at..at + s.len(), format!("a component of {what} must be a scalar")));
+                            return Err(self.err(
+                                at..at + s.len(),
+                                format!("a component of {what} must be a scalar"),
+                            ));
                         };
                         self.ld.constant(id, at..at + s.len(), what)?
                     }
@@ -160,7 +167,10 @@ mod tests {
             c.parameter(n, sv, None).unwrap();
         }
         assert_eq!(c.scalar(&t.x, "x").unwrap(), 6000.0);
-        assert_eq!(c.vector(&t.v, "v").unwrap(), [1.0, 3001.0, std::f64::consts::PI]);
+        assert_eq!(
+            c.vector(&t.v, "v").unwrap(),
+            [1.0, 3001.0, std::f64::consts::PI]
+        );
         let bad = "x = \"2*b\"\nv = [1, \"c\", 0]\n[p]\na = 1\n";
         let t: T = toml::from_str(bad).unwrap();
         let mut c = Constants::new(bad, "f.toml");

@@ -7,9 +7,9 @@
 //! turns each force declaration into loads on particles or massless frames. Every error carries
 //! the file, line and column of the offending text.
 
+pub mod constants;
 mod forces;
 pub(crate) mod raw;
-pub mod constants;
 pub mod spec;
 
 use crate::units::{looks_like_quantity, parse_quantity};

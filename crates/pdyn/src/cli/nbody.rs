@@ -30,10 +30,26 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
         return Ok(Outcome::text(HELP.into()));
     }
     for (given, option, instead) in [
-        (a.rtol.is_some(), "--rtol", "IAS15's accuracy is `epsilon` in [nbody]"),
-        (a.atol.is_some(), "--atol", "IAS15's accuracy is `epsilon` in [nbody]"),
-        (a.max_step.is_some(), "--max-step", "the fixed-step integrators take --dt"),
-        (a.max_steps.is_some(), "--max-steps", "shorten the run with --t-end"),
+        (
+            a.rtol.is_some(),
+            "--rtol",
+            "IAS15's accuracy is `epsilon` in [nbody]",
+        ),
+        (
+            a.atol.is_some(),
+            "--atol",
+            "IAS15's accuracy is `epsilon` in [nbody]",
+        ),
+        (
+            a.max_step.is_some(),
+            "--max-step",
+            "the fixed-step integrators take --dt",
+        ),
+        (
+            a.max_steps.is_some(),
+            "--max-steps",
+            "shorten the run with --t-end",
+        ),
     ] {
         if given {
             return Err(Error::argument(
@@ -52,7 +68,9 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
         spec.integrator = IntegratorKind::from_name(m).ok_or_else(|| {
             Error::argument(
                 "--method",
-                format!("--method {m}: N-body models take whfast, ias15 or leapfrog (--method help)"),
+                format!(
+                    "--method {m}: N-body models take whfast, ias15 or leapfrog (--method help)"
+                ),
             )
         })?;
         if spec.integrator == IntegratorKind::WhFast && spec.tree.is_some() {
@@ -64,13 +82,19 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
     }
     if let Some(dt) = a.dt {
         if !(dt.is_finite() && dt > 0.0) {
-            return Err(Error::argument("--dt", format!("--dt must be > 0 (got {dt})")));
+            return Err(Error::argument(
+                "--dt",
+                format!("--dt must be > 0 (got {dt})"),
+            ));
         }
         spec.dt = Some((dt, 0..0));
     }
     if let Some(t) = a.t_end {
         if !(t.is_finite() && t > 0.0) {
-            return Err(Error::argument("--t-end", format!("--t-end must be > 0 (got {t})")));
+            return Err(Error::argument(
+                "--t-end",
+                format!("--t-end must be > 0 (got {t})"),
+            ));
         }
         spec.t_end = Some(t);
     }
@@ -132,7 +156,11 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
             Some(t) => format!(
                 "tree (theta = {}, {})",
                 t.theta,
-                if t.quadrupole { "quadrupole" } else { "monopole" }
+                if t.quadrupole {
+                    "quadrupole"
+                } else {
+                    "monopole"
+                }
             ),
         },
         n_bodies,
@@ -185,7 +213,11 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
     } else {
         output::text_report(&spec, &info, &res, a.out.as_deref())
     };
-    let stderr: String = res.warnings.iter().map(|w| format!("warning: {w}\n")).collect();
+    let stderr: String = res
+        .warnings
+        .iter()
+        .map(|w| format!("warning: {w}\n"))
+        .collect();
     Ok(Outcome {
         stdout,
         stderr,

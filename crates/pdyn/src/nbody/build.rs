@@ -204,11 +204,7 @@ pub fn build(spec: &NbodySpec) -> Result<Built, BuildError> {
     })
 }
 
-fn add_body(
-    sim: &mut Simulation,
-    b: &BodySpec,
-    index: usize,
-) -> Result<usize, GravityError> {
+fn add_body(sim: &mut Simulation, b: &BodySpec, index: usize) -> Result<usize, GravityError> {
     debug_assert_eq!(sim.len(), index);
     match &b.state {
         InitialState::Cartesian { position, velocity } => sim.add_with_radius(
@@ -229,11 +225,19 @@ fn add_body(
 }
 
 fn located(e: GravityError, b: &BodySpec, spec: &NbodySpec) -> BuildError {
-    let name = |i: usize| spec.bodies.get(i).map_or(format!("body {i}"), |b| format!("`{}`", b.name));
+    let name = |i: usize| {
+        spec.bodies
+            .get(i)
+            .map_or(format!("body {i}"), |b| format!("`{}`", b.name))
+    };
     match e {
         GravityError::Coincident { other, .. } => BuildError::at(
             &b.origin,
-            format!("body `{}` is placed exactly on body {}", b.name, name(other)),
+            format!(
+                "body `{}` is placed exactly on body {}",
+                b.name,
+                name(other)
+            ),
         )
         .help("their mutual force would be infinite: give distinct positions"),
         GravityError::InvalidPrimary { .. } => BuildError::at(
@@ -261,7 +265,11 @@ fn check_overlaps(sim: &Simulation, spec: &NbodySpec) -> Result<(), BuildError> 
                     },
                     |b| b.origin.clone(),
                 );
-                let name = |i: usize| spec.bodies.get(i).map_or(format!("{i}"), |b| b.name.clone());
+                let name = |i: usize| {
+                    spec.bodies
+                        .get(i)
+                        .map_or(format!("{i}"), |b| b.name.clone())
+                };
                 return Err(BuildError::at(
                     &origin,
                     format!(

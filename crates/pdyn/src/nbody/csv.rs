@@ -1,16 +1,18 @@
 //! Bodies from a CSV file (`bodies_file = "..."`): a header line naming the columns, then one
-//! body per line. Columns: `name` (optional), `mass`, `radius` (optional), and either
-//! `x, y, z, vx, vy, vz` (Cartesian) or `primary` (optional), `a, e, inc, Omega, omega` and
-//! `M` or `f` (elements; angles in radians, or with a unit such as `12 deg`). Empty lines and
-//! lines starting with `#` are skipped. Every problem is located at its cell.
+//! body per line. Columns: `name` (optional), `mass`, `radius` (optional), and
+//! `x, y, z, vx, vy, vz` (Cartesian) and/or `primary` (optional), `a, e, inc, Omega, omega`
+//! and `M` or `f` (elements; angles in radians, or with a unit such as `12 deg`). Each line
+//! fills one set and leaves the other's cells empty; empty element cells other than `a` are
+//! 0. Empty lines and lines starting with `#` are skipped. Every problem is located at its
+//! cell.
 
 use super::spec::{check_elements, BodySpec, InitialState, Origin, UnitsSpec};
 use pdyn_mech::ModelError;
 use std::ops::Range;
 
 const KNOWN: [&str; 17] = [
-    "name", "mass", "radius", "x", "y", "z", "vx", "vy", "vz", "primary", "a", "e", "inc",
-    "Omega", "omega", "M", "f",
+    "name", "mass", "radius", "x", "y", "z", "vx", "vy", "vz", "primary", "a", "e", "inc", "Omega",
+    "omega", "M", "f",
 ];
 
 /// Cells of one line with their byte ranges in the file.
@@ -62,18 +64,26 @@ pub fn bodies(
     }
     let has = |c: &str| col.contains_key(c);
     let cart = ["x", "y", "z", "vx", "vy", "vz"];
-    let elem = ["a", "e"];
     let cartesian = cart.iter().all(|c| has(c));
-    let elements = elem.iter().all(|c| has(c));
+    let elements = has("a");
     let head_span = head_at..head_at + head.len();
     if !has("mass") {
-        return Err(err(head_span, "the bodies file has no `mass` column".into()));
-    }
-    if cartesian == elements {
         return Err(err(
             head_span,
-            "the header must give either x,y,z,vx,vy,vz or the elements a,e (not both, not neither)"
+            "the bodies file has no `mass` column".into(),
+        ));
+    }
+    if !cartesian && !elements {
+        return Err(err(
+            head_span,
+            "the header must have the columns x,y,z,vx,vy,vz or the elements a,e,... (or both)"
                 .into(),
+        ));
+    }
+    if cart.iter().any(|c| has(c)) && !cartesian {
+        return Err(err(
+            head_span,
+            "a Cartesian state needs all of x,y,z,vx,vy,vz".into(),
         ));
     }
     if has("M") && has("f") {
@@ -90,7 +100,7 @@ pub fn bodies(
         }
         let cell = |c: &str| col.get(c).map(|&k| &row[k]);
         let number = |c: &str, angle: bool| -> Result<Option<f64>, ModelError> {
-            let Some((t, span)) = cell(c) else {
+            let Some((t, span)) = cell(c).filter(|(t, _)| !t.is_empty()) else {
                 return Ok(None);
             };
             let v = if angle && pdyn_mech::units::looks_like_quantity(t) {
@@ -98,8 +108,11 @@ pub fn bodies(
                     .map_err(|e| err(span.clone(), format!("`{t}`: {}", e.message)))?
             } else {
                 t.parse::<f64>().map_err(|_| {
-                    err(span.clone(), format!("`{t}` is not a number"))
-                        .help(if angle || units.si { "a number, e.g. 1.5e-3 (angles may be `12 deg`)" } else { "a number in the model's units, e.g. 1.5e-3" })
+                    err(span.clone(), format!("`{t}` is not a number")).help(if angle || units.si {
+                        "a number, e.g. 1.5e-3 (angles may be `12 deg`)"
+                    } else {
+                        "a number in the model's units, e.g. 1.5e-3"
+                    })
                 })?
             };
             if !v.is_finite() {
@@ -118,17 +131,29 @@ pub fn bodies(
             _ => format!("body{index}"),
         };
         let (_, mass_span) = cell("mass").expect("checked in the header");
-        let mass = number("mass", false)?.unwrap_or(f64::NAN);
-        if !(mass > 0.0) {
-            return Err(err(mass_span.clone(), format!("mass must be > 0 (got {mass})")));
+        let mass = number("mass", false)?.unwrap_or(0.0);
+        if !(mass.is_finite() && mass > 0.0) {
+            return Err(err(
+                mass_span.clone(),
+                format!("mass must be > 0 (got {mass})"),
+            ));
         }
         let radius = number("radius", false)?.unwrap_or(0.0);
-        if !(radius >= 0.0) {
+        if !(radius.is_finite() && radius >= 0.0) {
             let span = cell("radius").map_or(mass_span.clone(), |c| c.1.clone());
             return Err(err(span, format!("radius must be >= 0 (got {radius})")));
         }
         let get = |c: &str| -> Result<f64, ModelError> { Ok(number(c, false)?.unwrap_or(0.0)) };
-        let state = if cartesian {
+        // Each line uses the columns it fills: a Cartesian state, or elements.
+        let filled = |c: &str| cell(c).is_some_and(|(t, _)| !t.is_empty());
+        let row_cartesian = cartesian && cart.iter().any(|c| filled(c));
+        if !row_cartesian && !filled("a") {
+            return Err(err(
+                at..at + line.len().max(1),
+                format!("body `{name}` has no initial state: fill x,y,z,vx,vy,vz or a,e,..."),
+            ));
+        }
+        let state = if row_cartesian {
             InitialState::Cartesian {
                 position: [get("x")?, get("y")?, get("z")?],
                 velocity: [get("vx")?, get("vy")?, get("vz")?],
@@ -137,9 +162,13 @@ pub fn bodies(
             let (a, e) = (get("a")?, get("e")?);
             check_elements(a, e).map_err(|msg| {
                 let c = if msg.starts_with('e') { "e" } else { "a" };
-                err(cell(c).expect("checked in the header").1.clone(), format!("body `{name}`: {msg}"))
+                err(
+                    cell(c).expect("checked in the header").1.clone(),
+                    format!("body `{name}`: {msg}"),
+                )
             })?;
-            let angle = |c: &str| -> Result<f64, ModelError> { Ok(number(c, true)?.unwrap_or(0.0)) };
+            let angle =
+                |c: &str| -> Result<f64, ModelError> { Ok(number(c, true)?.unwrap_or(0.0)) };
             let anomaly = if has("M") {
                 pdyn_gravity::Anomaly::Mean(angle("M")?)
             } else {

@@ -45,7 +45,9 @@ pub fn build(spec: &spec::NbodySpec, source: &str) -> Result<build::Built, Error
         } else {
             // The bodies file was read moments ago by `load`; reading it again for the message
             // is simpler than carrying its text through the spec.
-            std::fs::read_to_string(&e.origin.file).unwrap_or_default().into()
+            std::fs::read_to_string(&e.origin.file)
+                .unwrap_or_default()
+                .into()
         };
         Error::Model {
             error: e.model_error(),

@@ -110,7 +110,13 @@ fn virial(kinetic: f64, potential: f64) -> f64 {
 
 /// `summary.json`.
 pub fn summary(spec: &NbodySpec, info: &RunInfo, res: &NbodyResult) -> serde_json::Value {
-    let finite = |x: f64| if x.is_finite() { serde_json::json!(x) } else { serde_json::json!(x.to_string()) };
+    let finite = |x: f64| {
+        if x.is_finite() {
+            serde_json::json!(x)
+        } else {
+            serde_json::json!(x.to_string())
+        }
+    };
     let last = res.conservation.last();
     let final_bodies: Vec<serde_json::Value> = res
         .states
@@ -121,6 +127,7 @@ pub fn summary(spec: &NbodySpec, info: &RunInfo, res: &NbodyResult) -> serde_jso
                 .map(|s| {
                     serde_json::json!({
                         "name": res.names[s.body],
+                        "mass": s.mass,
                         "position": s.pos,
                         "velocity": s.vel,
                     })
@@ -131,6 +138,7 @@ pub fn summary(spec: &NbodySpec, info: &RunInfo, res: &NbodyResult) -> serde_jso
     serde_json::json!({
         "model": spec.name,
         "kind": "nbody",
+        "ok": res.failure.is_none(),
         "units": spec.units.label,
         "G": spec.units.units.g(),
         "integrator": info.integrator,
@@ -193,7 +201,11 @@ pub fn text_report(
     );
     if let Some(r) = res.conservation.last() {
         if r.n > 3 {
-            let _ = writeln!(s, "virial ratio 2T/|V| at the end: {:.4}", virial(r.kinetic, r.potential));
+            let _ = writeln!(
+                s,
+                "virial ratio 2T/|V| at the end: {:.4}",
+                virial(r.kinetic, r.potential)
+            );
         }
     }
     if let Some(states) = res.states.last() {

@@ -29,8 +29,8 @@ pub fn write(title: &str, res: &NbodyResult, dir: &Path) -> Result<(), Error> {
         let mut xyz: Vec<[Vec<f64>; 3]> = vec![[Vec::new(), Vec::new(), Vec::new()]; n_names];
         for states in &res.states {
             for s in states.iter().filter(|s| s.body < n_names) {
-                for k in 0..3 {
-                    xyz[s.body][k].push(s.pos[k]);
+                for (c, &x) in xyz[s.body].iter_mut().zip(&s.pos) {
+                    c.push(x);
                 }
             }
         }
@@ -50,10 +50,11 @@ pub fn write(title: &str, res: &NbodyResult, dir: &Path) -> Result<(), Error> {
         };
         both(dir, "orbits", |p| save(&fig, p))?;
         let extent = |k: usize| {
-            xyz.iter().flat_map(|c| c[k].iter()).fold(
-                (f64::INFINITY, f64::NEG_INFINITY),
-                |(lo, hi), &v| (lo.min(v), hi.max(v)),
-            )
+            xyz.iter()
+                .flat_map(|c| c[k].iter())
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                    (lo.min(v), hi.max(v))
+                })
         };
         let ((xlo, xhi), (ylo, yhi), (zlo, zhi)) = (extent(0), extent(1), extent(2));
         let scale = (xhi - xlo).max(yhi - ylo);
@@ -73,7 +74,10 @@ pub fn write(title: &str, res: &NbodyResult, dir: &Path) -> Result<(), Error> {
         }
         let mut panels = Vec::new();
         for (label, get) in [
-            ("a", (|o: &pdyn_gravity::Orbit| o.a) as fn(&pdyn_gravity::Orbit) -> f64),
+            (
+                "a",
+                (|o: &pdyn_gravity::Orbit| o.a) as fn(&pdyn_gravity::Orbit) -> f64,
+            ),
             ("e", |o| o.e),
             ("inc [rad]", |o| o.inc),
         ] {

@@ -65,7 +65,9 @@ pub fn output_times(t_end: f64, sampling: &Sampling) -> Result<Vec<f64>, String>
     match sampling {
         Sampling::Points(n) => {
             if *n < 2 || *n > MAX_POINTS {
-                return Err(format!("points must be between 2 and {MAX_POINTS} (got {n})"));
+                return Err(format!(
+                    "points must be between 2 and {MAX_POINTS} (got {n})"
+                ));
             }
             Ok((0..*n)
                 .map(|k| t_end * k as f64 / (*n - 1) as f64)
@@ -98,7 +100,10 @@ pub fn output_times(t_end: f64, sampling: &Sampling) -> Result<Vec<f64>, String>
                     return Err(format!("output time {t} is outside 0..{t_end}"));
                 }
                 if v.last().is_some_and(|&l| t <= l) && !(v.len() == 1 && t == 0.0) {
-                    return Err(format!("output times must increase ({t} after {:?})", v.last()));
+                    return Err(format!(
+                        "output times must increase ({t} after {:?})",
+                        v.last()
+                    ));
                 }
                 if t > 0.0 || v.is_empty() {
                     v.push(t);
@@ -114,6 +119,8 @@ pub fn output_times(t_end: f64, sampling: &Sampling) -> Result<Vec<f64>, String>
 pub struct BodyState {
     /// Index into [`NbodyResult::names`].
     pub body: usize,
+    /// Mass.
+    pub mass: f64,
     /// Position.
     pub pos: [f64; 3],
     /// Velocity.
@@ -245,11 +252,26 @@ impl Segment {
     fn update(&mut self, row: &ConservationRow) {
         let de = (row.energy - self.e0).abs() / self.e_scale;
         let l = row.angular_momentum;
-        let dl = ((l[0] - self.l0[0]).powi(2) + (l[1] - self.l0[1]).powi(2) + (l[2] - self.l0[2]).powi(2)).sqrt();
-        let dl = if self.l_scale > 0.0 { dl / self.l_scale } else { dl };
+        let dl = ((l[0] - self.l0[0]).powi(2)
+            + (l[1] - self.l0[1]).powi(2)
+            + (l[2] - self.l0[2]).powi(2))
+        .sqrt();
+        let dl = if self.l_scale > 0.0 {
+            dl / self.l_scale
+        } else {
+            dl
+        };
         // NaN compares false with max: keep it visible.
-        self.e_drift = if de.is_nan() { f64::NAN } else { self.e_drift.max(de) };
-        self.l_drift = if dl.is_nan() { f64::NAN } else { self.l_drift.max(dl) };
+        self.e_drift = if de.is_nan() {
+            f64::NAN
+        } else {
+            self.e_drift.max(de)
+        };
+        self.l_drift = if dl.is_nan() {
+            f64::NAN
+        } else {
+            self.l_drift.max(dl)
+        };
     }
 }
 
@@ -290,7 +312,15 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, String> {
     let mut t_offset = 0.0;
     let mut steps_before = 0u64;
     let mut engine_warnings: Vec<Warning> = Vec::new();
-    record(&sim, 0.0, &alive, &primary_of, options.trajectory, &mut res, &mut seg);
+    record(
+        &sim,
+        0.0,
+        &alive,
+        &primary_of,
+        options.trajectory,
+        &mut res,
+        &mut seg,
+    );
     'outer: for &tk in &times[1..] {
         loop {
             match sim.integrate((tk - t_offset).max(sim.t())) {
@@ -305,7 +335,15 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, String> {
                             bodies: vec![a.clone(), b.clone()],
                             message: format!("`{a}` and `{b}` touch; the run stops (collisions = \"merge\" would merge them)"),
                         });
-                        record(&sim, t, &alive, &primary_of, options.trajectory, &mut res, &mut seg);
+                        record(
+                            &sim,
+                            t,
+                            &alive,
+                            &primary_of,
+                            options.trajectory,
+                            &mut res,
+                            &mut seg,
+                        );
                         break 'outer;
                     }
                     let e_before = sim.energy();
@@ -327,7 +365,12 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, String> {
                     t_offset = t;
                     e_worst = e_worst.max(seg.e_drift);
                     l_worst = l_worst.max(seg.l_drift);
-                    sim = match (Config { dt: sim.dt(), ..config }).simulation(&bodies) {
+                    sim = match (Config {
+                        dt: sim.dt(),
+                        ..config
+                    })
+                    .simulation(&bodies)
+                    {
                         Ok(s) => s,
                         Err(e) => {
                             res.failure = Some(e);
@@ -358,7 +401,15 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, String> {
                             bodies: vec![a.clone()],
                             message: format!("`{a}` is {distance:.6e} from the origin, beyond escape_radius; the run stops{advice}"),
                         });
-                        record(&sim, t, &alive, &primary_of, options.trajectory, &mut res, &mut seg);
+                        record(
+                            &sim,
+                            t,
+                            &alive,
+                            &primary_of,
+                            options.trajectory,
+                            &mut res,
+                            &mut seg,
+                        );
                         break 'outer;
                     }
                     let mut bodies = bodies_of(&sim);
@@ -378,7 +429,12 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, String> {
                     if bodies.is_empty() {
                         break 'outer;
                     }
-                    sim = match (Config { dt: sim.dt(), ..config }).simulation(&bodies) {
+                    sim = match (Config {
+                        dt: sim.dt(),
+                        ..config
+                    })
+                    .simulation(&bodies)
+                    {
                         Ok(s) => s,
                         Err(e) => {
                             res.failure = Some(e);
@@ -390,7 +446,9 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, String> {
                 Ok(_) => break,
                 Err(e) => {
                     if let GravityError::CloseEncounter { t, body, ratio } = &e {
-                        let who = alive.get(*body).map_or(format!("Jacobi body {body}"), |&k| names[k].clone());
+                        let who = alive
+                            .get(*body)
+                            .map_or(format!("Jacobi body {body}"), |&k| names[k].clone());
                         res.events.push(NbodyEvent {
                             t: t + t_offset,
                             kind: "close_encounter",
@@ -406,7 +464,15 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, String> {
                 }
             }
         }
-        record(&sim, tk, &alive, &primary_of, options.trajectory, &mut res, &mut seg);
+        record(
+            &sim,
+            tk,
+            &alive,
+            &primary_of,
+            options.trajectory,
+            &mut res,
+            &mut seg,
+        );
     }
     e_worst = max_nan(e_worst, seg.e_drift);
     l_worst = max_nan(l_worst, seg.l_drift);
@@ -433,7 +499,12 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, String> {
     let tol = options.drift_tolerance;
     let first = res.conservation.first().copied();
     for (name, drift, scale, initial) in [
-        ("energy", e_worst, seg.e_scale, first.map_or(0.0, |r| r.energy)),
+        (
+            "energy",
+            e_worst,
+            seg.e_scale,
+            first.map_or(0.0, |r| r.energy),
+        ),
         (
             "angular_momentum",
             l_worst,
@@ -525,6 +596,7 @@ fn record(
         (0..p.len())
             .map(|i| BodyState {
                 body: alive[i],
+                mass: p.m[i],
                 pos: p.pos(i).0,
                 vel: p.vel(i).0,
             })

@@ -316,7 +316,11 @@ pub fn parse(
     })?;
     for (k, _) in set {
         if !raw.parameters.keys().any(|n| n.get_ref() == k) {
-            let names: Vec<&str> = raw.parameters.keys().map(|n| n.get_ref().as_str()).collect();
+            let names: Vec<&str> = raw
+                .parameters
+                .keys()
+                .map(|n| n.get_ref().as_str())
+                .collect();
             return Err(Box::new(SetOrSpecError::UnknownParameter {
                 name: k.clone(),
                 parameters: names.join(", "),
@@ -343,7 +347,9 @@ pub fn parse(
         },
     };
     r.units = units(&mut r, nb).map_err(in_model)?;
-    let spec = r.table(&raw, nb, origin, table_span.clone()).map_err(in_model)?;
+    let spec = r
+        .table(&raw, nb, origin, table_span.clone())
+        .map_err(in_model)?;
     let mut spec = spec;
     if let Some(file) = &nb.bodies_file {
         let dir = Path::new(origin).parent().unwrap_or(Path::new(""));
@@ -360,8 +366,8 @@ pub fn parse(
         })?;
         let csv_origin = path.display().to_string();
         let first = spec.bodies.len();
-        let csv_bodies = super::csv::bodies(&text, &csv_origin, r.units, &spec.bodies)
-            .map_err(|error| {
+        let csv_bodies =
+            super::csv::bodies(&text, &csv_origin, r.units, &spec.bodies).map_err(|error| {
                 Box::new(SetOrSpecError::Spec(SpecError {
                     error,
                     source: text.clone(),
@@ -372,8 +378,9 @@ pub fn parse(
     }
     if spec.bodies.is_empty() && spec.plummer.is_none() {
         return Err(in_model(
-            ModelError::new(origin, table_span, "the [nbody] table has no bodies")
-                .help("add [[nbody.bodies]] entries, bodies_file = \"...\" or plummer = { n = ... }"),
+            ModelError::new(origin, table_span, "the [nbody] table has no bodies").help(
+                "add [[nbody.bodies]] entries, bodies_file = \"...\" or plummer = { n = ... }",
+            ),
         ));
     }
     Ok(spec)
@@ -406,7 +413,7 @@ fn units(r: &mut Reader<'_>, nb: &RawNbody) -> Result<UnitsSpec, ModelError> {
         }),
         (None, Some(g)) => {
             let v = r.plain(g, "G", false)?;
-            if !(v > 0.0) {
+            if !(v.is_finite() && v > 0.0) {
                 return Err(r.c.err(g.span(), format!("G must be > 0 (got {v})")));
             }
             Ok(UnitsSpec {
@@ -468,16 +475,20 @@ impl Reader<'_> {
 
     fn positive(&mut self, sv: &Sv, what: &str) -> Result<f64, ModelError> {
         let v = self.plain(sv, what, false)?;
-        if !(v > 0.0) {
-            return Err(self.c.err(sv.span(), format!("{what} must be > 0 (got {v})")));
+        if !(v.is_finite() && v > 0.0) {
+            return Err(self
+                .c
+                .err(sv.span(), format!("{what} must be > 0 (got {v})")));
         }
         Ok(v)
     }
 
     fn non_negative(&mut self, sv: &Sv, what: &str) -> Result<f64, ModelError> {
         let v = self.plain(sv, what, false)?;
-        if !(v >= 0.0) {
-            return Err(self.c.err(sv.span(), format!("{what} must be >= 0 (got {v})")));
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(self
+                .c
+                .err(sv.span(), format!("{what} must be >= 0 (got {v})")));
         }
         Ok(v)
     }
@@ -515,7 +526,10 @@ impl Reader<'_> {
                         .help("0 (none), 3, 5, 7, 11 or 17"));
                 }
                 if integrator != IntegratorKind::WhFast {
-                    return Err(self.c.err(v.span(), "corrector applies to integrator = \"whfast\" only"));
+                    return Err(self.c.err(
+                        v.span(),
+                        "corrector applies to integrator = \"whfast\" only",
+                    ));
                 }
                 k as u32
             }
@@ -524,7 +538,9 @@ impl Reader<'_> {
             None => None,
             Some(sv) => {
                 if integrator != IntegratorKind::Ias15 {
-                    return Err(self.c.err(sv.span(), "epsilon applies to integrator = \"ias15\" only"));
+                    return Err(self
+                        .c
+                        .err(sv.span(), "epsilon applies to integrator = \"ias15\" only"));
                 }
                 Some(self.non_negative(sv, "epsilon")?)
             }
@@ -544,10 +560,14 @@ impl Reader<'_> {
         };
         let tree = match (tree, &nb.theta, &nb.quadrupole) {
             (None, Some(sv), _) => {
-                return Err(self.c.err(sv.span(), "theta applies to gravity = \"tree\" only"))
+                return Err(self
+                    .c
+                    .err(sv.span(), "theta applies to gravity = \"tree\" only"))
             }
             (None, None, Some(q)) => {
-                return Err(self.c.err(q.span(), "quadrupole applies to gravity = \"tree\" only"))
+                return Err(self
+                    .c
+                    .err(q.span(), "quadrupole applies to gravity = \"tree\" only"))
             }
             (None, None, None) => None,
             (Some(mut t), theta, q) => {
@@ -563,14 +583,21 @@ impl Reader<'_> {
         if tree.is_some() && integrator == IntegratorKind::WhFast {
             return Err(self
                 .c
-                .err(integrator_span.clone(), "WHFast with the tree is not supported")
+                .err(
+                    integrator_span.clone(),
+                    "WHFast with the tree is not supported",
+                )
                 .help("use integrator = \"leapfrog\" with gravity = \"tree\""));
         }
         let softening = match &nb.softening {
             None => 0.0,
             Some(sv) => self.non_negative(sv, "softening")?,
         };
-        let t_end = nb.t_end.as_ref().map(|sv| self.positive(sv, "t_end")).transpose()?;
+        let t_end = nb
+            .t_end
+            .as_ref()
+            .map(|sv| self.positive(sv, "t_end"))
+            .transpose()?;
         let output_dt = nb
             .output_dt
             .as_ref()
@@ -588,7 +615,9 @@ impl Reader<'_> {
             })
             .transpose()?;
         if let (Some(_), Some(p)) = (&nb.output_dt, &nb.points) {
-            return Err(self.c.err(p.span(), "give either points or output_dt, not both"));
+            return Err(self
+                .c
+                .err(p.span(), "give either points or output_dt, not both"));
         }
         let drift_tolerance = nb
             .drift_tolerance
@@ -663,7 +692,11 @@ impl Reader<'_> {
         })
     }
 
-    fn plummer(&mut self, p: &Spanned<RawPlummer>, origin: &str) -> Result<PlummerSpec, ModelError> {
+    fn plummer(
+        &mut self,
+        p: &Spanned<RawPlummer>,
+        origin: &str,
+    ) -> Result<PlummerSpec, ModelError> {
         let raw = p.get_ref();
         let n_sv = raw.n.as_ref().ok_or_else(|| {
             self.c
@@ -684,13 +717,20 @@ impl Reader<'_> {
             .seed
             .as_ref()
             .map(|s| {
-                u64::try_from(*s.get_ref())
-                    .map_err(|_| self.c.err(s.span(), "seed must be >= 0"))
+                u64::try_from(*s.get_ref()).map_err(|_| self.c.err(s.span(), "seed must be >= 0"))
             })
             .transpose()?
             .unwrap_or(1);
-        let mass = raw.mass.as_ref().map(|sv| self.positive(sv, "mass")).transpose()?;
-        let scale = raw.scale.as_ref().map(|sv| self.positive(sv, "scale")).transpose()?;
+        let mass = raw
+            .mass
+            .as_ref()
+            .map(|sv| self.positive(sv, "mass"))
+            .transpose()?;
+        let scale = raw
+            .scale
+            .as_ref()
+            .map(|sv| self.positive(sv, "scale"))
+            .transpose()?;
         Ok(PlummerSpec {
             n: n as usize,
             seed,
@@ -736,7 +776,9 @@ impl Reader<'_> {
             .map(|sv| self.non_negative(sv, "radius"))
             .transpose()?
             .unwrap_or(0.0);
-        let elements = [&raw.a, &raw.e, &raw.inc, &raw.Omega, &raw.omega, &raw.M, &raw.f];
+        let elements = [
+            &raw.a, &raw.e, &raw.inc, &raw.Omega, &raw.omega, &raw.M, &raw.f,
+        ];
         let has_elements = elements.iter().any(|x| x.is_some()) || raw.primary.is_some();
         let state = match (&raw.position, &raw.velocity, has_elements) {
             (Some(p), Some(v), false) => InitialState::Cartesian {
@@ -783,8 +825,10 @@ impl Reader<'_> {
         before: &[BodySpec],
     ) -> Result<InitialState, ModelError> {
         let a_sv = raw.a.as_ref().ok_or_else(|| {
-            self.c
-                .err(span.clone(), format!("body `{name}`: orbital elements need a (semi-major axis)"))
+            self.c.err(
+                span.clone(),
+                format!("body `{name}`: orbital elements need a (semi-major axis)"),
+            )
         })?;
         let a = self.plain(a_sv, "a", false)?;
         let e = match &raw.e {
@@ -793,7 +837,11 @@ impl Reader<'_> {
         };
         let e_span = raw.e.as_ref().map_or(span.clone(), |sv| sv.span());
         check_elements(a, e).map_err(|msg| {
-            let at = if msg.starts_with('e') { e_span.clone() } else { a_sv.span() };
+            let at = if msg.starts_with('e') {
+                e_span.clone()
+            } else {
+                a_sv.span()
+            };
             self.c.err(at, format!("body `{name}`: {msg}"))
         })?;
         let mut angle = |sv: &Option<Sv>, what: &str| -> Result<f64, ModelError> {
@@ -807,9 +855,10 @@ impl Reader<'_> {
         let omega = angle(&raw.omega, "omega")?;
         let anomaly = match (&raw.M, &raw.f) {
             (Some(_), Some(f)) => {
-                return Err(self
-                    .c
-                    .err(f.span(), "give the mean anomaly M or the true anomaly f, not both"))
+                return Err(self.c.err(
+                    f.span(),
+                    "give the mean anomaly M or the true anomaly f, not both",
+                ))
             }
             (Some(m), None) => pdyn_gravity::Anomaly::Mean(self.plain(m, "M", true)?),
             (None, Some(f)) => pdyn_gravity::Anomaly::True(self.plain(f, "f", true)?),
@@ -829,7 +878,12 @@ impl Reader<'_> {
                 if before.is_empty() {
                     return Err(self
                         .c
-                        .err(span.clone(), format!("body `{name}`: orbital elements need a body before it to orbit"))
+                        .err(
+                            span.clone(),
+                            format!(
+                                "body `{name}`: orbital elements need a body before it to orbit"
+                            ),
+                        )
                         .help("give the first body a position and velocity"));
                 }
                 None
@@ -842,9 +896,16 @@ impl Reader<'_> {
                         .c
                         .err(p.span(), format!("unknown primary `{}`", p.get_ref()));
                     err = match pdyn_expr::error::suggest(p.get_ref(), names.iter().copied()) {
-                        Some(s) => err.help(format!("did you mean `{s}`? (a primary must be declared before the body)")),
-                        None if names.is_empty() => err.help("a primary must be a body declared before this one"),
-                        None => err.help(format!("bodies declared before this one: {}", names.join(", "))),
+                        Some(s) => err.help(format!(
+                            "did you mean `{s}`? (a primary must be declared before the body)"
+                        )),
+                        None if names.is_empty() => {
+                            err.help("a primary must be a body declared before this one")
+                        }
+                        None => err.help(format!(
+                            "bodies declared before this one: {}",
+                            names.join(", ")
+                        )),
                     };
                     return Err(err);
                 }
@@ -867,16 +928,18 @@ impl Reader<'_> {
 /// The conditions for `a` and `e` to describe a Kepler orbit, as a message naming the one
 /// that fails (`e` first when the eccentricity is at fault).
 pub fn check_elements(a: f64, e: f64) -> Result<(), String> {
-    if !(e >= 0.0) {
+    if !(e.is_finite() && e >= 0.0) {
         return Err(format!("e = {e}: the eccentricity must be >= 0"));
     }
     if e == 1.0 {
         return Err("e = 1: a parabola has no semi-major axis; give a Cartesian state".into());
     }
-    if e < 1.0 && !(a > 0.0) {
-        return Err(format!("a = {a} <= 0 with e = {e} < 1: a bound orbit needs a > 0"));
+    if e < 1.0 && !(a.is_finite() && a > 0.0) {
+        return Err(format!(
+            "a = {a} <= 0 with e = {e} < 1: a bound orbit needs a > 0"
+        ));
     }
-    if e > 1.0 && !(a < 0.0) {
+    if e > 1.0 && !(a.is_finite() && a < 0.0) {
         return Err(format!(
             "a = {a} >= 0 with e = {e} > 1: a hyperbola has a < 0 (REBOUND's convention)"
         ));
