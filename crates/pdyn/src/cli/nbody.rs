@@ -7,6 +7,9 @@ use pdyn::nbody::{self, output, run::Sampling, spec::IntegratorKind};
 use pdyn::Error;
 use std::path::Path;
 
+/// Most per-body rows a run keeps for `trajectory.csv` (about 1 GB in memory).
+const MAX_TRAJECTORY_ROWS: usize = 10_000_000;
+
 /// Whether the file at `path` is an N-body model. A file that cannot be read or is not TOML
 /// is not (the mechanics loader then reports why, as for any model).
 pub fn is_nbody_file(path: &Path) -> bool {
@@ -139,14 +142,25 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
     } else {
         (Sampling::Points(spec.points.unwrap_or(201)), "points")
     };
-    nbody::run::output_times(t_end, &sampling)
-        .map_err(|m| Error::argument(option, format!("{option}: {m}")))?;
+    let n_outputs = nbody::run::output_times(t_end, &sampling)
+        .map_err(|m| Error::argument(option, format!("{option}: {m}")))?
+        .len();
 
     let built = nbody::build(&spec, &source)?;
     let n_bodies = built.sim.len();
     let trajectory = spec
         .trajectory
         .unwrap_or(n_bodies <= nbody::run::TRAJECTORY_LIMIT);
+    // Trajectories are kept in memory until written: refuse what would not fit.
+    if trajectory && n_bodies.saturating_mul(n_outputs) > MAX_TRAJECTORY_ROWS {
+        return Err(Error::argument(
+            option,
+            format!(
+                "{option}: {n_outputs} outputs of {n_bodies} bodies are more than {MAX_TRAJECTORY_ROWS} trajectory rows; \
+                 ask for fewer outputs (or trajectory = false)"
+            ),
+        ));
+    }
     let info = output::RunInfo {
         integrator: spec.integrator.name(),
         dt: built.config.dt,
