@@ -710,3 +710,91 @@ fn colliding_bodies_stop_or_merge_conserving_momentum() {
     assert!(p.iter().all(|x| x.abs() < 1e-15), "{p:?}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[path = "common/toml_values.rs"]
+mod toml_values;
+
+/// Every N-body example with one value replaced by a hostile one (as `mutations.rs` does for
+/// the mechanics examples): exit 0, 1 or 2, never a panic (exit 3) or a hang.
+#[test]
+fn mutated_nbody_examples_never_panic_or_hang() {
+    const HOSTILE: &[&str] = &[
+        "0",
+        "-1",
+        "1e308",
+        "-1e-308",
+        "\"nan\"",
+        "\"1/0\"",
+        "\"\"",
+        "\"((((x\"",
+        "\"[1, 2, 3]\"",
+        "\"1e400\"",
+        "\"2^100000\"",
+        "\"sqrt(-1)\"",
+        "\"t\"",
+        "[]",
+        "{}",
+        "true",
+        "\"150 knot\"",
+        "[1, 2]",
+        "[\"nan\", 0, 0]",
+        "\"Sun\"",
+        "1.0000001",
+    ];
+    let dir = scratch("mutations");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(root().join("examples/nbody"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    files.sort();
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut next = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed as usize
+    };
+    let mut failures = Vec::new();
+    for f in &files {
+        let src = std::fs::read_to_string(f).unwrap();
+        let spans = toml_values::value_spans(&src);
+        assert!(!spans.is_empty());
+        // The CSV example reads its bodies relative to the model file.
+        std::fs::copy(
+            root().join("examples/nbody/outer_solar_system.csv"),
+            dir.join("outer_solar_system.csv"),
+        )
+        .unwrap();
+        for k in 0..25 {
+            let (s, e) = spans[next() % spans.len()];
+            let hostile = HOSTILE[next() % HOSTILE.len()];
+            let mutated = format!("{}{}{}", &src[..s], hostile, &src[e..]);
+            let path = dir.join(format!("m{k}.toml"));
+            std::fs::write(&path, &mutated).unwrap();
+            let p = path.to_str().unwrap();
+            let mut args = vec!["run", p, "--json", "--points", "3"];
+            if f.ends_with("plummer_cluster.toml") {
+                args.extend(["--set", "N=50", "--t-end", "0.02"]);
+            } else {
+                // A few steps of each integrator (IAS15 adapts; the others take dt).
+                args.extend(["--t-end", "2"]);
+            }
+            let out = Command::new(env!("CARGO_BIN_EXE_pdyn"))
+                .args(&args)
+                .output()
+                .expect("run pdyn");
+            let code = out.status.code();
+            if !matches!(code, Some(0..=2)) {
+                failures.push(format!(
+                    "{} with `{}` -> `{hostile}`: exit {code:?}\n{}",
+                    f.display(),
+                    &src[s..e],
+                    String::from_utf8_lossy(&out.stderr)
+                ));
+            }
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
