@@ -425,6 +425,15 @@ fn bad_input_is_exit_2_with_file_line_column_and_a_json_error() {
             "unknown integrator",
         ),
         (model("colour = 1", ""), "colour", "unknown field"),
+        (
+            model(
+                "",
+                &planet("mass = 1e-3\nposition = [1, 0, 0]\nvelocity = [0, 6, 0]"),
+            )
+            .replace("dt = 0.01", "dt = 1e-300"),
+            "1e-300",
+            "far too small",
+        ),
     ];
     for (k, (text, at, words)) in cases.iter().enumerate() {
         let path = dir.join(format!("bad{k}.toml"));
@@ -554,6 +563,13 @@ fn options_that_do_not_apply_are_refused_by_name() {
         assert_eq!(e["location"]["file"], option, "{args:?}: {e}");
         assert!(err.contains(option), "{args:?}: {err}");
     }
+    // --t-eval: outputs at exactly these times (IAS15 lands on each).
+    let sum = run_ok(
+        "examples/nbody/figure_eight.toml",
+        &["--t-eval", "0,0.5,1.25"],
+    );
+    assert_eq!(sum["stats"]["outputs"], 3);
+    assert_eq!(sum["t_reached"], 1.25);
     // --set and --method do what they say.
     let sum = run_ok(
         "examples/nbody/figure_eight.toml",

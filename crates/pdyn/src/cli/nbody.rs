@@ -10,6 +10,9 @@ use std::path::Path;
 /// Most per-body rows a run keeps for `trajectory.csv` (about 1 GB in memory).
 const MAX_TRAJECTORY_ROWS: usize = 10_000_000;
 
+/// Most steps a fixed-step run may ask for (days of computing at a microsecond a step).
+const MAX_FIXED_STEPS: f64 = 1e11;
+
 /// Whether the file at `path` is an N-body model. A file that cannot be read or is not TOML
 /// is not (the mechanics loader then reports why, as for any model).
 pub fn is_nbody_file(path: &Path) -> bool {
@@ -146,6 +149,23 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
         .map_err(|m| Error::argument(option, format!("{option}: {m}")))?
         .len();
 
+    // A fixed step absurdly small for the span would run for days: say so instead.
+    if let (Some((dt, span)), true) = (&spec.dt, spec.integrator != IntegratorKind::Ias15) {
+        let steps = t_end / dt;
+        if steps > MAX_FIXED_STEPS {
+            let message = format!(
+                "t_end/dt = {steps:.3e} steps, more than {MAX_FIXED_STEPS:.0e}: dt = {dt} is far too small for t_end = {t_end}"
+            );
+            return Err(if span.is_empty() {
+                Error::argument("--dt", format!("--dt: {message}"))
+            } else {
+                Error::Model {
+                    error: pdyn_mech::ModelError::new(&origin, span.clone(), message),
+                    source: source.into(),
+                }
+            });
+        }
+    }
     let built = nbody::build(&spec, &source)?;
     let n_bodies = built.sim.len();
     let trajectory = spec
