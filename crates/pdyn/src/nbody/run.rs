@@ -484,17 +484,29 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, String> {
         .last()
         .map_or(0.0, |r| (r.energy - seg.e0) / seg.e0.abs());
     engine_warnings.extend(sim.warnings().iter().cloned());
+    // One line per kind of warning (IAS15 may raise the same one at thousands of steps): the
+    // first occurrence, and how many there were.
+    let mut kinds: Vec<(std::mem::Discriminant<Warning>, String, usize)> = Vec::new();
     for w in &engine_warnings {
+        let d = std::mem::discriminant(w);
+        if let Some(k) = kinds.iter_mut().find(|k| k.0 == d) {
+            k.2 += 1;
+            continue;
+        }
         let advice = match w {
             Warning::LongWhFastStep { .. } => {
                 " (accuracy degrades quickly above 1/20 of the period: reduce dt, or use IAS15)"
             }
             _ => "",
         };
-        let text = format!("{w}{advice}");
-        if !res.warnings.contains(&text) {
-            res.warnings.push(text);
-        }
+        kinds.push((d, format!("{w}{advice}"), 1));
+    }
+    for (_, text, count) in kinds {
+        res.warnings.push(if count > 1 {
+            format!("{text} (and {} more times)", count - 1)
+        } else {
+            text
+        });
     }
     let tol = options.drift_tolerance;
     let first = res.conservation.first().copied();
@@ -613,5 +625,47 @@ fn record(
             body: alive[i],
             orbit: sim.orbit(i, primary).ok(),
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn output_times_cover_the_span_and_refuse_bad_requests() {
+        assert_eq!(
+            output_times(1.0, &Sampling::Points(3)).unwrap(),
+            [0.0, 0.5, 1.0]
+        );
+        assert_eq!(
+            output_times(1.0, &Sampling::Every(0.4)).unwrap(),
+            [0.0, 0.4, 0.8, 1.0]
+        );
+        assert_eq!(
+            output_times(1.0, &Sampling::Every(0.5)).unwrap(),
+            [0.0, 0.5, 1.0]
+        );
+        assert_eq!(
+            output_times(2.0, &Sampling::Times(vec![0.5, 2.0])).unwrap(),
+            [0.0, 0.5, 2.0]
+        );
+        assert!(output_times(1.0, &Sampling::Points(1)).is_err());
+        assert!(output_times(1.0, &Sampling::Every(0.0)).is_err());
+        assert!(output_times(1.0, &Sampling::Every(1e-300)).is_err());
+        assert!(output_times(1.0, &Sampling::Times(vec![0.5, 0.2])).is_err());
+        assert!(output_times(1.0, &Sampling::Times(vec![2.0])).is_err());
+    }
+
+    #[test]
+    fn fixed_step_outputs_fall_on_the_step_grid_and_end_at_t_end() {
+        // dt = 0.3: 0.25 → 0.3, 0.5 → 0.6, 0.75 → 0.9 (rounding), 1.0 stays (t_end).
+        let t = on_step_grid(&[0.0, 0.25, 0.5, 0.75, 1.0], 0.3);
+        assert_eq!(t.len(), 5);
+        assert_eq!(t[0], 0.0);
+        assert!((t[1] - 0.3).abs() < 1e-15 && (t[2] - 0.6).abs() < 1e-15);
+        assert!((t[3] - 0.9).abs() < 1e-15 && t[4] == 1.0);
+        // Outputs closer than a step collapse onto one grid point.
+        assert_eq!(on_step_grid(&[0.0, 0.01, 0.02, 1.0], 0.5), [0.0, 1.0]);
     }
 }

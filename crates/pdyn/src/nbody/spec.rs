@@ -290,7 +290,15 @@ pub fn nbody_table_span(source: &str) -> Option<Range<usize>> {
     let span = probe.nbody?.span();
     // A `[nbody]` header's value span covers the table body; point at the header when there is
     // one, which is what a reader looks for.
-    Some(source.find("[nbody]").map_or(span, |p| p..p + 7))
+    let mut at = 0;
+    for line in source.split_inclusive('\n') {
+        let lead = line.len() - line.trim_start().len();
+        if line.trim_start().starts_with("[nbody]") {
+            return Some(at + lead..at + lead + 7);
+        }
+        at += line.len();
+    }
+    Some(span)
 }
 
 /// Reads the N-body model in `source` (the file `origin`, whose directory anchors
