@@ -154,14 +154,28 @@ impl Simulation {
         el: &Elements,
         primary: Primary,
     ) -> Result<usize, GravityError> {
+        self.add_orbit_with_radius(mass, el, primary, 0.0)
+    }
+
+    /// [`Simulation::add_orbit`] for a body with a collision radius (≥ 0).
+    pub fn add_orbit_with_radius(
+        &mut self,
+        mass: f64,
+        el: &Elements,
+        primary: Primary,
+        radius: f64,
+    ) -> Result<usize, GravityError> {
         let index = self.particles.len();
         let (mp, rp, vp) = self.primary_state(index, primary)?;
         let (r, v) = elements_to_cartesian(self.forces.g * (mp + mass), el)?;
-        self.add(Particle {
-            mass,
-            pos: rp + r,
-            vel: vp + v,
-        })
+        self.add_with_radius(
+            Particle {
+                mass,
+                pos: rp + r,
+                vel: vp + v,
+            },
+            radius,
+        )
     }
 
     fn primary_state(

@@ -142,6 +142,14 @@ pub enum Error {
         /// What went wrong.
         message: String,
     },
+    /// An N-body integration stopped by the engine (a close encounter WHFast cannot resolve,
+    /// IAS15's step underflow, a non-finite state): exit code 1, output up to it written.
+    Gravity {
+        /// The model file.
+        origin: String,
+        /// Why.
+        error: pdyn_gravity::GravityError,
+    },
 }
 
 impl Error {
@@ -162,13 +170,14 @@ impl Error {
             Error::Integration { .. } => "integration",
             Error::NonFinite { .. } => "non_finite",
             Error::Internal { .. } => "internal",
+            Error::Gravity { .. } => "gravity",
         }
     }
 
     /// The process exit code for this failure (see the module documentation).
     pub fn exit_code(&self) -> u8 {
         match self {
-            Error::Integration { .. } | Error::NonFinite { .. } => 1,
+            Error::Integration { .. } | Error::NonFinite { .. } | Error::Gravity { .. } => 1,
             Error::Internal { .. } => 3,
             _ => 2,
         }
@@ -204,7 +213,8 @@ impl Error {
             | Error::Value { origin, .. }
             | Error::Forces { origin, .. }
             | Error::Sim { origin, .. }
-            | Error::Integration { origin, .. } => Some(file(origin)),
+            | Error::Integration { origin, .. }
+            | Error::Gravity { origin, .. } => Some(file(origin)),
             _ => None,
         }
     }
@@ -276,6 +286,7 @@ impl fmt::Display for Error {
                 f,
                 "internal error — please report it with the command that caused it: {message}"
             ),
+            Error::Gravity { origin, error } => write!(f, "{origin}: error: {error}"),
         }
     }
 }

@@ -4,6 +4,7 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod nbody;
 pub mod output;
 pub mod plots;
 pub mod sim;

@@ -12,7 +12,7 @@ use crate::Error;
 use pdyn_plot::{save, save3, save_grid, Figure, Figure3, Marker, Series, Series3};
 use std::path::Path;
 
-fn both(
+pub(crate) fn both(
     dir: &Path,
     stem: &str,
     f: impl Fn(&Path) -> Result<(), pdyn_plot::PlotError>,

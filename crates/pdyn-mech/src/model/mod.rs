@@ -7,6 +7,7 @@
 //! turns each force declaration into loads on particles or massless frames. Every error carries
 //! the file, line and column of the offending text.
 
+pub mod constants;
 mod forces;
 mod loader;
 pub(crate) mod raw;

@@ -9,6 +9,7 @@ pub mod dsolve;
 pub mod expr;
 pub mod forces;
 pub mod kin;
+pub mod nbody;
 pub mod run;
 pub mod sweep;
 
@@ -105,6 +106,14 @@ pub fn load_model(path: &Path) -> Result<pdyn_mech::Model, Error> {
         action: "read the model file",
         error: Arc::new(e),
     })?;
+    if let Some(span) = pdyn::nbody::spec::nbody_table_span(&source) {
+        let error = pdyn_mech::ModelError::new(&path.display().to_string(), span, "N-body model: use `pdyn run`")
+            .help("an [nbody] table is integrated by pdyn run; it has no symbolic equations (docs/nbody.md)");
+        return Err(Error::Model {
+            error,
+            source: source.into(),
+        });
+    }
     pdyn_mech::load(&source, &path.display().to_string()).map_err(|error| Error::Model {
         error,
         source: source.into(),

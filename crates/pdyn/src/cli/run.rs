@@ -142,6 +142,9 @@ pub(crate) fn io_error(path: &Path, action: &'static str, e: std::io::Error) -> 
 
 /// `pdyn run MODEL`.
 pub fn run(a: RunArgs) -> Result<Outcome, Error> {
+    if super::nbody::is_nbody_file(&a.model) {
+        return super::nbody::run(a);
+    }
     if a.method.as_deref() == Some("help") {
         return Ok(Outcome::text(sim::methods_help()));
     }

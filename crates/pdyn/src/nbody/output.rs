@@ -1,0 +1,269 @@
+//! What an N-body run writes: `trajectory.csv` and `elements.csv` in long format (one row per
+//! body and output time, so mergers and removals need no changing columns),
+//! `conservation.csv` (energy, its parts, the virial ratio and the angular momentum at each
+//! output), `summary.json`, and the text report.
+
+use super::run::NbodyResult;
+use super::spec::NbodySpec;
+use std::fmt::Write as _;
+use std::io::Write;
+use std::path::Path;
+
+/// How the run was set up, for the summary and the report.
+#[derive(Debug, Clone)]
+pub struct RunInfo {
+    /// Integrator name.
+    pub integrator: &'static str,
+    /// Step (initial step for IAS15).
+    pub dt: f64,
+    /// End time asked for.
+    pub t_end: f64,
+    /// `direct` or `tree (theta = ...)`.
+    pub gravity: String,
+    /// Bodies at the start.
+    pub n_bodies: usize,
+    /// Drift tolerance of the monitors.
+    pub drift_tolerance: f64,
+}
+
+fn num(x: f64) -> String {
+    // Shortest representation that reads back exactly.
+    format!("{x:e}")
+}
+
+/// `trajectory.csv`: `t,body,x,y,z,vx,vy,vz`.
+pub fn write_trajectory(res: &NbodyResult, path: &Path) -> std::io::Result<()> {
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(w, "t,body,x,y,z,vx,vy,vz")?;
+    for (t, states) in res.times.iter().zip(&res.states) {
+        for s in states {
+            writeln!(
+                w,
+                "{},{},{},{},{},{},{},{}",
+                num(*t),
+                res.names[s.body],
+                num(s.pos[0]),
+                num(s.pos[1]),
+                num(s.pos[2]),
+                num(s.vel[0]),
+                num(s.vel[1]),
+                num(s.vel[2])
+            )?;
+        }
+    }
+    w.flush()
+}
+
+/// `elements.csv`: `t,body,a,e,inc,Omega,omega,f,M,period` (angles in radians; empty cells
+/// where a body has no elements).
+pub fn write_elements(res: &NbodyResult, path: &Path) -> std::io::Result<()> {
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(w, "t,body,a,e,inc,Omega,omega,f,M,period")?;
+    for r in &res.elements {
+        match r.orbit {
+            Some(o) => writeln!(
+                w,
+                "{},{},{},{},{},{},{},{},{},{}",
+                num(r.t),
+                res.names[r.body],
+                num(o.a),
+                num(o.e),
+                num(o.inc),
+                num(o.Omega),
+                num(o.omega),
+                num(o.f),
+                num(o.M),
+                num(o.period)
+            )?,
+            None => writeln!(w, "{},{},,,,,,,,", num(r.t), res.names[r.body])?,
+        }
+    }
+    w.flush()
+}
+
+/// `conservation.csv`: `t,n,energy,kinetic,potential,virial_ratio,Lx,Ly,Lz`.
+pub fn write_conservation(res: &NbodyResult, path: &Path) -> std::io::Result<()> {
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(w, "t,n,energy,kinetic,potential,virial_ratio,Lx,Ly,Lz")?;
+    for r in &res.conservation {
+        writeln!(
+            w,
+            "{},{},{},{},{},{},{},{},{}",
+            num(r.t),
+            r.n,
+            num(r.energy),
+            num(r.kinetic),
+            num(r.potential),
+            num(virial(r.kinetic, r.potential)),
+            num(r.angular_momentum[0]),
+            num(r.angular_momentum[1]),
+            num(r.angular_momentum[2])
+        )?;
+    }
+    w.flush()
+}
+
+/// `2T/|V|`: 1 for a system in virial equilibrium.
+fn virial(kinetic: f64, potential: f64) -> f64 {
+    2.0 * kinetic / potential.abs()
+}
+
+/// `summary.json`.
+pub fn summary(spec: &NbodySpec, info: &RunInfo, res: &NbodyResult) -> serde_json::Value {
+    let finite = |x: f64| {
+        if x.is_finite() {
+            serde_json::json!(x)
+        } else {
+            serde_json::json!(x.to_string())
+        }
+    };
+    let last = res.conservation.last();
+    let final_bodies: Vec<serde_json::Value> = res
+        .states
+        .last()
+        .map(|states| {
+            states
+                .iter()
+                .map(|s| {
+                    serde_json::json!({
+                        "name": res.names[s.body],
+                        "mass": s.mass,
+                        "position": s.pos,
+                        "velocity": s.vel,
+                    })
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    serde_json::json!({
+        "model": spec.name,
+        "kind": "nbody",
+        "ok": res.failure.is_none(),
+        "units": spec.units.label,
+        "G": spec.units.units.g(),
+        "integrator": info.integrator,
+        "gravity": info.gravity,
+        "dt": info.dt,
+        "t_end": info.t_end,
+        "t_reached": res.t_reached,
+        "bodies": {"initial": info.n_bodies, "final": last.map_or(0, |r| r.n)},
+        "stats": {"steps": res.steps, "final_dt": res.final_dt, "outputs": res.times.len()},
+        "energy": {
+            "initial": res.conservation.first().map(|r| r.energy),
+            "final": last.map(|r| r.energy),
+            "relative_error": finite(res.energy_error),
+        },
+        "virial_ratio": last.map(|r| finite(virial(r.kinetic, r.potential))),
+        "monitors": res.monitors.iter().map(|m| serde_json::json!({
+            "name": m.name,
+            "initial": m.initial,
+            "drift": finite(m.drift),
+            "scale": m.scale,
+            "relative": true,
+            "ok": m.ok,
+        })).collect::<Vec<_>>(),
+        "drift_tolerance": info.drift_tolerance,
+        "events": res.events.iter().map(|e| serde_json::json!({
+            "t": e.t, "kind": e.kind, "bodies": e.bodies, "message": e.message,
+        })).collect::<Vec<_>>(),
+        "warnings": res.warnings,
+        "final_state": final_bodies,
+        "parameters": spec.parameters.iter().map(|(n, v)| (n.clone(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
+    })
+}
+
+/// The text report of `pdyn run`.
+pub fn text_report(
+    spec: &NbodySpec,
+    info: &RunInfo,
+    res: &NbodyResult,
+    out: Option<&Path>,
+) -> String {
+    let mut s = format!("{}\n", spec.name);
+    let _ = writeln!(
+        s,
+        "{} bodies ({}, G = {}), {}, {} forces, dt = {}, t = 0..{}: {} steps, {} outputs",
+        info.n_bodies,
+        spec.units.label,
+        spec.units.units.g(),
+        info.integrator,
+        info.gravity,
+        info.dt,
+        res.t_reached,
+        res.steps,
+        res.times.len()
+    );
+    let _ = writeln!(
+        s,
+        "energy: initial {:.12e}, relative error at the end {:.3e}",
+        res.conservation.first().map_or(f64::NAN, |r| r.energy),
+        res.energy_error
+    );
+    if let Some(r) = res.conservation.last() {
+        if r.n > 3 {
+            let _ = writeln!(
+                s,
+                "virial ratio 2T/|V| at the end: {:.4}",
+                virial(r.kinetic, r.potential)
+            );
+        }
+    }
+    if let Some(states) = res.states.last() {
+        if states.len() <= 12 {
+            s += "\nfinal state:\n";
+            for b in states {
+                let _ = writeln!(
+                    s,
+                    "  {:<12} r = [{:.10e}, {:.10e}, {:.10e}]  v = [{:.10e}, {:.10e}, {:.10e}]",
+                    res.names[b.body], b.pos[0], b.pos[1], b.pos[2], b.vel[0], b.vel[1], b.vel[2]
+                );
+            }
+            let t_last = res.t_reached;
+            let rows: Vec<_> = res.elements.iter().filter(|r| r.t == t_last).collect();
+            if !rows.is_empty() {
+                s += "\nfinal orbital elements (about the declared primary, else Jacobi):\n";
+                for r in rows {
+                    match r.orbit {
+                        Some(o) => {
+                            let _ = writeln!(
+                                s,
+                                "  {:<12} a = {:.10e}  e = {:.6e}  inc = {:.6e}  period = {:.6e}",
+                                res.names[r.body], o.a, o.e, o.inc, o.period
+                            );
+                        }
+                        None => {
+                            let _ = writeln!(s, "  {:<12} (no orbit)", res.names[r.body]);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    if !res.events.is_empty() {
+        s += "\nevents:\n";
+        for e in &res.events {
+            let _ = writeln!(s, "  {:<16} t = {:.12e}: {}", e.kind, e.t, e.message);
+        }
+    }
+    s += "\nconserved quantities:\n";
+    for m in &res.monitors {
+        let _ = writeln!(
+            s,
+            "  {:<20} initial {:.10e}, drift {:.3e} (relative to {:.3e}) {}",
+            m.name,
+            m.initial,
+            m.drift,
+            m.scale,
+            if m.ok { "ok" } else { "DRIFTING" }
+        );
+    }
+    if let Some(dir) = out {
+        let files = if res.states.is_empty() {
+            "conservation.csv and summary.json"
+        } else {
+            "trajectory.csv, elements.csv, conservation.csv and summary.json"
+        };
+        let _ = writeln!(s, "\nwrote {files} in {}", dir.display());
+    }
+    s
+}
