@@ -127,11 +127,17 @@ impl fmt::Display for MdError {
                 "particles {i} and {j} overlap at the start (distance {distance} < {threshold}); \
                  run an energy minimisation (minimize_fire) first"
             ),
-            Unstable { step, atom, neighbor, displacement, energy_change_per_atom } => write!(
-                f,
-                "unstable at step {step}: particle {atom} (nearest {neighbor:?}) moved \
-                 {displacement} in one step, |ΔE|/N = {energy_change_per_atom}; reduce the time step"
-            ),
+            Unstable { step, atom, neighbor, displacement, energy_change_per_atom } => {
+                write!(f, "unstable at step {step}: particle {atom}")?;
+                if let Some(j) = neighbor {
+                    write!(f, " (nearest particle {j})")?;
+                }
+                write!(
+                    f,
+                    " moved {displacement:.4} in one step, |ΔE|/N = {energy_change_per_atom:.4e}; \
+                     reduce the time step"
+                )
+            }
             BondBroken { step, bond, atoms, length, max } => write!(
                 f,
                 "step {step}: FENE bond {bond} {atoms:?} stretched to {length} ≥ R0 = {max}"

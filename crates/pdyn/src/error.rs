@@ -142,6 +142,15 @@ pub enum Error {
         /// What went wrong.
         message: String,
     },
+    /// A molecular-dynamics run that stopped before its last step (exit code 1): unstable (the
+    /// step, the offending atoms) or a bond stretched past its limit. What was computed up to
+    /// there has been written.
+    MdRun {
+        /// The model file.
+        origin: String,
+        /// Where and why (carries the step and the atoms).
+        error: pdyn_md::MdError,
+    },
 }
 
 impl Error {
@@ -162,13 +171,14 @@ impl Error {
             Error::Integration { .. } => "integration",
             Error::NonFinite { .. } => "non_finite",
             Error::Internal { .. } => "internal",
+            Error::MdRun { .. } => "md_run",
         }
     }
 
     /// The process exit code for this failure (see the module documentation).
     pub fn exit_code(&self) -> u8 {
         match self {
-            Error::Integration { .. } | Error::NonFinite { .. } => 1,
+            Error::Integration { .. } | Error::NonFinite { .. } | Error::MdRun { .. } => 1,
             Error::Internal { .. } => 3,
             _ => 2,
         }
@@ -204,7 +214,8 @@ impl Error {
             | Error::Value { origin, .. }
             | Error::Forces { origin, .. }
             | Error::Sim { origin, .. }
-            | Error::Integration { origin, .. } => Some(file(origin)),
+            | Error::Integration { origin, .. }
+            | Error::MdRun { origin, .. } => Some(file(origin)),
             _ => None,
         }
     }
@@ -276,6 +287,12 @@ impl fmt::Display for Error {
                 f,
                 "internal error — please report it with the command that caused it: {message}"
             ),
+            Error::MdRun { origin, error } => {
+                write!(
+                    f,
+                    "{origin}: error: the run stopped: {error} (the output up to that step is kept)"
+                )
+            }
         }
     }
 }

@@ -9,6 +9,7 @@ pub mod dsolve;
 pub mod expr;
 pub mod forces;
 pub mod kin;
+pub mod md;
 pub mod run;
 pub mod sweep;
 
