@@ -105,7 +105,13 @@ impl FormulaPair {
         let mut uses_r = false;
         foreign_names(&ast, params, &mut foreign, &mut uses_r);
         if let Some((_, span)) = foreign.first() {
-            let names: Vec<String> = foreign.iter().map(|(n, _)| format!("`{n}`")).collect();
+            let mut names: Vec<String> = vec![];
+            for (n, _) in &foreign {
+                let n = format!("`{n}`");
+                if !names.contains(&n) {
+                    names.push(n);
+                }
+            }
             return Err(FormulaError {
                 span: span.clone(),
                 message: format!(
@@ -242,7 +248,8 @@ mod tests {
     fn other_symbols_are_named_and_located() {
         let e = FormulaPair::compile("4*eps*((s/r)^12 - (s/x)^6)", &params(), JitMode::Off).unwrap_err();
         assert!(e.message.contains("`s`") && e.message.contains("`x`"), "{}", e.message);
-        assert_eq!(e.span, 9..10);
+        assert_eq!(e.span, 8..9);
+        assert_eq!(e.message.matches("`s`").count(), 1, "{}", e.message);
         let e = FormulaPair::compile("eps*t", &params(), JitMode::Off).unwrap_err();
         assert!(e.message.contains("`t`"), "{}", e.message);
         let e = FormulaPair::compile("eps*sigma", &params(), JitMode::Off).unwrap_err();
