@@ -76,6 +76,7 @@ pub fn summary(prep: &Prepared, res: &MdResult) -> serde_json::Value {
             "total": json_num(r.total), "pressure": json_num(r.pressure),
             "total_per_atom": json_num(r.total / n),
         })),
+        "averages_from_step": res.average_from.max(1),
         "averages": {
             "temperature": avg_json(res.average(|r| r.temperature)),
             "pressure": avg_json(res.average(|r| r.pressure)),

@@ -90,13 +90,16 @@ pub struct MdResult {
     pub warnings: Vec<String>,
     /// Wall-clock seconds spent stepping.
     pub seconds: f64,
+    /// First step that counts in the averages.
+    pub average_from: u64,
 }
 
 impl MdResult {
-    /// Block average of one column of the records (`f` picks it); the first record (the start,
-    /// before any dynamics) is left out.
+    /// Block average of one column of the records (`f` picks it); the start (step 0, before
+    /// any dynamics) and the records before `equilibrate` are left out.
     pub fn average(&self, f: impl Fn(&ThermoRecord) -> f64) -> Option<Average> {
-        let xs: Vec<f64> = self.records.iter().skip(1).map(f).collect();
+        let from = self.average_from.max(1);
+        let xs: Vec<f64> = self.records.iter().filter(|r| r.step >= from).map(f).collect();
         block_average(&xs)
     }
 }
@@ -364,6 +367,7 @@ fn run_sim<P: PairPotential>(
         drift,
         warnings,
         seconds,
+        average_from: spec.equilibrate,
     })
 }
 

@@ -43,6 +43,7 @@ struct RawMd {
     rdf: Option<Spanned<bool>>,
     rdf_bins: Option<Sv>,
     msd: Option<Spanned<bool>>,
+    equilibrate: Option<Sv>,
     #[serde(default)]
     species: IndexMap<Name, Spanned<RawSpecies>>,
     #[serde(default)]
@@ -359,6 +360,8 @@ pub struct MdSpec {
     pub rdf_bins: usize,
     /// Mean-squared displacement post-processing.
     pub msd: bool,
+    /// Records before this step are left out of the averages (equilibration).
+    pub equilibrate: u64,
     /// Species in declaration order.
     pub species: Vec<Species>,
     /// Pair potentials.
@@ -472,6 +475,7 @@ pub fn parse(source: &str, origin: &str, overrides: &[(String, f64)]) -> Result<
         .transpose()?;
     let rdf_bins = r.count_or(&m.rdf_bins, "rdf_bins", &mspan, Some(100), 1 << 20)? as usize;
     let rdf_bins = rdf_bins.max(1);
+    let equilibrate = r.count_or(&m.equilibrate, "equilibrate", &mspan, Some(0), MAX_STEPS)?;
 
     if m.species.is_empty() {
         return Err(r
@@ -862,6 +866,7 @@ pub fn parse(source: &str, origin: &str, overrides: &[(String, f64)]) -> Result<
         rdf: m.rdf.as_ref().is_some_and(|b| *b.get_ref()),
         rdf_bins,
         msd: m.msd.as_ref().is_some_and(|b| *b.get_ref()),
+        equilibrate,
         species,
         pairs,
         start,
