@@ -92,6 +92,22 @@ fn every_md_example_runs_shrunk() {
             assert_eq!(first as u64, atoms, "{name}");
             assert!(traj.lines().nth(1).unwrap().contains("Lattice=\""), "{name}");
         }
+        if spec.rdf {
+            let rdf = std::fs::read_to_string(out.join("rdf.csv")).unwrap();
+            assert_eq!(rdf.lines().count(), spec.rdf_bins + 1, "{name}");
+            let g_max = rdf
+                .lines()
+                .skip(1)
+                .map(|l| l.split(',').nth(1).unwrap().parse::<f64>().unwrap())
+                .fold(0.0, f64::max);
+            // a crystal or a liquid has a first peak well above the ideal gas's 1
+            assert!(g_max > 2.0, "{name}: max g(r) = {g_max}");
+        }
+        if spec.msd {
+            let msd = std::fs::read_to_string(out.join("msd.csv")).unwrap();
+            let last: f64 = msd.lines().last().unwrap().split(',').nth(2).unwrap().parse().unwrap();
+            assert!(last > 0.0 && last < 1.0, "{name}: msd after 20 steps {last}");
+        }
         let on_disk = json(&std::fs::read_to_string(out.join("summary.json")).unwrap());
         assert_eq!(on_disk["atoms"], s["atoms"]);
     }
@@ -304,4 +320,24 @@ fn derive_on_an_md_model_says_to_use_run() {
     let e = json(&out)["error"].clone();
     assert!(e["message"].as_str().unwrap().contains("use `pdyn run`"), "{e}");
     assert_eq!(e["location"]["line"], line_of(&lj(), "[md]"));
+}
+
+#[test]
+fn plot_writes_the_thermo_figure() {
+    let out = scratch("plot");
+    let (code, _, err) = pdyn(&[
+        "run",
+        "examples/md/lj_liquid.toml",
+        "--set",
+        "n=4",
+        "--t-end",
+        "0.1",
+        "--out",
+        out.to_str().unwrap(),
+        "--plot",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let svg = std::fs::read_to_string(out.join("thermo.svg")).unwrap();
+    assert!(svg.contains("<svg") && svg.contains("temperature"));
+    assert!(std::fs::metadata(out.join("thermo.png")).unwrap().len() > 1000);
 }

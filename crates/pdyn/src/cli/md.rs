@@ -25,9 +25,11 @@ pub fn refuse(path: &Path, command: &str) -> Result<(), Error> {
         return Ok(());
     };
     let at = source.find("[md").unwrap_or(0);
+    // four characters, ending on a character boundary
+    let len: usize = source[at..].chars().take(4).map(char::len_utf8).sum();
     let error = ModelError::new(
         &path.display().to_string(),
-        at..at + 4.min(source.len() - at),
+        at..at + len,
         format!("molecular-dynamics model: use `pdyn run`, not `pdyn {command}`"),
     )
     .help("an [md] model has pair potentials and thermostats, not equations of motion to derive");

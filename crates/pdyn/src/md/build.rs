@@ -23,6 +23,9 @@ use pdyn_mech::ModelError;
 use std::ops::Range;
 use std::path::Path;
 
+/// Most thermodynamic records one run keeps (each is 64 bytes, and one MSD value each).
+pub const MAX_RECORDS: u64 = 10_000_000;
+
 /// Conversions between the file's units and the engine's (which needs `m v²` in energy units).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct UnitSystem {
@@ -93,6 +96,16 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
     let u = UnitSystem::of(spec.units);
     let err = |span: &Range<usize>, msg: String| ModelError::new(&spec.origin, span.clone(), msg);
     let md_err = |span: &Range<usize>, e: MdError| err(span, e.to_string());
+
+    // Thermo records are kept in memory: their number is checked before the run.
+    let records = spec.steps / spec.thermo_every.max(1);
+    if records > MAX_RECORDS {
+        return Err(err(&spec.span, format!(
+            "{} steps with thermo_every = {} would keep {records} thermo records (more than {MAX_RECORDS})",
+            spec.steps, spec.thermo_every
+        ))
+        .help("raise thermo_every"));
+    }
 
     // Potentials.
     let mut pairs = Vec::with_capacity(spec.pairs.len());

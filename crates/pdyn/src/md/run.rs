@@ -250,6 +250,7 @@ fn run_sim<P: PairPotential>(
     let mut records: Vec<ThermoRecord> = vec![];
     let mut msd = vec![];
     let mut rdf_seen = 0u64;
+    let mut rdf_frames = 0u64;
     let every = spec.thermo_every.max(1);
     let chunk = if spec.dump_every > 0 {
         gcd(every, spec.dump_every)
@@ -283,6 +284,7 @@ fn run_sim<P: PairPotential>(
                     if rdf_seen % rdf_every == 0 {
                         // the box is fixed, so `add` cannot refuse r_max here
                         let _ = h.add(s);
+                        rdf_frames += 1;
                     }
                     rdf_seen += 1;
                 }
@@ -315,9 +317,23 @@ fn run_sim<P: PairPotential>(
     }
     let seconds = start.elapsed().as_secs_f64();
     if failure.is_none() && records.last().map(|r| r.step) != Some(sim.step) {
+        // the last step, when it is not a multiple of thermo_every
         let c = convert(&sim.thermo(), u, dt);
         progress(Progress::Record(&c));
         records.push(c);
+        if let Some(m) = &msd0 {
+            msd.push([c.step as f64, c.time, m.value(&sim.system)]);
+        }
+        if let Some(h) = &mut rdf {
+            if c.step > 0 {
+                let _ = h.add(&sim.system);
+                rdf_frames += 1;
+            }
+        }
+    }
+    if spec.rdf && rdf.is_some() && rdf_frames == 0 {
+        warnings.push("rdf = true: no frame to average (the run has no steps)".into());
+        rdf = None;
     }
     if let Some((w, path)) = &mut traj {
         w.flush().map_err(|e| io_err(path, "write", e))?;
