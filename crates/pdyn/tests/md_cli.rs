@@ -90,7 +90,10 @@ fn every_md_example_runs_shrunk() {
             let traj = std::fs::read_to_string(out.join("traj.xyz")).unwrap();
             let first: usize = traj.lines().next().unwrap().trim().parse().unwrap();
             assert_eq!(first as u64, atoms, "{name}");
-            assert!(traj.lines().nth(1).unwrap().contains("Lattice=\""), "{name}");
+            assert!(
+                traj.lines().nth(1).unwrap().contains("Lattice=\""),
+                "{name}"
+            );
         }
         if spec.rdf {
             let rdf = std::fs::read_to_string(out.join("rdf.csv")).unwrap();
@@ -105,8 +108,19 @@ fn every_md_example_runs_shrunk() {
         }
         if spec.msd {
             let msd = std::fs::read_to_string(out.join("msd.csv")).unwrap();
-            let last: f64 = msd.lines().last().unwrap().split(',').nth(2).unwrap().parse().unwrap();
-            assert!(last > 0.0 && last < 1.0, "{name}: msd after 20 steps {last}");
+            let last: f64 = msd
+                .lines()
+                .last()
+                .unwrap()
+                .split(',')
+                .nth(2)
+                .unwrap()
+                .parse()
+                .unwrap();
+            assert!(
+                last > 0.0 && last < 1.0,
+                "{name}: msd after 20 steps {last}"
+            );
         }
         let on_disk = json(&std::fs::read_to_string(out.join("summary.json")).unwrap());
         assert_eq!(on_disk["atoms"], s["atoms"]);
@@ -126,8 +140,14 @@ fn run_json(file: &str, extra: &[&str]) -> serde_json::Value {
 #[test]
 fn formula_lj_equals_builtin_lj() {
     for steps in ["0", "0.05"] {
-        let a = run_json("examples/md/lj_liquid.toml", &["--set", "n=5", "--t-end", steps]);
-        let b = run_json("examples/md/lj_formula.toml", &["--set", "n=5", "--t-end", steps]);
+        let a = run_json(
+            "examples/md/lj_liquid.toml",
+            &["--set", "n=5", "--t-end", steps],
+        );
+        let b = run_json(
+            "examples/md/lj_formula.toml",
+            &["--set", "n=5", "--t-end", steps],
+        );
         for key in ["potential", "kinetic", "total", "pressure"] {
             let (x, y) = (
                 a["final"][key].as_f64().unwrap(),
@@ -150,15 +170,27 @@ fn nve_energy_is_conserved() {
     let src = std::fs::read_to_string(root().join("examples/md/lj_liquid.toml")).unwrap();
     let d = scratch("nve");
     let f = d.join("lj_shifted.toml");
-    std::fs::write(&f, src.replace("mode = \"plain\"", "mode = \"shifted-energy\"")).unwrap();
+    std::fs::write(
+        &f,
+        src.replace("mode = \"plain\"", "mode = \"shifted-energy\""),
+    )
+    .unwrap();
     let s = run_json(f.to_str().unwrap(), &["--set", "n=5", "--t-end", "1.0"]);
     let rel = s["energy_drift"]["relative"].as_f64().unwrap();
     let slope = s["energy_drift"]["slope_per_atom"].as_f64().unwrap();
     assert!(rel < 1e-3, "relative drift {rel}");
     assert!(slope.abs() < 1e-3, "slope {slope}");
-    assert_eq!(s["warnings"].as_array().unwrap().len(), 0, "{}", s["warnings"]);
+    assert_eq!(
+        s["warnings"].as_array().unwrap().len(),
+        0,
+        "{}",
+        s["warnings"]
+    );
     // and the plain cutoff of in.lj, whose energy jumps at r_c, is flagged when it drifts
-    let t = run_json("examples/md/lj_liquid.toml", &["--set", "n=5", "--t-end", "1.0"]);
+    let t = run_json(
+        "examples/md/lj_liquid.toml",
+        &["--set", "n=5", "--t-end", "1.0"],
+    );
     let rel_plain = t["energy_drift"]["relative"].as_f64().unwrap();
     assert!(rel_plain > rel, "plain {rel_plain} vs shifted {rel}");
 }
@@ -180,12 +212,20 @@ fn lj() -> String {
 }
 
 /// Asserts exit 2, a model error at `line` (and a column), and `needle` in the message.
-fn assert_located(name: &str, (code, e, stderr): (i32, serde_json::Value, String), line: u64, needle: &str) {
+fn assert_located(
+    name: &str,
+    (code, e, stderr): (i32, serde_json::Value, String),
+    line: u64,
+    needle: &str,
+) {
     assert_eq!(code, 2, "{name}: {stderr}");
     assert_eq!(e["kind"], "model", "{name}: {e}");
     assert_eq!(e["exit_code"], 2, "{name}");
     assert_eq!(e["location"]["line"], line, "{name}: {e}");
-    assert!(e["location"]["column"].as_u64().is_some_and(|c| c >= 1), "{name}: {e}");
+    assert!(
+        e["location"]["column"].as_u64().is_some_and(|c| c >= 1),
+        "{name}: {e}"
+    );
     let msg = e["message"].as_str().unwrap();
     assert!(msg.contains(needle), "{name}: `{needle}` not in {msg}");
     // the human message on stderr is file:line:col
@@ -199,18 +239,37 @@ fn line_of(text: &str, needle: &str) -> u64 {
 
 #[test]
 fn bad_parameters_of_builtin_kernels_are_located() {
-    for (value, needle) in [("-1.0", "must be > 0"), ("0", "must be > 0"), ("nan", "nan")] {
+    for (value, needle) in [
+        ("-1.0", "must be > 0"),
+        ("0", "must be > 0"),
+        ("nan", "nan"),
+    ] {
         let text = lj().replace("sigma = \"sigma\"", &format!("sigma = {value}"));
         let line = line_of(&text, &format!("sigma = {value}"));
-        assert_located("sigma", bad("sigma", &text, &["--set", "n=5"]), line, needle);
+        assert_located(
+            "sigma",
+            bad("sigma", &text, &["--set", "n=5"]),
+            line,
+            needle,
+        );
     }
     let text = lj().replace("epsilon = \"eps\"", "epsilon = \"-eps\"");
     let line = line_of(&text, "epsilon = ");
-    assert_located("epsilon", bad("epsilon", &text, &["--set", "n=5"]), line, "epsilon");
+    assert_located(
+        "epsilon",
+        bad("epsilon", &text, &["--set", "n=5"]),
+        line,
+        "epsilon",
+    );
     // a parameter set to a bad value on the command line is caught at its use
     let text = lj();
     let line = line_of(&text, "sigma = \"sigma\"");
-    assert_located("setsigma", bad("setsigma", &text, &["--set", "n=5,sigma=-2"]), line, "sigma");
+    assert_located(
+        "setsigma",
+        bad("setsigma", &text, &["--set", "n=5,sigma=-2"]),
+        line,
+        "sigma",
+    );
 }
 
 #[test]
@@ -223,24 +282,43 @@ fn formula_of_other_symbols_or_infinite_at_cutoff_is_located() {
     let text = f("4*eps*((sigma/r)^12 - (s/x)^6)");
     let line = line_of(&text, "potential");
     let r = bad("formula", &text, &["--set", "n=5"]);
-    assert!(r.1["message"].as_str().unwrap().contains("`s`, `x`"), "{}", r.1);
+    assert!(
+        r.1["message"].as_str().unwrap().contains("`s`, `x`"),
+        "{}",
+        r.1
+    );
     assert_located("formula", r, line, "function of r alone");
     let text = f("eps/(r - 2.5)");
-    assert_located("cutoff", bad("cutoff", &text, &["--set", "n=5"]), line, "no finite value at the cutoff");
+    assert_located(
+        "cutoff",
+        bad("cutoff", &text, &["--set", "n=5"]),
+        line,
+        "no finite value at the cutoff",
+    );
 }
 
 #[test]
 fn box_shorter_than_twice_cutoff_plus_skin_is_located() {
     let text = lj();
     let line = line_of(&text, "[md.lattice]");
-    assert_located("box", bad("box", &text, &["--set", "n=2"]), line, "2·(cutoff + skin)");
+    assert_located(
+        "box",
+        bad("box", &text, &["--set", "n=2"]),
+        line,
+        "2·(cutoff + skin)",
+    );
 }
 
 #[test]
 fn thermostat_without_temperature_is_located() {
     let text = lj() + "\n[md.thermostat]\nkind = \"nose-hoover\"\ntau = 0.5\n";
     let line = line_of(&text, "kind = \"nose-hoover\"");
-    assert_located("thermostat", bad("thermostat", &text, &["--set", "n=5"]), line, "needs a `temperature`");
+    assert_located(
+        "thermostat",
+        bad("thermostat", &text, &["--set", "n=5"]),
+        line,
+        "needs a `temperature`",
+    );
 }
 
 /// Two atoms 0.3σ apart in a file: refused with the pair and the distance and a hint at
@@ -251,7 +329,8 @@ fn overlapping_atoms_are_reported_and_minimize_resolves_them() {
     let xyz = "4\nLattice=\"8 0 0 0 8 0 0 0 8\" Properties=species:S:1:pos:R:3\n\
                Ar 1.0 1.0 1.0\nAr 1.3 1.0 1.0\nAr 5.0 5.0 5.0\nAr 1.0 5.0 3.0\n";
     std::fs::write(d.join("start.xyz"), xyz).unwrap();
-    let model = "name = \"overlap\"\n[md]\ndt = 0.002\nsteps = 10\n\n[md.species.Ar]\nmass = 1.0\n\n\
+    let model =
+        "name = \"overlap\"\n[md]\ndt = 0.002\nsteps = 10\n\n[md.species.Ar]\nmass = 1.0\n\n\
                  [[md.pairs]]\nkind = \"lj\"\nepsilon = 1.0\nsigma = 1.0\ncutoff = 2.5\n\n\
                  [md.read]\nfile = \"start.xyz\"\n";
     let f = d.join("overlap.toml");
@@ -259,15 +338,30 @@ fn overlapping_atoms_are_reported_and_minimize_resolves_them() {
     let (code, out, err) = pdyn(&["run", f.to_str().unwrap(), "--json"]);
     let e = json(&out)["error"].clone();
     assert_eq!(code, 2, "{err}");
-    assert_eq!(e["location"]["line"], line_of(model, "file = ") as u64, "{e}");
+    assert_eq!(
+        e["location"]["line"],
+        line_of(model, "file = "),
+        "{e}"
+    );
     let msg = e["message"].as_str().unwrap();
-    assert!(msg.contains("atoms 0 and 1") && msg.contains("0.3"), "{msg}");
+    assert!(
+        msg.contains("atoms 0 and 1") && msg.contains("0.3"),
+        "{msg}"
+    );
     assert!(msg.contains("minimize = true"), "{msg}");
-    std::fs::write(&f, model.replace("steps = 10\n", "steps = 10\nminimize = true\n")).unwrap();
+    std::fs::write(
+        &f,
+        model.replace("steps = 10\n", "steps = 10\nminimize = true\n"),
+    )
+    .unwrap();
     let (code, out, err) = pdyn(&["run", f.to_str().unwrap(), "--json"]);
     assert_eq!(code, 0, "{err}");
     let s = json(&out);
-    assert!(s["minimized"]["energy"].as_f64().unwrap() < 0.0, "{}", s["minimized"]);
+    assert!(
+        s["minimized"]["energy"].as_f64().unwrap() < 0.0,
+        "{}",
+        s["minimized"]
+    );
 }
 
 /// dt = 0.05 (ten times in.lj's): the run explodes within a few steps; exit 1, the step and
@@ -291,7 +385,10 @@ fn energy_explosion_is_reported_with_step_and_atoms_and_partial_output() {
     let e = &s["error"];
     assert_eq!(e["kind"], "md_run");
     let msg = e["message"].as_str().unwrap();
-    assert!(msg.contains("unstable at step") && msg.contains("particle"), "{msg}");
+    assert!(
+        msg.contains("unstable at step") && msg.contains("particle"),
+        "{msg}"
+    );
     let step = s["steps"].as_u64().unwrap();
     assert!((1..=10).contains(&step), "detected at step {step}");
     let thermo = std::fs::read_to_string(out.join("thermo.csv")).unwrap();
@@ -302,15 +399,30 @@ fn energy_explosion_is_reported_with_step_and_atoms_and_partial_output() {
 #[test]
 fn options_without_meaning_for_md_are_refused_by_name() {
     for opt in [["--rtol", "1e-3"], ["--method", "rk4"], ["--points", "10"]] {
-        let (code, out, _) = pdyn(&["run", "examples/md/lj_liquid.toml", opt[0], opt[1], "--json"]);
+        let (code, out, _) = pdyn(&[
+            "run",
+            "examples/md/lj_liquid.toml",
+            opt[0],
+            opt[1],
+            "--json",
+        ]);
         assert_eq!(code, 2);
         let e = json(&out)["error"].clone();
         assert_eq!(e["kind"], "argument");
         assert!(e["message"].as_str().unwrap().starts_with(opt[0]), "{e}");
     }
-    let (code, out, _) = pdyn(&["run", "examples/md/lj_liquid.toml", "--set", "nope=1", "--json"]);
+    let (code, out, _) = pdyn(&[
+        "run",
+        "examples/md/lj_liquid.toml",
+        "--set",
+        "nope=1",
+        "--json",
+    ]);
     assert_eq!(code, 2);
-    assert!(json(&out)["error"]["message"].as_str().unwrap().contains("`nope`"));
+    assert!(json(&out)["error"]["message"]
+        .as_str()
+        .unwrap()
+        .contains("`nope`"));
 }
 
 #[test]
@@ -318,7 +430,10 @@ fn derive_on_an_md_model_says_to_use_run() {
     let (code, out, err) = pdyn(&["derive", "examples/md/lj_liquid.toml", "--json"]);
     assert_eq!(code, 2, "{err}");
     let e = json(&out)["error"].clone();
-    assert!(e["message"].as_str().unwrap().contains("use `pdyn run`"), "{e}");
+    assert!(
+        e["message"].as_str().unwrap().contains("use `pdyn run`"),
+        "{e}"
+    );
     assert_eq!(e["location"]["line"], line_of(&lj(), "[md]"));
 }
 

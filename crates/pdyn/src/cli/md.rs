@@ -76,13 +76,19 @@ pub fn run(a: RunArgs, source: String) -> Result<Outcome, Error> {
             let names: Vec<&str> = spec.parameters.iter().map(|(n, _)| n.as_str()).collect();
             return Err(Error::argument(
                 "--set",
-                format!("--set: `{k}` is not a parameter (parameters: {})", names.join(", ")),
+                format!(
+                    "--set: `{k}` is not a parameter (parameters: {})",
+                    names.join(", ")
+                ),
             ));
         }
     }
     if let Some(dt) = a.dt {
         if !(dt.is_finite() && dt > 0.0) {
-            return Err(Error::argument("--dt", format!("--dt must be a positive number, got {dt}")));
+            return Err(Error::argument(
+                "--dt",
+                format!("--dt must be a positive number, got {dt}"),
+            ));
         }
         spec.dt.value = dt;
     }
@@ -91,7 +97,10 @@ pub fn run(a: RunArgs, source: String) -> Result<Outcome, Error> {
         if !(steps.is_finite() && steps >= 0.0 && steps <= md::spec::MAX_STEPS as f64) {
             return Err(Error::argument(
                 "--t-end",
-                format!("--t-end {t} with dt = {} is not a valid number of steps", spec.dt.value),
+                format!(
+                    "--t-end {t} with dt = {} is not a valid number of steps",
+                    spec.dt.value
+                ),
             ));
         }
         spec.steps = steps.round() as u64;
@@ -107,10 +116,14 @@ pub fn run(a: RunArgs, source: String) -> Result<Outcome, Error> {
         None => pdyn::sim::DEFAULT_DRIFT_TOLERANCE,
     };
     if a.plot && a.out.is_none() {
-        return Err(Error::argument("--plot", "--plot needs --out DIR to write the images into"));
+        return Err(Error::argument(
+            "--plot",
+            "--plot needs --out DIR to write the images into",
+        ));
     }
     let base = a.model.parent().unwrap_or(Path::new("."));
-    let mut prep = md::build(&spec, base, pdyn_jit::JitMode::Auto).map_err(|e| model_err(e, &source))?;
+    let mut prep =
+        md::build(&spec, base, pdyn_jit::JitMode::Auto).map_err(|e| model_err(e, &source))?;
     if let Some(dir) = &a.out {
         std::fs::create_dir_all(dir).map_err(|e| io_error(dir, "create", e))?;
     }
@@ -213,7 +226,11 @@ fn text_report(prep: &md::Prepared, res: &md::MdResult, out: Option<&Path>) -> S
         res.steps,
         res.builds,
         res.seconds,
-        if res.seconds > 0.0 { n * res.steps as f64 / res.seconds } else { 0.0 }
+        if res.seconds > 0.0 {
+            n * res.steps as f64 / res.seconds
+        } else {
+            0.0
+        }
     );
     if let Some(r) = res.records.last() {
         s += &format!(
@@ -226,7 +243,11 @@ fn text_report(prep: &md::Prepared, res: &md::MdResult, out: Option<&Path>) -> S
         );
     }
     let fmt = |name: &str, a: Option<md::run::Average>| match a {
-        Some(md::run::Average { mean, error: Some(e), .. }) => format!("  {name:<12} {mean:.6} ± {e:.2e}\n"),
+        Some(md::run::Average {
+            mean,
+            error: Some(e),
+            ..
+        }) => format!("  {name:<12} {mean:.6} ± {e:.2e}\n"),
         Some(a) => format!("  {name:<12} {:.6}\n", a.mean),
         None => String::new(),
     };

@@ -120,33 +120,42 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
         let at_cutoff = |e: MdError, what: &Range<usize>| match e {
             MdError::InvalidParameter { name, value } if name.contains("cutoff") => err(
                 what,
-                format!("the potential has no finite value at the cutoff r = {rc}: {name} = {value}"),
+                format!(
+                    "the potential has no finite value at the cutoff r = {rc}: {name} = {value}"
+                ),
             )
             .help("choose a cutoff where u(r) and u'(r) are finite"),
             e => md_err(&p.cutoff.span, e),
         };
         let pair = match &p.kind {
             PairKind::Lj { epsilon, sigma } => {
-                let lj = LennardJones::try_new(epsilon.value, sigma.value)
-                    .map_err(|e| param_err(&spec.origin, e, &[("epsilon", epsilon), ("sigma", sigma)]))?;
+                let lj = LennardJones::try_new(epsilon.value, sigma.value).map_err(|e| {
+                    param_err(&spec.origin, e, &[("epsilon", epsilon), ("sigma", sigma)])
+                })?;
                 Pair::Lj(Truncated::try_new(lj, rc, mode).map_err(|e| at_cutoff(e, &p.span))?)
             }
             PairKind::Morse { depth, alpha, r0 } => {
                 let m = Morse::try_new(depth.value, alpha.value, r0.value).map_err(|e| {
-                    param_err(&spec.origin, e, &[("depth", depth), ("alpha", alpha), ("r0", r0)])
+                    param_err(
+                        &spec.origin,
+                        e,
+                        &[("depth", depth), ("alpha", alpha), ("r0", r0)],
+                    )
                 })?;
                 Pair::Morse(Truncated::try_new(m, rc, mode).map_err(|e| at_cutoff(e, &p.span))?)
             }
             PairKind::Formula { text, offset, span } => {
-                let f = FormulaPair::compile(text, &spec.parameters, jit).map_err(|e: FormulaError| {
-                    let mut me = ModelError::new(
-                        &spec.origin,
-                        e.span.start + offset..e.span.end + offset,
-                        e.message,
-                    );
-                    me.help = e.help;
-                    me
-                })?;
+                let f = FormulaPair::compile(text, &spec.parameters, jit).map_err(
+                    |e: FormulaError| {
+                        let mut me = ModelError::new(
+                            &spec.origin,
+                            e.span.start + offset..e.span.end + offset,
+                            e.message,
+                        );
+                        me.help = e.help;
+                        me
+                    },
+                )?;
                 native &= f.is_native();
                 Pair::Formula(Truncated::try_new(f, rc, mode).map_err(|e| at_cutoff(e, span))?)
             }
@@ -195,12 +204,11 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
                     .help("the path is relative to the model file")
             })?;
             let r = std::io::BufReader::new(file);
-            let located = |e: MdError| {
-                err(span, format!("{}: {e}", full.display()))
-            };
+            let located = |e: MdError| err(span, format!("{}: {e}", full.display()));
             let mut s = match format {
                 FileFormat::Xyz => {
-                    let frame = pdyn_md::io::read_xyz(r, MAX_ATOMS as usize, 1.0).map_err(located)?;
+                    let frame =
+                        pdyn_md::io::read_xyz(r, MAX_ATOMS as usize, 1.0).map_err(located)?;
                     // The file's species names are mapped to the model's by name.
                     let mut map = Vec::with_capacity(frame.names.len());
                     for n in &frame.names {
@@ -218,7 +226,8 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
                     s
                 }
                 FileFormat::LammpsData => {
-                    let s = pdyn_md::io::read_lammps_data(r, MAX_ATOMS as usize).map_err(located)?;
+                    let s =
+                        pdyn_md::io::read_lammps_data(r, MAX_ATOMS as usize).map_err(located)?;
                     if let Some(&t) = s.types.iter().find(|&&t| t as usize >= nt) {
                         return Err(err(span, format!(
                             "{} has atom type {}, but the model declares {nt} species (types 1..{nt} in declaration order)",
@@ -242,16 +251,20 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
     };
     let n = system.particles.len();
     if n == 0 {
-        return Err(err(&start_span, "the initial configuration has no atoms".into()));
+        return Err(err(
+            &start_span,
+            "the initial configuration has no atoms".into(),
+        ));
     }
 
     // Bonds: consecutive atoms in chains of `chain_length`.
     if let Some(b) = &spec.bonds {
         let l = b.chain_length as usize;
         if n % l != 0 {
-            return Err(err(&b.span, format!(
-                "{n} atoms do not divide into chains of {l} beads"
-            ))
+            return Err(err(
+                &b.span,
+                format!("{n} atoms do not divide into chains of {l} beads"),
+            )
             .help("choose a chain_length that divides the number of atoms"));
         }
         let kind = match b.kind {
@@ -289,7 +302,8 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
         ),
         ..SimParams::default()
     };
-    let box_check = |e: MdError| match e {
+    let box_check = |e: MdError| {
+        match e {
         MdError::BoxTooSmall {
             axis,
             length,
@@ -301,6 +315,7 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
         ))
         .help("use more cells (or a larger box in the file), or a shorter cutoff or skin"),
         e => md_err(&spec.span, e),
+    }
     };
     // The box is checked before a minimisation, which builds a neighbour list of its own.
     pdyn_md::NeighborList::new(cutoff, params.skin)
@@ -312,7 +327,8 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
             skin: params.skin,
             ..FireParams::default()
         };
-        let rep = pdyn_md::minimize_fire(&mut system, &ff, &fp).map_err(|e| md_err(&spec.span, e))?;
+        let rep =
+            pdyn_md::minimize_fire(&mut system, &ff, &fp).map_err(|e| md_err(&spec.span, e))?;
         if let Some((t, seed)) = &spec.velocities {
             // FIRE leaves the atoms at rest: draw the velocities again.
             pdyn_md::maxwell_boltzmann(&mut system.particles, t.value, u.boltzmann, *seed)
@@ -347,7 +363,8 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
     }
     .map_err(|e| md_err(&th.span, e))?;
 
-    let start_err = |e: MdError| match e {
+    let start_err = |e: MdError| {
+        match e {
         MdError::Overlap {
             i,
             j,
@@ -370,9 +387,11 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
         )
         .help("atoms of a chain are consecutive in the configuration: they must start closer than r_max"),
         e => box_check(e),
+    }
     };
     let engine = if pairs.iter().all(|p| matches!(p, Pair::Lj(_))) {
-        let mut lf = ForceField::uniform(nt, lj_of(&pairs[0])).map_err(|e| md_err(&spec.span, e))?;
+        let mut lf =
+            ForceField::uniform(nt, lj_of(&pairs[0])).map_err(|e| md_err(&spec.span, e))?;
         for (p, pair) in spec.pairs.iter().zip(&pairs) {
             lf.set(p.between[0], p.between[1], lj_of(pair))
                 .map_err(|e| md_err(&p.span, e))?;
@@ -414,7 +433,11 @@ fn param_err(origin: &str, e: MdError, fields: &[(&str, &Num)]) -> ModelError {
         .find(|(n, _)| *n == name)
         .or(fields.first())
         .map_or(0..0, |(_, num)| num.span.clone());
-    ModelError::new(origin, span, format!("`{name}` must be finite and > 0, got {value}"))
+    ModelError::new(
+        origin,
+        span,
+        format!("`{name}` must be finite and > 0, got {value}"),
+    )
 }
 
 /// Number of atoms of the prepared system.

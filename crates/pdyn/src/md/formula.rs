@@ -73,7 +73,12 @@ impl Scope for RScope<'_> {
 
 /// Names used in `ast` that are neither `r`, a parameter, `pi` nor `e`, with their spans; and
 /// whether `r` appears at all.
-fn foreign_names(ast: &Ast, params: &[(String, f64)], out: &mut Vec<(String, Range<usize>)>, uses_r: &mut bool) {
+fn foreign_names(
+    ast: &Ast,
+    params: &[(String, f64)],
+    out: &mut Vec<(String, Range<usize>)>,
+    uses_r: &mut bool,
+) {
     match ast {
         Ast::Ident { name, span } => {
             if name == "r" {
@@ -83,7 +88,9 @@ fn foreign_names(ast: &Ast, params: &[(String, f64)], out: &mut Vec<(String, Ran
             }
         }
         Ast::Num { .. } => {}
-        Ast::Neg { expr, .. } | Ast::Component { expr, .. } => foreign_names(expr, params, out, uses_r),
+        Ast::Neg { expr, .. } | Ast::Component { expr, .. } => {
+            foreign_names(expr, params, out, uses_r)
+        }
         Ast::Prime { expr, span, .. } => {
             out.push(("'".into(), span.clone()));
             foreign_names(expr, params, out, uses_r)
@@ -92,14 +99,22 @@ fn foreign_names(ast: &Ast, params: &[(String, f64)], out: &mut Vec<(String, Ran
             foreign_names(lhs, params, out, uses_r);
             foreign_names(rhs, params, out, uses_r);
         }
-        Ast::Call { args, .. } => args.iter().for_each(|a| foreign_names(a, params, out, uses_r)),
-        Ast::Vector { items, .. } => items.iter().for_each(|a| foreign_names(a, params, out, uses_r)),
+        Ast::Call { args, .. } => args
+            .iter()
+            .for_each(|a| foreign_names(a, params, out, uses_r)),
+        Ast::Vector { items, .. } => items
+            .iter()
+            .for_each(|a| foreign_names(a, params, out, uses_r)),
     }
 }
 
 impl FormulaPair {
     /// Parses, differentiates and compiles `text` (a formula in `r` and `params`).
-    pub fn compile(text: &str, params: &[(String, f64)], mode: JitMode) -> Result<FormulaPair, FormulaError> {
+    pub fn compile(
+        text: &str,
+        params: &[(String, f64)],
+        mode: JitMode,
+    ) -> Result<FormulaPair, FormulaError> {
         let ast = pdyn_expr::syntax::parse(text)?;
         let mut foreign = vec![];
         let mut uses_r = false;
@@ -199,7 +214,13 @@ mod tests {
     use pdyn_md::potential::{CutoffMode, LennardJones, Morse, PairPotential, Truncated};
 
     fn params() -> Vec<(String, f64)> {
-        vec![("eps".into(), 1.3), ("sigma".into(), 0.9), ("D".into(), 0.8), ("a".into(), 1.7), ("r0".into(), 1.1)]
+        vec![
+            ("eps".into(), 1.3),
+            ("sigma".into(), 0.9),
+            ("D".into(), 0.8),
+            ("a".into(), 1.7),
+            ("r0".into(), 1.1),
+        ]
     }
 
     const LJ: &str = "4*eps*((sigma/r)^12 - (sigma/r)^6)";
@@ -209,13 +230,24 @@ mod tests {
     #[test]
     fn force_is_minus_derivative_by_finite_differences() {
         for mode in [JitMode::Auto, JitMode::Off] {
-            for text in [LJ, "D*((1 - exp(-a*(r - r0)))^2 - 1)", "eps*exp(-r/sigma)/r", "sin(r)^2 + r^3/7"] {
+            for text in [
+                LJ,
+                "D*((1 - exp(-a*(r - r0)))^2 - 1)",
+                "eps*exp(-r/sigma)/r",
+                "sin(r)^2 + r^3/7",
+            ] {
                 let f = FormulaPair::compile(text, &params(), mode).unwrap();
-                for cm in [CutoffMode::Plain, CutoffMode::ShiftedEnergy, CutoffMode::ShiftedForce] {
+                for cm in [
+                    CutoffMode::Plain,
+                    CutoffMode::ShiftedEnergy,
+                    CutoffMode::ShiftedForce,
+                ] {
                     let p = Truncated::new(f.clone(), 2.7, cm);
                     for r in [0.83, 0.97, 1.21, 1.77, 2.5] {
                         let h = 1e-6;
-                        let du = (p.energy_force((r + h) * (r + h)).0 - p.energy_force((r - h) * (r - h)).0) / (2.0 * h);
+                        let du = (p.energy_force((r + h) * (r + h)).0
+                            - p.energy_force((r - h) * (r - h)).0)
+                            / (2.0 * h);
                         let fr = p.energy_force(r * r).1;
                         assert!(
                             (fr * r + du).abs() < 1e-6 * (1.0 + du.abs()),
@@ -233,21 +265,36 @@ mod tests {
     #[test]
     fn formula_matches_builtin_kernels() {
         let lj = FormulaPair::compile(LJ, &params(), JitMode::Auto).unwrap();
-        let mo = FormulaPair::compile("D*((1 - exp(-a*(r - r0)))^2 - 1)", &params(), JitMode::Auto).unwrap();
+        let mo = FormulaPair::compile("D*((1 - exp(-a*(r - r0)))^2 - 1)", &params(), JitMode::Auto)
+            .unwrap();
         let klj = LennardJones::new(1.3, 0.9);
         let kmo = Morse::new(0.8, 1.7, 1.1);
         for r in [0.8, 0.9, 1.0, 1.3, 2.0, 2.4] {
-            for ((u, f), (v, g)) in [(lj.raw(r * r), klj.raw(r * r)), (mo.raw(r * r), kmo.raw(r * r))] {
-                assert!((u - v).abs() <= 1e-13 * (1.0 + v.abs()), "u {u} vs {v} at {r}");
-                assert!((f - g).abs() <= 1e-13 * (1.0 + g.abs()), "f/r {f} vs {g} at {r}");
+            for ((u, f), (v, g)) in [
+                (lj.raw(r * r), klj.raw(r * r)),
+                (mo.raw(r * r), kmo.raw(r * r)),
+            ] {
+                assert!(
+                    (u - v).abs() <= 1e-13 * (1.0 + v.abs()),
+                    "u {u} vs {v} at {r}"
+                );
+                assert!(
+                    (f - g).abs() <= 1e-13 * (1.0 + g.abs()),
+                    "f/r {f} vs {g} at {r}"
+                );
             }
         }
     }
 
     #[test]
     fn other_symbols_are_named_and_located() {
-        let e = FormulaPair::compile("4*eps*((s/r)^12 - (s/x)^6)", &params(), JitMode::Off).unwrap_err();
-        assert!(e.message.contains("`s`") && e.message.contains("`x`"), "{}", e.message);
+        let e = FormulaPair::compile("4*eps*((s/r)^12 - (s/x)^6)", &params(), JitMode::Off)
+            .unwrap_err();
+        assert!(
+            e.message.contains("`s`") && e.message.contains("`x`"),
+            "{}",
+            e.message
+        );
         assert_eq!(e.span, 8..9);
         assert_eq!(e.message.matches("`s`").count(), 1, "{}", e.message);
         let e = FormulaPair::compile("eps*t", &params(), JitMode::Off).unwrap_err();

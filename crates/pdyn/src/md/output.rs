@@ -47,8 +47,12 @@ pub fn summary(prep: &Prepared, res: &MdResult) -> serde_json::Value {
     let n = res.atoms.max(1) as f64;
     let last = res.records.last();
     let units = match spec.units {
-        Units::Lj => json!({"name": "lj", "energy": "ε", "length": "σ", "time": "τ", "temperature": "ε/k_B", "pressure": "ε/σ³"}),
-        Units::Real => json!({"name": "real", "energy": "kcal/mol", "length": "Å", "time": "fs", "temperature": "K", "pressure": "atm"}),
+        Units::Lj => {
+            json!({"name": "lj", "energy": "ε", "length": "σ", "time": "τ", "temperature": "ε/k_B", "pressure": "ε/σ³"})
+        }
+        Units::Real => {
+            json!({"name": "real", "energy": "kcal/mol", "length": "Å", "time": "fs", "temperature": "K", "pressure": "atm"})
+        }
     };
     json!({
         "model": spec.name,
@@ -127,7 +131,9 @@ pub fn write_plots(prep: &Prepared, res: &MdResult, dir: &Path) -> Result<(), Er
     }
     let n = res.atoms.max(1) as f64;
     let step: Vec<f64> = res.records.iter().map(|r| r.step as f64).collect();
-    let col = |f: &dyn Fn(&pdyn_md::ThermoRecord) -> f64| -> Vec<f64> { res.records.iter().map(f).collect() };
+    let col = |f: &dyn Fn(&pdyn_md::ThermoRecord) -> f64| -> Vec<f64> {
+        res.records.iter().map(f).collect()
+    };
     let energy = Figure {
         title: format!("{}: energy per atom", prep.spec.name),
         x_label: "step".into(),

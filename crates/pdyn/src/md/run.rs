@@ -99,7 +99,12 @@ impl MdResult {
     /// any dynamics) and the records before `equilibrate` are left out.
     pub fn average(&self, f: impl Fn(&ThermoRecord) -> f64) -> Option<Average> {
         let from = self.average_from.max(1);
-        let xs: Vec<f64> = self.records.iter().filter(|r| r.step >= from).map(f).collect();
+        let xs: Vec<f64> = self
+            .records
+            .iter()
+            .filter(|r| r.step >= from)
+            .map(f)
+            .collect();
         block_average(&xs)
     }
 }
@@ -195,7 +200,11 @@ fn write_frame(
         return pdyn_md::io::write_xyz(w, s, names, step, time);
     }
     let mut c = s.clone();
-    for v in [&mut c.particles.vx, &mut c.particles.vy, &mut c.particles.vz] {
+    for v in [
+        &mut c.particles.vx,
+        &mut c.particles.vy,
+        &mut c.particles.vz,
+    ] {
         v.iter_mut().for_each(|x| *x /= u.time);
     }
     pdyn_md::io::write_xyz(w, &c, names, step, time)
@@ -257,7 +266,10 @@ fn run_sim<P: PairPotential>(
     } else {
         every
     };
-    let ramp = match (&spec.thermostat.temperature, &spec.thermostat.final_temperature) {
+    let ramp = match (
+        &spec.thermostat.temperature,
+        &spec.thermostat.final_temperature,
+    ) {
         (Some(a), Some(b)) if spec.thermostat.ensemble != Ensemble::Nve => Some((a.value, b.value)),
         _ => None,
     };
@@ -341,7 +353,10 @@ fn run_sim<P: PairPotential>(
     let drift = match spec.thermostat.ensemble {
         Ensemble::Nve | Ensemble::NoseHoover { .. } if records.len() >= 2 => {
             let c0 = records[0].conserved;
-            let dev = records.iter().map(|r| (r.conserved - c0).abs()).fold(0.0, f64::max);
+            let dev = records
+                .iter()
+                .map(|r| (r.conserved - c0).abs())
+                .fold(0.0, f64::max);
             let scale = records.iter().map(|r| r.kinetic).sum::<f64>() / records.len() as f64;
             let relative = if scale > 0.0 { dev / scale } else { dev };
             let slope = fit_slope(&records, n);

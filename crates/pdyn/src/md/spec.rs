@@ -408,10 +408,18 @@ impl Scope for ParamScope {
 /// Reads the `[md]` table of `source`; `overrides` are `--set name=value` pairs for
 /// `[parameters]`, applied before anything is evaluated (names that are not parameters are
 /// ignored here: the caller compares them with [`MdSpec::parameters`]).
-pub fn parse(source: &str, origin: &str, overrides: &[(String, f64)]) -> Result<MdSpec, ModelError> {
+pub fn parse(
+    source: &str,
+    origin: &str,
+    overrides: &[(String, f64)],
+) -> Result<MdSpec, ModelError> {
     let raw: RawFile = toml::from_str(source).map_err(|e| {
-        ModelError::new(origin, e.span().unwrap_or(0..0), e.message().trim().to_string())
-            .help("see docs/md.md for the keys of a molecular-dynamics model")
+        ModelError::new(
+            origin,
+            e.span().unwrap_or(0..0),
+            e.message().trim().to_string(),
+        )
+        .help("see docs/md.md for the keys of a molecular-dynamics model")
     })?;
     let mut r = Resolver {
         origin,
@@ -486,7 +494,12 @@ pub fn parse(source: &str, origin: &str, overrides: &[(String, f64)]) -> Result<
     for (name, sp) in &m.species {
         let mass = match &sp.get_ref().mass {
             Some(sv) => r.positive(sv, "mass")?,
-            None => return Err(r.err(sp.span(), format!("species `{}` needs a `mass`", name.get_ref()))),
+            None => {
+                return Err(r.err(
+                    sp.span(),
+                    format!("species `{}` needs a `mass`", name.get_ref()),
+                ))
+            }
         };
         species.push(Species {
             name: name.get_ref().clone(),
@@ -494,16 +507,22 @@ pub fn parse(source: &str, origin: &str, overrides: &[(String, f64)]) -> Result<
         });
     }
     let species_index = |r: &Resolver, n: &Name| -> Result<usize, ModelError> {
-        species.iter().position(|s| &s.name == n.get_ref()).ok_or_else(|| {
-            let names: Vec<&str> = species.iter().map(|s| s.name.as_str()).collect();
-            r.err(n.span(), format!("unknown species `{}`", n.get_ref()))
-                .help(format!("species declared: {}", names.join(", ")))
-        })
+        species
+            .iter()
+            .position(|s| &s.name == n.get_ref())
+            .ok_or_else(|| {
+                let names: Vec<&str> = species.iter().map(|s| s.name.as_str()).collect();
+                r.err(n.span(), format!("unknown species `{}`", n.get_ref()))
+                    .help(format!("species declared: {}", names.join(", ")))
+            })
     };
 
     if m.pairs.is_empty() {
         return Err(r
-            .err(mspan.clone(), "an [md] model needs at least one [[md.pairs]] potential")
+            .err(
+                mspan.clone(),
+                "an [md] model needs at least one [[md.pairs]] potential",
+            )
             .help("e.g. kind = \"lj\", epsilon = 1, sigma = 1, cutoff = 2.5"));
     }
     let mut pairs: Vec<PairSpec> = vec![];
@@ -515,22 +534,31 @@ pub fn parse(source: &str, origin: &str, overrides: &[(String, f64)]) -> Result<
                 if b.get_ref().len() != 2 {
                     return Err(r.err(b.span(), "`between` names two species, e.g. [\"A\", \"B\"]"));
                 }
-                [species_index(&r, &b.get_ref()[0])?, species_index(&r, &b.get_ref()[1])?]
+                [
+                    species_index(&r, &b.get_ref()[0])?,
+                    species_index(&r, &b.get_ref()[1])?,
+                ]
             }
             None if species.len() == 1 => [0, 0],
             None => {
-                return Err(r
-                    .err(span.clone(), "with several species, each pair potential needs `between = [\"A\", \"B\"]`"))
+                return Err(r.err(
+                    span.clone(),
+                    "with several species, each pair potential needs `between = [\"A\", \"B\"]`",
+                ))
             }
         };
-        if let Some(prev) = pairs.iter().find(|o| {
-            o.between == between || o.between == [between[1], between[0]]
-        }) {
+        if let Some(prev) = pairs
+            .iter()
+            .find(|o| o.between == between || o.between == [between[1], between[0]])
+        {
             let (line, _) = pdyn_expr::error::line_col(source, prev.span.start);
-            return Err(r.err(span, format!(
-                "a second potential between {} and {} (the first is at line {line})",
-                species[between[0]].name, species[between[1]].name
-            )));
+            return Err(r.err(
+                span,
+                format!(
+                    "a second potential between {} and {} (the first is at line {line})",
+                    species[between[0]].name, species[between[1]].name
+                ),
+            ));
         }
         let kind = match (&q.kind, &q.potential) {
             (Some(_), Some(f)) => {
@@ -590,7 +618,12 @@ pub fn parse(source: &str, origin: &str, overrides: &[(String, f64)]) -> Result<
         }
         let cutoff = match &q.cutoff {
             Some(sv) => r.positive(sv, "cutoff")?,
-            None => return Err(r.err(span, "a pair potential needs a `cutoff` (e.g. \"2.5*sigma\")")),
+            None => {
+                return Err(r.err(
+                    span,
+                    "a pair potential needs a `cutoff` (e.g. \"2.5*sigma\")",
+                ))
+            }
         };
         let mode = match &q.mode {
             None => Mode::Plain,
@@ -615,12 +648,19 @@ pub fn parse(source: &str, origin: &str, overrides: &[(String, f64)]) -> Result<
     }
     for a in 0..species.len() {
         for b in a..species.len() {
-            if !pairs.iter().any(|p| p.between == [a, b] || p.between == [b, a]) {
-                return Err(r.err(mspan.clone(), format!(
-                    "no pair potential between {} and {}",
-                    species[a].name, species[b].name
-                ))
-                .help("every pair of species needs one [[md.pairs]] entry"));
+            if !pairs
+                .iter()
+                .any(|p| p.between == [a, b] || p.between == [b, a])
+            {
+                return Err(r
+                    .err(
+                        mspan.clone(),
+                        format!(
+                            "no pair potential between {} and {}",
+                            species[a].name, species[b].name
+                        ),
+                    )
+                    .help("every pair of species needs one [[md.pairs]] entry"));
             }
         }
     }
@@ -638,7 +678,9 @@ pub fn parse(source: &str, origin: &str, overrides: &[(String, f64)]) -> Result<
             let q = l.get_ref();
             let span = l.span();
             let kind = match &q.kind {
-                None => return Err(r.err(span, "[md.lattice] needs `kind` (\"sc\", \"bcc\", \"fcc\")")),
+                None => {
+                    return Err(r.err(span, "[md.lattice] needs `kind` (\"sc\", \"bcc\", \"fcc\")"))
+                }
                 Some(k) => match k.get_ref().as_str() {
                     "sc" => LatticeKind::Sc,
                     "bcc" => LatticeKind::Bcc,
@@ -672,11 +714,18 @@ pub fn parse(source: &str, origin: &str, overrides: &[(String, f64)]) -> Result<
                 }
             };
             let cells = match &q.cells {
-                None => return Err(r.err(span, "[md.lattice] needs `cells` (a count, or [nx, ny, nz])")),
+                None => {
+                    return Err(r.err(
+                        span,
+                        "[md.lattice] needs `cells` (a count, or [nx, ny, nz])",
+                    ))
+                }
                 Some(sv) => match sv.get_ref() {
                     toml::Value::Array(items) => {
                         if items.len() != 3 {
-                            return Err(r.err(sv.span(), "`cells` is one count or three, [nx, ny, nz]"));
+                            return Err(
+                                r.err(sv.span(), "`cells` is one count or three, [nx, ny, nz]")
+                            );
                         }
                         let mut c = [0; 3];
                         for (k, it) in items.iter().enumerate() {
@@ -695,15 +744,20 @@ pub fn parse(source: &str, origin: &str, overrides: &[(String, f64)]) -> Result<
                 .filter(|&n| n <= MAX_ATOMS);
             if n.is_none() {
                 let at = q.cells.as_ref().map_or(span.clone(), |c| c.span());
-                return Err(r.err(at, format!(
-                    "{} × {} × {} cells of {} atoms is more than {MAX_ATOMS} atoms",
-                    cells[0], cells[1], cells[2], basis as u64
-                )));
+                return Err(r.err(
+                    at,
+                    format!(
+                        "{} × {} × {} cells of {} atoms is more than {MAX_ATOMS} atoms",
+                        cells[0], cells[1], cells[2], basis as u64
+                    ),
+                ));
             }
             let sp = match &q.species {
                 Some(n) => species_index(&r, n)?,
                 None if species.len() == 1 => 0,
-                None => return Err(r.err(span, "with several species, [md.lattice] needs `species`")),
+                None => {
+                    return Err(r.err(span, "with several species, [md.lattice] needs `species`"))
+                }
             };
             Start::Lattice {
                 kind,
@@ -716,7 +770,10 @@ pub fn parse(source: &str, origin: &str, overrides: &[(String, f64)]) -> Result<
         (None, Some(rd)) => {
             let q = rd.get_ref();
             let Some(file) = &q.file else {
-                return Err(r.err(rd.span(), "[md.read] needs `file` (extended XYZ or LAMMPS data)"));
+                return Err(r.err(
+                    rd.span(),
+                    "[md.read] needs `file` (extended XYZ or LAMMPS data)",
+                ));
             };
             let path = file.get_ref().clone();
             let format = match &q.format {
@@ -730,12 +787,18 @@ pub fn parse(source: &str, origin: &str, overrides: &[(String, f64)]) -> Result<
                     }
                 },
                 None if path.ends_with(".xyz") || path.ends_with(".extxyz") => FileFormat::Xyz,
-                None if path.ends_with(".data") || path.ends_with(".lmp") || path.contains("data.") => {
+                None if path.ends_with(".data")
+                    || path.ends_with(".lmp")
+                    || path.contains("data.") =>
+                {
                     FileFormat::LammpsData
                 }
                 None => {
                     return Err(r
-                        .err(file.span(), format!("cannot tell the format of `{path}` from its name"))
+                        .err(
+                            file.span(),
+                            format!("cannot tell the format of `{path}` from its name"),
+                        )
                         .help("add format = \"xyz\" or format = \"lammps-data\""))
                 }
             };
@@ -775,23 +838,42 @@ pub fn parse(source: &str, origin: &str, overrides: &[(String, f64)]) -> Result<
             let ensemble = match kind {
                 "nve" | "none" => Ensemble::Nve,
                 "langevin" => Ensemble::Langevin {
-                    damping: r.positive_or(&q.damping, "damping", &span, Some(if units == Units::Real { 100.0 } else { 1.0 }))?,
+                    damping: r.positive_or(
+                        &q.damping,
+                        "damping",
+                        &span,
+                        Some(if units == Units::Real { 100.0 } else { 1.0 }),
+                    )?,
                     seed: r.count_or(&q.seed, "seed", &span, Some(1), u64::MAX)?,
                 },
                 "nose-hoover" | "nvt" => Ensemble::NoseHoover {
-                    tau: r.positive_or(&q.tau, "tau", &span, Some(if units == Units::Real { 100.0 } else { 0.5 }))?,
+                    tau: r.positive_or(
+                        &q.tau,
+                        "tau",
+                        &span,
+                        Some(if units == Units::Real { 100.0 } else { 0.5 }),
+                    )?,
                     chain: r.count_or(&q.chain, "chain", &span, Some(3), 64)?.max(1) as usize,
                 },
                 "berendsen" => Ensemble::Berendsen {
-                    tau: r.positive_or(&q.tau, "tau", &span, Some(if units == Units::Real { 100.0 } else { 0.5 }))?,
+                    tau: r.positive_or(
+                        &q.tau,
+                        "tau",
+                        &span,
+                        Some(if units == Units::Real { 100.0 } else { 0.5 }),
+                    )?,
                 },
                 other => {
-                    return Err(r
-                        .err(kspan, format!("unknown thermostat `{other}`"))
-                        .help("thermostats: \"nve\", \"langevin\", \"nose-hoover\", \"berendsen\""))
+                    return Err(r.err(kspan, format!("unknown thermostat `{other}`")).help(
+                        "thermostats: \"nve\", \"langevin\", \"nose-hoover\", \"berendsen\"",
+                    ))
                 }
             };
-            let temperature = q.temperature.as_ref().map(|sv| r.positive(sv, "temperature")).transpose()?;
+            let temperature = q
+                .temperature
+                .as_ref()
+                .map(|sv| r.positive(sv, "temperature"))
+                .transpose()?;
             let final_temperature = q
                 .final_temperature
                 .as_ref()
@@ -799,13 +881,27 @@ pub fn parse(source: &str, origin: &str, overrides: &[(String, f64)]) -> Result<
                 .transpose()?;
             if ensemble != Ensemble::Nve && temperature.is_none() {
                 return Err(r
-                    .err(kspan, format!("the {kind} thermostat needs a `temperature`"))
+                    .err(
+                        kspan,
+                        format!("the {kind} thermostat needs a `temperature`"),
+                    )
                     .help("add temperature = ... to [md.thermostat] (the target temperature)"));
             }
             if ensemble == Ensemble::Nve {
-                for (v, key) in [(&q.temperature, "temperature"), (&q.final_temperature, "final_temperature"), (&q.damping, "damping"), (&q.tau, "tau")] {
+                for (v, key) in [
+                    (&q.temperature, "temperature"),
+                    (&q.final_temperature, "final_temperature"),
+                    (&q.damping, "damping"),
+                    (&q.tau, "tau"),
+                ] {
                     if let Some(sv) = v {
-                        return Err(r.err(sv.span(), format!("`{key}` has no meaning without a thermostat (kind = \"nve\")"))
+                        return Err(r
+                            .err(
+                                sv.span(),
+                                format!(
+                                    "`{key}` has no meaning without a thermostat (kind = \"nve\")"
+                                ),
+                            )
                             .help("set kind = \"langevin\", \"nose-hoover\" or \"berendsen\""));
                     }
                 }
@@ -838,11 +934,15 @@ pub fn parse(source: &str, origin: &str, overrides: &[(String, f64)]) -> Result<
                         .err(ks, format!("unknown bond kind `{other}`"))
                         .help("bond kinds: \"harmonic\" (k, r0), \"fene\" (k, r_max)"))
                 }
-                None => return Err(r.err(span, "[md.bonds] needs `kind` (\"harmonic\" or \"fene\")")),
+                None => {
+                    return Err(r.err(span, "[md.bonds] needs `kind` (\"harmonic\" or \"fene\")"))
+                }
             };
             let chain_length = match &q.chain_length {
                 Some(sv) => r.count(sv, "chain_length", 2, MAX_ATOMS)?,
-                None => return Err(r.err(span, "[md.bonds] needs `chain_length` (beads per chain)")),
+                None => {
+                    return Err(r.err(span, "[md.bonds] needs `chain_length` (beads per chain)"))
+                }
             };
             Some(BondsSpec {
                 kind,
@@ -922,13 +1022,17 @@ impl Resolver<'_> {
         let located = |e: pdyn_expr::ExprError| {
             let e = e.offset(off);
             let mut me = ModelError::new(self.origin, e.span, e.message);
-            me.help = e.help.or(Some("only numbers and [parameters] declared above may appear here".into()));
+            me.help = e.help.or(Some(
+                "only numbers and [parameters] declared above may appear here".into(),
+            ));
             me
         };
         let ast = pdyn_expr::syntax::parse(&text).map_err(located)?;
         match pdyn_expr::lower::lower(&mut self.pool, &ast, &mut self.scope).map_err(located)? {
             Value::Scalar(id) => Ok(id),
-            Value::Vector(_) => Err(self.err(span, format!("{what} must be a scalar, not a vector"))),
+            Value::Vector(_) => {
+                Err(self.err(span, format!("{what} must be a scalar, not a vector")))
+            }
         }
     }
 
@@ -953,7 +1057,10 @@ impl Resolver<'_> {
     fn positive(&mut self, sv: &Sv, what: &str) -> Result<Num, ModelError> {
         let v = self.number(sv, what)?;
         if v > 0.0 {
-            Ok(Num { value: v, span: sv.span() })
+            Ok(Num {
+                value: v,
+                span: sv.span(),
+            })
         } else {
             Err(self.err(sv.span(), format!("`{what}` must be > 0, got {v}")))
         }
@@ -962,7 +1069,10 @@ impl Resolver<'_> {
     fn nonneg(&mut self, sv: &Sv, what: &str) -> Result<Num, ModelError> {
         let v = self.number(sv, what)?;
         if v >= 0.0 {
-            Ok(Num { value: v, span: sv.span() })
+            Ok(Num {
+                value: v,
+                span: sv.span(),
+            })
         } else {
             Err(self.err(sv.span(), format!("`{what}` must be ≥ 0, got {v}")))
         }
@@ -977,7 +1087,10 @@ impl Resolver<'_> {
     ) -> Result<Num, ModelError> {
         match (sv, default) {
             (Some(sv), _) => self.positive(sv, what),
-            (None, Some(v)) => Ok(Num { value: v, span: table.clone() }),
+            (None, Some(v)) => Ok(Num {
+                value: v,
+                span: table.clone(),
+            }),
             (None, None) => Err(self.err(table.clone(), format!("missing `{what}`"))),
         }
     }
@@ -999,7 +1112,10 @@ impl Resolver<'_> {
     fn count(&mut self, sv: &Sv, what: &str, min: u64, max: u64) -> Result<u64, ModelError> {
         let v = self.number(sv, what)?;
         if v.fract() != 0.0 || v < min as f64 || v > max as f64 {
-            return Err(self.err(sv.span(), format!("`{what}` must be a whole number in {min}..={max}, got {v}")));
+            return Err(self.err(
+                sv.span(),
+                format!("`{what}` must be a whole number in {min}..={max}, got {v}"),
+            ));
         }
         Ok(v as u64)
     }
