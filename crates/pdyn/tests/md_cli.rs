@@ -338,11 +338,7 @@ fn overlapping_atoms_are_reported_and_minimize_resolves_them() {
     let (code, out, err) = pdyn(&["run", f.to_str().unwrap(), "--json"]);
     let e = json(&out)["error"].clone();
     assert_eq!(code, 2, "{err}");
-    assert_eq!(
-        e["location"]["line"],
-        line_of(model, "file = "),
-        "{e}"
-    );
+    assert_eq!(e["location"]["line"], line_of(model, "file = "), "{e}");
     let msg = e["message"].as_str().unwrap();
     assert!(
         msg.contains("atoms 0 and 1") && msg.contains("0.3"),
