@@ -122,6 +122,21 @@ fn every_md_example_runs_shrunk() {
                 "{name}: msd after 20 steps {last}"
             );
         }
+        if let Some((t0, _)) = &spec.velocities {
+            // Maxwell–Boltzmann velocities are scaled to exactly T with 3N − 3 degrees of
+            // freedom, in the file's units (K in `real`, ε/k_B in `lj`); under Langevin, which
+            // does not conserve momentum, the temperature counts 3N
+            let first: f64 = rows[1].split(',').nth(2).unwrap().parse().unwrap();
+            let n3 = 3.0 * atoms as f64;
+            let expected = match spec.thermostat.ensemble {
+                pdyn::md::spec::Ensemble::Langevin { .. } => t0.value * (n3 - 3.0) / n3,
+                _ => t0.value,
+            };
+            assert!(
+                (first - expected).abs() < 1e-9 * expected,
+                "{name}: T(0) = {first}"
+            );
+        }
         let on_disk = json(&std::fs::read_to_string(out.join("summary.json")).unwrap());
         assert_eq!(on_disk["atoms"], s["atoms"]);
     }
@@ -451,4 +466,94 @@ fn plot_writes_the_thermo_figure() {
     let svg = std::fs::read_to_string(out.join("thermo.svg")).unwrap();
     assert!(svg.contains("<svg") && svg.contains("temperature"));
     assert!(std::fs::metadata(out.join("thermo.png")).unwrap().len() > 1000);
+}
+
+/// `dump_every = 5` over 20 steps: frames at steps 0, 5, 10, 15, 20, each a complete extended
+/// XYZ frame that pdyn-md reads back (species, box, positions inside it).
+#[test]
+fn trajectory_has_one_frame_per_dump() {
+    let d = scratch("traj");
+    let f = d.join("lj_dump.toml");
+    std::fs::write(
+        &f,
+        lj().replace("thermo_every = 50", "thermo_every = 5\ndump_every = 5"),
+    )
+    .unwrap();
+    let out = d.join("out");
+    let (code, _, err) = pdyn(&[
+        "run",
+        f.to_str().unwrap(),
+        "--set",
+        "n=4",
+        "--t-end",
+        "0.1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let text = std::fs::read_to_string(out.join("traj.xyz")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let (mut at, mut steps) = (0, vec![]);
+    while at < lines.len() {
+        let n: usize = lines[at].trim().parse().unwrap();
+        assert_eq!(n, 256);
+        let step = lines[at + 1]
+            .split_whitespace()
+            .find_map(|w| w.strip_prefix("Step="))
+            .unwrap();
+        steps.push(step.parse::<u64>().unwrap());
+        at += n + 2;
+    }
+    assert_eq!(steps, [0, 5, 10, 15, 20]);
+    let frame = pdyn_md::io::read_xyz(std::io::BufReader::new(text.as_bytes()), 1000, 1.0).unwrap();
+    assert_eq!(frame.names, ["Ar"]);
+    let l = frame.system.sim_box.l[0];
+    assert!(
+        (l - 4.0 * (4.0f64 / 0.8442).cbrt()).abs() < 1e-12,
+        "box {l}"
+    );
+    let p = &frame.system.particles;
+    assert!((0..p.len()).all(|i| (0.0..l).contains(&p.x[i])));
+}
+
+/// Morse: the built-in kernel and the formula `D*((1 - exp(-a*(r - r0)))^2 - 1)` on the same
+/// start give the same energies to round-off, in every cutoff mode.
+#[test]
+fn formula_morse_equals_builtin_morse() {
+    let d = scratch("morse");
+    for mode in ["plain", "shifted-energy", "shifted-force"] {
+        let base = lj()
+            .replace("eps = 1.0", "D = 0.8\nalpha = 1.7\nr0 = 1.1")
+            .replace("mode = \"plain\"", &format!("mode = \"{mode}\""));
+        let builtin = base
+            .replace(
+                "kind = \"lj\"",
+                "kind = \"morse\"\ndepth = \"D\"\nalpha = \"alpha\"\nr0 = \"r0\"",
+            )
+            .replace("epsilon = \"eps\"\n", "")
+            .replace("sigma = \"sigma\"\n", "");
+        let formula = base
+            .replace(
+                "kind = \"lj\"",
+                "potential = \"D*((1 - exp(-alpha*(r - r0)))^2 - 1)\"",
+            )
+            .replace("epsilon = \"eps\"\n", "")
+            .replace("sigma = \"sigma\"\n", "");
+        let (fa, fb) = (d.join("builtin.toml"), d.join("formula.toml"));
+        std::fs::write(&fa, builtin).unwrap();
+        std::fs::write(&fb, formula).unwrap();
+        let a = run_json(fa.to_str().unwrap(), &["--set", "n=5", "--t-end", "0.05"]);
+        let b = run_json(fb.to_str().unwrap(), &["--set", "n=5", "--t-end", "0.05"]);
+        for key in ["potential", "total", "pressure"] {
+            let (x, y) = (
+                a["final"][key].as_f64().unwrap(),
+                b["final"][key].as_f64().unwrap(),
+            );
+            assert!(x != 0.0, "{mode} {key}");
+            assert!(
+                (x - y).abs() <= 1e-10 * x.abs().max(1.0),
+                "{mode} {key}: built-in {x} vs formula {y}"
+            );
+        }
+    }
 }

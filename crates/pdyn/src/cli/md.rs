@@ -205,6 +205,20 @@ pub fn run(a: RunArgs, source: String) -> Result<Outcome, Error> {
     for w in &res.warnings {
         stderr += &format!("warning: {w}\n");
     }
+    if a.out.is_none() {
+        let files: Vec<&str> = [
+            (spec.dump_every > 0, "traj.xyz (dump_every)"),
+            (spec.rdf, "rdf.csv (rdf = true)"),
+            (spec.msd, "msd.csv (msd = true)"),
+        ]
+        .iter()
+        .filter(|(on, _)| *on)
+        .map(|(_, f)| *f)
+        .collect();
+        if !files.is_empty() {
+            stderr += &format!("warning: no --out DIR: {} not written\n", files.join(", "));
+        }
+    }
     let stdout = if a.json {
         format!("{sum:#}\n")
     } else {
