@@ -557,3 +557,69 @@ fn formula_morse_equals_builtin_morse() {
         }
     }
 }
+
+/// Two species from a file (extended XYZ by name, LAMMPS data by type order), one pair
+/// potential per pair of species (one of them a formula); a missing pair is a located error.
+#[test]
+fn two_species_from_xyz_and_lammps_data() {
+    let d = scratch("species");
+    // 4 x 4 x 4 simple cubic, spacing 1.5 in a box of 6: A and B alternate
+    let mut xyz =
+        String::from("64\nLattice=\"6 0 0 0 6 0 0 0 6\" Properties=species:S:1:pos:R:3\n");
+    let mut data = String::from("test\n\n64 atoms\n2 atom types\n\n0 6 xlo xhi\n0 6 ylo yhi\n0 6 zlo zhi\n\nMasses\n\n1 1.0\n2 2.0\n\nAtoms # atomic\n\n");
+    let mut k = 0;
+    for i in 0..4 {
+        for j in 0..4 {
+            for l in 0..4 {
+                let (x, y, z) = (
+                    0.75 + 1.5 * i as f64,
+                    0.75 + 1.5 * j as f64,
+                    0.75 + 1.5 * l as f64,
+                );
+                let sp = if (i + j + l) % 2 == 0 { "A" } else { "B" };
+                xyz += &format!("{sp} {x} {y} {z}\n");
+                k += 1;
+                data += &format!("{k} {} {x} {y} {z}\n", if sp == "A" { 1 } else { 2 });
+            }
+        }
+    }
+    std::fs::write(d.join("mix.xyz"), &xyz).unwrap();
+    std::fs::write(d.join("mix.data"), &data).unwrap();
+    let model = |file: &str, with_ab: bool| {
+        let ab = if with_ab {
+            "[[md.pairs]]\nbetween = [\"A\", \"B\"]\nkind = \"lj\"\nepsilon = 1.5\nsigma = 0.8\ncutoff = 2.0\n\n"
+        } else {
+            ""
+        };
+        format!(
+            "name = \"mixture\"\n[parameters]\neps_bb = 0.5\n\n[md]\ndt = 0.002\nsteps = 10\n\n\
+             [md.species.A]\nmass = 1.0\n\n[md.species.B]\nmass = 2.0\n\n\
+             [[md.pairs]]\nbetween = [\"A\", \"A\"]\nkind = \"lj\"\nepsilon = 1.0\nsigma = 1.0\ncutoff = 2.5\n\n{ab}\
+             [[md.pairs]]\nbetween = [\"B\", \"B\"]\npotential = \"4*eps_bb*((0.88/r)^12 - (0.88/r)^6)\"\ncutoff = 2.2\n\n\
+             [md.read]\nfile = \"{file}\"\n\n[md.velocities]\ntemperature = 1.0\nseed = 5\n"
+        )
+    };
+    let mut energies = vec![];
+    for file in ["mix.xyz", "mix.data"] {
+        let f = d.join("mix.toml");
+        std::fs::write(&f, model(file, true)).unwrap();
+        let s = run_json(f.to_str().unwrap(), &[]);
+        assert_eq!(s["atoms"], 64);
+        assert_eq!(s["formula_native"].as_bool().is_some(), true);
+        energies.push(s["final"]["potential"].as_f64().unwrap());
+    }
+    // the same atoms, species and velocities from both files: the same run
+    assert_eq!(energies[0], energies[1]);
+    let text = model("mix.xyz", false);
+    assert_located(
+        "mix",
+        {
+            let f = d.join("mix.toml");
+            std::fs::write(&f, &text).unwrap();
+            let (code, out, err) = pdyn(&["run", f.to_str().unwrap(), "--json"]);
+            (code, json(&out)["error"].clone(), err)
+        },
+        line_of(&text, "[md]"),
+        "no pair potential between A and B",
+    );
+}
