@@ -605,7 +605,7 @@ fn two_species_from_xyz_and_lammps_data() {
         std::fs::write(&f, model(file, true)).unwrap();
         let s = run_json(f.to_str().unwrap(), &[]);
         assert_eq!(s["atoms"], 64);
-        assert_eq!(s["formula_native"].as_bool().is_some(), true);
+        assert!(s["formula_native"].as_bool().is_some());
         energies.push(s["final"]["potential"].as_f64().unwrap());
     }
     // the same atoms, species and velocities from both files: the same run
