@@ -121,7 +121,8 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
             MdError::InvalidParameter { name, value } if name.contains("cutoff") => err(
                 what,
                 format!(
-                    "the potential has no finite value at the cutoff r = {rc}: {name} = {value}"
+                    "the potential has no finite value at the cutoff r = {}: {name} = {value}",
+                    short(rc)
                 ),
             )
             .help("choose a cutoff where u(r) and u'(r) are finite"),
@@ -309,9 +310,10 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
             length,
             required,
         } => err(&start_span, format!(
-            "the box is {length:.6} long along {}, shorter than 2·(cutoff + skin) = 2·({cutoff} + {}) = {required:.6}: the minimum image would miss interactions",
+            "the box is {length:.6} long along {}, shorter than 2·(cutoff + skin) = 2·({} + {}) = {required:.6}: the minimum image would miss interactions",
             ["x", "y", "z"][axis.min(2)],
-            spec.skin.value
+            short(cutoff),
+            short(spec.skin.value)
         ))
         .help("use more cells (or a larger box in the file), or a shorter cutoff or skin"),
         e => md_err(&spec.span, e),
@@ -412,6 +414,15 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
         native,
         cutoff,
     })
+}
+
+/// `x` plainly when it reads well so, in scientific notation otherwise (`1e-300`, not 300 zeros).
+fn short(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e6).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
 }
 
 fn lj_of(p: &Pair) -> Truncated<LennardJones> {
