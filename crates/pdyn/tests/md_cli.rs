@@ -437,15 +437,17 @@ fn options_without_meaning_for_md_are_refused_by_name() {
 }
 
 #[test]
-fn derive_on_an_md_model_says_to_use_run() {
-    let (code, out, err) = pdyn(&["derive", "examples/md/lj_liquid.toml", "--json"]);
-    assert_eq!(code, 2, "{err}");
-    let e = json(&out)["error"].clone();
-    assert!(
-        e["message"].as_str().unwrap().contains("use `pdyn run`"),
-        "{e}"
-    );
-    assert_eq!(e["location"]["line"], line_of(&lj(), "[md]"));
+fn other_commands_on_an_md_model_say_to_use_run() {
+    for command in ["derive", "forces", "check", "sweep"] {
+        let (code, out, err) = pdyn(&[command, "examples/md/lj_liquid.toml", "--json"]);
+        assert_eq!(code, 2, "{command}: {err}");
+        let e = json(&out)["error"].clone();
+        assert!(
+            e["message"].as_str().unwrap().contains("use `pdyn run`"),
+            "{command}: {e}"
+        );
+        assert_eq!(e["location"]["line"], line_of(&lj(), "[md]"), "{command}");
+    }
 }
 
 #[test]

@@ -41,7 +41,6 @@ pub struct DeriveArgs {
 
 /// `pdyn derive MODEL`.
 pub fn run(a: DeriveArgs) -> Result<String, Error> {
-    super::md::refuse(&a.model, "derive")?;
     let mut model = load_model(&a.model)?;
     let opts = DeriveOptions {
         form: match a.form {

@@ -19,21 +19,22 @@ pub fn md_source(path: &Path) -> Option<String> {
     md::is_md_source(&source).then_some(source)
 }
 
-/// The error of a command other than `run` given a molecular-dynamics model, at its `[md]`.
-pub fn refuse(path: &Path, command: &str) -> Result<(), Error> {
-    let Some(source) = md_source(path) else {
-        return Ok(());
-    };
+/// The error of a command other than `run` given a molecular-dynamics model (`source`), at
+/// its `[md]` table; `None` when `source` is not one.
+pub fn refusal(path: &Path, source: &str) -> Option<Error> {
+    if !md::is_md_source(source) {
+        return None;
+    }
     let at = source.find("[md").unwrap_or(0);
     // four characters, ending on a character boundary
     let len: usize = source[at..].chars().take(4).map(char::len_utf8).sum();
     let error = ModelError::new(
         &path.display().to_string(),
         at..at + len,
-        format!("molecular-dynamics model: use `pdyn run`, not `pdyn {command}`"),
+        "molecular-dynamics model: use `pdyn run` (this command works on mechanics models)",
     )
     .help("an [md] model has pair potentials and thermostats, not equations of motion to derive");
-    Err(Error::Model {
+    Some(Error::Model {
         error,
         source: source.into(),
     })

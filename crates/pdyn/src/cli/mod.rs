@@ -106,9 +106,12 @@ pub fn load_model(path: &Path) -> Result<pdyn_mech::Model, Error> {
         action: "read the model file",
         error: Arc::new(e),
     })?;
-    pdyn_mech::load(&source, &path.display().to_string()).map_err(|error| Error::Model {
-        error,
-        source: source.into(),
+    pdyn_mech::load(&source, &path.display().to_string()).map_err(|error| {
+        // an [md] model is not a mechanics model: say which command runs it
+        md::refusal(path, &source).unwrap_or_else(|| Error::Model {
+            error,
+            source: source.into(),
+        })
     })
 }
 
