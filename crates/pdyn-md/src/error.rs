@@ -116,23 +116,52 @@ impl fmt::Display for MdError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         use MdError::*;
         match self {
-            InvalidBox { lengths } => write!(f, "box edges must be finite and > 0 (got {lengths:?})"),
-            BoxTooSmall { axis, length, required } => write!(
+            InvalidBox { lengths } => {
+                write!(f, "box edges must be finite and > 0 (got {lengths:?})")
+            }
+            BoxTooSmall {
+                axis,
+                length,
+                required,
+            } => write!(
                 f,
                 "box edge {axis} is {length}, shorter than 2·(cutoff + skin) = {required}"
             ),
             InvalidParameter { name, value } => write!(f, "invalid {name} = {value}"),
-            Overlap { i, j, distance, threshold } => write!(
+            Overlap {
+                i,
+                j,
+                distance,
+                threshold,
+            } => write!(
                 f,
                 "particles {i} and {j} overlap at the start (distance {distance} < {threshold}); \
                  run an energy minimisation (minimize_fire) first"
             ),
-            Unstable { step, atom, neighbor, displacement, energy_change_per_atom } => write!(
-                f,
-                "unstable at step {step}: particle {atom} (nearest {neighbor:?}) moved \
-                 {displacement} in one step, |ΔE|/N = {energy_change_per_atom}; reduce the time step"
-            ),
-            BondBroken { step, bond, atoms, length, max } => write!(
+            Unstable {
+                step,
+                atom,
+                neighbor,
+                displacement,
+                energy_change_per_atom,
+            } => {
+                write!(f, "unstable at step {step}: particle {atom}")?;
+                if let Some(j) = neighbor {
+                    write!(f, " (nearest particle {j})")?;
+                }
+                write!(
+                    f,
+                    " moved {displacement:.4} in one step, |ΔE|/N = {energy_change_per_atom:.4e}; \
+                     reduce the time step"
+                )
+            }
+            BondBroken {
+                step,
+                bond,
+                atoms,
+                length,
+                max,
+            } => write!(
                 f,
                 "step {step}: FENE bond {bond} {atoms:?} stretched to {length} ≥ R0 = {max}"
             ),
@@ -140,10 +169,17 @@ impl fmt::Display for MdError {
                 write!(f, "{what} index {index} out of range (len {len})")
             }
             MissingTemperature { thermostat } => {
-                write!(f, "thermostat {thermostat} needs a positive target temperature")
+                write!(
+                    f,
+                    "thermostat {thermostat} needs a positive target temperature"
+                )
             }
             Particle(e) => write!(f, "{e}"),
-            Parse { format, line, expected } => {
+            Parse {
+                format,
+                line,
+                expected,
+            } => {
                 write!(f, "{format} line {line}: expected {expected}")
             }
             Io { kind } => write!(f, "I/O error: {kind}"),

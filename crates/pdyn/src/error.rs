@@ -150,6 +150,15 @@ pub enum Error {
         /// Why.
         error: pdyn_gravity::GravityError,
     },
+    /// A molecular-dynamics run that stopped before its last step (exit code 1): unstable (the
+    /// step, the offending atoms) or a bond stretched past its limit. What was computed up to
+    /// there has been written.
+    MdRun {
+        /// The model file.
+        origin: String,
+        /// Where and why (carries the step and the atoms).
+        error: pdyn_md::MdError,
+    },
 }
 
 impl Error {
@@ -171,13 +180,17 @@ impl Error {
             Error::NonFinite { .. } => "non_finite",
             Error::Internal { .. } => "internal",
             Error::Gravity { .. } => "gravity",
+            Error::MdRun { .. } => "md_run",
         }
     }
 
     /// The process exit code for this failure (see the module documentation).
     pub fn exit_code(&self) -> u8 {
         match self {
-            Error::Integration { .. } | Error::NonFinite { .. } | Error::Gravity { .. } => 1,
+            Error::Integration { .. }
+            | Error::NonFinite { .. }
+            | Error::Gravity { .. }
+            | Error::MdRun { .. } => 1,
             Error::Internal { .. } => 3,
             _ => 2,
         }
@@ -214,7 +227,8 @@ impl Error {
             | Error::Forces { origin, .. }
             | Error::Sim { origin, .. }
             | Error::Integration { origin, .. }
-            | Error::Gravity { origin, .. } => Some(file(origin)),
+            | Error::Gravity { origin, .. }
+            | Error::MdRun { origin, .. } => Some(file(origin)),
             _ => None,
         }
     }
@@ -287,6 +301,12 @@ impl fmt::Display for Error {
                 "internal error — please report it with the command that caused it: {message}"
             ),
             Error::Gravity { origin, error } => write!(f, "{origin}: error: {error}"),
+            Error::MdRun { origin, error } => {
+                write!(
+                    f,
+                    "{origin}: error: the run stopped: {error} (the output up to that step is kept)"
+                )
+            }
         }
     }
 }

@@ -4,6 +4,7 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod md;
 pub mod nbody;
 pub mod output;
 pub mod plots;

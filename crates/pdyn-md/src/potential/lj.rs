@@ -6,6 +6,7 @@
 //! `P_tail = (16/3)πρ²εσ³[(2/3)(σ/r_c)⁹ − (σ/r_c)³]`.
 
 use super::{CutoffMode, RawPair, Truncated};
+use crate::MdError;
 use std::f64::consts::PI;
 
 /// Lennard-Jones parameters (well depth `ε`, diameter `σ`).
@@ -30,6 +31,15 @@ impl LennardJones {
             eps4: 4.0 * epsilon,
             eps24: 24.0 * epsilon,
         }
+    }
+
+    /// LJ with `ε` and `σ` checked: both must be finite and > 0 (a zero or negative `σ` or
+    /// `ε` gives no repulsive core or an attractive one, and NaN poisons every force), else
+    /// `MdError::InvalidParameter` naming the field.
+    pub fn try_new(epsilon: f64, sigma: f64) -> Result<Self, MdError> {
+        crate::thermostat::positive("epsilon", epsilon)?;
+        crate::thermostat::positive("sigma", sigma)?;
+        Ok(Self::new(epsilon, sigma))
     }
 
     /// Truncated at `rc` with the given cutoff mode.

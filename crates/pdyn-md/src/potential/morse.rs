@@ -3,6 +3,7 @@
 //! `f/r = −u'(r)/r`.
 
 use super::{CutoffMode, RawPair, Truncated};
+use crate::MdError;
 
 /// Morse parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -19,6 +20,15 @@ impl Morse {
     /// Morse with depth `D`, stiffness `a`, equilibrium distance `r₀`.
     pub fn new(depth: f64, alpha: f64, r0: f64) -> Self {
         Morse { depth, alpha, r0 }
+    }
+
+    /// Morse with every parameter checked finite and > 0, else `MdError::InvalidParameter`
+    /// naming the field.
+    pub fn try_new(depth: f64, alpha: f64, r0: f64) -> Result<Self, MdError> {
+        crate::thermostat::positive("depth", depth)?;
+        crate::thermostat::positive("alpha", alpha)?;
+        crate::thermostat::positive("r0", r0)?;
+        Ok(Self::new(depth, alpha, r0))
     }
 
     /// Truncated at `rc` with the given cutoff mode.

@@ -6,6 +6,7 @@
 //! * shifted force: `u_c(r) = u(r) − u(r_c) − (r − r_c) u'(r_c)` (continuous energy and force).
 
 use super::{PairPotential, RawPair};
+use crate::MdError;
 
 /// How the potential is cut at `r_c`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -46,6 +47,20 @@ impl<P: RawPair> Truncated<P> {
             u_c,
             f_c,
         }
+    }
+
+    /// `inner` cut at `rc`, checked: `rc` finite and > 0, and the potential and force finite
+    /// at `rc` (a shift by a non-finite value would poison every pair), else
+    /// `MdError::InvalidParameter` (`cutoff`, or `u(cutoff)` with the offending value).
+    pub fn try_new(inner: P, rc: f64, mode: CutoffMode) -> Result<Self, MdError> {
+        crate::thermostat::positive("cutoff", rc)?;
+        let (u, fr) = inner.raw(rc * rc);
+        for (name, v) in [("u(cutoff)", u), ("f(cutoff)/cutoff", fr)] {
+            if !v.is_finite() {
+                return Err(MdError::InvalidParameter { name, value: v });
+            }
+        }
+        Ok(Self::new(inner, rc, mode))
     }
 
     /// The cutoff mode.
@@ -126,6 +141,15 @@ mod tests {
                     );
                 }
             }
+            assert!(LennardJones::try_new(1.0, 1.0).is_ok());
+            for (e, s) in [(0.0, 1.0), (-1.0, 1.0), (1.0, f64::NAN), (1.0, 0.0)] {
+                assert!(LennardJones::try_new(e, s).is_err(), "{e} {s}");
+            }
+            for (d, a, r0) in [(0.0, 1.0, 1.0), (1.0, -1.0, 1.0), (1.0, 1.0, f64::NAN)] {
+                assert!(Morse::try_new(d, a, r0).is_err());
+            }
+            assert!(Truncated::try_new(LennardJones::new(1.0, 1.0), 0.0, mode).is_err());
+            assert!(Truncated::try_new(Morse::new(1.0, 1.0, 1.0), f64::INFINITY, mode).is_err());
             if mode == CutoffMode::ShiftedForce {
                 let e = 2.5 * (1.0 - 1e-9);
                 let (u, f) = lj.energy_force(e * e);

@@ -9,6 +9,7 @@ pub mod dsolve;
 pub mod expr;
 pub mod forces;
 pub mod kin;
+pub mod md;
 pub mod nbody;
 pub mod run;
 pub mod sweep;
@@ -114,9 +115,12 @@ pub fn load_model(path: &Path) -> Result<pdyn_mech::Model, Error> {
             source: source.into(),
         });
     }
-    pdyn_mech::load(&source, &path.display().to_string()).map_err(|error| Error::Model {
-        error,
-        source: source.into(),
+    pdyn_mech::load(&source, &path.display().to_string()).map_err(|error| {
+        // an [md] model is not a mechanics model: say which command runs it
+        md::refusal(path, &source).unwrap_or_else(|| Error::Model {
+            error,
+            source: source.into(),
+        })
     })
 }
 

@@ -148,6 +148,9 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
     if a.method.as_deref() == Some("help") {
         return Ok(Outcome::text(sim::methods_help()));
     }
+    if let Some(source) = super::md::md_source(&a.model) {
+        return super::md::run(a, source);
+    }
     let mut model = load_model(&a.model)?;
     set_parameters(&mut model, &a.set)?;
     let mut set = settings(&model, &a)?;

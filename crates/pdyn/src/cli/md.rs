@@ -1,0 +1,296 @@
+//! `pdyn run FILE` for a molecular-dynamics model (a file with a top-level `[md]` table):
+//! options → `pdyn::md::{parse, build, run}` → live thermo table, files, summary.
+
+use super::run::{io_error, RunArgs};
+use super::{numeric_pairs, Outcome};
+use pdyn::md::{self, Progress, RunOptions};
+use pdyn::Error;
+use pdyn_mech::ModelError;
+use std::io::IsTerminal;
+use std::path::Path;
+use std::sync::Arc;
+
+/// Steps × atoms above which a progress bar is shown (when stderr is a terminal).
+const PROGRESS_WORK: u64 = 20_000_000;
+
+/// The text of `path` when it is a molecular-dynamics model.
+pub fn md_source(path: &Path) -> Option<String> {
+    let source = std::fs::read_to_string(path).ok()?;
+    md::is_md_source(&source).then_some(source)
+}
+
+/// The error of a command other than `run` given a molecular-dynamics model (`source`), at
+/// its `[md]` table; `None` when `source` is not one.
+pub fn refusal(path: &Path, source: &str) -> Option<Error> {
+    if !md::is_md_source(source) {
+        return None;
+    }
+    let at = source.find("[md").unwrap_or(0);
+    // four characters, ending on a character boundary
+    let len: usize = source[at..].chars().take(4).map(char::len_utf8).sum();
+    let error = ModelError::new(
+        &path.display().to_string(),
+        at..at + len,
+        "molecular-dynamics model: use `pdyn run` (this command works on mechanics models)",
+    )
+    .help("an [md] model has pair potentials and thermostats, not equations of motion to derive");
+    Some(Error::Model {
+        error,
+        source: source.into(),
+    })
+}
+
+fn model_err(error: ModelError, source: &str) -> Error {
+    Error::Model {
+        error,
+        source: source.into(),
+    }
+}
+
+/// `pdyn run` on an `[md]` model.
+pub fn run(a: RunArgs, source: String) -> Result<Outcome, Error> {
+    // Options of the ODE integrators have no meaning for fixed-step velocity Verlet.
+    let meaningless: [(&str, bool); 8] = [
+        ("--method", a.method.is_some()),
+        ("--rtol", a.rtol.is_some()),
+        ("--atol", a.atol.is_some()),
+        ("--max-step", a.max_step.is_some()),
+        ("--max-steps", a.max_steps.is_some()),
+        ("--points", a.points.is_some()),
+        ("--output-dt", a.output_dt.is_some()),
+        ("--t-eval", !a.t_eval.is_empty()),
+    ];
+    if let Some((opt, _)) = meaningless.iter().find(|(_, given)| *given) {
+        return Err(Error::argument(
+            *opt,
+            format!(
+                "{opt} has no meaning for a molecular-dynamics model (fixed-step velocity Verlet); \
+                 use --dt, --t-end (run length) and the [md] keys steps, thermo_every, dump_every"
+            ),
+        ));
+    }
+    let origin = a.model.display().to_string();
+    let sets = numeric_pairs(&a.set, "--set")?;
+    let mut spec = md::parse(&source, &origin, &sets).map_err(|e| model_err(e, &source))?;
+    for (k, _) in &sets {
+        if !spec.parameters.iter().any(|(n, _)| n == k) {
+            let names: Vec<&str> = spec.parameters.iter().map(|(n, _)| n.as_str()).collect();
+            return Err(Error::argument(
+                "--set",
+                format!(
+                    "--set: `{k}` is not a parameter (parameters: {})",
+                    names.join(", ")
+                ),
+            ));
+        }
+    }
+    if let Some(dt) = a.dt {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(Error::argument(
+                "--dt",
+                format!("--dt must be a positive number, got {dt}"),
+            ));
+        }
+        spec.dt.value = dt;
+    }
+    if let Some(t) = a.t_end {
+        let steps = t / spec.dt.value;
+        if !(steps.is_finite() && steps >= 0.0 && steps <= md::spec::MAX_STEPS as f64) {
+            return Err(Error::argument(
+                "--t-end",
+                format!(
+                    "--t-end {t} with dt = {} is not a valid number of steps",
+                    spec.dt.value
+                ),
+            ));
+        }
+        spec.steps = steps.round() as u64;
+    }
+    let drift_tolerance = match a.drift_tolerance {
+        Some(d) if d.is_finite() && d > 0.0 => d,
+        Some(d) => {
+            return Err(Error::argument(
+                "--drift-tolerance",
+                format!("--drift-tolerance must be a positive number, got {d}"),
+            ))
+        }
+        None => pdyn::sim::DEFAULT_DRIFT_TOLERANCE,
+    };
+    if a.plot && a.out.is_none() {
+        return Err(Error::argument(
+            "--plot",
+            "--plot needs --out DIR to write the images into",
+        ));
+    }
+    let base = a.model.parent().unwrap_or(Path::new("."));
+    let mut prep =
+        md::build(&spec, base, pdyn_jit::JitMode::Auto).map_err(|e| model_err(e, &source))?;
+    if let Some(dir) = &a.out {
+        std::fs::create_dir_all(dir).map_err(|e| io_error(dir, "create", e))?;
+    }
+    let n = md::build::atoms(&prep) as u64;
+    let work = n.saturating_mul(spec.steps);
+    let bar = if work >= PROGRESS_WORK && std::io::stderr().is_terminal() {
+        let b = indicatif::ProgressBar::new(spec.steps);
+        if let Ok(style) = indicatif::ProgressStyle::with_template(
+            "{spinner} md [{bar:40}] {pos}/{len} steps, {per_sec}, eta {eta}",
+        ) {
+            b.set_style(style.progress_chars("=> "));
+        }
+        b
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let live = !a.json;
+    if live {
+        eprintln!(
+            "{}: {n} atoms, {} steps of dt = {}, {}",
+            spec.name,
+            spec.steps,
+            spec.dt.value,
+            md::output::ensemble_name(&spec.thermostat.ensemble)
+        );
+        if let Some(m) = &prep.minimized {
+            eprintln!(
+                "minimised (FIRE): {} iterations, U = {:.6}, max |F| = {:.3e}{}",
+                m.iterations,
+                m.energy,
+                m.max_force,
+                if m.converged { "" } else { " (not converged)" }
+            );
+        }
+        bar.suspend(|| {
+            eprintln!(
+                "{:>10} {:>12} {:>14} {:>14} {:>14} {:>12}",
+                "step", "T", "KE", "PE", "E", "P"
+            )
+        });
+    }
+    let opts = RunOptions {
+        out: a.out.clone(),
+        drift_tolerance,
+    };
+    let mut progress = |p: Progress| match p {
+        Progress::Record(r) if live => bar.suspend(|| {
+            eprintln!(
+                "{:>10} {:>12.6} {:>14.6} {:>14.6} {:>14.6} {:>12.6}",
+                r.step, r.temperature, r.kinetic, r.potential, r.total, r.pressure
+            )
+        }),
+        Progress::Step(s) => bar.set_position(s),
+        _ => {}
+    };
+    let res = md::run(&mut prep, &opts, &mut progress)?;
+    bar.finish_and_clear();
+    let failure = res.failure.clone().map(|error| Error::MdRun {
+        origin: origin.clone(),
+        error,
+    });
+    let mut sum = md::output::summary(&prep, &res);
+    if let Some(f) = &failure {
+        sum["error"] = f.to_json()["error"].clone();
+    }
+    if let Some(dir) = &a.out {
+        md::output::write_files(&res, dir)?;
+        let js = dir.join("summary.json");
+        std::fs::write(&js, format!("{sum:#}\n")).map_err(|e| Error::Io {
+            path: js.clone(),
+            action: "write",
+            error: Arc::new(e),
+        })?;
+        if a.plot {
+            md::output::write_plots(&prep, &res, dir)?;
+        }
+    }
+    let mut stderr = String::new();
+    for w in &res.warnings {
+        stderr += &format!("warning: {w}\n");
+    }
+    if a.out.is_none() {
+        let files: Vec<&str> = [
+            (spec.dump_every > 0, "traj.xyz (dump_every)"),
+            (spec.rdf, "rdf.csv (rdf = true)"),
+            (spec.msd, "msd.csv (msd = true)"),
+        ]
+        .iter()
+        .filter(|(on, _)| *on)
+        .map(|(_, f)| *f)
+        .collect();
+        if !files.is_empty() {
+            stderr += &format!("warning: no --out DIR: {} not written\n", files.join(", "));
+        }
+    }
+    let stdout = if a.json {
+        format!("{sum:#}\n")
+    } else {
+        text_report(&prep, &res, a.out.as_deref())
+    };
+    Ok(Outcome {
+        stdout,
+        stderr,
+        failure,
+    })
+}
+
+fn text_report(prep: &md::Prepared, res: &md::MdResult, out: Option<&Path>) -> String {
+    let n = res.atoms.max(1) as f64;
+    let mut s = format!("{}\n", prep.spec.name);
+    s += &format!(
+        "{} atoms, {} steps ({} neighbour-list builds) in {:.3} s, {:.3e} atom-steps/s\n",
+        res.atoms,
+        res.steps,
+        res.builds,
+        res.seconds,
+        if res.seconds > 0.0 {
+            n * res.steps as f64 / res.seconds
+        } else {
+            0.0
+        }
+    );
+    if let Some(r) = res.records.last() {
+        s += &format!(
+            "final: step {}  T = {:.6}  E/N = {:.8}  PE/N = {:.8}  P = {:.6}\n",
+            r.step,
+            r.temperature,
+            r.total / n,
+            r.potential / n,
+            r.pressure
+        );
+    }
+    let fmt = |name: &str, a: Option<md::run::Average>| match a {
+        Some(md::run::Average {
+            mean,
+            error: Some(e),
+            ..
+        }) => format!("  {name:<12} {mean:.6} ± {e:.2e}\n"),
+        Some(a) => format!("  {name:<12} {:.6}\n", a.mean),
+        None => String::new(),
+    };
+    let avg = fmt("T", res.average(|r| r.temperature))
+        + &fmt("P", res.average(|r| r.pressure))
+        + &fmt("E/N", res.average(|r| r.total / n));
+    if !avg.is_empty() {
+        s += "averages (block error bars):\n";
+        s += &avg;
+    }
+    if let Some(d) = &res.drift {
+        s += &format!(
+            "energy drift: {:.3e} of the mean kinetic energy, slope {:.3e} per atom per time unit\n",
+            d.relative, d.slope_per_atom
+        );
+    }
+    if let Some(dir) = out {
+        s += &format!("wrote {}/thermo.csv and summary.json", dir.display());
+        if res.frames > 0 {
+            s += &format!(", traj.xyz ({} frames)", res.frames);
+        }
+        if res.rdf.is_some() {
+            s += ", rdf.csv";
+        }
+        if !res.msd.is_empty() {
+            s += ", msd.csv";
+        }
+        s += "\n";
+    }
+    s
+}

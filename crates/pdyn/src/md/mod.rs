@@ -1,0 +1,29 @@
+//! Molecular dynamics from a model file: the `[md]` table.
+//!
+//! The pipeline mirrors `sim` for the mechanics models: [`spec::parse`] reads the table with
+//! spans (numbers may be expressions of `[parameters]`, after `--set`), [`build::build`]
+//! compiles the pair potentials (built-in kernels, or a formula in `r` differentiated and
+//! compiled by pdyn-expr and pdyn-jit, [`formula`]) and sets up a `pdyn_md::Simulation`
+//! (lattice or file, bonds, Maxwell–Boltzmann velocities, minimisation, thermostat),
+//! [`run::run`] steps it and gathers thermodynamics, trajectory frames, RDF and MSD, and
+//! [`output`] writes the files and the summary. pdyn-md knows nothing of files or symbols:
+//! everything about the model file lives here. See `docs/md.md` for the format.
+
+pub mod build;
+pub mod formula;
+pub mod output;
+pub mod pair;
+pub mod run;
+pub mod spec;
+
+pub use build::{build, Prepared};
+pub use run::{run, MdResult, Progress, RunOptions};
+pub use spec::{parse, MdSpec};
+
+/// True when `source` is a TOML document with a top-level `[md]` table (a molecular-dynamics
+/// model). A document that does not parse is not one: the mechanics loader reports its error.
+pub fn is_md_source(source: &str) -> bool {
+    source
+        .parse::<toml::Table>()
+        .is_ok_and(|t| t.contains_key("md"))
+}

@@ -1,0 +1,171 @@
+//! Files and the summary of a run: `thermo.csv`, `rdf.csv`, `msd.csv`, `summary.json`, and
+//! the energy/temperature plot. (`traj.xyz` is written during the run, by [`super::run`].)
+
+use super::build::Prepared;
+use super::run::{Average, MdResult};
+use super::spec::{Ensemble, Units};
+use crate::output::json_num;
+use crate::Error;
+use pdyn_md::THERMO_CSV_HEADER;
+use serde_json::json;
+use std::fmt::Write as _;
+use std::path::Path;
+use std::sync::Arc;
+
+fn write(path: &Path, text: &str) -> Result<(), Error> {
+    std::fs::write(path, text).map_err(|e| Error::Io {
+        path: path.to_path_buf(),
+        action: "write",
+        error: Arc::new(e),
+    })
+}
+
+/// Name of the thermostat of a run, as in the file.
+pub fn ensemble_name(e: &Ensemble) -> &'static str {
+    match e {
+        Ensemble::Nve => "nve",
+        Ensemble::Langevin { .. } => "langevin",
+        Ensemble::NoseHoover { .. } => "nose-hoover",
+        Ensemble::Berendsen { .. } => "berendsen",
+    }
+}
+
+fn avg_json(a: Option<Average>) -> serde_json::Value {
+    match a {
+        None => serde_json::Value::Null,
+        Some(a) => json!({
+            "mean": json_num(a.mean),
+            "error": a.error.map(json_num),
+            "blocks": a.blocks,
+        }),
+    }
+}
+
+/// The JSON summary of a run.
+pub fn summary(prep: &Prepared, res: &MdResult) -> serde_json::Value {
+    let spec = &prep.spec;
+    let n = res.atoms.max(1) as f64;
+    let last = res.records.last();
+    let units = match spec.units {
+        Units::Lj => {
+            json!({"name": "lj", "energy": "ε", "length": "σ", "time": "τ", "temperature": "ε/k_B", "pressure": "ε/σ³"})
+        }
+        Units::Real => {
+            json!({"name": "real", "energy": "kcal/mol", "length": "Å", "time": "fs", "temperature": "K", "pressure": "atm"})
+        }
+    };
+    json!({
+        "model": spec.name,
+        "engine": "md",
+        "units": units,
+        "atoms": res.atoms,
+        "species": spec.species.iter().map(|s| json!({"name": s.name, "mass": s.mass.value})).collect::<Vec<_>>(),
+        "ensemble": ensemble_name(&spec.thermostat.ensemble),
+        "dt": spec.dt.value,
+        "steps": res.steps,
+        "steps_requested": spec.steps,
+        "thermo_every": spec.thermo_every,
+        "neighbor_builds": res.builds,
+        "trajectory_frames": res.frames,
+        "formula_native": prep.native,
+        "minimized": prep.minimized.map(|m| json!({
+            "iterations": m.iterations, "energy": json_num(m.energy),
+            "max_force": json_num(m.max_force), "converged": m.converged,
+        })),
+        "loop_seconds": res.seconds,
+        "atom_steps_per_second": if res.seconds > 0.0 { json_num(n * res.steps as f64 / res.seconds) } else { serde_json::Value::Null },
+        "final": last.map(|r| json!({
+            "step": r.step, "time": json_num(r.time), "temperature": json_num(r.temperature),
+            "kinetic": json_num(r.kinetic), "potential": json_num(r.potential),
+            "total": json_num(r.total), "pressure": json_num(r.pressure),
+            "total_per_atom": json_num(r.total / n),
+        })),
+        "averages_from_step": res.average_from.max(1),
+        "averages": {
+            "temperature": avg_json(res.average(|r| r.temperature)),
+            "pressure": avg_json(res.average(|r| r.pressure)),
+            "potential_per_atom": avg_json(res.average(|r| r.potential / n)),
+            "total_per_atom": avg_json(res.average(|r| r.total / n)),
+        },
+        "energy_drift": res.drift.as_ref().map(|d| json!({
+            "relative": json_num(d.relative),
+            "scale": json_num(d.scale),
+            "slope_per_atom": json_num(d.slope_per_atom),
+        })),
+        "warnings": res.warnings,
+    })
+}
+
+/// `thermo.csv`, plus `rdf.csv` and `msd.csv` when computed, into `dir`.
+pub fn write_files(res: &MdResult, dir: &Path) -> Result<(), Error> {
+    let mut s = format!("{THERMO_CSV_HEADER}\n");
+    for r in &res.records {
+        let _ = writeln!(s, "{r}");
+    }
+    write(&dir.join("thermo.csv"), &s)?;
+    if let Some((r, g)) = &res.rdf {
+        let mut s = String::from("r,g\n");
+        for (a, b) in r.iter().zip(g) {
+            let _ = writeln!(s, "{a},{b}");
+        }
+        write(&dir.join("rdf.csv"), &s)?;
+    }
+    if !res.msd.is_empty() {
+        let mut s = String::from("step,time,msd\n");
+        for m in &res.msd {
+            let _ = writeln!(s, "{},{},{}", m[0], m[1], m[2]);
+        }
+        write(&dir.join("msd.csv"), &s)?;
+    }
+    Ok(())
+}
+
+/// `thermo.svg`/`.png`: energies and temperature against the step.
+pub fn write_plots(prep: &Prepared, res: &MdResult, dir: &Path) -> Result<(), Error> {
+    use pdyn_plot::{save_grid, Figure, Series};
+    if res.records.len() < 2 {
+        return Err(Error::argument(
+            "--plot",
+            "too few thermo records to plot (lower thermo_every)",
+        ));
+    }
+    let n = res.atoms.max(1) as f64;
+    let step: Vec<f64> = res.records.iter().map(|r| r.step as f64).collect();
+    let col = |f: &dyn Fn(&pdyn_md::ThermoRecord) -> f64| -> Vec<f64> {
+        res.records.iter().map(f).collect()
+    };
+    let energy = Figure {
+        title: format!("{}: energy per atom", prep.spec.name),
+        x_label: "step".into(),
+        y_label: "energy / atom".into(),
+        series: vec![
+            Series::new("kinetic", step.clone(), col(&|r| r.kinetic / n)),
+            Series::new("potential", step.clone(), col(&|r| r.potential / n)),
+            Series::new("total", step.clone(), col(&|r| r.total / n)),
+        ],
+        ..Default::default()
+    };
+    let temp = Figure {
+        title: "temperature".into(),
+        x_label: "step".into(),
+        y_label: "T".into(),
+        series: vec![Series::new("T", step.clone(), col(&|r| r.temperature))],
+        ..Default::default()
+    };
+    let pressure = Figure {
+        title: "pressure".into(),
+        x_label: "step".into(),
+        y_label: "P".into(),
+        series: vec![Series::new("P", step, col(&|r| r.pressure))],
+        ..Default::default()
+    };
+    let figs = [energy, temp, pressure];
+    for ext in ["svg", "png"] {
+        let path = dir.join(format!("thermo.{ext}"));
+        save_grid(&figs, 1, &path).map_err(|e| Error::Plot {
+            path: path.clone(),
+            error: e.to_string(),
+        })?;
+    }
+    Ok(())
+}

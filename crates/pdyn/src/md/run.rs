@@ -1,0 +1,437 @@
+//! Running a prepared model: steps in chunks (so that trajectory frames, temperature ramps and
+//! progress happen between them), thermodynamics converted to the file's units, RDF and MSD
+//! gathered on the way, and the energy-drift check of an NVE (or Nosé–Hoover) run.
+//!
+//! A run that becomes unstable (pdyn-md detects a non-finite state, a jump larger than half
+//! a length unit in one step, or a change of the conserved energy beyond 1 energy unit per
+//! atom) stops there; everything recorded up to that step is returned with the failure, and
+//! the trajectory written so far ends with the failing configuration.
+
+use super::build::{Engine, Prepared, UnitSystem};
+use super::spec::{Ensemble, MdSpec, Mode, Units};
+use crate::Error;
+use pdyn_md::analysis::{Msd, Rdf};
+use pdyn_md::potential::PairPotential;
+use pdyn_md::thermostat::Thermostat;
+use pdyn_md::{MdError, Simulation, System, ThermoRecord};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Largest system for the RDF (an all-pairs histogram, `O(N²)` per frame).
+pub const RDF_MAX_ATOMS: usize = 100_000;
+
+/// Frames the RDF averages over at most (taken from the second half of the run).
+pub const RDF_MAX_FRAMES: usize = 20;
+
+/// What a run is asked to do besides stepping.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Directory for `traj.xyz` (written during the run when `dump_every > 0`).
+    pub out: Option<PathBuf>,
+    /// Relative drift of the conserved energy that triggers a warning.
+    pub drift_tolerance: f64,
+}
+
+/// What happens during a run, for a live display.
+#[derive(Debug, Clone, Copy)]
+pub enum Progress<'a> {
+    /// A thermodynamic record (file units).
+    Record(&'a ThermoRecord),
+    /// Steps completed so far.
+    Step(u64),
+}
+
+/// Energy conservation of a run whose dynamics conserve an energy (NVE, Nosé–Hoover).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Drift {
+    /// `max |E(t) − E(0)|` over the records divided by the mean kinetic energy (the scale of
+    /// the energy's fluctuations; `E` itself may be near zero).
+    pub relative: f64,
+    /// Slope of a least-squares line through `E(t)/N` (energy per atom per time unit).
+    pub slope_per_atom: f64,
+    /// The scale used (mean kinetic energy).
+    pub scale: f64,
+}
+
+/// A mean and its standard error from block averages.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Average {
+    /// Mean over the records.
+    pub mean: f64,
+    /// Standard error of the mean from `blocks` block averages (None with too few records).
+    pub error: Option<f64>,
+    /// Number of blocks.
+    pub blocks: usize,
+}
+
+/// The results of a run.
+#[derive(Debug, Clone)]
+pub struct MdResult {
+    /// Thermodynamic records, file units.
+    pub records: Vec<ThermoRecord>,
+    /// Why the run stopped early, if it did.
+    pub failure: Option<MdError>,
+    /// Steps completed.
+    pub steps: u64,
+    /// Neighbour-list builds.
+    pub builds: u64,
+    /// Atoms.
+    pub atoms: usize,
+    /// Trajectory frames written.
+    pub frames: u64,
+    /// `(r, g(r))` when asked for.
+    pub rdf: Option<(Vec<f64>, Vec<f64>)>,
+    /// `(step, time, msd)` at every record when asked for.
+    pub msd: Vec<[f64; 3]>,
+    /// Energy conservation (NVE, Nosé–Hoover).
+    pub drift: Option<Drift>,
+    /// Warnings for the user.
+    pub warnings: Vec<String>,
+    /// Wall-clock seconds spent stepping.
+    pub seconds: f64,
+    /// First step that counts in the averages.
+    pub average_from: u64,
+}
+
+impl MdResult {
+    /// Block average of one column of the records (`f` picks it); the start (step 0, before
+    /// any dynamics) and the records before `equilibrate` are left out.
+    pub fn average(&self, f: impl Fn(&ThermoRecord) -> f64) -> Option<Average> {
+        let from = self.average_from.max(1);
+        let xs: Vec<f64> = self
+            .records
+            .iter()
+            .filter(|r| r.step >= from)
+            .map(f)
+            .collect();
+        block_average(&xs)
+    }
+}
+
+/// Mean and standard error from `5` contiguous blocks (Flyvbjerg & Petersen, J. Chem. Phys.
+/// 91, 461 (1989)): the error of correlated samples is estimated from block means, which are
+/// nearly independent when blocks are longer than the correlation time. Fewer than 10 values
+/// give a mean without an error.
+pub fn block_average(xs: &[f64]) -> Option<Average> {
+    if xs.is_empty() {
+        return None;
+    }
+    let mean = xs.iter().sum::<f64>() / xs.len() as f64;
+    const NB: usize = 5;
+    if xs.len() < 2 * NB {
+        return Some(Average {
+            mean,
+            error: None,
+            blocks: 0,
+        });
+    }
+    let len = xs.len() / NB;
+    let bm: Vec<f64> = (0..NB)
+        .map(|b| xs[b * len..(b + 1) * len].iter().sum::<f64>() / len as f64)
+        .collect();
+    let m = bm.iter().sum::<f64>() / NB as f64;
+    let var = bm.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (NB * (NB - 1)) as f64;
+    Some(Average {
+        mean,
+        error: Some(var.sqrt()),
+        blocks: NB,
+    })
+}
+
+fn io_err(path: &Path, action: &'static str, e: std::io::Error) -> Error {
+    Error::Io {
+        path: path.to_path_buf(),
+        action,
+        error: Arc::new(e),
+    }
+}
+
+/// Runs `prep` for its `steps`, reporting to `progress`.
+pub fn run(
+    prep: &mut Prepared,
+    opts: &RunOptions,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<MdResult, Error> {
+    let spec = prep.spec.clone();
+    let u = prep.units;
+    match &mut prep.engine {
+        Engine::Lj(sim) => run_sim(sim, &spec, u, opts, progress),
+        Engine::General(sim) => run_sim(sim, &spec, u, opts, progress),
+    }
+}
+
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+/// A record in file units.
+fn convert(r: &ThermoRecord, u: UnitSystem, dt: f64) -> ThermoRecord {
+    ThermoRecord {
+        time: r.step as f64 * dt,
+        pressure: r.pressure * u.pressure,
+        ..*r
+    }
+}
+
+fn set_target(t: &mut Thermostat, temperature: f64) {
+    match t {
+        Thermostat::Langevin(l) => l.temperature = temperature,
+        Thermostat::NoseHooverChain(c) => c.temperature = temperature,
+        Thermostat::Berendsen(b) => b.temperature = temperature,
+        _ => {}
+    }
+}
+
+/// One trajectory frame in file units (velocities converted in `real`).
+fn write_frame(
+    w: &mut impl Write,
+    s: &System,
+    names: &[&str],
+    u: UnitSystem,
+    step: u64,
+    time: f64,
+) -> Result<(), MdError> {
+    if u.units == Units::Lj {
+        return pdyn_md::io::write_xyz(w, s, names, step, time);
+    }
+    let mut c = s.clone();
+    for v in [
+        &mut c.particles.vx,
+        &mut c.particles.vy,
+        &mut c.particles.vz,
+    ] {
+        v.iter_mut().for_each(|x| *x /= u.time);
+    }
+    pdyn_md::io::write_xyz(w, &c, names, step, time)
+}
+
+fn run_sim<P: PairPotential>(
+    sim: &mut Simulation<P>,
+    spec: &MdSpec,
+    u: UnitSystem,
+    opts: &RunOptions,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<MdResult, Error> {
+    let n = sim.system.particles.len();
+    let dt = spec.dt.value;
+    let names: Vec<&str> = spec.species.iter().map(|s| s.name.as_str()).collect();
+    let mut traj = match (&opts.out, spec.dump_every) {
+        (Some(dir), d) if d > 0 => {
+            let path = dir.join("traj.xyz");
+            let f = std::fs::File::create(&path).map_err(|e| io_err(&path, "create", e))?;
+            Some((std::io::BufWriter::new(f), path))
+        }
+        _ => None,
+    };
+    let traj_err = |path: &Path, e: MdError| match e {
+        MdError::Io { kind } => io_err(path, "write", std::io::Error::from(kind)),
+        e => Error::Internal {
+            message: format!("writing a trajectory frame: {e}"),
+        },
+    };
+    let mut frames = 0u64;
+    if let Some((w, path)) = &mut traj {
+        write_frame(w, &sim.system, &names, u, sim.step, sim.step as f64 * dt)
+            .map_err(|e| traj_err(path, e))?;
+        frames += 1;
+    }
+    let msd0 = spec.msd.then(|| Msd::new(&sim.system));
+    let mut rdf = if spec.rdf && n <= RDF_MAX_ATOMS {
+        let r_max = 0.5 * sim.system.sim_box.min_edge() * (1.0 - 1e-9);
+        Some(Rdf::new(r_max, spec.rdf_bins).map_err(|e| Error::Internal {
+            message: format!("RDF: {e}"),
+        })?)
+    } else {
+        None
+    };
+    let mut warnings = vec![];
+    if spec.rdf && rdf.is_none() {
+        warnings.push(format!(
+            "rdf = true ignored: {n} atoms is more than {RDF_MAX_ATOMS} for the all-pairs histogram"
+        ));
+    }
+    let rdf_every = (spec.steps / spec.thermo_every.max(1) / 2 / RDF_MAX_FRAMES as u64).max(1);
+    let mut records: Vec<ThermoRecord> = vec![];
+    let mut msd = vec![];
+    let mut rdf_seen = 0u64;
+    let mut rdf_frames = 0u64;
+    let every = spec.thermo_every.max(1);
+    let chunk = if spec.dump_every > 0 {
+        gcd(every, spec.dump_every)
+    } else {
+        every
+    };
+    let ramp = match (
+        &spec.thermostat.temperature,
+        &spec.thermostat.final_temperature,
+    ) {
+        (Some(a), Some(b)) if spec.thermostat.ensemble != Ensemble::Nve => Some((a.value, b.value)),
+        _ => None,
+    };
+    let half = spec.steps / 2;
+    let start = std::time::Instant::now();
+    let mut failure = None;
+    let mut builds = 0;
+    let mut done = 0u64;
+    while done < spec.steps || (done == 0 && records.is_empty()) {
+        let k = chunk.min(spec.steps - done);
+        if let Some((a, b)) = ramp {
+            let frac = (done as f64 + 0.5 * k as f64) / spec.steps.max(1) as f64;
+            set_target(&mut sim.thermostat, a + (b - a) * frac);
+        }
+        let mut obs = |r: &ThermoRecord, s: &System| {
+            let c = convert(r, u, dt);
+            progress(Progress::Record(&c));
+            records.push(c);
+            if let Some(m) = &msd0 {
+                msd.push([r.step as f64, c.time, m.value(s)]);
+            }
+            if let Some(h) = &mut rdf {
+                if r.step >= half && r.step > 0 {
+                    if rdf_seen % rdf_every == 0 {
+                        // the box is fixed, so `add` cannot refuse r_max here
+                        let _ = h.add(s);
+                        rdf_frames += 1;
+                    }
+                    rdf_seen += 1;
+                }
+            }
+        };
+        let outcome = sim.run(k, &mut obs);
+        match outcome {
+            Ok(rep) => {
+                builds += rep.builds;
+                done += rep.steps;
+            }
+            Err(f) => {
+                builds += f.partial.builds;
+                done += f.partial.steps;
+                failure = Some(f.error);
+            }
+        }
+        progress(Progress::Step(done));
+        if let Some((w, path)) = &mut traj {
+            let dump = spec.dump_every > 0 && sim.step % spec.dump_every == 0;
+            if dump || failure.is_some() {
+                write_frame(w, &sim.system, &names, u, sim.step, sim.step as f64 * dt)
+                    .map_err(|e| traj_err(path, e))?;
+                frames += 1;
+            }
+        }
+        if failure.is_some() || k == 0 {
+            break;
+        }
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    if failure.is_none() && records.last().map(|r| r.step) != Some(sim.step) {
+        // the last step, when it is not a multiple of thermo_every
+        let c = convert(&sim.thermo(), u, dt);
+        progress(Progress::Record(&c));
+        records.push(c);
+        if let Some(m) = &msd0 {
+            msd.push([c.step as f64, c.time, m.value(&sim.system)]);
+        }
+        if let Some(h) = &mut rdf {
+            if c.step > 0 {
+                let _ = h.add(&sim.system);
+                rdf_frames += 1;
+            }
+        }
+    }
+    if spec.rdf && rdf.is_some() && rdf_frames == 0 {
+        warnings.push("rdf = true: no frame to average (the run has no steps)".into());
+        rdf = None;
+    }
+    if let Some((w, path)) = &mut traj {
+        w.flush().map_err(|e| io_err(path, "write", e))?;
+    }
+    let drift = match spec.thermostat.ensemble {
+        Ensemble::Nve | Ensemble::NoseHoover { .. } if records.len() >= 2 => {
+            let c0 = records[0].conserved;
+            let dev = records
+                .iter()
+                .map(|r| (r.conserved - c0).abs())
+                .fold(0.0, f64::max);
+            let scale = records.iter().map(|r| r.kinetic).sum::<f64>() / records.len() as f64;
+            let relative = if scale > 0.0 { dev / scale } else { dev };
+            let slope = fit_slope(&records, n);
+            Some(Drift {
+                relative,
+                slope_per_atom: slope,
+                scale,
+            })
+        }
+        _ => None,
+    };
+    if let Some(d) = &drift {
+        if d.relative.is_nan() || d.relative > opts.drift_tolerance {
+            let plain = spec.pairs.iter().any(|p| p.mode == Mode::Plain);
+            warnings.push(format!(
+                "the total energy should be conserved but drifted by {:.3e} of the mean kinetic energy over {} steps: \
+                 this result cannot be trusted (the First Law of Scientific Computing). {}",
+                d.relative,
+                done,
+                if plain {
+                    "With mode = \"plain\" the energy jumps each time a pair crosses the cutoff: \
+                     mode = \"shifted-energy\" removes that; if the drift remains, reduce the time step."
+                        .to_string()
+                } else {
+                    format!("Reduce the time step (--dt {}).", dt / 2.0)
+                }
+            ));
+        }
+    }
+    Ok(MdResult {
+        records,
+        failure,
+        steps: done,
+        builds,
+        atoms: n,
+        frames,
+        rdf: rdf.map(|h| h.result()),
+        msd,
+        drift,
+        warnings,
+        seconds,
+        average_from: spec.equilibrate,
+    })
+}
+
+/// Least-squares slope of the conserved energy per atom against time.
+fn fit_slope(records: &[ThermoRecord], n: usize) -> f64 {
+    let m = records.len() as f64;
+    let n = n.max(1) as f64;
+    let tm = records.iter().map(|r| r.time).sum::<f64>() / m;
+    let em = records.iter().map(|r| r.conserved / n).sum::<f64>() / m;
+    let (mut sxy, mut sxx) = (0.0, 0.0);
+    for r in records {
+        sxy += (r.time - tm) * (r.conserved / n - em);
+        sxx += (r.time - tm).powi(2);
+    }
+    if sxx > 0.0 {
+        sxy / sxx
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn block_average_of_known_blocks() {
+        // five blocks with means 1..5: mean 3, standard error sqrt(2.5/5) = sqrt(0.5)
+        let xs: Vec<f64> = (1..=5).flat_map(|b| [b as f64; 4]).collect();
+        let a = block_average(&xs).unwrap();
+        assert!((a.mean - 3.0).abs() < 1e-15);
+        assert!((a.error.unwrap() - 0.5f64.sqrt()).abs() < 1e-15);
+        assert_eq!(block_average(&[1.0, 2.0]).unwrap().error, None);
+        assert!(block_average(&[]).is_none());
+    }
+}
