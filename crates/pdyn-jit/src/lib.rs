@@ -15,9 +15,10 @@
 //! SSA value, in the program's order, so the
 //! arithmetic is the same sequence of IEEE operations as the interpreter's (no reassociation,
 //! no fused multiply-add). `+ − × ÷`, negation, `sqrt`, `abs` and `sign` are native
-//! instructions (correctly rounded, like Rust's). Transcendental functions (`sin`, `cos`,
+//! instructions (correctly rounded, like Rust's); integer powers up to 64 are multiplied out
+//! in `f64::powi`'s own order. Transcendental functions (`sin`, `cos`,
 //! `tan`, `asin`, `acos`, `atan`, `atan2`, `sinh`, `cosh`, `tanh`, `exp`, `ln`, `powf`,
-//! `powi`) and `min`/`max` call `extern "C"` shims that call the same `f64` methods the
+//! larger `powi`) and `min`/`max` call `extern "C"` shims that call the same `f64` methods the
 //! interpreter calls, hence the same libm: the JIT and [`Program::eval`] give identical bits
 //! (NaN payloads aside). `min`/`max` go through shims because Rust's NaN-ignoring semantics and
 //! its choice between `+0` and `−0` are not those of Cranelift's `fmin`/`fmax`.
@@ -142,6 +143,34 @@ impl std::fmt::Debug for JitProgram {
             .field("chunks", &self.code.funcs.len())
             .finish()
     }
+}
+
+/// Largest exponent of `x^k` multiplied out inline rather than called.
+const MAX_INLINE_POWI: i32 = 64;
+
+/// `x^k` for `0 ≤ k`, as the same multiplications in the same order as `f64::powi` (LLVM's
+/// `__powidf2`: square-and-multiply from the lowest bit, the result starting at 1), so the
+/// bits agree with the interpreter; a call per power was most of the cost of a pair
+/// potential such as `(sigma/r)^12`.
+fn inline_powi(b: &mut FunctionBuilder, x: Value, k: u32) -> Value {
+    let mut base = x;
+    let mut acc: Option<Value> = None;
+    let mut k = k;
+    loop {
+        if k & 1 == 1 {
+            // 1·x is x exactly, so the first factor needs no multiplication.
+            acc = Some(match acc {
+                None => base,
+                Some(r) => b.ins().fmul(r, base),
+            });
+        }
+        k >>= 1;
+        if k == 0 {
+            break;
+        }
+        base = b.ins().fmul(base, base);
+    }
+    acc.unwrap_or_else(|| b.ins().f64const(1.0))
 }
 
 /// Which values cross from one chunk to a later one, and where they are kept meanwhile.
@@ -280,13 +309,18 @@ fn emit_chunk(
                 b.ins().select(gt, one, r)
             }
             Op::Powi => {
-                let f = b.ins().iconst(
-                    ptr,
-                    shims::powi as extern "C" fn(f64, i32) -> f64 as usize as i64,
-                );
-                let e = b.ins().iconst(types::I32, ins.b() as i32 as i64);
-                let call = b.ins().call_indirect(sigi, f, &[a, e]);
-                b.inst_results(call)[0]
+                let k = ins.b() as i32;
+                if (0..=MAX_INLINE_POWI).contains(&k) {
+                    inline_powi(&mut b, a, k as u32)
+                } else {
+                    let f = b.ins().iconst(
+                        ptr,
+                        shims::powi as extern "C" fn(f64, i32) -> f64 as usize as i64,
+                    );
+                    let e = b.ins().iconst(types::I32, k as i64);
+                    let call = b.ins().call_indirect(sigi, f, &[a, e]);
+                    b.inst_results(call)[0]
+                }
             }
             op => {
                 if let Some(s) = unary_shim(op) {
@@ -610,6 +644,39 @@ mod tests {
     }
 
     #[test]
+    fn integer_powers_multiplied_out_agree_with_powi_bit_for_bit() {
+        // Every exponent the compiler emits as Powi (4 and up; 64 is the last inlined, 65+
+        // call), at inputs spread over many binades, including overflow and underflow.
+        let mut p = Pool::new();
+        let x = p.var("x");
+        let outs: Vec<Id> = (4..=70)
+            .map(|k| p.parse_scalar(&format!("x^{k}")).unwrap())
+            .collect();
+        let prog = Program::compile(&mut p, &[x], &outs).unwrap();
+        let jit = JitProgram::compile(&prog).unwrap();
+        let mut ws = prog.workspace();
+        let (mut o1, mut o2) = (vec![0.0; outs.len()], vec![0.0; outs.len()]);
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        for _ in 0..2000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let mantissa = (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+            let exponent = ((state >> 3) % 40) as i32 - 20;
+            let v = mantissa * 10f64.powi(exponent);
+            prog.eval(&[v], &mut ws, &mut o1);
+            jit.eval(&[v], &mut [], &mut o2);
+            for (k, (a, b)) in o1.iter().zip(&o2).enumerate() {
+                assert!(
+                    a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+                    "x^{} at x = {v:e}: interpreter {a:e}, jit {b:e}",
+                    k + 4
+                );
+            }
+        }
+    }
+
+    #[test]
     fn every_operation_agrees_with_the_interpreter() {
         let mut p = Pool::new();
         let (x, y) = (p.var("x"), p.var("y"));
@@ -622,6 +689,13 @@ mod tests {
             "x^2",
             "x^3",
             "x^7",
+            "x^4",
+            "x^6",
+            "x^12",
+            "x^13",
+            "x^64",
+            "x^65",
+            "x^(-12)",
             "x^(-3)",
             "x^(3/2)",
             "x^(5/2)",
