@@ -11,10 +11,15 @@
 //! at the initial time (or at the previous located zero) is not reported again: a crossing
 //! needs `g(t_old) ≠ 0`.
 //!
-//! Limitation: an even number of zeros of the same `g` inside one step is not seen (as in
-//! MATLAB and SciPy); limit `max_step` if events can be that close.
+//! Two zeros of the same `g` inside one step leave its sign unchanged, and MATLAB and SciPy
+//! miss them. Here the last three values of each `g` are fitted by a parabola: when its vertex
+//! lies in the step just taken and on the other side of zero, the step is sampled at
+//! [`DIP_SAMPLES`] interior points of the dense output and every sign change found is located
+//! as above. When the vertex lies in the step before (no dense output any more), or sampling
+//! finds no sign change, the interval is recorded in [`EventState::suspects`] so that callers
+//! can warn that a crossing may have been missed (limit `max_step` then).
 
-use crate::solution::{Direction, EventHit};
+use crate::solution::{Direction, EventHit, PossibleMiss};
 
 /// Dense output of the last accepted step: the state at any `t` in `[t_old, t_new]`.
 pub trait DenseOutput {
@@ -65,14 +70,29 @@ impl std::fmt::Debug for Event<'_> {
     }
 }
 
+/// Interior points at which a step is sampled when an event function seems to dip through
+/// zero and back within it.
+pub const DIP_SAMPLES: usize = 8;
+
 /// Per-solve state of the event locator (allocated once).
 pub(crate) struct EventState<'e, 'a> {
     events: &'e [Event<'a>],
+    /// `g` at the start of the current step (`t_prev`) and of the one before (`t_prev2`).
     g_prev: Vec<f64>,
+    g_prev2: Vec<f64>,
+    t_prev: f64,
+    t_prev2: f64,
     g_new: Vec<f64>,
+    /// Per event, the vertex of its parabola through the last three values when it dips
+    /// across zero inside this step.
+    dipping: Vec<Option<f64>>,
+    /// Sample times of a dipping step (scratch).
+    samples: Vec<f64>,
     counts: Vec<usize>,
     ytmp: Vec<f64>,
     found: Vec<(f64, usize, Direction)>,
+    /// `(event, t_from, t_to)`: intervals where a pair of crossings may have been missed.
+    pub(crate) suspects: Vec<(usize, f64, f64)>,
 }
 
 impl<'e, 'a> EventState<'e, 'a> {
@@ -81,11 +101,35 @@ impl<'e, 'a> EventState<'e, 'a> {
         EventState {
             events,
             g_new: g_prev.clone(),
+            g_prev2: vec![f64::NAN; events.len()],
             g_prev,
+            t_prev: t0,
+            t_prev2: f64::NAN,
+            dipping: vec![None; events.len()],
+            samples: Vec::with_capacity(DIP_SAMPLES + 2),
             counts: vec![0; events.len()],
             ytmp: vec![0.0; n],
             found: Vec::with_capacity(events.len()),
+            suspects: Vec::new(),
         }
+    }
+
+    /// The suspicious intervals recorded since the last call, as [`PossibleMiss`]es.
+    pub(crate) fn drain_suspects(&mut self, into: &mut Vec<PossibleMiss>) {
+        into.extend(self.suspects.drain(..).map(|(index, a, b)| PossibleMiss {
+            index,
+            t_from: a.min(b),
+            t_to: a.max(b),
+        }));
+    }
+
+    /// Moves the history one step on: the step ending at `t_new` has been dealt with.
+    fn advance(&mut self, t_new: f64) {
+        std::mem::swap(&mut self.g_prev2, &mut self.g_prev);
+        self.g_prev.copy_from_slice(&self.g_new);
+        self.t_prev2 = self.t_prev;
+        self.t_prev = t_new;
+        self.dipping.iter_mut().for_each(|d| *d = None);
     }
 
     /// Evaluates the event functions at the end of the step; `true` when some crossing must be
@@ -97,10 +141,27 @@ impl<'e, 'a> EventState<'e, 'a> {
             self.g_new[i] = gn;
             if crossing(self.g_prev[i], gn, e.direction).is_some() {
                 any = true;
+                continue;
+            }
+            let points = [
+                (self.t_prev2, self.g_prev2[i]),
+                (self.t_prev, self.g_prev[i]),
+                (t_new, gn),
+            ];
+            match dip(points) {
+                Some(t) if within(t, self.t_prev, t_new) => {
+                    self.dipping[i] = Some(t);
+                    any = true;
+                }
+                Some(t) if within(t, self.t_prev2, self.t_prev) => {
+                    // The step before is gone: only say so.
+                    self.suspects.push((i, self.t_prev2, self.t_prev));
+                }
+                _ => {}
             }
         }
         if !any {
-            self.g_prev.copy_from_slice(&self.g_new);
+            self.advance(t_new);
         }
         any
     }
@@ -118,16 +179,47 @@ impl<'e, 'a> EventState<'e, 'a> {
         let tol_step = f64::EPSILON * (t_new - t_old).abs();
         for (i, e) in self.events.iter().enumerate() {
             let (gp, gn) = (self.g_prev[i], self.g_new[i]);
-            let Some(dir) = crossing(gp, gn, e.direction) else {
-                continue;
-            };
             let ytmp = &mut self.ytmp;
             let mut g = |t: f64| {
                 interp.interpolate(t, ytmp);
                 (e.g)(t, ytmp)
             };
-            let t = brent(&mut g, t_old, t_new, gp, gn, tol_step);
-            self.found.push((t, i, dir));
+            if let Some(dir) = crossing(gp, gn, e.direction) {
+                let t = brent(&mut g, t_old, t_new, gp, gn, tol_step);
+                self.found.push((t, i, dir));
+            } else if let Some(vertex) = self.dipping[i] {
+                // Sample the step evenly and at the parabola's vertex (where the dip most
+                // likely is); locate every sign change between neighbouring samples.
+                let samples = &mut self.samples;
+                samples.clear();
+                samples.extend(
+                    (1..=DIP_SAMPLES)
+                        .map(|k| t_old + (t_new - t_old) * k as f64 / (DIP_SAMPLES + 1) as f64),
+                );
+                samples.push(vertex);
+                if t_new >= t_old {
+                    samples.sort_by(f64::total_cmp);
+                } else {
+                    samples.sort_by(|a, b| b.total_cmp(a));
+                }
+                samples.push(t_new);
+                let mut found_any = false;
+                let (mut ta, mut ga) = (t_old, gp);
+                for (k, &tb) in samples.iter().enumerate() {
+                    let gb = if k + 1 == samples.len() { gn } else { g(tb) };
+                    if let Some(dir) = crossing(ga, gb, Direction::Both) {
+                        found_any = true;
+                        if crossing(ga, gb, e.direction).is_some() {
+                            let t = brent(&mut g, ta, tb, ga, gb, tol_step);
+                            self.found.push((t, i, dir));
+                        }
+                    }
+                    (ta, ga) = (tb, gb);
+                }
+                if !found_any {
+                    self.suspects.push((i, t_old, t_new));
+                }
+            }
         }
         let fwd = t_new >= t_old;
         self.found.sort_by(|a, b| {
@@ -138,7 +230,7 @@ impl<'e, 'a> EventState<'e, 'a> {
                 o.reverse()
             }
         });
-        self.g_prev.copy_from_slice(&self.g_new);
+        self.advance(t_new);
         for &(t, i, dir) in &self.found {
             interp.interpolate(t, &mut self.ytmp);
             hits.push(EventHit {
@@ -156,6 +248,33 @@ impl<'e, 'a> EventState<'e, 'a> {
         }
         None
     }
+}
+
+/// Whether `t` lies strictly inside the interval between `a` and `b` (either order).
+fn within(t: f64, a: f64, b: f64) -> bool {
+    (a < t && t < b) || (b < t && t < a)
+}
+
+/// The vertex `t*` of the parabola through three `(t, g)` points when the parabola crosses
+/// zero there and back — its value at `t*` has the other sign than the last point's while the
+/// last two points have the same sign — that is, where two zeros may hide between samples.
+fn dip(p: [(f64, f64); 3]) -> Option<f64> {
+    let [(t0, g0), (t1, g1), (t2, g2)] = p;
+    if !(g0.is_finite() && g1.is_finite() && g2.is_finite() && t0.is_finite()) {
+        return None;
+    }
+    if g1 == 0.0 || g2 == 0.0 || (g1 > 0.0) != (g2 > 0.0) {
+        return None;
+    }
+    let f01 = (g1 - g0) / (t1 - t0);
+    let f12 = (g2 - g1) / (t2 - t1);
+    let a = (f12 - f01) / (t2 - t0);
+    if !a.is_finite() || a == 0.0 {
+        return None;
+    }
+    let tv = 0.5 * (t0 + t1) - f01 / (2.0 * a);
+    let gv = g0 + f01 * (tv - t0) + a * (tv - t0) * (tv - t1);
+    ((gv > 0.0) != (g2 > 0.0) && gv != 0.0).then_some(tv)
 }
 
 /// Direction of a crossing from `gp` (at the start of the step) to `gn`, if it counts.

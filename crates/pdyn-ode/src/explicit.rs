@@ -262,6 +262,7 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
             } else {
                 None
             };
+            ev.drain_suspects(&mut sol.possible_misses);
             out.emit(&mut sol, &rk, t_new, &y_new, stop.map(|s| s.0), &mut ytmp);
             if let Some((_, idx)) = stop {
                 sol.status = Status::TerminalEvent(idx);

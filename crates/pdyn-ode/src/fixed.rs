@@ -166,6 +166,7 @@ pub(crate) fn integrate_fixed<P: ?Sized, F: OdeSystem + ?Sized, M: FixedStepper<
         } else {
             None
         };
+        ev.drain_suspects(&mut sol.possible_misses);
         out.emit(&mut sol, &herm, t_new, &y_new, stop.map(|s| s.0), &mut ytmp);
         if let Some((_, idx)) = stop {
             sol.status = Status::TerminalEvent(idx);

@@ -83,7 +83,7 @@ pub use problem::{
     FirstOrderForm, FnSecondOrder, FnSystem, FnSystemWithJacobian, MassInverse, MassKind,
     OdeSystem, SecondOrderSystem,
 };
-pub use solution::{Direction, EventHit, Solution, Stats, Status};
+pub use solution::{Direction, EventHit, PossibleMiss, Solution, Stats, Status};
 
 /// The integration methods. Everything descriptive about a method (name, aliases, order,
 /// kind, documentation) is one row of [`METHODS`]; see [`Method::info`].
@@ -468,6 +468,7 @@ fn auto<S: OdeSystem + ?Sized>(
         sol.t.extend_from_slice(&r.t[skip..]);
         sol.y.extend_from_slice(&r.y[skip * r.n..]);
         sol.events.append(&mut r.events);
+        sol.possible_misses.append(&mut r.possible_misses);
         let (a, b) = (&mut sol.stats, &r.stats);
         a.steps += b.steps;
         a.accepted += b.accepted;

@@ -61,6 +61,17 @@ pub enum Status {
     TerminalEvent(usize),
 }
 
+/// An interval in which event `index` may have crossed zero twice unseen.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PossibleMiss {
+    /// Index of the event function.
+    pub index: usize,
+    /// Start of the interval.
+    pub t_from: f64,
+    /// End of the interval.
+    pub t_to: f64,
+}
+
 /// Output of a solve. States are stored flat: `y[k*n..(k+1)*n]` belongs to `t[k]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Solution {
@@ -74,6 +85,9 @@ pub struct Solution {
     pub y: Vec<f64>,
     /// Located events in time order.
     pub events: Vec<EventHit>,
+    /// Intervals where an event function came back from (nearly) crossing zero between two
+    /// evaluations, and sampling did not settle it: a pair of crossings may have been missed.
+    pub possible_misses: Vec<PossibleMiss>,
     /// Work statistics.
     pub stats: Stats,
     /// How the integration ended.
@@ -88,6 +102,7 @@ impl Solution {
             t: Vec::new(),
             y: Vec::new(),
             events: Vec::new(),
+            possible_misses: Vec::new(),
             stats: Stats::default(),
             status: Status::Finished,
         }

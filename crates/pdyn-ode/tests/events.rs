@@ -298,3 +298,62 @@ fn backward_integration_locates_events() {
     assert_eq!(times.len(), 3);
     assert!((times[0] - 2.5 * PI).abs() < 1e-9 && (times[2] - 0.5 * PI).abs() < 1e-9);
 }
+
+/// `y' = 1` is integrated exactly, so the adaptive methods take ever longer steps; the two
+/// zeros of `g = (y − 1)² − 1e-6`, at 0.999 and 1.001, end up inside one step where `g` has
+/// the same sign at both ends. MATLAB and SciPy report nothing there.
+#[test]
+fn two_zeros_inside_one_step_are_found() {
+    let sys = FnSystem::new(1, |_t, _y: &[f64], f: &mut [f64]| f[0] = 1.0);
+    let g = |_t: f64, y: &[f64]| (y[0] - 1.0).powi(2) - 1e-6;
+    for method in [Method::Dopri5, Method::Dop853, Method::Radau5] {
+        let ev = [Event::new(&g)];
+        let sol =
+            solve_with_events(method, &sys, (0.0, 3.0), &[0.0], &Options::default(), &ev).unwrap();
+        // Steps are longer than the 0.002 between the zeros (else this tests nothing).
+        assert!(sol.stats.accepted < 40, "{method}: {:?}", sol.stats);
+        let ts: Vec<f64> = sol.events.iter().map(|e| e.t).collect();
+        assert_eq!(
+            ts.len(),
+            2,
+            "{method}: {ts:?} {:?} {:?}",
+            sol.possible_misses,
+            sol.t
+        );
+        assert!(
+            (ts[0] - 0.999).abs() < 1e-9 && (ts[1] - 1.001).abs() < 1e-9,
+            "{method}: {ts:?}"
+        );
+        assert_eq!(sol.events[0].direction, Direction::Falling);
+        assert_eq!(sol.events[1].direction, Direction::Rising);
+    }
+}
+
+/// A dip too narrow for the samples is reported as a possible miss, not ignored.
+#[test]
+fn a_dip_narrower_than_the_samples_is_reported() {
+    let sys = FnSystem::new(1, |_t, _y: &[f64], f: &mut [f64]| f[0] = 1.0);
+    // Zeros at 1 ± 1e-7: between two of the eight samples of a step of length ~1.
+    let g = |_t: f64, y: &[f64]| (y[0] - 1.0).powi(2) - 1e-14;
+    let ev = [Event::new(&g)];
+    let sol = solve_with_events(
+        Method::Dopri5,
+        &sys,
+        (0.0, 3.0),
+        &[0.0],
+        &Options::default(),
+        &ev,
+    )
+    .unwrap();
+    let found = sol.events.len() == 2;
+    let reported = sol
+        .possible_misses
+        .iter()
+        .any(|m| m.index == 0 && m.t_from < 1.0 && 1.0 < m.t_to);
+    assert!(
+        found || reported,
+        "{:?} {:?}",
+        sol.events,
+        sol.possible_misses
+    );
+}

@@ -578,6 +578,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                     } else {
                         None
                     };
+                    ev.drain_suspects(&mut sol.possible_misses);
                     out.emit(&mut sol, &dense, x, &y, stop.map(|s| s.0), &mut ytmp);
                     if let Some((_, idx)) = stop {
                         sol.status = Status::TerminalEvent(idx);

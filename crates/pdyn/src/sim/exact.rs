@@ -122,6 +122,7 @@ pub fn run_exact(
         t: Vec::with_capacity(ts.len()),
         y: Vec::with_capacity(ts.len() * n2),
         events: Vec::new(),
+        possible_misses: Vec::new(),
         stats: Default::default(),
         status: pdyn_ode::Status::Finished,
     };

@@ -866,6 +866,18 @@ pub(crate) fn tabulate(
     if rows.iter().any(|r| r.iter().any(|x| !x.is_finite())) && failure.is_none() {
         warnings.push("some output values are not finite (NaN or infinity)".into());
     }
+    for miss in &sol.possible_misses {
+        let name = prep
+            .events
+            .get(miss.index)
+            .map_or("event", |e| e.name.as_str());
+        warnings.push(format!(
+            "event `{name}` may have crossed zero twice between t = {:.6e} and t = {:.6e} \
+             unseen (its function came back towards zero and away within one step): limit the \
+             step (--max-step) to be sure",
+            miss.t_from, miss.t_to
+        ));
+    }
     RunResult {
         columns,
         rows,
