@@ -119,7 +119,7 @@ impl Pool {
                             .map(|(_, &f)| f)
                             .collect();
                         let r = self.mul(&others);
-                        views.push((i, c, r, k1, a1[0], k2, a2[0]));
+                        views.push((i, c.clone(), r, k1, a1[0], k2, a2[0]));
                     }
                 }
             }
@@ -164,7 +164,7 @@ impl Pool {
                     let (v, w) = (anchor, other);
                     let arg = if sum { self.add2(a, b) } else { self.sub(a, b) };
                     let call = self.call(f, &[arg]);
-                    let coef = self.num(v.1);
+                    let coef = self.num(v.1.clone());
                     let term = self.mul(&[coef, v.2, call]);
                     merged = Some((v.0, w.0, term));
                     break 'search;
@@ -296,22 +296,23 @@ impl RationalForm {
                 Some(acc)
             }
             Node::Pow(b, x) => {
-                let r = p.as_num(x).and_then(Number::as_rational);
+                // Exponents past i64 are treated like symbolic ones: an atom.
+                let r = p.as_num(x).and_then(|n| n.as_rational().and_then(|r| r.small()));
                 match r {
-                    Some(r) if r.is_integer() => {
+                    Some((num, 1)) => {
                         let base = self.convert(p, b)?;
-                        self.power(base, r.numer())
+                        self.power(base, num)
                     }
-                    Some(r) => {
+                    Some((num, den)) => {
                         // b^(p/q) = (b^(1/q))^p with b^(1/q) an atom.
-                        let inv_q = p.num(Number::ratio(1, r.denom()));
+                        let inv_q = p.num(Number::ratio(1, den));
                         let root = p.pow(b, inv_q);
                         if matches!(p.node(root), Node::Pow(rb, _) if *rb == b) {
                             let a = self.atom(root);
-                            self.power((a, one()), r.numer())
+                            self.power((a, one()), num)
                         } else {
                             // The root simplified (sqrt(m^2) = m for m > 0): use root^p.
-                            let pe = p.int(r.numer());
+                            let pe = p.int(num);
                             let v = p.pow(root, pe);
                             if v == e {
                                 return Some((self.atom(e), one()));
@@ -427,7 +428,7 @@ impl RationalForm {
         let mut terms = Vec::with_capacity(poly.terms.len());
         for (m, c) in &poly.terms {
             let mut fs = Vec::with_capacity(m.len() + 1);
-            fs.push(p.num(Number::Rat(*c)));
+            fs.push(p.num(Number::Rat(c.clone())));
             for &(a, e) in m {
                 let base = self.atoms[a as usize];
                 fs.push(p.powi(base, e as i64));
@@ -447,7 +448,7 @@ fn eliminate_square(poly: &Poly, x: u32, y: u32, b: &mut Budget) -> Option<Poly>
         let k = m.iter().find(|&&(a, _)| a == x).map_or(0, |&(_, e)| e);
         let term_poly = |mono: Mono| {
             let mut t = Poly::zero();
-            t.terms.insert(mono, *c);
+            t.terms.insert(mono, c.clone());
             t
         };
         if k < 2 {
