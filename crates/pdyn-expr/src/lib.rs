@@ -24,6 +24,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod budget;
 pub mod build;
 pub mod compile;
 mod constant;
@@ -44,6 +45,7 @@ pub mod syntax;
 pub mod vector;
 
 pub use compile::Program;
+pub use budget::BudgetError;
 pub use error::ExprError;
 pub use lower::{Binding, FreeScope, Scope, Value};
 pub use number::{Number, Rational};

@@ -347,14 +347,8 @@ impl Lowerer<'_> {
                 if let (Some(bn), Some(en)) = (p.as_num(x), p.as_num(y)) {
                     if let (Some(br), Some(er)) = (bn.as_rational(), en.as_rational()) {
                         if p.as_num(r).is_none() && er.is_integer() {
-                            let digits = er
-                                .small()
-                                .map(|(k, _)| {
-                                    crate::number::bits_to_digits(
-                                        br.pow_bits(k).min(u64::MAX as u128) as u64,
-                                    )
-                                })
-                                .unwrap_or(u64::MAX);
+                            let digits =
+                                er.small().map_or(u64::MAX, |(k, _)| br.pow_digits(k));
                             return Err(too_large(span, format!("{bn}^{en}"), digits));
                         }
                     }

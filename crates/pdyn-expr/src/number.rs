@@ -295,9 +295,13 @@ impl Rational {
         let r = self.mul(o);
         (r.bits() <= MAX_BITS).then_some(r)
     }
-    /// Estimated bits of `self^e` (an upper bound within a few bits).
-    pub fn pow_bits(&self, e: i64) -> u128 {
-        self.bits() as u128 * e.unsigned_abs() as u128
+    /// Estimated decimal digits of `self^e` (numerator plus denominator), for messages.
+    pub fn pow_digits(&self, e: i64) -> u64 {
+        let log10 = match &self.0 {
+            Repr::Small(n, d) => (n.unsigned_abs() as f64).log10() + (*d as f64).log10(),
+            Repr::Big(_) => self.bits() as f64 * std::f64::consts::LOG10_2,
+        };
+        (log10 * e.unsigned_abs() as f64).ceil().min(u64::MAX as f64) as u64
     }
     /// Integer power; `None` for `0^negative` or when the result would exceed [`MAX_BITS`]
     /// (checked before computing anything).

@@ -1,0 +1,68 @@
+//! Limits on symbolic work, and the typed error when one is reached.
+//!
+//! Symbolic algorithms can blow up on small inputs: `(a+b+c+d)^40` has 12,341 terms, the
+//! hundredth derivative of `exp(x^2)` thousands of nodes, `x^100000` differentiated 100,000
+//! times coefficients of half a million digits. Each such algorithm counts its work and stops
+//! with a [`BudgetError`] that says what ran out and what to do instead, so that no input
+//! makes pdyn hang. The limits are constants here, one place to read and tune them.
+
+use std::fmt;
+
+/// Most terms in one sum produced by [`Pool::try_expand`](crate::Pool::try_expand).
+pub const MAX_EXPAND_TERMS: usize = 5_000;
+/// Most products of two terms formed by one expansion (the work, counted before collecting
+/// like terms).
+pub const MAX_EXPAND_PRODUCTS: usize = 200_000;
+/// Most distinct nodes in a derivative computed by
+/// [`Pool::try_derivative_n`](crate::Pool::try_derivative_n).
+pub const MAX_DERIVATIVE_NODES: usize = 100_000;
+
+/// A symbolic operation would exceed its limit.
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum BudgetError {
+    /// Expanding would produce a sum of more than `limit` terms, or form more than
+    /// [`MAX_EXPAND_PRODUCTS`] products of terms.
+    ExpandTerms {
+        /// The limit that was reached.
+        limit: usize,
+    },
+    /// The `order`-th derivative grew past `limit` distinct nodes.
+    DerivativeSize {
+        /// The derivative being computed when the limit was reached (1 = first).
+        order: usize,
+        /// The limit on distinct nodes.
+        limit: usize,
+    },
+    /// A coefficient of the `order`-th derivative exceeded the size of exact numbers.
+    DerivativeNumbers {
+        /// The derivative being computed when the limit was reached.
+        order: usize,
+    },
+}
+
+impl fmt::Display for BudgetError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            BudgetError::ExpandTerms { limit } => write!(
+                f,
+                "expanding would produce more than {limit} terms: keep the expression \
+                 factored (simplify without --expand), or evaluate it numerically"
+            ),
+            BudgetError::DerivativeSize { order, limit } => write!(
+                f,
+                "derivative {order} has more than {limit} distinct nodes: differentiate \
+                 fewer times, or evaluate the derivative numerically (finite differences, \
+                 or integrate the equations numerically with `pdyn run`)"
+            ),
+            BudgetError::DerivativeNumbers { order } => write!(
+                f,
+                "derivative {order} has coefficients over the limit of {} digits for exact \
+                 numbers: differentiate fewer times, or evaluate numerically",
+                crate::number::MAX_DIGITS
+            ),
+        }
+    }
+}
+
+impl std::error::Error for BudgetError {}
