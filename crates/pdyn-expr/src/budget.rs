@@ -13,7 +13,7 @@ pub const MAX_EXPAND_TERMS: usize = 5_000;
 /// Most products of two terms formed by one expansion (the work, counted before collecting
 /// like terms).
 pub const MAX_EXPAND_PRODUCTS: usize = 200_000;
-/// Most distinct nodes in a derivative computed by
+/// Most new expression nodes created by
 /// [`Pool::try_derivative_n`](crate::Pool::try_derivative_n).
 pub const MAX_DERIVATIVE_NODES: usize = 100_000;
 
@@ -27,11 +27,11 @@ pub enum BudgetError {
         /// The limit that was reached.
         limit: usize,
     },
-    /// The `order`-th derivative grew past `limit` distinct nodes.
+    /// The derivatives up to `order` needed more than `limit` new expression nodes.
     DerivativeSize {
         /// The derivative being computed when the limit was reached (1 = first).
         order: usize,
-        /// The limit on distinct nodes.
+        /// The limit on new nodes.
         limit: usize,
     },
     /// A coefficient of the `order`-th derivative exceeded the size of exact numbers.
@@ -51,8 +51,8 @@ impl fmt::Display for BudgetError {
             ),
             BudgetError::DerivativeSize { order, limit } => write!(
                 f,
-                "derivative {order} has more than {limit} distinct nodes: differentiate \
-                 fewer times, or evaluate the derivative numerically (finite differences, \
+                "the derivatives up to order {order} need more than {limit} expression \
+                 nodes: differentiate fewer times, or evaluate the derivative numerically (finite differences, \
                  or integrate the equations numerically with `pdyn run`)"
             ),
             BudgetError::DerivativeNumbers { order } => write!(

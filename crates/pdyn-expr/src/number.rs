@@ -61,13 +61,44 @@ pub fn bits_to_digits(bits: u64) -> u64 {
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Rational(Repr);
 
-#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Debug)]
 enum Repr {
     /// `num/den`, reduced, `den > 0`.
     Small(i64, i64),
     /// Reduced, `den > 0`, and at least one part does not fit `i64`. Shared: cloning a node's
     /// number must not copy thousands of digits.
     Big(Arc<BigRational>),
+}
+
+// Equality and hashing compare the (reduced, canonical) parts directly: num-rational's own
+// `Eq`/`Hash` go through continued fractions, quadratic in the number of digits.
+impl PartialEq for Repr {
+    fn eq(&self, o: &Repr) -> bool {
+        match (self, o) {
+            (Repr::Small(a, b), Repr::Small(c, d)) => a == c && b == d,
+            (Repr::Big(x), Repr::Big(y)) => x.numer() == y.numer() && x.denom() == y.denom(),
+            _ => false,
+        }
+    }
+}
+impl Eq for Repr {}
+impl std::hash::Hash for Repr {
+    fn hash<H: std::hash::Hasher>(&self, h: &mut H) {
+        match self {
+            Repr::Small(n, d) => (0u8, n, d).hash(h),
+            Repr::Big(r) => (1u8, r.numer(), r.denom()).hash(h),
+        }
+    }
+}
+
+/// `gcd(a, b)`, skipping the work when either is ±1 (num-bigint's binary gcd is quadratic in
+/// the number of bits, even against 1).
+fn gcd_big(a: &BigInt, b: &BigInt) -> BigInt {
+    if a.magnitude().is_one() || b.magnitude().is_one() {
+        BigInt::one()
+    } else {
+        a.gcd(b)
+    }
 }
 
 /// Greatest common divisor (Euclid); `gcd(0, 0) = 0`. The one machine-integer gcd of the
@@ -234,7 +265,19 @@ impl Rational {
             let n = *a as i128 * *d as i128 + *c as i128 * *b as i128;
             return Rational::new(n, *b as i128 * *d as i128).unwrap_or(Rational::ZERO);
         }
-        Rational::from_big(self.big() + o.big())
+        let (x, y) = (self.big(), o.big());
+        if x.is_integer() && y.is_integer() {
+            return Rational::from_bigint(x.numer() + y.numer());
+        }
+        if x.denom() == y.denom() {
+            let n = x.numer() + y.numer();
+            let g = gcd_big(&n, x.denom());
+            if g.is_one() {
+                return Rational::from_big(BigRational::new_raw(n, x.denom().clone()));
+            }
+            return Rational::from_big(BigRational::new_raw(&n / &g, x.denom() / &g));
+        }
+        Rational::from_big(x + y)
     }
     /// Difference.
     pub fn sub(&self, o: &Rational) -> Rational {
@@ -254,7 +297,14 @@ impl Rational {
         if self.is_zero() || o.is_zero() {
             return Rational::ZERO;
         }
-        Rational::from_big(self.big() * o.big())
+        // Cross-cancellation: (a/b)(c/d) = (a/g1)(c/g2) / ((b/g2)(d/g1)), already reduced.
+        let (x, y) = (self.big(), o.big());
+        let g1 = gcd_big(x.numer(), y.denom());
+        let g2 = gcd_big(y.numer(), x.denom());
+        let div = |v: &BigInt, g: &BigInt| if g.is_one() { v.clone() } else { v / g };
+        let n = div(x.numer(), &g1) * div(y.numer(), &g2);
+        let d = div(x.denom(), &g2) * div(y.denom(), &g1);
+        Rational::from_big(BigRational::new_raw(n, d))
     }
     /// Negation (exact: `-i64::MIN` becomes big).
     pub fn neg(&self) -> Rational {
@@ -382,7 +432,11 @@ impl Ord for Rational {
             (Repr::Small(a, b), Repr::Small(c, d)) => {
                 (*a as i128 * *d as i128).cmp(&(*c as i128 * *b as i128))
             }
-            _ => self.big().cmp(&o.big()),
+            _ => {
+                // Cross-multiplication (denominators are positive).
+                let (x, y) = (self.big(), o.big());
+                (x.numer() * y.denom()).cmp(&(y.numer() * x.denom()))
+            }
         }
     }
 }

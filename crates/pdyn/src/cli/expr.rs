@@ -155,13 +155,25 @@ pub fn diff(a: DiffArgs) -> Result<String, Error> {
             }
         }
     };
-    let mut r = v;
-    for _ in 0..a.times {
-        r = r.map(|x| match var {
-            None => pool.dt(x),
-            Some(w) => pool.diff(x, w),
-        });
-    }
+    // Under a budget: `-n 100000` either finds the derivative (periodic or vanishing ones are
+    // cheap) or stops with an error naming the limit, never runs for ever.
+    let budget = |error| Error::Budget {
+        context: format!("diff -n {}", a.times),
+        error,
+    };
+    let r = match v {
+        Value::Scalar(x) => {
+            Value::Scalar(pool.try_derivative_n(x, var, a.times).map_err(budget)?)
+        }
+        Value::Vector(c) => {
+            let mut out = c;
+            for (o, x) in out.iter_mut().zip(c) {
+                *o = pool.try_derivative_n(x, var, a.times).map_err(budget)?;
+            }
+            Value::Vector(out)
+        }
+    };
+    let mut r = r;
     if a.simplify {
         r = r.map(|x| pool.simplify(x));
     }
