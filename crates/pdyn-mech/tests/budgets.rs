@@ -23,11 +23,11 @@ fn fuzz_kin_timeout_polar_angle_finishes() {
         theta,
         z: Pool::ZERO,
     };
-    let start = std::time::Instant::now();
-    let k = analyze(&mut p, motion);
-    eprintln!("analyze: {:?} in {:?}", k.is_ok(), start.elapsed());
+    assert!(analyze(&mut p, motion).is_ok());
     let t = p.time();
     let target = p.parse_scalar("1").unwrap();
     let _ = maximum(&mut p, target, t, Pool::ZERO, Pool::ONE);
-    eprintln!("total {:?}, pool {}", start.elapsed(), p.len());
+    // The work shows in the pool: 2,908 nodes when this test was written (the trig
+    // contraction is bounded; a regression to unbounded rewriting would show here).
+    assert!(p.len() < 20_000, "{} nodes", p.len());
 }
