@@ -16,6 +16,9 @@ pub const MAX_EXPAND_PRODUCTS: usize = 200_000;
 /// Most new expression nodes created by
 /// [`Pool::try_derivative_n`](crate::Pool::try_derivative_n).
 pub const MAX_DERIVATIVE_NODES: usize = 100_000;
+/// Most term views built plus pairs of views compared by one
+/// [`Pool::contract_trig`](crate::Pool::contract_trig).
+pub const MAX_CONTRACT_WORK: usize = 1_000_000;
 
 /// A symbolic operation would exceed its limit.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -32,6 +35,12 @@ pub enum BudgetError {
         /// The derivative being computed when the limit was reached (1 = first).
         order: usize,
         /// The limit on new nodes.
+        limit: usize,
+    },
+    /// Contracting products of sines and cosines into angle sums needed more than `limit`
+    /// comparisons.
+    Contract {
+        /// The limit on views and comparisons.
         limit: usize,
     },
     /// A coefficient of the `order`-th derivative exceeded the size of exact numbers.
@@ -54,6 +63,12 @@ impl fmt::Display for BudgetError {
                 "the derivatives up to order {order} need more than {limit} expression \
                  nodes: differentiate fewer times, or evaluate the derivative numerically (finite differences, \
                  or integrate the equations numerically with `pdyn run`)"
+            ),
+            BudgetError::Contract { limit } => write!(
+                f,
+                "contracting sines and cosines into angle sums needed more than {limit} \
+                 comparisons: the expression is left expanded (it is equal); simplify a \
+                 smaller part, or evaluate numerically"
             ),
             BudgetError::DerivativeNumbers { order } => write!(
                 f,

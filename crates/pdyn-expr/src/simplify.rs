@@ -13,6 +13,7 @@
 //! The candidates (the input, and the rational form with and without trig expansion) are
 //! compared by [`Pool::tree_size`]; ties keep the earlier candidate.
 
+use crate::budget::{BudgetError, MAX_CONTRACT_WORK};
 use crate::number::{Number, Rational};
 use crate::poly::{gcd, Budget, Mono, Poly};
 use crate::pool::{Func, Id, Node, Pool};
@@ -66,24 +67,49 @@ impl Pool {
     /// `R cos a cos b ± R sin a sin b = R cos(a ∓ b)`, `R sin a cos b ± R cos a sin b =
     /// R sin(a ± b)` (the inverse of the expansion used to find cancellations, so that results
     /// read like `cos(theta - phi)` rather than four products).
+    ///
+    /// The search is bounded ([`MAX_CONTRACT_WORK`] term views and view pairs per call): when
+    /// the bound is reached the remaining sums are left as they are (equal, not contracted).
     pub fn contract_trig(&mut self, e: Id) -> Id {
-        self.rewrite(
+        self.contract_trig_counted(e).0
+    }
+
+    /// [`Pool::contract_trig`], or [`BudgetError::Contract`] when the bound was reached.
+    pub fn try_contract_trig(&mut self, e: Id) -> Result<Id, BudgetError> {
+        match self.contract_trig_counted(e) {
+            (r, false) => Ok(r),
+            (_, true) => Err(BudgetError::Contract {
+                limit: MAX_CONTRACT_WORK,
+            }),
+        }
+    }
+
+    /// The contraction and whether the work bound was reached.
+    fn contract_trig_counted(&mut self, e: Id) -> (Id, bool) {
+        let mut work = 0usize;
+        let r = self.rewrite(
             e,
             |_, _| None,
             |p, r| {
-                if matches!(p.node(r), Node::Add(_)) {
-                    p.contract_sum(r)
+                if matches!(p.node(r), Node::Add(_)) && work <= MAX_CONTRACT_WORK {
+                    p.contract_sum(r, &mut work)
                 } else {
                     r
                 }
             },
-        )
+        );
+        (r, work > MAX_CONTRACT_WORK)
     }
 
-    /// One sum: repeatedly merges a matching pair of terms.
-    fn contract_sum(&mut self, s: Id) -> Id {
+    /// One sum: repeatedly merges a matching pair of terms, counting the views built and the
+    /// pairs of views compared in `work` (quadratic in the trig factors per term: a few terms
+    /// with many sines and cosines once stalled here for over 30 s).
+    fn contract_sum(&mut self, s: Id, work: &mut usize) -> Id {
         let mut cur = s;
         for _ in 0..32 {
+            if *work > MAX_CONTRACT_WORK {
+                return cur;
+            }
             let Node::Add(ts) = self.node(cur).clone() else {
                 return cur;
             };
@@ -101,6 +127,11 @@ impl Pool {
                 let trig: Vec<usize> = (0..fs.len())
                     .filter(|&k| matches!(self.node(fs[k]), Node::Call(Func::Sin | Func::Cos, _)))
                     .collect();
+                // Bounded before building: each view costs a product node.
+                *work += trig.len() * trig.len().saturating_sub(1) / 2;
+                if *work > MAX_CONTRACT_WORK {
+                    return cur;
+                }
                 for x in 0..trig.len() {
                     for y in x + 1..trig.len() {
                         let (f1, f2) = (fs[trig[x]], fs[trig[y]]);
@@ -122,6 +153,10 @@ impl Pool {
                         views.push((i, c.clone(), r, k1, a1[0], k2, a2[0]));
                     }
                 }
+            }
+            *work += views.len() + views.len() * views.len() / 2;
+            if *work > MAX_CONTRACT_WORK {
+                return cur;
             }
             let mut merged = None;
             'search: for (x, v) in views.iter().enumerate() {
@@ -551,6 +586,29 @@ mod tests {
                 p.to_text(c)
             );
         }
+    }
+
+    #[test]
+    fn trig_contraction_is_bounded() {
+        let mut p = Pool::new();
+        // 64 terms of 12 trig factors each: 66 pairs per term, 4,224 views, 8.9 million pairs
+        // of views per pass, over the bound: a typed error, and the lenient form returns an
+        // equal expression.
+        let trig: Vec<String> = (0..12)
+            .map(|i| format!("{}(a{i})", if i % 2 == 0 { "cos" } else { "sin" }))
+            .collect();
+        let terms: Vec<String> = (0..64).map(|k| format!("b{k}*{}", trig.join("*"))).collect();
+        let e = p.parse_scalar(&terms.join(" + ")).unwrap();
+        assert_eq!(
+            p.try_contract_trig(e),
+            Err(crate::BudgetError::Contract {
+                limit: crate::budget::MAX_CONTRACT_WORK
+            })
+        );
+        assert_eq!(p.contract_trig(e), e);
+        // Small sums are contracted as before.
+        let e = p.parse_scalar("cos(a)*cos(b) - sin(a)*sin(b)").unwrap();
+        assert_eq!(p.try_contract_trig(e), Ok(p.parse_scalar("cos(a + b)").unwrap()));
     }
 
     #[test]
