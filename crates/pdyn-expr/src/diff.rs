@@ -241,7 +241,10 @@ mod tests {
         // Periodic and fixed-point sequences: found in a few steps, exactly.
         let s = p.parse_scalar("sin(x)").unwrap();
         let d = p.try_derivative_n(s, Some(x), 100_000).unwrap();
-        assert_eq!(d, s, "the 100000th derivative of sin is sin (100000 = 0 mod 4)");
+        assert_eq!(
+            d, s,
+            "the 100000th derivative of sin is sin (100000 = 0 mod 4)"
+        );
         let d = p.try_derivative_n(s, Some(x), 100_001).unwrap();
         assert_eq!(d, p.parse_scalar("cos(x)").unwrap());
         let c = p.parse_scalar("x^3").unwrap();

@@ -44,8 +44,8 @@ pub mod subs;
 pub mod syntax;
 pub mod vector;
 
-pub use compile::Program;
 pub use budget::BudgetError;
+pub use compile::Program;
 pub use error::ExprError;
 pub use lower::{Binding, FreeScope, Scope, Value};
 pub use number::{Number, Rational};

@@ -399,8 +399,7 @@ impl Lowerer<'_> {
                 if let (Some(bn), Some(en)) = (p.as_num(x), p.as_num(y)) {
                     if let (Some(br), Some(er)) = (bn.as_rational(), en.as_rational()) {
                         if p.as_num(r).is_none() && er.is_integer() {
-                            let digits =
-                                er.small().map_or(u64::MAX, |(k, _)| br.pow_digits(k));
+                            let digits = er.small().map_or(u64::MAX, |(k, _)| br.pow_digits(k));
                             return Err(too_large(span, format!("{bn}^{en}"), digits));
                         }
                     }
@@ -577,7 +576,10 @@ mod tests {
         assert_eq!(literal("1.5e-3"), Some(Number::ratio(3, 2000)));
         assert_eq!(literal(".5"), Some(Number::ratio(1, 2)));
         assert_eq!(literal("12"), Some(Number::int(12)));
-        assert_eq!(literal("1e300").map(|n| n.to_string()), Some("1e300".into()));
+        assert_eq!(
+            literal("1e300").map(|n| n.to_string()),
+            Some("1e300".into())
+        );
         assert_eq!(
             literal("1.3806503e-23").map(|n| n.to_f64()),
             Some(1.3806503e-23)

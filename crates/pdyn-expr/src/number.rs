@@ -144,7 +144,6 @@ impl Rational {
         Some(Rational::from_big(BigRational::new_raw(n, BigInt::from(d))))
     }
 
-
     /// The integer `n` of any size.
     pub fn from_bigint(n: BigInt) -> Rational {
         Rational::from_big(BigRational::from_integer(n))
@@ -351,7 +350,9 @@ impl Rational {
             Repr::Small(n, d) => (n.unsigned_abs() as f64).log10() + (*d as f64).log10(),
             Repr::Big(_) => self.bits() as f64 * std::f64::consts::LOG10_2,
         };
-        (log10 * e.unsigned_abs() as f64).ceil().min(u64::MAX as f64) as u64
+        (log10 * e.unsigned_abs() as f64)
+            .ceil()
+            .min(u64::MAX as f64) as u64
     }
     /// Integer power; `None` for `0^negative` or when the result would exceed [`MAX_BITS`]
     /// (checked before computing anything).
@@ -369,7 +370,11 @@ impl Rational {
                 return Some(Rational::ONE);
             }
             if n == -1 {
-                return Some(if e % 2 == 0 { Rational::ONE } else { Rational::MINUS_ONE });
+                return Some(if e % 2 == 0 {
+                    Rational::ONE
+                } else {
+                    Rational::MINUS_ONE
+                });
             }
         }
         let base = if e < 0 { self.recip()? } else { self.clone() };
@@ -718,14 +723,19 @@ mod tests {
         // 2^64 + 1 - 2^64 = 1 exactly.
         let two64 = Number::int(2).pow(&Number::int(64)).unwrap();
         assert_eq!(two64.add(&Number::ONE).add(&two64.neg()), Number::ONE);
-        assert_eq!(Number::int(i64::MIN).neg().to_string(), "9223372036854775808");
+        assert_eq!(
+            Number::int(i64::MIN).neg().to_string(),
+            "9223372036854775808"
+        );
         assert!(matches!(Number::ZERO.recip(), Number::Float(f) if f.is_infinite()));
     }
 
     #[test]
     fn powers_are_exact_within_the_budget() {
         let r = Number::ratio(2, 3).pow(&Number::int(200)).unwrap();
-        let Number::Rat(r) = r else { panic!("not exact") };
+        let Number::Rat(r) = r else {
+            panic!("not exact")
+        };
         assert_eq!(r.numer_big(), num_traits::pow(BigInt::from(2), 200));
         assert_eq!(r.denom_big(), num_traits::pow(BigInt::from(3), 200));
         let p = Number::int(2).pow(&Number::int(100_000)).unwrap();
@@ -733,7 +743,10 @@ mod tests {
         // Over the budget: not computed (and not a float either).
         assert_eq!(Number::int(2).pow(&Number::int(1_000_000)), None);
         assert_eq!(Number::int(10).pow(&Number::int(-200_000)), None);
-        assert_eq!(Number::MINUS_ONE.pow(&Number::int(i64::MAX)), Some(Number::MINUS_ONE));
+        assert_eq!(
+            Number::MINUS_ONE.pow(&Number::int(i64::MAX)),
+            Some(Number::MINUS_ONE)
+        );
         // Exact roots of big values.
         let p2 = Number::int(3).pow(&Number::int(100)).unwrap();
         assert_eq!(
@@ -744,8 +757,11 @@ mod tests {
 
     #[test]
     fn big_values_print_exactly_and_compare() {
-        let k = Rational::from_parts(BigInt::from(13806503), num_traits::pow(BigInt::from(10), 30))
-            .unwrap();
+        let k = Rational::from_parts(
+            BigInt::from(13806503),
+            num_traits::pow(BigInt::from(10), 30),
+        )
+        .unwrap();
         assert_eq!(k.to_string(), "1.3806503e-23");
         assert!((k.to_f64() - 1.3806503e-23).abs() < 1e-37);
         let e30 = Rational::from_bigint(num_traits::pow(BigInt::from(10), 30));

@@ -332,7 +332,9 @@ impl RationalForm {
             }
             Node::Pow(b, x) => {
                 // Exponents past i64 are treated like symbolic ones: an atom.
-                let r = p.as_num(x).and_then(|n| n.as_rational().and_then(|r| r.small()));
+                let r = p
+                    .as_num(x)
+                    .and_then(|n| n.as_rational().and_then(|r| r.small()));
                 match r {
                     Some((num, 1)) => {
                         let base = self.convert(p, b)?;
@@ -597,7 +599,9 @@ mod tests {
         let trig: Vec<String> = (0..12)
             .map(|i| format!("{}(a{i})", if i % 2 == 0 { "cos" } else { "sin" }))
             .collect();
-        let terms: Vec<String> = (0..64).map(|k| format!("b{k}*{}", trig.join("*"))).collect();
+        let terms: Vec<String> = (0..64)
+            .map(|k| format!("b{k}*{}", trig.join("*")))
+            .collect();
         let e = p.parse_scalar(&terms.join(" + ")).unwrap();
         assert_eq!(
             p.try_contract_trig(e),
@@ -608,7 +612,10 @@ mod tests {
         assert_eq!(p.contract_trig(e), e);
         // Small sums are contracted as before.
         let e = p.parse_scalar("cos(a)*cos(b) - sin(a)*sin(b)").unwrap();
-        assert_eq!(p.try_contract_trig(e), Ok(p.parse_scalar("cos(a + b)").unwrap()));
+        assert_eq!(
+            p.try_contract_trig(e),
+            Ok(p.parse_scalar("cos(a + b)").unwrap())
+        );
     }
 
     #[test]

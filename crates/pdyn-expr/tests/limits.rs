@@ -30,7 +30,13 @@ fn numbers_past_64_bits_stay_exact() {
 #[test]
 fn numbers_over_the_budget_are_refused_with_the_limit() {
     let mut p = Pool::new();
-    for src in ["2^1000000", "(3/7)^-400000", "2^300000*2^300000", "1e200000", "10^99999999999999999999"] {
+    for src in [
+        "2^1000000",
+        "(3/7)^-400000",
+        "2^300000*2^300000",
+        "1e200000",
+        "10^99999999999999999999",
+    ] {
         let err = p.parse_scalar(src).expect_err(src);
         assert!(
             err.message.contains("100000 digits"),
@@ -67,15 +73,21 @@ fn long_sums_and_products_are_near_linear_and_shallow() {
         let back = p.to_text(s);
         assert_eq!(p.parse_scalar(&back).unwrap(), s);
         // Differences and long products keep their meaning when built as balanced trees.
-        let d = p.parse_scalar(&format!("{} - a0", src.join(" - "))).unwrap();
+        let d = p
+            .parse_scalar(&format!("{} - a0", src.join(" - ")))
+            .unwrap();
         // a0 - a1 - ... - a19999 - a0 = -(a1 + ... + a19999)
         let expected = {
             let rest = p.parse_scalar(&src[1..].join(" + ")).unwrap();
             p.neg(rest)
         };
         assert_eq!(d, expected);
-        let q = p.parse_scalar(&format!("x*{}/y/z", src[..5000].join("*"))).unwrap();
-        let r = p.parse_scalar(&format!("x/y*{}/z", src[..5000].join("*"))).unwrap();
+        let q = p
+            .parse_scalar(&format!("x*{}/y/z", src[..5000].join("*")))
+            .unwrap();
+        let r = p
+            .parse_scalar(&format!("x/y*{}/z", src[..5000].join("*")))
+            .unwrap();
         assert_eq!(q, r);
     });
 }

@@ -265,7 +265,10 @@ fn expansion_is_complete_or_a_budget_error() {
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(v["error"]["kind"], "budget");
     assert_eq!(v["error"]["exit_code"], 2);
-    assert!(v["error"]["message"].as_str().unwrap().contains("5000 terms"));
+    assert!(v["error"]["message"]
+        .as_str()
+        .unwrap()
+        .contains("5000 terms"));
 }
 
 #[test]

@@ -162,9 +162,7 @@ pub fn diff(a: DiffArgs) -> Result<String, Error> {
         error,
     };
     let r = match v {
-        Value::Scalar(x) => {
-            Value::Scalar(pool.try_derivative_n(x, var, a.times).map_err(budget)?)
-        }
+        Value::Scalar(x) => Value::Scalar(pool.try_derivative_n(x, var, a.times).map_err(budget)?),
         Value::Vector(c) => {
             let mut out = c;
             for (o, x) in out.iter_mut().zip(c) {
