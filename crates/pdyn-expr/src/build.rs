@@ -55,10 +55,10 @@ impl Pool {
     /// Splits a term into numeric coefficient and the rest: `3*x*y -> (3, x*y)`.
     pub fn split_coeff(&mut self, t: Id) -> (Number, Id) {
         match self.node(t) {
-            Node::Num(n) => (*n, Pool::ONE),
+            Node::Num(n) => (n.clone(), Pool::ONE),
             Node::Mul(fs) => {
                 if let Node::Num(c) = self.node(fs[0]) {
-                    let c = *c;
+                    let c = c.clone();
                     let rest: Vec<Id> = fs[1..].to_vec();
                     let rest = if rest.len() == 1 {
                         rest[0]
@@ -89,11 +89,11 @@ impl Pool {
         while let Some(t) = stack.pop() {
             match self.node(t) {
                 Node::Add(ts) => stack.extend(ts.iter().rev().copied()),
-                Node::Num(n) => constant = constant.add(*n),
+                Node::Num(n) => constant = constant.add(n),
                 _ => {
                     let (c, rest) = self.split_coeff(t);
                     match coeffs.get_mut(&rest) {
-                        Some(acc) => *acc = acc.add(c),
+                        Some(acc) => *acc = acc.add(&c),
                         None => {
                             coeffs.insert(rest, c);
                             order.push(rest);
@@ -104,7 +104,7 @@ impl Pool {
         }
         let mut out: Vec<Id> = Vec::with_capacity(order.len() + 1);
         for rest in order {
-            let c = coeffs[&rest];
+            let c = coeffs.remove(&rest).unwrap_or(Number::ZERO);
             if !c.is_zero() {
                 let term = self.scale_term(c, rest);
                 out.push(term);
@@ -155,13 +155,13 @@ impl Pool {
                     continue;
                 }
                 Node::Num(n) => {
-                    coeff = coeff.mul(*n);
+                    coeff = coeff.mul(n);
                     continue;
                 }
                 Node::Pow(b, e) => (*b, *e),
                 Node::Add(_) => match self.add_content(f) {
                     Some((c, prim)) => {
-                        coeff = coeff.mul(c);
+                        coeff = coeff.mul(&c);
                         (prim, Pool::ONE)
                     }
                     None => (f, Pool::ONE),
@@ -197,7 +197,7 @@ impl Pool {
                 self.pow(b, e)
             };
             match self.node(p) {
-                Node::Num(n) => coeff = coeff.mul(*n),
+                Node::Num(n) => coeff = coeff.mul(n),
                 Node::Mul(_) => {
                     reflatten = true;
                     out.push(p)
@@ -232,7 +232,7 @@ impl Pool {
                     .into_iter()
                     .map(|t| {
                         let (c, rest) = self.split_coeff(t);
-                        let nc = c.mul(coeff);
+                        let nc = c.mul(&coeff);
                         if rest == Pool::ONE {
                             self.num(nc)
                         } else {
@@ -261,24 +261,26 @@ impl Pool {
         let en = self.as_num(e);
         match (self.node(b).clone(), en) {
             (Node::Num(x), Some(y)) => {
-                if let Some(r) = x.pow(y) {
+                if let Some(r) = x.pow(&y) {
                     return self.num(r);
                 }
                 // Exact base, fractional exponent without exact root: 2^(3/2) = 2*2^(1/2).
-                if let (Some(xr), Some(yr)) = (x.as_rational(), y.as_rational()) {
-                    let (p, q) = (yr.numer(), yr.denom());
+                let exponent = y.as_rational().and_then(|r| r.small());
+                if let (Some(xr), Some((p, q))) = (x.as_rational(), exponent) {
                     let whole = p.div_euclid(q);
                     let frac = p.rem_euclid(q);
-                    if whole != 0 && xr.numer() > 0 {
-                        let w = self.num(
-                            x.pow(Number::int(whole))
-                                .unwrap_or(Number::Float(x.to_f64().powf(whole as f64))),
-                        );
-                        let fe = self.num(Number::ratio(frac, q));
-                        let fp = self.intern(Node::Pow(b, fe));
-                        return self.mul(&[w, fp]);
+                    if q != 1 && whole != 0 && xr.signum() > 0 {
+                        // `None` when the whole part is over the size budget of exact numbers:
+                        // then the power stays as written, exact, never a silent float.
+                        if let Some(w) = x.pow(&Number::int(whole)) {
+                            let w = self.num(w);
+                            let fe = self.num(Number::ratio(frac, q));
+                            let fp = self.intern(Node::Pow(b, fe));
+                            return self.mul(&[w, fp]);
+                        }
                     }
                 }
+                // An integer power over the size budget (2^1000000) also stays symbolic.
                 self.intern(Node::Pow(b, e))
             }
             (Node::Const(Constant::E), _) => self.call(Func::Exp, &[e]),
@@ -302,7 +304,7 @@ impl Pool {
                     return self.pow(b2, ne);
                 }
                 if let Some(n) = self.as_num(e2).and_then(|n| n.as_integer()) {
-                    let prod = Number::int(n).mul(y);
+                    let prod = Number::int(n).mul(&y);
                     if n % 2 == 0 && prod.as_integer().is_some() {
                         // sqrt(x^2) = |x| for real x.
                         let a = self.call(Func::Abs, &[b2]);
@@ -363,26 +365,29 @@ impl Pool {
         let mut parts = Vec::with_capacity(ts.len());
         for &t in &ts {
             let (c, rest) = self.split_coeff(t);
-            let r = c.as_rational()?;
+            // Sums with big coefficients are left as they are (a normalisation, not needed
+            // for correctness; the machine-integer gcd keeps the common case cheap).
+            let r = c.as_rational()?.clone();
+            let (n, d) = r.small()?;
             if rest != Pool::ONE && sign_neg.is_none() {
-                sign_neg = Some(r.numer() < 0);
+                sign_neg = Some(n < 0);
             }
-            num_gcd = gcd_i64(num_gcd, r.numer());
-            let g = gcd_i64(den_lcm, r.denom());
-            den_lcm = (den_lcm / g).checked_mul(r.denom())?;
+            num_gcd = gcd_i64(num_gcd, n);
+            let g = gcd_i64(den_lcm, d);
+            den_lcm = (den_lcm / g).checked_mul(d)?;
             parts.push((r, rest));
         }
         let mut content = crate::number::Rational::new(num_gcd as i128, den_lcm as i128)?;
         if sign_neg == Some(true) {
-            content = content.checked_neg()?;
+            content = content.neg();
         }
-        if content == crate::number::Rational::ONE || content.numer() == 0 {
+        if content == crate::number::Rational::ONE || content.is_zero() {
             return None;
         }
         let inv = content.recip()?;
         let mut terms = Vec::with_capacity(parts.len());
         for (r, rest) in parts {
-            let c = Number::Rat(r.checked_mul(inv)?);
+            let c = Number::Rat(r.mul(&inv));
             terms.push(if rest == Pool::ONE {
                 self.num(c)
             } else {
@@ -438,7 +443,7 @@ impl Pool {
         match self.node(id) {
             Node::Const(Constant::Pi) => Some(crate::number::Rational::ONE),
             Node::Mul(fs) if fs.len() == 2 => {
-                let c = self.as_num(fs[0])?.as_rational()?;
+                let c = self.as_num(fs[0])?.as_rational()?.clone();
                 matches!(self.node(fs[1]), Node::Const(Constant::Pi)).then_some(c)
             }
             _ => None,
@@ -465,8 +470,9 @@ impl Pool {
                 if let Some(k) = self.pi_multiple(u) {
                     match f {
                         Func::Sin | Func::Tan if k.is_integer() => return Pool::ZERO,
-                        Func::Sin if k.denom() == 2 => {
-                            let s = if k.numer().rem_euclid(4) == 1 { 1 } else { -1 };
+                        Func::Sin if k.small().is_some_and(|(_, d)| d == 2) => {
+                            let n = k.small().map_or(1, |(n, _)| n);
+                            let s = if n.rem_euclid(4) == 1 { 1 } else { -1 };
                             return self.int(s);
                         }
                         _ => {}
@@ -484,9 +490,10 @@ impl Pool {
                 if f == Func::Cos {
                     if let Some(k) = self.pi_multiple(u) {
                         if k.is_integer() {
-                            return self.int(if k.numer() % 2 == 0 { 1 } else { -1 });
+                            let even = k.mul(&crate::number::Rational::HALF).is_integer();
+                            return self.int(if even { 1 } else { -1 });
                         }
-                        if k.denom() == 2 {
+                        if k.small().is_some_and(|(_, d)| d == 2) {
                             return Pool::ZERO;
                         }
                     }
@@ -557,7 +564,7 @@ impl Pool {
                     return u;
                 }
                 if let (Some(a), Some(b)) = (self.as_num(u), self.as_num(v)) {
-                    let a_smaller = a.total_cmp(b).is_le();
+                    let a_smaller = a.total_cmp(&b).is_le();
                     return if (f == Func::Min) == a_smaller { u } else { v };
                 }
                 // Commutative: order the arguments canonically.

@@ -305,11 +305,11 @@ impl Compiler<'_> {
                 }
             });
         }
-        if let Some(r) = x.as_rational() {
-            if r.denom() == 2 {
+        if let Some((n, 2)) = x.as_rational().and_then(|r| r.small()) {
+            {
                 // b^(k/2) = sqrt(b) * b^((k-1)/2)
                 let s = self.emit(Op::Sqrt, bv, 0);
-                let whole = (r.numer() - 1) / 2;
+                let whole = (n - 1) / 2;
                 if whole == 0 {
                     return Ok(s);
                 }

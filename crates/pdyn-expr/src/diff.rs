@@ -6,8 +6,10 @@
 //! and the usual rules combine them. Results are memoised per pool, so differentiating a
 //! shared subexpression twice costs nothing.
 
-use crate::number::Number;
+use crate::budget::{BudgetError, MAX_DERIVATIVE_NODES};
+use crate::number::{Number, MAX_BITS};
 use crate::pool::{Func, Id, Node, Pool};
+use rustc_hash::FxHashMap;
 
 impl Pool {
     /// Total time derivative `d/dt`.
@@ -18,6 +20,52 @@ impl Pool {
     /// `k`-th total time derivative.
     pub fn dt_n(&mut self, e: Id, k: usize) -> Id {
         (0..k).fold(e, |acc, _| self.dt(acc))
+    }
+
+    /// The `n`-th derivative of `e`, in time (`var = None`) or with respect to the leaf `var`,
+    /// under a budget: at most [`MAX_DERIVATIVE_NODES`] new nodes in all, and coefficients
+    /// within the size of exact numbers. Repetition is detected, so `sin(x)` or `exp(t)`
+    /// differentiated 100,000 times costs a few steps.
+    pub fn try_derivative_n(
+        &mut self,
+        e: Id,
+        var: Option<Id>,
+        n: usize,
+    ) -> Result<Id, BudgetError> {
+        let start = self.len();
+        // Each derivative seen, with its order: a repeat means the sequence is periodic from
+        // there on (sin → cos → -sin → -cos → sin; exp → exp; 0 → 0).
+        let mut seen: FxHashMap<Id, usize> = FxHashMap::default();
+        let mut history = vec![e];
+        seen.insert(e, 0);
+        let mut cur = e;
+        for k in 1..=n {
+            let before = self.len();
+            cur = match var {
+                None => self.dt(cur),
+                Some(v) => self.diff(cur, v),
+            };
+            if self.len() - start > MAX_DERIVATIVE_NODES {
+                return Err(BudgetError::DerivativeSize {
+                    order: k,
+                    limit: MAX_DERIVATIVE_NODES,
+                });
+            }
+            // Only nodes created by this step can hold new coefficients.
+            let too_big = (before..self.len()).any(|i| {
+                matches!(self.node(Id(i as u32)), Node::Num(Number::Rat(r)) if r.bits() > MAX_BITS)
+            });
+            if too_big {
+                return Err(BudgetError::DerivativeNumbers { order: k });
+            }
+            if let Some(&j) = seen.get(&cur) {
+                let period = k - j;
+                return Ok(history[j + (n - j) % period]);
+            }
+            seen.insert(cur, k);
+            history.push(cur);
+        }
+        Ok(cur)
     }
 
     /// Partial derivative with respect to the leaf `var` (a symbol, a coordinate or one of its
@@ -183,6 +231,45 @@ impl Pool {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn high_order_derivatives_are_bounded() {
+        use crate::budget::BudgetError;
+        use crate::pool::Pool;
+        let mut p = Pool::new();
+        let x = p.var("x");
+        // Periodic and fixed-point sequences: found in a few steps, exactly.
+        let s = p.parse_scalar("sin(x)").unwrap();
+        let d = p.try_derivative_n(s, Some(x), 100_000).unwrap();
+        assert_eq!(
+            d, s,
+            "the 100000th derivative of sin is sin (100000 = 0 mod 4)"
+        );
+        let d = p.try_derivative_n(s, Some(x), 100_001).unwrap();
+        assert_eq!(d, p.parse_scalar("cos(x)").unwrap());
+        let c = p.parse_scalar("x^3").unwrap();
+        assert_eq!(p.try_derivative_n(c, Some(x), 100_000), Ok(Pool::ZERO));
+        // Growing coefficients: (10^40)^k passes 100,000 digits at k = 2,500.
+        let big = p.parse_scalar("x^(10^40)").unwrap();
+        assert_eq!(
+            p.try_derivative_n(big, Some(x), 100_000),
+            Err(BudgetError::DerivativeNumbers { order: 2_500 })
+        );
+        // Growing expressions: the k-th derivative of exp(x^2) has about k terms.
+        let g = p.parse_scalar("exp(x^2)*sin(x^3)").unwrap();
+        assert!(matches!(
+            p.try_derivative_n(g, Some(x), 100_000),
+            Err(BudgetError::DerivativeSize { .. })
+        ));
+        // Within the budget, the same as repeated differentiation.
+        let f = p.parse_scalar("x^2*sin(x)").unwrap();
+        let mut r = f;
+        for _ in 0..5 {
+            r = p.diff(r, x);
+        }
+        assert_eq!(p.try_derivative_n(f, Some(x), 5), Ok(r));
+    }
+
     use crate::pool::Pool;
 
     #[test]

@@ -24,6 +24,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod budget;
 pub mod build;
 pub mod compile;
 mod constant;
@@ -43,6 +44,7 @@ pub mod subs;
 pub mod syntax;
 pub mod vector;
 
+pub use budget::BudgetError;
 pub use compile::Program;
 pub use error::ExprError;
 pub use lower::{Binding, FreeScope, Scope, Value};

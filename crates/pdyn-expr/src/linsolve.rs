@@ -81,7 +81,11 @@ impl std::fmt::Display for LinearError {
             LinearError::Inconsistent { equation } => {
                 write!(f, "equation {} contradicts the others", equation + 1)
             }
-            LinearError::TooLarge => write!(f, "system too large to solve symbolically"),
+            LinearError::TooLarge => write!(
+                f,
+                "system too large to solve symbolically (over the work budget of exact \
+                 elimination): solve it numerically instead"
+            ),
         }
     }
 }

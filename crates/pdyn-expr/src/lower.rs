@@ -137,39 +137,60 @@ impl Scope for FreeScope {
 
 const VECTOR_FUNCS: [&str; 5] = ["dot", "cross", "norm", "unit", "sqrt"];
 
-/// Converts a numeric literal exactly (falls back to `f64` for huge exponents or mantissas).
+/// Converts a numeric literal exactly (`1.3806503e-23` is `13806503/10^30`); `None` when it
+/// is not a number or its exact value would exceed the size budget of exact numbers
+/// ([`crate::number::MAX_DIGITS`] digits, e.g. `1e200000`).
 pub fn literal(text: &str) -> Option<Number> {
     let (mant, exp) = match text.find(['e', 'E']) {
-        Some(i) => (&text[..i], text[i + 1..].parse::<i32>().ok()?),
+        Some(i) => (&text[..i], text[i + 1..].parse::<i64>().ok()?),
         None => (text, 0),
     };
     let (int, frac) = match mant.find('.') {
         Some(i) => (&mant[..i], &mant[i + 1..]),
         None => (mant, ""),
     };
+    if !(int.bytes().chain(frac.bytes())).all(|c| c.is_ascii_digit()) || int.len() + frac.len() == 0
+    {
+        return None;
+    }
     let digits = format!("{int}{frac}");
-    let exp10 = exp as i64 - frac.len() as i64;
-    let exact = (|| {
+    let exp10 = exp.checked_sub(frac.len() as i64)?;
+    // Checked before building anything: `1e99999999` must not allocate a billion digits.
+    if exp10.unsigned_abs() + digits.len() as u64 > crate::number::MAX_DIGITS {
+        return None;
+    }
+    // Fast path: everything fits i128.
+    if digits.len() <= 18 && exp10.abs() <= 18 {
         let m: i128 = digits.parse().ok()?;
-        if exp10.abs() > 36 {
-            return None;
-        }
-        let p = 10i128.checked_pow(exp10.unsigned_abs() as u32)?;
-        if exp10 >= 0 {
-            Rational::new(m.checked_mul(p)?, 1)
+        let p = 10i128.pow(exp10.unsigned_abs() as u32);
+        let r = if exp10 >= 0 {
+            Rational::new(m * p, 1)
         } else {
             Rational::new(m, p)
-        }
-    })();
-    match exact {
-        Some(r) => Some(Number::Rat(r)),
-        None => text.parse::<f64>().ok().map(Number::Float),
+        };
+        return r.map(Number::Rat);
     }
+    let m: num_bigint::BigInt = digits.parse().ok()?;
+    let p = num_bigint::BigInt::from(10).pow(u32::try_from(exp10.unsigned_abs()).ok()?);
+    let r = if exp10 >= 0 {
+        Rational::from_parts(m * p, 1.into())
+    } else {
+        Rational::from_parts(m, p)
+    };
+    r.map(Number::Rat)
 }
 
 /// Lowers a parsed expression into `pool`, resolving names through `scope`.
 pub fn lower(pool: &mut Pool, ast: &Ast, scope: &mut dyn Scope) -> Result<Value, ExprError> {
     Lowerer { pool, scope }.value(ast)
+}
+
+fn too_large(span: Range<usize>, what: String, digits: u64) -> ExprError {
+    let e = crate::number::NumberTooLarge { what, digits };
+    ExprError::new(span, e.to_string()).with_help(
+        "pdyn keeps numbers exact: rescale the quantity (other units), or make the base a \
+         parameter so that the power stays symbolic until it is evaluated",
+    )
 }
 
 struct Lowerer<'a> {
@@ -182,7 +203,15 @@ impl Lowerer<'_> {
         match ast {
             Ast::Num { text, span } => {
                 let n = literal(text).ok_or_else(|| {
-                    ExprError::new(span.clone(), format!("invalid number `{text}`"))
+                    let message = if text.parse::<f64>().is_ok() {
+                        format!(
+                            "number `{text}` is too large for exact arithmetic (over {} digits)",
+                            crate::number::MAX_DIGITS
+                        )
+                    } else {
+                        format!("invalid number `{text}`")
+                    };
+                    ExprError::new(span.clone(), message)
                 })?;
                 Ok(Value::Scalar(self.pool.num(n)))
             }
@@ -191,11 +220,19 @@ impl Lowerer<'_> {
                 let v = self.value(expr)?;
                 Ok(v.map(|x| self.pool.neg(x)))
             }
-            Ast::Binary { op, lhs, rhs, span } => {
-                let a = self.value(lhs)?;
-                let b = self.value(rhs)?;
-                self.binary(*op, a, b, span.clone(), lhs.span(), rhs.span())
+            Ast::Binary {
+                op: BinOp::Add | BinOp::Sub,
+                ..
+            } => {
+                // A sum is built with one call to `add` over all its terms: pairwise, each
+                // `+` would re-flatten and re-sort the sum so far (quadratic: a 20,000-term
+                // sum took 38 s).
+                if let Some(v) = self.sum(ast)? {
+                    return Ok(v);
+                }
+                self.binary_ast(ast)
             }
+            Ast::Binary { .. } => self.binary_ast(ast),
             Ast::Call {
                 name,
                 name_span,
@@ -275,6 +312,50 @@ impl Lowerer<'_> {
         Err(err)
     }
 
+    /// A `Binary` node lowered from its two sides.
+    fn binary_ast(&mut self, ast: &Ast) -> Result<Value, ExprError> {
+        let Ast::Binary { op, lhs, rhs, span } = ast else {
+            return self.value(ast);
+        };
+        let a = self.value(lhs)?;
+        let b = self.value(rhs)?;
+        self.binary(*op, a, b, span.clone(), lhs.span(), rhs.span())
+    }
+
+    /// The whole tree of `+` and `-` under `ast` as one canonical sum, when every term is a
+    /// scalar; `None` otherwise (vectors and shape errors take the pairwise path).
+    fn sum(&mut self, ast: &Ast) -> Result<Option<Value>, ExprError> {
+        let mut terms = Vec::new();
+        let mut stack = vec![(ast, false)];
+        while let Some((a, negated)) = stack.pop() {
+            match a {
+                Ast::Binary {
+                    op: op @ (BinOp::Add | BinOp::Sub),
+                    lhs,
+                    rhs,
+                    ..
+                } => {
+                    // Right first so that terms come out in source order.
+                    stack.push((rhs, negated != (*op == BinOp::Sub)));
+                    stack.push((lhs, negated));
+                }
+                _ => match self.value(a)? {
+                    Value::Scalar(x) if negated => terms.push(self.pool.neg(x)),
+                    Value::Scalar(x) => terms.push(x),
+                    Value::Vector(_) => return Ok(None),
+                },
+            }
+        }
+        let r = self.pool.add(&terms);
+        if let Some(crate::number::Number::Rat(q)) = self.pool.as_num(r) {
+            if q.bits() > crate::number::MAX_BITS {
+                let digits = crate::number::bits_to_digits(q.bits());
+                return Err(too_large(ast.span(), "this sum".into(), digits));
+            }
+        }
+        Ok(Some(Value::Scalar(r)))
+    }
+
     fn binary(
         &mut self,
         op: BinOp,
@@ -311,7 +392,20 @@ impl Lowerer<'_> {
                 return Err(ExprError::new(rspan, "cannot divide by a vector")
                     .with_help("divide by a scalar such as norm(v)"))
             }
-            (BinOp::Pow, S(x), S(y)) => S(p.pow(x, y)),
+            (BinOp::Pow, S(x), S(y)) => {
+                let r = p.pow(x, y);
+                // An exact power over the size budget stays symbolic in the pool (`pow` has no
+                // error path); here, where the user wrote it, it is refused with the limit.
+                if let (Some(bn), Some(en)) = (p.as_num(x), p.as_num(y)) {
+                    if let (Some(br), Some(er)) = (bn.as_rational(), en.as_rational()) {
+                        if p.as_num(r).is_none() && er.is_integer() {
+                            let digits = er.small().map_or(u64::MAX, |(k, _)| br.pow_digits(k));
+                            return Err(too_large(span, format!("{bn}^{en}"), digits));
+                        }
+                    }
+                }
+                S(r)
+            }
             (BinOp::Pow, V(_), _) => {
                 return Err(ExprError::new(lspan, "cannot raise a vector to a power")
                     .with_help("use dot(v, v) for the squared length"))
@@ -320,6 +414,15 @@ impl Lowerer<'_> {
                 return Err(ExprError::new(rspan, "an exponent must be a scalar"))
             }
         };
+        // Products of big literals grow too (`2^300000 * 2^300000`).
+        if let S(x) = r {
+            if let Some(crate::number::Number::Rat(q)) = p.as_num(x) {
+                if q.bits() > crate::number::MAX_BITS {
+                    let digits = crate::number::bits_to_digits(q.bits());
+                    return Err(too_large(span, "this expression".into(), digits));
+                }
+            }
+        }
         Ok(r)
     }
 
@@ -473,7 +576,16 @@ mod tests {
         assert_eq!(literal("1.5e-3"), Some(Number::ratio(3, 2000)));
         assert_eq!(literal(".5"), Some(Number::ratio(1, 2)));
         assert_eq!(literal("12"), Some(Number::int(12)));
-        assert!(matches!(literal("1e300"), Some(Number::Float(_))));
+        assert_eq!(
+            literal("1e300").map(|n| n.to_string()),
+            Some("1e300".into())
+        );
+        assert_eq!(
+            literal("1.3806503e-23").map(|n| n.to_f64()),
+            Some(1.3806503e-23)
+        );
+        assert_eq!(literal("1e200000"), None);
+        assert_eq!(literal("1e-99999999999"), None);
     }
 
     #[test]

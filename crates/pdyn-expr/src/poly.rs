@@ -103,13 +103,13 @@ impl Poly {
     pub fn as_constant(&self) -> Option<Rational> {
         match self.terms.len() {
             0 => Some(Rational::ZERO),
-            1 => self.terms.get(&Vec::new()).copied(),
+            1 => self.terms.get(&Vec::new()).cloned(),
             _ => None,
         }
     }
     /// Leading (monomial, coefficient) in lex order.
     pub fn leading(&self) -> Option<(&Mono, Rational)> {
-        self.terms.iter().next_back().map(|(m, c)| (m, *c))
+        self.terms.iter().next_back().map(|(m, c)| (m, c.clone()))
     }
 
     fn add_term(&mut self, m: Mono, c: Rational) -> Option<()> {
@@ -118,7 +118,7 @@ impl Poly {
         }
         match self.terms.get_mut(&m) {
             Some(x) => {
-                let s = x.checked_add(c)?;
+                let s = x.checked_add(&c)?;
                 if s == Rational::ZERO {
                     self.terms.remove(&m);
                 } else {
@@ -137,7 +137,7 @@ impl Poly {
         b.spend(self.terms.len() + other.terms.len())?;
         let mut out = self.clone();
         for (m, c) in &other.terms {
-            out.add_term(m.clone(), c.checked_mul(k)?)?;
+            out.add_term(m.clone(), c.checked_mul(&k)?)?;
         }
         Some(out)
     }
@@ -155,7 +155,7 @@ impl Poly {
         let mut out = Poly::zero();
         for (m1, c1) in &self.terms {
             for (m2, c2) in &o.terms {
-                out.add_term(mono_mul(m1, m2)?, c1.checked_mul(*c2)?)?;
+                out.add_term(mono_mul(m1, m2)?, c1.checked_mul(c2)?)?;
             }
         }
         Some(out)
@@ -165,7 +165,7 @@ impl Poly {
         b.spend(self.terms.len())?;
         let mut out = Poly::zero();
         for (m1, c1) in &self.terms {
-            out.add_term(mono_mul(m1, m)?, c1.checked_mul(c)?)?;
+            out.add_term(mono_mul(m1, m)?, c1.checked_mul(&c)?)?;
         }
         Some(out)
     }
@@ -187,8 +187,8 @@ impl Poly {
         let mut q = Poly::zero();
         while let Some((rm, rc)) = r.leading() {
             let m = mono_div(rm, &dm)?;
-            let c = rc.checked_mul(inv)?;
-            q.add_term(m.clone(), c)?;
+            let c = rc.checked_mul(&inv)?;
+            q.add_term(m.clone(), c.clone())?;
             let sub = d.mul_term(&m, c, b)?;
             r = r.sub(&sub, b)?;
         }
@@ -218,7 +218,7 @@ impl Poly {
         for (m, c) in &self.terms {
             if deg_in(m, v) == k {
                 let rest: Mono = m.iter().copied().filter(|&(w, _)| w != v).collect();
-                out.terms.insert(rest, *c);
+                out.terms.insert(rest, c.clone());
             }
         }
         out
@@ -231,7 +231,7 @@ impl Poly {
         }
         let mut out = Poly::zero();
         for (m, c) in &self.terms {
-            out.terms.insert(mono_mul(m, &vec![(v, k)])?, *c);
+            out.terms.insert(mono_mul(m, &vec![(v, k)])?, c.clone());
         }
         Some(out)
     }
@@ -242,7 +242,7 @@ impl Poly {
         let inv = lc.recip()?;
         let mut out = Poly::zero();
         for (m, c) in &self.terms {
-            out.terms.insert(m.clone(), c.checked_mul(inv)?);
+            out.terms.insert(m.clone(), c.checked_mul(&inv)?);
         }
         Some(out)
     }

@@ -298,7 +298,7 @@ impl Pool {
     /// The number, when `id` is a numeric constant.
     pub fn as_num(&self, id: Id) -> Option<Number> {
         match self.node(id) {
-            Node::Num(n) => Some(*n),
+            Node::Num(n) => Some(n.clone()),
             _ => None,
         }
     }
@@ -494,7 +494,7 @@ impl Pool {
             return r;
         }
         match (na, nb) {
-            (Node::Num(x), Node::Num(y)) => x.total_cmp(*y),
+            (Node::Num(x), Node::Num(y)) => x.total_cmp(y),
             (Node::Const(x), Node::Const(y)) => x.cmp(y),
             (Node::Sym(x), Node::Sym(y)) => self.name(*x).cmp(self.name(*y)),
             (Node::Coord(x, i), Node::Coord(y, j)) => {

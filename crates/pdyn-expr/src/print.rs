@@ -8,7 +8,7 @@ use crate::number::Number;
 use crate::pool::{Constant, Func, Id, Node, Pool};
 
 /// One factor of a product as printed.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 enum Factor {
     Number(Number),
     /// `base^exp` with `exp` a positive number (1 for a bare base).
@@ -46,15 +46,23 @@ fn fraction(p: &Pool, id: Id) -> Fraction {
                     f.negative = !f.negative;
                     n.neg()
                 } else {
-                    *n
+                    n.clone()
                 };
-                match n {
+                match &n {
+                    // A big value with a short exact decimal form prints as one number
+                    // (`1.3806503e-23`, not thirty zeros under a fraction bar).
+                    Number::Rat(r) if r.small().is_none() && n.to_string().contains('e') => {
+                        f.num.push(Factor::Number(n))
+                    }
                     Number::Rat(r) => {
-                        if r.numer() != 1 {
-                            f.num.push(Factor::Number(Number::int(r.numer())));
+                        let (num, den) = (r.numer_big(), r.denom_big());
+                        if num != 1.into() {
+                            let k = crate::number::Rational::from_bigint(num);
+                            f.num.push(Factor::Number(Number::Rat(k)));
                         }
-                        if r.denom() != 1 {
-                            f.den.push(Factor::Number(Number::int(r.denom())));
+                        if den != 1.into() {
+                            let k = crate::number::Rational::from_bigint(den);
+                            f.den.push(Factor::Number(Number::Rat(k)));
                         }
                     }
                     Number::Float(_) => f.num.push(Factor::Number(n)),
@@ -222,7 +230,7 @@ impl TextPrinter<'_> {
                         _ => format!("sqrt({n}/({}))", list(db)),
                     }
                 }
-                _ => self.factor(*f),
+                _ => self.factor(f.clone()),
             })
             .collect();
         parts.join("*")
@@ -236,7 +244,7 @@ impl TextPrinter<'_> {
             Factor::Power(b, e) if e == Number::ratio(1, 2) => format!("sqrt({})", self.expr(b)),
             Factor::Power(b, e) => {
                 let es = match e {
-                    Number::Rat(r) if r.is_integer() => e.to_string(),
+                    Number::Rat(ref r) if r.is_integer() => e.to_string(),
                     _ => format!("({e})"),
                 };
                 format!("{}^{es}", self.wrap(b, 4))
@@ -434,7 +442,7 @@ impl LatexPrinter<'_> {
                         format!("\\sqrt{{\\frac{{{n}}}{{{}}}}}", list(db))
                     }
                 }
-                _ => self.factor(*f),
+                _ => self.factor(f.clone()),
             };
             if i > 0 {
                 s += if part.starts_with(|c: char| c.is_ascii_digit()) {
@@ -458,10 +466,15 @@ impl LatexPrinter<'_> {
             }
         };
         match f {
-            Factor::Number(n) => match n {
-                Number::Float(x) => format!("{x:e}").replace('e', " \\times 10^{") + "}",
-                _ => n.to_string(),
-            },
+            Factor::Number(n) => {
+                let s = n.to_string();
+                if s.contains('e') && !s.contains('/') {
+                    // A float, or an exact decimal printed in e notation.
+                    s.replace('e', " \\times 10^{") + "}"
+                } else {
+                    s
+                }
+            }
             Factor::Power(b, e) if e.is_one() => {
                 if precedence(p, b) >= 3 && !p.looks_negative(b) {
                     self.expr(b)
@@ -475,7 +488,7 @@ impl LatexPrinter<'_> {
             Factor::Power(b, e) => {
                 let es = match e {
                     Number::Rat(r) if !r.is_integer() => {
-                        format!("\\frac{{{}}}{{{}}}", r.numer(), r.denom())
+                        format!("\\frac{{{}}}{{{}}}", r.numer_big(), r.denom_big())
                     }
                     _ => e.to_string(),
                 };
@@ -513,7 +526,7 @@ impl RustPrinter<'_> {
         let p = self.pool;
         match p.node(id) {
             Node::Num(n) => {
-                let s = Self::num(*n);
+                let s = Self::num(n.clone());
                 if n.is_negative() {
                     format!("({s})")
                 } else {

@@ -13,6 +13,7 @@
 //! The candidates (the input, and the rational form with and without trig expansion) are
 //! compared by [`Pool::tree_size`]; ties keep the earlier candidate.
 
+use crate::budget::{BudgetError, MAX_CONTRACT_WORK};
 use crate::number::{Number, Rational};
 use crate::poly::{gcd, Budget, Mono, Poly};
 use crate::pool::{Func, Id, Node, Pool};
@@ -66,24 +67,49 @@ impl Pool {
     /// `R cos a cos b ± R sin a sin b = R cos(a ∓ b)`, `R sin a cos b ± R cos a sin b =
     /// R sin(a ± b)` (the inverse of the expansion used to find cancellations, so that results
     /// read like `cos(theta - phi)` rather than four products).
+    ///
+    /// The search is bounded ([`MAX_CONTRACT_WORK`] term views and view pairs per call): when
+    /// the bound is reached the remaining sums are left as they are (equal, not contracted).
     pub fn contract_trig(&mut self, e: Id) -> Id {
-        self.rewrite(
+        self.contract_trig_counted(e).0
+    }
+
+    /// [`Pool::contract_trig`], or [`BudgetError::Contract`] when the bound was reached.
+    pub fn try_contract_trig(&mut self, e: Id) -> Result<Id, BudgetError> {
+        match self.contract_trig_counted(e) {
+            (r, false) => Ok(r),
+            (_, true) => Err(BudgetError::Contract {
+                limit: MAX_CONTRACT_WORK,
+            }),
+        }
+    }
+
+    /// The contraction and whether the work bound was reached.
+    fn contract_trig_counted(&mut self, e: Id) -> (Id, bool) {
+        let mut work = 0usize;
+        let r = self.rewrite(
             e,
             |_, _| None,
             |p, r| {
-                if matches!(p.node(r), Node::Add(_)) {
-                    p.contract_sum(r)
+                if matches!(p.node(r), Node::Add(_)) && work <= MAX_CONTRACT_WORK {
+                    p.contract_sum(r, &mut work)
                 } else {
                     r
                 }
             },
-        )
+        );
+        (r, work > MAX_CONTRACT_WORK)
     }
 
-    /// One sum: repeatedly merges a matching pair of terms.
-    fn contract_sum(&mut self, s: Id) -> Id {
+    /// One sum: repeatedly merges a matching pair of terms, counting the views built and the
+    /// pairs of views compared in `work` (quadratic in the trig factors per term: a few terms
+    /// with many sines and cosines once stalled here for over 30 s).
+    fn contract_sum(&mut self, s: Id, work: &mut usize) -> Id {
         let mut cur = s;
         for _ in 0..32 {
+            if *work > MAX_CONTRACT_WORK {
+                return cur;
+            }
             let Node::Add(ts) = self.node(cur).clone() else {
                 return cur;
             };
@@ -101,6 +127,11 @@ impl Pool {
                 let trig: Vec<usize> = (0..fs.len())
                     .filter(|&k| matches!(self.node(fs[k]), Node::Call(Func::Sin | Func::Cos, _)))
                     .collect();
+                // Bounded before building: each view costs a product node.
+                *work += trig.len() * trig.len().saturating_sub(1) / 2;
+                if *work > MAX_CONTRACT_WORK {
+                    return cur;
+                }
                 for x in 0..trig.len() {
                     for y in x + 1..trig.len() {
                         let (f1, f2) = (fs[trig[x]], fs[trig[y]]);
@@ -119,9 +150,13 @@ impl Pool {
                             .map(|(_, &f)| f)
                             .collect();
                         let r = self.mul(&others);
-                        views.push((i, c, r, k1, a1[0], k2, a2[0]));
+                        views.push((i, c.clone(), r, k1, a1[0], k2, a2[0]));
                     }
                 }
+            }
+            *work += views.len() + views.len() * views.len() / 2;
+            if *work > MAX_CONTRACT_WORK {
+                return cur;
             }
             let mut merged = None;
             'search: for (x, v) in views.iter().enumerate() {
@@ -164,7 +199,7 @@ impl Pool {
                     let (v, w) = (anchor, other);
                     let arg = if sum { self.add2(a, b) } else { self.sub(a, b) };
                     let call = self.call(f, &[arg]);
-                    let coef = self.num(v.1);
+                    let coef = self.num(v.1.clone());
                     let term = self.mul(&[coef, v.2, call]);
                     merged = Some((v.0, w.0, term));
                     break 'search;
@@ -296,22 +331,25 @@ impl RationalForm {
                 Some(acc)
             }
             Node::Pow(b, x) => {
-                let r = p.as_num(x).and_then(Number::as_rational);
+                // Exponents past i64 are treated like symbolic ones: an atom.
+                let r = p
+                    .as_num(x)
+                    .and_then(|n| n.as_rational().and_then(|r| r.small()));
                 match r {
-                    Some(r) if r.is_integer() => {
+                    Some((num, 1)) => {
                         let base = self.convert(p, b)?;
-                        self.power(base, r.numer())
+                        self.power(base, num)
                     }
-                    Some(r) => {
+                    Some((num, den)) => {
                         // b^(p/q) = (b^(1/q))^p with b^(1/q) an atom.
-                        let inv_q = p.num(Number::ratio(1, r.denom()));
+                        let inv_q = p.num(Number::ratio(1, den));
                         let root = p.pow(b, inv_q);
                         if matches!(p.node(root), Node::Pow(rb, _) if *rb == b) {
                             let a = self.atom(root);
-                            self.power((a, one()), r.numer())
+                            self.power((a, one()), num)
                         } else {
                             // The root simplified (sqrt(m^2) = m for m > 0): use root^p.
-                            let pe = p.int(r.numer());
+                            let pe = p.int(num);
                             let v = p.pow(root, pe);
                             if v == e {
                                 return Some((self.atom(e), one()));
@@ -427,7 +465,7 @@ impl RationalForm {
         let mut terms = Vec::with_capacity(poly.terms.len());
         for (m, c) in &poly.terms {
             let mut fs = Vec::with_capacity(m.len() + 1);
-            fs.push(p.num(Number::Rat(*c)));
+            fs.push(p.num(Number::Rat(c.clone())));
             for &(a, e) in m {
                 let base = self.atoms[a as usize];
                 fs.push(p.powi(base, e as i64));
@@ -447,7 +485,7 @@ fn eliminate_square(poly: &Poly, x: u32, y: u32, b: &mut Budget) -> Option<Poly>
         let k = m.iter().find(|&&(a, _)| a == x).map_or(0, |&(_, e)| e);
         let term_poly = |mono: Mono| {
             let mut t = Poly::zero();
-            t.terms.insert(mono, *c);
+            t.terms.insert(mono, c.clone());
             t
         };
         if k < 2 {
@@ -550,6 +588,34 @@ mod tests {
                 p.to_text(c)
             );
         }
+    }
+
+    #[test]
+    fn trig_contraction_is_bounded() {
+        let mut p = Pool::new();
+        // 64 terms of 12 trig factors each: 66 pairs per term, 4,224 views, 8.9 million pairs
+        // of views per pass, over the bound: a typed error, and the lenient form returns an
+        // equal expression.
+        let trig: Vec<String> = (0..12)
+            .map(|i| format!("{}(a{i})", if i % 2 == 0 { "cos" } else { "sin" }))
+            .collect();
+        let terms: Vec<String> = (0..64)
+            .map(|k| format!("b{k}*{}", trig.join("*")))
+            .collect();
+        let e = p.parse_scalar(&terms.join(" + ")).unwrap();
+        assert_eq!(
+            p.try_contract_trig(e),
+            Err(crate::BudgetError::Contract {
+                limit: crate::budget::MAX_CONTRACT_WORK
+            })
+        );
+        assert_eq!(p.contract_trig(e), e);
+        // Small sums are contracted as before.
+        let e = p.parse_scalar("cos(a)*cos(b) - sin(a)*sin(b)").unwrap();
+        assert_eq!(
+            p.try_contract_trig(e),
+            Ok(p.parse_scalar("cos(a + b)").unwrap())
+        );
     }
 
     #[test]

@@ -253,7 +253,8 @@ impl<'a> Parser<'a> {
 
     fn expr(&mut self) -> Result<Ast, ExprError> {
         self.enter()?;
-        let mut lhs = self.term()?;
+        let first = self.term()?;
+        let mut rest = Vec::new();
         loop {
             let op = match self.tok {
                 Tok::Op('+') => BinOp::Add,
@@ -261,15 +262,15 @@ impl<'a> Parser<'a> {
                 _ => break,
             };
             self.bump()?;
-            let rhs = self.term()?;
-            lhs = binary(op, lhs, rhs);
+            rest.push((op, self.term()?));
         }
         self.depth -= 1;
-        Ok(lhs)
+        Ok(chain(first, rest, BinOp::Add))
     }
 
     fn term(&mut self) -> Result<Ast, ExprError> {
-        let mut lhs = self.unary()?;
+        let first = self.unary()?;
+        let mut rest = Vec::new();
         loop {
             let op = match self.tok {
                 Tok::Op('*') => BinOp::Mul,
@@ -277,10 +278,9 @@ impl<'a> Parser<'a> {
                 _ => break,
             };
             self.bump()?;
-            let rhs = self.unary()?;
-            lhs = binary(op, lhs, rhs);
+            rest.push((op, self.unary()?));
         }
-        Ok(lhs)
+        Ok(chain(first, rest, BinOp::Mul))
     }
 
     fn unary(&mut self) -> Result<Ast, ExprError> {
@@ -438,6 +438,63 @@ impl<'a> Parser<'a> {
         }
         Ok(())
     }
+}
+
+/// Chains of one precedence level longer than this are built as balanced trees.
+const MAX_CHAIN: usize = 32;
+
+/// `first op1 x1 op2 x2 ...` for the operators of one level (`+ -` with `plus = Add`, or
+/// `* /` with `plus = Mul`). Short chains are left-associative as written. Long ones (a sum
+/// of 20,000 terms) become a balanced tree, of depth log2(n) instead of n, so that no tree
+/// walk can overflow the stack: `a - b + c ...` is the sum of `a`, `-b`, `c`...;
+/// `a / b * c ...` is the product of the numerators over the product of the denominators
+/// (equal in exact arithmetic, which is what the pool does).
+fn chain(first: Ast, rest: Vec<(BinOp, Ast)>, plus: BinOp) -> Ast {
+    if rest.len() < MAX_CHAIN {
+        return rest
+            .into_iter()
+            .fold(first, |lhs, (op, rhs)| binary(op, lhs, rhs));
+    }
+    let mut pos = vec![first];
+    let mut neg = Vec::new();
+    for (op, x) in rest {
+        if op == plus {
+            pos.push(x);
+        } else if plus == BinOp::Add {
+            let span = x.span();
+            pos.push(Ast::Neg {
+                expr: Box::new(x),
+                span,
+            });
+        } else {
+            neg.push(x);
+        }
+    }
+    let top = balanced(pos, plus);
+    if neg.is_empty() {
+        top
+    } else {
+        binary(BinOp::Div, top, balanced(neg, BinOp::Mul))
+    }
+}
+
+/// `items` combined with `op` as a balanced binary tree (`items` is not empty).
+fn balanced(mut items: Vec<Ast>, op: BinOp) -> Ast {
+    while items.len() > 1 {
+        let mut next = Vec::with_capacity(items.len().div_ceil(2));
+        let mut it = items.into_iter();
+        while let Some(a) = it.next() {
+            next.push(match it.next() {
+                Some(b) => binary(op, a, b),
+                None => a,
+            });
+        }
+        items = next;
+    }
+    items.pop().unwrap_or(Ast::Num {
+        text: "0".into(),
+        span: 0..0,
+    })
 }
 
 fn binary(op: BinOp, lhs: Ast, rhs: Ast) -> Ast {

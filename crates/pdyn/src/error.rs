@@ -137,6 +137,14 @@ pub enum Error {
         /// Which components are not finite.
         components: Vec<usize>,
     },
+    /// Symbolic work that would exceed its limit (an expansion with too many terms, a
+    /// derivative of too high an order): nothing was computed (exit code 2).
+    Budget {
+        /// What was being done (`simplify --expand`, `diff -n`).
+        context: String,
+        /// Which limit, and what to do instead.
+        error: pdyn_expr::BudgetError,
+    },
     /// A bug in pdyn.
     Internal {
         /// What went wrong.
@@ -178,6 +186,7 @@ impl Error {
             Error::Plot { .. } => "plot",
             Error::Integration { .. } => "integration",
             Error::NonFinite { .. } => "non_finite",
+            Error::Budget { .. } => "budget",
             Error::Internal { .. } => "internal",
             Error::Gravity { .. } => "gravity",
             Error::MdRun { .. } => "md_run",
@@ -273,6 +282,7 @@ impl fmt::Display for Error {
                 error,
             } => f.write_str(&error.render(text, argument)),
             Error::Argument { message, .. } => f.write_str(message),
+            Error::Budget { context, error } => write!(f, "{context}: error: {error}"),
             Error::Derive { origin, error } => write!(f, "{origin}: error: {error}"),
             Error::Value {
                 origin,

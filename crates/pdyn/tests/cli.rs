@@ -246,3 +246,54 @@ fn native_code_and_the_interpreter_give_the_same_run() {
         assert!(native.contains("\"final\""), "{native}");
     }
 }
+
+#[test]
+fn numbers_are_exact_past_64_bits() {
+    let (ok, out, err) = pdyn(&["eval", "2^64 + 1 - 2^64"]);
+    assert!(ok, "{err}");
+    assert_eq!(out, "1\n");
+    // An exact fraction also shows its floating-point value; JSON says which is exact.
+    let (ok, out, _) = pdyn(&["eval", "1/3"]);
+    assert!(ok);
+    assert_eq!(out, "1/3 ≈ 0.3333333333333333\n");
+    let (ok, out, _) = pdyn(&["eval", "[1/3, sqrt(2), 0]", "--json"]);
+    assert!(ok);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["exact"], serde_json::json!(["1/3", null, "0"]));
+    // 2^100000: exact (30,103 digits), not `1/0`.
+    let (ok, out, err) = pdyn(&["simplify", "2^100000"]);
+    assert!(ok, "{err}");
+    assert_eq!(out.trim_end().len(), 30_103);
+    // Over the budget: a located error with the limit, exit 2.
+    let (ok, _, err) = pdyn(&["eval", "2^1000000"]);
+    assert!(!ok);
+    assert!(err.contains("over the limit of 100000 digits"), "{err}");
+}
+
+#[test]
+fn expansion_is_complete_or_a_budget_error() {
+    let (ok, out, err) = pdyn(&["simplify", "--expand", "(x+y)^25"]);
+    assert!(ok, "{err}");
+    assert_eq!(out.matches(" + ").count(), 25, "{out}");
+    assert!(out.contains("5200300*x^12*y^13"), "{out}");
+    let (ok, out, _) = pdyn(&["simplify", "--expand", "(a+b+c+d)^40", "--json"]);
+    assert!(!ok);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["error"]["kind"], "budget");
+    assert_eq!(v["error"]["exit_code"], 2);
+    assert!(v["error"]["message"]
+        .as_str()
+        .unwrap()
+        .contains("5000 terms"));
+}
+
+#[test]
+fn high_order_derivatives_finish() {
+    let (ok, out, err) = pdyn(&["diff", "sin(x)", "--wrt", "x", "-n", "100001"]);
+    assert!(ok, "{err}");
+    assert_eq!(out, "cos(x)\n");
+    let (ok, _, err) = pdyn(&["diff", "exp(x^2)", "--wrt", "x", "-n", "100000"]);
+    assert!(!ok);
+    assert!(err.contains("diff -n 100000: error:"), "{err}");
+    assert!(err.contains("expression nodes"), "{err}");
+}

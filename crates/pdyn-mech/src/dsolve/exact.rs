@@ -53,7 +53,7 @@ pub(crate) fn solve_scalar(
     let mut cases_modes: Vec<(Option<Condition>, Vec<Mode>)> = Vec::new();
     let exact: Option<Vec<pdyn_expr::Rational>> = c
         .iter()
-        .map(|&x| pool.as_num(x).and_then(|n| n.as_rational()))
+        .map(|&x| pool.as_num(x).and_then(|n| n.as_rational().cloned()))
         .collect();
     let mut base_modes = Vec::new();
     let rest: Vec<Id> = if let Some(rc) = exact {
@@ -62,7 +62,7 @@ pub(crate) fn solve_scalar(
             let rate = pool.num(Number::Rat(r));
             base_modes.push(Mode::Exp { rate, mult: m });
         }
-        rest.iter().map(|&r| pool.num(Number::Rat(r))).collect()
+        rest.into_iter().map(|r| pool.num(Number::Rat(r))).collect()
     } else {
         // Remove the root λ = 0 (equations missing the lowest derivatives).
         let mut k = 0;
@@ -312,8 +312,7 @@ fn quadratic_modes(pool: &mut Pool, c1: Id, c0: Id) -> Vec<(Option<Condition>, V
                 // A perfect square gives two rational exponentials.
                 if let Some(r) = pool
                     .as_num(disc)
-                    .and_then(|n| n.as_rational())
-                    .and_then(|r| r.exact_root(2))
+                    .and_then(|n| n.as_rational().and_then(|r| r.exact_root(2)))
                 {
                     let rn = pool.num(Number::Rat(r));
                     let r1 = pool.add2(rate, rn);
@@ -389,7 +388,7 @@ fn threshold(pool: &mut Pool, key: Id) -> Option<(Id, Id)> {
     if !pool.is_positive(base) || !c1.is_positive() || !n.is_positive() {
         return None;
     }
-    let ratio = c0.neg().mul(c1.recip());
+    let ratio = c0.neg().mul(&c1.recip());
     if !ratio.is_positive() {
         return None;
     }

@@ -251,7 +251,7 @@ pub(crate) fn rational_roots(coeffs: &[Rational]) -> (Vec<(Rational, usize)>, Ve
             roots.push((r, 1));
         }
     };
-    while c.len() > 1 && c[0].numer() == 0 {
+    while c.len() > 1 && c[0].is_zero() {
         c.remove(0);
         push(&mut roots, Rational::ZERO);
     }
@@ -271,7 +271,7 @@ pub(crate) fn rational_roots(coeffs: &[Rational]) -> (Vec<(Rational, usize)>, Ve
                     let Some(r) = Rational::new(s * p, q) else {
                         continue;
                     };
-                    if let Some(d) = deflate(&c, r) {
+                    if let Some(d) = deflate(&c, &r) {
                         hit = Some((r, d));
                         break 'search;
                     }
@@ -289,15 +289,18 @@ pub(crate) fn rational_roots(coeffs: &[Rational]) -> (Vec<(Rational, usize)>, Ve
     (roots, c)
 }
 
-/// Clears denominators: integer coefficients with the same roots.
+/// Clears denominators: integer coefficients with the same roots (`None` past `i128`: such
+/// coefficients are too large to factor quickly anyway).
 fn to_integers(c: &[Rational]) -> Option<Vec<i128>> {
+    let parts: Vec<(i64, i64)> = c.iter().map(Rational::small).collect::<Option<_>>()?;
     let mut l: i128 = 1;
-    for r in c {
-        let d = r.denom() as i128;
+    for &(_, d) in &parts {
+        let d = d as i128;
         l = l.checked_mul(d / gcd(l, d))?;
     }
-    c.iter()
-        .map(|r| (r.numer() as i128).checked_mul(l / r.denom() as i128))
+    parts
+        .iter()
+        .map(|&(n, d)| (n as i128).checked_mul(l / d as i128))
         .collect()
 }
 
@@ -329,15 +332,16 @@ fn divisors(n: i128) -> Option<Vec<i128>> {
 }
 
 /// `c / (λ - r)` when `r` is an exact root (synthetic division), else `None`.
-fn deflate(c: &[Rational], r: Rational) -> Option<Vec<Rational>> {
+fn deflate(c: &[Rational], r: &Rational) -> Option<Vec<Rational>> {
     let n = c.len() - 1;
     let mut q = vec![Rational::ZERO; n];
-    let mut acc = c[n];
+    let mut acc = c[n].clone();
     for k in (0..n).rev() {
+        let next = c[k].checked_add(&acc.checked_mul(r)?)?;
         q[k] = acc;
-        acc = c[k].checked_add(acc.checked_mul(r)?)?;
+        acc = next;
     }
-    (acc.numer() == 0).then_some(q)
+    acc.is_zero().then_some(q)
 }
 
 #[cfg(test)]

@@ -103,14 +103,28 @@ fn show_value(pool: &Pool, v: Value, f: Format) -> String {
 pub fn simplify(a: SimplifyArgs) -> Result<String, Error> {
     let mut pool = Pool::new();
     let v = parse(&mut pool, &a.expr, &a.common, "<expr>")?;
-    let r = v.map(|x| {
-        let e = pool.expand(x);
-        if a.expand {
-            e
-        } else {
-            pool.simplify(e)
+    let r = if a.expand {
+        // Asked for: an expansion over the limit is an error, never the input returned as is.
+        let budget = |error| Error::Budget {
+            context: "simplify --expand".into(),
+            error,
+        };
+        match v {
+            Value::Scalar(x) => Value::Scalar(pool.try_expand(x).map_err(budget)?),
+            Value::Vector(c) => {
+                let mut out = c;
+                for (o, x) in out.iter_mut().zip(c) {
+                    *o = pool.try_expand(x).map_err(budget)?;
+                }
+                Value::Vector(out)
+            }
         }
-    });
+    } else {
+        v.map(|x| {
+            let e = pool.expand(x);
+            pool.simplify(e)
+        })
+    };
     Ok(if a.common.json {
         format!(
             "{}\n",
@@ -141,13 +155,23 @@ pub fn diff(a: DiffArgs) -> Result<String, Error> {
             }
         }
     };
-    let mut r = v;
-    for _ in 0..a.times {
-        r = r.map(|x| match var {
-            None => pool.dt(x),
-            Some(w) => pool.diff(x, w),
-        });
-    }
+    // Under a budget: `-n 100000` either finds the derivative (periodic or vanishing ones are
+    // cheap) or stops with an error naming the limit, never runs for ever.
+    let budget = |error| Error::Budget {
+        context: format!("diff -n {}", a.times),
+        error,
+    };
+    let r = match v {
+        Value::Scalar(x) => Value::Scalar(pool.try_derivative_n(x, var, a.times).map_err(budget)?),
+        Value::Vector(c) => {
+            let mut out = c;
+            for (o, x) in out.iter_mut().zip(c) {
+                *o = pool.try_derivative_n(x, var, a.times).map_err(budget)?;
+            }
+            Value::Vector(out)
+        }
+    };
+    let mut r = r;
     if a.simplify {
         r = r.map(|x| pool.simplify(x));
     }
@@ -309,7 +333,19 @@ pub fn eval(a: EvalArgs) -> Result<super::Outcome, Error> {
     let mut ws = prog.workspace();
     let mut out = vec![0.0; outs.len()];
     prog.eval(&values, &mut ws, &mut out);
-    let non_finite: Vec<usize> = (0..out.len()).filter(|&i| !out[i].is_finite()).collect();
+    // Components that folded to an exact rational print exactly (`2^64 + 1 - 2^64` is 1,
+    // `2^100000` has 30,103 digits); the others are evaluated in floating point, and JSON
+    // says which is which (`exact` is null for a floating-point value).
+    let exact: Vec<Option<String>> = outs
+        .iter()
+        .map(|&o| match pool.as_num(o) {
+            Some(n @ pdyn_expr::Number::Rat(_)) => Some(n.to_string()),
+            _ => None,
+        })
+        .collect();
+    let non_finite: Vec<usize> = (0..out.len())
+        .filter(|&i| !out[i].is_finite() && exact[i].is_none())
+        .collect();
     let failure = (!non_finite.is_empty()).then(|| Error::NonFinite {
         what: format!("`{}`", a.expr),
         components: non_finite.clone(),
@@ -319,18 +355,25 @@ pub fn eval(a: EvalArgs) -> Result<super::Outcome, Error> {
             out.iter().map(|&x| pdyn::output::json_num(x)).collect();
         format!(
             "{}\n",
-            json!({"input": a.expr, "value": value, "non_finite": non_finite})
+            json!({"input": a.expr, "value": value, "exact": exact, "non_finite": non_finite})
         )
-    } else if out.len() == 1 {
-        format!("{}\n", out[0])
     } else {
-        format!(
-            "[{}]\n",
-            out.iter()
-                .map(|x| x.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        )
+        let shown: Vec<String> = out
+            .iter()
+            .zip(&exact)
+            .map(|(x, e)| e.clone().unwrap_or_else(|| x.to_string()))
+            .collect();
+        if shown.len() == 1 {
+            match &exact[0] {
+                // An exact fraction also shows its floating-point value.
+                Some(e) if e.contains('/') && out[0].is_finite() => {
+                    format!("{e} ≈ {}\n", out[0])
+                }
+                _ => format!("{}\n", shown[0]),
+            }
+        } else {
+            format!("[{}]\n", shown.join(", "))
+        }
     };
     Ok(super::Outcome {
         stdout,

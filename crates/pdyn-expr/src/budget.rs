@@ -1,0 +1,83 @@
+//! Limits on symbolic work, and the typed error when one is reached.
+//!
+//! Symbolic algorithms can blow up on small inputs: `(a+b+c+d)^40` has 12,341 terms, the
+//! hundredth derivative of `exp(x^2)` thousands of nodes, `x^100000` differentiated 100,000
+//! times coefficients of half a million digits. Each such algorithm counts its work and stops
+//! with a [`BudgetError`] that says what ran out and what to do instead, so that no input
+//! makes pdyn hang. The limits are constants here, one place to read and tune them.
+
+use std::fmt;
+
+/// Most terms in one sum produced by [`Pool::try_expand`](crate::Pool::try_expand).
+pub const MAX_EXPAND_TERMS: usize = 5_000;
+/// Most products of two terms formed by one expansion (the work, counted before collecting
+/// like terms).
+pub const MAX_EXPAND_PRODUCTS: usize = 200_000;
+/// Most new expression nodes created by
+/// [`Pool::try_derivative_n`](crate::Pool::try_derivative_n).
+pub const MAX_DERIVATIVE_NODES: usize = 100_000;
+/// Most term views built plus pairs of views compared by one
+/// [`Pool::contract_trig`](crate::Pool::contract_trig).
+pub const MAX_CONTRACT_WORK: usize = 1_000_000;
+
+/// A symbolic operation would exceed its limit.
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum BudgetError {
+    /// Expanding would produce a sum of more than `limit` terms, or form more than
+    /// [`MAX_EXPAND_PRODUCTS`] products of terms.
+    ExpandTerms {
+        /// The limit that was reached.
+        limit: usize,
+    },
+    /// The derivatives up to `order` needed more than `limit` new expression nodes.
+    DerivativeSize {
+        /// The derivative being computed when the limit was reached (1 = first).
+        order: usize,
+        /// The limit on new nodes.
+        limit: usize,
+    },
+    /// Contracting products of sines and cosines into angle sums needed more than `limit`
+    /// comparisons.
+    Contract {
+        /// The limit on views and comparisons.
+        limit: usize,
+    },
+    /// A coefficient of the `order`-th derivative exceeded the size of exact numbers.
+    DerivativeNumbers {
+        /// The derivative being computed when the limit was reached.
+        order: usize,
+    },
+}
+
+impl fmt::Display for BudgetError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            BudgetError::ExpandTerms { limit } => write!(
+                f,
+                "expanding would produce more than {limit} terms: keep the expression \
+                 factored (simplify without --expand), or evaluate it numerically"
+            ),
+            BudgetError::DerivativeSize { order, limit } => write!(
+                f,
+                "the derivatives up to order {order} need more than {limit} expression \
+                 nodes: differentiate fewer times, or evaluate the derivative numerically (finite differences, \
+                 or integrate the equations numerically with `pdyn run`)"
+            ),
+            BudgetError::Contract { limit } => write!(
+                f,
+                "contracting sines and cosines into angle sums needed more than {limit} \
+                 comparisons: the expression is left expanded (it is equal); simplify a \
+                 smaller part, or evaluate numerically"
+            ),
+            BudgetError::DerivativeNumbers { order } => write!(
+                f,
+                "derivative {order} has coefficients over the limit of {} digits for exact \
+                 numbers: differentiate fewer times, or evaluate numerically",
+                crate::number::MAX_DIGITS
+            ),
+        }
+    }
+}
+
+impl std::error::Error for BudgetError {}
