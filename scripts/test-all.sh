@@ -20,7 +20,8 @@ venv="$root/target/venv-test"
 if [ ! -x "$venv/bin/python" ]; then
     python3 -m venv "$venv"
 fi
-"$venv/bin/pip" install --quiet --upgrade maturin pytest numpy scipy pandas sympy
+"$venv/bin/pip" install --quiet --upgrade maturin pytest numpy scipy pandas sympy \
+    "dask[distributed]" pyarrow tqdm
 # A debug build of the extension, installed into the venv.
 (cd crates/pdyn-py && VIRTUAL_ENV="$venv" PATH="$venv/bin:$PATH" "$venv/bin/maturin" develop --quiet)
 

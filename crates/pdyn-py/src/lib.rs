@@ -7,7 +7,7 @@
 //! with the GIL released, except when they must call back into Python.
 #![warn(missing_docs)]
 
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pdyn::sim::{self, sweep, Prepared, RunResult, RunSettings};
 use pdyn::Error;
 use pdyn_expr::{Id, Pool, Program};
@@ -164,6 +164,46 @@ impl PyModel {
         Ok(model)
     }
 
+    /// The model with `measures` (`(name, expression, statistic)`) written into its
+    /// `[sweep]` table and reloaded, so that they are checked and compiled exactly as a file's
+    /// measures; the model itself when `measures` is `None`.
+    fn with_measures(
+        &self,
+        py: Python<'_>,
+        measures: Option<&[(String, String, String)]>,
+        parameter: &str,
+        values: &[f64],
+    ) -> PyResult<PyModel> {
+        let Some(ms) = measures else {
+            return Ok(PyModel {
+                model: self.model.clone(),
+            });
+        };
+        let mut table: toml::Table = toml::from_str(&self.model.source)
+            .map_err(|e| pdyn_error(py, "PdynError", e.to_string()))?;
+        let mut sw = toml::Table::new();
+        sw.insert("parameter".into(), toml::Value::String(parameter.into()));
+        sw.insert(
+            "values".into(),
+            toml::Value::Array(values.iter().map(|&v| toml::Value::Float(v)).collect()),
+        );
+        let mut mt = toml::Table::new();
+        for (name, of, stat) in ms {
+            let mut one = toml::Table::new();
+            one.insert("of".into(), toml::Value::String(of.clone()));
+            one.insert("stat".into(), toml::Value::String(stat.clone()));
+            mt.insert(name.clone(), toml::Value::Table(one));
+        }
+        sw.insert("measures".into(), toml::Value::Table(mt));
+        table.insert("sweep".into(), toml::Value::Table(sw));
+        let text =
+            toml::to_string(&table).map_err(|e| pdyn_error(py, "PdynError", e.to_string()))?;
+        let origin = format!("{} (with the measures)", self.model.origin);
+        Ok(PyModel {
+            model: pdyn_mech::load(&text, &origin).map_err(|e| to_py(py, &load_error(&text, e)))?,
+        })
+    }
+
     fn settings(model: &pdyn_mech::Model, o: Overrides) -> Result<RunSettings, Error> {
         let sim_err = |error| Error::Sim {
             origin: model.origin.clone(),
@@ -223,9 +263,12 @@ fn run_dict(
     res: RunResult,
     n_states: usize,
     event_names: Vec<String>,
+    drift_tolerance: f64,
 ) -> PyResult<PyObject> {
     let d = PyDict::new(py);
     d.set_item("event_names", event_names)?;
+    d.set_item("status", res.status.code())?;
+    d.set_item("drift_tolerance", drift_tolerance)?;
     let rows = res.rows.len();
     let cols = res.columns.len();
     let flat: Vec<f64> = res.rows.into_iter().flatten().collect();
@@ -404,7 +447,7 @@ impl PyModel {
         };
         let outcome = py.allow_threads(|| {
             catch_unwind(AssertUnwindSafe(
-                || -> Result<(RunResult, usize, Vec<String>), Error> {
+                || -> Result<(RunResult, usize, Vec<String>, f64), Error> {
                     let mut model = self.with_params(params)?;
                     let set = Self::settings(&model, o)?;
                     let prep = Self::prepare(&mut model)?;
@@ -414,12 +457,12 @@ impl PyModel {
                         error,
                     })?;
                     let names = prep.events.iter().map(|e| e.name.clone()).collect();
-                    Ok((res, prep.state_names.len(), names))
+                    Ok((res, prep.state_names.len(), names, set.drift_tolerance))
                 },
             ))
         });
         match outcome {
-            Ok(Ok((res, n, names))) => run_dict(py, res, n, names),
+            Ok(Ok((res, n, names, tol))) => run_dict(py, res, n, names, tol),
             Ok(Err(e)) => Err(to_py(py, &e)),
             Err(_) => Err(pdyn_error(
                 py,
@@ -511,39 +554,7 @@ impl PyModel {
         params: Option<Vec<(String, f64)>>,
     ) -> PyResult<PyObject> {
         let values = values.as_slice()?.to_vec();
-        // Measures given from Python are written into the model's [sweep] table and the model
-        // reloaded: they are then checked and compiled exactly as a file's measures.
-        let base = match &measures {
-            Some(ms) => {
-                let mut table: toml::Table = toml::from_str(&self.model.source)
-                    .map_err(|e| pdyn_error(py, "PdynError", e.to_string()))?;
-                let mut sw = toml::Table::new();
-                sw.insert("parameter".into(), toml::Value::String(parameter.clone()));
-                sw.insert(
-                    "values".into(),
-                    toml::Value::Array(values.iter().map(|&v| toml::Value::Float(v)).collect()),
-                );
-                let mut mt = toml::Table::new();
-                for (name, of, stat) in ms {
-                    let mut one = toml::Table::new();
-                    one.insert("of".into(), toml::Value::String(of.clone()));
-                    one.insert("stat".into(), toml::Value::String(stat.clone()));
-                    mt.insert(name.clone(), toml::Value::Table(one));
-                }
-                sw.insert("measures".into(), toml::Value::Table(mt));
-                table.insert("sweep".into(), toml::Value::Table(sw));
-                let text = toml::to_string(&table)
-                    .map_err(|e| pdyn_error(py, "PdynError", e.to_string()))?;
-                let origin = format!("{} (with the sweep's measures)", self.model.origin);
-                PyModel {
-                    model: pdyn_mech::load(&text, &origin)
-                        .map_err(|e| to_py(py, &load_error(&text, e)))?,
-                }
-            }
-            None => PyModel {
-                model: self.model.clone(),
-            },
-        };
+        let base = self.with_measures(py, measures.as_deref(), &parameter, &values)?;
         let o = Overrides {
             t_end,
             method,
@@ -628,6 +639,438 @@ impl PyModel {
         d.set_item("runs", res.runs)?;
         d.set_item("seconds", res.seconds)?;
         d.set_item("threads", res.threads)?;
+        Ok(d.into_any().unbind())
+    }
+    /// Runs the model once per row of `params` (and of `initial`), in parallel on all cores
+    /// with the GIL released (see `pdyn.Model.ensemble`). With `dry_run`, only checks every
+    /// row (names, masses > 0) and returns the problems.
+    #[pyo3(signature = (param_names, params, initial_names, initial=None, measures=None, t_end=None, method=None, rtol=None, atol=None, max_step=None, dt=None, points=None, drift_tolerance=None, threads=None, dry_run=false))]
+    #[allow(clippy::too_many_arguments)]
+    fn ensemble(
+        &self,
+        py: Python<'_>,
+        param_names: Vec<String>,
+        params: PyReadonlyArray2<'_, f64>,
+        initial_names: Vec<String>,
+        initial: Option<PyReadonlyArray2<'_, f64>>,
+        measures: Option<Vec<(String, String, String)>>,
+        t_end: Option<f64>,
+        method: Option<String>,
+        rtol: Option<f64>,
+        atol: Option<f64>,
+        max_step: Option<f64>,
+        dt: Option<f64>,
+        points: Option<usize>,
+        drift_tolerance: Option<f64>,
+        threads: Option<usize>,
+        dry_run: bool,
+    ) -> PyResult<PyObject> {
+        let shape = params.shape();
+        let (runs, k) = (shape[0], shape[1]);
+        if k != param_names.len() {
+            return Err(pdyn_error(
+                py,
+                "ParameterError",
+                format!(
+                    "params has {k} columns for {} parameter names",
+                    param_names.len()
+                ),
+            ));
+        }
+        let pvals: Vec<f64> = params.as_array().iter().copied().collect();
+        let ivals: Vec<f64> = match &initial {
+            Some(a) => {
+                let sh = a.shape();
+                if sh[0] != runs || sh[1] != initial_names.len() {
+                    return Err(pdyn_error(
+                        py,
+                        "ParameterError",
+                        format!(
+                            "initial has shape ({}, {}); expected ({runs}, {}): one row per run, one column per name in initial_names",
+                            sh[0],
+                            sh[1],
+                            initial_names.len()
+                        ),
+                    ));
+                }
+                a.as_array().iter().copied().collect()
+            }
+            None if initial_names.is_empty() => Vec::new(),
+            None => {
+                return Err(pdyn_error(
+                    py,
+                    "ParameterError",
+                    "initial_names given without initial values".into(),
+                ))
+            }
+        };
+        let first = self
+            .model
+            .parameters
+            .first()
+            .map(|p| (p.name.clone(), p.value));
+        let base = match (&measures, first) {
+            (Some(_), Some((name, v))) => {
+                self.with_measures(py, measures.as_deref(), &name, &[v])?
+            }
+            (Some(_), None) => {
+                return Err(pdyn_error(
+                    py,
+                    "ParameterError",
+                    "measures need a model with at least one parameter".into(),
+                ))
+            }
+            (None, _) => PyModel {
+                model: self.model.clone(),
+            },
+        };
+        let o = Overrides {
+            t_end,
+            method,
+            rtol,
+            atol,
+            max_step,
+            dt,
+            points,
+            drift_tolerance,
+            ..Overrides::default()
+        };
+        let outcome = py.allow_threads(|| {
+            catch_unwind(AssertUnwindSafe(|| -> Result<EnsembleOut, Error> {
+                let mut model = base.model.clone();
+                let set = Self::settings(&model, o)?;
+                set.validate().map_err(|error| Error::Sim {
+                    origin: model.origin.clone(),
+                    context: "",
+                    error,
+                })?;
+                let prep = Self::prepare(&mut model)?;
+                let pidx = param_names
+                    .iter()
+                    .map(|name| {
+                        prep.parameter_names
+                            .iter()
+                            .position(|p| p == name)
+                            .ok_or_else(|| {
+                                Error::argument(
+                                    "params",
+                                    format!(
+                                        "`{name}` is not a parameter (parameters: {})",
+                                        prep.parameter_names.join(", ")
+                                    ),
+                                )
+                            })
+                    })
+                    .collect::<Result<Vec<_>, _>>()?;
+                let sidx = initial_names
+                    .iter()
+                    .map(|name| {
+                        prep.state_names
+                            .iter()
+                            .position(|p| p == name)
+                            .ok_or_else(|| {
+                                Error::argument(
+                                    "initial",
+                                    format!(
+                                        "`{name}` is not a state component (state: {})",
+                                        prep.state_names.join(", ")
+                                    ),
+                                )
+                            })
+                    })
+                    .collect::<Result<Vec<_>, _>>()?;
+                let defaults = prep.system.parameters();
+                let row_params = |r: usize| -> Vec<f64> {
+                    let mut v = defaults.clone();
+                    for (j, &i) in pidx.iter().enumerate() {
+                        v[i] = pvals[r * k + j];
+                    }
+                    v
+                };
+                if dry_run {
+                    let mut problems = Vec::new();
+                    for r in 0..runs {
+                        let v = row_params(r);
+                        if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+                            problems.push((r, format!("a parameter value is not finite ({x})")));
+                        } else if let Err(e) = prep.check_parameters(&v) {
+                            problems.push((r, e.to_string()));
+                        }
+                    }
+                    return Ok(EnsembleOut::dry(problems, &prep));
+                }
+                let stats: Vec<_> = model
+                    .run
+                    .sweep
+                    .as_ref()
+                    .map(|s| s.measures.iter().map(|m| m.stat).collect())
+                    .unwrap_or_default();
+                let ni = sidx.len();
+                let names = EnsembleOut::names(&prep);
+                let work = move || -> Vec<RunOut> {
+                    use rayon::prelude::*;
+                    (0..runs)
+                        .into_par_iter()
+                        .map_with(prep.clone(), |p, r| {
+                            p.set_parameters(&row_params(r));
+                            for (j, &i) in sidx.iter().enumerate() {
+                                p.y0[i] = ivals[r * ni + j];
+                            }
+                            one_run(p, &set, &stats)
+                        })
+                        .collect()
+                };
+                let start = std::time::Instant::now();
+                let (outs, threads) = match threads {
+                    Some(n) => {
+                        let pool = rayon_pool(n)?;
+                        (pool.install(work), n.max(1))
+                    }
+                    None => (work(), rayon::current_num_threads()),
+                };
+                Ok(EnsembleOut::new(
+                    outs,
+                    names,
+                    start.elapsed().as_secs_f64(),
+                    threads,
+                ))
+            }))
+        });
+        let out = match outcome {
+            Ok(Ok(r)) => r,
+            Ok(Err(e)) => return Err(to_py(py, &e)),
+            Err(_) => {
+                return Err(pdyn_error(
+                    py,
+                    "PdynError",
+                    "internal error in pdyn during the ensemble (please report it)".into(),
+                ))
+            }
+        };
+        out.into_py_dict(py, runs)
+    }
+}
+
+/// What one run of an ensemble keeps: its measures, final state, first event hits, monitor
+/// drifts, status and the message of a problem.
+struct RunOut {
+    measures: Vec<f64>,
+    t_final: f64,
+    final_state: Vec<f64>,
+    /// `(t, state)` of each event's first occurrence.
+    events: Vec<Option<(f64, Vec<f64>)>>,
+    drifts: Vec<f64>,
+    drifted: bool,
+    status: i32,
+    nfev: usize,
+    message: Option<String>,
+}
+
+/// Runs one member of an ensemble.
+fn one_run(p: &Prepared, set: &RunSettings, stats: &[pdyn_mech::model::spec::Stat]) -> RunOut {
+    let n_meas = stats.len();
+    let n_ev = p.events.len();
+    let n_states = p.state_names.len();
+    let mut out = RunOut {
+        measures: vec![f64::NAN; n_meas],
+        t_final: f64::NAN,
+        final_state: vec![f64::NAN; n_states],
+        events: vec![None; n_ev],
+        drifts: Vec::new(),
+        drifted: false,
+        status: -2,
+        nfev: 0,
+        message: None,
+    };
+    let res = match sim::run(p, set) {
+        Ok(r) => r,
+        Err(e) => {
+            out.message = Some(e.to_string());
+            return out;
+        }
+    };
+    out.status = res.status.code();
+    out.nfev = res.stats.fevals;
+    out.message = res.failure.as_ref().map(|f| f.to_string());
+    if let Some(last) = res.rows.last() {
+        out.t_final = last[0];
+        out.final_state.copy_from_slice(&last[1..1 + n_states]);
+    }
+    for e in &res.events {
+        if let Some(i) = p.events.iter().position(|pe| pe.name == e.name) {
+            if out.events[i].is_none() {
+                out.events[i] = Some((e.t, e.state.clone()));
+            }
+        }
+    }
+    for m in res.monitors.iter().filter(|m| m.conserved) {
+        out.drifts.push(m.drift);
+        if !(m.drift <= set.drift_tolerance) {
+            out.drifted = true;
+        }
+    }
+    if let Some(m) = &p.measures {
+        let n = p.system.n;
+        let mut series = vec![Vec::with_capacity(res.rows.len()); n_meas];
+        let mut ts = Vec::with_capacity(res.rows.len());
+        let mut input = Vec::new();
+        let mut vals = vec![0.0; n_meas];
+        for row in &res.rows {
+            p.system
+                .observation_input(row[0], &row[1..1 + 2 * n], &mut input);
+            m.eval(&input, &mut vals);
+            ts.push(row[0]);
+            for (s, &o) in series.iter_mut().zip(&vals) {
+                s.push(o);
+            }
+        }
+        for (j, s) in series.iter().enumerate() {
+            out.measures[j] = sweep::statistic(stats[j], &ts, s);
+        }
+    }
+    out
+}
+
+/// The names of an ensemble's measures, events, state components and conserved monitors.
+type Names = (Vec<String>, Vec<String>, Vec<String>, Vec<String>);
+
+/// An ensemble's results, gathered column by column.
+struct EnsembleOut {
+    measure_names: Vec<String>,
+    event_names: Vec<String>,
+    state_names: Vec<String>,
+    monitor_names: Vec<String>,
+    outs: Vec<RunOut>,
+    problems: Vec<(usize, String)>,
+    seconds: f64,
+    threads: usize,
+}
+
+impl EnsembleOut {
+    fn names(prep: &Prepared) -> Names {
+        let measures = prep
+            .measures
+            .as_ref()
+            .map(|m| m.names.clone())
+            .unwrap_or_default();
+        let events = prep.events.iter().map(|e| e.name.clone()).collect();
+        let monitors = prep
+            .observer
+            .names
+            .iter()
+            .zip(&prep.conserved)
+            .filter(|(_, &c)| c)
+            .map(|(n, _)| n.clone())
+            .collect();
+        (measures, events, prep.state_names.clone(), monitors)
+    }
+
+    fn dry(problems: Vec<(usize, String)>, prep: &Prepared) -> EnsembleOut {
+        let (measure_names, event_names, state_names, monitor_names) = Self::names(prep);
+        EnsembleOut {
+            measure_names,
+            event_names,
+            state_names,
+            monitor_names,
+            outs: Vec::new(),
+            problems,
+            seconds: 0.0,
+            threads: 0,
+        }
+    }
+
+    fn new(outs: Vec<RunOut>, names: Names, seconds: f64, threads: usize) -> EnsembleOut {
+        let (measure_names, event_names, state_names, monitor_names) = names;
+        let problems = outs
+            .iter()
+            .enumerate()
+            .filter_map(|(r, o)| o.message.clone().map(|m| (r, m)))
+            .collect();
+        EnsembleOut {
+            measure_names,
+            event_names,
+            state_names,
+            monitor_names,
+            outs,
+            problems,
+            seconds,
+            threads,
+        }
+    }
+
+    fn into_py_dict(self, py: Python<'_>, runs: usize) -> PyResult<PyObject> {
+        let d = PyDict::new(py);
+        d.set_item("problems", self.problems)?;
+        d.set_item("measure_names", &self.measure_names)?;
+        d.set_item("event_names", &self.event_names)?;
+        d.set_item("state_names", &self.state_names)?;
+        d.set_item("monitor_names", &self.monitor_names)?;
+        d.set_item("seconds", self.seconds)?;
+        d.set_item("threads", self.threads)?;
+        if self.outs.is_empty() && runs > 0 {
+            return Ok(d.into_any().unbind());
+        }
+        let o = &self.outs;
+        let ns = self.state_names.len();
+        let nm = self.measure_names.len();
+        let ne = self.event_names.len();
+        let nd = self.monitor_names.len();
+        let flat = |f: &dyn Fn(&RunOut) -> Vec<f64>| -> Vec<f64> { o.iter().flat_map(f).collect() };
+        d.set_item(
+            "measures",
+            f64_matrix(py, flat(&|r| r.measures.clone()), runs, nm)?,
+        )?;
+        d.set_item(
+            "t_final",
+            f64_array(py, o.iter().map(|r| r.t_final).collect()),
+        )?;
+        d.set_item(
+            "final",
+            f64_matrix(py, flat(&|r| r.final_state.clone()), runs, ns)?,
+        )?;
+        d.set_item(
+            "event_t",
+            f64_matrix(
+                py,
+                flat(&|r| {
+                    r.events
+                        .iter()
+                        .map(|e| e.as_ref().map_or(f64::NAN, |x| x.0))
+                        .collect()
+                }),
+                runs,
+                ne,
+            )?,
+        )?;
+        let ev_state = flat(&|r| {
+            r.events
+                .iter()
+                .flat_map(|e| match e {
+                    Some((_, y)) => y.clone(),
+                    None => vec![f64::NAN; ns],
+                })
+                .collect()
+        });
+        let a = PyArray1::from_vec(py, ev_state);
+        d.set_item("event_state", a.reshape([runs, ne, ns])?)?;
+        d.set_item(
+            "drift",
+            f64_matrix(
+                py,
+                flat(&|r| {
+                    if r.drifts.len() == nd {
+                        r.drifts.clone()
+                    } else {
+                        vec![f64::NAN; nd]
+                    }
+                }),
+                runs,
+                nd,
+            )?,
+        )?;
+        d.set_item("drifted", o.iter().map(|r| r.drifted).collect::<Vec<_>>())?;
+        d.set_item("status", o.iter().map(|r| r.status).collect::<Vec<_>>())?;
+        d.set_item("nfev", o.iter().map(|r| r.nfev).collect::<Vec<_>>())?;
         Ok(d.into_any().unbind())
     }
 }

@@ -20,18 +20,28 @@ A numerical failure returns ``success=False`` with the partial solution, as SciP
 
 import math
 import os
-from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from . import _pdyn
 from ._errors import DriftWarning, ModelError, ParameterError, PdynError
-from ._result import Derivation, Expr, OdeResult, SweepResult, _from_ivp, _from_run
+from ._result import (Derivation, EnsembleResult, Expr, OdeResult, SweepResult,
+                      _concat_raw, _from_ivp, _from_run)
 
 __version__ = _pdyn.__version__
 
+
+def __getattr__(name: str):
+    # pdyn.study (alias pdyn.ensemble) is imported on first use: `import pdyn` stays light.
+    if name in ("study", "ensemble"):
+        import importlib
+        return importlib.import_module(".study", __name__)
+    raise AttributeError(f"module 'pdyn' has no attribute {name!r}")
+
 __all__ = [
     "Model", "solve_ivp", "methods", "OdeResult", "Derivation", "Expr", "SweepResult",
+    "EnsembleResult",
     "PdynError", "ModelError", "ParameterError", "DriftWarning", "__version__",
 ]
 
@@ -41,6 +51,19 @@ def _array1(x, name: str) -> np.ndarray:
     if a.ndim != 1:
         raise ValueError(f"{name} must be one-dimensional")
     return a
+
+
+def _measures(measures):
+    if measures is None:
+        return None
+    ms = []
+    for name, spec in measures.items():
+        if isinstance(spec, str):
+            ms.append((str(name), spec, "max_abs"))
+        else:
+            of, stat = spec
+            ms.append((str(name), str(of), str(stat)))
+    return ms
 
 
 def _params(params: Optional[Mapping[str, float]]):
@@ -145,15 +168,7 @@ class Model:
         for the model's ``[sweep.measures]``. Returns a :class:`SweepResult` with one
         float64 array per measure (NaN where a run failed; see ``problems``).
         """
-        ms = None
-        if measures is not None:
-            ms = []
-            for name, spec in measures.items():
-                if isinstance(spec, str):
-                    ms.append((str(name), spec, "max_abs"))
-                else:
-                    of, stat = spec
-                    ms.append((str(name), str(of), str(stat)))
+        ms = _measures(measures)
         raw = self._m.sweep(str(param), _array1(values, "values"), measures=ms, t_end=t_end,
                             method=method, rtol=rtol, atol=atol, max_step=max_step, dt=dt,
                             points=points, threads=threads, params=_params(params))
@@ -163,6 +178,111 @@ class Model:
             threads=raw["threads"],
         )
 
+
+    def _names(self) -> Tuple[List[str], List[str]]:
+        """(parameter names, state names) in model order."""
+        raw = self._m.ensemble([], np.empty((0, 0)), [], dry_run=True)
+        return list(self.parameters), list(raw["state_names"])
+
+    def check_ensemble(self, params: Any = None, initial: Any = None) -> List[Tuple[int, str]]:
+        """Checks an ensemble's rows without running anything: unknown names raise
+        :class:`ParameterError`; returns ``[(row, message)]`` for the rows whose parameter
+        values the model refuses (a mass <= 0, a value that is not finite)."""
+        pn, pm, sn, sm = self._ensemble_inputs(params, initial)
+        raw = self._m.ensemble(pn, pm, sn, sm, dry_run=True)
+        return [(int(r), m) for r, m in raw["problems"]]
+
+    def _ensemble_inputs(self, params: Any, initial: Any):
+        def columns(x, what, default_names):
+            if x is None:
+                return [], None
+            if hasattr(x, "columns") and hasattr(x, "to_numpy"):  # a pandas DataFrame
+                names = [str(c) for c in x.columns]
+                return names, np.ascontiguousarray(x.to_numpy(dtype=np.float64))
+            if isinstance(x, Mapping):
+                names = [str(k) for k in x]
+                cols = [np.asarray(v, dtype=np.float64).ravel() for v in x.values()]
+                if len({len(c) for c in cols}) > 1:
+                    raise ParameterError(f"{what}: the columns have different lengths "
+                                         f"{[len(c) for c in cols]}")
+                if not cols:
+                    return [], None
+                return names, np.ascontiguousarray(np.column_stack(cols))
+            a = np.asarray(x, dtype=np.float64)
+            if a.ndim != 2:
+                raise ParameterError(f"{what} must be a dict of columns, a DataFrame, or a "
+                                     f"2-D array (runs, columns); got shape {a.shape}")
+            names = default_names()
+            if a.shape[1] != len(names):
+                raise ParameterError(f"{what} has {a.shape[1]} columns; a bare 2-D array needs "
+                                     f"one per name, in order: {names}")
+            return names, np.ascontiguousarray(a)
+
+        pn, pm = columns(params, "params", lambda: self._names()[0])
+        sn, sm = columns(initial, "initial", lambda: self._names()[1])
+        if pm is None and sm is None:
+            raise ParameterError("an ensemble needs params or initial (one row per run)")
+        if pm is None:
+            pm = np.empty((sm.shape[0], 0))
+        if sm is not None and sm.shape[0] != pm.shape[0]:
+            raise ParameterError(f"params has {pm.shape[0]} rows and initial {sm.shape[0]}: "
+                                 "one row per run in both")
+        return pn, pm, sn, sm
+
+    def ensemble(self, params: Any = None, initial: Any = None,
+                 measures: Optional[Mapping[str, Union[str, Tuple[str, str]]]] = None,
+                 t_end: Optional[float] = None, method: Optional[str] = None,
+                 rtol: Optional[float] = None, atol: Optional[float] = None,
+                 max_step: Optional[float] = None, dt: Optional[float] = None,
+                 points: Optional[int] = None, drift_tolerance: Optional[float] = None,
+                 threads: Optional[int] = None, progress: bool = False) -> EnsembleResult:
+        """Runs the model once per parameter set (and initial state), in parallel on all
+        cores in Rust with the GIL released; returns one array per quantity.
+
+        ``params``: ``{name: values}`` (equal lengths), a pandas DataFrame, or a 2-D array
+        ``(runs, n_parameters)`` in the order of :attr:`parameters`; parameters not given
+        keep their value. ``initial``: the same for state components (``"x"``, ``"x'"``...;
+        a bare 2-D array is ``(runs, n_states)`` in the state order); components not given
+        take the model's initial conditions evaluated with the run's parameters.
+        ``measures``: as in :meth:`sweep` (``None``: the model's ``[sweep.measures]``, if any).
+        Every run also records its final state, the first occurrence of each event (time and
+        state), the drift of each conserved quantity, and its status.
+
+        A run that fails is not an exception: its ``status`` is -1 (or -2 when it could not
+        start, e.g. a mass <= 0) and ``problems`` says why. ``progress=True`` shows a tqdm
+        bar (when tqdm is installed; the runs are then done in slices).
+        """
+        pn, pm, sn, sm = self._ensemble_inputs(params, initial)
+        ms = _measures(measures)
+        kw = dict(measures=ms, t_end=t_end, method=method, rtol=rtol, atol=atol,
+                  max_step=max_step, dt=dt, points=points, drift_tolerance=drift_tolerance,
+                  threads=threads)
+        runs = pm.shape[0]
+        bar = None
+        if progress:
+            try:
+                from tqdm.auto import tqdm
+                bar = tqdm(total=runs, unit="run")
+            except ImportError:
+                bar = None
+        if bar is None:
+            raw = self._m.ensemble(pn, pm, sn, sm, **kw)
+        else:
+            parts = []
+            step = max(1, -(-runs // 20))
+            for a in range(0, runs, step):
+                b = min(runs, a + step)
+                parts.append(self._m.ensemble(pn, np.ascontiguousarray(pm[a:b]), sn,
+                                              None if sm is None else
+                                              np.ascontiguousarray(sm[a:b]), **kw))
+                bar.update(b - a)
+            bar.close()
+            raw = _concat_raw(parts)
+        return EnsembleResult(
+            raw,
+            {n: np.ascontiguousarray(pm[:, j]) for j, n in enumerate(pn)},
+            {} if sm is None else {n: np.ascontiguousarray(sm[:, j]) for j, n in enumerate(sn)},
+        )
 
 def methods() -> Dict[str, str]:
     """pdyn's integration methods: name -> description (order, adaptivity, paper)."""

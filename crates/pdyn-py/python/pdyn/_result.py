@@ -2,7 +2,7 @@
 :class:`SweepResult`."""
 
 import warnings
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 
@@ -88,12 +88,13 @@ def _from_run(raw: Dict[str, Any], event_names: List[str]) -> OdeResult:
     n = raw["n_states"]
     failure = raw["failure"]
     hits = raw["events"]
-    if failure is not None:
-        status, message = -1, failure
-    elif hits and event_names and table.shape[0] and hits[-1][1] == table[-1, 0]:
-        status, message = 1, "A termination event occurred."
+    status = raw["status"]
+    if status == -1:
+        message = failure
+    elif status == 1:
+        message = "A termination event occurred."
     else:
-        status, message = 0, "The solver successfully reached the end of the integration interval."
+        message = "The solver successfully reached the end of the integration interval."
     names = list(dict.fromkeys(event_names + [h[0] for h in hits]))
     t_events = [np.array([h[1] for h in hits if h[0] == nm], dtype=np.float64) for nm in names]
     y_events = [
@@ -119,10 +120,22 @@ def _from_run(raw: Dict[str, Any], event_names: List[str]) -> OdeResult:
         _table=table,
         **_stats_counts(raw["stats"]),
     )
-    for w in res["warnings"]:
-        category = DriftWarning if "should be conserved" in w else RuntimeWarning
-        warnings.warn(w, category, stacklevel=3)
+    _warn(res, raw["drift_tolerance"])
     return res
+
+
+def _warn(res: "OdeResult", tolerance: float) -> None:
+    """Emits the run's warnings: a :class:`DriftWarning` (with ``quantity``, ``drift``,
+    ``tolerance``) per drifting conserved quantity, a ``RuntimeWarning`` for the others."""
+    drifting = {m["name"]: m for m in res["monitors"] if m["conserved"]}
+    for w in res["warnings"]:
+        name = w.split(" should be conserved", 1)[0] if " should be conserved" in w else None
+        mon = drifting.get(name) if name is not None else None
+        if mon is not None:
+            warnings.warn(DriftWarning(w, mon["name"], float(mon["drift"]), float(tolerance),
+                                       bool(mon["relative"])), stacklevel=4)
+        else:
+            warnings.warn(w, RuntimeWarning, stacklevel=4)
 
 
 def _from_ivp(raw: Dict[str, Any], n_events: int, n: int) -> OdeResult:
@@ -254,3 +267,111 @@ class SweepResult:
         data = {self.parameter: self.values}
         data.update(self.measures)
         return pd.DataFrame(data)
+
+
+class EnsembleResult:
+    """The result of :meth:`pdyn.Model.ensemble`: one row per run, every field an array.
+
+    * ``params`` -- ``{name: float64 (runs,)}``, the parameter values given;
+    * ``initial`` -- ``{state: float64 (runs,)}``, the initial values given (may be empty);
+    * ``measures`` -- ``{name: float64 (runs,)}`` (NaN where a run did not run);
+    * ``t_final`` (runs,), ``final`` (runs, n_states) with column names ``state_names``;
+    * ``event_t`` -- ``{event: float64 (runs,)}`` the time of its first occurrence (NaN when
+      it did not occur); ``event_state`` -- ``{event: (runs, n_states)}``, the state then;
+    * ``drift`` -- ``{conserved quantity: float64 (runs,)}``; ``drifted`` -- bool (runs,),
+      whether any conserved quantity drifted beyond the tolerance;
+    * ``status`` -- int32 (runs,): 0 end reached, 1 terminal event, -1 integration failed
+      (partial run measured), -2 not run (e.g. a mass <= 0); ``problems`` -- ``[(row, message)]``;
+    * ``nfev`` (runs,), ``seconds``, ``threads``; :meth:`to_pandas`, :meth:`column`.
+    """
+
+    def __init__(self, raw: Dict[str, Any], params: Dict[str, np.ndarray],
+                 initial: Dict[str, np.ndarray]):
+        self.params = params
+        self.initial = initial
+        self.state_names: List[str] = list(raw["state_names"])
+        self.measures: Dict[str, np.ndarray] = {
+            n: np.ascontiguousarray(raw["measures"][:, j])
+            for j, n in enumerate(raw["measure_names"])}
+        self.t_final: np.ndarray = raw["t_final"]
+        self.final: np.ndarray = raw["final"]
+        self.event_t: Dict[str, np.ndarray] = {
+            n: np.ascontiguousarray(raw["event_t"][:, j])
+            for j, n in enumerate(raw["event_names"])}
+        self.event_state: Dict[str, np.ndarray] = {
+            n: np.ascontiguousarray(raw["event_state"][:, j, :])
+            for j, n in enumerate(raw["event_names"])}
+        self.drift: Dict[str, np.ndarray] = {
+            n: np.ascontiguousarray(raw["drift"][:, j])
+            for j, n in enumerate(raw["monitor_names"])}
+        self.drifted: np.ndarray = np.asarray(raw["drifted"], dtype=bool)
+        self.status: np.ndarray = np.asarray(raw["status"], dtype=np.int32)
+        self.nfev: np.ndarray = np.asarray(raw["nfev"], dtype=np.int64)
+        self.problems: List[Tuple[int, str]] = [(int(r), m) for r, m in raw["problems"]]
+        self.seconds: float = raw["seconds"]
+        self.threads: int = raw["threads"]
+
+    def __len__(self) -> int:
+        return len(self.status)
+
+    def __repr__(self) -> str:
+        return (f"EnsembleResult({len(self)} runs, measures {list(self.measures)}, "
+                f"events {list(self.event_t)}, {len(self.problems)} problems, "
+                f"{self.seconds:.3f} s on {self.threads} threads)")
+
+    def columns(self) -> Dict[str, np.ndarray]:
+        """Every per-run column by name: the parameters, ``initial.<state>``, the measures,
+        ``t_final``, ``final.<state>``, ``<event>.t`` and ``<event>.<state>``,
+        ``drift.<quantity>``, ``drifted``, ``status``, ``nfev``."""
+        out: Dict[str, np.ndarray] = {}
+        out.update(self.params)
+        out.update({f"initial.{k}": v for k, v in self.initial.items()})
+        out.update(self.measures)
+        out["t_final"] = self.t_final
+        for j, s in enumerate(self.state_names):
+            out[f"final.{s}"] = np.ascontiguousarray(self.final[:, j])
+        for e, t in self.event_t.items():
+            out[f"{e}.t"] = t
+            for j, s in enumerate(self.state_names):
+                out[f"{e}.{s}"] = np.ascontiguousarray(self.event_state[e][:, j])
+        out.update({f"drift.{k}": v for k, v in self.drift.items()})
+        out["drifted"] = self.drifted
+        out["status"] = self.status
+        out["nfev"] = self.nfev
+        return out
+
+    def column(self, name: str) -> np.ndarray:
+        """One column of :meth:`columns` by name."""
+        cols = self.columns()
+        if name not in cols:
+            raise KeyError(f"no column {name!r} (columns: {list(cols)})")
+        return cols[name]
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.column(name)
+
+    def to_pandas(self):
+        """One row per run, the columns of :meth:`columns`, as a pandas DataFrame."""
+        try:
+            import pandas as pd
+        except ImportError as e:  # pragma: no cover
+            raise ImportError("EnsembleResult.to_pandas() needs pandas: pip install pandas") from e
+        return pd.DataFrame(self.columns())
+
+
+def _concat_raw(parts: List[Dict[str, Any]]) -> Dict[str, Any]:
+    """Joins the raw results of consecutive slices of one ensemble."""
+    if len(parts) == 1:
+        return parts[0]
+    out = dict(parts[0])
+    for key in ("measures", "t_final", "final", "event_t", "event_state", "drift"):
+        out[key] = np.concatenate([p[key] for p in parts], axis=0)
+    for key in ("drifted", "status", "nfev"):
+        out[key] = [x for p in parts for x in p[key]]
+    offset, problems = 0, []
+    for p in parts:
+        problems += [(r + offset, m) for r, m in p["problems"]]
+        offset += len(p["status"])
+    out["problems"] = problems
+    out["seconds"] = sum(p["seconds"] for p in parts)
+    return out
