@@ -281,3 +281,47 @@ def test_from_file_error_names_the_file_and_methods_are_listed(tmp_path):
         pdyn.Model.from_file(
             pathlib.Path(__file__).resolve().parents[3] / "examples" / "kremlin_stone.toml"
         ).run(method="nope")
+
+
+PENDULUM_TOML = '''name = "pendulum"
+gravity = "[0, -g, 0]"
+[parameters]
+g = 9.81
+L = 1.0
+m = 1.0
+[coordinates]
+q = { initial = 0.3, rate = 0.0 }
+[particles.bob]
+mass = "m"
+position = "L*[sin(q), -cos(q), 0]"
+'''
+
+
+def test_builder_model_derives_the_same_equations_as_its_toml():
+    m = pdyn.Model("pendulum")
+    q = m.coordinate("q", initial=0.3, rate=0.0)
+    assert q == "q"
+    m.particle("bob", mass="m", position="L*[sin(q), -cos(q), 0]")
+    m.gravity("[0, -g, 0]")
+    m.parameters(g=9.81, L=1, m=1)
+    assert m.parameters == {"g": 9.81, "L": 1.0, "m": 1.0}
+    built = m.derive()
+    loaded = pdyn.Model.from_toml(PENDULUM_TOML).derive()
+    assert [(l, str(a), str(b)) for l, a, b in built.equations] == \
+        [(l, str(a), str(b)) for l, a, b in loaded.equations]
+    assert [(s, str(e)) for s, e in built.first_order] == \
+        [(s, str(e)) for s, e in loaded.first_order]
+    a = m.run(t_end=2.0, rtol=1e-10, atol=1e-12)
+    b = pdyn.Model.from_toml(PENDULUM_TOML).run(t_end=2.0, rtol=1e-10, atol=1e-12)
+    np.testing.assert_array_equal(a.y, b.y)
+    with pytest.raises(pdyn.ParameterError, match="loaded"):
+        pdyn.Model.from_toml(PENDULUM_TOML).parameters(g=1.0)
+    sympy = pytest.importorskip("sympy")
+    L, qs = sympy.symbols("L q")
+    s = pdyn.Model("pendulum")
+    s.coordinate("q", initial=0.3)
+    s.particle("bob", mass="m", position=[L * sympy.sin(qs), -L * sympy.cos(qs), 0])
+    s.gravity("[0, -g, 0]")
+    s.parameters(g=9.81, L=1, m=1)
+    c = s.run(t_end=2.0, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(c.y, b.y, rtol=0, atol=1e-9)

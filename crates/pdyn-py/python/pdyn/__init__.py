@@ -53,6 +53,47 @@ def _array1(x, name: str) -> np.ndarray:
     return a
 
 
+class _Parameters(dict):
+    """``Model.parameters``: a dict of the values, callable on a built model to set them."""
+
+    def __init__(self, model: "Model", values: Dict[str, float]):
+        super().__init__(values)
+        self._model = model
+
+    def __call__(self, **values: Any) -> None:
+        self._model._edit().setdefault("parameters", {}).update(
+            {k: _value(v) for k, v in values.items()})
+
+
+def _text(x: Any) -> str:
+    """An expression as pdyn text: a string as is, a SymPy expression through its text
+    form (``**`` written ``^``), a list of three as a vector."""
+    if isinstance(x, str):
+        return x
+    if isinstance(x, (list, tuple)):
+        return "[" + ", ".join(_text(e) for e in x) + "]"
+    if isinstance(x, (int, float)) and not isinstance(x, bool):
+        return repr(float(x))
+    if hasattr(x, "free_symbols"):  # SymPy
+        return str(x).replace("**", "^")
+    raise TypeError(f"cannot use {x!r} as an expression (give a string or a SymPy expression)")
+
+
+def _value(x: Any) -> Any:
+    """A number stays a number; anything else becomes expression text."""
+    if isinstance(x, (int, float)) and not isinstance(x, bool):
+        return float(x)
+    return _text(x)
+
+
+def _field(x: Any) -> Any:
+    if isinstance(x, (list, tuple)) and all(isinstance(e, str) for e in x):
+        return list(x)
+    if isinstance(x, (bool, dict)):
+        return x
+    return _value(x)
+
+
 def _measures(measures):
     if measures is None:
         return None
@@ -79,10 +120,87 @@ class Model:
     does not load raises :class:`ModelError` with the file, line and column.
     """
 
-    __slots__ = ("_m",)
+    __slots__ = ("_inner", "_spec")
 
-    def __init__(self, inner: "_pdyn.Model"):
-        self._m = inner
+    def __init__(self, name: Union[str, "_pdyn.Model"] = "model"):
+        """``Model("pendulum")`` starts a model built in code (see :meth:`coordinate`,
+        :meth:`particle`, :meth:`gravity`, :meth:`parameters`...); the class methods
+        :meth:`from_file`, :meth:`from_toml` and :meth:`from_dict` load one."""
+        if isinstance(name, str):
+            self._inner = None
+            self._spec: Optional[Dict[str, Any]] = {"name": name}
+        else:
+            self._inner = name
+            self._spec = None
+
+    @property
+    def _m(self) -> "_pdyn.Model":
+        # A built model is loaded (and checked, with its errors located in the generated
+        # TOML) when first used; changing it again reloads it.
+        if self._inner is None:
+            self._inner = _pdyn.Model.from_dict(self._spec)
+        return self._inner
+
+    # -- the builder ------------------------------------------------------------------------
+
+    def _edit(self) -> Dict[str, Any]:
+        if self._spec is None:
+            raise ParameterError("this model was loaded from a file or text; build one with "
+                                 "pdyn.Model(name), or pass params= to run/sweep/ensemble")
+        self._inner = None
+        return self._spec
+
+    def coordinate(self, name: str, initial: Any = 0.0, rate: Any = 0.0,
+                   expr: Any = None) -> str:
+        """Adds a generalized coordinate with its initial value and rate (numbers or
+        expressions of the parameters), or, with ``expr``, a prescribed function of ``t``
+        (``m.coordinate("d", expr="d0*sin(omega*t)")``). Returns the name."""
+        table = self._edit().setdefault("coordinates", {})
+        table[name] = _text(expr) if expr is not None else {
+            "initial": _value(initial), "rate": _value(rate)}
+        return name
+
+    def particle(self, name: str, mass: Any, position: Any) -> str:
+        """Adds a particle: ``mass`` (a number or expression), ``position`` (an expression
+        of a 3-vector, ``"L*[sin(q), -cos(q), 0]"``, or a list of three expressions)."""
+        self._edit().setdefault("particles", {})[name] = {
+            "mass": _value(mass), "position": _text(position)}
+        return name
+
+    def point(self, name: str, position: Any) -> str:
+        """Adds a named point (a fixed or moving position forces can attach to)."""
+        self._edit().setdefault("points", {})[name] = _text(position)
+        return name
+
+    def gravity(self, g: Any) -> None:
+        """Uniform gravity, a 3-vector: ``m.gravity("[0, -g, 0]")``."""
+        self._edit()["gravity"] = _text(g)
+
+    def force(self, kind: str, **fields: Any) -> None:
+        """Adds a ``[[forces]]`` entry: ``m.force("spring", between=["a", "b"], k="k",
+        l0="L")`` (fields as in docs/model-format.md; expressions as strings or SymPy)."""
+        entry = {"kind": kind}
+        entry.update({k: _field(v) for k, v in fields.items()})
+        self._edit().setdefault("forces", []).append(entry)
+
+    def event(self, name: str, when: Any, direction: str = "both",
+              terminal: bool = False) -> None:
+        """Adds an ``[[events]]`` entry: the zeros of ``when``."""
+        self._edit().setdefault("events", []).append(
+            {"name": name, "when": _text(when), "direction": direction,
+             "terminal": bool(terminal)})
+
+    def monitor(self, name: str, expr: Any) -> None:
+        """Tabulates ``expr`` as a column of every run."""
+        self._edit().setdefault("monitors", {})[name] = _text(expr)
+
+    def simulate(self, **settings: Any) -> None:
+        """The model's default run settings (``t_end``, ``method``, ``rtol``, ...)."""
+        self._edit().setdefault("simulate", {}).update(settings)
+
+    def to_toml(self) -> str:
+        """The model as the text of a model file."""
+        return self._m.source
 
     @classmethod
     def from_file(cls, path: Union[str, "os.PathLike[str]"]) -> "Model":
@@ -114,12 +232,17 @@ class Model:
         return self._m.source
 
     @property
-    def parameters(self) -> Dict[str, float]:
+    def parameters(self) -> "_Parameters":
         """Parameter values in SI units, in file order (a copy: pass ``params=`` to
-        :meth:`run` to change them)."""
-        return dict(self._m.parameters)
+        :meth:`run` to change them). On a model built in code, calling it sets values:
+        ``m.parameters(g=9.81, L=1, m=1)`` (numbers, or quantities with units as text)."""
+        if self._spec is not None and self._inner is None and "parameters" not in self._spec:
+            return _Parameters(self, {})
+        return _Parameters(self, dict(self._m.parameters))
 
     def __repr__(self) -> str:
+        if self._spec is not None and self._inner is None:
+            return f"pdyn.Model({self._spec.get('name')!r}, built in code, not yet loaded)"
         return f"pdyn.Model({self.name!r}, origin={self._m.origin!r})"
 
     def run(self, t_end: Optional[float] = None, method: Optional[str] = None,
