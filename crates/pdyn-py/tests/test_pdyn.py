@@ -325,3 +325,14 @@ def test_builder_model_derives_the_same_equations_as_its_toml():
     s.parameters(g=9.81, L=1, m=1)
     c = s.run(t_end=2.0, rtol=1e-10, atol=1e-12)
     np.testing.assert_allclose(c.y, b.y, rtol=0, atol=1e-9)
+
+
+def test_notebooks_are_stored_without_outputs(examples):
+    notebooks = sorted((examples / "notebooks").glob("*.ipynb"))
+    assert {p.name for p in notebooks} >= {"satellite_drift.ipynb", "building_resonance.ipynb",
+                                           "pendulum_chain.ipynb"}
+    for p in notebooks:
+        nb = json.loads(p.read_text())
+        for cell in nb["cells"]:
+            if cell["cell_type"] == "code":
+                assert cell["outputs"] == [] and cell["execution_count"] is None, p.name
