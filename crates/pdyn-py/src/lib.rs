@@ -1257,7 +1257,7 @@ fn integrate(
 /// `solve_ivp`'s Rust part: returns a dict of plain data (`pdyn.solve_ivp` builds the
 /// `OdeResult`). `fun` is a callable `fun(t, y)` or a list of expression strings.
 #[pyfunction]
-#[pyo3(signature = (fun, t0, tf, y0, method, t_eval, rtol, atol, max_step, first_step, max_steps, events, args))]
+#[pyo3(signature = (fun, t0, tf, y0, method, t_eval, rtol, atol, max_step, first_step, max_steps, events, args, dense=false))]
 #[allow(clippy::too_many_arguments)]
 fn _solve_ivp(
     py: Python<'_>,
@@ -1274,6 +1274,7 @@ fn _solve_ivp(
     max_steps: Option<usize>,
     events: Vec<(Bound<'_, PyAny>, Option<usize>, i32)>,
     args: Vec<(String, f64)>,
+    dense: bool,
 ) -> PyResult<PyObject> {
     let y0 = y0.as_slice()?.to_vec();
     let n = y0.len();
@@ -1419,6 +1420,36 @@ fn _solve_ivp(
     d.set_item("status", status)?;
     d.set_item("method", sol.method.name())?;
     d.set_item("gil_released", all_compiled)?;
+    if dense {
+        // f(t, y) at every output point, for the Hermite interpolant of `sol.sol` (extra
+        // evaluations, not counted in nfev).
+        let mut f_rows = vec![0.0; len * n];
+        match &rhs {
+            Rhs::Compiled(p) => {
+                let ev = Evaluator::new(p, n, &args);
+                for k in 0..len {
+                    ev.eval(sol.t[k], sol.y_at(k), &mut f_rows[k * n..(k + 1) * n]);
+                }
+            }
+            Rhs::Callable(func) => {
+                let np = py.import("numpy")?;
+                for k in 0..len {
+                    let arr = PyArray1::from_slice(py, sol.y_at(k));
+                    let v = func.call1(py, (sol.t[k], arr))?;
+                    let v = np.call_method1("asarray", (v, "float64"))?;
+                    let v: Vec<f64> = v.call_method0("ravel")?.extract()?;
+                    if v.len() != n {
+                        return Err(PyErr::new::<pyo3::exceptions::PyValueError, _>(format!(
+                            "fun returned {} values for {n} states",
+                            v.len()
+                        )));
+                    }
+                    f_rows[k * n..(k + 1) * n].copy_from_slice(&v);
+                }
+            }
+        }
+        d.set_item("f_rows", f64_matrix(py, f_rows, len, n)?)?;
+    }
     Ok(d.into_any().unbind())
 }
 

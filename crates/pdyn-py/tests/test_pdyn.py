@@ -336,3 +336,21 @@ def test_notebooks_are_stored_without_outputs(examples):
         for cell in nb["cells"]:
             if cell["cell_type"] == "code":
                 assert cell["outputs"] == [] and cell["execution_count"] is None, p.name
+
+
+def test_dense_output_interpolates_like_scipy():
+    for fun in (["y1", "-y0"], lambda t, y: [y[1], -y[0]]):
+        te = np.linspace(0, 10, 7)
+        sol = pdyn.solve_ivp(fun, (0, 10), [1.0, 0.0], rtol=1e-10, atol=1e-12,
+                             dense_output=True, t_eval=te)
+        assert sol.t.shape == (7,) and sol.sol is not None
+        tt = np.linspace(0, 10, 1001)
+        y = sol.sol(tt)
+        assert y.shape == (2, 1001) and sol.sol(3.0).shape == (2,)
+        h = np.max(np.diff(sol.sol.ts))
+        # Cubic Hermite: error <= h^4/384 max|y''''| (= 1 here), plus the solver's error.
+        assert np.max(np.abs(y[0] - np.cos(tt))) < h**4 / 384 + 1e-8
+        np.testing.assert_allclose(sol.sol(te), sol.y, rtol=0, atol=h**4 / 384 + 1e-8)
+        # Exact at the steps.
+        plain = pdyn.solve_ivp(fun, (0, 10), [1.0, 0.0], rtol=1e-10, atol=1e-12)
+        np.testing.assert_array_equal(sol.sol(plain.t), plain.y)

@@ -26,7 +26,7 @@ import numpy as np
 
 from . import _pdyn
 from ._errors import DriftWarning, ModelError, ParameterError, PdynError
-from ._result import (Derivation, EnsembleResult, Expr, OdeResult, SweepResult,
+from ._result import (DenseOutput, Derivation, EnsembleResult, Expr, OdeResult, SweepResult,
                       _concat_raw, _from_ivp, _from_run)
 
 __version__ = _pdyn.__version__
@@ -41,7 +41,7 @@ def __getattr__(name: str):
 
 __all__ = [
     "Model", "solve_ivp", "methods", "OdeResult", "Derivation", "Expr", "SweepResult",
-    "EnsembleResult",
+    "EnsembleResult", "DenseOutput",
     "PdynError", "ModelError", "ParameterError", "DriftWarning", "__version__",
 ]
 
@@ -439,10 +439,11 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
 
     Returns an :class:`OdeResult`; ``nfev`` is the Rust solver's count (``stats`` has all).
     A numerical failure returns ``success=False``, ``status=-1`` and the partial solution.
-    ``dense_output`` and ``vectorized`` are not supported (``sol.sol`` is ``None``).
+    ``dense_output=True`` sets ``sol.sol``, a :class:`DenseOutput` callable ``sol.sol(t)``
+    as SciPy's: a cubic Hermite interpolant through every step (its error is O(h^4) in the
+    step size h -- coarser than the methods' own continuous extensions; the values at the
+    steps are exact). ``vectorized=True`` is not supported.
     """
-    if dense_output:
-        raise NotImplementedError("pdyn.solve_ivp: dense_output is not supported yet; use t_eval")
     if options:
         raise TypeError(f"pdyn.solve_ivp: unsupported options {sorted(options)}")
     t0, tf = (float(t_span[0]), float(t_span[1]))
@@ -472,9 +473,25 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
             else:
                 term = int(terminal) if terminal else None
             ev_list.append((g, term, int(np.sign(direction))))
+    if vectorized:
+        raise NotImplementedError("pdyn.solve_ivp: vectorized=True is not supported (fun is "
+                                  "called with one state at a time; it may still be vectorized)")
     te = None if t_eval is None else _array1(t_eval, "t_eval")
-    raw = _pdyn._solve_ivp(
-        fun, t0, tf, y0a, str(method), te, _tol(rtol, "rtol"), _tol(atol, "atol"),
-        None if math.isinf(max_step) else float(max_step),
-        None if first_step is None else float(first_step), max_steps, ev_list, named_args)
-    return _from_ivp(raw, len(ev_list), len(y0a))
+    common = (str(method), _tol(rtol, "rtol"), _tol(atol, "atol"),
+              None if math.isinf(max_step) else float(max_step),
+              None if first_step is None else float(first_step), max_steps, ev_list, named_args)
+
+    def solve(t_eval_, dense):
+        m_, r_, a_, ms_, fs_, mx_, ev_, na_ = common
+        return _pdyn._solve_ivp(fun, t0, tf, y0a, m_, t_eval_, r_, a_, ms_, fs_, mx_, ev_, na_,
+                                dense)
+
+    raw = solve(te, dense_output and te is None)
+    res = _from_ivp(raw, len(ev_list), len(y0a))
+    if dense_output:
+        # The interpolant needs every step: with t_eval, a second solve without it (the
+        # same steps; the result's t and y stay at t_eval).
+        steps = raw if te is None else solve(None, True)
+        res["sol"] = DenseOutput(steps["t"], np.ascontiguousarray(steps["y_rows"].T),
+                                 np.ascontiguousarray(steps["f_rows"].T))
+    return res
