@@ -18,11 +18,15 @@ both :class:`PdynError`; a drifting conserved quantity warns with :class:`DriftW
 A numerical failure returns ``success=False`` with the partial solution, as SciPy does.
 """
 
+from __future__ import annotations
+
 import math
 import os
 from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
-import numpy as np
+from ._lazy import LazyModule
+
+np = LazyModule("numpy")  # imported on first use
 
 from . import _pdyn
 from ._errors import DriftWarning, ModelError, ParameterError, PdynError

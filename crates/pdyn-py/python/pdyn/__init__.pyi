@@ -24,6 +24,12 @@ class DriftWarning(UserWarning):
     def __init__(self, message: str, quantity: str = ..., drift: float = ...,
                  tolerance: float = ..., relative: bool = ...) -> None: ...
 
+class DenseOutput:
+    ts: npt.NDArray[np.float64]
+    t_min: float
+    t_max: float
+    def __call__(self, t: Any) -> npt.NDArray[np.float64]: ...
+
 class OdeResult(dict):
     t: npt.NDArray[np.float64]
     y: npt.NDArray[np.float64]
@@ -35,7 +41,7 @@ class OdeResult(dict):
     nfev: int
     njev: int
     nlu: int
-    sol: None
+    sol: Optional[DenseOutput]
     stats: Dict[str, Any]
     method: str
     columns: List[str]

@@ -1,10 +1,14 @@
 """Result objects: :class:`OdeResult` (SciPy's shape), :class:`Derivation`, :class:`Expr`,
 :class:`SweepResult`."""
 
+from __future__ import annotations
+
 import warnings
 from typing import Any, Dict, List, Optional, Tuple
 
-import numpy as np
+from ._lazy import LazyModule
+
+np = LazyModule("numpy")  # imported on first use
 
 from ._errors import DriftWarning
 
