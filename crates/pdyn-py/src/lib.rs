@@ -18,6 +18,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::cell::RefCell;
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::Mutex;
 
 /// Builds an instance of an exception class of `pdyn._errors`.
 fn py_error<'py>(
@@ -108,6 +109,18 @@ fn method_name(name: &str) -> String {
 #[pyclass(module = "pdyn._pdyn", name = "Model", frozen)]
 struct PyModel {
     model: pdyn_mech::Model,
+    /// The model compiled for an ensemble, keyed by its measures: an ensemble run chunk by
+    /// chunk (pdyn.study) derives and compiles the model once, not once per chunk.
+    prepared: Mutex<Option<(String, Prepared)>>,
+}
+
+impl PyModel {
+    fn new(model: pdyn_mech::Model) -> PyModel {
+        PyModel {
+            model,
+            prepared: Mutex::new(None),
+        }
+    }
 }
 
 /// The run settings given from Python (any may be `None`: the model's `[simulate]` applies).
@@ -175,9 +188,7 @@ impl PyModel {
         values: &[f64],
     ) -> PyResult<PyModel> {
         let Some(ms) = measures else {
-            return Ok(PyModel {
-                model: self.model.clone(),
-            });
+            return Ok(PyModel::new(self.model.clone()));
         };
         let mut table: toml::Table = toml::from_str(&self.model.source)
             .map_err(|e| pdyn_error(py, "PdynError", e.to_string()))?;
@@ -199,9 +210,9 @@ impl PyModel {
         let text =
             toml::to_string(&table).map_err(|e| pdyn_error(py, "PdynError", e.to_string()))?;
         let origin = format!("{} (with the measures)", self.model.origin);
-        Ok(PyModel {
-            model: pdyn_mech::load(&text, &origin).map_err(|e| to_py(py, &load_error(&text, e)))?,
-        })
+        Ok(PyModel::new(
+            pdyn_mech::load(&text, &origin).map_err(|e| to_py(py, &load_error(&text, e)))?,
+        ))
     }
 
     fn settings(model: &pdyn_mech::Model, o: Overrides) -> Result<RunSettings, Error> {
@@ -371,7 +382,7 @@ impl PyModel {
     fn from_toml(py: Python<'_>, text: &str, origin: &str) -> PyResult<PyModel> {
         guarded(py, || {
             pdyn_mech::load(text, origin)
-                .map(|model| PyModel { model })
+                .map(PyModel::new)
                 .map_err(|e| to_py(py, &load_error(text, e)))
         })
     }
@@ -720,9 +731,7 @@ impl PyModel {
                     "measures need a model with at least one parameter".into(),
                 ))
             }
-            (None, _) => PyModel {
-                model: self.model.clone(),
-            },
+            (None, _) => PyModel::new(self.model.clone()),
         };
         let o = Overrides {
             t_end,
@@ -744,7 +753,23 @@ impl PyModel {
                     context: "",
                     error,
                 })?;
-                let prep = Self::prepare(&mut model)?;
+                let key = format!("{measures:?}");
+                let cached = {
+                    let guard = self.prepared.lock().unwrap_or_else(|e| e.into_inner());
+                    guard
+                        .as_ref()
+                        .filter(|(k, _)| *k == key)
+                        .map(|(_, p)| p.clone())
+                };
+                let prep = match cached {
+                    Some(p) => p,
+                    None => {
+                        let p = Self::prepare(&mut model)?;
+                        *self.prepared.lock().unwrap_or_else(|e| e.into_inner()) =
+                            Some((key, p.clone()));
+                        p
+                    }
+                };
                 let pidx = param_names
                     .iter()
                     .map(|name| {

@@ -287,6 +287,22 @@ def design_from_dict(d: Mapping[str, Any]) -> Design:
 # Running
 # ---------------------------------------------------------------------------------------
 
+_MODELS: Dict[Tuple[str, str], Any] = {}
+
+
+def _model(source: str, origin: str):
+    """The model for a chunk, loaded once per process: a worker running many chunks of a
+    study derives and compiles it once (the compiled form is cached in the model)."""
+    from . import Model
+    key = (source, origin)
+    m = _MODELS.get(key)
+    if m is None:
+        if len(_MODELS) >= 8:
+            _MODELS.clear()
+        m = _MODELS[key] = Model.from_toml(source, origin)
+    return m
+
+
 def _run_chunk(source: str, origin: str, param_names: List[str], params: np.ndarray,
                state_names: List[str], initial: Optional[np.ndarray],
                measures: Optional[Dict[str, Tuple[str, str]]], settings: Dict[str, Any],
@@ -294,10 +310,9 @@ def _run_chunk(source: str, origin: str, param_names: List[str], params: np.ndar
                _delay: float = 0.0) -> Dict[str, np.ndarray]:
     """One chunk: the Rust ensemble over ``params``' rows (GIL released), as columns.
     Runs on a Dask worker as well as locally; everything it needs is in its arguments."""
-    from . import Model
     if _delay:
         time.sleep(_delay)
-    m = Model.from_toml(source, origin)
+    m = _model(source, origin)
     res = m.ensemble(params=dict(zip(param_names, params.T)) if param_names else None,
                      initial=None if initial is None else dict(zip(state_names, initial.T)),
                      measures=measures, threads=threads, **settings)
