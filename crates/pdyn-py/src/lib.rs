@@ -545,6 +545,76 @@ impl PyModel {
         })
     }
 
+    /// The unknown forces of a prescribed motion at an instant (see `pdyn.Model.forces`).
+    #[pyo3(signature = (at=None, params=None))]
+    fn forces(
+        &self,
+        py: Python<'_>,
+        at: Option<Vec<(String, f64)>>,
+        params: Option<Vec<(String, f64)>>,
+    ) -> PyResult<PyObject> {
+        guarded(py, || {
+            let mut model = self.with_params(params).map_err(|e| to_py(py, &e))?;
+            let opts = pdyn_mech::prescribed::ForcesOptions {
+                at: at.unwrap_or_default(),
+            };
+            let res = pdyn_mech::prescribed::solve_forces(&mut model, &opts).map_err(|error| {
+                to_py(
+                    py,
+                    &Error::Forces {
+                        origin: model.origin.clone(),
+                        error,
+                    },
+                )
+            })?;
+            let p: &Pool = &model.pool;
+            let e = |id: Id| (p.to_text(id), p.to_latex(id));
+            let out = PyDict::new(py);
+            out.set_item("instant", res.instant.clone())?;
+            out.set_item(
+                "equations",
+                res.equations
+                    .iter()
+                    .map(|q| (q.label.clone(), e(q.lhs), e(q.rhs)))
+                    .collect::<Vec<_>>(),
+            )?;
+            out.set_item("unknowns", res.unknowns.clone())?;
+            out.set_item(
+                "symbolic",
+                res.symbolic
+                    .as_ref()
+                    .map(|s| s.iter().map(|&x| e(x)).collect::<Vec<_>>()),
+            )?;
+            out.set_item("numeric", res.numeric.clone())?;
+            let checks = PyList::empty(py);
+            for c in &res.checks {
+                let d = PyDict::new(py);
+                d.set_item("name", c.name.clone())?;
+                d.set_item("condition", c.condition.clone())?;
+                d.set_item("parameter", c.parameter.clone())?;
+                d.set_item(
+                    "symbolic",
+                    c.symbolic.iter().map(|&x| e(x)).collect::<Vec<_>>(),
+                )?;
+                d.set_item("min", c.min)?;
+                d.set_item("max", c.max)?;
+                d.set_item("over", c.over.clone())?;
+                d.set_item("forces_at_critical", c.forces_at_critical.clone())?;
+                d.set_item(
+                    "critical",
+                    c.critical
+                        .iter()
+                        .map(|k| (k.value, k.forces.clone()))
+                        .collect::<Vec<_>>(),
+                )?;
+                checks.append(d)?;
+            }
+            out.set_item("checks", checks)?;
+            out.set_item("notes", res.notes.clone())?;
+            Ok(out.into_any().unbind())
+        })
+    }
+
     /// Runs the model once per value of `parameter`, in parallel (see `pdyn.Model.sweep`).
     #[pyo3(signature = (parameter, values, measures=None, t_end=None, method=None, rtol=None, atol=None, max_step=None, dt=None, points=None, threads=None, params=None))]
     #[allow(clippy::too_many_arguments)]

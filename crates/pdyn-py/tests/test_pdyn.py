@@ -354,3 +354,25 @@ def test_dense_output_interpolates_like_scipy():
         # Exact at the steps.
         plain = pdyn.solve_ivp(fun, (0, 10), [1.0, 0.0], rtol=1e-10, atol=1e-12)
         np.testing.assert_array_equal(sol.sol(plain.t), plain.y)
+
+
+def test_forces_mirror_the_cli(examples, pdyn_bin):
+    path = examples / "banked_curve.toml"
+    m = pdyn.Model.from_file(path)
+    res = m.forces()
+    code, cli = cli_json(pdyn_bin, "forces", str(path))
+    assert code == 0
+    assert res.unknowns == cli["unknowns"]
+    for ours, theirs in zip(res.values, cli["solutions"]):
+        for k, v in theirs.items():
+            assert rel(ours[k], v) <= 1e-12
+    crit = res.checks[0]["critical"]
+    assert [round(v, 9) for v, _ in crit] == \
+        [round(k["value"], 9) for k in cli["checks"][0]["critical"]]
+    # V^2 = g R (sin b -+ mu cos b)/(cos b +- mu sin b): the least and the greatest speed.
+    g, R, b, mu = 9.81, 50.0, math.radians(30), 0.2
+    vmin = math.sqrt(g * R * (math.sin(b) - mu * math.cos(b)) / (math.cos(b) + mu * math.sin(b)))
+    assert abs(crit[0][0] - vmin) < 1e-9
+    faster = m.forces(params={"V": 20.0})
+    assert faster.values[0]["N"] > res.values[0]["N"]
+    assert isinstance(res.equations[0][1], pdyn.Expr)

@@ -30,7 +30,8 @@ np = LazyModule("numpy")  # imported on first use
 
 from . import _pdyn
 from ._errors import DriftWarning, ModelError, ParameterError, PdynError
-from ._result import (DenseOutput, Derivation, EnsembleResult, Expr, OdeResult, SweepResult,
+from ._result import (DenseOutput, Derivation, EnsembleResult, Expr, ForcesResult,
+                      OdeResult, SweepResult,
                       _concat_raw, _from_ivp, _from_run)
 
 __version__ = _pdyn.__version__
@@ -45,7 +46,7 @@ def __getattr__(name: str):
 
 __all__ = [
     "Model", "solve_ivp", "methods", "OdeResult", "Derivation", "Expr", "SweepResult",
-    "EnsembleResult", "DenseOutput",
+    "EnsembleResult", "DenseOutput", "ForcesResult",
     "PdynError", "ModelError", "ParameterError", "DriftWarning", "__version__",
 ]
 
@@ -279,6 +280,17 @@ class Model:
         """The equations of motion (F = ma or the projected form), the unknowns, their exact
         solution when the system is small, and the first-order system."""
         return Derivation(self._m.derive())
+
+    def forces(self, at: Optional[Mapping[str, float]] = None,
+               params: Optional[Mapping[str, float]] = None) -> ForcesResult:
+        """The unknown forces (reactions, friction, ...) of a prescribed motion at an instant,
+        like ``pdyn forces``: ``at`` sets ``t`` and coordinates (``{"theta": 0.3}``; default:
+        the initial values), ``params`` parameter values. Returns a :class:`ForcesResult`:
+        the equations, the unknowns, their exact solution (``symbolic``) and values
+        (``values``: one dict per real solution), and the ``[[checks]]`` (critical values
+        of a parameter, e.g. the speeds at which a car skids)."""
+        raw = self._m.forces(at=_params(at), params=_params(params))
+        return ForcesResult(raw)
 
     def sweep(self, param: str, values: Sequence[float],
               measures: Optional[Mapping[str, Union[str, Tuple[str, str]]]] = None,

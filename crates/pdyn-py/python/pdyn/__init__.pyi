@@ -98,6 +98,15 @@ class EnsembleResult:
     def __getitem__(self, name: str) -> npt.NDArray[Any]: ...
     def to_pandas(self) -> Any: ...
 
+class ForcesResult:
+    instant: Dict[str, float]
+    equations: List[Tuple[str, Expr, Expr]]
+    unknowns: List[str]
+    symbolic: Optional[Dict[str, Expr]]
+    values: List[Dict[str, float]]
+    checks: List[Dict[str, Any]]
+    notes: List[str]
+
 class _Parameters(Dict[str, float]):
     def __call__(self, **values: Any) -> None: ...
 
@@ -139,6 +148,8 @@ class Model:
               max_step: Optional[float] = ..., dt: Optional[float] = ...,
               points: Optional[int] = ..., threads: Optional[int] = ...,
               params: Optional[Mapping[str, float]] = ...) -> SweepResult: ...
+    def forces(self, at: Optional[Mapping[str, float]] = ...,
+               params: Optional[Mapping[str, float]] = ...) -> ForcesResult: ...
     def check_ensemble(self, params: Any = ..., initial: Any = ...) -> List[Tuple[int, str]]: ...
     def ensemble(self, params: Any = ..., initial: Any = ...,
                  measures: Optional[Mapping[str, Union[str, Tuple[str, str]]]] = ...,

@@ -418,3 +418,42 @@ class DenseOutput:
 
     def __repr__(self) -> str:
         return f"DenseOutput({len(self.ts)} steps on [{self.t_min}, {self.t_max}])"
+
+
+class ForcesResult:
+    """The result of :meth:`pdyn.Model.forces`.
+
+    * ``instant`` -- ``{name: value}`` of ``t`` and the coordinates;
+    * ``equations`` -- ``[(label, lhs, rhs)]`` of :class:`Expr`;
+    * ``unknowns`` -- names; ``symbolic`` -- ``{unknown: Expr}`` or ``None``;
+    * ``values`` -- one ``{unknown: float}`` per real solution at the instant;
+    * ``checks`` -- one dict per ``[[checks]]``: ``name``, ``condition``, ``parameter``,
+      ``symbolic`` (list of Expr), ``min``/``max`` (``(value, at)``), ``over``,
+      ``critical`` (``[(value, {force: value})]``), ``forces_at_critical``;
+    * ``notes``.
+    """
+
+    def __init__(self, raw: Dict[str, Any]):
+        self.instant: Dict[str, float] = dict(raw["instant"])
+        self.equations = [(lab, _expr(l), _expr(r)) for lab, l, r in raw["equations"]]
+        self.unknowns: List[str] = list(raw["unknowns"])
+        sym = raw["symbolic"]
+        self.symbolic = None if sym is None else {
+            u: _expr(e) for u, e in zip(self.unknowns, sym)}
+        self.values: List[Dict[str, float]] = [dict(zip(self.unknowns, row))
+                                               for row in raw["numeric"]]
+        self.checks: List[Dict[str, Any]] = []
+        for c in raw["checks"]:
+            c = dict(c)
+            c["symbolic"] = [_expr(e) for e in c["symbolic"]]
+            c["critical"] = [(v, dict(f)) for v, f in c["critical"]]
+            c["forces_at_critical"] = dict(c["forces_at_critical"])
+            self.checks.append(c)
+        self.notes: List[str] = list(raw["notes"])
+
+    def __repr__(self) -> str:
+        return f"ForcesResult(unknowns {self.unknowns}, values {self.values})"
+
+    def _repr_latex_(self) -> str:
+        rows = " \\\\ ".join(f"{l.latex()} &= {r.latex()}" for _, l, r in self.equations)
+        return "$\\begin{aligned}" + rows + "\\end{aligned}$"
