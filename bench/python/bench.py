@@ -45,11 +45,16 @@ PLEIADES_Y0 = [float(v) for v in PX + PY + PVX + PVY]
 
 
 def pleiades_exprs():
+    # r_ij^3 is written the same way for (i, j) and (j, i), so that the compiler shares it
+    # (as a hand-written right-hand side would compute each pair once).
+    def r3(i, j):
+        a, b = min(i, j), max(i, j)
+        return f"((y{a} - y{b})^2 + (y{7 + a} - y{7 + b})^2)^(3/2)"
     out = [f"y{14 + i}" for i in range(7)] + [f"y{21 + i}" for i in range(7)]
     for axis in (0, 7):
         for i in range(7):
-            terms = [f"{j + 1}*(y{axis + j} - y{axis + i})/((y{j} - y{i})^2 + "
-                     f"(y{7 + j} - y{7 + i})^2)^(3/2)" for j in range(7) if j != i]
+            terms = [f"{j + 1}*(y{axis + j} - y{axis + i})/{r3(i, j)}" for j in range(7)
+                     if j != i]
             out.append(" + ".join(terms))
     return out
 
