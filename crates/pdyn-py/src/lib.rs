@@ -11,7 +11,7 @@ use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUnty
 use pdyn::sim::{self, sweep, Prepared, RunResult, RunSettings};
 use pdyn::Error;
 use pdyn_expr::{Id, Pool, Program};
-use pdyn_mech::model::spec::SimulateSpec;
+use pdyn_mech::model::spec::{SimulateSpec, Stat};
 use pdyn_ode::{Direction, Event, FnSystem, Method, Options, Solution, Status};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -111,7 +111,7 @@ struct PyModel {
     model: pdyn_mech::Model,
     /// The model compiled for an ensemble, keyed by its measures: an ensemble run chunk by
     /// chunk (pdyn.study) derives and compiles the model once, not once per chunk.
-    prepared: Mutex<Option<(String, Prepared)>>,
+    prepared: Mutex<Option<(String, Prepared, Vec<Stat>)>>,
 }
 
 impl PyModel {
@@ -423,7 +423,7 @@ impl PyModel {
     }
 
     /// Integrates the model; returns a dict of plain data (see `pdyn.Model.run`).
-    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, t_eval=None, max_step=None, dt=None, max_steps=None, points=None, drift_tolerance=None, params=None))]
+    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, t_eval=None, max_step=None, dt=None, max_steps=None, points=None, drift_tolerance=None, params=None, plots=None))]
     #[allow(clippy::too_many_arguments)]
     fn run(
         &self,
@@ -439,6 +439,7 @@ impl PyModel {
         points: Option<usize>,
         drift_tolerance: Option<f64>,
         params: Option<Vec<(String, f64)>>,
+        plots: Option<std::path::PathBuf>,
     ) -> PyResult<PyObject> {
         let t_eval = match t_eval {
             Some(a) => Some(a.as_slice()?.to_vec()),
@@ -467,6 +468,16 @@ impl PyModel {
                         context: "",
                         error,
                     })?;
+                    if let Some(dir) = &plots {
+                        // pdyn's own PNG/SVG plots, as `pdyn run --out DIR`.
+                        std::fs::create_dir_all(dir).map_err(|e| {
+                            Error::argument(
+                                "plots",
+                                format!("cannot create {}: {e}", dir.display()),
+                            )
+                        })?;
+                        pdyn::plots::write_run_plots(&model, &prep, &res, dir)?;
+                    }
                     let names = prep.events.iter().map(|e| e.name.clone()).collect();
                     Ok((res, prep.state_names.len(), names, set.drift_tolerance))
                 },
@@ -785,23 +796,28 @@ impl PyModel {
                 ))
             }
         };
-        let first = self
-            .model
-            .parameters
-            .first()
-            .map(|p| (p.name.clone(), p.value));
-        let base = match (&measures, first) {
-            (Some(_), Some((name, v))) => {
-                self.with_measures(py, measures.as_deref(), &name, &[v])?
+        // The compiled model and its measures' statistics, from the cache when this model
+        // already ran an ensemble with the same measures.
+        let key = format!("{measures:?}");
+        let cached = self
+            .prepared
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .as_ref()
+            .filter(|c| c.0 == key)
+            .map(|c| (c.1.clone(), c.2.clone()));
+        let base = match (&cached, &measures, self.model.parameters.first()) {
+            (Some(_), _, _) | (None, None, _) => None,
+            (None, Some(_), Some(p)) => {
+                Some(self.with_measures(py, measures.as_deref(), &p.name, &[p.value])?)
             }
-            (Some(_), None) => {
+            (None, Some(_), None) => {
                 return Err(pdyn_error(
                     py,
                     "ParameterError",
                     "measures need a model with at least one parameter".into(),
                 ))
             }
-            (None, _) => PyModel::new(self.model.clone()),
         };
         let o = Overrides {
             t_end,
@@ -816,28 +832,29 @@ impl PyModel {
         };
         let outcome = py.allow_threads(|| {
             catch_unwind(AssertUnwindSafe(|| -> Result<EnsembleOut, Error> {
-                let mut model = base.model.clone();
-                let set = Self::settings(&model, o)?;
+                let set = Self::settings(&self.model, o)?;
                 set.validate().map_err(|error| Error::Sim {
-                    origin: model.origin.clone(),
+                    origin: self.model.origin.clone(),
                     context: "",
                     error,
                 })?;
-                let key = format!("{measures:?}");
-                let cached = {
-                    let guard = self.prepared.lock().unwrap_or_else(|e| e.into_inner());
-                    guard
-                        .as_ref()
-                        .filter(|(k, _)| *k == key)
-                        .map(|(_, p)| p.clone())
-                };
-                let prep = match cached {
-                    Some(p) => p,
+                let (prep, stats) = match cached {
+                    Some(c) => c,
                     None => {
+                        let mut model = match &base {
+                            Some(b) => b.model.clone(),
+                            None => self.model.clone(),
+                        };
                         let p = Self::prepare(&mut model)?;
+                        let stats: Vec<Stat> = model
+                            .run
+                            .sweep
+                            .as_ref()
+                            .map(|s| s.measures.iter().map(|m| m.stat).collect())
+                            .unwrap_or_default();
                         *self.prepared.lock().unwrap_or_else(|e| e.into_inner()) =
-                            Some((key, p.clone()));
-                        p
+                            Some((key, p.clone(), stats.clone()));
+                        (p, stats)
                     }
                 };
                 let pidx = param_names
@@ -894,12 +911,6 @@ impl PyModel {
                     }
                     return Ok(EnsembleOut::dry(problems, &prep));
                 }
-                let stats: Vec<_> = model
-                    .run
-                    .sweep
-                    .as_ref()
-                    .map(|s| s.measures.iter().map(|m| m.stat).collect())
-                    .unwrap_or_default();
                 let ni = sidx.len();
                 let names = EnsembleOut::names(&prep);
                 let work = move || -> Vec<RunOut> {
@@ -962,7 +973,7 @@ struct RunOut {
 }
 
 /// Runs one member of an ensemble.
-fn one_run(p: &Prepared, set: &RunSettings, stats: &[pdyn_mech::model::spec::Stat]) -> RunOut {
+fn one_run(p: &Prepared, set: &RunSettings, stats: &[Stat]) -> RunOut {
     let n_meas = stats.len();
     let n_ev = p.events.len();
     let n_states = p.state_names.len();
@@ -1503,8 +1514,6 @@ fn _solve_ivp(
     };
     let d = PyDict::new(py);
     let len = sol.len();
-    d.set_item("t", f64_array(py, sol.t.clone()))?;
-    d.set_item("y_rows", f64_matrix(py, sol.y.clone(), len, n)?)?;
     let hits = PyList::empty(py);
     for h in &sol.events {
         hits.append((h.index, h.t, f64_array(py, h.y.clone())))?;
@@ -1545,6 +1554,9 @@ fn _solve_ivp(
         }
         d.set_item("f_rows", f64_matrix(py, f_rows, len, n)?)?;
     }
+    // The solution's own buffers become the arrays: no copy.
+    d.set_item("t", f64_array(py, sol.t))?;
+    d.set_item("y_rows", f64_matrix(py, sol.y, len, n)?)?;
     Ok(d.into_any().unbind())
 }
 

@@ -376,3 +376,28 @@ def test_forces_mirror_the_cli(examples, pdyn_bin):
     faster = m.forces(params={"V": 20.0})
     assert faster.values[0]["N"] > res.values[0]["N"]
     assert isinstance(res.equations[0][1], pdyn.Expr)
+
+
+def test_plots_with_and_without_matplotlib(examples, tmp_path):
+    m = pdyn.Model.from_file(examples / "projectile_drag.toml")
+    sol = m.run(plots=tmp_path / "plots")
+    written = [p.suffix for p in (tmp_path / "plots").iterdir()]
+    assert ".png" in written or ".svg" in written, written
+    pytest.importorskip("matplotlib")
+    import matplotlib
+    matplotlib.use("Agg")
+    ax = sol.plot("x", "z")
+    assert len(ax.get_lines()) == 2
+    ax = sol.plot_trajectory("x", "z")
+    np.testing.assert_array_equal(ax.get_lines()[0].get_ydata(), sol["z"])
+    ivp = pdyn.solve_ivp(["y1", "-y0"], (0, 1), [1.0, 0.0])
+    assert len(ivp.plot().get_lines()) == 2
+
+
+def test_the_trajectory_is_not_copied_beyond_one(examples):
+    sol = pdyn.Model.from_file(examples / "projectile_drag.toml").run()
+    table = dict.__getitem__(sol, "_table")
+    assert np.shares_memory(sol.y, table) and np.shares_memory(sol.t, table)
+    assert table.flags.owndata or table.base is not None
+    ivp = pdyn.solve_ivp(["y1", "-y0"], (0, 1), [1.0, 0.0])
+    assert ivp.y.shape == (2, len(ivp.t)) and ivp.y.base is not None

@@ -255,7 +255,8 @@ class Model:
             t_eval: Optional[Sequence[float]] = None, max_step: Optional[float] = None,
             dt: Optional[float] = None, max_steps: Optional[int] = None,
             points: Optional[int] = None, drift_tolerance: Optional[float] = None,
-            params: Optional[Mapping[str, float]] = None) -> OdeResult:
+            params: Optional[Mapping[str, float]] = None,
+            plots: Optional[Union[str, "os.PathLike[str]"]] = None) -> OdeResult:
         """Integrates the equations of motion, like ``pdyn run``.
 
         Every argument left ``None`` takes the model's ``[simulate]`` value, then pdyn's
@@ -263,7 +264,9 @@ class Model:
         (``"RK45"``, ``"DOP853"``, ``"Radau"``) or pdyn's (:func:`methods`). ``t_eval``:
         output times within [0, t_end]; ``points``: that many equally spaced outputs;
         ``dt``: the fixed step (symplectic methods, RK4) or the first step; ``params``:
-        parameter values (checked like ``pdyn run --set``).
+        parameter values (checked like ``pdyn run --set``); ``plots``: a directory where
+        pdyn's own PNG/SVG plots are written, as ``pdyn run --out DIR`` (no matplotlib
+        needed; ``sol.plot()`` and ``sol.plot_trajectory()`` use matplotlib).
 
         Returns an :class:`OdeResult` (``success=False`` with the partial solution when the
         integration fails). Warns :class:`DriftWarning` when a conserved quantity drifts
@@ -273,7 +276,8 @@ class Model:
         te = None if t_eval is None else _array1(t_eval, "t_eval")
         raw = self._m.run(t_end=t_end, method=method, rtol=rtol, atol=atol, t_eval=te,
                           max_step=max_step, dt=dt, max_steps=max_steps, points=points,
-                          drift_tolerance=drift_tolerance, params=_params(params))
+                          drift_tolerance=drift_tolerance, params=_params(params),
+                          plots=None if plots is None else os.fspath(plots))
         return _from_run(raw, list(raw["event_names"]))
 
     def derive(self) -> Derivation:

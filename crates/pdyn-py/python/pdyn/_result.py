@@ -19,7 +19,8 @@ class OdeResult(dict):
     Attributes (also available as ``sol["name"]`` for SciPy's own fields):
 
     * ``t`` -- output times, 1-D float64 array of length ``n_times``;
-    * ``y`` -- states, 2-D float64 array of shape ``(n_states, n_times)``;
+    * ``y`` -- states, 2-D float64 array of shape ``(n_states, n_times)`` (a transposed view
+      of the one table the run produced: the trajectory is copied once, from the solver);
     * ``t_events``, ``y_events`` -- one array per event (``None`` without events);
     * ``status`` (0 end reached, 1 terminal event, -1 integration failed), ``message``,
       ``success``;
@@ -79,6 +80,54 @@ class OdeResult(dict):
         return pd.DataFrame(data, columns=list(cols))
 
 
+def _plot_axes(ax):
+    if ax is None:
+        try:
+            import matplotlib.pyplot as plt
+        except ImportError as e:
+            raise ImportError("plot() needs matplotlib: pip install matplotlib (or run a model "
+                              "with plots=DIR for pdyn's own PNG/SVG plots)") from e
+        _, ax = plt.subplots()
+    return ax
+
+
+def _plot(self, *names: str, ax=None):
+    """Plots columns against ``t`` (default: the states) with matplotlib; returns the axes."""
+    ax = _plot_axes(ax)
+    cols = self.get("columns")
+    if not names:
+        names = tuple(cols[1:1 + self["y"].shape[0]]) if cols else tuple(
+            f"y{k}" for k in range(self["y"].shape[0]))
+    for name in names:
+        if cols and name in cols:
+            data = self.column(name)
+        else:
+            data = self["y"][int(name[1:])]
+        ax.plot(self["t"], data, label=name)
+    ax.set_xlabel("t")
+    ax.legend()
+    return ax
+
+
+def _plot_trajectory(self, x: str = None, y: str = None, ax=None):
+    """Plots column ``y`` against column ``x`` (default: the first two coordinates, or
+    ``y0``, ``y1``) with matplotlib, equal aspect; returns the axes."""
+    ax = _plot_axes(ax)
+    cols = self.get("columns")
+    if x is None or y is None:
+        x, y = (cols[1], cols[2]) if cols and len(cols) > 2 else ("y0", "y1")
+    get = (lambda n: self.column(n)) if cols else (lambda n: self["y"][int(n[1:])])
+    ax.plot(get(x), get(y))
+    ax.set_xlabel(x)
+    ax.set_ylabel(y)
+    ax.set_aspect("equal", adjustable="datalim")
+    return ax
+
+
+OdeResult.plot = _plot
+OdeResult.plot_trajectory = _plot_trajectory
+
+
 def _stats_counts(stats: Dict[str, Any]) -> Dict[str, int]:
     return {
         "nfev": stats["fevals"],
@@ -107,8 +156,9 @@ def _from_run(raw: Dict[str, Any], event_names: List[str]) -> OdeResult:
         for nm in names
     ]
     res = OdeResult(
-        t=np.ascontiguousarray(table[:, 0]),
-        y=np.ascontiguousarray(table[:, 1:1 + n].T),
+        # Views of the one table the run produced: the trajectory is not copied again.
+        t=table[:, 0],
+        y=table[:, 1:1 + n].T,
         t_events=t_events if names else None,
         y_events=y_events if names else None,
         event_names=names,
@@ -153,7 +203,7 @@ def _from_ivp(raw: Dict[str, Any], n_events: int, n: int) -> OdeResult:
                     for k in range(n_events)]
     return OdeResult(
         t=raw["t"],
-        y=np.ascontiguousarray(raw["y_rows"].T),
+        y=raw["y_rows"].T,  # a view: (n_states, n_times) as SciPy, not copied
         t_events=t_events,
         y_events=y_events,
         status=raw["status"],
