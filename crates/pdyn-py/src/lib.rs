@@ -1011,7 +1011,7 @@ fn one_run(p: &Prepared, set: &RunSettings, stats: &[Stat]) -> RunOut {
     }
     for m in res.monitors.iter().filter(|m| m.conserved) {
         out.drifts.push(m.drift);
-        if !(m.drift <= set.drift_tolerance) {
+        if m.drift.is_nan() || m.drift > set.drift_tolerance {
             out.drifted = true;
         }
     }
