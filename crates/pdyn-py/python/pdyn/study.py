@@ -429,6 +429,8 @@ class Study:
             for k, v in measures.items()}
         self.chunk_size, self.out = int(chunk_size), out
         self._matrix: Optional[np.ndarray] = None
+        self._key: Optional[str] = None
+        self._meta: Optional[Dict[str, Any]] = None
         self._split: Optional[Tuple[List[str], List[int], List[str], List[int]]] = None
 
     # -- the design against the model ----------------------------------------------------
@@ -504,6 +506,11 @@ class Study:
 
     def metadata(self) -> Dict[str, Any]:
         """What makes a result file reproducible on its own."""
+        if self._meta is None:
+            self._meta = self._metadata()
+        return dict(self._meta)
+
+    def _metadata(self) -> Dict[str, Any]:
         from . import __version__
         return {"model": self.model.source, "origin": self.model._m.origin,
                 "pdyn_version": __version__, "design": self.design.describe(),
@@ -511,11 +518,15 @@ class Study:
                 "settings": self.settings, "chunk_size": self.chunk_size}
 
     def _study_key(self) -> str:
+        # Computed once: it hashes the whole design (a per-chunk cost otherwise).
+        if self._key is not None:
+            return self._key
         meta = self.metadata()
         meta.pop("pdyn_version")
         h = hashlib.sha256(json.dumps(meta, sort_keys=True, default=str).encode())
         h.update(self.matrix().tobytes())
-        return h.hexdigest()
+        self._key = h.hexdigest()
+        return self._key
 
     def chunk_key(self, index: int, a: int, b: int) -> str:
         """The checkpoint key of a chunk: a hash of model, design, measures, settings and
