@@ -22,7 +22,7 @@ if [ ! -x "$venv/bin/python" ]; then
     python3 -m venv "$venv"
 fi
 "$venv/bin/pip" install --quiet --upgrade maturin pytest numpy scipy pandas sympy \
-    "dask[distributed]" pyarrow tqdm nbmake ipykernel matplotlib
+    "dask[distributed]" pyarrow tqdm xarray nbmake ipykernel matplotlib
 # A debug build of the extension, installed into the venv.
 (cd crates/pdyn-py && VIRTUAL_ENV="$venv" PATH="$venv/bin:$PATH" "$venv/bin/maturin" develop --quiet)
 

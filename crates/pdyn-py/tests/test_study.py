@@ -209,3 +209,22 @@ def test_cli_runs_a_study_file_and_resumes(examples, tmp_path, capsys):
     bad.write_text('[design]\nkind = "grid"\nvariables.v0 = []\n')
     assert pdyn.study.main([args[0], "--design", str(bad), "--out", str(out)]) == 2
     assert "empty grid" in capsys.readouterr().err
+
+
+def test_grid_as_xarray_plot_and_progress(examples):
+    m = kremlin(examples)
+    res = Study(m, Grid(v0=[10.0, 11.0, 12.0], theta=[0.6, 0.7]), measures=MEASURES).run(
+        progress=True)
+    assert res.chunks_run == 1 and len(res.table) == 6
+    xr = pytest.importorskip("xarray")
+    ds = res.to_xarray()
+    assert isinstance(ds, xr.Dataset) and ds["range"].shape == (3, 2)
+    assert ds["range"].sel(v0=11.0, theta=0.7).item() == \
+        res.table.query("v0 == 11.0 and theta == 0.7")["range"].item()
+    pytest.importorskip("matplotlib")
+    import matplotlib
+    matplotlib.use("Agg")
+    ax = res.plot("range", bins=3)
+    assert ax.get_xlabel() == "range"
+    ens = m.ensemble(params={"v0": np.linspace(10, 12, 40)}, progress=True)
+    np.testing.assert_array_equal(ens.final, m.ensemble(params={"v0": np.linspace(10, 12, 40)}).final)
