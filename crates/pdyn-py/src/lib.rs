@@ -142,37 +142,8 @@ impl PyModel {
     /// The loaded model with `params` applied as `pdyn run --set` applies them.
     fn with_params(&self, params: Option<Vec<(String, f64)>>) -> Result<pdyn_mech::Model, Error> {
         let mut model = self.model.clone();
-        let Some(params) = params else {
-            return Ok(model);
-        };
-        for (k, v) in &params {
-            match model.parameters.iter_mut().find(|p| &p.name == k) {
-                Some(p) => p.value = *v,
-                None => {
-                    let names: Vec<&str> = self
-                        .model
-                        .parameters
-                        .iter()
-                        .map(|p| p.name.as_str())
-                        .collect();
-                    return Err(Error::argument(
-                        "params",
-                        format!(
-                            "`{k}` is not a parameter (parameters: {})",
-                            names.join(", ")
-                        ),
-                    ));
-                }
-            }
-        }
-        if !params.is_empty() {
-            pdyn_mech::validity::check_parameter_values(&mut model).map_err(|error| {
-                Error::Value {
-                    origin: model.origin.clone(),
-                    option: "params".into(),
-                    error,
-                }
-            })?;
+        if let Some(params) = params {
+            pdyn::params::set_parameter_values(&mut model, &params, "params")?;
         }
         Ok(model)
     }

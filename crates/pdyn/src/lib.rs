@@ -5,6 +5,7 @@
 
 pub mod error;
 pub mod output;
+pub mod params;
 pub mod plots;
 pub mod sim;
 

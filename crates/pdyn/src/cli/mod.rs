@@ -149,30 +149,8 @@ pub fn numeric_pairs(list: &[String], flag: &str) -> Result<Vec<(String, f64)>, 
 
 /// Applies `--set name=value` (numbers) to a model's parameters.
 pub fn set_parameters(model: &mut pdyn_mech::Model, set: &[String]) -> Result<(), Error> {
-    for (k, v) in numeric_pairs(set, "--set")? {
-        match model.parameters.iter_mut().find(|p| p.name == k) {
-            Some(p) => p.value = v,
-            None => {
-                let names: Vec<&str> = model.parameters.iter().map(|p| p.name.as_str()).collect();
-                return Err(Error::argument(
-                    "--set",
-                    format!(
-                        "--set: `{k}` is not a parameter (parameters: {})",
-                        names.join(", ")
-                    ),
-                ));
-            }
-        }
-    }
-    if !set.is_empty() {
-        pdyn_mech::parameters::refresh_initial_values(model);
-        pdyn_mech::validity::check_parameter_values(model).map_err(|error| Error::Value {
-            origin: model.origin.clone(),
-            option: "--set".into(),
-            error,
-        })?;
-    }
-    Ok(())
+    let values = numeric_pairs(set, "--set")?;
+    pdyn::params::set_parameter_values(model, &values, "--set")
 }
 
 /// Splits at top-level commas (not inside parentheses or brackets).
