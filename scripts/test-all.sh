@@ -5,7 +5,8 @@
 #   SKIP_CARGO=1 scripts/test-all.sh   # only the Python part
 #
 # The venv lives in target/venv-test (ignored with target/); pip needs PyPI for maturin,
-# pytest, numpy (and scipy, pandas, sympy, which some tests use and skip without).
+# pytest, numpy (and scipy, pandas, sympy, dask.distributed, pyarrow, which some tests use
+# and skip without; nbmake, ipykernel and matplotlib run the notebooks).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
@@ -20,12 +21,15 @@ venv="$root/target/venv-test"
 if [ ! -x "$venv/bin/python" ]; then
     python3 -m venv "$venv"
 fi
-"$venv/bin/pip" install --quiet --upgrade maturin pytest numpy scipy pandas sympy
+"$venv/bin/pip" install --quiet --upgrade maturin pytest numpy scipy pandas sympy \
+    "dask[distributed]" pyarrow tqdm xarray nbmake ipykernel matplotlib
 # A debug build of the extension, installed into the venv.
 (cd crates/pdyn-py && VIRTUAL_ENV="$venv" PATH="$venv/bin:$PATH" "$venv/bin/maturin" develop --quiet)
 
 set +e
-PDYN_BIN="$root/target/debug/pdyn" "$venv/bin/python" -m pytest -q crates/pdyn-py/tests
+# The package's tests, then the notebooks of examples/notebooks executed by nbmake.
+PDYN_BIN="$root/target/debug/pdyn" "$venv/bin/python" -m pytest -q crates/pdyn-py/tests \
+    --nbmake examples/notebooks
 code=$?
 set -e
 if [ "$code" -eq 5 ]; then

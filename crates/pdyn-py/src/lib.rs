@@ -7,17 +7,18 @@
 //! with the GIL released, except when they must call back into Python.
 #![warn(missing_docs)]
 
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pdyn::sim::{self, sweep, Prepared, RunResult, RunSettings};
 use pdyn::Error;
 use pdyn_expr::{Id, Pool, Program};
-use pdyn_mech::model::spec::SimulateSpec;
+use pdyn_mech::model::spec::{SimulateSpec, Stat};
 use pdyn_ode::{Direction, Event, FnSystem, Method, Options, Solution, Status};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::cell::RefCell;
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::Mutex;
 
 /// Builds an instance of an exception class of `pdyn._errors`.
 fn py_error<'py>(
@@ -108,6 +109,18 @@ fn method_name(name: &str) -> String {
 #[pyclass(module = "pdyn._pdyn", name = "Model", frozen)]
 struct PyModel {
     model: pdyn_mech::Model,
+    /// The model compiled for an ensemble, keyed by its measures: an ensemble run chunk by
+    /// chunk (pdyn.study) derives and compiles the model once, not once per chunk.
+    prepared: Mutex<Option<(String, Prepared, Vec<Stat>)>>,
+}
+
+impl PyModel {
+    fn new(model: pdyn_mech::Model) -> PyModel {
+        PyModel {
+            model,
+            prepared: Mutex::new(None),
+        }
+    }
 }
 
 /// The run settings given from Python (any may be `None`: the model's `[simulate]` applies).
@@ -129,39 +142,48 @@ impl PyModel {
     /// The loaded model with `params` applied as `pdyn run --set` applies them.
     fn with_params(&self, params: Option<Vec<(String, f64)>>) -> Result<pdyn_mech::Model, Error> {
         let mut model = self.model.clone();
-        let Some(params) = params else {
-            return Ok(model);
-        };
-        for (k, v) in &params {
-            match model.parameters.iter_mut().find(|p| &p.name == k) {
-                Some(p) => p.value = *v,
-                None => {
-                    let names: Vec<&str> = self
-                        .model
-                        .parameters
-                        .iter()
-                        .map(|p| p.name.as_str())
-                        .collect();
-                    return Err(Error::argument(
-                        "params",
-                        format!(
-                            "`{k}` is not a parameter (parameters: {})",
-                            names.join(", ")
-                        ),
-                    ));
-                }
-            }
-        }
-        if !params.is_empty() {
-            pdyn_mech::validity::check_parameter_values(&mut model).map_err(|error| {
-                Error::Value {
-                    origin: model.origin.clone(),
-                    option: "params".into(),
-                    error,
-                }
-            })?;
+        if let Some(params) = params {
+            pdyn::params::set_parameter_values(&mut model, &params, "params")?;
         }
         Ok(model)
+    }
+
+    /// The model with `measures` (`(name, expression, statistic)`) written into its
+    /// `[sweep]` table and reloaded, so that they are checked and compiled exactly as a file's
+    /// measures; the model itself when `measures` is `None`.
+    fn with_measures(
+        &self,
+        py: Python<'_>,
+        measures: Option<&[(String, String, String)]>,
+        parameter: &str,
+        values: &[f64],
+    ) -> PyResult<PyModel> {
+        let Some(ms) = measures else {
+            return Ok(PyModel::new(self.model.clone()));
+        };
+        let mut table: toml::Table = toml::from_str(&self.model.source)
+            .map_err(|e| pdyn_error(py, "PdynError", e.to_string()))?;
+        let mut sw = toml::Table::new();
+        sw.insert("parameter".into(), toml::Value::String(parameter.into()));
+        sw.insert(
+            "values".into(),
+            toml::Value::Array(values.iter().map(|&v| toml::Value::Float(v)).collect()),
+        );
+        let mut mt = toml::Table::new();
+        for (name, of, stat) in ms {
+            let mut one = toml::Table::new();
+            one.insert("of".into(), toml::Value::String(of.clone()));
+            one.insert("stat".into(), toml::Value::String(stat.clone()));
+            mt.insert(name.clone(), toml::Value::Table(one));
+        }
+        sw.insert("measures".into(), toml::Value::Table(mt));
+        table.insert("sweep".into(), toml::Value::Table(sw));
+        let text =
+            toml::to_string(&table).map_err(|e| pdyn_error(py, "PdynError", e.to_string()))?;
+        let origin = format!("{} (with the measures)", self.model.origin);
+        Ok(PyModel::new(
+            pdyn_mech::load(&text, &origin).map_err(|e| to_py(py, &load_error(&text, e)))?,
+        ))
     }
 
     fn settings(model: &pdyn_mech::Model, o: Overrides) -> Result<RunSettings, Error> {
@@ -223,9 +245,12 @@ fn run_dict(
     res: RunResult,
     n_states: usize,
     event_names: Vec<String>,
+    drift_tolerance: f64,
 ) -> PyResult<PyObject> {
     let d = PyDict::new(py);
     d.set_item("event_names", event_names)?;
+    d.set_item("status", res.status.code())?;
+    d.set_item("drift_tolerance", drift_tolerance)?;
     let rows = res.rows.len();
     let cols = res.columns.len();
     let flat: Vec<f64> = res.rows.into_iter().flatten().collect();
@@ -328,7 +353,7 @@ impl PyModel {
     fn from_toml(py: Python<'_>, text: &str, origin: &str) -> PyResult<PyModel> {
         guarded(py, || {
             pdyn_mech::load(text, origin)
-                .map(|model| PyModel { model })
+                .map(PyModel::new)
                 .map_err(|e| to_py(py, &load_error(text, e)))
         })
     }
@@ -369,7 +394,7 @@ impl PyModel {
     }
 
     /// Integrates the model; returns a dict of plain data (see `pdyn.Model.run`).
-    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, t_eval=None, max_step=None, dt=None, max_steps=None, points=None, drift_tolerance=None, params=None))]
+    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, t_eval=None, max_step=None, dt=None, max_steps=None, points=None, drift_tolerance=None, params=None, plots=None))]
     #[allow(clippy::too_many_arguments)]
     fn run(
         &self,
@@ -385,6 +410,7 @@ impl PyModel {
         points: Option<usize>,
         drift_tolerance: Option<f64>,
         params: Option<Vec<(String, f64)>>,
+        plots: Option<std::path::PathBuf>,
     ) -> PyResult<PyObject> {
         let t_eval = match t_eval {
             Some(a) => Some(a.as_slice()?.to_vec()),
@@ -404,7 +430,7 @@ impl PyModel {
         };
         let outcome = py.allow_threads(|| {
             catch_unwind(AssertUnwindSafe(
-                || -> Result<(RunResult, usize, Vec<String>), Error> {
+                || -> Result<(RunResult, usize, Vec<String>, f64), Error> {
                     let mut model = self.with_params(params)?;
                     let set = Self::settings(&model, o)?;
                     let prep = Self::prepare(&mut model)?;
@@ -413,13 +439,23 @@ impl PyModel {
                         context: "",
                         error,
                     })?;
+                    if let Some(dir) = &plots {
+                        // pdyn's own PNG/SVG plots, as `pdyn run --out DIR`.
+                        std::fs::create_dir_all(dir).map_err(|e| {
+                            Error::argument(
+                                "plots",
+                                format!("cannot create {}: {e}", dir.display()),
+                            )
+                        })?;
+                        pdyn::plots::write_run_plots(&model, &prep, &res, dir)?;
+                    }
                     let names = prep.events.iter().map(|e| e.name.clone()).collect();
-                    Ok((res, prep.state_names.len(), names))
+                    Ok((res, prep.state_names.len(), names, set.drift_tolerance))
                 },
             ))
         });
         match outcome {
-            Ok(Ok((res, n, names))) => run_dict(py, res, n, names),
+            Ok(Ok((res, n, names, tol))) => run_dict(py, res, n, names, tol),
             Ok(Err(e)) => Err(to_py(py, &e)),
             Err(_) => Err(pdyn_error(
                 py,
@@ -491,6 +527,76 @@ impl PyModel {
         })
     }
 
+    /// The unknown forces of a prescribed motion at an instant (see `pdyn.Model.forces`).
+    #[pyo3(signature = (at=None, params=None))]
+    fn forces(
+        &self,
+        py: Python<'_>,
+        at: Option<Vec<(String, f64)>>,
+        params: Option<Vec<(String, f64)>>,
+    ) -> PyResult<PyObject> {
+        guarded(py, || {
+            let mut model = self.with_params(params).map_err(|e| to_py(py, &e))?;
+            let opts = pdyn_mech::prescribed::ForcesOptions {
+                at: at.unwrap_or_default(),
+            };
+            let res = pdyn_mech::prescribed::solve_forces(&mut model, &opts).map_err(|error| {
+                to_py(
+                    py,
+                    &Error::Forces {
+                        origin: model.origin.clone(),
+                        error,
+                    },
+                )
+            })?;
+            let p: &Pool = &model.pool;
+            let e = |id: Id| (p.to_text(id), p.to_latex(id));
+            let out = PyDict::new(py);
+            out.set_item("instant", res.instant.clone())?;
+            out.set_item(
+                "equations",
+                res.equations
+                    .iter()
+                    .map(|q| (q.label.clone(), e(q.lhs), e(q.rhs)))
+                    .collect::<Vec<_>>(),
+            )?;
+            out.set_item("unknowns", res.unknowns.clone())?;
+            out.set_item(
+                "symbolic",
+                res.symbolic
+                    .as_ref()
+                    .map(|s| s.iter().map(|&x| e(x)).collect::<Vec<_>>()),
+            )?;
+            out.set_item("numeric", res.numeric.clone())?;
+            let checks = PyList::empty(py);
+            for c in &res.checks {
+                let d = PyDict::new(py);
+                d.set_item("name", c.name.clone())?;
+                d.set_item("condition", c.condition.clone())?;
+                d.set_item("parameter", c.parameter.clone())?;
+                d.set_item(
+                    "symbolic",
+                    c.symbolic.iter().map(|&x| e(x)).collect::<Vec<_>>(),
+                )?;
+                d.set_item("min", c.min)?;
+                d.set_item("max", c.max)?;
+                d.set_item("over", c.over.clone())?;
+                d.set_item("forces_at_critical", c.forces_at_critical.clone())?;
+                d.set_item(
+                    "critical",
+                    c.critical
+                        .iter()
+                        .map(|k| (k.value, k.forces.clone()))
+                        .collect::<Vec<_>>(),
+                )?;
+                checks.append(d)?;
+            }
+            out.set_item("checks", checks)?;
+            out.set_item("notes", res.notes.clone())?;
+            Ok(out.into_any().unbind())
+        })
+    }
+
     /// Runs the model once per value of `parameter`, in parallel (see `pdyn.Model.sweep`).
     #[pyo3(signature = (parameter, values, measures=None, t_end=None, method=None, rtol=None, atol=None, max_step=None, dt=None, points=None, threads=None, params=None))]
     #[allow(clippy::too_many_arguments)]
@@ -511,39 +617,7 @@ impl PyModel {
         params: Option<Vec<(String, f64)>>,
     ) -> PyResult<PyObject> {
         let values = values.as_slice()?.to_vec();
-        // Measures given from Python are written into the model's [sweep] table and the model
-        // reloaded: they are then checked and compiled exactly as a file's measures.
-        let base = match &measures {
-            Some(ms) => {
-                let mut table: toml::Table = toml::from_str(&self.model.source)
-                    .map_err(|e| pdyn_error(py, "PdynError", e.to_string()))?;
-                let mut sw = toml::Table::new();
-                sw.insert("parameter".into(), toml::Value::String(parameter.clone()));
-                sw.insert(
-                    "values".into(),
-                    toml::Value::Array(values.iter().map(|&v| toml::Value::Float(v)).collect()),
-                );
-                let mut mt = toml::Table::new();
-                for (name, of, stat) in ms {
-                    let mut one = toml::Table::new();
-                    one.insert("of".into(), toml::Value::String(of.clone()));
-                    one.insert("stat".into(), toml::Value::String(stat.clone()));
-                    mt.insert(name.clone(), toml::Value::Table(one));
-                }
-                sw.insert("measures".into(), toml::Value::Table(mt));
-                table.insert("sweep".into(), toml::Value::Table(sw));
-                let text = toml::to_string(&table)
-                    .map_err(|e| pdyn_error(py, "PdynError", e.to_string()))?;
-                let origin = format!("{} (with the sweep's measures)", self.model.origin);
-                PyModel {
-                    model: pdyn_mech::load(&text, &origin)
-                        .map_err(|e| to_py(py, &load_error(&text, e)))?,
-                }
-            }
-            None => PyModel {
-                model: self.model.clone(),
-            },
-        };
+        let base = self.with_measures(py, measures.as_deref(), &parameter, &values)?;
         let o = Overrides {
             t_end,
             method,
@@ -628,6 +702,456 @@ impl PyModel {
         d.set_item("runs", res.runs)?;
         d.set_item("seconds", res.seconds)?;
         d.set_item("threads", res.threads)?;
+        Ok(d.into_any().unbind())
+    }
+    /// Runs the model once per row of `params` (and of `initial`), in parallel on all cores
+    /// with the GIL released (see `pdyn.Model.ensemble`). With `dry_run`, only checks every
+    /// row (names, masses > 0) and returns the problems.
+    #[pyo3(signature = (param_names, params, initial_names, initial=None, measures=None, t_end=None, method=None, rtol=None, atol=None, max_step=None, dt=None, points=None, drift_tolerance=None, threads=None, dry_run=false))]
+    #[allow(clippy::too_many_arguments)]
+    fn ensemble(
+        &self,
+        py: Python<'_>,
+        param_names: Vec<String>,
+        params: PyReadonlyArray2<'_, f64>,
+        initial_names: Vec<String>,
+        initial: Option<PyReadonlyArray2<'_, f64>>,
+        measures: Option<Vec<(String, String, String)>>,
+        t_end: Option<f64>,
+        method: Option<String>,
+        rtol: Option<f64>,
+        atol: Option<f64>,
+        max_step: Option<f64>,
+        dt: Option<f64>,
+        points: Option<usize>,
+        drift_tolerance: Option<f64>,
+        threads: Option<usize>,
+        dry_run: bool,
+    ) -> PyResult<PyObject> {
+        let shape = params.shape();
+        let (runs, k) = (shape[0], shape[1]);
+        if k != param_names.len() {
+            return Err(pdyn_error(
+                py,
+                "ParameterError",
+                format!(
+                    "params has {k} columns for {} parameter names",
+                    param_names.len()
+                ),
+            ));
+        }
+        let pvals: Vec<f64> = params.as_array().iter().copied().collect();
+        let ivals: Vec<f64> = match &initial {
+            Some(a) => {
+                let sh = a.shape();
+                if sh[0] != runs || sh[1] != initial_names.len() {
+                    return Err(pdyn_error(
+                        py,
+                        "ParameterError",
+                        format!(
+                            "initial has shape ({}, {}); expected ({runs}, {}): one row per run, one column per name in initial_names",
+                            sh[0],
+                            sh[1],
+                            initial_names.len()
+                        ),
+                    ));
+                }
+                a.as_array().iter().copied().collect()
+            }
+            None if initial_names.is_empty() => Vec::new(),
+            None => {
+                return Err(pdyn_error(
+                    py,
+                    "ParameterError",
+                    "initial_names given without initial values".into(),
+                ))
+            }
+        };
+        // The compiled model and its measures' statistics, from the cache when this model
+        // already ran an ensemble with the same measures.
+        let key = format!("{measures:?}");
+        let cached = self
+            .prepared
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .as_ref()
+            .filter(|c| c.0 == key)
+            .map(|c| (c.1.clone(), c.2.clone()));
+        let base = match (&cached, &measures, self.model.parameters.first()) {
+            (Some(_), _, _) | (None, None, _) => None,
+            (None, Some(_), Some(p)) => {
+                Some(self.with_measures(py, measures.as_deref(), &p.name, &[p.value])?)
+            }
+            (None, Some(_), None) => {
+                return Err(pdyn_error(
+                    py,
+                    "ParameterError",
+                    "measures need a model with at least one parameter".into(),
+                ))
+            }
+        };
+        let o = Overrides {
+            t_end,
+            method,
+            rtol,
+            atol,
+            max_step,
+            dt,
+            points,
+            drift_tolerance,
+            ..Overrides::default()
+        };
+        let outcome = py.allow_threads(|| {
+            catch_unwind(AssertUnwindSafe(|| -> Result<EnsembleOut, Error> {
+                let set = Self::settings(&self.model, o)?;
+                set.validate().map_err(|error| Error::Sim {
+                    origin: self.model.origin.clone(),
+                    context: "",
+                    error,
+                })?;
+                let (prep, stats) = match cached {
+                    Some(c) => c,
+                    None => {
+                        let mut model = match &base {
+                            Some(b) => b.model.clone(),
+                            None => self.model.clone(),
+                        };
+                        let p = Self::prepare(&mut model)?;
+                        let stats: Vec<Stat> = model
+                            .run
+                            .sweep
+                            .as_ref()
+                            .map(|s| s.measures.iter().map(|m| m.stat).collect())
+                            .unwrap_or_default();
+                        *self.prepared.lock().unwrap_or_else(|e| e.into_inner()) =
+                            Some((key, p.clone(), stats.clone()));
+                        (p, stats)
+                    }
+                };
+                let pidx = param_names
+                    .iter()
+                    .map(|name| {
+                        prep.parameter_names
+                            .iter()
+                            .position(|p| p == name)
+                            .ok_or_else(|| {
+                                Error::argument(
+                                    "params",
+                                    format!(
+                                        "`{name}` is not a parameter (parameters: {})",
+                                        prep.parameter_names.join(", ")
+                                    ),
+                                )
+                            })
+                    })
+                    .collect::<Result<Vec<_>, _>>()?;
+                let sidx = initial_names
+                    .iter()
+                    .map(|name| {
+                        prep.state_names
+                            .iter()
+                            .position(|p| p == name)
+                            .ok_or_else(|| {
+                                Error::argument(
+                                    "initial",
+                                    format!(
+                                        "`{name}` is not a state component (state: {})",
+                                        prep.state_names.join(", ")
+                                    ),
+                                )
+                            })
+                    })
+                    .collect::<Result<Vec<_>, _>>()?;
+                let defaults = prep.system.parameters();
+                let derived = prep.derived.clone();
+                // A row's parameters: the given ones, the model's values for the rest, and the
+                // derived ones (`m = "4/3*pi*a^3*rho"`) recomputed unless given.
+                let row_params = |r: usize| -> Vec<f64> {
+                    let mut v = defaults.clone();
+                    for (j, &i) in pidx.iter().enumerate() {
+                        v[i] = pvals[r * k + j];
+                    }
+                    derived.apply(&mut v, &pidx);
+                    v
+                };
+                if dry_run {
+                    let mut problems = Vec::new();
+                    for r in 0..runs {
+                        let v = row_params(r);
+                        if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+                            problems.push((r, format!("a parameter value is not finite ({x})")));
+                        } else if let Err(e) = prep.check_parameters(&v) {
+                            problems.push((r, e.to_string()));
+                        }
+                    }
+                    return Ok(EnsembleOut::dry(problems, &prep));
+                }
+                let ni = sidx.len();
+                let names = EnsembleOut::names(&prep);
+                let work = move || -> Vec<RunOut> {
+                    use rayon::prelude::*;
+                    (0..runs)
+                        .into_par_iter()
+                        .map_with(prep.clone(), |p, r| {
+                            p.set_parameters(&row_params(r));
+                            for (j, &i) in sidx.iter().enumerate() {
+                                p.y0[i] = ivals[r * ni + j];
+                            }
+                            one_run(p, &set, &stats)
+                        })
+                        .collect()
+                };
+                let start = std::time::Instant::now();
+                let (outs, threads) = match threads {
+                    Some(n) => {
+                        let pool = rayon_pool(n)?;
+                        (pool.install(work), n.max(1))
+                    }
+                    None => (work(), rayon::current_num_threads()),
+                };
+                Ok(EnsembleOut::new(
+                    outs,
+                    names,
+                    start.elapsed().as_secs_f64(),
+                    threads,
+                ))
+            }))
+        });
+        let out = match outcome {
+            Ok(Ok(r)) => r,
+            Ok(Err(e)) => return Err(to_py(py, &e)),
+            Err(_) => {
+                return Err(pdyn_error(
+                    py,
+                    "PdynError",
+                    "internal error in pdyn during the ensemble (please report it)".into(),
+                ))
+            }
+        };
+        out.into_py_dict(py, runs)
+    }
+}
+
+/// What one run of an ensemble keeps: its measures, final state, first event hits, monitor
+/// drifts, status and the message of a problem.
+struct RunOut {
+    measures: Vec<f64>,
+    t_final: f64,
+    final_state: Vec<f64>,
+    /// `(t, state)` of each event's first occurrence.
+    events: Vec<Option<(f64, Vec<f64>)>>,
+    drifts: Vec<f64>,
+    drifted: bool,
+    status: i32,
+    nfev: usize,
+    message: Option<String>,
+}
+
+/// Runs one member of an ensemble.
+fn one_run(p: &Prepared, set: &RunSettings, stats: &[Stat]) -> RunOut {
+    let n_meas = stats.len();
+    let n_ev = p.events.len();
+    let n_states = p.state_names.len();
+    let mut out = RunOut {
+        measures: vec![f64::NAN; n_meas],
+        t_final: f64::NAN,
+        final_state: vec![f64::NAN; n_states],
+        events: vec![None; n_ev],
+        drifts: Vec::new(),
+        drifted: false,
+        status: -2,
+        nfev: 0,
+        message: None,
+    };
+    let res = match sim::run(p, set) {
+        Ok(r) => r,
+        Err(e) => {
+            out.message = Some(e.to_string());
+            return out;
+        }
+    };
+    out.status = res.status.code();
+    out.nfev = res.stats.fevals;
+    out.message = res.failure.as_ref().map(|f| f.to_string());
+    if let Some(last) = res.rows.last() {
+        out.t_final = last[0];
+        out.final_state.copy_from_slice(&last[1..1 + n_states]);
+    }
+    for e in &res.events {
+        if let Some(i) = p.events.iter().position(|pe| pe.name == e.name) {
+            if out.events[i].is_none() {
+                out.events[i] = Some((e.t, e.state.clone()));
+            }
+        }
+    }
+    for m in res.monitors.iter().filter(|m| m.conserved) {
+        out.drifts.push(m.drift);
+        if m.drift.is_nan() || m.drift > set.drift_tolerance {
+            out.drifted = true;
+        }
+    }
+    if let Some(m) = &p.measures {
+        let n = p.system.n;
+        let mut series = vec![Vec::with_capacity(res.rows.len()); n_meas];
+        let mut ts = Vec::with_capacity(res.rows.len());
+        let mut input = Vec::new();
+        let mut vals = vec![0.0; n_meas];
+        for row in &res.rows {
+            p.system
+                .observation_input(row[0], &row[1..1 + 2 * n], &mut input);
+            m.eval(&input, &mut vals);
+            ts.push(row[0]);
+            for (s, &o) in series.iter_mut().zip(&vals) {
+                s.push(o);
+            }
+        }
+        for (j, s) in series.iter().enumerate() {
+            out.measures[j] = sweep::statistic(stats[j], &ts, s);
+        }
+    }
+    out
+}
+
+/// The names of an ensemble's measures, events, state components and conserved monitors.
+type Names = (Vec<String>, Vec<String>, Vec<String>, Vec<String>);
+
+/// An ensemble's results, gathered column by column.
+struct EnsembleOut {
+    measure_names: Vec<String>,
+    event_names: Vec<String>,
+    state_names: Vec<String>,
+    monitor_names: Vec<String>,
+    outs: Vec<RunOut>,
+    problems: Vec<(usize, String)>,
+    seconds: f64,
+    threads: usize,
+}
+
+impl EnsembleOut {
+    fn names(prep: &Prepared) -> Names {
+        let measures = prep
+            .measures
+            .as_ref()
+            .map(|m| m.names.clone())
+            .unwrap_or_default();
+        let events = prep.events.iter().map(|e| e.name.clone()).collect();
+        let monitors = prep
+            .observer
+            .names
+            .iter()
+            .zip(&prep.conserved)
+            .filter(|(_, &c)| c)
+            .map(|(n, _)| n.clone())
+            .collect();
+        (measures, events, prep.state_names.clone(), monitors)
+    }
+
+    fn dry(problems: Vec<(usize, String)>, prep: &Prepared) -> EnsembleOut {
+        let (measure_names, event_names, state_names, monitor_names) = Self::names(prep);
+        EnsembleOut {
+            measure_names,
+            event_names,
+            state_names,
+            monitor_names,
+            outs: Vec::new(),
+            problems,
+            seconds: 0.0,
+            threads: 0,
+        }
+    }
+
+    fn new(outs: Vec<RunOut>, names: Names, seconds: f64, threads: usize) -> EnsembleOut {
+        let (measure_names, event_names, state_names, monitor_names) = names;
+        let problems = outs
+            .iter()
+            .enumerate()
+            .filter_map(|(r, o)| o.message.clone().map(|m| (r, m)))
+            .collect();
+        EnsembleOut {
+            measure_names,
+            event_names,
+            state_names,
+            monitor_names,
+            outs,
+            problems,
+            seconds,
+            threads,
+        }
+    }
+
+    fn into_py_dict(self, py: Python<'_>, runs: usize) -> PyResult<PyObject> {
+        let d = PyDict::new(py);
+        d.set_item("problems", self.problems)?;
+        d.set_item("measure_names", &self.measure_names)?;
+        d.set_item("event_names", &self.event_names)?;
+        d.set_item("state_names", &self.state_names)?;
+        d.set_item("monitor_names", &self.monitor_names)?;
+        d.set_item("seconds", self.seconds)?;
+        d.set_item("threads", self.threads)?;
+        if self.outs.is_empty() && runs > 0 {
+            return Ok(d.into_any().unbind());
+        }
+        let o = &self.outs;
+        let ns = self.state_names.len();
+        let nm = self.measure_names.len();
+        let ne = self.event_names.len();
+        let nd = self.monitor_names.len();
+        let flat = |f: &dyn Fn(&RunOut) -> Vec<f64>| -> Vec<f64> { o.iter().flat_map(f).collect() };
+        d.set_item(
+            "measures",
+            f64_matrix(py, flat(&|r| r.measures.clone()), runs, nm)?,
+        )?;
+        d.set_item(
+            "t_final",
+            f64_array(py, o.iter().map(|r| r.t_final).collect()),
+        )?;
+        d.set_item(
+            "final",
+            f64_matrix(py, flat(&|r| r.final_state.clone()), runs, ns)?,
+        )?;
+        d.set_item(
+            "event_t",
+            f64_matrix(
+                py,
+                flat(&|r| {
+                    r.events
+                        .iter()
+                        .map(|e| e.as_ref().map_or(f64::NAN, |x| x.0))
+                        .collect()
+                }),
+                runs,
+                ne,
+            )?,
+        )?;
+        let ev_state = flat(&|r| {
+            r.events
+                .iter()
+                .flat_map(|e| match e {
+                    Some((_, y)) => y.clone(),
+                    None => vec![f64::NAN; ns],
+                })
+                .collect()
+        });
+        let a = PyArray1::from_vec(py, ev_state);
+        d.set_item("event_state", a.reshape([runs, ne, ns])?)?;
+        d.set_item(
+            "drift",
+            f64_matrix(
+                py,
+                flat(&|r| {
+                    if r.drifts.len() == nd {
+                        r.drifts.clone()
+                    } else {
+                        vec![f64::NAN; nd]
+                    }
+                }),
+                runs,
+                nd,
+            )?,
+        )?;
+        d.set_item("drifted", o.iter().map(|r| r.drifted).collect::<Vec<_>>())?;
+        d.set_item("status", o.iter().map(|r| r.status).collect::<Vec<_>>())?;
+        d.set_item("nfev", o.iter().map(|r| r.nfev).collect::<Vec<_>>())?;
         Ok(d.into_any().unbind())
     }
 }
@@ -814,7 +1338,7 @@ fn integrate(
 /// `solve_ivp`'s Rust part: returns a dict of plain data (`pdyn.solve_ivp` builds the
 /// `OdeResult`). `fun` is a callable `fun(t, y)` or a list of expression strings.
 #[pyfunction]
-#[pyo3(signature = (fun, t0, tf, y0, method, t_eval, rtol, atol, max_step, first_step, max_steps, events, args))]
+#[pyo3(signature = (fun, t0, tf, y0, method, t_eval, rtol, atol, max_step, first_step, max_steps, events, args, dense=false))]
 #[allow(clippy::too_many_arguments)]
 fn _solve_ivp(
     py: Python<'_>,
@@ -831,6 +1355,7 @@ fn _solve_ivp(
     max_steps: Option<usize>,
     events: Vec<(Bound<'_, PyAny>, Option<usize>, i32)>,
     args: Vec<(String, f64)>,
+    dense: bool,
 ) -> PyResult<PyObject> {
     let y0 = y0.as_slice()?.to_vec();
     let n = y0.len();
@@ -964,8 +1489,6 @@ fn _solve_ivp(
     };
     let d = PyDict::new(py);
     let len = sol.len();
-    d.set_item("t", f64_array(py, sol.t.clone()))?;
-    d.set_item("y_rows", f64_matrix(py, sol.y.clone(), len, n)?)?;
     let hits = PyList::empty(py);
     for h in &sol.events {
         hits.append((h.index, h.t, f64_array(py, h.y.clone())))?;
@@ -976,6 +1499,39 @@ fn _solve_ivp(
     d.set_item("status", status)?;
     d.set_item("method", sol.method.name())?;
     d.set_item("gil_released", all_compiled)?;
+    if dense {
+        // f(t, y) at every output point, for the Hermite interpolant of `sol.sol` (extra
+        // evaluations, not counted in nfev).
+        let mut f_rows = vec![0.0; len * n];
+        match &rhs {
+            Rhs::Compiled(p) => {
+                let ev = Evaluator::new(p, n, &args);
+                for k in 0..len {
+                    ev.eval(sol.t[k], sol.y_at(k), &mut f_rows[k * n..(k + 1) * n]);
+                }
+            }
+            Rhs::Callable(func) => {
+                let np = py.import("numpy")?;
+                for k in 0..len {
+                    let arr = PyArray1::from_slice(py, sol.y_at(k));
+                    let v = func.call1(py, (sol.t[k], arr))?;
+                    let v = np.call_method1("asarray", (v, "float64"))?;
+                    let v: Vec<f64> = v.call_method0("ravel")?.extract()?;
+                    if v.len() != n {
+                        return Err(PyErr::new::<pyo3::exceptions::PyValueError, _>(format!(
+                            "fun returned {} values for {n} states",
+                            v.len()
+                        )));
+                    }
+                    f_rows[k * n..(k + 1) * n].copy_from_slice(&v);
+                }
+            }
+        }
+        d.set_item("f_rows", f64_matrix(py, f_rows, len, n)?)?;
+    }
+    // The solution's own buffers become the arrays: no copy.
+    d.set_item("t", f64_array(py, sol.t))?;
+    d.set_item("y_rows", f64_matrix(py, sol.y, len, n)?)?;
     Ok(d.into_any().unbind())
 }
 

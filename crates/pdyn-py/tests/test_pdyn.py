@@ -281,3 +281,123 @@ def test_from_file_error_names_the_file_and_methods_are_listed(tmp_path):
         pdyn.Model.from_file(
             pathlib.Path(__file__).resolve().parents[3] / "examples" / "kremlin_stone.toml"
         ).run(method="nope")
+
+
+PENDULUM_TOML = '''name = "pendulum"
+gravity = "[0, -g, 0]"
+[parameters]
+g = 9.81
+L = 1.0
+m = 1.0
+[coordinates]
+q = { initial = 0.3, rate = 0.0 }
+[particles.bob]
+mass = "m"
+position = "L*[sin(q), -cos(q), 0]"
+'''
+
+
+def test_builder_model_derives_the_same_equations_as_its_toml():
+    m = pdyn.Model("pendulum")
+    q = m.coordinate("q", initial=0.3, rate=0.0)
+    assert q == "q"
+    m.particle("bob", mass="m", position="L*[sin(q), -cos(q), 0]")
+    m.gravity("[0, -g, 0]")
+    m.parameters(g=9.81, L=1, m=1)
+    assert m.parameters == {"g": 9.81, "L": 1.0, "m": 1.0}
+    built = m.derive()
+    loaded = pdyn.Model.from_toml(PENDULUM_TOML).derive()
+    assert [(l, str(a), str(b)) for l, a, b in built.equations] == \
+        [(l, str(a), str(b)) for l, a, b in loaded.equations]
+    assert [(s, str(e)) for s, e in built.first_order] == \
+        [(s, str(e)) for s, e in loaded.first_order]
+    a = m.run(t_end=2.0, rtol=1e-10, atol=1e-12)
+    b = pdyn.Model.from_toml(PENDULUM_TOML).run(t_end=2.0, rtol=1e-10, atol=1e-12)
+    np.testing.assert_array_equal(a.y, b.y)
+    with pytest.raises(pdyn.ParameterError, match="loaded"):
+        pdyn.Model.from_toml(PENDULUM_TOML).parameters(g=1.0)
+    sympy = pytest.importorskip("sympy")
+    L, qs = sympy.symbols("L q")
+    s = pdyn.Model("pendulum")
+    s.coordinate("q", initial=0.3)
+    s.particle("bob", mass="m", position=[L * sympy.sin(qs), -L * sympy.cos(qs), 0])
+    s.gravity("[0, -g, 0]")
+    s.parameters(g=9.81, L=1, m=1)
+    c = s.run(t_end=2.0, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(c.y, b.y, rtol=0, atol=1e-9)
+
+
+def test_notebooks_are_stored_without_outputs(examples):
+    notebooks = sorted((examples / "notebooks").glob("*.ipynb"))
+    assert {p.name for p in notebooks} >= {"satellite_drift.ipynb", "building_resonance.ipynb",
+                                           "pendulum_chain.ipynb"}
+    for p in notebooks:
+        nb = json.loads(p.read_text())
+        for cell in nb["cells"]:
+            if cell["cell_type"] == "code":
+                assert cell["outputs"] == [] and cell["execution_count"] is None, p.name
+
+
+def test_dense_output_interpolates_like_scipy():
+    for fun in (["y1", "-y0"], lambda t, y: [y[1], -y[0]]):
+        te = np.linspace(0, 10, 7)
+        sol = pdyn.solve_ivp(fun, (0, 10), [1.0, 0.0], rtol=1e-10, atol=1e-12,
+                             dense_output=True, t_eval=te)
+        assert sol.t.shape == (7,) and sol.sol is not None
+        tt = np.linspace(0, 10, 1001)
+        y = sol.sol(tt)
+        assert y.shape == (2, 1001) and sol.sol(3.0).shape == (2,)
+        h = np.max(np.diff(sol.sol.ts))
+        # Cubic Hermite: error <= h^4/384 max|y''''| (= 1 here), plus the solver's error.
+        assert np.max(np.abs(y[0] - np.cos(tt))) < h**4 / 384 + 1e-8
+        np.testing.assert_allclose(sol.sol(te), sol.y, rtol=0, atol=h**4 / 384 + 1e-8)
+        # Exact at the steps.
+        plain = pdyn.solve_ivp(fun, (0, 10), [1.0, 0.0], rtol=1e-10, atol=1e-12)
+        np.testing.assert_array_equal(sol.sol(plain.t), plain.y)
+
+
+def test_forces_mirror_the_cli(examples, pdyn_bin):
+    path = examples / "banked_curve.toml"
+    m = pdyn.Model.from_file(path)
+    res = m.forces()
+    code, cli = cli_json(pdyn_bin, "forces", str(path))
+    assert code == 0
+    assert res.unknowns == cli["unknowns"]
+    for ours, theirs in zip(res.values, cli["solutions"]):
+        for k, v in theirs.items():
+            assert rel(ours[k], v) <= 1e-12
+    crit = res.checks[0]["critical"]
+    assert [round(v, 9) for v, _ in crit] == \
+        [round(k["value"], 9) for k in cli["checks"][0]["critical"]]
+    # V^2 = g R (sin b -+ mu cos b)/(cos b +- mu sin b): the least and the greatest speed.
+    g, R, b, mu = 9.81, 50.0, math.radians(30), 0.2
+    vmin = math.sqrt(g * R * (math.sin(b) - mu * math.cos(b)) / (math.cos(b) + mu * math.sin(b)))
+    assert abs(crit[0][0] - vmin) < 1e-9
+    faster = m.forces(params={"V": 20.0})
+    assert faster.values[0]["N"] > res.values[0]["N"]
+    assert isinstance(res.equations[0][1], pdyn.Expr)
+
+
+def test_plots_with_and_without_matplotlib(examples, tmp_path):
+    m = pdyn.Model.from_file(examples / "projectile_drag.toml")
+    sol = m.run(plots=tmp_path / "plots")
+    written = [p.suffix for p in (tmp_path / "plots").iterdir()]
+    assert ".png" in written or ".svg" in written, written
+    pytest.importorskip("matplotlib")
+    import matplotlib
+    matplotlib.use("Agg")
+    ax = sol.plot("x", "z")
+    assert len(ax.get_lines()) == 2
+    ax = sol.plot_trajectory("x", "z")
+    np.testing.assert_array_equal(ax.get_lines()[0].get_ydata(), sol["z"])
+    ivp = pdyn.solve_ivp(["y1", "-y0"], (0, 1), [1.0, 0.0])
+    assert len(ivp.plot().get_lines()) == 2
+
+
+def test_the_trajectory_is_not_copied_beyond_one(examples):
+    sol = pdyn.Model.from_file(examples / "projectile_drag.toml").run()
+    table = dict.__getitem__(sol, "_table")
+    assert np.shares_memory(sol.y, table) and np.shares_memory(sol.t, table)
+    assert table.flags.owndata or table.base is not None
+    ivp = pdyn.solve_ivp(["y1", "-y0"], (0, 1), [1.0, 0.0])
+    assert ivp.y.shape == (2, len(ivp.t)) and ivp.y.base is not None

@@ -7,6 +7,7 @@ pub mod error;
 pub mod md;
 pub mod nbody;
 pub mod output;
+pub mod params;
 pub mod plots;
 pub mod sim;
 

@@ -18,20 +18,35 @@ both :class:`PdynError`; a drifting conserved quantity warns with :class:`DriftW
 A numerical failure returns ``success=False`` with the partial solution, as SciPy does.
 """
 
+from __future__ import annotations
+
 import math
 import os
-from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
-import numpy as np
+from ._lazy import LazyModule
+
+np = LazyModule("numpy")  # imported on first use
 
 from . import _pdyn
 from ._errors import DriftWarning, ModelError, ParameterError, PdynError
-from ._result import Derivation, Expr, OdeResult, SweepResult, _from_ivp, _from_run
+from ._result import (DenseOutput, Derivation, EnsembleResult, Expr, ForcesResult,
+                      OdeResult, SweepResult,
+                      _concat_raw, _from_ivp, _from_run)
 
 __version__ = _pdyn.__version__
 
+
+def __getattr__(name: str):
+    # pdyn.study (alias pdyn.ensemble) is imported on first use: `import pdyn` stays light.
+    if name in ("study", "ensemble"):
+        import importlib
+        return importlib.import_module(".study", __name__)
+    raise AttributeError(f"module 'pdyn' has no attribute {name!r}")
+
 __all__ = [
     "Model", "solve_ivp", "methods", "OdeResult", "Derivation", "Expr", "SweepResult",
+    "EnsembleResult", "DenseOutput", "ForcesResult",
     "PdynError", "ModelError", "ParameterError", "DriftWarning", "__version__",
 ]
 
@@ -41,6 +56,60 @@ def _array1(x, name: str) -> np.ndarray:
     if a.ndim != 1:
         raise ValueError(f"{name} must be one-dimensional")
     return a
+
+
+class _Parameters(dict):
+    """``Model.parameters``: a dict of the values, callable on a built model to set them."""
+
+    def __init__(self, model: "Model", values: Dict[str, float]):
+        super().__init__(values)
+        self._model = model
+
+    def __call__(self, **values: Any) -> None:
+        self._model._edit().setdefault("parameters", {}).update(
+            {k: _value(v) for k, v in values.items()})
+
+
+def _text(x: Any) -> str:
+    """An expression as pdyn text: a string as is, a SymPy expression through its text
+    form (``**`` written ``^``), a list of three as a vector."""
+    if isinstance(x, str):
+        return x
+    if isinstance(x, (list, tuple)):
+        return "[" + ", ".join(_text(e) for e in x) + "]"
+    if isinstance(x, (int, float)) and not isinstance(x, bool):
+        return repr(float(x))
+    if hasattr(x, "free_symbols"):  # SymPy
+        return str(x).replace("**", "^")
+    raise TypeError(f"cannot use {x!r} as an expression (give a string or a SymPy expression)")
+
+
+def _value(x: Any) -> Any:
+    """A number stays a number; anything else becomes expression text."""
+    if isinstance(x, (int, float)) and not isinstance(x, bool):
+        return float(x)
+    return _text(x)
+
+
+def _field(x: Any) -> Any:
+    if isinstance(x, (list, tuple)) and all(isinstance(e, str) for e in x):
+        return list(x)
+    if isinstance(x, (bool, dict)):
+        return x
+    return _value(x)
+
+
+def _measures(measures):
+    if measures is None:
+        return None
+    ms = []
+    for name, spec in measures.items():
+        if isinstance(spec, str):
+            ms.append((str(name), spec, "max_abs"))
+        else:
+            of, stat = spec
+            ms.append((str(name), str(of), str(stat)))
+    return ms
 
 
 def _params(params: Optional[Mapping[str, float]]):
@@ -56,10 +125,87 @@ class Model:
     does not load raises :class:`ModelError` with the file, line and column.
     """
 
-    __slots__ = ("_m",)
+    __slots__ = ("_inner", "_spec")
 
-    def __init__(self, inner: "_pdyn.Model"):
-        self._m = inner
+    def __init__(self, name: Union[str, "_pdyn.Model"] = "model"):
+        """``Model("pendulum")`` starts a model built in code (see :meth:`coordinate`,
+        :meth:`particle`, :meth:`gravity`, :meth:`parameters`...); the class methods
+        :meth:`from_file`, :meth:`from_toml` and :meth:`from_dict` load one."""
+        if isinstance(name, str):
+            self._inner = None
+            self._spec: Optional[Dict[str, Any]] = {"name": name}
+        else:
+            self._inner = name
+            self._spec = None
+
+    @property
+    def _m(self) -> "_pdyn.Model":
+        # A built model is loaded (and checked, with its errors located in the generated
+        # TOML) when first used; changing it again reloads it.
+        if self._inner is None:
+            self._inner = _pdyn.Model.from_dict(self._spec)
+        return self._inner
+
+    # -- the builder ------------------------------------------------------------------------
+
+    def _edit(self) -> Dict[str, Any]:
+        if self._spec is None:
+            raise ParameterError("this model was loaded from a file or text; build one with "
+                                 "pdyn.Model(name), or pass params= to run/sweep/ensemble")
+        self._inner = None
+        return self._spec
+
+    def coordinate(self, name: str, initial: Any = 0.0, rate: Any = 0.0,
+                   expr: Any = None) -> str:
+        """Adds a generalized coordinate with its initial value and rate (numbers or
+        expressions of the parameters), or, with ``expr``, a prescribed function of ``t``
+        (``m.coordinate("d", expr="d0*sin(omega*t)")``). Returns the name."""
+        table = self._edit().setdefault("coordinates", {})
+        table[name] = _text(expr) if expr is not None else {
+            "initial": _value(initial), "rate": _value(rate)}
+        return name
+
+    def particle(self, name: str, mass: Any, position: Any) -> str:
+        """Adds a particle: ``mass`` (a number or expression), ``position`` (an expression
+        of a 3-vector, ``"L*[sin(q), -cos(q), 0]"``, or a list of three expressions)."""
+        self._edit().setdefault("particles", {})[name] = {
+            "mass": _value(mass), "position": _text(position)}
+        return name
+
+    def point(self, name: str, position: Any) -> str:
+        """Adds a named point (a fixed or moving position forces can attach to)."""
+        self._edit().setdefault("points", {})[name] = _text(position)
+        return name
+
+    def gravity(self, g: Any) -> None:
+        """Uniform gravity, a 3-vector: ``m.gravity("[0, -g, 0]")``."""
+        self._edit()["gravity"] = _text(g)
+
+    def force(self, kind: str, **fields: Any) -> None:
+        """Adds a ``[[forces]]`` entry: ``m.force("spring", between=["a", "b"], k="k",
+        l0="L")`` (fields as in docs/model-format.md; expressions as strings or SymPy)."""
+        entry = {"kind": kind}
+        entry.update({k: _field(v) for k, v in fields.items()})
+        self._edit().setdefault("forces", []).append(entry)
+
+    def event(self, name: str, when: Any, direction: str = "both",
+              terminal: bool = False) -> None:
+        """Adds an ``[[events]]`` entry: the zeros of ``when``."""
+        self._edit().setdefault("events", []).append(
+            {"name": name, "when": _text(when), "direction": direction,
+             "terminal": bool(terminal)})
+
+    def monitor(self, name: str, expr: Any) -> None:
+        """Tabulates ``expr`` as a column of every run."""
+        self._edit().setdefault("monitors", {})[name] = _text(expr)
+
+    def simulate(self, **settings: Any) -> None:
+        """The model's default run settings (``t_end``, ``method``, ``rtol``, ...)."""
+        self._edit().setdefault("simulate", {}).update(settings)
+
+    def to_toml(self) -> str:
+        """The model as the text of a model file."""
+        return self._m.source
 
     @classmethod
     def from_file(cls, path: Union[str, "os.PathLike[str]"]) -> "Model":
@@ -91,12 +237,17 @@ class Model:
         return self._m.source
 
     @property
-    def parameters(self) -> Dict[str, float]:
+    def parameters(self) -> "_Parameters":
         """Parameter values in SI units, in file order (a copy: pass ``params=`` to
-        :meth:`run` to change them)."""
-        return dict(self._m.parameters)
+        :meth:`run` to change them). On a model built in code, calling it sets values:
+        ``m.parameters(g=9.81, L=1, m=1)`` (numbers, or quantities with units as text)."""
+        if self._spec is not None and self._inner is None and "parameters" not in self._spec:
+            return _Parameters(self, {})
+        return _Parameters(self, dict(self._m.parameters))
 
     def __repr__(self) -> str:
+        if self._spec is not None and self._inner is None:
+            return f"pdyn.Model({self._spec.get('name')!r}, built in code, not yet loaded)"
         return f"pdyn.Model({self.name!r}, origin={self._m.origin!r})"
 
     def run(self, t_end: Optional[float] = None, method: Optional[str] = None,
@@ -104,7 +255,8 @@ class Model:
             t_eval: Optional[Sequence[float]] = None, max_step: Optional[float] = None,
             dt: Optional[float] = None, max_steps: Optional[int] = None,
             points: Optional[int] = None, drift_tolerance: Optional[float] = None,
-            params: Optional[Mapping[str, float]] = None) -> OdeResult:
+            params: Optional[Mapping[str, float]] = None,
+            plots: Optional[Union[str, "os.PathLike[str]"]] = None) -> OdeResult:
         """Integrates the equations of motion, like ``pdyn run``.
 
         Every argument left ``None`` takes the model's ``[simulate]`` value, then pdyn's
@@ -112,7 +264,9 @@ class Model:
         (``"RK45"``, ``"DOP853"``, ``"Radau"``) or pdyn's (:func:`methods`). ``t_eval``:
         output times within [0, t_end]; ``points``: that many equally spaced outputs;
         ``dt``: the fixed step (symplectic methods, RK4) or the first step; ``params``:
-        parameter values (checked like ``pdyn run --set``).
+        parameter values (checked like ``pdyn run --set``); ``plots``: a directory where
+        pdyn's own PNG/SVG plots are written, as ``pdyn run --out DIR`` (no matplotlib
+        needed; ``sol.plot()`` and ``sol.plot_trajectory()`` use matplotlib).
 
         Returns an :class:`OdeResult` (``success=False`` with the partial solution when the
         integration fails). Warns :class:`DriftWarning` when a conserved quantity drifts
@@ -122,13 +276,25 @@ class Model:
         te = None if t_eval is None else _array1(t_eval, "t_eval")
         raw = self._m.run(t_end=t_end, method=method, rtol=rtol, atol=atol, t_eval=te,
                           max_step=max_step, dt=dt, max_steps=max_steps, points=points,
-                          drift_tolerance=drift_tolerance, params=_params(params))
+                          drift_tolerance=drift_tolerance, params=_params(params),
+                          plots=None if plots is None else os.fspath(plots))
         return _from_run(raw, list(raw["event_names"]))
 
     def derive(self) -> Derivation:
         """The equations of motion (F = ma or the projected form), the unknowns, their exact
         solution when the system is small, and the first-order system."""
         return Derivation(self._m.derive())
+
+    def forces(self, at: Optional[Mapping[str, float]] = None,
+               params: Optional[Mapping[str, float]] = None) -> ForcesResult:
+        """The unknown forces (reactions, friction, ...) of a prescribed motion at an instant,
+        like ``pdyn forces``: ``at`` sets ``t`` and coordinates (``{"theta": 0.3}``; default:
+        the initial values), ``params`` parameter values. Returns a :class:`ForcesResult`:
+        the equations, the unknowns, their exact solution (``symbolic``) and values
+        (``values``: one dict per real solution), and the ``[[checks]]`` (critical values
+        of a parameter, e.g. the speeds at which a car skids)."""
+        raw = self._m.forces(at=_params(at), params=_params(params))
+        return ForcesResult(raw)
 
     def sweep(self, param: str, values: Sequence[float],
               measures: Optional[Mapping[str, Union[str, Tuple[str, str]]]] = None,
@@ -145,15 +311,7 @@ class Model:
         for the model's ``[sweep.measures]``. Returns a :class:`SweepResult` with one
         float64 array per measure (NaN where a run failed; see ``problems``).
         """
-        ms = None
-        if measures is not None:
-            ms = []
-            for name, spec in measures.items():
-                if isinstance(spec, str):
-                    ms.append((str(name), spec, "max_abs"))
-                else:
-                    of, stat = spec
-                    ms.append((str(name), str(of), str(stat)))
+        ms = _measures(measures)
         raw = self._m.sweep(str(param), _array1(values, "values"), measures=ms, t_end=t_end,
                             method=method, rtol=rtol, atol=atol, max_step=max_step, dt=dt,
                             points=points, threads=threads, params=_params(params))
@@ -163,6 +321,111 @@ class Model:
             threads=raw["threads"],
         )
 
+
+    def _names(self) -> Tuple[List[str], List[str]]:
+        """(parameter names, state names) in model order."""
+        raw = self._m.ensemble([], np.empty((0, 0)), [], dry_run=True)
+        return list(self.parameters), list(raw["state_names"])
+
+    def check_ensemble(self, params: Any = None, initial: Any = None) -> List[Tuple[int, str]]:
+        """Checks an ensemble's rows without running anything: unknown names raise
+        :class:`ParameterError`; returns ``[(row, message)]`` for the rows whose parameter
+        values the model refuses (a mass <= 0, a value that is not finite)."""
+        pn, pm, sn, sm = self._ensemble_inputs(params, initial)
+        raw = self._m.ensemble(pn, pm, sn, sm, dry_run=True)
+        return [(int(r), m) for r, m in raw["problems"]]
+
+    def _ensemble_inputs(self, params: Any, initial: Any):
+        def columns(x, what, default_names):
+            if x is None:
+                return [], None
+            if hasattr(x, "columns") and hasattr(x, "to_numpy"):  # a pandas DataFrame
+                names = [str(c) for c in x.columns]
+                return names, np.ascontiguousarray(x.to_numpy(dtype=np.float64))
+            if isinstance(x, Mapping):
+                names = [str(k) for k in x]
+                cols = [np.asarray(v, dtype=np.float64).ravel() for v in x.values()]
+                if len({len(c) for c in cols}) > 1:
+                    raise ParameterError(f"{what}: the columns have different lengths "
+                                         f"{[len(c) for c in cols]}")
+                if not cols:
+                    return [], None
+                return names, np.ascontiguousarray(np.column_stack(cols))
+            a = np.asarray(x, dtype=np.float64)
+            if a.ndim != 2:
+                raise ParameterError(f"{what} must be a dict of columns, a DataFrame, or a "
+                                     f"2-D array (runs, columns); got shape {a.shape}")
+            names = default_names()
+            if a.shape[1] != len(names):
+                raise ParameterError(f"{what} has {a.shape[1]} columns; a bare 2-D array needs "
+                                     f"one per name, in order: {names}")
+            return names, np.ascontiguousarray(a)
+
+        pn, pm = columns(params, "params", lambda: self._names()[0])
+        sn, sm = columns(initial, "initial", lambda: self._names()[1])
+        if pm is None and sm is None:
+            raise ParameterError("an ensemble needs params or initial (one row per run)")
+        if pm is None:
+            pm = np.empty((sm.shape[0], 0))
+        if sm is not None and sm.shape[0] != pm.shape[0]:
+            raise ParameterError(f"params has {pm.shape[0]} rows and initial {sm.shape[0]}: "
+                                 "one row per run in both")
+        return pn, pm, sn, sm
+
+    def ensemble(self, params: Any = None, initial: Any = None,
+                 measures: Optional[Mapping[str, Union[str, Tuple[str, str]]]] = None,
+                 t_end: Optional[float] = None, method: Optional[str] = None,
+                 rtol: Optional[float] = None, atol: Optional[float] = None,
+                 max_step: Optional[float] = None, dt: Optional[float] = None,
+                 points: Optional[int] = None, drift_tolerance: Optional[float] = None,
+                 threads: Optional[int] = None, progress: bool = False) -> EnsembleResult:
+        """Runs the model once per parameter set (and initial state), in parallel on all
+        cores in Rust with the GIL released; returns one array per quantity.
+
+        ``params``: ``{name: values}`` (equal lengths), a pandas DataFrame, or a 2-D array
+        ``(runs, n_parameters)`` in the order of :attr:`parameters`; parameters not given
+        keep their value. ``initial``: the same for state components (``"x"``, ``"x'"``...;
+        a bare 2-D array is ``(runs, n_states)`` in the state order); components not given
+        take the model's initial conditions evaluated with the run's parameters.
+        ``measures``: as in :meth:`sweep` (``None``: the model's ``[sweep.measures]``, if any).
+        Every run also records its final state, the first occurrence of each event (time and
+        state), the drift of each conserved quantity, and its status.
+
+        A run that fails is not an exception: its ``status`` is -1 (or -2 when it could not
+        start, e.g. a mass <= 0) and ``problems`` says why. ``progress=True`` shows a tqdm
+        bar (when tqdm is installed; the runs are then done in slices).
+        """
+        pn, pm, sn, sm = self._ensemble_inputs(params, initial)
+        ms = _measures(measures)
+        kw = dict(measures=ms, t_end=t_end, method=method, rtol=rtol, atol=atol,
+                  max_step=max_step, dt=dt, points=points, drift_tolerance=drift_tolerance,
+                  threads=threads)
+        runs = pm.shape[0]
+        bar = None
+        if progress:
+            try:
+                from tqdm.auto import tqdm
+                bar = tqdm(total=runs, unit="run")
+            except ImportError:
+                bar = None
+        if bar is None:
+            raw = self._m.ensemble(pn, pm, sn, sm, **kw)
+        else:
+            parts = []
+            step = max(1, -(-runs // 20))
+            for a in range(0, runs, step):
+                b = min(runs, a + step)
+                parts.append(self._m.ensemble(pn, np.ascontiguousarray(pm[a:b]), sn,
+                                              None if sm is None else
+                                              np.ascontiguousarray(sm[a:b]), **kw))
+                bar.update(b - a)
+            bar.close()
+            raw = _concat_raw(parts)
+        return EnsembleResult(
+            raw,
+            {n: np.ascontiguousarray(pm[:, j]) for j, n in enumerate(pn)},
+            {} if sm is None else {n: np.ascontiguousarray(sm[:, j]) for j, n in enumerate(sn)},
+        )
 
 def methods() -> Dict[str, str]:
     """pdyn's integration methods: name -> description (order, adaptivity, paper)."""
@@ -196,10 +459,11 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
 
     Returns an :class:`OdeResult`; ``nfev`` is the Rust solver's count (``stats`` has all).
     A numerical failure returns ``success=False``, ``status=-1`` and the partial solution.
-    ``dense_output`` and ``vectorized`` are not supported (``sol.sol`` is ``None``).
+    ``dense_output=True`` sets ``sol.sol``, a :class:`DenseOutput` callable ``sol.sol(t)``
+    as SciPy's: a cubic Hermite interpolant through every step (its error is O(h^4) in the
+    step size h -- coarser than the methods' own continuous extensions; the values at the
+    steps are exact). ``vectorized=True`` is not supported.
     """
-    if dense_output:
-        raise NotImplementedError("pdyn.solve_ivp: dense_output is not supported yet; use t_eval")
     if options:
         raise TypeError(f"pdyn.solve_ivp: unsupported options {sorted(options)}")
     t0, tf = (float(t_span[0]), float(t_span[1]))
@@ -229,9 +493,25 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
             else:
                 term = int(terminal) if terminal else None
             ev_list.append((g, term, int(np.sign(direction))))
+    if vectorized:
+        raise NotImplementedError("pdyn.solve_ivp: vectorized=True is not supported (fun is "
+                                  "called with one state at a time; it may still be vectorized)")
     te = None if t_eval is None else _array1(t_eval, "t_eval")
-    raw = _pdyn._solve_ivp(
-        fun, t0, tf, y0a, str(method), te, _tol(rtol, "rtol"), _tol(atol, "atol"),
-        None if math.isinf(max_step) else float(max_step),
-        None if first_step is None else float(first_step), max_steps, ev_list, named_args)
-    return _from_ivp(raw, len(ev_list), len(y0a))
+    common = (str(method), _tol(rtol, "rtol"), _tol(atol, "atol"),
+              None if math.isinf(max_step) else float(max_step),
+              None if first_step is None else float(first_step), max_steps, ev_list, named_args)
+
+    def solve(t_eval_, dense):
+        m_, r_, a_, ms_, fs_, mx_, ev_, na_ = common
+        return _pdyn._solve_ivp(fun, t0, tf, y0a, m_, t_eval_, r_, a_, ms_, fs_, mx_, ev_, na_,
+                                dense)
+
+    raw = solve(te, dense_output and te is None)
+    res = _from_ivp(raw, len(ev_list), len(y0a))
+    if dense_output:
+        # The interpolant needs every step: with t_eval, a second solve without it (the
+        # same steps; the result's t and y stay at t_eval).
+        steps = raw if te is None else solve(None, True)
+        res["sol"] = DenseOutput(steps["t"], np.ascontiguousarray(steps["y_rows"].T),
+                                 np.ascontiguousarray(steps["f_rows"].T))
+    return res

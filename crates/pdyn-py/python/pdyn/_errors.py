@@ -32,4 +32,17 @@ class ParameterError(PdynError, ValueError):
 class DriftWarning(UserWarning):
     """A quantity that should be conserved (energy, angular momentum) drifted by more than
     the drift tolerance: the result cannot be trusted (tighten rtol or use a symplectic
-    method)."""
+    method).
+
+    Typed: ``quantity`` (the monitor's name, e.g. ``"energy"``), ``drift`` (relative to the
+    quantity's scale, or absolute when ``relative`` is False; NaN when it became NaN),
+    ``tolerance`` (the run's drift tolerance). ``str(w)`` is the full message.
+    """
+
+    def __init__(self, message: str, quantity: str = "", drift: float = float("nan"),
+                 tolerance: float = float("nan"), relative: bool = True):
+        super().__init__(message)
+        self.quantity = quantity
+        self.drift = drift
+        self.tolerance = tolerance
+        self.relative = relative

@@ -1,10 +1,14 @@
 """Result objects: :class:`OdeResult` (SciPy's shape), :class:`Derivation`, :class:`Expr`,
 :class:`SweepResult`."""
 
-import warnings
-from typing import Any, Dict, List, Optional
+from __future__ import annotations
 
-import numpy as np
+import warnings
+from typing import Any, Dict, List, Optional, Tuple
+
+from ._lazy import LazyModule
+
+np = LazyModule("numpy")  # imported on first use
 
 from ._errors import DriftWarning
 
@@ -15,7 +19,8 @@ class OdeResult(dict):
     Attributes (also available as ``sol["name"]`` for SciPy's own fields):
 
     * ``t`` -- output times, 1-D float64 array of length ``n_times``;
-    * ``y`` -- states, 2-D float64 array of shape ``(n_states, n_times)``;
+    * ``y`` -- states, 2-D float64 array of shape ``(n_states, n_times)`` (a transposed view
+      of the one table the run produced: the trajectory is copied once, from the solver);
     * ``t_events``, ``y_events`` -- one array per event (``None`` without events);
     * ``status`` (0 end reached, 1 terminal event, -1 integration failed), ``message``,
       ``success``;
@@ -75,6 +80,54 @@ class OdeResult(dict):
         return pd.DataFrame(data, columns=list(cols))
 
 
+def _plot_axes(ax):
+    if ax is None:
+        try:
+            import matplotlib.pyplot as plt
+        except ImportError as e:
+            raise ImportError("plot() needs matplotlib: pip install matplotlib (or run a model "
+                              "with plots=DIR for pdyn's own PNG/SVG plots)") from e
+        _, ax = plt.subplots()
+    return ax
+
+
+def _plot(self, *names: str, ax=None):
+    """Plots columns against ``t`` (default: the states) with matplotlib; returns the axes."""
+    ax = _plot_axes(ax)
+    cols = self.get("columns")
+    if not names:
+        names = tuple(cols[1:1 + self["y"].shape[0]]) if cols else tuple(
+            f"y{k}" for k in range(self["y"].shape[0]))
+    for name in names:
+        if cols and name in cols:
+            data = self.column(name)
+        else:
+            data = self["y"][int(name[1:])]
+        ax.plot(self["t"], data, label=name)
+    ax.set_xlabel("t")
+    ax.legend()
+    return ax
+
+
+def _plot_trajectory(self, x: str = None, y: str = None, ax=None):
+    """Plots column ``y`` against column ``x`` (default: the first two coordinates, or
+    ``y0``, ``y1``) with matplotlib, equal aspect; returns the axes."""
+    ax = _plot_axes(ax)
+    cols = self.get("columns")
+    if x is None or y is None:
+        x, y = (cols[1], cols[2]) if cols and len(cols) > 2 else ("y0", "y1")
+    get = (lambda n: self.column(n)) if cols else (lambda n: self["y"][int(n[1:])])
+    ax.plot(get(x), get(y))
+    ax.set_xlabel(x)
+    ax.set_ylabel(y)
+    ax.set_aspect("equal", adjustable="datalim")
+    return ax
+
+
+OdeResult.plot = _plot
+OdeResult.plot_trajectory = _plot_trajectory
+
+
 def _stats_counts(stats: Dict[str, Any]) -> Dict[str, int]:
     return {
         "nfev": stats["fevals"],
@@ -88,12 +141,13 @@ def _from_run(raw: Dict[str, Any], event_names: List[str]) -> OdeResult:
     n = raw["n_states"]
     failure = raw["failure"]
     hits = raw["events"]
-    if failure is not None:
-        status, message = -1, failure
-    elif hits and event_names and table.shape[0] and hits[-1][1] == table[-1, 0]:
-        status, message = 1, "A termination event occurred."
+    status = raw["status"]
+    if status == -1:
+        message = failure
+    elif status == 1:
+        message = "A termination event occurred."
     else:
-        status, message = 0, "The solver successfully reached the end of the integration interval."
+        message = "The solver successfully reached the end of the integration interval."
     names = list(dict.fromkeys(event_names + [h[0] for h in hits]))
     t_events = [np.array([h[1] for h in hits if h[0] == nm], dtype=np.float64) for nm in names]
     y_events = [
@@ -102,8 +156,9 @@ def _from_run(raw: Dict[str, Any], event_names: List[str]) -> OdeResult:
         for nm in names
     ]
     res = OdeResult(
-        t=np.ascontiguousarray(table[:, 0]),
-        y=np.ascontiguousarray(table[:, 1:1 + n].T),
+        # Views of the one table the run produced: the trajectory is not copied again.
+        t=table[:, 0],
+        y=table[:, 1:1 + n].T,
         t_events=t_events if names else None,
         y_events=y_events if names else None,
         event_names=names,
@@ -119,10 +174,22 @@ def _from_run(raw: Dict[str, Any], event_names: List[str]) -> OdeResult:
         _table=table,
         **_stats_counts(raw["stats"]),
     )
-    for w in res["warnings"]:
-        category = DriftWarning if "should be conserved" in w else RuntimeWarning
-        warnings.warn(w, category, stacklevel=3)
+    _warn(res, raw["drift_tolerance"])
     return res
+
+
+def _warn(res: "OdeResult", tolerance: float) -> None:
+    """Emits the run's warnings: a :class:`DriftWarning` (with ``quantity``, ``drift``,
+    ``tolerance``) per drifting conserved quantity, a ``RuntimeWarning`` for the others."""
+    drifting = {m["name"]: m for m in res["monitors"] if m["conserved"]}
+    for w in res["warnings"]:
+        name = w.split(" should be conserved", 1)[0] if " should be conserved" in w else None
+        mon = drifting.get(name) if name is not None else None
+        if mon is not None:
+            warnings.warn(DriftWarning(w, mon["name"], float(mon["drift"]), float(tolerance),
+                                       bool(mon["relative"])), stacklevel=4)
+        else:
+            warnings.warn(w, RuntimeWarning, stacklevel=4)
 
 
 def _from_ivp(raw: Dict[str, Any], n_events: int, n: int) -> OdeResult:
@@ -136,7 +203,7 @@ def _from_ivp(raw: Dict[str, Any], n_events: int, n: int) -> OdeResult:
                     for k in range(n_events)]
     return OdeResult(
         t=raw["t"],
-        y=np.ascontiguousarray(raw["y_rows"].T),
+        y=raw["y_rows"].T,  # a view: (n_states, n_times) as SciPy, not copied
         t_events=t_events,
         y_events=y_events,
         status=raw["status"],
@@ -254,3 +321,189 @@ class SweepResult:
         data = {self.parameter: self.values}
         data.update(self.measures)
         return pd.DataFrame(data)
+
+
+class EnsembleResult:
+    """The result of :meth:`pdyn.Model.ensemble`: one row per run, every field an array.
+
+    * ``params`` -- ``{name: float64 (runs,)}``, the parameter values given;
+    * ``initial`` -- ``{state: float64 (runs,)}``, the initial values given (may be empty);
+    * ``measures`` -- ``{name: float64 (runs,)}`` (NaN where a run did not run);
+    * ``t_final`` (runs,), ``final`` (runs, n_states) with column names ``state_names``;
+    * ``event_t`` -- ``{event: float64 (runs,)}`` the time of its first occurrence (NaN when
+      it did not occur); ``event_state`` -- ``{event: (runs, n_states)}``, the state then;
+    * ``drift`` -- ``{conserved quantity: float64 (runs,)}``; ``drifted`` -- bool (runs,),
+      whether any conserved quantity drifted beyond the tolerance;
+    * ``status`` -- int32 (runs,): 0 end reached, 1 terminal event, -1 integration failed
+      (partial run measured), -2 not run (e.g. a mass <= 0); ``problems`` -- ``[(row, message)]``;
+    * ``nfev`` (runs,), ``seconds``, ``threads``; :meth:`to_pandas`, :meth:`column`.
+    """
+
+    def __init__(self, raw: Dict[str, Any], params: Dict[str, np.ndarray],
+                 initial: Dict[str, np.ndarray]):
+        self.params = params
+        self.initial = initial
+        self.state_names: List[str] = list(raw["state_names"])
+        self.measures: Dict[str, np.ndarray] = {
+            n: np.ascontiguousarray(raw["measures"][:, j])
+            for j, n in enumerate(raw["measure_names"])}
+        self.t_final: np.ndarray = raw["t_final"]
+        self.final: np.ndarray = raw["final"]
+        self.event_t: Dict[str, np.ndarray] = {
+            n: np.ascontiguousarray(raw["event_t"][:, j])
+            for j, n in enumerate(raw["event_names"])}
+        self.event_state: Dict[str, np.ndarray] = {
+            n: np.ascontiguousarray(raw["event_state"][:, j, :])
+            for j, n in enumerate(raw["event_names"])}
+        self.drift: Dict[str, np.ndarray] = {
+            n: np.ascontiguousarray(raw["drift"][:, j])
+            for j, n in enumerate(raw["monitor_names"])}
+        self.drifted: np.ndarray = np.asarray(raw["drifted"], dtype=bool)
+        self.status: np.ndarray = np.asarray(raw["status"], dtype=np.int32)
+        self.nfev: np.ndarray = np.asarray(raw["nfev"], dtype=np.int64)
+        self.problems: List[Tuple[int, str]] = [(int(r), m) for r, m in raw["problems"]]
+        self.seconds: float = raw["seconds"]
+        self.threads: int = raw["threads"]
+
+    def __len__(self) -> int:
+        return len(self.status)
+
+    def __repr__(self) -> str:
+        return (f"EnsembleResult({len(self)} runs, measures {list(self.measures)}, "
+                f"events {list(self.event_t)}, {len(self.problems)} problems, "
+                f"{self.seconds:.3f} s on {self.threads} threads)")
+
+    def columns(self) -> Dict[str, np.ndarray]:
+        """Every per-run column by name: the parameters, ``initial.<state>``, the measures,
+        ``t_final``, ``final.<state>``, ``<event>.t`` and ``<event>.<state>``,
+        ``drift.<quantity>``, ``drifted``, ``status``, ``nfev``."""
+        out: Dict[str, np.ndarray] = {}
+        out.update(self.params)
+        out.update({f"initial.{k}": v for k, v in self.initial.items()})
+        out.update(self.measures)
+        out["t_final"] = self.t_final
+        for j, s in enumerate(self.state_names):
+            out[f"final.{s}"] = np.ascontiguousarray(self.final[:, j])
+        for e, t in self.event_t.items():
+            out[f"{e}.t"] = t
+            for j, s in enumerate(self.state_names):
+                out[f"{e}.{s}"] = np.ascontiguousarray(self.event_state[e][:, j])
+        out.update({f"drift.{k}": v for k, v in self.drift.items()})
+        out["drifted"] = self.drifted
+        out["status"] = self.status
+        out["nfev"] = self.nfev
+        return out
+
+    def column(self, name: str) -> np.ndarray:
+        """One column of :meth:`columns` by name."""
+        cols = self.columns()
+        if name not in cols:
+            raise KeyError(f"no column {name!r} (columns: {list(cols)})")
+        return cols[name]
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.column(name)
+
+    def to_pandas(self):
+        """One row per run, the columns of :meth:`columns`, as a pandas DataFrame."""
+        try:
+            import pandas as pd
+        except ImportError as e:  # pragma: no cover
+            raise ImportError("EnsembleResult.to_pandas() needs pandas: pip install pandas") from e
+        return pd.DataFrame(self.columns())
+
+
+def _concat_raw(parts: List[Dict[str, Any]]) -> Dict[str, Any]:
+    """Joins the raw results of consecutive slices of one ensemble."""
+    if len(parts) == 1:
+        return parts[0]
+    out = dict(parts[0])
+    for key in ("measures", "t_final", "final", "event_t", "event_state", "drift"):
+        out[key] = np.concatenate([p[key] for p in parts], axis=0)
+    for key in ("drifted", "status", "nfev"):
+        out[key] = [x for p in parts for x in p[key]]
+    offset, problems = 0, []
+    for p in parts:
+        problems += [(r + offset, m) for r, m in p["problems"]]
+        offset += len(p["status"])
+    out["problems"] = problems
+    out["seconds"] = sum(p["seconds"] for p in parts)
+    return out
+
+
+class DenseOutput:
+    """``sol.sol`` of :func:`pdyn.solve_ivp` with ``dense_output=True``: ``sol.sol(t)`` is the
+    state at ``t`` (shape ``(n,)`` for a scalar, ``(n, len(t))`` for an array), like SciPy's
+    ``OdeSolution``. A cubic Hermite interpolant through every step and its slope ``f(t, y)``
+    there: exact at the steps, O(h^4) between them. ``ts`` are the steps; ``t_min``,
+    ``t_max`` the interval."""
+
+    def __init__(self, ts: np.ndarray, ys: np.ndarray, fs: np.ndarray):
+        self.ts, self._y, self._f = ts, ys, fs
+        self.t_min, self.t_max = float(min(ts[0], ts[-1])), float(max(ts[0], ts[-1]))
+
+    def __call__(self, t: Any) -> np.ndarray:
+        ta = np.asarray(t, dtype=np.float64)
+        scalar = ta.ndim == 0
+        ta = np.atleast_1d(ta)
+        ts = self.ts
+        forward = ts[-1] >= ts[0]
+        key = ts if forward else -ts
+        tk = ta if forward else -ta
+        i = np.clip(np.searchsorted(key, tk, side="right") - 1, 0, max(len(ts) - 2, 0))
+        if len(ts) == 1:
+            out = np.repeat(self._y[:, :1], len(ta), axis=1)
+            return out[:, 0] if scalar else out
+        t0, t1 = ts[i], ts[i + 1]
+        h = t1 - t0
+        s = (ta - t0) / h
+        y0, y1 = self._y[:, i], self._y[:, i + 1]
+        f0, f1 = self._f[:, i], self._f[:, i + 1]
+        h00 = 2 * s**3 - 3 * s**2 + 1
+        h10 = s**3 - 2 * s**2 + s
+        h01 = -2 * s**3 + 3 * s**2
+        h11 = s**3 - s**2
+        out = h00 * y0 + h10 * h * f0 + h01 * y1 + h11 * h * f1
+        return out[:, 0] if scalar else out
+
+    def __repr__(self) -> str:
+        return f"DenseOutput({len(self.ts)} steps on [{self.t_min}, {self.t_max}])"
+
+
+class ForcesResult:
+    """The result of :meth:`pdyn.Model.forces`.
+
+    * ``instant`` -- ``{name: value}`` of ``t`` and the coordinates;
+    * ``equations`` -- ``[(label, lhs, rhs)]`` of :class:`Expr`;
+    * ``unknowns`` -- names; ``symbolic`` -- ``{unknown: Expr}`` or ``None``;
+    * ``values`` -- one ``{unknown: float}`` per real solution at the instant;
+    * ``checks`` -- one dict per ``[[checks]]``: ``name``, ``condition``, ``parameter``,
+      ``symbolic`` (list of Expr), ``min``/``max`` (``(value, at)``), ``over``,
+      ``critical`` (``[(value, {force: value})]``), ``forces_at_critical``;
+    * ``notes``.
+    """
+
+    def __init__(self, raw: Dict[str, Any]):
+        self.instant: Dict[str, float] = dict(raw["instant"])
+        self.equations = [(lab, _expr(l), _expr(r)) for lab, l, r in raw["equations"]]
+        self.unknowns: List[str] = list(raw["unknowns"])
+        sym = raw["symbolic"]
+        self.symbolic = None if sym is None else {
+            u: _expr(e) for u, e in zip(self.unknowns, sym)}
+        self.values: List[Dict[str, float]] = [dict(zip(self.unknowns, row))
+                                               for row in raw["numeric"]]
+        self.checks: List[Dict[str, Any]] = []
+        for c in raw["checks"]:
+            c = dict(c)
+            c["symbolic"] = [_expr(e) for e in c["symbolic"]]
+            c["critical"] = [(v, dict(f)) for v, f in c["critical"]]
+            c["forces_at_critical"] = dict(c["forces_at_critical"])
+            self.checks.append(c)
+        self.notes: List[str] = list(raw["notes"])
+
+    def __repr__(self) -> str:
+        return f"ForcesResult(unknowns {self.unknowns}, values {self.values})"
+
+    def _repr_latex_(self) -> str:
+        rows = " \\\\ ".join(f"{l.latex()} &= {r.latex()}" for _, l, r in self.equations)
+        return "$\\begin{aligned}" + rows + "\\end{aligned}$"

@@ -164,14 +164,7 @@ pub fn numeric_pairs(list: &[String], flag: &str) -> Result<Vec<(String, f64)>, 
 /// initial conditions follow ([`pdyn_mech::parameters::set_values`]).
 pub fn set_parameters(model: &mut pdyn_mech::Model, set: &[String]) -> Result<(), Error> {
     let values = numeric_pairs(set, "--set")?;
-    pdyn_mech::parameters::set_values(model, &values).map_err(|e| match e {
-        pdyn_mech::parameters::SetError::Invalid(error) => Error::Value {
-            origin: model.origin.clone(),
-            option: "--set".into(),
-            error,
-        },
-        other => Error::argument("--set", format!("--set: {other}")),
-    })
+    pdyn::params::set_parameter_values(model, &values, "--set")
 }
 
 /// Splits at top-level commas (not inside parentheses or brackets).

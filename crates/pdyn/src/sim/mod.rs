@@ -23,7 +23,7 @@ pub use pdyn_jit::JitMode;
 use pdyn_mech::conservation::conserved_quantities;
 use pdyn_mech::model::spec::{Crossing, SimulateSpec};
 use pdyn_mech::parameters::DerivedParameters;
-use pdyn_mech::validity::ValueChecks;
+use pdyn_mech::validity::{InvalidValue, ValueChecks};
 use pdyn_mech::{derive, DeriveOptions, Model};
 use pdyn_ode::{Direction, Event, Method, MethodKind, Options, Solution};
 use std::fmt;
@@ -259,6 +259,26 @@ pub struct Prepared {
 }
 
 impl Prepared {
+    /// Sets every parameter value (in model order, as [`Prepared::parameter_names`]) and
+    /// recomputes the initial state from them, in place: one run of an ensemble. The values
+    /// are taken as given: recompute the derived ones first with [`Prepared::derived`]. They
+    /// are checked (masses > 0) when the model runs.
+    pub fn set_parameters(&mut self, values: &[f64]) {
+        self.system.set_parameters(values);
+        let mut y0 = std::mem::take(&mut self.y0);
+        self.initial_conditions.eval(values, &mut y0);
+        self.y0 = y0;
+    }
+
+    /// Checks parameter values (in model order) against the model's physical requirements
+    /// (every mass finite and > 0) without running anything.
+    pub fn check_parameters(&self, values: &[f64]) -> Result<(), InvalidValue> {
+        match &self.value_checks {
+            Some(c) => c.check(values),
+            None => Ok(()),
+        }
+    }
+
     /// A copy with the parameters `(index, value)` set, the derived parameters that depend on
     /// them and the initial conditions recomputed.
     pub fn with_parameters(&self, given: &[(usize, f64)]) -> Prepared {
@@ -364,6 +384,31 @@ pub struct RunResult {
     pub method: Solver,
     /// Why the integration stopped early, with time and state.
     pub failure: Option<RunFailure>,
+    /// How the run ended (SciPy's `status`: 0, 1, -1).
+    pub status: RunStatus,
+}
+
+/// How a run ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RunStatus {
+    /// Reached `t_end`.
+    Finished,
+    /// A terminal event stopped it; the index of the event in [`Prepared::events`].
+    TerminalEvent(usize),
+    /// The integration failed ([`RunResult::failure`] says where and why); the result holds
+    /// everything computed up to there.
+    Failed,
+}
+
+impl RunStatus {
+    /// SciPy's `OdeResult.status`: 0 end reached, 1 terminal event, -1 failed.
+    pub fn code(self) -> i32 {
+        match self {
+            RunStatus::Finished => 0,
+            RunStatus::TerminalEvent(_) => 1,
+            RunStatus::Failed => -1,
+        }
+    }
 }
 
 /// Derives, compiles, and sets up monitors and events.
@@ -878,6 +923,11 @@ pub(crate) fn tabulate(
             miss.t_from, miss.t_to
         ));
     }
+    let status = match (&failure, sol.status) {
+        (Some(_), _) => RunStatus::Failed,
+        (None, pdyn_ode::Status::Finished) => RunStatus::Finished,
+        (None, pdyn_ode::Status::TerminalEvent(k)) => RunStatus::TerminalEvent(k),
+    };
     RunResult {
         columns,
         rows,
@@ -887,5 +937,6 @@ pub(crate) fn tabulate(
         stats: sol.stats.clone(),
         method: Solver::Ode(sol.method),
         failure,
+        status,
     }
 }

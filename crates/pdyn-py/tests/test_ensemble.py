@@ -1,0 +1,117 @@
+"""Model.ensemble: parameter sets and initial states run in Rust on all cores, as arrays."""
+
+import math
+import os
+import threading
+import time
+import warnings
+
+import numpy as np
+import pytest
+
+import pdyn
+
+
+def kremlin_range(v0, theta, g=9.81, H=71.0):
+    vz = v0 * math.sin(theta)
+    t = (vz + math.sqrt(vz * vz + 2 * g * H)) / g
+    return t, v0 * math.cos(theta) * t
+
+
+def test_ensemble_equals_single_runs_bit_for_bit(examples):
+    m = pdyn.Model.from_file(examples / "kremlin_stone.toml")
+    rng = np.random.default_rng(1)
+    v0 = 11.176 + 0.5 * rng.standard_normal(50)
+    theta = math.radians(45) + 0.05 * rng.standard_normal(50)
+    ens = m.ensemble(params={"v0": v0, "theta": theta}, measures={"top": ("z", "max")})
+    assert len(ens) == 50 and ens.threads >= 1
+    assert set(ens.status) == {1}  # every run stopped by the terminal event
+    hit = "hits the ground"
+    assert ens.event_t[hit].dtype == np.float64 and ens.event_t[hit].shape == (50,)
+    assert ens.final.shape == (50, 4) and ens.state_names == ["x", "z", "x'", "z'"]
+    for k in (0, 17, 49):
+        single = m.run(params={"v0": float(v0[k]), "theta": float(theta[k])})
+        assert single.t_events[0][0] == ens.event_t[hit][k]
+        np.testing.assert_array_equal(single.y[:, -1], ens.final[k])
+        assert single["z"].max() == ens.measures["top"][k]
+        t, x = kremlin_range(v0[k], theta[k])
+        assert abs(ens.event_state[hit][k, 0] - x) < 1e-8 * x
+    # The same rows on one thread and on all give the same bits.
+    one = m.ensemble(params={"v0": v0, "theta": theta}, threads=1)
+    np.testing.assert_array_equal(one.final, ens.final)
+    df = pytest.importorskip("pandas").DataFrame(ens.columns())
+    assert {"v0", "theta", "top", f"{hit}.t", f"{hit}.x", "status", "drifted"} <= set(df.columns)
+
+
+def test_ensemble_initial_states_and_a_bare_parameter_array(examples):
+    m = pdyn.Model.from_file(examples / "kremlin_stone.toml")
+    heights = np.array([10.0, 71.0, 200.0])
+    ens = m.ensemble(initial={"z": heights})
+    for k, h in enumerate(heights):
+        t, _ = kremlin_range(11.176, math.radians(45), H=h)
+        assert abs(ens.event_t["hits the ground"][k] - t) < 1e-8
+    np.testing.assert_array_equal(ens.initial["z"], heights)
+    # A 2-D array with one column per parameter, in model order.
+    p = m.parameters
+    table = np.array([[p["g"], 30.0, p["v0"], p["theta"]], [p["g"], 71.0, p["v0"], p["theta"]]])
+    ens2 = m.ensemble(params=table)
+    assert list(ens2.params) == ["g", "H", "v0", "theta"]
+    assert ens2.event_t["hits the ground"][1] == ens.event_t["hits the ground"][1]
+    with pytest.raises(pdyn.ParameterError, match="columns"):
+        m.ensemble(params=np.ones((2, 3)))
+    with pytest.raises(pdyn.ParameterError, match="not a parameter"):
+        m.ensemble(params={"nope": [1.0]})
+    with pytest.raises(pdyn.ParameterError, match="not a state component"):
+        m.ensemble(initial={"q": [1.0]})
+
+
+def test_ensemble_bad_rows_are_reported_not_raised(examples):
+    m = pdyn.Model.from_file(examples / "projectile_drag.toml")
+    masses = np.array([1.0, -1.0, 2.0])
+    assert m.check_ensemble(params={"m": masses}) == [(1, m.check_ensemble(params={"m": masses})[0][1])]
+    assert "mass" in m.check_ensemble(params={"m": masses})[0][1]
+    ens = m.ensemble(params={"m": masses})
+    assert list(ens.status) == [0, -2, 0]
+    assert np.isnan(ens.final[1]).all() and ens.problems[0][0] == 1
+
+
+def test_ensemble_drift_flags(examples):
+    m = pdyn.Model.from_file(examples / "satellite_ode45.toml")
+    ens = m.ensemble(params={n: [v, v] for n, v in list(m.parameters.items())[:1]},
+                     rtol=1e-3)
+    assert ens.drifted.all()
+    assert all((d > 5e-3).all() for d in ens.drift.values() if not np.isnan(d).all())
+
+
+def test_typed_drift_warning(examples):
+    m = pdyn.Model.from_file(examples / "satellite_ode45.toml")
+    with pytest.warns(pdyn.DriftWarning) as record:
+        m.run()
+    w = [r.message for r in record if isinstance(r.message, pdyn.DriftWarning)][0]
+    assert w.quantity and w.drift > w.tolerance == 5e-3
+
+
+def test_ensemble_releases_the_gil_and_uses_every_core(examples):
+    m = pdyn.Model.from_file(examples / "projectile_drag.toml")
+    c = np.linspace(0.1, 1.0, 600)
+    ticks = []
+    stop = threading.Event()
+
+    def ticker():
+        while not stop.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.001)
+
+    th = threading.Thread(target=ticker)
+    th.start()
+    t0 = time.perf_counter()
+    ens = m.ensemble(params={"c": c})
+    t1 = time.perf_counter()
+    stop.set()
+    th.join()
+    assert len(ens) == 600
+    assert t1 - t0 > 0.05, "too short to tell"
+    assert len([t for t in ticks if t0 < t < t1]) >= 10
+    # All cores: rayon's pool has one thread per core this process may use.
+    usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    assert ens.threads == usable or (usable >= 2 and ens.threads >= 2), (ens.threads, usable)
