@@ -416,12 +416,18 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
             Ok(sol) => Some(sol.into_iter().map(|s| simp(p, s, opts.simplify)).collect()),
             Err(LinearError::Underdetermined { free }) => {
                 let names: Vec<String> = free.iter().map(|&f| p.to_text(f)).collect();
+                if let Some(e) = crate::constraint_rank::dependent_constraint(model) {
+                    return Err(e);
+                }
                 return Err(derr(
                     format!("the equations do not determine {}", names.join(", ")),
                     "the system is singular: look for a missing constraint or a reaction with no independent equation",
                 ));
             }
             Err(LinearError::Inconsistent { equation }) => {
+                if let Some(e) = crate::constraint_rank::dependent_constraint(model) {
+                    return Err(e);
+                }
                 return Err(derr(
                     format!(
                         "equation `{}` contradicts the others",

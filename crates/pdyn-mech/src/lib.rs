@@ -12,6 +12,7 @@
 
 pub mod algebra;
 pub mod conservation;
+mod constraint_rank;
 pub mod derive;
 pub mod dsolve;
 pub mod kinematics;

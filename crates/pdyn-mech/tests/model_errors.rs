@@ -195,3 +195,46 @@ fn garbage_never_panics() {
         let _ = load(src, "x.toml").map_err(|e| e.render(src));
     }
 }
+
+const RAILS: &str = r#"
+name = "a ball on two rails"
+gravity = "[0, -g, 0]"
+[parameters]
+g = 9.81
+[coordinates]
+x = { initial = 0, rate = 0 }
+y = { initial = 0, rate = 0 }
+[particles.a]
+mass = 1
+position = "[x, y, 0]"
+[[constraints]]
+name = "rail 1"
+equation = "x + y = 0"
+[[constraints]]
+name = "rail 2"
+equation = "SECOND"
+"#;
+
+#[test]
+fn contradictory_constraints_are_named_with_their_lines() {
+    let e = derive_err(&RAILS.replace("SECOND", "x + y = 1"));
+    assert!(
+        e.contains("constraint `rail 2` (line 17) contradicts `rail 1` (line 14)"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_redundant_constraint_is_named_as_such() {
+    let e = derive_err(&RAILS.replace("SECOND", "2*x + 2*y = 0"));
+    assert!(
+        e.contains("constraint `rail 2` (line 17) repeats `rail 1` (line 14)"),
+        "{e}"
+    );
+    // Independent rails are neither (this model lacks the rails' reactions, a different error).
+    let e = derive_err(&RAILS.replace("SECOND", "x - y = 0"));
+    assert!(
+        !e.contains("repeats") && !e.contains("contradicts `rail"),
+        "{e}"
+    );
+}

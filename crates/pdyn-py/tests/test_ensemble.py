@@ -115,3 +115,24 @@ def test_ensemble_releases_the_gil_and_uses_every_core(examples):
     # All cores: rayon's pool has one thread per core this process may use.
     usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     assert ens.threads == usable or (usable >= 2 and ens.threads >= 2), (ens.threads, usable)
+
+
+def test_derived_parameters_follow_in_run_sweep_and_ensemble(examples):
+    # The nanoparticle's mass is defined by its radius (m = 4/3*pi*a^3*rho); it rises to
+    # h = kB*T/(m*g) (all kinetic energy kB*T into height), so h scales as a^-3.
+    m = pdyn.Model.from_file(examples / "nanoparticle.toml")
+
+    def height(a):
+        mass = 4 / 3 * math.pi * a**3 * 2330.0
+        return 1.3806503e-23 * 293.0 / (mass * 9.81)
+
+    radii = np.array([10e-9, 20e-9, 40e-9])
+    single = m.run(params={"a": 10e-9})
+    assert abs(single["z"].max() - height(10e-9)) < 1e-6 * height(10e-9)
+    ens = m.ensemble(params={"a": radii}, measures={"top": ("z", "max")})
+    np.testing.assert_allclose(ens.measures["top"], [height(a) for a in radii], rtol=1e-6)
+    # A value given for the derived parameter itself wins over its definition.
+    given = m.ensemble(params={"a": radii, "m": np.full(3, 1e-19)},
+                       measures={"top": ("z", "max")})
+    np.testing.assert_allclose(given.measures["top"], 1.3806503e-23 * 293.0 / (1e-19 * 9.81),
+                               rtol=1e-6)

@@ -173,6 +173,8 @@ pub struct Constraint {
     pub label: String,
     /// `f(q, t)` meaning `f = 0`.
     pub equation: Id,
+    /// Where it is written in the model file.
+    pub span: Range<usize>,
 }
 
 /// A quantity to solve for (thrust, bank angle, ...), with a search range if it enters

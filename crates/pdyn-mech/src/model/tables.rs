@@ -432,7 +432,11 @@ impl Loader<'_> {
                 .name
                 .as_ref()
                 .map_or(text.clone(), |n| n.get_ref().clone());
-            constraints.push(Constraint { label, equation: e });
+            constraints.push(Constraint {
+                label,
+                equation: e,
+                span: eq.span(),
+            });
         }
         Ok(constraints)
     }
