@@ -53,7 +53,6 @@ pub(crate) fn dependent_constraint(model: &mut Model) -> Option<DeriveError> {
     }
     let m = fs.len();
     // Rows [∇f_i | f_i | e_i]: the identity part records which constraints each row combines.
-    let width = n + 1 + m;
     let mut rows: Vec<Vec<f64>> = (0..m)
         .map(|i| {
             let mut r = out[i * n..(i + 1) * n].to_vec();
@@ -68,8 +67,9 @@ pub(crate) fn dependent_constraint(model: &mut Model) -> Option<DeriveError> {
         for &(pr, pc) in &pivots {
             let factor = rows[i][pc] / rows[pr][pc];
             if factor != 0.0 {
-                for j in 0..width {
-                    rows[i][j] -= factor * rows[pr][j];
+                let pivot_row = rows[pr].clone();
+                for (x, p) in rows[i].iter_mut().zip(&pivot_row) {
+                    *x -= factor * p;
                 }
             }
         }
