@@ -2,30 +2,9 @@
 //! error) and `--json` on failure: every command prints a JSON error object on stdout with
 //! `error.kind` set, as well as the human message on stderr.
 
-use std::process::Command;
-
-fn root() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-/// Runs `pdyn ARGS` in the repository root: (exit code, stdout, stderr).
-fn pdyn_env(args: &[&str], env: &[(&str, &str)]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_pdyn"))
-        .args(args)
-        .envs(env.iter().copied())
-        .current_dir(root())
-        .output()
-        .expect("run pdyn");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn pdyn(args: &[&str]) -> (i32, String, String) {
-    pdyn_env(args, &[])
-}
+#[path = "common/in_root.rs"]
+mod in_root;
+use in_root::{pdyn, pdyn_env};
 
 fn json_error(stdout: &str) -> serde_json::Value {
     let v: serde_json::Value = serde_json::from_str(stdout)

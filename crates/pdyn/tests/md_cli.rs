@@ -4,30 +4,11 @@
 //! located error (file:line:col, and a JSON error object with `--json`), or, for a run that
 //! explodes, exit code 1 with the output up to that step kept.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::PathBuf;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-/// `pdyn ARGS` in the repository root: (exit code, stdout, stderr).
-fn pdyn(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_pdyn"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .expect("run pdyn");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn json(stdout: &str) -> serde_json::Value {
-    serde_json::from_str(stdout).unwrap_or_else(|e| panic!("stdout is not JSON ({e}):\n{stdout}"))
-}
+#[path = "common/in_root.rs"]
+mod in_root;
+use in_root::{json, pdyn, root};
 
 /// A fresh scratch directory for one test.
 fn scratch(name: &str) -> PathBuf {

@@ -3,30 +3,12 @@
 //! input of issue 14 gives exit code 2 with `file:line:col` and a JSON error object; events
 //! (close encounters, escapes, mergers) and warnings are reported.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::Command;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-/// Runs `pdyn ARGS` in the repository root: (exit code, stdout, stderr).
-fn pdyn(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_pdyn"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .expect("run pdyn");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn json(stdout: &str) -> serde_json::Value {
-    serde_json::from_str(stdout).unwrap_or_else(|e| panic!("stdout is not JSON ({e}):\n{stdout}"))
-}
+#[path = "common/in_root.rs"]
+mod in_root;
+use in_root::{json, pdyn, root};
 
 /// `pdyn run FILE ARGS --json`, expecting success: the summary.
 fn run_ok(file: &str, args: &[&str]) -> serde_json::Value {

@@ -169,20 +169,12 @@ impl Loader<'_> {
         let (rate, rate_expr) = self.initial_condition(n, sv, t, "rate")?;
         out.initial_exprs.push((index, initial_expr, rate_expr));
         if let Some(acc) = t.get("acceleration") {
-            let text = match acc {
-                toml::Value::String(s) => s.clone(),
-                toml::Value::Integer(i) => i.to_string(),
-                toml::Value::Float(f) => format!("{f:e}"),
-                other => {
-                    return Err(self.err(
-                        sv.span(),
-                        format!(
-                            "`acceleration` must be a number or an expression, found {}",
-                            other.type_str()
-                        ),
-                    ))
-                }
-            };
+            let text = number_text(acc).map_err(|found| {
+                self.err(
+                    sv.span(),
+                    format!("`acceleration` must be a number or an expression, found {found}"),
+                )
+            })?;
             let ast = pdyn_expr::syntax::parse(&text)
                 .map_err(|e| self.err(sv.span(), format!("in `acceleration`: {}", e.message)))?;
             let v = lower(&mut self.pool, &ast, &mut self.scope).map_err(|e| {
@@ -221,17 +213,12 @@ impl Loader<'_> {
                 )
                 .help(hint));
         };
-        let text = match v {
-            toml::Value::String(s) => s.clone(),
-            toml::Value::Integer(i) => i.to_string(),
-            toml::Value::Float(f) => format!("{f:e}"),
-            other => {
-                return Err(self.err(
-                    sv.span(),
-                    format!("`{key}` must be a number, found {}", other.type_str()),
-                ))
-            }
-        };
+        let text = number_text(v).map_err(|found| {
+            self.err(
+                sv.span(),
+                format!("`{key}` must be a number, found {found}"),
+            )
+        })?;
         if looks_like_quantity(&text) {
             let q = parse_quantity(&text)
                 .map_err(|e| self.err(sv.span(), format!("in `{key}`: {}", e.message)))?;
@@ -439,5 +426,16 @@ impl Loader<'_> {
             });
         }
         Ok(constraints)
+    }
+}
+
+/// The text of a value inside a coordinate's table: an expression string, or a number written
+/// as one; otherwise the TOML type found.
+fn number_text(v: &toml::Value) -> Result<String, &'static str> {
+    match v {
+        toml::Value::String(s) => Ok(s.clone()),
+        toml::Value::Integer(i) => Ok(i.to_string()),
+        toml::Value::Float(f) => Ok(format!("{f:e}")),
+        other => Err(other.type_str()),
     }
 }
