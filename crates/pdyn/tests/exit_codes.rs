@@ -214,3 +214,44 @@ fn set_accepts_quantities_with_units_as_model_files_do() {
     assert_eq!(code, 2);
     assert!(err.contains("unknown unit `parsec`"), "{err}");
 }
+
+#[test]
+fn a_run_that_tabulates_nan_is_a_failure_naming_the_columns() {
+    // x/L with L = 0: the state stays finite (nothing accelerates x) but the position column
+    // and the energy are not; that must not pass as a run with a conserved energy.
+    let dir = std::env::temp_dir().join(format!("pdyn-nan-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("nan.toml");
+    std::fs::write(
+        &path,
+        r#"
+name = "division by zero in a position"
+gravity = "[0, -g, 0]"
+[parameters]
+g = 9.81
+L = 0
+[coordinates]
+x = { initial = 1, rate = 0 }
+[particles.a]
+mass = 1
+position = "[x/L, 0, 0]"
+[simulate]
+t_end = 1
+"#,
+    )
+    .unwrap();
+    let p = path.to_str().unwrap();
+    let (code, out, err) = pdyn(&["run", p, "--json"]);
+    assert_eq!(code, 1, "{err}");
+    let e = json_error(&out);
+    assert_eq!(e["kind"], "non_finite");
+    let msg = e["message"].as_str().unwrap();
+    assert!(msg.contains("`a.x`") && msg.contains("`energy`"), "{msg}");
+    assert!(
+        err.contains("energy should be conserved but is not finite"),
+        "{err}"
+    );
+    let (code, out, _) = pdyn(&["run", p]);
+    assert_eq!(code, 1);
+    assert!(out.contains("DRIFTING"), "{out}");
+}

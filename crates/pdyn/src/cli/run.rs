@@ -170,10 +170,14 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
     for w in &res.warnings {
         stderr += &format!("warning: {w}\n");
     }
-    let failure = res.failure.clone().map(|failure| Error::Integration {
-        origin: model.origin.clone(),
-        failure: Box::new(failure),
-    });
+    let failure = res
+        .failure
+        .clone()
+        .map(|failure| Error::Integration {
+            origin: model.origin.clone(),
+            failure: Box::new(failure),
+        })
+        .or_else(|| non_finite_columns(&model, &res));
     let mut sum = summary(&res, &model.name, &prep.state_names);
     if let Some(f) = &failure {
         sum["error"] = f.to_json()["error"].clone();
@@ -202,6 +206,32 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
         stdout,
         stderr,
         failure,
+    })
+}
+
+/// A run that finished but tabulated NaN or infinity (a division by zero or a function outside
+/// its domain in a position, a monitor, the energy): a failure naming the columns and the
+/// first time, so that the exit code is not 0.
+fn non_finite_columns(model: &pdyn_mech::Model, res: &sim::RunResult) -> Option<Error> {
+    let bad: Vec<usize> = (0..res.columns.len())
+        .filter(|&c| res.rows.iter().any(|r| !r[c].is_finite()))
+        .collect();
+    let first_t = res
+        .rows
+        .iter()
+        .find(|r| r.iter().any(|x| !x.is_finite()))
+        .map(|r| r[0])?;
+    let names: Vec<String> = bad
+        .iter()
+        .map(|&c| format!("`{}`", res.columns[c]))
+        .collect();
+    Some(Error::NonFinite {
+        what: format!(
+            "{}: the output column(s) {} (first at t = {first_t:e})",
+            model.origin,
+            names.join(", ")
+        ),
+        components: bad,
     })
 }
 

@@ -881,15 +881,28 @@ pub(crate) fn tabulate(
         let Some(first) = rows.first().map(|r| r[offset + j]) else {
             continue;
         };
+        // NaN propagates (f64::max would drop it and call a NaN energy conserved).
         let dev = rows
             .iter()
             .map(|r| (r[offset + j] - first).abs())
-            .fold(0.0, f64::max);
+            .fold(0.0, |a: f64, d| {
+                if d.is_nan() || a.is_nan() {
+                    f64::NAN
+                } else {
+                    a.max(d)
+                }
+            });
         let k = monitors.len();
         let scale = scales.get(k).copied().unwrap_or(f64::NAN);
         let relative = scale > 0.0;
         let drift = if relative { dev / scale } else { dev };
-        if drift.is_nan() || drift > set.drift_tolerance {
+        if drift.is_nan() {
+            warnings.push(format!(
+                "{name} should be conserved but is not finite (NaN or infinite) along the run: \
+                 this result cannot be trusted; look for a division by zero or a function \
+                 outside its domain in the model"
+            ));
+        } else if drift > set.drift_tolerance {
             let t_last = rows.last().map_or(0.0, |r| r[0]);
             warnings.push(format!(
                 "{name} should be conserved but drifted by {drift:.3e} ({}) over t = 0..{t_last}: \
