@@ -255,3 +255,32 @@ t_end = 1
     assert_eq!(code, 1);
     assert!(out.contains("DRIFTING"), "{out}");
 }
+
+#[test]
+fn a_non_finite_state_names_what_is_not_finite() {
+    // sqrt(x - 2) at x = 1: the acceleration is NaN from the start; the failure says which
+    // acceleration and which columns, not only "non-finite state" next to a finite state.
+    let dir = std::env::temp_dir().join(format!("pdyn-nan-state-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("sqrt.toml");
+    std::fs::write(
+        &path,
+        r#"
+name = "a function outside its domain"
+gravity = "[0, -g, 0]"
+[parameters]
+g = 9.81
+[coordinates]
+x = { initial = 1, rate = 0 }
+[particles.a]
+mass = 1
+position = "[x, sqrt(x - 2), 0]"
+[simulate]
+t_end = 1
+"#,
+    )
+    .unwrap();
+    let (code, _, err) = pdyn(&["run", path.to_str().unwrap()]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("not finite at that state: x'', a.y"), "{err}");
+}

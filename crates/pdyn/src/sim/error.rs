@@ -164,6 +164,9 @@ pub struct RunFailure {
     /// Where an explicit method's stiffness test fired before the failure (Hairer's test, as
     /// in `dopri5.f`): the likely reason for running out of steps.
     pub stiff_at: Option<f64>,
+    /// What is not finite at that state, by name (`x''`, `a.y`, `energy`): where a
+    /// non-finite state came from (a division by zero, a function outside its domain).
+    pub non_finite: Vec<String>,
 }
 
 impl fmt::Display for RunFailure {
@@ -180,6 +183,14 @@ impl fmt::Display for RunFailure {
             self.error,
             state.join(", ")
         )?;
+        if !self.non_finite.is_empty() {
+            write!(
+                f,
+                "\n  not finite at that state: {} (a division by zero or a function outside \
+                 its domain in what defines them)",
+                self.non_finite.join(", ")
+            )?;
+        }
         if let Some(at) = self.stiff_at {
             write!(
                 f,

@@ -683,6 +683,32 @@ pub fn methods_help() -> String {
     s
 }
 
+/// The accelerations and output columns that are not finite at `(t, y)`, by name.
+fn non_finite_at(prep: &Prepared, sys: &CompiledModel, t: f64, y: &[f64]) -> Vec<String> {
+    let n = sys.n;
+    if y.len() < 2 * n || y.iter().any(|v| !v.is_finite()) {
+        return Vec::new();
+    }
+    let mut names = Vec::new();
+    let mut dydt = vec![0.0f64; 2 * n];
+    pdyn_ode::OdeSystem::rhs(sys, t, y, &mut dydt);
+    for (k, d) in dydt[n..].iter().enumerate() {
+        if !d.is_finite() {
+            names.push(format!("{}'", prep.state_names[n + k]));
+        }
+    }
+    let mut input = Vec::new();
+    sys.observation_input(t, y, &mut input);
+    let mut out = vec![0.0; prep.observer.len()];
+    prep.observer.eval(&input, &mut out);
+    for (name, v) in prep.observer.names.iter().zip(&out) {
+        if !v.is_finite() {
+            names.push(name.clone());
+        }
+    }
+    names
+}
+
 /// Integrates a prepared model.
 pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, SimError> {
     let method = method_by_name(&set.method).ok_or_else(|| SimError::UnknownMethod {
@@ -793,6 +819,7 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, SimError> {
                         .collect(),
                     error: e.clone(),
                     stiff_at: fp.partial.stats.stiffness_detected_at,
+                    non_finite: non_finite_at(prep, sys, fp.t, &fp.y),
                 };
                 ((*fp.partial).clone(), Some(failure))
             }
