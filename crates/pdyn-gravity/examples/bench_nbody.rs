@@ -20,28 +20,30 @@ use pdyn_gravity::{
     WhFastParams,
 };
 
-fn arg<T: std::str::FromStr>(args: &[String], i: usize, what: &str) -> T {
+type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
+
+fn arg<T: std::str::FromStr>(args: &[String], i: usize, what: &str) -> Result<T> {
     args.get(i)
         .and_then(|s| s.parse().ok())
-        .unwrap_or_else(|| panic!("argument {i} ({what}) missing or invalid"))
+        .ok_or_else(|| format!("argument {i} ({what}) missing or invalid").into())
 }
 
-fn load(path: &str) -> Simulation {
-    let bytes = std::fs::read(path).expect("read initial conditions");
-    let v: Vec<f64> = bytes
-        .chunks_exact(8)
-        .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
-        .collect();
+fn load(path: &str) -> Result<Simulation> {
+    let bytes =
+        std::fs::read(path).map_err(|e| format!("cannot read initial conditions {path}: {e}"))?;
+    let mut v: Vec<f64> = Vec::with_capacity(bytes.len() / 8);
+    for c in bytes.chunks_exact(8) {
+        v.push(f64::from_le_bytes(c.try_into()?));
+    }
     let mut sim = Simulation::new(Units::GEqualsOne);
     for r in v.chunks_exact(7) {
         sim.add(Particle {
             mass: r[0],
             pos: Vec3::new(r[1], r[2], r[3]),
             vel: Vec3::new(r[4], r[5], r[6]),
-        })
-        .unwrap();
+        })?;
     }
-    sim
+    Ok(sim)
 }
 
 fn report(case: &str, sim: &Simulation, secs: f64, de: f64) {
@@ -53,77 +55,74 @@ fn report(case: &str, sim: &Simulation, secs: f64, de: f64) {
     );
 }
 
-fn main() {
+fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().collect();
     let case = args.get(1).map(String::as_str).unwrap_or("");
     match case {
         "whfast" => {
-            let steps: u64 = arg(&args, 2, "steps");
+            let steps: u64 = arg(&args, 2, "steps")?;
             let mut sim = outer_solar_system();
-            let dt = sim.orbit(1, Primary::Interior).unwrap().period / 20.0;
-            sim.set_dt(dt).unwrap();
+            let dt = sim.orbit(1, Primary::Interior)?.period / 20.0;
+            sim.set_dt(dt)?;
             sim.set_integrator(Integrator::WhFast(WhFastParams {
                 corrector: 17,
                 ..WhFastParams::default()
-            }))
-            .unwrap();
+            }))?;
             let e0 = sim.energy();
             let t0 = Instant::now();
-            sim.integrate(steps as f64 * dt).unwrap();
+            sim.integrate(steps as f64 * dt)?;
             let secs = t0.elapsed().as_secs_f64();
             report(case, &sim, secs, (sim.energy() - e0) / e0);
         }
         "ias15" => {
-            let years: f64 = arg(&args, 2, "years");
+            let years: f64 = arg(&args, 2, "years")?;
             let mut sim = outer_solar_system();
-            sim.set_dt(10.0).unwrap();
-            sim.set_integrator(Integrator::Ias15(Ias15Params::default()))
-                .unwrap();
+            sim.set_dt(10.0)?;
+            sim.set_integrator(Integrator::Ias15(Ias15Params::default()))?;
             let e0 = sim.energy();
             let t0 = Instant::now();
-            sim.integrate(years * 365.25).unwrap();
+            sim.integrate(years * 365.25)?;
             let secs = t0.elapsed().as_secs_f64();
             report(case, &sim, secs, (sim.energy() - e0) / e0);
         }
         "plummer-ics" => {
-            let n: usize = arg(&args, 2, "n");
-            let seed: u64 = arg(&args, 3, "seed");
-            let path: String = arg(&args, 4, "file");
-            let mut f = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
-            for p in plummer(n, seed, 1 << 24).unwrap() {
+            let n: usize = arg(&args, 2, "n")?;
+            let seed: u64 = arg(&args, 3, "seed")?;
+            let path: String = arg(&args, 4, "file")?;
+            let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+            for p in plummer(n, seed, 1 << 24)? {
                 for v in [
                     p.mass, p.pos.0[0], p.pos.0[1], p.pos.0[2], p.vel.0[0], p.vel.0[1], p.vel.0[2],
                 ] {
-                    f.write_all(&v.to_le_bytes()).unwrap();
+                    f.write_all(&v.to_le_bytes())?;
                 }
             }
         }
         "leapfrog-direct" | "leapfrog-tree" => {
-            let path: String = arg(&args, 2, "file");
-            let steps: u64 = arg(&args, 3, "steps");
-            let dt: f64 = arg(&args, 4, "dt");
-            let eps: f64 = arg(&args, 5, "softening");
-            let mut sim = load(&path);
-            sim.set_softening(eps).unwrap();
-            sim.set_integrator(Integrator::Leapfrog).unwrap();
-            sim.set_dt(dt).unwrap();
+            let path: String = arg(&args, 2, "file")?;
+            let steps: u64 = arg(&args, 3, "steps")?;
+            let dt: f64 = arg(&args, 4, "dt")?;
+            let eps: f64 = arg(&args, 5, "softening")?;
+            let mut sim = load(&path)?;
+            sim.set_softening(eps)?;
+            sim.set_integrator(Integrator::Leapfrog)?;
+            sim.set_dt(dt)?;
             if case == "leapfrog-tree" {
-                let theta: f64 = arg(&args, 6, "theta");
-                let quadrupole: u8 = arg(&args, 7, "quadrupole 0/1");
+                let theta: f64 = arg(&args, 6, "theta")?;
+                let quadrupole: u8 = arg(&args, 7, "quadrupole 0/1")?;
                 sim.set_gravity(Gravity::Tree(TreeParams {
                     theta,
                     quadrupole: quadrupole == 1,
-                }))
-                .unwrap();
+                }))?;
             }
             let t0 = Instant::now();
-            sim.integrate(steps as f64 * dt).unwrap();
+            sim.integrate(steps as f64 * dt)?;
             let secs = t0.elapsed().as_secs_f64();
             report(case, &sim, secs, f64::NAN);
         }
         _ => {
-            eprintln!("usage: see the file's doc comment");
-            std::process::exit(2);
+            return Err("usage: see the file's doc comment".into());
         }
     }
+    Ok(())
 }

@@ -31,7 +31,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let mut sim = Simulation::new(system, ff, Thermostat::None, params)?;
     let rep = sim.run(steps, &mut |_: &ThermoRecord, _: &System| {})?;
-    let last = rep.records.last().expect("a record");
+    let last = rep
+        .records
+        .last()
+        .ok_or("the run recorded no thermo line")?;
     println!(
         "{},{},{},{}",
         last.step, last.temperature, last.total, last.pressure

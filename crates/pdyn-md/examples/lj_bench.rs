@@ -11,7 +11,7 @@ use pdyn_md::thermostat::Thermostat;
 use pdyn_md::*;
 use std::time::Instant;
 
-fn main() {
+fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<usize> = std::env::args()
         .skip(1)
         .filter_map(|a| a.parse().ok())
@@ -21,23 +21,19 @@ fn main() {
     let threads = args.get(2).copied().unwrap_or(1);
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
-        .build_global()
-        .expect("thread pool");
+        .build_global()?;
     let t0 = Instant::now();
-    let (mut p, bx) = lattice(Lattice::Fcc, 0.8442, [cells; 3], 1.0, 1 << 26).expect("lattice");
-    maxwell_boltzmann(&mut p, 1.44, 1.0, 87287).expect("velocities");
+    let (mut p, bx) = lattice(Lattice::Fcc, 0.8442, [cells; 3], 1.0, 1 << 26)?;
+    maxwell_boltzmann(&mut p, 1.44, 1.0, 87287)?;
     let ff = ForceField::single(LennardJones::new(1.0, 1.0).truncated(2.5, CutoffMode::Plain));
     let params = SimParams {
         thermo_every: 50,
         ..SimParams::default()
     };
-    let mut sim =
-        Simulation::new(System::new(p, bx), ff, Thermostat::None, params).expect("set-up");
+    let mut sim = Simulation::new(System::new(p, bx), ff, Thermostat::None, params)?;
     let setup = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    let rep = sim
-        .run(steps, &mut |_: &ThermoRecord, _: &System| {})
-        .expect("run");
+    let rep = sim.run(steps, &mut |_: &ThermoRecord, _: &System| {})?;
     let dt = t1.elapsed().as_secs_f64();
     let n = sim.system.particles.len();
     let pairs = sim.pairs_within_cutoff() as f64;
@@ -51,4 +47,5 @@ fn main() {
         last.total / n as f64,
         last.pressure
     );
+    Ok(())
 }
