@@ -12,6 +12,7 @@
 //!   identity, trigonometric expansion, polynomial GCD cancellation);
 //! - [`linsolve`] extracts `A x = b` from equations linear in chosen unknowns and solves it,
 //!   symbolically (fraction-free elimination) or numerically via [`lu`];
+//! - [`units`] reads unit literals (`25 mph`, `2*pi/(120 s)`) with their [`dimension`]s;
 //! - [`print`] writes text (re-parsable), LaTeX and Rust;
 //! - [`compile`] turns a set of expressions into one flat, allocation-free program.
 //!
@@ -29,6 +30,7 @@ pub mod build;
 pub mod compile;
 mod constant;
 pub mod diff;
+pub mod dimension;
 pub mod error;
 pub mod expand;
 pub mod linsolve;
@@ -42,10 +44,12 @@ pub mod print;
 pub mod simplify;
 pub mod subs;
 pub mod syntax;
+pub mod units;
 pub mod vector;
 
 pub use budget::BudgetError;
 pub use compile::Program;
+pub use dimension::Dimension;
 pub use error::ExprError;
 pub use lower::{Binding, FreeScope, Scope, Value};
 pub use number::{Number, Rational};

@@ -113,7 +113,7 @@ impl FreeScope {
                 self.learn(rhs);
             }
             Ast::Vector { items, .. } => items.iter().for_each(|a| self.learn(a)),
-            Ast::Num { .. } | Ast::Ident { .. } => {}
+            Ast::Num { .. } | Ast::Quantity { .. } | Ast::Ident { .. } => {}
         }
     }
 }
@@ -214,6 +214,24 @@ impl Lowerer<'_> {
                     ExprError::new(span.clone(), message)
                 })?;
                 Ok(Value::Scalar(self.pool.num(n)))
+            }
+            Ast::Quantity { text, unit, span } => {
+                // Exact when the number and the unit's factor are (`150 knot` is 2315/30 m/s;
+                // `45 deg` is pi/4).
+                let exact = literal(text).and_then(|n| crate::units::exact_quantity(&n, unit));
+                let Some((n, pi)) = exact else {
+                    return Err(ExprError::new(
+                        span.clone(),
+                        format!("quantity `{text} {unit}` is too large for exact arithmetic"),
+                    ));
+                };
+                let n = self.pool.num(n);
+                if pi == 0 {
+                    return Ok(Value::Scalar(n));
+                }
+                let pi_const = self.pool.constant(Constant::Pi);
+                let pi_pow = self.pool.powi(pi_const, pi);
+                Ok(Value::Scalar(self.pool.mul2(n, pi_pow)))
             }
             Ast::Ident { name, span } => self.ident(name, span),
             Ast::Neg { expr, .. } => {
@@ -613,5 +631,24 @@ mod tests {
         assert_eq!(n, Value::Scalar(p.int(5)));
         let c = p.parse_value("[a, b, c].y").unwrap();
         assert_eq!(c, Value::Scalar(p.var("b")));
+    }
+
+    #[test]
+    fn unit_literals_inside_expressions_are_exact() {
+        let mut p = Pool::new();
+        let mut text = |src: &str| {
+            let v = p.parse_scalar(src).unwrap();
+            p.to_text(v)
+        };
+        assert_eq!(text("2*pi/(120 s)"), "pi/60");
+        assert_eq!(text("150 knot"), "463/6");
+        assert_eq!(text("45 deg"), "pi/4");
+        assert_eq!(text("45°"), "pi/4");
+        assert_eq!(text("9.81 m/s^2*t"), "981*t/100");
+        assert_eq!(text("3 km/h * x"), "5*x/6");
+        assert_eq!(text("2 mm^2"), "1/500000");
+        assert_eq!(text("(2 mm)^2"), "1/250000");
+        let e = p.parse_value("2 x").unwrap_err();
+        assert!(e.help.unwrap().contains('*'));
     }
 }

@@ -7,9 +7,11 @@
 //! unary    := ('-' | '+') unary | power
 //! power    := postfix (('^' | '**') unary)?          right associative: 2^-x, -x^2 = -(x^2)
 //! postfix  := primary ("'" | '.' ('x'|'y'|'z'))*     x'' is the second time derivative
-//! primary  := number | ident | ident '(' args ')' | '(' expr ')' | '[' expr, expr (, expr)? ']'
+//! primary  := number unit? | ident | ident '(' args ')' | '(' expr ')' | '[' expr, expr (, expr)? ']'
 //! ```
-//! Numbers: `12`, `1.5`, `.5`, `1.5e-3`. Identifiers: letters (Unicode allowed, e.g. `θ`),
+//! Numbers: `12`, `1.5`, `.5`, `1.5e-3`, optionally followed by a unit (`120 s`, `9.81 m/s^2`,
+//! `45 deg`: see [`crate::units`]); a name after a number that is not a unit is an error
+//! (multiplication is written with `*`). Identifiers: letters (Unicode allowed, e.g. `θ`),
 //! digits and `_`, not starting with a digit.
 
 use crate::error::ExprError;
@@ -32,6 +34,12 @@ pub enum BinOp {
 pub enum Ast {
     /// A numeric literal, kept as text so that it converts exactly.
     Num { text: String, span: Range<usize> },
+    /// A number with a unit: `120 s`, `9.81 m/s^2`.
+    Quantity {
+        text: String,
+        unit: crate::units::UnitExpr,
+        span: Range<usize>,
+    },
     /// A name.
     Ident { name: String, span: Range<usize> },
     /// `-expr`.
@@ -67,10 +75,25 @@ pub enum Ast {
 }
 
 impl Ast {
+    fn set_span(&mut self, to: Range<usize>) {
+        match self {
+            Ast::Num { span, .. }
+            | Ast::Quantity { span, .. }
+            | Ast::Ident { span, .. }
+            | Ast::Neg { span, .. }
+            | Ast::Binary { span, .. }
+            | Ast::Call { span, .. }
+            | Ast::Vector { span, .. }
+            | Ast::Prime { span, .. }
+            | Ast::Component { span, .. } => *span = to,
+        }
+    }
+
     /// Byte span covered by this node.
     pub fn span(&self) -> Range<usize> {
         match self {
             Ast::Num { span, .. }
+            | Ast::Quantity { span, .. }
             | Ast::Ident { span, .. }
             | Ast::Neg { span, .. }
             | Ast::Binary { span, .. }
@@ -85,6 +108,7 @@ impl Ast {
 #[derive(Clone, Debug, PartialEq)]
 enum Tok {
     Num(String),
+    Quantity(String, crate::units::UnitExpr),
     Ident(String),
     Op(char),
     Pow,
@@ -182,7 +206,17 @@ impl<'a> Lexer<'a> {
             }
         }
         self.pos = i;
-        Ok((Tok::Num(self.src[start..i].to_string()), start..i))
+        let text = self.src[start..i].to_string();
+        // A unit right after the number (`120 s`, `9.81m/s^2`).
+        let mut j = i;
+        while j < b.len() && (b[j] == b' ' || b[j] == b'\t') {
+            j += 1;
+        }
+        if let Ok(Some((len, unit))) = crate::units::scan_unit(&self.src[j..], false) {
+            self.pos = j + len;
+            return Ok((Tok::Quantity(text, unit), start..j + len));
+        }
+        Ok((Tok::Num(text), start..i))
     }
 }
 
@@ -219,6 +253,7 @@ impl<'a> Parser<'a> {
         match &self.tok {
             Tok::End => "end of input".to_string(),
             Tok::Num(n) => format!("number `{n}`"),
+            Tok::Quantity(n, u) => format!("quantity `{n} {u}`"),
             Tok::Ident(n) => format!("name `{n}`"),
             Tok::Op(c) => format!("`{c}`"),
             Tok::Pow => "`^`".to_string(),
@@ -372,6 +407,10 @@ impl<'a> Parser<'a> {
                 self.bump()?;
                 Ok(Ast::Num { text, span })
             }
+            Tok::Quantity(text, unit) => {
+                self.bump()?;
+                Ok(Ast::Quantity { text, unit, span })
+            }
             Tok::Ident(name) => {
                 self.bump()?;
                 if self.tok == Tok::Op('(') {
@@ -397,8 +436,10 @@ impl<'a> Parser<'a> {
             }
             Tok::Op('(') => {
                 self.bump()?;
-                let e = self.expr()?;
-                self.expect(')', "to close `(`")?;
+                let mut e = self.expr()?;
+                let close = self.expect(')', "to close `(`")?;
+                // The parentheses belong to the term: `2*pi/(120 s)` ends at `)`.
+                e.set_span(span.start..close.end);
                 Ok(e)
             }
             Tok::Op('[') => {
@@ -431,7 +472,10 @@ impl<'a> Parser<'a> {
                 self.describe()
             );
             let mut e = ExprError::new(self.span.clone(), msg);
-            if matches!(self.tok, Tok::Ident(_) | Tok::Num(_) | Tok::Op('(')) {
+            if matches!(
+                self.tok,
+                Tok::Ident(_) | Tok::Num(_) | Tok::Quantity(..) | Tok::Op('(')
+            ) {
                 e = e.with_help("write multiplication explicitly with `*`");
             }
             return Err(e);

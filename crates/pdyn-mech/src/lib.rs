@@ -14,6 +14,7 @@ pub mod algebra;
 pub mod conservation;
 mod constraint_rank;
 pub mod derive;
+pub mod dimensions;
 pub mod dsolve;
 pub mod kinematics;
 pub mod model;

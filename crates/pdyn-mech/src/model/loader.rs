@@ -4,8 +4,10 @@
 
 use super::raw::Sv;
 use super::{ModelError, Parameter};
-use crate::units::{looks_like_quantity, parse_quantity};
+use crate::dimensions::{Form, Inference, Source};
+use crate::units::{looks_like_quantity, parse_quantity_with_dimension};
 use pdyn_expr::lower::{lower, Binding, Scope};
+use pdyn_expr::syntax::Ast;
 use pdyn_expr::{ExprError, Id, Number, Pool, Program, Value};
 use rustc_hash::FxHashMap;
 use std::ops::Range;
@@ -40,6 +42,13 @@ pub(crate) struct Loader<'a> {
     pub pool: Pool,
     pub scope: ModelScope,
     pub params: Vec<Parameter>,
+    /// The dimensions of names and expressions ([`crate::dimensions`]).
+    pub dims: Inference,
+    /// The dimension of the last value [`Loader::value`] read.
+    pub last: Form,
+    /// Whether that value was a bare number (`mass = 2`), which takes the dimension its field
+    /// needs.
+    pub last_bare: bool,
 }
 
 impl<'a> Loader<'a> {
@@ -51,6 +60,9 @@ impl<'a> Loader<'a> {
             pool: Pool::new(),
             scope: ModelScope::default(),
             params: Vec::new(),
+            dims: Inference::default(),
+            last: Form::default(),
+            last_bare: false,
         }
     }
 
@@ -125,19 +137,77 @@ impl<'a> Loader<'a> {
         }
     }
 
-    /// Parses an expression-valued field.
+    /// Parses an expression-valued field; its dimension is left in [`Loader::last`].
     pub fn value(&mut self, sv: &Sv) -> Result<Value, ModelError> {
         let (text, off) = self.expr_text(sv)?;
         if looks_like_quantity(&text) {
-            let x = parse_quantity(&text).map_err(|e| {
+            let (x, dim) = parse_quantity_with_dimension(&text).map_err(|e| {
                 let mut me = self.err(e.span.start + off..e.span.end + off, e.message);
                 me.help = e.help;
                 me
             })?;
+            self.dims.has_units = true;
+            self.last = dim.into();
+            self.last_bare = false;
             return Ok(Value::Scalar(self.pool.num(Number::Float(x))));
         }
         let ast = pdyn_expr::syntax::parse(&text).map_err(|e| self.located(e, off))?;
-        lower(&mut self.pool, &ast, &mut self.scope).map_err(|e| self.located(e, off))
+        let v = lower(&mut self.pool, &ast, &mut self.scope).map_err(|e| self.located(e, off))?;
+        self.last_bare = is_bare_number(&ast);
+        self.last = if self.last_bare {
+            self.dims.fresh(&text)
+        } else {
+            self.dims.infer(
+                &ast,
+                Source {
+                    text: &text,
+                    offset: off,
+                },
+            )
+        };
+        Ok(v)
+    }
+
+    /// Requires the value just read from `sv` to have the dimension `want` (checked at the end
+    /// of loading, and reported only in a model that uses units).
+    pub fn want(&mut self, sv: &Sv, want: impl Into<Form>, what: &str) {
+        let got = self.last.clone();
+        self.dims.expect(
+            &got,
+            &want.into(),
+            sv.span(),
+            what,
+            "write the quantity with its units (\"2 kg\", \"0.5 m\", \"100 N/m\"), or check \
+             the units of the parameters it uses",
+        );
+    }
+
+    /// Requires the value just read from `sv`, times `other`, to have the dimension `want`
+    /// (`N · normal` is a force).
+    pub fn want_times(&mut self, sv: &Sv, other: &Form, want: impl Into<Form>, what: &str) {
+        if let Some(product) = self.last.mul(other) {
+            self.last = product;
+            self.want(sv, want, what);
+        }
+    }
+
+    /// The dimension to give a name defined by the value just read: its own unknown when that
+    /// was a bare number (`g = 9.81`), else the value's.
+    pub fn last_for(&mut self, name: &str) -> Form {
+        if self.last_bare {
+            self.dims.fresh(name)
+        } else {
+            self.last.clone()
+        }
+    }
+
+    /// The first dimension error, in a model that writes units anywhere.
+    pub fn dimension_error(&self) -> Option<ModelError> {
+        if !self.dims.has_units {
+            return None;
+        }
+        let e = self.dims.errors.first()?;
+        Some(self.err(e.span.clone(), &e.message).help(&e.help))
     }
 
     /// Parses a field that must be a scalar.
@@ -179,6 +249,15 @@ impl<'a> Loader<'a> {
             return Err(self.err(span, format!("{what} evaluates to {}", out[0])));
         }
         Ok(out[0])
+    }
+}
+
+/// `2`, `-1.5e3`: a number without units.
+fn is_bare_number(ast: &Ast) -> bool {
+    match ast {
+        Ast::Num { .. } => true,
+        Ast::Neg { expr, .. } => is_bare_number(expr),
+        _ => false,
     }
 }
 

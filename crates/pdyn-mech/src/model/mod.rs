@@ -280,6 +280,9 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
     let params = ld.params.clone();
     let run = spec::read(&mut ld, &raw, &params)?;
     let checks = spec::read_checks(&mut ld, &raw)?;
+    if let Some(e) = ld.dimension_error() {
+        return Err(e);
+    }
 
     Ok(Model {
         run,

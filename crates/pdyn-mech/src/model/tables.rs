@@ -7,10 +7,11 @@ use super::raw::{RawModel, Sv};
 use super::{
     Constraint, Coordinate, CoordinateKind, Frame, ModelError, Parameter, Particle, UnknownQuantity,
 };
-use crate::units::{looks_like_quantity, parse_quantity};
+use crate::dimensions::{Form, Source};
+use crate::units::{looks_like_quantity, parse_quantity_with_dimension};
 use pdyn_expr::error::suggest;
 use pdyn_expr::lower::{lower, Binding};
-use pdyn_expr::{Id, Number, Value};
+use pdyn_expr::{Dimension, Id, Number, Value};
 
 /// What `[coordinates]` declares.
 pub(super) struct Coordinates {
@@ -29,6 +30,8 @@ impl Loader<'_> {
             let id = self.scalar(sv, "a parameter")?;
             let value = self.constant(id, sv.span(), "a parameter")?;
             let definition = self.depends_on_parameters(id).then_some(id);
+            let form = self.last_for(name.get_ref());
+            self.dims.bind(name.get_ref(), form);
             let sym = self.pool.symbol(name.get_ref(), value > 0.0);
             let sid = self.pool.sym(sym);
             self.declare(
@@ -61,6 +64,7 @@ impl Loader<'_> {
         for (name, su) in &raw.unknowns {
             let s = self.pool.symbol(name.get_ref(), false);
             let id = self.pool.sym(s);
+            self.dims.bind_unknown(name.get_ref());
             self.declare(
                 name.get_ref(),
                 name.span(),
@@ -73,9 +77,13 @@ impl Loader<'_> {
                     if r.get_ref().len() != 2 {
                         return Err(self.err(r.span(), "`range` is [low, high]"));
                     }
+                    let what = format!("a range bound of `{}`", name.get_ref());
+                    let own = self.dims.of(name.get_ref()).unwrap_or_default();
                     let lo = self.scalar(&r.get_ref()[0], "a range bound")?;
+                    self.want(&r.get_ref()[0], own.clone(), &what);
                     let lo = self.constant(lo, r.span(), "a range bound")?;
                     let hi = self.scalar(&r.get_ref()[1], "a range bound")?;
+                    self.want(&r.get_ref()[1], own, &what);
                     let hi = self.constant(hi, r.span(), "a range bound")?;
                     if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
                         return Err(self.err(r.span(), format!("empty range [{lo}, {hi}]")));
@@ -105,9 +113,14 @@ impl Loader<'_> {
             let kind = match sv.get_ref() {
                 toml::Value::String(_) => {
                     let expr = self.scalar(sv, "a prescribed coordinate")?;
+                    let form = self.last_for(n);
+                    self.dims.bind(n, form);
                     CoordinateKind::Prescribed { expr }
                 }
-                toml::Value::Table(t) => self.coordinate_table(n, sv, t, index, &mut out)?,
+                toml::Value::Table(t) => {
+                    self.dims.bind_unknown(n);
+                    self.coordinate_table(n, sv, t, index, &mut out)?
+                }
                 other => {
                     return Err(self
                         .err(sv.span(), format!("coordinate `{n}` must be a table or a string, found a {}", other.type_str()))
@@ -160,6 +173,18 @@ impl Loader<'_> {
                 .map_err(|e| self.err(sv.span(), format!("in `prescribed`: {}", e.message)))?;
             let v = lower(&mut self.pool, &ast, &mut self.scope)
                 .map_err(|e| self.err(sv.span(), format!("in `prescribed`: {}", e.message)))?;
+            let before = self.dims.errors.len();
+            let form = self.dims.infer(
+                &ast,
+                Source {
+                    text: &text,
+                    offset: sv.span().start,
+                },
+            );
+            for e in &mut self.dims.errors[before..] {
+                e.span = sv.span();
+            }
+            self.dims.bind(n, form);
             return match v {
                 Value::Scalar(expr) => Ok(CoordinateKind::Prescribed { expr }),
                 Value::Vector(_) => Err(self.err(sv.span(), "a coordinate is a scalar")),
@@ -187,6 +212,7 @@ impl Loader<'_> {
             let Value::Scalar(id) = v else {
                 return Err(self.err(sv.span(), "`acceleration` must be a scalar"));
             };
+            self.coordinate_dimension(n, sv, &ast, &text, 2, "acceleration");
             out.known_accelerations.push((index, id));
         }
         Ok(CoordinateKind::Free { initial, rate })
@@ -219,9 +245,14 @@ impl Loader<'_> {
                 format!("`{key}` must be a number, found {found}"),
             )
         })?;
+        let order = if key == "rate" { 1 } else { 0 };
         if looks_like_quantity(&text) {
-            let q = parse_quantity(&text)
+            let (q, dim) = parse_quantity_with_dimension(&text)
                 .map_err(|e| self.err(sv.span(), format!("in `{key}`: {}", e.message)))?;
+            self.dims.has_units = true;
+            let want = self.coordinate_form(n, order);
+            let what = format!("`{key}` of `{n}`");
+            self.dims.expect(&dim.into(), &want, sv.span(), &what, "");
             return Ok((q, self.pool.num(Number::Float(q))));
         }
         let ast = pdyn_expr::syntax::parse(&text)
@@ -233,10 +264,51 @@ impl Loader<'_> {
         let Value::Scalar(id) = v else {
             return Err(self.err(sv.span(), format!("`{key}` must be a scalar")));
         };
+        self.coordinate_dimension(n, sv, &ast, &text, order, key);
         Ok((
             self.constant(id, sv.span(), &format!("`{key}` of `{n}`"))?,
             id,
         ))
+    }
+
+    /// The dimension of coordinate `n`'s `order`-th time derivative.
+    fn coordinate_form(&mut self, n: &str, order: i64) -> Form {
+        let own = self.dims.of(n).unwrap_or_default();
+        Form::from(Dimension::TIME)
+            .pow(order.into())
+            .and_then(|t| own.div(&t))
+            .unwrap_or(own)
+    }
+
+    /// Checks an initial value, rate or acceleration written for coordinate `n` (a bare number
+    /// takes the coordinate's dimension).
+    fn coordinate_dimension(
+        &mut self,
+        n: &str,
+        sv: &Sv,
+        ast: &pdyn_expr::syntax::Ast,
+        text: &str,
+        order: i64,
+        key: &str,
+    ) {
+        if ast_is_number(ast) {
+            return;
+        }
+        // The table's values carry no spans of their own: errors inside point at the table.
+        let before = self.dims.errors.len();
+        let got = self.dims.infer(
+            ast,
+            Source {
+                text,
+                offset: sv.span().start,
+            },
+        );
+        for e in &mut self.dims.errors[before..] {
+            e.span = sv.span();
+        }
+        let want = self.coordinate_form(n, order);
+        let what = format!("`{key}` of `{n}`");
+        self.dims.expect(&got, &want, sv.span(), &what, "");
     }
 
     /// `[definitions]`: named expressions.
@@ -247,6 +319,8 @@ impl Loader<'_> {
         let mut definitions = Vec::new();
         for (name, sv) in &raw.definitions {
             let v = self.value(sv)?;
+            let form = self.last_for(name.get_ref());
+            self.dims.bind(name.get_ref(), form);
             self.declare(name.get_ref(), name.span(), "definition", Binding::Value(v))?;
             definitions.push((name.get_ref().clone(), v));
         }
@@ -261,6 +335,12 @@ impl Loader<'_> {
         let mut points = Vec::new();
         for (name, sv) in &raw.points {
             let v = self.vector(sv, &format!("point `{}`", name.get_ref()))?;
+            self.want(
+                sv,
+                Dimension::LENGTH,
+                &format!("point `{}`", name.get_ref()),
+            );
+            self.dims.bind(name.get_ref(), Dimension::LENGTH.into());
             self.declare(
                 name.get_ref(),
                 name.span(),
@@ -290,6 +370,7 @@ impl Loader<'_> {
                     .help("add position = \"[x, y, z]\" in terms of the coordinates"));
             };
             let mass = self.scalar(msv, "a mass")?;
+            self.want(msv, Dimension::MASS, &format!("the mass of `{n}`"));
             let mv = self.constant(mass, msv.span(), "a mass")?;
             if mv <= 0.0 {
                 return Err(self
@@ -300,6 +381,14 @@ impl Loader<'_> {
                     .help("a massless body is a frame: declare it under [frames]"));
             }
             let position = self.vector(psv, &format!("the position of `{n}`"))?;
+            self.want(psv, Dimension::LENGTH, &format!("the position of `{n}`"));
+            for (prefix, d) in [
+                ("", Dimension::LENGTH),
+                ("r_", Dimension::LENGTH),
+                ("v_", Dimension::VELOCITY),
+            ] {
+                self.dims.bind(&format!("{prefix}{n}"), d.into());
+            }
             let vel = position.map(|c| self.pool.dt(c));
             for (prefix, v) in [("r_", position), ("v_", vel)] {
                 let key = format!("{prefix}{n}");
@@ -371,7 +460,11 @@ impl Loader<'_> {
         points: &[(String, [Id; 3])],
     ) -> Result<forces::Built, ModelError> {
         let gravity = match &raw.gravity {
-            Some(g) => Some(self.vector(g, "gravity")?),
+            Some(g) => {
+                let v = self.vector(g, "gravity")?;
+                self.want(g, Dimension::ACCELERATION, "gravity");
+                Some(v)
+            }
             None => None,
         };
         let mut fb = forces::ForceBuilder::new(particles, frames, points);
@@ -412,6 +505,20 @@ impl Loader<'_> {
                 .pool
                 .parse_equation_in(&text, &mut self.scope)
                 .map_err(|e| self.located(e, off))?;
+            if let Ok((lhs, Some(rhs))) = pdyn_expr::syntax::parse_equation(&text) {
+                let src = Source {
+                    text: &text,
+                    offset: off,
+                };
+                let a = self.dims.infer(&lhs, src);
+                let b = self.dims.infer(&rhs, src);
+                self.dims.mismatch(
+                    src,
+                    (&lhs, &a),
+                    (&rhs, &b),
+                    " between the two sides of a constraint",
+                );
+            }
             let Value::Scalar(e) = v else {
                 return Err(self.err(eq.span(), "a constraint equation must be scalar"));
             };
@@ -426,6 +533,15 @@ impl Loader<'_> {
             });
         }
         Ok(constraints)
+    }
+}
+
+/// `2`, `-0.5`: a number without units.
+fn ast_is_number(ast: &pdyn_expr::syntax::Ast) -> bool {
+    match ast {
+        pdyn_expr::syntax::Ast::Num { .. } => true,
+        pdyn_expr::syntax::Ast::Neg { expr, .. } => ast_is_number(expr),
+        _ => false,
     }
 }
 

@@ -142,11 +142,19 @@ pub fn numeric_pairs(list: &[String], flag: &str) -> Result<Vec<(String, f64)>, 
                         )
                     })?
                 }
+                // A constant expression, units allowed: `--set omega="2*pi/(120 s)"`.
                 Err(_) => {
-                    return Err(Error::argument(
-                        flag,
-                        format!("{flag}: `{v}` is not a number or a quantity such as `150 knot` (in `{kv}`)"),
-                    ))
+                    let mut pool = pdyn_expr::Pool::new();
+                    let value = pool
+                        .parse_scalar(v)
+                        .map_err(|e| e.message)
+                        .and_then(|e| pool.eval_const(e).map_err(|e| e.to_string()));
+                    value.map_err(|why| {
+                        Error::argument(
+                            flag,
+                            format!("{flag}: `{v}` is not a number, a quantity such as `150 knot` or a constant expression such as `2*pi/(120 s)`: {why} (in `{kv}`)"),
+                        )
+                    })?
                 }
             };
             if !x.is_finite() {
@@ -221,7 +229,7 @@ pub fn idents(ast: &Ast, out: &mut Vec<String>) {
                 out.push(name.clone())
             }
         }
-        Ast::Num { .. } => {}
+        Ast::Num { .. } | Ast::Quantity { .. } => {}
         Ast::Neg { expr, .. } | Ast::Prime { expr, .. } | Ast::Component { expr, .. } => {
             idents(expr, out)
         }

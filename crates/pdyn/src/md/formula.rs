@@ -87,7 +87,7 @@ fn foreign_names(
                 out.push((name.clone(), span.clone()));
             }
         }
-        Ast::Num { .. } => {}
+        Ast::Num { .. } | Ast::Quantity { .. } => {}
         Ast::Neg { expr, .. } | Ast::Component { expr, .. } => {
             foreign_names(expr, params, out, uses_r)
         }

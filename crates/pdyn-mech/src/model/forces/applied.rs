@@ -15,6 +15,7 @@ fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelEr
     let (target, r) = b.target(ld, e)?;
     let fsv = e.need(ld, &e.raw.force, "force")?;
     let force = b.with_local(ld, r, |ld| ld.vector(fsv, "an applied force"))?;
+    ld.want(fsv, pdyn_expr::Dimension::FORCE, "an applied force");
     b.loads.push(Load {
         label: e.label.clone(),
         target,

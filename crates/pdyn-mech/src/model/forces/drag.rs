@@ -2,7 +2,7 @@
 //! `linear_drag` (`-c v_rel`), where `v_rel = v - wind`. Not conservative.
 
 use super::{vector, Entry, ForceBuilder, Id, Kind, Load, Loader, ModelError, Target};
-use pdyn_expr::Number;
+use pdyn_expr::{Dimension, Number};
 
 pub(super) const DRAG: Kind = Kind {
     name: "drag",
@@ -24,13 +24,29 @@ fn build_quadratic(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(
     let (target, vrel) = relative_velocity(b, ld, e)?;
     let raw = e.raw;
     let coef = if let Some(c) = &raw.coefficient {
-        let c = ld.scalar(c, "`coefficient`")?;
+        let csv = c;
+        let c = ld.scalar(csv, "`coefficient`")?;
+        ld.want(
+            csv,
+            Dimension::from_ints([-1, 1, 0, 0]),
+            "the drag `coefficient` (force/speed^2)",
+        );
         let speed = vector::norm(&mut ld.pool, vrel);
         ld.pool.mul2(c, speed)
     } else {
-        let rho = ld.scalar(e.need(ld, &raw.rho, "rho (or coefficient)")?, "`rho`")?;
-        let cd = ld.scalar(e.need(ld, &raw.cd, "cd")?, "`cd`")?;
-        let area = ld.scalar(e.need(ld, &raw.area, "area")?, "`area`")?;
+        let rsv = e.need(ld, &raw.rho, "rho (or coefficient)")?;
+        let rho = ld.scalar(rsv, "`rho`")?;
+        ld.want(
+            rsv,
+            Dimension::from_ints([-3, 1, 0, 0]),
+            "the density `rho`",
+        );
+        let csv = e.need(ld, &raw.cd, "cd")?;
+        let cd = ld.scalar(csv, "`cd`")?;
+        ld.want(csv, Dimension::NONE, "the drag coefficient `cd`");
+        let asv = e.need(ld, &raw.area, "area")?;
+        let area = ld.scalar(asv, "`area`")?;
+        ld.want(asv, Dimension::from_ints([2, 0, 0, 0]), "the `area`");
         let half = ld.pool.num(Number::ratio(1, 2));
         let speed = vector::norm(&mut ld.pool, vrel);
         ld.pool.mul(&[half, rho, cd, area, speed])
@@ -41,7 +57,13 @@ fn build_quadratic(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(
 
 fn build_linear(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelError> {
     let (target, vrel) = relative_velocity(b, ld, e)?;
-    let coef = ld.scalar(e.need(ld, &e.raw.c, "c")?, "`c`")?;
+    let csv = e.need(ld, &e.raw.c, "c")?;
+    let coef = ld.scalar(csv, "`c`")?;
+    ld.want(
+        csv,
+        super::damper::damping(),
+        "the linear drag coefficient `c`",
+    );
     push(b, ld, e, target, coef, vrel);
     Ok(())
 }
@@ -56,7 +78,9 @@ fn relative_velocity(
     let v = r.map(|c| ld.pool.dt(c));
     let vrel = match &e.raw.wind {
         Some(w) => {
-            let w = ld.vector(w, "`wind`")?;
+            let wsv = w;
+            let w = ld.vector(wsv, "`wind`")?;
+            ld.want(wsv, Dimension::VELOCITY, "the `wind`");
             vector::sub(&mut ld.pool, v, w)
         }
         None => v,

@@ -28,6 +28,13 @@ fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelEr
         .as_ref()
         .map_or("T".to_string(), |n| n.get_ref().clone());
     let n_id = b.reaction(ld, &n_name, e.span_or_kind(&raw.normal_force))?;
+    let n_form = ld.dims.of(&n_name).unwrap_or_default();
+    ld.want_times(
+        nsv,
+        &n_form,
+        pdyn_expr::Dimension::FORCE,
+        &format!("the normal force `{n_name}` times `normal`"),
+    );
     let nforce = vector::scale(&mut ld.pool, n_id, normal);
     b.loads.push(Load {
         label: format!("normal force {n_name}"),
@@ -44,6 +51,13 @@ fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelEr
             )?;
             let tangent = ld.vector(tsv, "`tangent`")?;
             let t_id = b.reaction(ld, &t_name, e.span_or_kind(&raw.friction_force))?;
+            let t_form = ld.dims.of(&t_name).unwrap_or_default();
+            ld.want_times(
+                tsv,
+                &t_form,
+                pdyn_expr::Dimension::FORCE,
+                &format!("the friction force `{t_name}` times `tangent`"),
+            );
             b.friction_forces.push(t_name.clone());
             let tforce = vector::scale(&mut ld.pool, t_id, tangent);
             b.loads.push(Load {
@@ -53,7 +67,13 @@ fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelEr
             });
         }
         "slip" => {
-            let mu = ld.scalar(e.need(ld, &raw.mu, "mu")?, "`mu`")?;
+            let musv = e.need(ld, &raw.mu, "mu")?;
+            let mu = ld.scalar(musv, "`mu`")?;
+            ld.want(
+                musv,
+                pdyn_expr::Dimension::NONE,
+                "the friction coefficient `mu`",
+            );
             let dir = match &raw.opposes {
                 Some(s) => {
                     let s = ld.vector(s, "`opposes`")?;
@@ -65,7 +85,13 @@ fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelEr
                     let v = at.map(|c| ld.pool.dt(c));
                     let v = match &raw.surface_velocity {
                         Some(s) => {
-                            let s = ld.vector(s, "`surface_velocity`")?;
+                            let ssv = s;
+                            let s = ld.vector(ssv, "`surface_velocity`")?;
+                            ld.want(
+                                ssv,
+                                pdyn_expr::Dimension::VELOCITY,
+                                "the `surface_velocity`",
+                            );
                             vector::sub(&mut ld.pool, v, s)
                         }
                         None => v,

@@ -13,7 +13,16 @@ pub(super) const INVERSE_SQUARE: Kind = Kind {
 
 fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelError> {
     let ends = b.pair(ld, e)?;
-    let strength = ld.scalar(e.need(ld, &e.raw.strength, "strength")?, "`strength`")?;
+    let ssv = e.need(ld, &e.raw.strength, "strength")?;
+    let strength = ld.scalar(ssv, "`strength`")?;
+    let want = pdyn_expr::Dimension::FORCE.mul(&pdyn_expr::Dimension::from_ints([2, 0, 0, 0]));
+    if let Some(want) = want {
+        ld.want(
+            ssv,
+            want,
+            "the `strength` (force times distance^2, as G m1 m2)",
+        );
+    }
     let rel = vector::sub(&mut ld.pool, ends[0].1, ends[1].1);
     let d = vector::norm(&mut ld.pool, rel);
     let d3 = ld.pool.powi(d, -3);

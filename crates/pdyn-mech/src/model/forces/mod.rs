@@ -204,7 +204,15 @@ impl<'a> ForceBuilder<'a> {
         }
         if let Some(j) = self.frames.iter().position(|fr| &fr.name == on.get_ref()) {
             let at = match &e.raw.at {
-                Some(sv) => ld.vector(sv, "`at`")?,
+                Some(sv) => {
+                    let at = ld.vector(sv, "`at`")?;
+                    ld.want(
+                        sv,
+                        pdyn_expr::Dimension::LENGTH,
+                        "the point of application `at`",
+                    );
+                    at
+                }
                 None => {
                     return Err(ld
                         .err(
@@ -314,13 +322,21 @@ impl<'a> ForceBuilder<'a> {
     ) -> Result<(Id, [Id; 3]), ModelError> {
         let rel = vector::sub(&mut ld.pool, ends[0].1, ends[1].1);
         let l = match &e.raw.length {
-            Some(sv) => ld.scalar(sv, "`length`")?,
+            Some(sv) => {
+                let l = ld.scalar(sv, "`length`")?;
+                ld.want(sv, pdyn_expr::Dimension::LENGTH, "the `length`");
+                l
+            }
             None => vector::norm(&mut ld.pool, rel),
         };
         // Attachments away from the particles' positions: the user gives the unit
         // direction (from the second end to the first) along with the length.
         let dir = match &e.raw.direction {
-            Some(d) => ld.vector(d, "`direction`")?,
+            Some(d) => {
+                let dir = ld.vector(d, "`direction`")?;
+                ld.want(d, pdyn_expr::Dimension::NONE, "the unit vector `direction`");
+                dir
+            }
             None => rel.map(|c| ld.pool.div(c, l)),
         };
         Ok((l, dir))
@@ -354,6 +370,7 @@ impl<'a> ForceBuilder<'a> {
         }
         let s = ld.pool.symbol(name, false);
         let id = ld.pool.sym(s);
+        ld.dims.bind_unknown(name);
         self.reactions.push(Reaction {
             name: name.to_string(),
             id,
@@ -374,7 +391,11 @@ impl<'a> ForceBuilder<'a> {
         ld.scope
             .local
             .insert("v".into(), Binding::Value(Value::Vector(v)));
+        ld.dims.bind("r", pdyn_expr::Dimension::LENGTH.into());
+        ld.dims.bind("v", pdyn_expr::Dimension::VELOCITY.into());
         let out = body(ld);
+        ld.dims.unbind("r");
+        ld.dims.unbind("v");
         ld.scope.local.remove("r");
         ld.scope.local.remove("v");
         out

@@ -19,7 +19,12 @@ fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelEr
     ld.scope
         .local
         .insert("dist".into(), Binding::Value(Value::Scalar(dist)));
+    ld.dims.bind("dist", pdyn_expr::Dimension::LENGTH.into());
     let pot = ld.scalar(vsv, "`potential`");
+    if pot.is_ok() {
+        ld.want(vsv, pdyn_expr::Dimension::ENERGY, "the `potential`");
+    }
+    ld.dims.unbind("dist");
     ld.scope.local.remove("dist");
     let pot = pot?;
     let rel = vector::sub(&mut ld.pool, ends[0].1, ends[1].1);

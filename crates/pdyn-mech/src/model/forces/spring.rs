@@ -3,7 +3,12 @@
 //! `k (l - l0)²/2`.
 
 use super::{Entry, ForceBuilder, Kind, Loader, ModelError, PotentialTerm};
-use pdyn_expr::Number;
+use pdyn_expr::{Dimension, Number};
+
+/// N/m.
+pub(super) fn stiffness() -> Dimension {
+    Dimension::from_ints([0, 1, -2, 0])
+}
 
 pub(super) const SPRING: Kind = Kind {
     name: "spring",
@@ -16,8 +21,12 @@ pub(super) const SPRING: Kind = Kind {
 fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelError> {
     let ends = b.pair(ld, e)?;
     let (l, dir) = b.line_of_action(ld, e, &ends)?;
-    let k = ld.scalar(e.need(ld, &e.raw.k, "k")?, "`k`")?;
-    let l0 = ld.scalar(e.need(ld, &e.raw.l0, "l0")?, "`l0`")?;
+    let ksv = e.need(ld, &e.raw.k, "k")?;
+    let k = ld.scalar(ksv, "`k`")?;
+    ld.want(ksv, stiffness(), "the stiffness `k`");
+    let l0sv = e.need(ld, &e.raw.l0, "l0")?;
+    let l0 = ld.scalar(l0sv, "`l0`")?;
+    ld.want(l0sv, Dimension::LENGTH, "the free length `l0`");
     let stretch = ld.pool.sub(l, l0);
     let half = ld.pool.num(Number::ratio(1, 2));
     let s2 = ld.pool.powi(stretch, 2);
