@@ -104,6 +104,7 @@ pub(crate) fn dependent_constraint(model: &mut Model) -> Option<DeriveError> {
                      (at the initial state they leave a residual of {residual:.3e})"
                 ),
                 help: Some("remove or correct one of them".into()),
+                location: Some(line_col(&model.source, model.constraints[i].span.start)),
             }
         } else {
             DeriveError {
@@ -112,6 +113,7 @@ pub(crate) fn dependent_constraint(model: &mut Model) -> Option<DeriveError> {
                      cannot be determined"
                 ),
                 help: Some("remove it; the remaining constraints already impose it".into()),
+                location: Some(line_col(&model.source, model.constraints[i].span.start)),
             }
         });
     }

@@ -67,6 +67,9 @@ pub struct DeriveError {
     pub message: String,
     /// What to do about it.
     pub help: Option<String>,
+    /// Line and column (1-based) in the model file of the declaration at fault (a
+    /// constraint), when there is one.
+    pub location: Option<(usize, usize)>,
 }
 
 impl std::fmt::Display for DeriveError {
@@ -85,6 +88,7 @@ fn derr(message: impl Into<String>, help: impl Into<String>) -> DeriveError {
     DeriveError {
         message: message.into(),
         help: Some(help.into()),
+        location: None,
     }
 }
 

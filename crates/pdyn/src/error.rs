@@ -231,8 +231,12 @@ impl Error {
                 Some(file(&path.display().to_string()))
             }
             Error::Argument { argument, .. } if !argument.is_empty() => Some(file(argument)),
-            Error::Derive { origin, .. }
-            | Error::Value { origin, .. }
+            Error::Derive { origin, error } => Some(Location {
+                file: origin.clone(),
+                line: error.location.map(|l| l.0),
+                column: error.location.map(|l| l.1),
+            }),
+            Error::Value { origin, .. }
             | Error::Forces { origin, .. }
             | Error::Sim { origin, .. }
             | Error::Integration { origin, .. }
@@ -283,7 +287,10 @@ impl fmt::Display for Error {
             } => f.write_str(&error.render(text, argument)),
             Error::Argument { message, .. } => f.write_str(message),
             Error::Budget { context, error } => write!(f, "{context}: error: {error}"),
-            Error::Derive { origin, error } => write!(f, "{origin}: error: {error}"),
+            Error::Derive { origin, error } => match error.location {
+                Some((line, column)) => write!(f, "{origin}:{line}:{column}: error: {error}"),
+                None => write!(f, "{origin}: error: {error}"),
+            },
             Error::Value {
                 origin,
                 option,

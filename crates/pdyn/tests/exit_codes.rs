@@ -76,6 +76,33 @@ fn model_errors_carry_file_line_and_column_in_json() {
 }
 
 #[test]
+fn contradictory_constraints_and_dimension_errors_are_located_in_json() {
+    let rails = "name = \"rails\"\ngravity = \"[0, -g, 0]\"\n[parameters]\ng = 9.81\n\
+                 [coordinates]\nx = { initial = 0, rate = 0 }\ny = { initial = 0, rate = 0 }\n\
+                 [particles.a]\nmass = 1\nposition = \"[x, y, 0]\"\n\
+                 [[constraints]]\nequation = \"x + y = 0\"\n\
+                 [[constraints]]\nequation = \"x + y = 1\"\n";
+    let units = "[parameters]\nm = \"2 kg\"\nk = \"100 N/m\"\n\
+                 [coordinates]\nx = { initial = 0, rate = 0 }\n\
+                 [particles.a]\nmass = \"m\"\nposition = \"[x, 0, 0]\"\n\
+                 [[forces]]\nkind = \"applied\"\non = \"a\"\nforce = \"[-k*x + x', 0, 0]\"\n";
+    for (name, text, line, kind) in [
+        ("rails", rails, 14, "derivation"),
+        ("units", units, 12, "model"),
+    ] {
+        let path = std::env::temp_dir().join(format!("pdyn-{name}-{}.toml", std::process::id()));
+        std::fs::write(&path, text).unwrap();
+        let (code, out, err) = pdyn(&["derive", path.to_str().unwrap(), "--json"]);
+        assert_eq!(code, 2, "{err}");
+        let e = json_error(&out);
+        assert_eq!(e["kind"], kind, "{e}");
+        assert_eq!(e["location"]["line"], line, "{e}");
+        assert!(e["location"]["column"].as_u64().is_some(), "{e}");
+        std::fs::remove_file(&path).ok();
+    }
+}
+
+#[test]
 fn usage_errors_are_json_too() {
     let (code, out, _) = pdyn(&["run", "--no-such-flag", "--json"]);
     assert_eq!(code, 2);
