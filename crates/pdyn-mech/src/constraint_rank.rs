@@ -104,7 +104,7 @@ pub(crate) fn dependent_constraint(model: &mut Model) -> Option<DeriveError> {
                      (at the initial state they leave a residual of {residual:.3e})"
                 ),
                 help: Some("remove or correct one of them".into()),
-                location: Some(line_col(&model.source, model.constraints[i].span.start)),
+                location: Some(located(model, i)),
             }
         } else {
             DeriveError {
@@ -113,11 +113,18 @@ pub(crate) fn dependent_constraint(model: &mut Model) -> Option<DeriveError> {
                      cannot be determined"
                 ),
                 help: Some("remove it; the remaining constraints already impose it".into()),
-                location: Some(line_col(&model.source, model.constraints[i].span.start)),
+                location: Some(located(model, i)),
             }
         });
     }
     None
+}
+
+/// Line and column of constraint `k`.
+fn located(model: &Model, k: usize) -> (u32, u32) {
+    let (line, column) = line_col(&model.source, model.constraints[k].span.start);
+    let narrow = |x: usize| u32::try_from(x).unwrap_or(u32::MAX);
+    (narrow(line), narrow(column))
 }
 
 /// `` `label` (line N) `` of constraint `k`.

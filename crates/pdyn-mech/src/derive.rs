@@ -69,7 +69,7 @@ pub struct DeriveError {
     pub help: Option<String>,
     /// Line and column (1-based) in the model file of the declaration at fault (a
     /// constraint), when there is one.
-    pub location: Option<(usize, usize)>,
+    pub location: Option<(u32, u32)>,
 }
 
 impl std::fmt::Display for DeriveError {

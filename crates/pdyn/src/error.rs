@@ -233,8 +233,8 @@ impl Error {
             Error::Argument { argument, .. } if !argument.is_empty() => Some(file(argument)),
             Error::Derive { origin, error } => Some(Location {
                 file: origin.clone(),
-                line: error.location.map(|l| l.0),
-                column: error.location.map(|l| l.1),
+                line: error.location.map(|l| l.0 as usize),
+                column: error.location.map(|l| l.1 as usize),
             }),
             Error::Value { origin, .. }
             | Error::Forces { origin, .. }
