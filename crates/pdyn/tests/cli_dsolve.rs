@@ -117,7 +117,14 @@ fn system_goes_numeric_and_reports_residual() {
     ]);
     assert!(ok, "{err}");
     assert!(out.contains("relative residual"), "{out}");
-    assert!(out.contains("t = 0: x1 = 0.1"), "{out}");
+    // The value at t = 0 reproduces the initial condition to rounding (the modes carry it).
+    let x1: f64 = out
+        .split("t = 0: x1 = ")
+        .nth(1)
+        .and_then(|rest| rest.split(',').next())
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or_else(|| panic!("no x1 at t = 0 in {out}"));
+    assert!((x1 - 0.1).abs() < 1e-15, "{out}");
 }
 
 #[test]

@@ -29,6 +29,10 @@
 //!   each coordinate obeys `det P(D) q_j = Σ_i adj P(D)_{ji} f_i`; its initial derivatives come
 //!   from the equations solved for the highest derivatives, and the exact solver does the rest.
 //!   Uncoupled equations (the projectile) are solved one by one.
+//! - **modal** (second-order systems `M q'' + C q' + K q = f` with numeric, symmetric or
+//!   symmetrisable `M`, `K`, classical damping, any number of coordinates): the symmetric
+//!   eigen-decomposition of `L⁻¹ K L⁻ᵀ` (`M = L Lᵀ`) decouples the modes, each solved by the
+//!   exact scalar solver; see `modal.rs`.
 //! - **numeric** (systems, or numeric equations whose characteristic polynomial has irrational
 //!   roots of degree ≥ 3): `χ` is interpolated from `det Σ A_k λ^k` at points on a circle, its
 //!   roots found by the Aberth–Ehrlich iteration (simultaneous Newton with repulsion) and grouped
@@ -66,6 +70,7 @@
 mod eliminate;
 mod exact;
 mod linear;
+mod modal;
 mod numeric;
 pub mod quad;
 mod roots;
@@ -293,7 +298,11 @@ pub fn solve_with(
     } else if let Some(cf) = eliminate::solve_by_elimination(pool, &ode, initial, t0)? {
         return Ok(cf);
     }
-    // Roots not exact, or a coupled system: the numeric solver.
+    // Roots not exact, or a coupled system: by modes when M and K are symmetric (any size),
+    // else the general numeric solver.
+    if let Some(cf) = modal::solve_modal(pool, &ode, initial, t0)? {
+        return Ok(cf);
+    }
     numeric::solve_numeric(pool, &ode, initial, t0)
 }
 
