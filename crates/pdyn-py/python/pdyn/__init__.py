@@ -16,6 +16,8 @@ the same engine as the ``pdyn`` command::
 Errors: :class:`ModelError` (with ``file``, ``line``, ``column``), :class:`ParameterError`,
 both :class:`PdynError`; a drifting conserved quantity warns with :class:`DriftWarning`.
 A numerical failure returns ``success=False`` with the partial solution, as SciPy does.
+
+The symbolic commands: :func:`kin` (``pdyn kin``) and :func:`dsolve` (``pdyn dsolve``).
 """
 
 from __future__ import annotations
@@ -33,6 +35,8 @@ from ._errors import DriftWarning, ModelError, ParameterError, PdynError
 from ._result import (DenseOutput, Derivation, EnsembleResult, Expr, ForcesResult,
                       OdeResult, SweepResult,
                       _concat_raw, _from_ivp, _from_run)
+from ._symbolic import (DsolveCase, DsolveResult, KinInstant, KinResult, RuleResult, Vector,
+                        dsolve, kin)
 
 __version__ = _pdyn.__version__
 
@@ -47,6 +51,8 @@ def __getattr__(name: str):
 __all__ = [
     "Model", "solve_ivp", "methods", "OdeResult", "Derivation", "Expr", "SweepResult",
     "EnsembleResult", "DenseOutput", "ForcesResult",
+    "kin", "dsolve", "KinResult", "KinInstant", "DsolveResult", "DsolveCase", "RuleResult",
+    "Vector",
     "PdynError", "ModelError", "ParameterError", "DriftWarning", "__version__",
 ]
 
@@ -269,7 +275,10 @@ class Model:
         needed; ``sol.plot()`` and ``sol.plot_trajectory()`` use matplotlib).
 
         Returns an :class:`OdeResult` (``success=False`` with the partial solution when the
-        integration fails). Warns :class:`DriftWarning` when a conserved quantity drifts
+        integration fails, or when an output column becomes NaN or infinite: ``status``
+        -1, ``message`` naming the columns and the first time, ``non_finite`` the columns,
+        as ``pdyn run`` exits 1 with a ``non_finite`` error). Warns :class:`DriftWarning`
+        when a conserved quantity drifts
         more than ``drift_tolerance`` (relative, default 5e-3). The GIL is released while
         the integration runs.
         """
@@ -446,7 +455,7 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
               args: Optional[Any] = None, rtol: Union[float, Sequence[float]] = 1e-3,
               atol: Union[float, Sequence[float]] = 1e-6, max_step: float = math.inf,
               first_step: Optional[float] = None, max_steps: Optional[int] = None,
-              **options: Any) -> OdeResult:
+              jit: bool = True, **options: Any) -> OdeResult:
     """Solves ``y' = fun(t, y)`` with SciPy's signature and result, integrated by pdyn.
 
     ``fun`` is either a Python callable ``fun(t, y) -> array`` (called with the GIL held for
@@ -463,6 +472,11 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
     as SciPy's: a cubic Hermite interpolant through every step (its error is O(h^4) in the
     step size h -- coarser than the methods' own continuous extensions; the values at the
     steps are exact). ``vectorized=True`` is not supported.
+
+    Compiled expressions run as native code (the Cranelift JIT of ``pdyn-jit``, compiled once
+    per distinct list of expressions and cached), with pdyn's interpreter as the fallback
+    where there is no JIT or with ``jit=False``; both give the same bits.
+    ``sol.native`` says which ran.
     """
     if options:
         raise TypeError(f"pdyn.solve_ivp: unsupported options {sorted(options)}")
@@ -504,7 +518,7 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
     def solve(t_eval_, dense):
         m_, r_, a_, ms_, fs_, mx_, ev_, na_ = common
         return _pdyn._solve_ivp(fun, t0, tf, y0a, m_, t_eval_, r_, a_, ms_, fs_, mx_, ev_, na_,
-                                dense)
+                                dense, bool(jit))
 
     raw = solve(te, dense_output and te is None)
     res = _from_ivp(raw, len(ev_list), len(y0a))
