@@ -213,12 +213,33 @@ impl PyModel {
         RunSettings::resolve(&file, &overrides, o.t_eval).map_err(sim_err)
     }
 
-    fn prepare(model: &mut pdyn_mech::Model) -> Result<Prepared, Error> {
-        sim::prepare(model).map_err(|error| Error::Sim {
+    /// Derives and compiles `model`: the right-hand side as native code with `jit` (the
+    /// interpreter otherwise, or where there is no JIT).
+    fn prepare(model: &mut pdyn_mech::Model, jit: bool) -> Result<Prepared, Error> {
+        let mode = if jit {
+            sim::JitMode::Auto
+        } else {
+            sim::JitMode::Off
+        };
+        sim::prepare_with_jit(model, &sim::run_options(), mode).map_err(|error| Error::Sim {
             origin: model.origin.clone(),
             context: "",
             error,
         })
+    }
+}
+
+/// Output columns, conservation scales, measures and events as native code (the right-hand
+/// side already is, from [`sim::prepare`]): a sweep or an ensemble evaluates them at every
+/// output point of every run. The same results bit for bit.
+fn native_observers(p: &mut Prepared) {
+    p.observer.make_native();
+    p.scales.make_native();
+    if let Some(m) = p.measures.as_mut() {
+        m.make_native();
+    }
+    for e in &mut p.events {
+        e.function.make_native();
     }
 }
 
@@ -440,7 +461,7 @@ impl PyModel {
     }
 
     /// Integrates the model; returns a dict of plain data (see `pdyn.Model.run`).
-    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, t_eval=None, max_step=None, dt=None, max_steps=None, points=None, drift_tolerance=None, params=None, plots=None))]
+    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, t_eval=None, max_step=None, dt=None, max_steps=None, points=None, drift_tolerance=None, params=None, plots=None, jit=true))]
     #[allow(clippy::too_many_arguments)]
     fn run(
         &self,
@@ -457,6 +478,7 @@ impl PyModel {
         drift_tolerance: Option<f64>,
         params: Option<Vec<(String, f64)>>,
         plots: Option<std::path::PathBuf>,
+        jit: bool,
     ) -> PyResult<PyObject> {
         let t_eval = match t_eval {
             Some(a) => Some(a.as_slice()?.to_vec()),
@@ -479,7 +501,7 @@ impl PyModel {
                 || -> Result<(RunResult, usize, Vec<String>, f64), Error> {
                     let mut model = self.with_params(params)?;
                     let set = Self::settings(&model, o)?;
-                    let prep = Self::prepare(&mut model)?;
+                    let prep = Self::prepare(&mut model, jit)?;
                     let res = sim::run(&prep, &set).map_err(|error| Error::Sim {
                         origin: model.origin.clone(),
                         context: "",
@@ -644,7 +666,7 @@ impl PyModel {
     }
 
     /// Runs the model once per value of `parameter`, in parallel (see `pdyn.Model.sweep`).
-    #[pyo3(signature = (parameter, values, measures=None, t_end=None, method=None, rtol=None, atol=None, max_step=None, dt=None, points=None, threads=None, params=None))]
+    #[pyo3(signature = (parameter, values, measures=None, t_end=None, method=None, rtol=None, atol=None, max_step=None, dt=None, points=None, threads=None, params=None, jit=true))]
     #[allow(clippy::too_many_arguments)]
     fn sweep(
         &self,
@@ -661,6 +683,7 @@ impl PyModel {
         points: Option<usize>,
         threads: Option<usize>,
         params: Option<Vec<(String, f64)>>,
+        jit: bool,
     ) -> PyResult<PyObject> {
         let values = values.as_slice()?.to_vec();
         let base = self.with_measures(py, measures.as_deref(), &parameter, &values)?;
@@ -703,7 +726,10 @@ impl PyModel {
                 spec.values = values;
                 spec.others.clear();
                 let set = Self::settings(&model, o)?;
-                let prep = Self::prepare(&mut model)?;
+                let mut prep = Self::prepare(&mut model, jit)?;
+                if jit {
+                    native_observers(&mut prep);
+                }
                 let stats: Vec<_> = spec.measures.iter().map(|m| m.stat).collect();
                 match threads {
                     Some(n) => {
@@ -753,7 +779,7 @@ impl PyModel {
     /// Runs the model once per row of `params` (and of `initial`), in parallel on all cores
     /// with the GIL released (see `pdyn.Model.ensemble`). With `dry_run`, only checks every
     /// row (names, masses > 0) and returns the problems.
-    #[pyo3(signature = (param_names, params, initial_names, initial=None, measures=None, t_end=None, method=None, rtol=None, atol=None, max_step=None, dt=None, points=None, drift_tolerance=None, threads=None, dry_run=false))]
+    #[pyo3(signature = (param_names, params, initial_names, initial=None, measures=None, t_end=None, method=None, rtol=None, atol=None, max_step=None, dt=None, points=None, drift_tolerance=None, threads=None, dry_run=false, jit=true))]
     #[allow(clippy::too_many_arguments)]
     fn ensemble(
         &self,
@@ -773,6 +799,7 @@ impl PyModel {
         drift_tolerance: Option<f64>,
         threads: Option<usize>,
         dry_run: bool,
+        jit: bool,
     ) -> PyResult<PyObject> {
         let shape = params.shape();
         let (runs, k) = (shape[0], shape[1]);
@@ -815,7 +842,7 @@ impl PyModel {
         };
         // The compiled model and its measures' statistics, from the cache when this model
         // already ran an ensemble with the same measures.
-        let key = format!("{measures:?}");
+        let key = format!("{measures:?} jit={jit}");
         let cached = self
             .prepared
             .lock()
@@ -862,7 +889,10 @@ impl PyModel {
                             Some(b) => b.model.clone(),
                             None => self.model.clone(),
                         };
-                        let p = Self::prepare(&mut model)?;
+                        let mut p = Self::prepare(&mut model, jit)?;
+                        if jit {
+                            native_observers(&mut p);
+                        }
                         let stats: Vec<Stat> = model
                             .run
                             .sweep

@@ -211,3 +211,18 @@ def test_compiled_rhs_runs_natively_and_equals_the_interpreter():
     c = pdyn.solve_ivp(exprs, (0, 10), [1.0, 0.0], rtol=1e-10, atol=1e-12,
                        args={"k": 9.0, "c": 0.0})
     assert c.y[0, -1] == pytest.approx(math.cos(30.0), abs=1e-7)
+
+
+def test_model_paths_native_and_interpreted_agree(examples):
+    m = pdyn.Model.from_file(examples / "building.toml")
+    values = np.linspace(5, 12, 6)
+    meas = {"top": ("y2 - (2*L - 3*m*g/(2*k))", "max_abs")}
+    a = m.sweep("omega", values, measures=meas, t_end=2.0, jit=True)
+    b = m.sweep("omega", values, measures=meas, t_end=2.0, jit=False)
+    assert np.array_equal(a.measures["top"], b.measures["top"])
+    ea = m.ensemble(params={"omega": values}, measures=meas, t_end=2.0)
+    eb = m.ensemble(params={"omega": values}, measures=meas, t_end=2.0, jit=False)
+    assert np.array_equal(ea.final, eb.final) and np.array_equal(ea["top"], eb["top"])
+    ra = m.run(t_end=2.0)
+    rb = m.run(t_end=2.0, jit=False)
+    assert np.array_equal(ra.y, rb.y) and ra.columns == rb.columns

@@ -262,7 +262,8 @@ class Model:
             dt: Optional[float] = None, max_steps: Optional[int] = None,
             points: Optional[int] = None, drift_tolerance: Optional[float] = None,
             params: Optional[Mapping[str, float]] = None,
-            plots: Optional[Union[str, "os.PathLike[str]"]] = None) -> OdeResult:
+            plots: Optional[Union[str, "os.PathLike[str]"]] = None,
+            jit: bool = True) -> OdeResult:
         """Integrates the equations of motion, like ``pdyn run``.
 
         Every argument left ``None`` takes the model's ``[simulate]`` value, then pdyn's
@@ -272,7 +273,9 @@ class Model:
         ``dt``: the fixed step (symplectic methods, RK4) or the first step; ``params``:
         parameter values (checked like ``pdyn run --set``); ``plots``: a directory where
         pdyn's own PNG/SVG plots are written, as ``pdyn run --out DIR`` (no matplotlib
-        needed; ``sol.plot()`` and ``sol.plot_trajectory()`` use matplotlib).
+        needed; ``sol.plot()`` and ``sol.plot_trajectory()`` use matplotlib); ``jit``:
+        the right-hand side as native code (Cranelift), ``False`` for the interpreter (the
+        same results bit for bit).
 
         Returns an :class:`OdeResult` (``success=False`` with the partial solution when the
         integration fails, or when an output column becomes NaN or infinite: ``status``
@@ -286,7 +289,7 @@ class Model:
         raw = self._m.run(t_end=t_end, method=method, rtol=rtol, atol=atol, t_eval=te,
                           max_step=max_step, dt=dt, max_steps=max_steps, points=points,
                           drift_tolerance=drift_tolerance, params=_params(params),
-                          plots=None if plots is None else os.fspath(plots))
+                          plots=None if plots is None else os.fspath(plots), jit=bool(jit))
         return _from_run(raw, list(raw["event_names"]))
 
     def derive(self) -> Derivation:
@@ -311,19 +314,22 @@ class Model:
               rtol: Optional[float] = None, atol: Optional[float] = None,
               max_step: Optional[float] = None, dt: Optional[float] = None,
               points: Optional[int] = None, threads: Optional[int] = None,
-              params: Optional[Mapping[str, float]] = None) -> SweepResult:
+              params: Optional[Mapping[str, float]] = None, jit: bool = True) -> SweepResult:
         """Runs the model once per value of parameter ``param``, in parallel on all cores
         (``threads`` to limit), with the GIL released, like ``pdyn sweep``.
 
         ``measures``: ``{name: (expression, statistic)}`` (statistic: max, min, max_abs,
         peak_to_peak, final, mean, rms; a bare expression means ``max_abs``), or ``None``
         for the model's ``[sweep.measures]``. Returns a :class:`SweepResult` with one
-        float64 array per measure (NaN where a run failed; see ``problems``).
+        float64 array per measure (NaN where a run failed; see ``problems``). The right-hand
+        side, output columns and measures run as native code (``jit=False``: the
+        interpreter; the same results).
         """
         ms = _measures(measures)
         raw = self._m.sweep(str(param), _array1(values, "values"), measures=ms, t_end=t_end,
                             method=method, rtol=rtol, atol=atol, max_step=max_step, dt=dt,
-                            points=points, threads=threads, params=_params(params))
+                            points=points, threads=threads, params=_params(params),
+                            jit=bool(jit))
         return SweepResult(
             parameter=raw["parameter"], values=raw["values"], measures=dict(raw["measures"]),
             problems=list(raw["problems"]), runs=raw["runs"], seconds=raw["seconds"],
@@ -387,7 +393,8 @@ class Model:
                  rtol: Optional[float] = None, atol: Optional[float] = None,
                  max_step: Optional[float] = None, dt: Optional[float] = None,
                  points: Optional[int] = None, drift_tolerance: Optional[float] = None,
-                 threads: Optional[int] = None, progress: bool = False) -> EnsembleResult:
+                 threads: Optional[int] = None, progress: bool = False,
+                 jit: bool = True) -> EnsembleResult:
         """Runs the model once per parameter set (and initial state), in parallel on all
         cores in Rust with the GIL released; returns one array per quantity.
 
@@ -402,13 +409,14 @@ class Model:
 
         A run that fails is not an exception: its ``status`` is -1 (or -2 when it could not
         start, e.g. a mass <= 0) and ``problems`` says why. ``progress=True`` shows a tqdm
-        bar (when tqdm is installed; the runs are then done in slices).
+        bar (when tqdm is installed; the runs are then done in slices). ``jit=False``: the
+        interpreter instead of native code (the same results).
         """
         pn, pm, sn, sm = self._ensemble_inputs(params, initial)
         ms = _measures(measures)
         kw = dict(measures=ms, t_end=t_end, method=method, rtol=rtol, atol=atol,
                   max_step=max_step, dt=dt, points=points, drift_tolerance=drift_tolerance,
-                  threads=threads)
+                  threads=threads, jit=bool(jit))
         runs = pm.shape[0]
         bar = None
         if progress:
