@@ -88,6 +88,7 @@ def test_kin_errors_are_located_model_errors():
     e = ei.value
     assert isinstance(e, ValueError)
     assert e.file == "<position>" and e.line == 1 and e.column is not None and e.column > 10
+    assert e.argument == "position"
     with pytest.raises(pdyn.ModelError) as ei:
         pdyn.kin("[t, 0, 0]", polar="r = 1, theta = t")
     assert "exactly one" in str(ei.value)
@@ -160,6 +161,10 @@ def test_dsolve_errors_are_located_model_errors():
     with pytest.raises(pdyn.ModelError) as ei:
         pdyn.dsolve("x'' + * x = 0")
     assert ei.value.file == "<equation 1>" and ei.value.column is not None
+    assert ei.value.argument == "equations"
+    with pytest.raises(pdyn.ModelError) as ei:
+        pdyn.dsolve("x'' + x = 0", ic="x(0)=1, x'(0)=0", at=["1 +"])
+    assert ei.value.argument == "at" and ei.value.file == "--at"
     with pytest.raises(pdyn.ModelError):
         pdyn.dsolve("x'' + x = 0", ic="x(0)=1, z(0)=2")
 

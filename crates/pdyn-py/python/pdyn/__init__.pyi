@@ -12,6 +12,7 @@ class ModelError(PdynError, ValueError):
     line: Optional[int]
     column: Optional[int]
     message: str
+    argument: str
     def __init__(self, text: str, file: str = ..., line: Optional[int] = ...,
                  column: Optional[int] = ..., message: str = ...) -> None: ...
 

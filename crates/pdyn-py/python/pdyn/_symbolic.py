@@ -3,8 +3,9 @@
 The computation is the library's (``pdyn::kin``, ``pdyn::dsolve``), the same as the
 commands'; expressions come back as :class:`~pdyn.Expr` (3-vectors as :class:`Vector`),
 numbers as floats and float64 NumPy arrays. Bad input raises :class:`~pdyn.ModelError`
-located in the argument it came from (``file``: ``<position>``, ``--at``, ``<equation 1>``...,
-with ``line`` and ``column`` inside an expression's text).
+located in the argument it came from (``file``: the command's name for it, ``<position>``,
+``--at``, ``<equation 1>``...; ``argument``: the Python keyword, ``position``, ``at``,
+``equations``...; ``line`` and ``column`` inside an expression's text).
 """
 
 from __future__ import annotations
@@ -12,10 +13,29 @@ from __future__ import annotations
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
 
 from . import _pdyn
+from ._errors import ModelError
 from ._lazy import LazyModule
 from ._result import Expr
 
 np = LazyModule("numpy")  # imported on first use
+
+
+# The commands' names of the arguments, as the messages say them -> the Python keywords.
+_KEYWORDS = {
+    "<position>": "position", "--polar": "polar", "--path": "path", "--speed": "speed",
+    "--at": "at", "--set": "params", "--max": "max", "--over": "over", "--ic": "ic",
+    "--rule": "rule", "--when": "when",
+}
+
+
+def _call(fn, **kw):
+    """Calls the Rust function; a ModelError gets ``argument``, the Python keyword."""
+    try:
+        return fn(**kw)
+    except ModelError as e:
+        f = e.file or ""
+        e.argument = "equations" if f.startswith("<equation") else _KEYWORDS.get(f, f)
+        raise
 
 
 class Vector(tuple):
@@ -176,7 +196,8 @@ def kin(position: Any = None, *, polar: Any = None, path: Any = None, param: str
 
     Returns a :class:`KinResult`; raises :class:`~pdyn.ModelError` (located) on bad input.
     """
-    raw = _pdyn._kin(
+    raw = _call(
+        _pdyn._kin,
         position=None if position is None else _text(position),
         polar=None if polar is None else _assignments(polar),
         path=None if path is None else _assignments(path),
@@ -327,7 +348,8 @@ def dsolve(*equations: Any, ic: Any = None, rule: Any = None,
         times = [_text(at)]
     else:
         times = [_text(a) if isinstance(a, str) else repr(float(a)) for a in at]
-    raw = _pdyn._dsolve(
+    raw = _call(
+        _pdyn._dsolve,
         equations=[_text(e) for e in equations], ic=_ic(ic),
         rule=None if rule is None else _text(rule), set=_set(params), at=times,
         when=None if when is None else _text(when),
