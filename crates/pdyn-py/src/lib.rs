@@ -18,7 +18,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::cell::RefCell;
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 /// Builds an instance of an exception class of `pdyn._errors`.
 fn py_error<'py>(
@@ -213,12 +213,33 @@ impl PyModel {
         RunSettings::resolve(&file, &overrides, o.t_eval).map_err(sim_err)
     }
 
-    fn prepare(model: &mut pdyn_mech::Model) -> Result<Prepared, Error> {
-        sim::prepare(model).map_err(|error| Error::Sim {
+    /// Derives and compiles `model`: the right-hand side as native code with `jit` (the
+    /// interpreter otherwise, or where there is no JIT).
+    fn prepare(model: &mut pdyn_mech::Model, jit: bool) -> Result<Prepared, Error> {
+        let mode = if jit {
+            sim::JitMode::Auto
+        } else {
+            sim::JitMode::Off
+        };
+        sim::prepare_with_jit(model, &sim::run_options(), mode).map_err(|error| Error::Sim {
             origin: model.origin.clone(),
             context: "",
             error,
         })
+    }
+}
+
+/// Output columns, conservation scales, measures and events as native code (the right-hand
+/// side already is, from [`sim::prepare`]): a sweep or an ensemble evaluates them at every
+/// output point of every run. The same results bit for bit.
+fn native_observers(p: &mut Prepared) {
+    p.observer.make_native();
+    p.scales.make_native();
+    if let Some(m) = p.measures.as_mut() {
+        m.make_native();
+    }
+    for e in &mut p.events {
+        e.function.make_native();
     }
 }
 
@@ -242,6 +263,7 @@ fn f64_matrix(py: Python<'_>, v: Vec<f64>, rows: usize, cols: usize) -> PyResult
 /// A run result as a dict of plain data (the Python layer builds `pdyn.OdeResult`).
 fn run_dict(
     py: Python<'_>,
+    origin: &str,
     res: RunResult,
     n_states: usize,
     event_names: Vec<String>,
@@ -249,7 +271,30 @@ fn run_dict(
 ) -> PyResult<PyObject> {
     let d = PyDict::new(py);
     d.set_item("event_names", event_names)?;
-    d.set_item("status", res.status.code())?;
+    // A run that finished but tabulated NaN or infinity fails, as `pdyn run` exits 1 with a
+    // `non_finite` error.
+    let non_finite = if res.failure.is_none() {
+        non_finite_columns(origin, &res)
+    } else {
+        None
+    };
+    let status = match &non_finite {
+        Some(_) => -1,
+        None => res.status.code(),
+    };
+    d.set_item("status", status)?;
+    match &non_finite {
+        Some((names, t, e)) => {
+            d.set_item("non_finite", names.clone())?;
+            d.set_item("non_finite_t", *t)?;
+            d.set_item("failure", e.to_string())?;
+        }
+        None => {
+            d.set_item("non_finite", PyList::empty(py))?;
+            d.set_item("non_finite_t", py.None())?;
+            d.set_item("failure", res.failure.as_ref().map(|f| f.to_string()))?;
+        }
+    }
     d.set_item("drift_tolerance", drift_tolerance)?;
     let rows = res.rows.len();
     let cols = res.columns.len();
@@ -278,8 +323,30 @@ fn run_dict(
     d.set_item("warnings", res.warnings)?;
     d.set_item("stats", stats_dict(py, &res.stats)?)?;
     d.set_item("method", res.method.to_string())?;
-    d.set_item("failure", res.failure.map(|f| f.to_string()))?;
     Ok(d.into_any().unbind())
+}
+
+/// The output columns of a run that hold NaN or infinity, the first time one does, and the
+/// error `pdyn run` reports for them (`non_finite`, exit code 1); `None` when all are finite.
+fn non_finite_columns(origin: &str, res: &RunResult) -> Option<(Vec<String>, f64, Error)> {
+    let first_t = res
+        .rows
+        .iter()
+        .find(|r| r.iter().any(|x| !x.is_finite()))
+        .map(|r| r[0])?;
+    let bad: Vec<usize> = (0..res.columns.len())
+        .filter(|&c| res.rows.iter().any(|r| !r[c].is_finite()))
+        .collect();
+    let names: Vec<String> = bad.iter().map(|&c| res.columns[c].clone()).collect();
+    let quoted: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
+    let error = Error::NonFinite {
+        what: format!(
+            "{origin}: the output column(s) {} (first at t = {first_t:e})",
+            quoted.join(", ")
+        ),
+        components: bad,
+    };
+    Some((names, first_t, error))
 }
 
 fn stats_dict<'py>(py: Python<'py>, s: &pdyn_ode::Stats) -> PyResult<Bound<'py, PyDict>> {
@@ -394,7 +461,7 @@ impl PyModel {
     }
 
     /// Integrates the model; returns a dict of plain data (see `pdyn.Model.run`).
-    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, t_eval=None, max_step=None, dt=None, max_steps=None, points=None, drift_tolerance=None, params=None, plots=None))]
+    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, t_eval=None, max_step=None, dt=None, max_steps=None, points=None, drift_tolerance=None, params=None, plots=None, jit=true))]
     #[allow(clippy::too_many_arguments)]
     fn run(
         &self,
@@ -411,6 +478,7 @@ impl PyModel {
         drift_tolerance: Option<f64>,
         params: Option<Vec<(String, f64)>>,
         plots: Option<std::path::PathBuf>,
+        jit: bool,
     ) -> PyResult<PyObject> {
         let t_eval = match t_eval {
             Some(a) => Some(a.as_slice()?.to_vec()),
@@ -433,7 +501,7 @@ impl PyModel {
                 || -> Result<(RunResult, usize, Vec<String>, f64), Error> {
                     let mut model = self.with_params(params)?;
                     let set = Self::settings(&model, o)?;
-                    let prep = Self::prepare(&mut model)?;
+                    let prep = Self::prepare(&mut model, jit)?;
                     let res = sim::run(&prep, &set).map_err(|error| Error::Sim {
                         origin: model.origin.clone(),
                         context: "",
@@ -455,7 +523,7 @@ impl PyModel {
             ))
         });
         match outcome {
-            Ok(Ok((res, n, names, tol))) => run_dict(py, res, n, names, tol),
+            Ok(Ok((res, n, names, tol))) => run_dict(py, &self.model.origin, res, n, names, tol),
             Ok(Err(e)) => Err(to_py(py, &e)),
             Err(_) => Err(pdyn_error(
                 py,
@@ -598,7 +666,7 @@ impl PyModel {
     }
 
     /// Runs the model once per value of `parameter`, in parallel (see `pdyn.Model.sweep`).
-    #[pyo3(signature = (parameter, values, measures=None, t_end=None, method=None, rtol=None, atol=None, max_step=None, dt=None, points=None, threads=None, params=None))]
+    #[pyo3(signature = (parameter, values, measures=None, t_end=None, method=None, rtol=None, atol=None, max_step=None, dt=None, points=None, threads=None, params=None, jit=true))]
     #[allow(clippy::too_many_arguments)]
     fn sweep(
         &self,
@@ -615,6 +683,7 @@ impl PyModel {
         points: Option<usize>,
         threads: Option<usize>,
         params: Option<Vec<(String, f64)>>,
+        jit: bool,
     ) -> PyResult<PyObject> {
         let values = values.as_slice()?.to_vec();
         let base = self.with_measures(py, measures.as_deref(), &parameter, &values)?;
@@ -657,7 +726,10 @@ impl PyModel {
                 spec.values = values;
                 spec.others.clear();
                 let set = Self::settings(&model, o)?;
-                let prep = Self::prepare(&mut model)?;
+                let mut prep = Self::prepare(&mut model, jit)?;
+                if jit {
+                    native_observers(&mut prep);
+                }
                 let stats: Vec<_> = spec.measures.iter().map(|m| m.stat).collect();
                 match threads {
                     Some(n) => {
@@ -707,7 +779,7 @@ impl PyModel {
     /// Runs the model once per row of `params` (and of `initial`), in parallel on all cores
     /// with the GIL released (see `pdyn.Model.ensemble`). With `dry_run`, only checks every
     /// row (names, masses > 0) and returns the problems.
-    #[pyo3(signature = (param_names, params, initial_names, initial=None, measures=None, t_end=None, method=None, rtol=None, atol=None, max_step=None, dt=None, points=None, drift_tolerance=None, threads=None, dry_run=false))]
+    #[pyo3(signature = (param_names, params, initial_names, initial=None, measures=None, t_end=None, method=None, rtol=None, atol=None, max_step=None, dt=None, points=None, drift_tolerance=None, threads=None, dry_run=false, jit=true))]
     #[allow(clippy::too_many_arguments)]
     fn ensemble(
         &self,
@@ -727,6 +799,7 @@ impl PyModel {
         drift_tolerance: Option<f64>,
         threads: Option<usize>,
         dry_run: bool,
+        jit: bool,
     ) -> PyResult<PyObject> {
         let shape = params.shape();
         let (runs, k) = (shape[0], shape[1]);
@@ -769,7 +842,7 @@ impl PyModel {
         };
         // The compiled model and its measures' statistics, from the cache when this model
         // already ran an ensemble with the same measures.
-        let key = format!("{measures:?}");
+        let key = format!("{measures:?} jit={jit}");
         let cached = self
             .prepared
             .lock()
@@ -816,7 +889,10 @@ impl PyModel {
                             Some(b) => b.model.clone(),
                             None => self.model.clone(),
                         };
-                        let p = Self::prepare(&mut model)?;
+                        let mut p = Self::prepare(&mut model, jit)?;
+                        if jit {
+                            native_observers(&mut p);
+                        }
                         let stats: Vec<Stat> = model
                             .run
                             .sweep
@@ -973,6 +1049,12 @@ fn one_run(p: &Prepared, set: &RunSettings, stats: &[Stat]) -> RunOut {
     out.status = res.status.code();
     out.nfev = res.stats.fevals;
     out.message = res.failure.as_ref().map(|f| f.to_string());
+    if res.failure.is_none() {
+        if let Some((_, _, e)) = non_finite_columns("this run", &res) {
+            out.status = -1;
+            out.message = Some(e.to_string());
+        }
+    }
     if let Some(last) = res.rows.last() {
         out.t_final = last[0];
         out.final_state.copy_from_slice(&last[1..1 + n_states]);
@@ -1171,10 +1253,49 @@ struct IvpEvent {
     direction: Direction,
 }
 
-/// A right-hand side or event function: compiled expressions, or a Python callable.
+/// A right-hand side or event function: compiled expressions (native code by the Cranelift
+/// JIT, or the interpreter where there is none), or a Python callable.
 enum Rhs {
-    Compiled(Program),
+    Compiled(Arc<pdyn_jit::Evaluator>),
     Callable(PyObject),
+}
+
+/// Compiled right-hand sides by their expressions, state size, parameter names and JIT mode:
+/// a loop calling `solve_ivp` with the same expressions (other values of `args`, `y0`)
+/// compiles them once. Bounded: cleared when it holds [`CACHE_SIZE`] programs.
+type CacheKey = (Vec<String>, usize, Vec<String>, bool);
+static COMPILED: Mutex<Vec<(CacheKey, Arc<pdyn_jit::Evaluator>)>> = Mutex::new(Vec::new());
+const CACHE_SIZE: usize = 64;
+
+/// [`compile_exprs`], then native code (`jit`) with the interpreter as fallback; cached.
+fn compile_rhs(
+    exprs: &[String],
+    n: usize,
+    params: &[(String, f64)],
+    jit: bool,
+) -> Result<Arc<pdyn_jit::Evaluator>, String> {
+    let key: CacheKey = (
+        exprs.to_vec(),
+        n,
+        params.iter().map(|p| p.0.clone()).collect(),
+        jit,
+    );
+    let mut cache = COMPILED.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((_, ev)) = cache.iter().find(|(k, _)| *k == key) {
+        return Ok(ev.clone());
+    }
+    let program = compile_exprs(exprs, n, params)?;
+    let mode = if jit {
+        pdyn_jit::JitMode::Auto
+    } else {
+        pdyn_jit::JitMode::Off
+    };
+    let ev = Arc::new(pdyn_jit::Evaluator::new(program, mode));
+    if cache.len() >= CACHE_SIZE {
+        cache.clear();
+    }
+    cache.push((key, ev.clone()));
+    Ok(ev)
 }
 
 /// Compiles expressions in `t`, `y0..y{n-1}` and the names of `params` into one program
@@ -1206,13 +1327,13 @@ fn compile_exprs(exprs: &[String], n: usize, params: &[(String, f64)]) -> Result
 
 /// Evaluates one compiled program with its own registers.
 struct Evaluator<'a> {
-    program: &'a Program,
+    program: &'a pdyn_jit::Evaluator,
     inputs: RefCell<Vec<f64>>,
     ws: RefCell<Vec<f64>>,
 }
 
 impl<'a> Evaluator<'a> {
-    fn new(program: &'a Program, n: usize, params: &[(String, f64)]) -> Self {
+    fn new(program: &'a pdyn_jit::Evaluator, n: usize, params: &[(String, f64)]) -> Self {
         let mut inputs = vec![0.0; 1 + n];
         inputs.extend(params.iter().map(|p| p.1));
         Evaluator {
@@ -1338,7 +1459,7 @@ fn integrate(
 /// `solve_ivp`'s Rust part: returns a dict of plain data (`pdyn.solve_ivp` builds the
 /// `OdeResult`). `fun` is a callable `fun(t, y)` or a list of expression strings.
 #[pyfunction]
-#[pyo3(signature = (fun, t0, tf, y0, method, t_eval, rtol, atol, max_step, first_step, max_steps, events, args, dense=false))]
+#[pyo3(signature = (fun, t0, tf, y0, method, t_eval, rtol, atol, max_step, first_step, max_steps, events, args, dense=false, jit=true))]
 #[allow(clippy::too_many_arguments)]
 fn _solve_ivp(
     py: Python<'_>,
@@ -1356,6 +1477,7 @@ fn _solve_ivp(
     events: Vec<(Bound<'_, PyAny>, Option<usize>, i32)>,
     args: Vec<(String, f64)>,
     dense: bool,
+    jit: bool,
 ) -> PyResult<PyObject> {
     let y0 = y0.as_slice()?.to_vec();
     let n = y0.len();
@@ -1395,7 +1517,7 @@ fn _solve_ivp(
                 ));
             }
         }
-        compile_exprs(&exprs, n, &args)
+        compile_rhs(&exprs, n, &args, jit)
             .map(Rhs::Compiled)
             .map_err(|e| pdyn_error(py, "ParameterError", format!("{what}: {e}")))
     };
@@ -1499,6 +1621,10 @@ fn _solve_ivp(
     d.set_item("status", status)?;
     d.set_item("method", sol.method.name())?;
     d.set_item("gil_released", all_compiled)?;
+    d.set_item(
+        "native",
+        matches!(&rhs, Rhs::Compiled(ev) if ev.is_native()),
+    )?;
     if dense {
         // f(t, y) at every output point, for the Hermite interpolant of `sol.sol` (extra
         // evaluations, not counted in nfev).
@@ -1535,6 +1661,302 @@ fn _solve_ivp(
     Ok(d.into_any().unbind())
 }
 
+/// An error of `pdyn.kin` / `pdyn.dsolve`: `ModelError` located in the argument it came from
+/// (`file` is the argument: `<position>`, `--at`, `<equation 1>`...; `line`/`column` within
+/// its text when the error is in an expression), `PdynError` for a bug.
+fn input_error(py: Python<'_>, e: &Error) -> PyErr {
+    let loc = e.location();
+    let (file, line, column) = loc.as_ref().map_or((String::new(), None, None), |l| {
+        (l.file.clone(), l.line, l.column)
+    });
+    let message = match e {
+        Error::Expr { error, .. } => error.message.clone(),
+        other => other.to_string(),
+    };
+    match e {
+        Error::Internal { .. } => to_py(py, e),
+        _ => py_error(py, "ModelError", |c| {
+            c.call1((e.to_string(), file, line, column, message))
+        }),
+    }
+}
+
+/// `(text, latex)` of an expression.
+fn tl(pool: &Pool, id: Id) -> (String, String) {
+    (pool.to_text(id), pool.to_latex(id))
+}
+
+/// A kinematic quantity: `(text, latex)` for a scalar, a list of three for a vector.
+fn quantity_py(
+    py: Python<'_>,
+    pool: &Pool,
+    q: pdyn_mech::kinematics::Quantity,
+) -> PyResult<PyObject> {
+    use pdyn_mech::kinematics::Quantity;
+    Ok(match q {
+        Quantity::Scalar(s) => tl(pool, s).into_pyobject(py)?.into_any().unbind(),
+        Quantity::Vector(v) => PyList::new(py, v.iter().map(|&c| tl(pool, c)))?
+            .into_any()
+            .unbind(),
+    })
+}
+
+/// `pdyn kin`'s computation: returns a dict of plain data (`pdyn.kin` builds the result).
+#[pyfunction]
+#[pyo3(signature = (position=None, polar=None, path=None, param="s".to_string(), speed="V".to_string(), at=Vec::new(), set=Vec::new(), max=None, over=None, signed=Vec::new()))]
+#[allow(clippy::too_many_arguments)]
+fn _kin(
+    py: Python<'_>,
+    position: Option<String>,
+    polar: Option<String>,
+    path: Option<String>,
+    param: String,
+    speed: String,
+    at: Vec<String>,
+    set: Vec<String>,
+    max: Option<String>,
+    over: Option<String>,
+    signed: Vec<String>,
+) -> PyResult<PyObject> {
+    let input = pdyn::kin::KinInput {
+        position,
+        polar,
+        path,
+        param,
+        speed,
+        at,
+        set,
+        max,
+        over,
+        signed,
+    };
+    let r = py
+        .allow_threads(|| catch_unwind(AssertUnwindSafe(|| pdyn::kin::kin(&input))))
+        .map_err(|_| {
+            pdyn_error(
+                py,
+                "PdynError",
+                "internal error in pdyn during kin (please report it)".into(),
+            )
+        })?
+        .map_err(|e| input_error(py, &e))?;
+    guarded(py, || {
+        let pool = &r.pool;
+        let d = PyDict::new(py);
+        d.set_item("variable", &r.variable)?;
+        d.set_item("straight", r.straight)?;
+        let qs = PyList::empty(py);
+        for (name, q) in &r.quantities {
+            qs.append((*name, quantity_py(py, pool, *q)?))?;
+        }
+        d.set_item("quantities", qs)?;
+        let instants = PyList::empty(py);
+        for i in &r.instants {
+            let vals = PyList::empty(py);
+            for (name, q, nums) in &i.values {
+                vals.append((*name, quantity_py(py, pool, *q)?, nums.clone()))?;
+            }
+            instants.append((i.spec.clone(), i.resolved.clone(), vals))?;
+        }
+        d.set_item("instants", instants)?;
+        match &r.max {
+            None => d.set_item("max", py.None())?,
+            Some(m) => {
+                let md = PyDict::new(py);
+                md.set_item("expr", &m.expr)?;
+                md.set_item("over", &m.over)?;
+                md.set_item("variable", &m.variable)?;
+                match &m.found {
+                    pdyn_mech::kinematics::Maximum::Numeric(e) => {
+                        md.set_item("value", e.value)?;
+                        md.set_item("at", e.at)?;
+                        md.set_item("exact", false)?;
+                        md.set_item("parameters", PyList::empty(py))?;
+                    }
+                    pdyn_mech::kinematics::Maximum::Exact {
+                        at,
+                        value,
+                        parameters,
+                    } => {
+                        md.set_item("value", tl(pool, *value))?;
+                        md.set_item("at", tl(pool, *at))?;
+                        md.set_item("exact", true)?;
+                        md.set_item("parameters", parameters.clone())?;
+                    }
+                }
+                d.set_item("max", md)?;
+            }
+        }
+        d.set_item("assumed_positive", r.assumed_positive.clone())?;
+        Ok(d.into_any().unbind())
+    })
+}
+
+/// `pdyn dsolve`'s computation: returns a dict of plain data (`pdyn.dsolve` builds the
+/// result).
+#[pyfunction]
+#[pyo3(signature = (equations=Vec::new(), ic=None, rule=None, set=Vec::new(), at=Vec::new(), when=None, signed=Vec::new()))]
+#[allow(clippy::too_many_arguments)]
+fn _dsolve(
+    py: Python<'_>,
+    equations: Vec<String>,
+    ic: Option<String>,
+    rule: Option<String>,
+    set: Vec<String>,
+    at: Vec<String>,
+    when: Option<String>,
+    signed: Vec<String>,
+) -> PyResult<PyObject> {
+    use pdyn::dsolve::Solved;
+    use pdyn_mech::dsolve::{Method, Relation};
+    let input = pdyn::dsolve::DsolveInput {
+        equations,
+        ic,
+        rule,
+        set,
+        at,
+        when,
+        signed,
+    };
+    let r = py
+        .allow_threads(|| catch_unwind(AssertUnwindSafe(|| pdyn::dsolve::dsolve(&input))))
+        .map_err(|_| {
+            pdyn_error(
+                py,
+                "PdynError",
+                "internal error in pdyn during dsolve (please report it)".into(),
+            )
+        })?
+        .map_err(|e| input_error(py, &e))?;
+    guarded(py, || {
+        let pool = &r.pool;
+        let d = PyDict::new(py);
+        match &r.solved {
+            Solved::Equations(s) => {
+                let cf = &s.closed_form;
+                d.set_item("kind", "equations")?;
+                let coords: Vec<String> = cf
+                    .coords
+                    .iter()
+                    .map(|&c| pool.name(c).to_string())
+                    .collect();
+                d.set_item("coords", coords.clone())?;
+                d.set_item(
+                    "method",
+                    match cf.method {
+                        Method::Exact => "exact",
+                        Method::Numeric => "numeric",
+                    },
+                )?;
+                d.set_item("residual", cf.residual)?;
+                let cases = PyList::empty(py);
+                for (ci, c) in cf.cases.iter().enumerate() {
+                    let cd = PyDict::new(py);
+                    let cond = c.condition.map(|k| {
+                        (
+                            tl(pool, k.expr),
+                            match k.relation {
+                                Relation::Positive => ">",
+                                Relation::Zero => "=",
+                                Relation::Negative => "<",
+                            },
+                        )
+                    });
+                    cd.set_item("condition", cond)?;
+                    cd.set_item(
+                        "solution",
+                        coords
+                            .iter()
+                            .zip(&c.solution)
+                            .map(|(n, &e)| (n.clone(), tl(pool, e)))
+                            .collect::<Vec<_>>(),
+                    )?;
+                    cd.set_item("roots", c.roots.clone())?;
+                    cd.set_item(
+                        "constants",
+                        c.constants
+                            .iter()
+                            .map(|&k| pool.to_text(k))
+                            .collect::<Vec<_>>(),
+                    )?;
+                    match s.table.get(ci) {
+                        Some(rows) => {
+                            let w = 2 * coords.len();
+                            let flat: Vec<f64> = rows.iter().flatten().copied().collect();
+                            cd.set_item("values", f64_matrix(py, flat, rows.len(), w)?)?;
+                        }
+                        None => cd.set_item("values", py.None())?,
+                    }
+                    cases.append(cd)?;
+                }
+                d.set_item("cases", cases)?;
+                d.set_item("times", f64_array(py, s.times.clone()))?;
+                match &s.when {
+                    None => d.set_item("when", py.None())?,
+                    Some(w) => {
+                        let wd = PyDict::new(py);
+                        wd.set_item("condition", &w.condition)?;
+                        wd.set_item("t", tl(pool, w.found.t))?;
+                        wd.set_item("exact", w.found.exact)?;
+                        wd.set_item("value", w.found.value)?;
+                        wd.set_item(
+                            "state",
+                            w.found
+                                .state
+                                .iter()
+                                .map(|st| (st.name.clone(), tl(pool, st.exact), st.value))
+                                .collect::<Vec<_>>(),
+                        )?;
+                        d.set_item("when", wd)?;
+                    }
+                }
+                d.set_item("assumed_positive", s.assumed_positive.clone())?;
+            }
+            Solved::Rule(s) => {
+                d.set_item("kind", "rule")?;
+                d.set_item("rule", &s.rule)?;
+                d.set_item("variable", s.variable)?;
+                d.set_item("points", f64_array(py, s.points.clone()))?;
+                let qs = PyList::empty(py);
+                for (q, vals) in s.solution.quantities.iter().zip(&s.values) {
+                    let qd = PyDict::new(py);
+                    qd.set_item("name", &q.name)?;
+                    qd.set_item("closed", q.closed.map(|c| tl(pool, c)))?;
+                    qd.set_item("describe", q.describe(pool))?;
+                    qd.set_item(
+                        "values",
+                        f64_array(
+                            py,
+                            vals.iter()
+                                .map(|v| v.as_ref().map_or(f64::NAN, |e| e.value))
+                                .collect(),
+                        ),
+                    )?;
+                    qd.set_item(
+                        "errors",
+                        f64_array(
+                            py,
+                            vals.iter()
+                                .map(|v| v.as_ref().map_or(f64::NAN, |e| e.error))
+                                .collect(),
+                        ),
+                    )?;
+                    qd.set_item(
+                        "messages",
+                        vals.iter()
+                            .map(|v| v.as_ref().err().cloned())
+                            .collect::<Vec<_>>(),
+                    )?;
+                    qs.append(qd)?;
+                }
+                d.set_item("quantities", qs)?;
+                d.set_item("assumed_positive", s.assumed_positive.clone())?;
+            }
+        }
+        Ok(d.into_any().unbind())
+    })
+}
+
 /// Names and descriptions of the integration methods.
 #[pyfunction]
 fn methods() -> Vec<(String, String)> {
@@ -1555,6 +1977,8 @@ fn _pdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyModel>()?;
     m.add_function(wrap_pyfunction!(_solve_ivp, m)?)?;
     m.add_function(wrap_pyfunction!(methods, m)?)?;
+    m.add_function(wrap_pyfunction!(_kin, m)?)?;
+    m.add_function(wrap_pyfunction!(_dsolve, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

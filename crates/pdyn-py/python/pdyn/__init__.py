@@ -16,6 +16,8 @@ the same engine as the ``pdyn`` command::
 Errors: :class:`ModelError` (with ``file``, ``line``, ``column``), :class:`ParameterError`,
 both :class:`PdynError`; a drifting conserved quantity warns with :class:`DriftWarning`.
 A numerical failure returns ``success=False`` with the partial solution, as SciPy does.
+
+The symbolic commands: :func:`kin` (``pdyn kin``) and :func:`dsolve` (``pdyn dsolve``).
 """
 
 from __future__ import annotations
@@ -33,6 +35,8 @@ from ._errors import DriftWarning, ModelError, ParameterError, PdynError
 from ._result import (DenseOutput, Derivation, EnsembleResult, Expr, ForcesResult,
                       OdeResult, SweepResult,
                       _concat_raw, _from_ivp, _from_run)
+from ._symbolic import (DsolveCase, DsolveResult, KinInstant, KinResult, RuleResult, Vector,
+                        dsolve, kin)
 
 __version__ = _pdyn.__version__
 
@@ -47,6 +51,8 @@ def __getattr__(name: str):
 __all__ = [
     "Model", "solve_ivp", "methods", "OdeResult", "Derivation", "Expr", "SweepResult",
     "EnsembleResult", "DenseOutput", "ForcesResult",
+    "kin", "dsolve", "KinResult", "KinInstant", "DsolveResult", "DsolveCase", "RuleResult",
+    "Vector",
     "PdynError", "ModelError", "ParameterError", "DriftWarning", "__version__",
 ]
 
@@ -256,7 +262,8 @@ class Model:
             dt: Optional[float] = None, max_steps: Optional[int] = None,
             points: Optional[int] = None, drift_tolerance: Optional[float] = None,
             params: Optional[Mapping[str, float]] = None,
-            plots: Optional[Union[str, "os.PathLike[str]"]] = None) -> OdeResult:
+            plots: Optional[Union[str, "os.PathLike[str]"]] = None,
+            jit: bool = True) -> OdeResult:
         """Integrates the equations of motion, like ``pdyn run``.
 
         Every argument left ``None`` takes the model's ``[simulate]`` value, then pdyn's
@@ -266,10 +273,15 @@ class Model:
         ``dt``: the fixed step (symplectic methods, RK4) or the first step; ``params``:
         parameter values (checked like ``pdyn run --set``); ``plots``: a directory where
         pdyn's own PNG/SVG plots are written, as ``pdyn run --out DIR`` (no matplotlib
-        needed; ``sol.plot()`` and ``sol.plot_trajectory()`` use matplotlib).
+        needed; ``sol.plot()`` and ``sol.plot_trajectory()`` use matplotlib); ``jit``:
+        the right-hand side as native code (Cranelift), ``False`` for the interpreter (the
+        same results bit for bit).
 
         Returns an :class:`OdeResult` (``success=False`` with the partial solution when the
-        integration fails). Warns :class:`DriftWarning` when a conserved quantity drifts
+        integration fails, or when an output column becomes NaN or infinite: ``status``
+        -1, ``message`` naming the columns and the first time, ``non_finite`` the columns,
+        as ``pdyn run`` exits 1 with a ``non_finite`` error). Warns :class:`DriftWarning`
+        when a conserved quantity drifts
         more than ``drift_tolerance`` (relative, default 5e-3). The GIL is released while
         the integration runs.
         """
@@ -277,7 +289,7 @@ class Model:
         raw = self._m.run(t_end=t_end, method=method, rtol=rtol, atol=atol, t_eval=te,
                           max_step=max_step, dt=dt, max_steps=max_steps, points=points,
                           drift_tolerance=drift_tolerance, params=_params(params),
-                          plots=None if plots is None else os.fspath(plots))
+                          plots=None if plots is None else os.fspath(plots), jit=bool(jit))
         return _from_run(raw, list(raw["event_names"]))
 
     def derive(self) -> Derivation:
@@ -302,19 +314,22 @@ class Model:
               rtol: Optional[float] = None, atol: Optional[float] = None,
               max_step: Optional[float] = None, dt: Optional[float] = None,
               points: Optional[int] = None, threads: Optional[int] = None,
-              params: Optional[Mapping[str, float]] = None) -> SweepResult:
+              params: Optional[Mapping[str, float]] = None, jit: bool = True) -> SweepResult:
         """Runs the model once per value of parameter ``param``, in parallel on all cores
         (``threads`` to limit), with the GIL released, like ``pdyn sweep``.
 
         ``measures``: ``{name: (expression, statistic)}`` (statistic: max, min, max_abs,
         peak_to_peak, final, mean, rms; a bare expression means ``max_abs``), or ``None``
         for the model's ``[sweep.measures]``. Returns a :class:`SweepResult` with one
-        float64 array per measure (NaN where a run failed; see ``problems``).
+        float64 array per measure (NaN where a run failed; see ``problems``). The right-hand
+        side, output columns and measures run as native code (``jit=False``: the
+        interpreter; the same results).
         """
         ms = _measures(measures)
         raw = self._m.sweep(str(param), _array1(values, "values"), measures=ms, t_end=t_end,
                             method=method, rtol=rtol, atol=atol, max_step=max_step, dt=dt,
-                            points=points, threads=threads, params=_params(params))
+                            points=points, threads=threads, params=_params(params),
+                            jit=bool(jit))
         return SweepResult(
             parameter=raw["parameter"], values=raw["values"], measures=dict(raw["measures"]),
             problems=list(raw["problems"]), runs=raw["runs"], seconds=raw["seconds"],
@@ -378,7 +393,8 @@ class Model:
                  rtol: Optional[float] = None, atol: Optional[float] = None,
                  max_step: Optional[float] = None, dt: Optional[float] = None,
                  points: Optional[int] = None, drift_tolerance: Optional[float] = None,
-                 threads: Optional[int] = None, progress: bool = False) -> EnsembleResult:
+                 threads: Optional[int] = None, progress: bool = False,
+                 jit: bool = True) -> EnsembleResult:
         """Runs the model once per parameter set (and initial state), in parallel on all
         cores in Rust with the GIL released; returns one array per quantity.
 
@@ -393,13 +409,14 @@ class Model:
 
         A run that fails is not an exception: its ``status`` is -1 (or -2 when it could not
         start, e.g. a mass <= 0) and ``problems`` says why. ``progress=True`` shows a tqdm
-        bar (when tqdm is installed; the runs are then done in slices).
+        bar (when tqdm is installed; the runs are then done in slices). ``jit=False``: the
+        interpreter instead of native code (the same results).
         """
         pn, pm, sn, sm = self._ensemble_inputs(params, initial)
         ms = _measures(measures)
         kw = dict(measures=ms, t_end=t_end, method=method, rtol=rtol, atol=atol,
                   max_step=max_step, dt=dt, points=points, drift_tolerance=drift_tolerance,
-                  threads=threads)
+                  threads=threads, jit=bool(jit))
         runs = pm.shape[0]
         bar = None
         if progress:
@@ -446,7 +463,7 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
               args: Optional[Any] = None, rtol: Union[float, Sequence[float]] = 1e-3,
               atol: Union[float, Sequence[float]] = 1e-6, max_step: float = math.inf,
               first_step: Optional[float] = None, max_steps: Optional[int] = None,
-              **options: Any) -> OdeResult:
+              jit: bool = True, **options: Any) -> OdeResult:
     """Solves ``y' = fun(t, y)`` with SciPy's signature and result, integrated by pdyn.
 
     ``fun`` is either a Python callable ``fun(t, y) -> array`` (called with the GIL held for
@@ -463,6 +480,11 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
     as SciPy's: a cubic Hermite interpolant through every step (its error is O(h^4) in the
     step size h -- coarser than the methods' own continuous extensions; the values at the
     steps are exact). ``vectorized=True`` is not supported.
+
+    Compiled expressions run as native code (the Cranelift JIT of ``pdyn-jit``, compiled once
+    per distinct list of expressions and cached), with pdyn's interpreter as the fallback
+    where there is no JIT or with ``jit=False``; both give the same bits.
+    ``sol.native`` says which ran.
     """
     if options:
         raise TypeError(f"pdyn.solve_ivp: unsupported options {sorted(options)}")
@@ -504,7 +526,7 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
     def solve(t_eval_, dense):
         m_, r_, a_, ms_, fs_, mx_, ev_, na_ = common
         return _pdyn._solve_ivp(fun, t0, tf, y0a, m_, t_eval_, r_, a_, ms_, fs_, mx_, ev_, na_,
-                                dense)
+                                dense, bool(jit))
 
     raw = solve(te, dense_output and te is None)
     res = _from_ivp(raw, len(ev_list), len(y0a))

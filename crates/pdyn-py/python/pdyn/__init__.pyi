@@ -12,6 +12,7 @@ class ModelError(PdynError, ValueError):
     line: Optional[int]
     column: Optional[int]
     message: str
+    argument: str
     def __init__(self, text: str, file: str = ..., line: Optional[int] = ...,
                  column: Optional[int] = ..., message: str = ...) -> None: ...
 
@@ -47,6 +48,9 @@ class OdeResult(dict):
     columns: List[str]
     monitors: List[Dict[str, Any]]
     warnings: List[str]
+    non_finite: List[str]
+    non_finite_t: Optional[float]
+    native: bool
     def __getitem__(self, key: str) -> Any: ...
     def column(self, name: str) -> npt.NDArray[np.float64]: ...
     def to_pandas(self) -> Any: ...
@@ -142,7 +146,8 @@ class Model:
             dt: Optional[float] = ..., max_steps: Optional[int] = ...,
             points: Optional[int] = ..., drift_tolerance: Optional[float] = ...,
             params: Optional[Mapping[str, float]] = ...,
-            plots: Optional[Union[str, os.PathLike[str]]] = ...) -> OdeResult: ...
+            plots: Optional[Union[str, os.PathLike[str]]] = ...,
+            jit: bool = ...) -> OdeResult: ...
     def derive(self) -> Derivation: ...
     def sweep(self, param: str, values: Sequence[float],
               measures: Optional[Mapping[str, Union[str, Tuple[str, str]]]] = ...,
@@ -150,7 +155,7 @@ class Model:
               rtol: Optional[float] = ..., atol: Optional[float] = ...,
               max_step: Optional[float] = ..., dt: Optional[float] = ...,
               points: Optional[int] = ..., threads: Optional[int] = ...,
-              params: Optional[Mapping[str, float]] = ...) -> SweepResult: ...
+              params: Optional[Mapping[str, float]] = ..., jit: bool = ...) -> SweepResult: ...
     def forces(self, at: Optional[Mapping[str, float]] = ...,
                params: Optional[Mapping[str, float]] = ...) -> ForcesResult: ...
     def check_ensemble(self, params: Any = ..., initial: Any = ...) -> List[Tuple[int, str]]: ...
@@ -160,7 +165,8 @@ class Model:
                  rtol: Optional[float] = ..., atol: Optional[float] = ...,
                  max_step: Optional[float] = ..., dt: Optional[float] = ...,
                  points: Optional[int] = ..., drift_tolerance: Optional[float] = ...,
-                 threads: Optional[int] = ..., progress: bool = ...) -> EnsembleResult: ...
+                 threads: Optional[int] = ..., progress: bool = ...,
+                 jit: bool = ...) -> EnsembleResult: ...
 
 def methods() -> Dict[str, str]: ...
 
@@ -170,6 +176,67 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
               args: Optional[Any] = ..., rtol: Union[float, Sequence[float]] = ...,
               atol: Union[float, Sequence[float]] = ..., max_step: float = ...,
               first_step: Optional[float] = ..., max_steps: Optional[int] = ...,
-              **options: Any) -> OdeResult: ...
+              jit: bool = ..., **options: Any) -> OdeResult: ...
+
+class Vector(Tuple[Expr, Expr, Expr]):
+    def latex(self) -> str: ...
+    def _repr_latex_(self) -> str: ...
+    def to_sympy(self) -> Any: ...
+
+class KinInstant:
+    at: str
+    resolved: str
+    exact: Dict[str, Union[Expr, Vector]]
+    values: Dict[str, Any]
+    def __getitem__(self, name: str) -> Any: ...
+
+class KinResult:
+    variable: str
+    straight: bool
+    quantities: Dict[str, Union[Expr, Vector]]
+    instants: List[KinInstant]
+    max: Optional[Dict[str, Any]]
+    assumed_positive: List[str]
+    def __getitem__(self, name: str) -> Union[Expr, Vector]: ...
+    def __getattr__(self, name: str) -> Union[Expr, Vector]: ...
+
+def kin(position: Any = ..., *, polar: Any = ..., path: Any = ..., param: str = ...,
+        speed: Any = ..., at: Any = ..., params: Optional[Mapping[str, Any]] = ...,
+        max: Any = ..., over: Any = ..., signed: Optional[Sequence[str]] = ...) -> KinResult: ...
+
+class DsolveCase:
+    condition: Optional[Tuple[Expr, str]]
+    solution: Dict[str, Expr]
+    roots: List[str]
+    constants: List[str]
+    values: Optional[npt.NDArray[np.float64]]
+
+class DsolveResult:
+    coords: List[str]
+    method: str
+    residual: Optional[float]
+    cases: List[DsolveCase]
+    solution: Optional[Dict[str, Expr]]
+    times: npt.NDArray[np.float64]
+    values: Optional[npt.NDArray[np.float64]]
+    when: Optional[Dict[str, Any]]
+    assumed_positive: List[str]
+    def __getitem__(self, name: str) -> Expr: ...
+
+class RuleResult:
+    rule: str
+    variable: str
+    points: npt.NDArray[np.float64]
+    quantities: Dict[str, Optional[Expr]]
+    values: Dict[str, npt.NDArray[np.float64]]
+    errors: Dict[str, npt.NDArray[np.float64]]
+    messages: Dict[str, List[Optional[str]]]
+    descriptions: Dict[str, str]
+    assumed_positive: List[str]
+    def __getitem__(self, name: str) -> Optional[Expr]: ...
+
+def dsolve(*equations: Any, ic: Any = ..., rule: Any = ...,
+           params: Optional[Mapping[str, Any]] = ..., at: Any = ..., when: Any = ...,
+           signed: Optional[Sequence[str]] = ...) -> Union[DsolveResult, RuleResult]: ...
 from . import study as study
 from . import study as ensemble

@@ -12,7 +12,9 @@ class ModelError(PdynError, ValueError):
 
     ``str(e)`` is the full report (file:line:column, the offending line, a caret, help);
     the attributes locate it: ``file``, ``line`` and ``column`` (1-based, ``None`` when
-    unknown) and ``message`` (what is wrong, one line).
+    unknown) and ``message`` (what is wrong, one line). From :func:`pdyn.kin` and
+    :func:`pdyn.dsolve`, ``file`` names the command's argument (``<position>``, ``--at``) and
+    ``argument`` the Python keyword (``position``, ``at``); ``""`` otherwise.
     """
 
     def __init__(self, text: str, file: str = "", line: Optional[int] = None,
@@ -22,6 +24,7 @@ class ModelError(PdynError, ValueError):
         self.line = line
         self.column = column
         self.message = message or text
+        self.argument = ""
 
 
 class ParameterError(PdynError, ValueError):

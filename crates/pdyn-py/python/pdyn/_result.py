@@ -171,6 +171,8 @@ def _from_run(raw: Dict[str, Any], event_names: List[str]) -> OdeResult:
         warnings=list(raw["warnings"]),
         stats=dict(raw["stats"]),
         method=raw["method"],
+        non_finite=list(raw.get("non_finite", [])),
+        non_finite_t=raw.get("non_finite_t"),
         _table=table,
         **_stats_counts(raw["stats"]),
     )
@@ -213,6 +215,7 @@ def _from_ivp(raw: Dict[str, Any], n_events: int, n: int) -> OdeResult:
         stats=dict(raw["stats"]),
         method=raw["method"],
         gil_released=raw["gil_released"],
+        native=raw.get("native", False),
         **_stats_counts(raw["stats"]),
     )
 

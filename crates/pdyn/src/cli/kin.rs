@@ -1,12 +1,13 @@
 //! `pdyn kin`: kinematics of a particle from its position (Cartesian or polar) or its path and
 //! speed: velocity, acceleration, normal–tangential and polar components, curvature, values at
-//! instants and maxima over a range.
+//! instants and maxima over a range. Computed by [`pdyn::kin`]; printed here.
 
-use super::{assignments, idents, split_top, subs_all, Format};
+use super::Format;
 use clap::Args;
+use pdyn::kin::{kin, value, KinInput, KinMax, KinResult};
 use pdyn::Error;
-use pdyn_expr::{Binding, FreeScope, Id, Number, Pool, Scope, Value};
-use pdyn_mech::kinematics::{analyze, maximum, solve_time, Kinematics, Maximum, Motion, Quantity};
+use pdyn_expr::Pool;
+use pdyn_mech::kinematics::{Maximum, Quantity};
 use serde_json::json;
 
 /// `pdyn kin`.
@@ -56,14 +57,6 @@ pub struct KinArgs {
     json: bool,
 }
 
-/// A kinematic quantity as an expression value.
-fn value(q: Quantity) -> Value {
-    match q {
-        Quantity::Scalar(s) => Value::Scalar(s),
-        Quantity::Vector(v) => Value::Vector(v),
-    }
-}
-
 fn show_q(pool: &Pool, q: Quantity, f: Format) -> String {
     f.show_value(pool, value(q))
 }
@@ -72,499 +65,127 @@ fn json_q(pool: &Pool, q: Quantity) -> serde_json::Value {
     super::value_json(pool, value(q))
 }
 
-/// Parses `src` as a scalar with `scope`; errors carry the location.
-fn scalar(pool: &mut Pool, src: &str, scope: &mut dyn Scope, origin: &str) -> Result<Id, Error> {
-    match pool
-        .parse_in(src, scope)
-        .map_err(|e| Error::expr(origin, src, e))?
-    {
-        Value::Scalar(s) => Ok(s),
-        Value::Vector(_) => Err(Error::argument(
-            "",
-            format!("{origin}: `{src}` is a vector, expected a scalar"),
-        )),
-    }
-}
-
-/// Names bound to the kinematic quantities, other names free (parameters).
-struct KinScope {
-    named: Vec<(String, Value)>,
-    free: FreeScope,
-}
-
-impl Scope for KinScope {
-    fn resolve(&mut self, pool: &mut Pool, name: &str) -> Option<Binding> {
-        if let Some((_, v)) = self.named.iter().find(|(n, _)| n == name) {
-            return Some(Binding::Value(*v));
-        }
-        self.free.resolve(pool, name)
-    }
-    fn names(&self) -> Vec<String> {
-        self.named.iter().map(|(n, _)| n.clone()).collect()
-    }
-}
-
-/// The motion, its input names (for `--at theta=pi`), and the independent variable's name.
-struct Input {
-    motion: Motion,
-    inputs: Vec<(String, Id)>,
-    variable: String,
-}
-
-fn read_input(a: &KinArgs, pool: &mut Pool, scope: &mut FreeScope) -> Result<Input, Error> {
-    let given = [a.position.is_some(), a.polar.is_some(), a.path.is_some()]
-        .iter()
-        .filter(|&&b| b)
-        .count();
-    if given != 1 {
-        return Err(Error::argument("", "give exactly one of: a position \"[x, y, z]\", --polar \"r = ..., theta = ...\", or --path \"y = f(x)\""));
-    }
-    if let Some(src) = &a.position {
-        let v = pool
-            .parse_in(src, scope)
-            .map_err(|e| Error::expr("<position>", src, e))?;
-        let Value::Vector(r) = v else {
-            return Err(Error::argument(
-                "<position>",
-                format!(
-                    "<position>: `{src}` is a scalar; write the position as a vector [x, y, z]"
-                ),
-            ));
-        };
-        return Ok(Input {
-            motion: Motion::Cartesian(r),
-            inputs: vec![("x".into(), r[0]), ("y".into(), r[1]), ("z".into(), r[2])],
-            variable: "t".into(),
-        });
-    }
-    if let Some(src) = &a.polar {
-        let (mut r, mut th, mut z) = (None, None, Pool::ZERO);
-        for (k, v) in assignments(src, "--polar")? {
-            let e = scalar(pool, &v, scope, "--polar")?;
-            match k.as_str() {
-                "r" => r = Some(e),
-                "theta" | "th" => th = Some(e),
-                "z" => z = e,
-                other => {
-                    return Err(Error::argument(
-                        "--polar",
-                        format!("--polar: unknown component `{other}` (use r, theta, z)"),
-                    ))
-                }
-            }
-        }
-        let (Some(r), Some(th)) = (r, th) else {
-            return Err(Error::argument(
-                "--polar",
-                "--polar: give both r = ... and theta = ...",
-            ));
-        };
-        return Ok(Input {
-            motion: Motion::Polar { r, theta: th, z },
-            inputs: vec![("r".into(), r), ("theta".into(), th), ("z".into(), z)],
-            variable: "t".into(),
-        });
-    }
-    let src = a.path.as_deref().unwrap_or_default();
-    let items = assignments(src, "--path")?;
-    let speed = scalar(pool, &a.speed, scope, "--speed")?;
-    match items.as_slice() {
-        [(k, v)] if k == "y" => {
-            let y = scalar(pool, v, scope, "--path")?;
-            let x = pool.var("x");
-            Ok(Input {
-                motion: Motion::Path {
-                    x,
-                    y,
-                    parameter: x,
-                    speed,
-                },
-                inputs: vec![("y".into(), y)],
-                variable: "x".into(),
-            })
-        }
-        [(k1, v1), (k2, v2)] if k1 == "x" && k2 == "y" => {
-            let x = scalar(pool, v1, scope, "--path")?;
-            let y = scalar(pool, v2, scope, "--path")?;
-            let p = pool.var(&a.param);
-            if !pool.contains(x, p) && !pool.contains(y, p) {
-                return Err(Error::argument(
-                    "--path",
-                    format!(
-                    "--path: neither x nor y depends on the parameter `{}` (set it with --param)",
-                    a.param
-                ),
-                ));
-            }
-            Ok(Input {
-                motion: Motion::Path {
-                    x,
-                    y,
-                    parameter: p,
-                    speed,
-                },
-                inputs: vec![("x".into(), x), ("y".into(), y)],
-                variable: a.param.clone(),
-            })
-        }
-        _ => Err(Error::argument(
-            "--path",
-            "--path: write `y = f(x)` or `x = f(s), y = g(s)`",
-        )),
-    }
-}
-
-fn numeric(pool: &mut Pool, e: Id) -> Option<f64> {
-    pool.eval_const(e).ok()
-}
-
-fn tidy(pool: &mut Pool, e: Id) -> Id {
-    let x = pool.expand(e);
-    pool.simplify(x)
-}
-
 /// `pdyn kin ...`.
 pub fn run(a: KinArgs) -> Result<String, Error> {
-    let mut pool = Pool::new();
-    // Parameters: every plain name except t, the path variable and the quantity names.
-    let mut names = Vec::new();
-    for src in [&a.position, &a.polar, &a.path]
-        .into_iter()
-        .flatten()
-        .chain(a.path.is_some().then_some(&a.speed))
-    {
-        for item in split_top(src) {
-            let rhs = item
-                .split_once('=')
-                .map_or(item.as_str(), |(_, r)| r)
-                .trim();
-            if let Ok(ast) = pdyn_expr::syntax::parse(rhs) {
-                idents(&ast, &mut names);
-            }
-        }
-    }
-    let mut scope = FreeScope::default();
-    for src in [&a.position, &a.polar, &a.path].into_iter().flatten() {
-        for item in split_top(src) {
-            let rhs = item
-                .split_once('=')
-                .map_or(item.as_str(), |(_, r)| r)
-                .trim();
-            if let Ok(ast) = pdyn_expr::syntax::parse(rhs) {
-                scope.learn(&ast);
-            }
-        }
-    }
-    let path_var = if a
-        .path
-        .as_deref()
-        .is_some_and(|p| p.trim_start().starts_with('y'))
-    {
-        "x".to_string()
-    } else {
-        a.param.clone()
+    let input = KinInput {
+        position: a.position,
+        polar: a.polar,
+        path: a.path,
+        param: a.param,
+        speed: a.speed,
+        at: a.at,
+        set: a.set,
+        max: a.max,
+        over: a.over,
+        signed: a.signed,
     };
-    let signed_by_set = super::not_positive_in_set(&a.set);
-    let params: Vec<String> = names
-        .into_iter()
-        .filter(|n| {
-            n != "t"
-                && n != "pi"
-                && n != "e"
-                && !(a.path.is_some() && *n == path_var)
-                && !scope.coordinates.contains(n)
-                && !a.signed.contains(n)
-                && !signed_by_set.contains(n)
-        })
-        .collect();
-    scope.positive = params.iter().cloned().collect();
-    let input = read_input(&a, &mut pool, &mut scope)?;
-    let k = analyze(&mut pool, input.motion).map_err(|error| Error::Kin {
-        context: String::new(),
-        error,
-    })?;
-    // --set values.
-    let mut set = Vec::new();
-    for (name, v) in a
-        .set
-        .iter()
-        .map(|kv| assignments(kv, "--set"))
-        .collect::<Result<Vec<_>, _>>()?
-        .into_iter()
-        .flatten()
-    {
-        let val = scalar(&mut pool, &v, &mut scope, "--set")?;
-        let sym = pool.var(&name);
-        set.push((sym, val));
-    }
-    let named: Vec<(&'static str, Quantity)> = k.named();
-    let mut out = String::new();
-    let mut js = serde_json::Map::new();
-    if !a.json {
-        for (name, q) in &named {
-            out += &format!("{name} = {}\n", show_q(&pool, *q, a.format));
-        }
-        if k.straight {
-            out +=
-                "(straight-line motion: the normal is undefined, shown as 0, and R is infinite)\n";
-        }
+    let r = kin(&input)?;
+    Ok(if a.json {
+        to_json(&r)
     } else {
-        let m: serde_json::Map<String, serde_json::Value> = named
-            .iter()
-            .map(|(n, q)| (n.to_string(), json_q(&pool, *q)))
-            .collect();
-        js.insert("variable".into(), json!(input.variable));
-        js.insert("straight".into(), json!(k.straight));
-        js.insert("quantities".into(), serde_json::Value::Object(m));
+        to_text(&r, a.format)
+    })
+}
+
+fn to_text(r: &KinResult, format: Format) -> String {
+    let pool = &r.pool;
+    let mut out = String::new();
+    for (name, q) in &r.quantities {
+        out += &format!("{name} = {}\n", show_q(pool, *q, format));
     }
-    // Instants.
-    let mut instants_json = Vec::new();
-    for spec in &a.at {
-        let (header, values) = instant(&mut pool, &k, &input, &named, &set, spec, &mut scope)?;
-        if a.json {
-            let vals: serde_json::Map<String, serde_json::Value> = values
-                .iter()
-                .map(|(n, q, nums)| {
-                    (
-                        n.to_string(),
-                        json!({"exact": json_q(&pool, *q), "value": nums}),
-                    )
-                })
-                .collect();
-            instants_json.push(json!({"at": spec, "resolved": header, "values": vals}));
-        } else {
-            out += &format!("at {header}:\n");
-            for (n, q, nums) in &values {
-                let num_text = match nums {
-                    Some(v) if v.len() == 1 => format!("  ≈ {}", v[0]),
-                    Some(v) => format!(
-                        "  ≈ [{}]",
-                        v.iter().map(f64::to_string).collect::<Vec<_>>().join(", ")
-                    ),
-                    None => String::new(),
-                };
-                out += &format!("  {n} = {}{num_text}\n", show_q(&pool, *q, a.format));
-            }
+    if r.straight {
+        out += "(straight-line motion: the normal is undefined, shown as 0, and R is infinite)\n";
+    }
+    for i in &r.instants {
+        out += &format!("at {}:\n", i.resolved);
+        for (n, q, nums) in &i.values {
+            let num_text = match nums {
+                Some(v) if v.len() == 1 => format!("  ≈ {}", v[0]),
+                Some(v) => format!(
+                    "  ≈ [{}]",
+                    v.iter().map(f64::to_string).collect::<Vec<_>>().join(", ")
+                ),
+                None => String::new(),
+            };
+            out += &format!("  {n} = {}{num_text}\n", show_q(pool, *q, format));
         }
     }
-    if a.json && !a.at.is_empty() {
-        js.insert("at".into(), json!(instants_json));
+    if let Some(m) = &r.max {
+        out += &max_text(pool, m, format);
     }
-    // Maximum.
-    if let Some(expr) = &a.max {
-        let over = a.over.as_deref().ok_or_else(|| {
-            Error::argument("--max", "--max needs a range: --over x=0..L (or t=0..T)")
-        })?;
-        let (text, j) = max_over(
-            &mut pool, &k, &input, &named, &set, expr, over, &mut scope, a.format,
-        )?;
-        if a.json {
-            js.insert("max".into(), j);
-        } else {
-            out += &text;
-        }
-    } else if a.over.is_some() {
-        return Err(Error::argument(
-            "--over",
-            "--over is the range of --max; give --max too",
-        ));
-    }
-    let assumed: Vec<&String> = params
-        .iter()
-        .filter(|p| !set.iter().any(|&(s, _)| pool.to_text(s) == **p))
-        .collect();
-    if a.json {
-        js.insert("assumed_positive".into(), json!(assumed));
-        return Ok(format!("{}\n", serde_json::Value::Object(js)));
-    }
-    if !assumed.is_empty() {
+    if !r.assumed_positive.is_empty() {
         out += &format!(
             "assuming {} > 0 (use --signed NAME for a parameter that may be negative)\n",
-            assumed
-                .iter()
-                .map(|s| s.as_str())
-                .collect::<Vec<_>>()
-                .join(", ")
+            r.assumed_positive.join(", ")
         );
     }
-    Ok(out)
+    out
 }
 
-type InstantValues = Vec<(&'static str, Quantity, Option<Vec<f64>>)>;
-
-/// Resolves one `--at` spec and evaluates every quantity there.
-fn instant(
-    pool: &mut Pool,
-    k: &Kinematics,
-    input: &Input,
-    named: &[(&'static str, Quantity)],
-    set: &[(Id, Id)],
-    spec: &str,
-    scope: &mut FreeScope,
-) -> Result<(String, InstantValues), Error> {
-    let t = pool.time();
-    let mut map: Vec<(Id, Id)> = set.to_vec();
-    let mut header = Vec::new();
-    for (name, v) in assignments(spec, "--at")? {
-        let val = scalar(pool, &v, scope, "--at")?;
-        let val = subs_all(pool, val, set);
-        if name == "t" {
-            map.push((t, val));
-            header.push(format!("t = {}", pool.to_text(val)));
-        } else if name == input.variable {
-            let var = k.variable;
-            map.push((var, val));
-            header.push(format!("{name} = {}", pool.to_text(val)));
-        } else if let Some(&(_, e)) = input.inputs.iter().find(|(n, _)| *n == name) {
-            if k.variable != t {
-                return Err(Error::argument("--at", format!(
-                    "--at: for a path, give the position along it (`{} = ...`) and, if the speed varies, `t = ...`",
-                    input.variable
-                )));
-            }
-            let e = subs_all(pool, e, set);
-            let (exact, tv) = solve_time(pool, e, val).map_err(|error| Error::Kin {
-                context: format!("--at {spec}"),
-                error,
-            })?;
-            let tt = match exact {
-                Some(x) => x,
-                None => pool.num(Number::Float(tv)),
-            };
-            header.push(format!(
-                "{name} = {} (t = {}{})",
-                pool.to_text(val),
-                pool.to_text(tt),
-                if exact.is_some() && tv.is_finite() && pool.as_num(tt).is_none() {
-                    format!(" ≈ {tv}")
-                } else {
-                    String::new()
-                }
-            ));
-            map.push((t, tt));
-        } else {
-            return Err(Error::argument(
-                "--at",
-                format!(
-                    "--at: `{name}` is not t, {} or a component of the input ({})",
-                    input.variable,
-                    input
-                        .inputs
-                        .iter()
-                        .map(|(n, _)| n.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ),
-            ));
-        }
-    }
-    let mut values = Vec::new();
-    for (n, q) in named {
-        let ev = |pool: &mut Pool, e: Id| {
-            let s = subs_all(pool, e, &map);
-            tidy(pool, s)
-        };
-        let (q2, nums) = match *q {
-            Quantity::Scalar(s) => {
-                let x = ev(pool, s);
-                let v = numeric(pool, x).map(|v| vec![v]);
-                (Quantity::Scalar(x), v)
-            }
-            Quantity::Vector(v) => {
-                let x = v.map(|c| ev(pool, c));
-                let nums: Option<Vec<f64>> = x.iter().map(|&c| numeric(pool, c)).collect();
-                (Quantity::Vector(x), nums)
-            }
-        };
-        values.push((*n, q2, nums));
-    }
-    Ok((header.join(", "), values))
-}
-
-/// `--max EXPR --over VAR=LO..HI`: the expression in the names printed, the range parsed, and
-/// the maximum found by [`pdyn_mech::kinematics::maximum`].
-#[allow(clippy::too_many_arguments)] // the command's parsed state, passed once
-fn max_over(
-    pool: &mut Pool,
-    k: &Kinematics,
-    input: &Input,
-    named: &[(&'static str, Quantity)],
-    set: &[(Id, Id)],
-    expr: &str,
-    over: &str,
-    scope: &mut FreeScope,
-    format: Format,
-) -> Result<(String, serde_json::Value), Error> {
-    let mut ks = KinScope {
-        named: named
+fn to_json(r: &KinResult) -> String {
+    let pool = &r.pool;
+    let mut js = serde_json::Map::new();
+    let m: serde_json::Map<String, serde_json::Value> = r
+        .quantities
+        .iter()
+        .map(|(n, q)| (n.to_string(), json_q(pool, *q)))
+        .collect();
+    js.insert("variable".into(), json!(r.variable));
+    js.insert("straight".into(), json!(r.straight));
+    js.insert("quantities".into(), serde_json::Value::Object(m));
+    if !r.instants.is_empty() {
+        let instants_json: Vec<serde_json::Value> = r
+            .instants
             .iter()
-            .map(|(n, q)| (n.to_string(), value(*q)))
-            .collect(),
-        free: scope.clone(),
-    };
-    let f = scalar(pool, expr, &mut ks, "--max")?;
-    let (var_name, range) = over.split_once('=').ok_or_else(|| {
-        Error::argument("--over", format!("--over: expected `x=0..L`, got `{over}`"))
-    })?;
-    let var_name = var_name.trim();
-    let (lo_s, hi_s) = range.split_once("..").ok_or_else(|| {
-        Error::argument(
-            "--over",
-            format!("--over: expected `lo..hi`, got `{range}`"),
-        )
-    })?;
-    let var = if var_name == "t" {
-        pool.time()
-    } else if var_name == input.variable {
-        k.variable
-    } else {
-        return Err(Error::argument(
-            "--over",
-            format!(
-                "--over: the range must be in t or {} (got `{var_name}`)",
-                input.variable
-            ),
-        ));
-    };
-    let lo = scalar(pool, lo_s.trim(), scope, "--over")?;
-    let hi = scalar(pool, hi_s.trim(), scope, "--over")?;
-    let f = subs_all(pool, f, set);
-    let f = tidy(pool, f);
-    let (lo, hi) = (subs_all(pool, lo, set), subs_all(pool, hi, set));
-    let found = maximum(pool, f, var, lo, hi).map_err(|error| {
-        use pdyn_mech::kinematics::KinError;
-        let context = match error {
-            KinError::DependsOnTime { .. } | KinError::LocationDependsOn { .. } => "--max",
-            _ => "",
-        };
-        Error::Kin {
-            context: context.into(),
-            error,
-        }
-    })?;
-    match found {
-        Maximum::Numeric(e) => {
-            let text = format!(
-                "max {expr} over {over}: {} at {var_name} = {}\n",
-                e.value, e.at
-            );
-            Ok((text, json!({"expr": expr, "value": e.value, "at": e.at})))
-        }
+            .map(|i| {
+                let vals: serde_json::Map<String, serde_json::Value> = i
+                    .values
+                    .iter()
+                    .map(|(n, q, nums)| {
+                        (
+                            n.to_string(),
+                            json!({"exact": json_q(pool, *q), "value": nums}),
+                        )
+                    })
+                    .collect();
+                json!({"at": i.spec, "resolved": i.resolved, "values": vals})
+            })
+            .collect();
+        js.insert("at".into(), json!(instants_json));
+    }
+    if let Some(m) = &r.max {
+        js.insert("max".into(), max_json(pool, m));
+    }
+    js.insert("assumed_positive".into(), json!(r.assumed_positive));
+    format!("{}\n", serde_json::Value::Object(js))
+}
+
+fn max_text(pool: &Pool, m: &KinMax, format: Format) -> String {
+    let (expr, over, var_name) = (&m.expr, &m.over, &m.variable);
+    match &m.found {
+        Maximum::Numeric(e) => format!(
+            "max {expr} over {over}: {} at {var_name} = {}\n",
+            e.value, e.at
+        ),
         Maximum::Exact {
             at,
             value,
             parameters,
-        } => {
-            let text = format!(
-                "max {expr} over {over}: {} at {var_name} = {}\n  (location found numerically for random values of {} and checked on a third set)\n",
-                format.show(pool, value),
-                format.show(pool, at),
-                parameters.join(", ")
-            );
-            Ok((
-                text,
-                json!({"expr": expr, "value": super::both(pool, value), "at": super::both(pool, at)}),
-            ))
+        } => format!(
+            "max {expr} over {over}: {} at {var_name} = {}\n  (location found numerically for random values of {} and checked on a third set)\n",
+            format.show(pool, *value),
+            format.show(pool, *at),
+            parameters.join(", ")
+        ),
+    }
+}
+
+fn max_json(pool: &Pool, m: &KinMax) -> serde_json::Value {
+    let expr = &m.expr;
+    match &m.found {
+        Maximum::Numeric(e) => json!({"expr": expr, "value": e.value, "at": e.at}),
+        Maximum::Exact { at, value, .. } => {
+            json!({"expr": expr, "value": super::both(pool, *value), "at": super::both(pool, *at)})
         }
     }
 }
