@@ -181,3 +181,26 @@ fn results_do_not_depend_on_thread_count() {
     assert_eq!(p1, p3);
     assert_eq!(t1, t3);
 }
+
+#[test]
+fn results_do_not_depend_on_thread_count_with_several_segments() {
+    // 2,048 atoms: the force loop is cut into two segments, each with its own Newton buffer
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut sim = lj_liquid(8, 11, 0.005);
+            sim.run(40, &mut |_: &ThermoRecord, _: &System| {}).unwrap();
+            (sim.system.particles.clone(), sim.thermo())
+        })
+    };
+    let (p1, t1) = run(1);
+    let (p2, t2) = run(2);
+    let (p3, t3) = run(3);
+    assert_eq!(p1, p2);
+    assert_eq!(t1, t2);
+    assert_eq!(p1, p3);
+    assert_eq!(t1, t3);
+}
