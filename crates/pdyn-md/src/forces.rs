@@ -118,16 +118,21 @@ impl<P: PairPotential> ForceField<P> {
         let sums: Vec<(f64, f64)> = if self.ntypes == 1 {
             let p = &self.table[0];
             let rc2 = p.cutoff() * p.cutoff();
+            let batched = p.prefers_batch();
             scratch
                 .bufs
                 .par_iter_mut()
                 .enumerate()
                 .map(|(s, buf)| {
+                    let range = bounds[s]..bounds[s + 1];
+                    if batched {
+                        return segment_batched(pos, offsets, neigh, range, buf, p, rc2);
+                    }
                     segment(
                         pos,
                         offsets,
                         neigh,
-                        bounds[s]..bounds[s + 1],
+                        range,
                         buf,
                         |_, _, r2| {
                             let mut r2m = [0.0f64; 4];
@@ -323,6 +328,96 @@ fn segment(
             }
             tail[0] += u;
             tail[1] += fr * r2;
+        }
+        let b = &mut buf[i - base];
+        for k in 0..3 {
+            b[k] += fi[k];
+        }
+    }
+    let lanes = |a: &[f64; B]| (a[0] + a[1]) + (a[2] + a[3]);
+    (lanes(&ew[0]) + tail[0], lanes(&ew[1]) + tail[1])
+}
+
+/// [`segment`] for one potential that is cheaper called once per batch
+/// ([`PairPotential::prefers_batch`], a compiled formula): each particle's neighbours are
+/// gathered, up to `CH` at a time, and evaluated by one [`PairPotential::energy_force_batch`].
+/// Pairs are summed exactly as in [`segment`] (lanes by position modulo 4, the last
+/// `len % 4` one by one after the lanes), so the two loops give the same bits for the same
+/// `(u, f/r)`.
+fn segment_batched<P: PairPotential>(
+    pos: &[[f64; 3]],
+    offsets: &[u32],
+    neigh: &[u32],
+    range: std::ops::Range<usize>,
+    buf: &mut [[f64; 3]],
+    p: &P,
+    rc2: f64,
+) -> (f64, f64) {
+    const B: usize = 4;
+    const CH: usize = 64; // a multiple of B: blocks of four never straddle two batches
+    buf.iter_mut().for_each(|b| *b = [0.0; 3]);
+    let base = range.start;
+    let mut ew = [[0.0f64; B]; 2];
+    let mut tail = [0.0f64; 2];
+    let mut d = [[0.0f64; CH]; 3];
+    let mut r2 = [0.0f64; CH];
+    let mut r2m = [0.0f64; CH];
+    let mut u = [0.0f64; CH];
+    let mut fr = [0.0f64; CH];
+    for i in range {
+        let ri = pos[i];
+        let list = &neigh[offsets[i] as usize..offsets[i + 1] as usize];
+        let mut fa = [[0.0f64; B]; 3];
+        let mut rest = 0..0; // the last len % 4 pairs, within the last batch
+        for chunk in list.chunks(CH) {
+            let m = chunk.len();
+            for (k, &j) in chunk.iter().enumerate() {
+                let q = pos[j as usize];
+                d[0][k] = ri[0] - q[0];
+                d[1][k] = ri[1] - q[1];
+                d[2][k] = ri[2] - q[2];
+                r2[k] = d[0][k] * d[0][k] + d[1][k] * d[1][k] + d[2][k] * d[2][k];
+                // pairs in the skin shell are evaluated at r_c and masked below
+                r2m[k] = if r2[k] < rc2 { r2[k] } else { rc2 };
+            }
+            p.energy_force_batch(&r2m[..m], &mut u[..m], &mut fr[..m]);
+            for k in 0..m {
+                let inside = r2[k] < rc2;
+                u[k] = if inside { u[k] } else { 0.0 };
+                fr[k] = if inside { fr[k] } else { 0.0 };
+            }
+            let full = m / B * B;
+            for k0 in (0..full).step_by(B) {
+                for l in 0..B {
+                    let k = k0 + l;
+                    let fd = [fr[k] * d[0][k], fr[k] * d[1][k], fr[k] * d[2][k]];
+                    fa[0][l] += fd[0];
+                    fa[1][l] += fd[1];
+                    fa[2][l] += fd[2];
+                    ew[0][l] += u[k];
+                    ew[1][l] += fr[k] * r2[k];
+                    let b = &mut buf[chunk[k] as usize - base];
+                    b[0] -= fd[0];
+                    b[1] -= fd[1];
+                    b[2] -= fd[2];
+                }
+            }
+            rest = full..m;
+        }
+        let mut fi = [0.0f64; 3];
+        for (f, a) in fi.iter_mut().zip(&fa) {
+            *f = (a[0] + a[1]) + (a[2] + a[3]);
+        }
+        let last = &list[list.len() - rest.len()..];
+        for (k, &j) in rest.zip(last) {
+            let fd = [fr[k] * d[0][k], fr[k] * d[1][k], fr[k] * d[2][k]];
+            let b = &mut buf[j as usize - base];
+            for c in 0..3 {
+                fi[c] += fd[c];
+                b[c] -= fd[c];
+            }
+            tail[0] += u[k];
+            tail[1] += fr[k] * r2[k];
         }
         let b = &mut buf[i - base];
         for k in 0..3 {

@@ -120,6 +120,15 @@ pub struct SimParams {
     /// Largest change of the conserved quantity per particle since the start of the run
     /// (NVE, Nosé–Hoover) before the run is declared unstable (default 1.0 ε).
     pub max_energy_change: f64,
+    /// The neighbour list is considered every this many steps (LAMMPS `neigh_modify every`;
+    /// default 1, 0 counts as 1).
+    pub neighbor_every: u64,
+    /// `true` (default): at a considered step, rebuild only if the exact displacement test
+    /// ([`NeighborList::needs_rebuild`]) asks for it. `false`: rebuild unconditionally at every
+    /// considered step (LAMMPS `check no`, as in `bench/in.lj` with `every 20`), which skips
+    /// the test but lets pairs that come within the cutoff between builds go unseen. The list
+    /// is exact only with `neighbor_every = 1` and `neighbor_check = true`.
+    pub neighbor_check: bool,
 }
 
 impl Default for SimParams {
@@ -132,6 +141,8 @@ impl Default for SimParams {
             overlap_distance: 0.7,
             max_displacement: 0.5,
             max_energy_change: 1.0,
+            neighbor_every: 1,
+            neighbor_check: true,
         }
     }
 }
@@ -427,7 +438,10 @@ impl<P: PairPotential> Simulation<P> {
         } else {
             p.drift(h);
         }
-        if self.nl.needs_rebuild(&self.system.particles) {
+        let considered = step % self.params.neighbor_every.max(1) == 0;
+        if considered
+            && (!self.params.neighbor_check || self.nl.needs_rebuild(&self.system.particles))
+        {
             self.rebuild();
         } else {
             self.nl.update_ghosts(&self.system.particles);
