@@ -115,10 +115,32 @@ impl<P: PairPotential> ForceField<P> {
             b.resize(n_ext - bounds[s], [0.0; 3]);
         }
         let (pos, offsets, neigh) = (&nl.pos[..], &nl.offsets[..], &nl.neigh[..]);
+        // the bounds invariant of `segment::<true>`; buffers are sized to it just above
+        let unchecked = nl.verified;
         let sums: Vec<(f64, f64)> = if self.ntypes == 1 {
             let p = &self.table[0];
             let rc2 = p.cutoff() * p.cutoff();
             let batched = p.prefers_batch();
+            let e4 = |_: usize, _: [usize; 4], r2: [f64; 4]| {
+                let mut r2m = [0.0f64; 4];
+                for l in 0..4 {
+                    r2m[l] = if r2[l] < rc2 { r2[l] } else { rc2 };
+                }
+                let (mut u, mut fr) = p.energy_force4(r2m);
+                for l in 0..4 {
+                    let inside = r2[l] < rc2;
+                    u[l] = if inside { u[l] } else { 0.0 };
+                    fr[l] = if inside { fr[l] } else { 0.0 };
+                }
+                (u, fr)
+            };
+            let e1 = |_: usize, _: usize, r2: f64| {
+                if r2 < rc2 {
+                    p.energy_force(r2)
+                } else {
+                    (0.0, 0.0)
+                }
+            };
             scratch
                 .bufs
                 .par_iter_mut()
@@ -128,33 +150,11 @@ impl<P: PairPotential> ForceField<P> {
                     if batched {
                         return segment_batched(pos, offsets, neigh, range, buf, p, rc2);
                     }
-                    segment(
-                        pos,
-                        offsets,
-                        neigh,
-                        range,
-                        buf,
-                        |_, _, r2| {
-                            let mut r2m = [0.0f64; 4];
-                            for l in 0..4 {
-                                r2m[l] = if r2[l] < rc2 { r2[l] } else { rc2 };
-                            }
-                            let (mut u, mut fr) = p.energy_force4(r2m);
-                            for l in 0..4 {
-                                let inside = r2[l] < rc2;
-                                u[l] = if inside { u[l] } else { 0.0 };
-                                fr[l] = if inside { fr[l] } else { 0.0 };
-                            }
-                            (u, fr)
-                        },
-                        |_, _, r2| {
-                            if r2 < rc2 {
-                                p.energy_force(r2)
-                            } else {
-                                (0.0, 0.0)
-                            }
-                        },
-                    )
+                    if unchecked {
+                        segment::<true>(pos, offsets, neigh, range, buf, e4, e1)
+                    } else {
+                        segment::<false>(pos, offsets, neigh, range, buf, e4, e1)
+                    }
                 })
                 .collect()
         } else {
@@ -182,7 +182,7 @@ impl<P: PairPotential> ForceField<P> {
                 .par_iter_mut()
                 .enumerate()
                 .map(|(s, buf)| {
-                    segment(
+                    segment::<false>(
                         pos,
                         offsets,
                         neigh,
@@ -250,7 +250,7 @@ impl<P: PairPotential> ForceField<P> {
 /// `(u, f/r)` for four neighbours of `i` at squared distances `r2`, zero outside the cutoff
 /// (branch-free, so that the four lanes use packed arithmetic); `eval1` the same for one.
 #[inline(always)]
-fn segment(
+fn segment<const UNCHECKED: bool>(
     pos: &[[f64; 3]],
     offsets: &[u32],
     neigh: &[u32],
@@ -262,6 +262,10 @@ fn segment(
     const B: usize = 4;
     buf.iter_mut().for_each(|b| *b = [0.0; 3]);
     let base = range.start;
+    // UNCHECKED is true only when the caller has verified (`NeighborList::verified`) that
+    // every neighbour `j` of a particle `i` has `i < j < pos.len()`, and `buf` covers
+    // `base..pos.len()`: then `pos[j]` and `buf[j - base]` are in bounds for `i ≥ base`.
+    debug_assert!(!UNCHECKED || buf.len() == pos.len() - base);
     // Per-lane energy and virial sums: each lane adds a fixed subsequence of the pairs.
     let mut ew = [[0.0f64; B]; 2];
     let mut tail = [0.0f64; 2];
@@ -279,7 +283,12 @@ fn segment(
             ];
             let mut d = [[0.0f64; B]; 3];
             for l in 0..B {
-                let q = pos[js[l]];
+                let q = if UNCHECKED {
+                    // SAFETY: j < pos.len() (see UNCHECKED above)
+                    unsafe { *pos.get_unchecked(js[l]) }
+                } else {
+                    pos[js[l]]
+                };
                 d[0][l] = ri[0] - q[0];
                 d[1][l] = ri[1] - q[1];
                 d[2][l] = ri[2] - q[2];
@@ -304,7 +313,12 @@ fn segment(
             }
             // Newton's third law: every j of i's half list has owner > i ≥ base
             for l in 0..B {
-                let b = &mut buf[js[l] - base];
+                let b = if UNCHECKED {
+                    // SAFETY: base ≤ i < j < pos.len() = base + buf.len() (see UNCHECKED)
+                    unsafe { buf.get_unchecked_mut(js[l] - base) }
+                } else {
+                    &mut buf[js[l] - base]
+                };
                 b[0] -= fd[0][l];
                 b[1] -= fd[1][l];
                 b[2] -= fd[2][l];

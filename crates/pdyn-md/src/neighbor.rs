@@ -49,6 +49,9 @@ pub struct NeighborList {
     bin_pos: Vec<[f64; 3]>,
     bin_owner: Vec<u32>,
     x0: Vec<[f64; 3]>,
+    /// Verified at the last build: every neighbour `j` of every `i` has `i < j < pos.len()`
+    /// (true by construction; the force loop skips its bounds checks only when this holds).
+    pub(crate) verified: bool,
     /// Number of builds so far.
     pub builds: u64,
 }
@@ -343,6 +346,11 @@ impl NeighborList {
                 self.offsets.push(total);
             }
         }
+        self.verified = (0..n).all(|i| {
+            self.neigh[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+                .iter()
+                .all(|&j| i < j as usize && (j as usize) < self.pos.len())
+        });
         self.builds += 1;
     }
 }
