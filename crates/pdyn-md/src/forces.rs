@@ -1,21 +1,37 @@
-//! Pair forces from the neighbour list, one particle per task.
+//! Pair forces from the half neighbour list, with Newton's third law.
 //!
-//! For every real particle `i`: `Fᵢ = Σⱼ (f/r)(r²ᵢⱼ)·(rᵢ − rⱼ)` over its full neighbour list in
-//! list order, `eᵢ = ½ Σⱼ u(rᵢⱼ)`, `wᵢ = ½ Σⱼ (f/r)·r²ᵢⱼ` (each pair is seen from both ends).
-//! Totals `U = Σ eᵢ`, `W = Σ wᵢ` are summed afterwards in index order, so results do not depend
-//! on the number of threads. Species: each particle has a type `t`, and a symmetric table holds
-//! one potential per pair of types.
+//! The internal particles `0..n` (spatially sorted, see [`NeighborList`]) are cut into `S`
+//! contiguous *segments*, `S` a function of `n` only. A segment walks its particles `i` in
+//! order and, for each pair `(i, j)` of the half list, adds `(f/r)·(rᵢ − rⱼ)` to `i` and
+//! subtracts it from `j` in a force buffer of its own (LAMMPS's `newton_pair on`, with
+//! per-task arrays as in its OPENMP package). The buffers are then added in segment order,
+//! and ghost forces are folded into their owners in ghost order. Every sum is thus taken in
+//! an order fixed by the particles and the list alone: results are bitwise identical for any
+//! number of threads, which only decide which segments run at the same time.
+//!
+//! Each pair's energy `u` and virial `(f/r)·r²` are summed per segment (four lanes, in list
+//! order), then over segments in order. Species: each particle has a type `t`, and a
+//! symmetric table holds one potential per pair of types.
 
 use crate::potential::PairPotential;
 use crate::{MdError, NeighborList};
 use rayon::prelude::*;
 
-/// Per-particle force, energy and virial from pair interactions.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub(crate) struct PairOut {
-    pub f: [f64; 3],
-    pub e: f64,
-    pub w: f64,
+/// Most segments the force loop is cut into (and so the most threads it can use): each costs
+/// one force buffer, zeroed and summed every step.
+const MAX_SEGMENTS: usize = 4;
+/// Fewest particles per segment: below that a buffer costs more than the parallelism gains.
+const MIN_SEGMENT: usize = 1000;
+
+/// Buffers the force loop reuses from step to step.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ForceScratch {
+    /// One buffer per segment, covering extended indices from the segment's first particle.
+    bufs: Vec<Vec<[f64; 3]>>,
+    /// Total force per internal index.
+    total: Vec<[f64; 3]>,
+    /// Type of every extended index (only with several types).
+    types_ext: Vec<u32>,
 }
 
 /// One pair potential per pair of particle types (symmetric).
@@ -81,172 +97,347 @@ impl<P: PairPotential> ForceField<P> {
         self.table.iter().map(|p| p.cutoff()).fold(0.0, f64::max)
     }
 
-    /// Fills `out[i]` for every real particle.
-    pub(crate) fn compute(&self, nl: &NeighborList, types: &[u32], out: &mut [PairOut]) {
-        let pos = &nl.pos;
-        let owner = &nl.owner;
-        if self.ntypes == 1 {
+    /// Pair forces on every particle into `forces` (particle order, overwritten); returns the
+    /// pair energy and virial `Σ (f/r)·r²`.
+    pub(crate) fn compute(
+        &self,
+        nl: &NeighborList,
+        types: &[u32],
+        scratch: &mut ForceScratch,
+        forces: &mut [[f64; 3]],
+    ) -> (f64, f64) {
+        let n = nl.len();
+        let n_ext = nl.pos.len();
+        let nseg = (n / MIN_SEGMENT).clamp(1, MAX_SEGMENTS);
+        let bounds: Vec<usize> = (0..=nseg).map(|s| s * n / nseg).collect();
+        scratch.bufs.resize_with(nseg, Vec::new);
+        for (s, b) in scratch.bufs.iter_mut().enumerate() {
+            b.resize(n_ext - bounds[s], [0.0; 3]);
+        }
+        let (pos, offsets, neigh) = (&nl.pos[..], &nl.offsets[..], &nl.neigh[..]);
+        // the bounds invariant of `segment::<true>`; buffers are sized to it just above
+        let unchecked = nl.verified;
+        let sums: Vec<(f64, f64)> = if self.ntypes == 1 {
             let p = &self.table[0];
             let rc2 = p.cutoff() * p.cutoff();
-            out.par_iter_mut()
+            let batched = p.prefers_batch();
+            let e4 = |_: usize, _: [usize; 4], r2: [f64; 4]| {
+                let mut r2m = [0.0f64; 4];
+                for l in 0..4 {
+                    r2m[l] = if r2[l] < rc2 { r2[l] } else { rc2 };
+                }
+                let (mut u, mut fr) = p.energy_force4(r2m);
+                for l in 0..4 {
+                    let inside = r2[l] < rc2;
+                    u[l] = if inside { u[l] } else { 0.0 };
+                    fr[l] = if inside { fr[l] } else { 0.0 };
+                }
+                (u, fr)
+            };
+            let e1 = |_: usize, _: usize, r2: f64| {
+                if r2 < rc2 {
+                    p.energy_force(r2)
+                } else {
+                    (0.0, 0.0)
+                }
+            };
+            scratch
+                .bufs
+                .par_iter_mut()
                 .enumerate()
-                .with_min_len(128)
-                .for_each(|(i, o)| {
-                    *o = kernel_single(pos, nl.neighbors(i), i, p, rc2);
-                });
+                .map(|(s, buf)| {
+                    let range = bounds[s]..bounds[s + 1];
+                    if batched {
+                        return segment_batched(pos, offsets, neigh, range, buf, p, rc2);
+                    }
+                    if unchecked {
+                        segment::<true>(pos, offsets, neigh, range, buf, e4, e1)
+                    } else {
+                        segment::<false>(pos, offsets, neigh, range, buf, e4, e1)
+                    }
+                })
+                .collect()
         } else {
             let nt = self.ntypes;
-            out.par_iter_mut()
-                .enumerate()
-                .with_min_len(128)
-                .for_each(|(i, o)| {
-                    let ti = types[i] as usize * nt;
-                    *o = kernel(pos, nl.neighbors(i), i, |j| {
-                        let p = &self.table[ti + types[owner[j] as usize] as usize];
-                        (p, p.cutoff() * p.cutoff())
-                    });
-                });
-        }
-    }
-}
-
-#[inline(always)]
-fn kernel<'a, P: PairPotential + 'a>(
-    pos: &[[f64; 3]],
-    list: &[u32],
-    i: usize,
-    pot: impl Fn(usize) -> (&'a P, f64),
-) -> PairOut {
-    // Neighbours are taken in blocks of `B`: gathered, then evaluated branch-free (pairs in
-    // the skin shell r_c ≤ r < r_c + δ are evaluated at r_c and masked), which lets the
-    // compiler use packed arithmetic. Each lane sums a fixed subsequence of the list, and the
-    // lanes are added in a fixed order: the result is independent of the thread count.
-    const B: usize = 4;
-    let ri = pos[i];
-    let mut acc = [[0.0f64; B]; 5];
-    let mut blocks = list.chunks_exact(B);
-    for blk in &mut blocks {
-        let mut d = [[0.0f64; B]; 3];
-        let mut r2 = [0.0f64; B];
-        let mut rc2 = [0.0f64; B];
-        let mut pp: [Option<&P>; B] = [None; B];
-        for l in 0..B {
-            let j = blk[l] as usize;
-            let q = pos[j];
-            d[0][l] = ri[0] - q[0];
-            d[1][l] = ri[1] - q[1];
-            d[2][l] = ri[2] - q[2];
-            r2[l] = d[0][l] * d[0][l] + d[1][l] * d[1][l] + d[2][l] * d[2][l];
-            let (p, c) = pot(j);
-            pp[l] = Some(p);
-            rc2[l] = c;
-        }
-        for l in 0..B {
-            let inside = r2[l] < rc2[l];
-            let (u, fr) = match pp[l] {
-                Some(p) => p.energy_force(if inside { r2[l] } else { rc2[l] }),
-                None => (0.0, 0.0),
+            let te = &mut scratch.types_ext;
+            te.clear();
+            te.extend(
+                nl.owner
+                    .iter()
+                    .map(|&o| types[nl.perm[o as usize] as usize]),
+            );
+            let te = &scratch.types_ext[..];
+            let table = &self.table[..];
+            let pair = move |i: usize, j: usize, r2: f64| -> (f64, f64) {
+                let p = &table[te[i] as usize * nt + te[j] as usize];
+                let rc2 = p.cutoff() * p.cutoff();
+                if r2 < rc2 {
+                    p.energy_force(r2)
+                } else {
+                    (0.0, 0.0)
+                }
             };
-            let fr = if inside { fr } else { 0.0 };
-            acc[0][l] += fr * d[0][l];
-            acc[1][l] += fr * d[1][l];
-            acc[2][l] += fr * d[2][l];
-            acc[3][l] += if inside { u } else { 0.0 };
-            acc[4][l] += fr * r2[l];
+            scratch
+                .bufs
+                .par_iter_mut()
+                .enumerate()
+                .map(|(s, buf)| {
+                    segment::<false>(
+                        pos,
+                        offsets,
+                        neigh,
+                        bounds[s]..bounds[s + 1],
+                        buf,
+                        |i, js, r2| {
+                            let mut u = [0.0; 4];
+                            let mut fr = [0.0; 4];
+                            for l in 0..4 {
+                                (u[l], fr[l]) = pair(i, js[l], r2[l]);
+                            }
+                            (u, fr)
+                        },
+                        pair,
+                    )
+                })
+                .collect()
+        };
+        let (mut u, mut w) = (0.0, 0.0);
+        for (e, v) in sums {
+            u += e;
+            w += v;
         }
-    }
-    let mut t = [0.0f64; 5];
-    for (tk, a) in t.iter_mut().zip(&acc) {
-        *tk = (a[0] + a[1]) + (a[2] + a[3]);
-    }
-    for &j in blocks.remainder() {
-        let q = pos[j as usize];
-        let dx = ri[0] - q[0];
-        let dy = ri[1] - q[1];
-        let dz = ri[2] - q[2];
-        let r2 = dx * dx + dy * dy + dz * dz;
-        let (p, rc2) = pot(j as usize);
-        if r2 < rc2 {
-            let (u, fr) = p.energy_force(r2);
-            t[0] += fr * dx;
-            t[1] += fr * dy;
-            t[2] += fr * dz;
-            t[3] += u;
-            t[4] += fr * r2;
+        // real particles: buffers in segment order (segment s covers indices ≥ bounds[s])
+        let total = &mut scratch.total;
+        total.clear();
+        total.resize(n, [0.0; 3]);
+        let bufs = &scratch.bufs;
+        const CHUNK: usize = 4096;
+        total
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(c, out)| {
+                for (m, t) in out.iter_mut().enumerate() {
+                    let k = c * CHUNK + m;
+                    let mut f = [0.0; 3];
+                    for (b, &lo) in bufs.iter().zip(&bounds) {
+                        if k >= lo {
+                            let v = b[k - lo];
+                            f = [f[0] + v[0], f[1] + v[1], f[2] + v[2]];
+                        }
+                    }
+                    *t = f;
+                }
+            });
+        // ghosts, in ghost order, onto their owners
+        for g in n..n_ext {
+            let o = nl.owner[g] as usize;
+            for (b, &lo) in bufs.iter().zip(&bounds) {
+                let v = b[g - lo];
+                for k in 0..3 {
+                    total[o][k] += v[k];
+                }
+            }
         }
-    }
-    PairOut {
-        f: [t[0], t[1], t[2]],
-        e: 0.5 * t[3],
-        w: 0.5 * t[4],
+        for (t, &k) in total.iter().zip(&nl.perm) {
+            forces[k as usize] = *t;
+        }
+        (u, w)
     }
 }
 
-/// [`kernel`] for one potential: its parameters stay in registers and the blocks vectorise.
+/// Forces of the pairs of internal particles `range` into `buf` (zeroed first; `buf[k]` is
+/// extended index `range.start + k`); returns the segment's energy and virial. `eval4` gives
+/// `(u, f/r)` for four neighbours of `i` at squared distances `r2`, zero outside the cutoff
+/// (branch-free, so that the four lanes use packed arithmetic); `eval1` the same for one.
 #[inline(always)]
-fn kernel_single<P: PairPotential>(
+fn segment<const UNCHECKED: bool>(
     pos: &[[f64; 3]],
-    list: &[u32],
-    i: usize,
+    offsets: &[u32],
+    neigh: &[u32],
+    range: std::ops::Range<usize>,
+    buf: &mut [[f64; 3]],
+    eval4: impl Fn(usize, [usize; 4], [f64; 4]) -> ([f64; 4], [f64; 4]),
+    eval1: impl Fn(usize, usize, f64) -> (f64, f64),
+) -> (f64, f64) {
+    const B: usize = 4;
+    buf.iter_mut().for_each(|b| *b = [0.0; 3]);
+    let base = range.start;
+    // UNCHECKED is true only when the caller has verified (`NeighborList::verified`) that
+    // every neighbour `j` of a particle `i` has `i < j < pos.len()`, and `buf` covers
+    // `base..pos.len()`: then `pos[j]` and `buf[j - base]` are in bounds for `i ≥ base`.
+    debug_assert!(!UNCHECKED || buf.len() == pos.len() - base);
+    // Per-lane energy and virial sums: each lane adds a fixed subsequence of the pairs.
+    let mut ew = [[0.0f64; B]; 2];
+    let mut tail = [0.0f64; 2];
+    for i in range {
+        let ri = pos[i];
+        let list = &neigh[offsets[i] as usize..offsets[i + 1] as usize];
+        let mut fa = [[0.0f64; B]; 3];
+        let mut blocks = list.chunks_exact(B);
+        for blk in &mut blocks {
+            let js = [
+                blk[0] as usize,
+                blk[1] as usize,
+                blk[2] as usize,
+                blk[3] as usize,
+            ];
+            let mut d = [[0.0f64; B]; 3];
+            for l in 0..B {
+                let q = if UNCHECKED {
+                    // SAFETY: j < pos.len() (see UNCHECKED above)
+                    unsafe { *pos.get_unchecked(js[l]) }
+                } else {
+                    pos[js[l]]
+                };
+                d[0][l] = ri[0] - q[0];
+                d[1][l] = ri[1] - q[1];
+                d[2][l] = ri[2] - q[2];
+            }
+            let mut r2 = [0.0f64; B];
+            for l in 0..B {
+                r2[l] = d[0][l] * d[0][l] + d[1][l] * d[1][l] + d[2][l] * d[2][l];
+            }
+            let (u, fr) = eval4(i, js, r2);
+            let mut fd = [[0.0f64; B]; 3];
+            for l in 0..B {
+                fd[0][l] = fr[l] * d[0][l];
+                fd[1][l] = fr[l] * d[1][l];
+                fd[2][l] = fr[l] * d[2][l];
+            }
+            for l in 0..B {
+                fa[0][l] += fd[0][l];
+                fa[1][l] += fd[1][l];
+                fa[2][l] += fd[2][l];
+                ew[0][l] += u[l];
+                ew[1][l] += fr[l] * r2[l];
+            }
+            // Newton's third law: every j of i's half list has owner > i ≥ base
+            for l in 0..B {
+                let b = if UNCHECKED {
+                    // SAFETY: base ≤ i < j < pos.len() = base + buf.len() (see UNCHECKED)
+                    unsafe { buf.get_unchecked_mut(js[l] - base) }
+                } else {
+                    &mut buf[js[l] - base]
+                };
+                b[0] -= fd[0][l];
+                b[1] -= fd[1][l];
+                b[2] -= fd[2][l];
+            }
+        }
+        let mut fi = [0.0f64; 3];
+        for (f, a) in fi.iter_mut().zip(&fa) {
+            *f = (a[0] + a[1]) + (a[2] + a[3]);
+        }
+        for &j in blocks.remainder() {
+            let j = j as usize;
+            let q = pos[j];
+            let d = [ri[0] - q[0], ri[1] - q[1], ri[2] - q[2]];
+            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            let (u, fr) = eval1(i, j, r2);
+            let fd = [fr * d[0], fr * d[1], fr * d[2]];
+            let b = &mut buf[j - base];
+            for k in 0..3 {
+                fi[k] += fd[k];
+                b[k] -= fd[k];
+            }
+            tail[0] += u;
+            tail[1] += fr * r2;
+        }
+        let b = &mut buf[i - base];
+        for k in 0..3 {
+            b[k] += fi[k];
+        }
+    }
+    let lanes = |a: &[f64; B]| (a[0] + a[1]) + (a[2] + a[3]);
+    (lanes(&ew[0]) + tail[0], lanes(&ew[1]) + tail[1])
+}
+
+/// [`segment`] for one potential that is cheaper called once per batch
+/// ([`PairPotential::prefers_batch`], a compiled formula): each particle's neighbours are
+/// gathered, up to `CH` at a time, and evaluated by one [`PairPotential::energy_force_batch`].
+/// Pairs are summed exactly as in [`segment`] (lanes by position modulo 4, the last
+/// `len % 4` one by one after the lanes), so the two loops give the same bits for the same
+/// `(u, f/r)`.
+fn segment_batched<P: PairPotential>(
+    pos: &[[f64; 3]],
+    offsets: &[u32],
+    neigh: &[u32],
+    range: std::ops::Range<usize>,
+    buf: &mut [[f64; 3]],
     p: &P,
     rc2: f64,
-) -> PairOut {
+) -> (f64, f64) {
     const B: usize = 4;
-    let ri = pos[i];
-    let mut acc = [[0.0f64; B]; 5];
-    let mut blocks = list.chunks_exact(B);
-    for blk in &mut blocks {
-        let mut d = [[0.0f64; B]; 3];
-        let mut r2 = [0.0f64; B];
-        for l in 0..B {
-            let q = pos[blk[l] as usize];
-            d[0][l] = ri[0] - q[0];
-            d[1][l] = ri[1] - q[1];
-            d[2][l] = ri[2] - q[2];
+    const CH: usize = 64; // a multiple of B: blocks of four never straddle two batches
+    buf.iter_mut().for_each(|b| *b = [0.0; 3]);
+    let base = range.start;
+    let mut ew = [[0.0f64; B]; 2];
+    let mut tail = [0.0f64; 2];
+    let mut d = [[0.0f64; CH]; 3];
+    let mut r2 = [0.0f64; CH];
+    let mut r2m = [0.0f64; CH];
+    let mut u = [0.0f64; CH];
+    let mut fr = [0.0f64; CH];
+    for i in range {
+        let ri = pos[i];
+        let list = &neigh[offsets[i] as usize..offsets[i + 1] as usize];
+        let mut fa = [[0.0f64; B]; 3];
+        let mut rest = 0..0; // the last len % 4 pairs, within the last batch
+        for chunk in list.chunks(CH) {
+            let m = chunk.len();
+            for (k, &j) in chunk.iter().enumerate() {
+                let q = pos[j as usize];
+                d[0][k] = ri[0] - q[0];
+                d[1][k] = ri[1] - q[1];
+                d[2][k] = ri[2] - q[2];
+                r2[k] = d[0][k] * d[0][k] + d[1][k] * d[1][k] + d[2][k] * d[2][k];
+                // pairs in the skin shell are evaluated at r_c and masked below
+                r2m[k] = if r2[k] < rc2 { r2[k] } else { rc2 };
+            }
+            p.energy_force_batch(&r2m[..m], &mut u[..m], &mut fr[..m]);
+            for k in 0..m {
+                let inside = r2[k] < rc2;
+                u[k] = if inside { u[k] } else { 0.0 };
+                fr[k] = if inside { fr[k] } else { 0.0 };
+            }
+            let full = m / B * B;
+            for k0 in (0..full).step_by(B) {
+                for l in 0..B {
+                    let k = k0 + l;
+                    let fd = [fr[k] * d[0][k], fr[k] * d[1][k], fr[k] * d[2][k]];
+                    fa[0][l] += fd[0];
+                    fa[1][l] += fd[1];
+                    fa[2][l] += fd[2];
+                    ew[0][l] += u[k];
+                    ew[1][l] += fr[k] * r2[k];
+                    let b = &mut buf[chunk[k] as usize - base];
+                    b[0] -= fd[0];
+                    b[1] -= fd[1];
+                    b[2] -= fd[2];
+                }
+            }
+            rest = full..m;
         }
-        for l in 0..B {
-            r2[l] = d[0][l] * d[0][l] + d[1][l] * d[1][l] + d[2][l] * d[2][l];
+        let mut fi = [0.0f64; 3];
+        for (f, a) in fi.iter_mut().zip(&fa) {
+            *f = (a[0] + a[1]) + (a[2] + a[3]);
         }
-        let mut r2m = [0.0f64; B];
-        for l in 0..B {
-            r2m[l] = if r2[l] < rc2 { r2[l] } else { rc2 };
+        let last = &list[list.len() - rest.len()..];
+        for (k, &j) in rest.zip(last) {
+            let fd = [fr[k] * d[0][k], fr[k] * d[1][k], fr[k] * d[2][k]];
+            let b = &mut buf[j as usize - base];
+            for c in 0..3 {
+                fi[c] += fd[c];
+                b[c] -= fd[c];
+            }
+            tail[0] += u[k];
+            tail[1] += fr[k] * r2[k];
         }
-        let (mut u, mut fr) = p.energy_force4(r2m);
-        for l in 0..B {
-            let inside = r2[l] < rc2;
-            u[l] = if inside { u[l] } else { 0.0 };
-            fr[l] = if inside { fr[l] } else { 0.0 };
-        }
-        for l in 0..B {
-            acc[0][l] += fr[l] * d[0][l];
-            acc[1][l] += fr[l] * d[1][l];
-            acc[2][l] += fr[l] * d[2][l];
-            acc[3][l] += u[l];
-            acc[4][l] += fr[l] * r2[l];
+        let b = &mut buf[i - base];
+        for k in 0..3 {
+            b[k] += fi[k];
         }
     }
-    let mut t = [0.0f64; 5];
-    for (tk, a) in t.iter_mut().zip(&acc) {
-        *tk = (a[0] + a[1]) + (a[2] + a[3]);
-    }
-    for &j in blocks.remainder() {
-        let q = pos[j as usize];
-        let dx = ri[0] - q[0];
-        let dy = ri[1] - q[1];
-        let dz = ri[2] - q[2];
-        let r2 = dx * dx + dy * dy + dz * dz;
-        if r2 < rc2 {
-            let (u, fr) = p.energy_force(r2);
-            t[0] += fr * dx;
-            t[1] += fr * dy;
-            t[2] += fr * dz;
-            t[3] += u;
-            t[4] += fr * r2;
-        }
-    }
-    PairOut {
-        f: [t[0], t[1], t[2]],
-        e: 0.5 * t[3],
-        w: 0.5 * t[4],
-    }
+    let lanes = |a: &[f64; B]| (a[0] + a[1]) + (a[2] + a[3]);
+    (lanes(&ew[0]) + tail[0], lanes(&ew[1]) + tail[1])
 }

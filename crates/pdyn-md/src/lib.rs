@@ -1,16 +1,18 @@
 //! Molecular dynamics of particle ensembles with short-range interactions.
 //!
 //! Particles live in an orthorhombic periodic box (`SimBox`, minimum image); pair forces with a
-//! cutoff `r_c` are found through a Verlet neighbour list with a skin `δ` (built from a cell
-//! list, rebuilt automatically once some particle has moved more than `δ/2` since the last
-//! build, Verlet 1967; Allen & Tildesley, *Computer Simulation of Liquids*, 2nd ed., §5.3).
+//! cutoff `r_c` are found through a half Verlet neighbour list with a skin `δ` (built from a
+//! bin list over particles sorted by bin, rebuilt automatically once the two largest
+//! displacements since the last build exceed `δ`, or on a fixed schedule as LAMMPS's
+//! `neigh_modify every N check no`; Verlet 1967; Allen & Tildesley, *Computer Simulation of
+//! Liquids*, 2nd ed., §5.3).
 //! Equations of motion `ẋ = v`, `m v̇ = F = −∇U` are integrated by velocity Verlet (Swope et
 //! al., J. Chem. Phys. 76, 637 (1982)), optionally coupled to a thermostat (Langevin BAOAB,
 //! Nosé–Hoover chain, Berendsen).
 //!
-//! Determinism: forces use a *full* neighbour list, so every particle's force is the sum over
-//! its own neighbours in list order, computed by one thread; energies and virials are summed
-//! per particle, then sequentially in index order. Results are bitwise identical for any
+//! Determinism: each pair is computed once (Newton's third law) by one of a fixed number of
+//! segments of particles, into the segment's own force buffer; the buffers, energies and
+//! virials are summed in segment order (`forces.rs`). Results are bitwise identical for any
 //! number of rayon threads.
 //!
 //! Particle storage (`Particles`, kick, drift, kinetic energy, momentum) is shared with the

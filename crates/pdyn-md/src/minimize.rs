@@ -78,21 +78,22 @@ pub fn minimize_fire<P: PairPotential>(
     let mut nl = NeighborList::new(ff.max_cutoff(), params.skin)?;
     nl.check_box(&system.sim_box)?;
     let n = system.particles.len();
-    let mut out = vec![crate::forces::PairOut::default(); n];
+    let mut out = vec![[0.0; 3]; n];
+    let mut scratch = crate::forces::ForceScratch::default();
     let mut eval = |s: &mut System, nl: &mut NeighborList| -> Result<(f64, f64), MdError> {
         if nl.needs_rebuild(&s.particles) {
             nl.build(&mut s.particles, &mut s.images, &s.sim_box);
         } else {
             nl.update_ghosts(&s.particles);
         }
-        ff.compute(nl, &s.types, &mut out);
-        let (mut u, _) = bond_forces(s, &mut out)?;
+        let (u_p, _) = ff.compute(nl, &s.types, &mut scratch, &mut out);
+        let (u_b, _) = bond_forces(s, &mut out)?;
+        let u = u_p + u_b;
         let mut fmax2: f64 = 0.0;
         let p = &mut s.particles;
-        for (i, o) in out.iter().enumerate() {
-            [p.ax[i], p.ay[i], p.az[i]] = o.f; // forces, not accelerations (unit mass)
-            u += o.e;
-            fmax2 = fmax2.max(o.f[0] * o.f[0] + o.f[1] * o.f[1] + o.f[2] * o.f[2]);
+        for (i, f) in out.iter().enumerate() {
+            [p.ax[i], p.ay[i], p.az[i]] = *f; // forces, not accelerations (unit mass)
+            fmax2 = fmax2.max(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
         }
         Ok((u, fmax2.sqrt()))
     };

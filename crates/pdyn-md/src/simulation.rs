@@ -12,7 +12,7 @@
 //! offending particle; the records so far are returned in `RunFailure::partial`.
 
 use crate::bonds::Bond;
-use crate::forces::PairOut;
+use crate::forces::ForceScratch;
 use crate::potential::PairPotential;
 use crate::thermostat::Thermostat;
 use crate::{ForceField, MdError, NeighborList, RunFailure, SimBox, ThermoRecord};
@@ -120,6 +120,15 @@ pub struct SimParams {
     /// Largest change of the conserved quantity per particle since the start of the run
     /// (NVE, Nosé–Hoover) before the run is declared unstable (default 1.0 ε).
     pub max_energy_change: f64,
+    /// The neighbour list is considered every this many steps (LAMMPS `neigh_modify every`;
+    /// default 1, 0 counts as 1).
+    pub neighbor_every: u64,
+    /// `true` (default): at a considered step, rebuild only if the exact displacement test
+    /// ([`NeighborList::needs_rebuild`]) asks for it. `false`: rebuild unconditionally at every
+    /// considered step (LAMMPS `check no`, as in `bench/in.lj` with `every 20`), which skips
+    /// the test but lets pairs that come within the cutoff between builds go unseen. The list
+    /// is exact only with `neighbor_every = 1` and `neighbor_check = true`.
+    pub neighbor_check: bool,
 }
 
 impl Default for SimParams {
@@ -132,6 +141,8 @@ impl Default for SimParams {
             overlap_distance: 0.7,
             max_displacement: 0.5,
             max_energy_change: 1.0,
+            neighbor_every: 1,
+            neighbor_check: true,
         }
     }
 }
@@ -171,7 +182,9 @@ pub struct Simulation<P> {
     /// Parameters.
     pub params: SimParams,
     nl: NeighborList,
-    out: Vec<PairOut>,
+    scratch: ForceScratch,
+    /// Total force on every particle (pair + bond), particle order.
+    out: Vec<[f64; 3]>,
     /// Steps taken so far.
     pub step: u64,
     potential: f64,
@@ -219,7 +232,8 @@ impl<P: PairPotential> Simulation<P> {
             thermostat,
             params,
             nl,
-            out: vec![PairOut::default(); n],
+            scratch: ForceScratch::default(),
+            out: vec![[0.0; 3]; n],
             step: 0,
             potential: 0.0,
             virial: 0.0,
@@ -239,42 +253,50 @@ impl<P: PairPotential> Simulation<P> {
     fn check_overlap(&self) -> Result<(), MdError> {
         let d2 = self.params.overlap_distance.powi(2);
         let p = &self.system.particles;
-        for i in 0..p.len() {
-            let ri = self.nl.pos[i];
-            for &j in self.nl.neighbors(i) {
-                let q = self.nl.pos[j as usize];
+        // of the pairs below the threshold, the first in particle order (i < j), whatever the
+        // list's internal order
+        let mut worst: Option<(usize, usize, f64)> = None;
+        for k in 0..p.len() {
+            let ri = self.nl.position(k);
+            for &j in self.nl.neighbors(k) {
+                let q = self.nl.position(j as usize);
                 let r2 = (ri[0] - q[0]).powi(2) + (ri[1] - q[1]).powi(2) + (ri[2] - q[2]).powi(2);
-                let o = self.nl.owner[j as usize] as usize;
-                if r2 < d2 && o > i {
-                    return Err(MdError::Overlap {
-                        i,
-                        j: o,
-                        distance: r2.sqrt(),
-                        threshold: self.params.overlap_distance,
-                    });
+                if r2 < d2 {
+                    let (a, b) = (self.nl.particle(k), self.nl.owner_particle(j as usize));
+                    let pair = (a.min(b), a.max(b), r2);
+                    if worst.is_none_or(|w| pair < w) {
+                        worst = Some(pair);
+                    }
                 }
             }
         }
-        Ok(())
+        match worst {
+            Some((i, j, r2)) => Err(MdError::Overlap {
+                i,
+                j,
+                distance: r2.sqrt(),
+                threshold: self.params.overlap_distance,
+            }),
+            None => Ok(()),
+        }
     }
 
     /// Pair and bond forces into accelerations; potential energy and virial.
     fn forces(&mut self) -> Result<(), MdError> {
         let s = &mut self.system;
-        self.force_field.compute(&self.nl, &s.types, &mut self.out);
+        let (u_p, w_p) =
+            self.force_field
+                .compute(&self.nl, &s.types, &mut self.scratch, &mut self.out);
         let (u_b, w_b) = bond_forces(s, &mut self.out)?;
         let p = &mut s.particles;
-        let (mut u, mut w) = (u_b, w_b);
-        for (i, o) in self.out.iter().enumerate() {
+        for (i, f) in self.out.iter().enumerate() {
             let inv_m = if p.m[i] > 0.0 { 1.0 / p.m[i] } else { 0.0 };
-            p.ax[i] = o.f[0] * inv_m;
-            p.ay[i] = o.f[1] * inv_m;
-            p.az[i] = o.f[2] * inv_m;
-            u += o.e;
-            w += o.w;
+            p.ax[i] = f[0] * inv_m;
+            p.ay[i] = f[1] * inv_m;
+            p.az[i] = f[2] * inv_m;
         }
-        self.potential = u;
-        self.virial = w;
+        self.potential = u_p + u_b;
+        self.virial = w_p + w_b;
         Ok(())
     }
 
@@ -295,26 +317,24 @@ impl<P: PairPotential> Simulation<P> {
     /// Number of distinct pairs currently inside their cutoff (a diagnostic, `O(N)` work).
     pub fn pairs_within_cutoff(&self) -> usize {
         let rc2 = self.force_field.max_cutoff().powi(2);
-        let pos = &self.nl.pos;
-        (0..self.system.particles.len())
+        let nl = &self.nl;
+        (0..nl.len())
             .map(|i| {
-                let r = pos[i];
-                self.nl
-                    .neighbors(i)
+                let r = nl.position(i);
+                nl.neighbors(i)
                     .iter()
                     .filter(|&&j| {
-                        let q = pos[j as usize];
+                        let q = nl.position(j as usize);
                         (r[0] - q[0]).powi(2) + (r[1] - q[1]).powi(2) + (r[2] - q[2]).powi(2) < rc2
                     })
                     .count()
             })
             .sum::<usize>()
-            / 2
     }
 
     /// Forces `mᵢ aᵢ` of particle `i` at the current positions.
     pub fn force(&self, i: usize) -> Vec3 {
-        Vec3(self.out[i].f)
+        Vec3(self.out[i])
     }
 
     /// Thermodynamic state now.
@@ -418,7 +438,10 @@ impl<P: PairPotential> Simulation<P> {
         } else {
             p.drift(h);
         }
-        if self.nl.needs_rebuild(&self.system.particles) {
+        let considered = step % self.params.neighbor_every.max(1) == 0;
+        if considered
+            && (!self.params.neighbor_check || self.nl.needs_rebuild(&self.system.particles))
+        {
             self.rebuild();
         } else {
             self.nl.update_ghosts(&self.system.particles);
@@ -491,7 +514,7 @@ impl MdError {
 }
 
 /// Adds bond forces to `out` (in bond order); returns bond energy and virial.
-pub(crate) fn bond_forces(s: &System, out: &mut [PairOut]) -> Result<(f64, f64), MdError> {
+pub(crate) fn bond_forces(s: &System, out: &mut [[f64; 3]]) -> Result<(f64, f64), MdError> {
     let (mut u, mut w) = (0.0, 0.0);
     let p = &s.particles;
     for (b, bond) in s.bonds.iter().enumerate() {
@@ -511,8 +534,8 @@ pub(crate) fn bond_forces(s: &System, out: &mut [PairOut]) -> Result<(f64, f64),
             });
         };
         for (k, dk) in d.iter().enumerate() {
-            out[bond.i].f[k] += fr * dk;
-            out[bond.j].f[k] -= fr * dk;
+            out[bond.i][k] += fr * dk;
+            out[bond.j][k] -= fr * dk;
         }
         u += e;
         w += fr * r2;

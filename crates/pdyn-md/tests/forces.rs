@@ -181,3 +181,89 @@ fn results_do_not_depend_on_thread_count() {
     assert_eq!(p1, p3);
     assert_eq!(t1, t3);
 }
+
+#[test]
+fn results_do_not_depend_on_thread_count_with_several_segments() {
+    // 2,048 atoms: the force loop is cut into two segments, each with its own Newton buffer
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut sim = lj_liquid(8, 11, 0.005);
+            sim.run(40, &mut |_: &ThermoRecord, _: &System| {}).unwrap();
+            (sim.system.particles.clone(), sim.thermo())
+        })
+    };
+    let (p1, t1) = run(1);
+    let (p2, t2) = run(2);
+    let (p3, t3) = run(3);
+    assert_eq!(p1, p2);
+    assert_eq!(t1, t2);
+    assert_eq!(p1, p3);
+    assert_eq!(t1, t3);
+}
+
+#[test]
+fn neighbour_policy_every_n_steps() {
+    // LAMMPS in.lj: `neigh_modify delay 0 every 20 check no` rebuilds at steps 20, 40, ...
+    let mut sim = lj_liquid(4, 3, 0.005);
+    sim.params.neighbor_every = 20;
+    sim.params.neighbor_check = false;
+    let rep = sim
+        .run(100, &mut |_: &ThermoRecord, _: &System| {})
+        .unwrap();
+    assert_eq!(rep.builds, 5);
+    // every 10 with the exact test: never more builds than considered steps
+    let mut sim = lj_liquid(4, 3, 0.005);
+    sim.params.neighbor_every = 10;
+    let rep = sim
+        .run(100, &mut |_: &ThermoRecord, _: &System| {})
+        .unwrap();
+    assert!(rep.builds <= 10, "{} builds", rep.builds);
+}
+
+/// A potential that asks the force loop for batches (as a compiled formula does).
+#[derive(Clone)]
+struct Batched<P>(P);
+
+impl<P: PairPotential> PairPotential for Batched<P> {
+    fn cutoff(&self) -> f64 {
+        self.0.cutoff()
+    }
+    fn energy_force(&self, r2: f64) -> (f64, f64) {
+        self.0.energy_force(r2)
+    }
+    fn prefers_batch(&self) -> bool {
+        true
+    }
+}
+
+#[test]
+fn batched_force_loop_gives_the_same_bits() {
+    for mode in [CutoffMode::Plain, CutoffMode::ShiftedForce] {
+        let lj = LennardJones::new(1.0, 1.0).truncated(2.5, mode);
+        let (mut p, bx) = lattice(Lattice::Fcc, 0.8442, [8; 3], 1.0, 1 << 24).unwrap();
+        maxwell_boltzmann(&mut p, 1.44, 1.0, 4).unwrap();
+        let s = System::new(p, bx);
+        let mut a = Simulation::new(
+            s.clone(),
+            ForceField::single(lj),
+            Thermostat::None,
+            SimParams::default(),
+        )
+        .unwrap();
+        let mut b = Simulation::new(
+            s,
+            ForceField::single(Batched(lj)),
+            Thermostat::None,
+            SimParams::default(),
+        )
+        .unwrap();
+        a.run(30, &mut |_: &ThermoRecord, _: &System| {}).unwrap();
+        b.run(30, &mut |_: &ThermoRecord, _: &System| {}).unwrap();
+        assert_eq!(a.system.particles, b.system.particles, "{mode:?}");
+        assert_eq!(a.thermo(), b.thermo(), "{mode:?}");
+    }
+}

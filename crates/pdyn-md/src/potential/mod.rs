@@ -35,12 +35,54 @@ pub trait PairPotential: Send + Sync {
         }
         (u, f)
     }
+
+    /// `(u, f/r)` for a batch: `u[k], fr[k]` at `r2[k]` (each `< cutoff()²`; the three slices
+    /// have the same length). The default takes blocks of four
+    /// ([`PairPotential::energy_force4`]), then the rest one by one; a compiled formula
+    /// overrides it to run its program once per batch instead of once per pair.
+    #[inline(always)]
+    fn energy_force_batch(&self, r2: &[f64], u: &mut [f64], fr: &mut [f64]) {
+        let m = r2.len().min(u.len()).min(fr.len());
+        let (r2, u, fr) = (&r2[..m], &mut u[..m], &mut fr[..m]);
+        let mut k = 0;
+        while k + 4 <= m {
+            let (a, b) = self.energy_force4([r2[k], r2[k + 1], r2[k + 2], r2[k + 3]]);
+            u[k..k + 4].copy_from_slice(&a);
+            fr[k..k + 4].copy_from_slice(&b);
+            k += 4;
+        }
+        for k in k..m {
+            (u[k], fr[k]) = self.energy_force(r2[k]);
+        }
+    }
+
+    /// Whether the force loop should gather a particle's neighbours and call
+    /// [`PairPotential::energy_force_batch`] once for them (a compiled formula, whose cost is
+    /// per call), rather than [`PairPotential::energy_force4`] per block of four (default).
+    fn prefers_batch(&self) -> bool {
+        false
+    }
 }
 
 /// The untruncated potential: `(u(r), −u'(r)/r)` at `r² = r2`, for any `r > 0`.
 pub trait RawPair: Send + Sync {
     /// `(u, f/r)` at squared distance `r2`.
     fn raw(&self, r2: f64) -> (f64, f64);
+
+    /// [`RawPair::raw`] for a batch (slices of the same length); the default calls `raw` for
+    /// each element, a compiled formula evaluates its program once for the whole batch.
+    #[inline]
+    fn raw_batch(&self, r2: &[f64], u: &mut [f64], fr: &mut [f64]) {
+        for ((&r, u), f) in r2.iter().zip(u).zip(fr) {
+            (*u, *f) = self.raw(r);
+        }
+    }
+
+    /// Whether [`RawPair::raw_batch`] is much cheaper per pair than `raw` (see
+    /// [`PairPotential::prefers_batch`]).
+    fn prefers_batch(&self) -> bool {
+        false
+    }
 }
 
 impl<P: PairPotential + ?Sized> PairPotential for Box<P> {
@@ -54,5 +96,12 @@ impl<P: PairPotential + ?Sized> PairPotential for Box<P> {
     #[inline]
     fn energy_force4(&self, r2: [f64; 4]) -> ([f64; 4], [f64; 4]) {
         (**self).energy_force4(r2)
+    }
+    #[inline]
+    fn energy_force_batch(&self, r2: &[f64], u: &mut [f64], fr: &mut [f64]) {
+        (**self).energy_force_batch(r2, u, fr)
+    }
+    fn prefers_batch(&self) -> bool {
+        (**self).prefers_batch()
     }
 }

@@ -110,6 +110,28 @@ impl<P: RawPair> PairPotential for Truncated<P> {
         }
         (u, f)
     }
+
+    #[inline]
+    fn energy_force_batch(&self, r2: &[f64], u: &mut [f64], fr: &mut [f64]) {
+        let m = r2.len().min(u.len()).min(fr.len());
+        let (r2, u, fr) = (&r2[..m], &mut u[..m], &mut fr[..m]);
+        self.inner.raw_batch(r2, u, fr);
+        // the same operations, in the same order, as `energy_force`
+        let (u_c, f_c, rc) = (self.u_c, self.f_c, self.rc);
+        if self.mode == CutoffMode::ShiftedForce {
+            for ((&s, u), f) in r2.iter().zip(u).zip(fr) {
+                let r = s.sqrt();
+                *u = *u - u_c + (r - rc) * f_c;
+                *f -= f_c / r;
+            }
+        } else {
+            u.iter_mut().for_each(|u| *u -= u_c);
+        }
+    }
+
+    fn prefers_batch(&self) -> bool {
+        self.inner.prefers_batch()
+    }
 }
 
 #[cfg(test)]

@@ -45,4 +45,21 @@ impl PairPotential for Pair {
             Pair::Formula(p) => p.energy_force4(r2),
         }
     }
+
+    #[inline]
+    fn energy_force_batch(&self, r2: &[f64], u: &mut [f64], fr: &mut [f64]) {
+        match self {
+            Pair::Lj(p) => p.energy_force_batch(r2, u, fr),
+            Pair::Morse(p) => p.energy_force_batch(r2, u, fr),
+            Pair::Formula(p) => p.energy_force_batch(r2, u, fr),
+        }
+    }
+
+    fn prefers_batch(&self) -> bool {
+        match self {
+            Pair::Lj(p) => p.prefers_batch(),
+            Pair::Morse(p) => p.prefers_batch(),
+            Pair::Formula(p) => p.prefers_batch(),
+        }
+    }
 }
