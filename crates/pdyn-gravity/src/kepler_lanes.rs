@@ -186,14 +186,16 @@ fn drift_lanes(mu: &[f64], r: &mut [[f64; 3]], v: &mut [[f64; 3]], dt: f64) -> [
     let mut g2 = [0.0; L];
     let mut g3 = [0.0; L];
     for _ in 0..HALLEY_MAX_FAST {
+        // The arithmetic of all lanes first, free of branches and masks (so that it runs
+        // in vector registers), then the per-lane decisions.
+        let mut xn = [0.0; L];
+        let mut s = [[0.0; 3]; L];
+        let mut in_range = [false; L];
+        let mut settles = [false; L];
         for l in 0..L {
             let (xx, b) = (x[l], beta[l]);
             let x2 = xx * xx;
             let z = b * x2;
-            // Beyond the series' range the lane goes to the scalar solver. (A settled lane
-            // is only recomputed, and discarded, while other lanes iterate: its fate must
-            // not depend on them.)
-            live[l] &= done[l] | (z.abs() <= Z_SERIES);
             let (c2, c3) = c2_c3_series(z);
             let gg0 = 1.0 - z * c2;
             let gg1 = xx * (1.0 - z * c3);
@@ -204,33 +206,42 @@ fn drift_lanes(mu: &[f64], r: &mut [[f64; 3]], v: &mut [[f64; 3]], dt: f64) -> [
             let fpp = eta0[l] * gg0 + zeta0[l] * gg1;
             let fppp = zeta0[l] * gg0 - b * eta0[l] * gg1;
             let d = -2.0 * f * fp / (2.0 * fp * fp - f * fpp);
-            let xn = xx + d;
-            live[l] &= done[l] | ((xn.abs() < f64::INFINITY) & (fp > 0.0));
+            xn[l] = xx + d;
             let d2 = d * d;
             // Halley's error constant times F'², A F'² = F''²/4 − F'''F'/6 (no division).
             let afp2 = 0.25 * fpp * fpp - fppp * fp * (1.0 / 6.0);
-            let settles = (d2 <= 1e-10 * xn * xn)
+            let fp2 = fp * fp;
+            // Beyond the series' range the lane goes to the scalar solver.
+            in_range[l] = (z.abs() <= Z_SERIES) & (xn[l].abs() < f64::INFINITY) & (fp > 0.0);
+            settles[l] = (d2 <= 1e-10 * xn[l] * xn[l])
                 & (d2 * b.abs() <= 1e-10)
                 // In the asymptotic regime Halley's and Newton's steps agree (|F F''| ≪
                 // F'²); without this a huge F'' could shrink a step far from the root.
-                & ((f * fpp).abs() <= 1e-4 * fp * fp)
-                & (afp2.abs() * d2 * d.abs() <= 1e-17 * xn.abs() * fp * fp);
-            let now = settles & !done[l];
+                & ((f * fpp).abs() <= 1e-4 * fp2)
+                & (afp2.abs() * d2 * d.abs() <= 1e-17 * xn[l].abs() * fp2);
             // Taylor shift of the G-functions from xx to xn = xx + δ (to δ³), with
             // G₋₁ = dG₀/dX = −βG₁ and G₋₂ = −βG₀.
             let (h2, h3) = (0.5 * d2, d2 * d * (1.0 / 6.0));
             let (gm1, gm2) = (-b * gg1, -b * gg0);
-            let s3 = gg3 + d * gg2 + h2 * gg1 + h3 * gg0;
-            let s2 = gg2 + d * gg1 + h2 * gg0 + h3 * gm1;
-            let s1 = gg1 + d * gg0 + h2 * gm1 + h3 * gm2;
-            g3[l] = if now { s3 } else { g3[l] };
-            g2[l] = if now { s2 } else { g2[l] };
-            g1[l] = if now { s1 } else { g1[l] };
-            x[l] = if done[l] { xx } else { xn };
-            done[l] |= settles;
+            s[l] = [
+                gg1 + d * gg0 + h2 * gm1 + h3 * gm2,
+                gg2 + d * gg1 + h2 * gg0 + h3 * gm1,
+                gg3 + d * gg2 + h2 * gg1 + h3 * gg0,
+            ];
         }
+        // A settled lane is only recomputed, and discarded, while other lanes iterate: its
+        // fate must not depend on them.
         let mut pending = false;
         for l in 0..L {
+            if done[l] {
+                continue;
+            }
+            live[l] &= in_range[l];
+            x[l] = xn[l];
+            if settles[l] {
+                [g1[l], g2[l], g3[l]] = s[l];
+                done[l] = true;
+            }
             pending |= live[l] & !done[l];
         }
         if !pending {
