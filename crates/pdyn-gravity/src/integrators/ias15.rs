@@ -226,6 +226,47 @@ fn zeros7(n: usize) -> Coeffs {
     std::array::from_fn(|_| vec![0.0; n])
 }
 
+/// Predicted positions of one coordinate block at node `hs` (the same operations, in the
+/// same order, as REBOUND's predictor). Slices of one length, so no bounds checks and no
+/// aliasing stand in the way of vectorisation.
+#[allow(clippy::too_many_arguments)]
+fn predict_positions(
+    dst: &mut [f64],
+    b: [&[f64]; 7],
+    a0: &[f64],
+    v0: &[f64],
+    x0: &[f64],
+    csx: &[f64],
+    h: f64,
+    hs: f64,
+) {
+    let n = dst.len();
+    let (a0, v0, x0, csx) = (&a0[..n], &v0[..n], &x0[..n], &csx[..n]);
+    let b: [&[f64]; 7] = std::array::from_fn(|j| &b[j][..n]);
+    for i in 0..n {
+        let inner =
+            ((((((b[6][i] * 7.0 * hs / 9.0 + b[5][i]) * 3.0 * hs / 4.0 + b[4][i]) * 5.0 * hs
+                / 7.0
+                + b[3][i])
+                * 2.0
+                * hs
+                / 3.0
+                + b[2][i])
+                * 3.0
+                * hs
+                / 5.0
+                + b[1][i])
+                * hs
+                / 2.0
+                + b[0][i])
+                * hs
+                / 3.0
+                + a0[i];
+        let dx = -csx[i] + (inner * h * hs / 2.0 + v0[i]) * h * hs;
+        dst[i] = dx + x0[i];
+    }
+}
+
 /// IAS15 workspace (all of it allocated once, in [`Ias15::new`]). Coordinates are stored
 /// planar, `k = c·N + i` (all x, then all y, then all z), matching the particle arrays, so
 /// that copies in and out are slice copies.
@@ -397,37 +438,19 @@ impl Ias15 {
             iterations += 1;
             for s in 1..8 {
                 let hs = H[s];
-                // Predicted positions at node s (same operations, in the same order, as
-                // REBOUND's predictor), coordinate block by block.
-                let b = &self.b;
-                let (x0, v0, a0, csx) = (&self.x0, &self.v0, &self.a0, &self.csx);
+                // Predicted positions at node s, coordinate block by block.
                 for (c, dst) in [&mut p.x, &mut p.y, &mut p.z].into_iter().enumerate() {
-                    let base = c * n;
-                    for i in 0..n {
-                        let k = base + i;
-                        let inner = ((((((b[6][k] * 7.0 * hs / 9.0 + b[5][k]) * 3.0 * hs / 4.0
-                            + b[4][k])
-                            * 5.0
-                            * hs
-                            / 7.0
-                            + b[3][k])
-                            * 2.0
-                            * hs
-                            / 3.0
-                            + b[2][k])
-                            * 3.0
-                            * hs
-                            / 5.0
-                            + b[1][k])
-                            * hs
-                            / 2.0
-                            + b[0][k])
-                            * hs
-                            / 3.0
-                            + a0[k];
-                        let dx = -csx[k] + (inner * h * hs / 2.0 + v0[k]) * h * hs;
-                        dst[i] = dx + x0[k];
-                    }
+                    let r = c * n..(c + 1) * n;
+                    predict_positions(
+                        dst,
+                        std::array::from_fn(|j| &self.b[j][r.clone()]),
+                        &self.a0[r.clone()],
+                        &self.v0[r.clone()],
+                        &self.x0[r.clone()],
+                        &self.csx[r],
+                        h,
+                        hs,
+                    );
                 }
                 f.compute(p, false);
                 Self::gather(&mut self.at, &p.ax, &p.ay, &p.az);
@@ -436,30 +459,29 @@ impl Ias15 {
                 // g_j = (…((a_s − a₀)/(h_s − h₀) − g₀)/(h_s − h₁) … − g_{j−1})/(h_s − h_j).
                 let gk = &mut self.gk;
                 let r0 = RR[tri(s, 0)];
-                for k in 0..n3 {
-                    gk[k] = (self.at[k] - self.a0[k]) / r0;
+                for ((g, at), a0) in gk.iter_mut().zip(&self.at).zip(&self.a0) {
+                    *g = (at - a0) / r0;
                 }
                 for m in 0..j {
-                    let (gm, rm) = (&self.g[m], RR[tri(s, m + 1)]);
-                    for k in 0..n3 {
-                        gk[k] = (gk[k] - gm[k]) / rm;
+                    let rm = RR[tri(s, m + 1)];
+                    for (g, gm) in gk.iter_mut().zip(&self.g[m]) {
+                        *g = (*g - gm) / rm;
                     }
                 }
                 let delta = &mut self.delta;
-                for k in 0..n3 {
-                    delta[k] = gk[k] - self.g[j][k];
+                for ((d, g), gj) in delta.iter_mut().zip(gk.iter()).zip(&self.g[j]) {
+                    *d = g - gj;
                 }
                 self.g[j].copy_from_slice(gk);
                 for r in 0..j {
                     let cr = C_PACKED[tri(j, r)];
-                    let (br, cs) = (&mut self.b[r], &mut self.csb[r]);
-                    for k in 0..n3 {
-                        add_cs(&mut br[k], &mut cs[k], delta[k] * cr);
+                    for ((b, cs), d) in self.b[r].iter_mut().zip(&mut self.csb[r]).zip(delta.iter())
+                    {
+                        add_cs(b, cs, d * cr);
                     }
                 }
-                let (bj, cs) = (&mut self.b[j], &mut self.csb[j]);
-                for k in 0..n3 {
-                    add_cs(&mut bj[k], &mut cs[k], delta[k]);
+                for ((b, cs), d) in self.b[j].iter_mut().zip(&mut self.csb[j]).zip(delta.iter()) {
+                    add_cs(b, cs, *d);
                 }
                 if s == 7 {
                     let mut max_a: f64 = 0.0;
