@@ -3,6 +3,7 @@
 //! ```text
 //! cargo run --release -p pdyn-gravity --example bench_nbody -- whfast STEPS
 //! cargo run --release -p pdyn-gravity --example bench_nbody -- ias15 YEARS
+//! cargo run --release -p pdyn-gravity --example bench_nbody -- whfast-positions YEARS
 //! cargo run --release -p pdyn-gravity --example bench_nbody -- plummer-ics N SEED FILE
 //! cargo run --release -p pdyn-gravity --example bench_nbody -- leapfrog-direct FILE STEPS DT EPS
 //! cargo run --release -p pdyn-gravity --example bench_nbody -- leapfrog-tree FILE STEPS DT EPS THETA QUAD
@@ -73,6 +74,28 @@ fn main() -> Result<()> {
             sim.integrate(steps as f64 * dt)?;
             let secs = t0.elapsed().as_secs_f64();
             report(case, &sim, secs, (sim.energy() - e0) / e0);
+        }
+        "whfast-positions" => {
+            // The benchmark's WHFast run, to a given time; prints the positions (for the
+            // agreement check against REBOUND in bench/nbody/run.py).
+            let years: f64 = arg(&args, 2, "years")?;
+            let mut sim = outer_solar_system();
+            let dt = sim.orbit(1, Primary::Interior)?.period / 20.0;
+            sim.set_dt(dt)?;
+            sim.set_integrator(Integrator::WhFast(WhFastParams {
+                corrector: 17,
+                ..WhFastParams::default()
+            }))?;
+            sim.integrate(years * 365.25)?;
+            let p = sim.particles();
+            let pos: Vec<String> = (0..p.len())
+                .map(|i| format!("[{:e}, {:e}, {:e}]", p.x[i], p.y[i], p.z[i]))
+                .collect();
+            println!(
+                "{{\"case\": \"{case}\", \"t\": {:e}, \"positions\": [{}]}}",
+                sim.t(),
+                pos.join(", ")
+            );
         }
         "ias15" => {
             let years: f64 = arg(&args, 2, "years")?;

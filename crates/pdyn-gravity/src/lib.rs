@@ -41,6 +41,7 @@ pub mod error;
 pub mod forces;
 pub mod integrators;
 pub mod kepler;
+mod kepler_lanes;
 pub mod orbit;
 pub mod plummer;
 pub mod rng;

@@ -193,10 +193,21 @@ fn conversion_matrices() -> ([[f64; 7]; 7], [[f64; 7]; 7]) {
     (c, d)
 }
 
-/// Binomial coefficient `C(n, k)` for the step-ratio prediction.
-fn binom(n: usize, k: usize) -> f64 {
-    (0..k).fold(1.0, |acc, i| acc * (n - i) as f64 / (i + 1) as f64)
-}
+/// Binomial coefficients `C(n, k)` for `n, k ≤ 7` (exact integers), for the prediction.
+const BINOM: [[f64; 8]; 8] = {
+    let mut t = [[0.0; 8]; 8];
+    let mut n = 0;
+    while n < 8 {
+        t[n][0] = 1.0;
+        let mut k = 1;
+        while k <= n {
+            t[n][k] = t[n - 1][k - 1] + if k < n { t[n - 1][k] } else { 0.0 };
+            k += 1;
+        }
+        n += 1;
+    }
+    t
+};
 
 #[inline]
 fn add_cs(p: &mut f64, cs: &mut f64, inp: f64) {
@@ -206,15 +217,60 @@ fn add_cs(p: &mut f64, cs: &mut f64, inp: f64) {
     *p = t;
 }
 
-/// Seven coefficients per coordinate, contiguous: `c[k][j]` is coefficient `j` of
-/// coordinate `k`.
-type Coeffs = Vec<[f64; 7]>;
+/// Seven coefficients in structure-of-arrays form: `c[j][k]` is coefficient `j` of
+/// coordinate `k`, so that every loop over coordinates runs over contiguous memory and
+/// vectorises (the divided differences divide: `divpd` does two or four at once).
+type Coeffs = [Vec<f64>; 7];
 
 fn zeros7(n: usize) -> Coeffs {
-    vec![[0.0; 7]; n]
+    std::array::from_fn(|_| vec![0.0; n])
 }
 
-/// IAS15 workspace (all of it allocated once, in [`Ias15::new`]).
+/// Predicted positions of one coordinate block at node `hs` (REBOUND's predictor, with the
+/// node's constants hoisted). Slices of one length, so no bounds checks and no
+/// aliasing stand in the way of vectorisation.
+#[allow(clippy::too_many_arguments)]
+fn predict_positions(
+    dst: &mut [f64],
+    b: [&[f64]; 7],
+    a0: &[f64],
+    v0: &[f64],
+    x0: &[f64],
+    csx: &[f64],
+    h: f64,
+    hs: f64,
+) {
+    let n = dst.len();
+    let (a0, v0, x0, csx) = (&a0[..n], &v0[..n], &x0[..n], &csx[..n]);
+    let b: [&[f64]; 7] = std::array::from_fn(|j| &b[j][..n]);
+    // The node's Horner factors once, not per coordinate: the divisions by 9, 7, 5, 3 are
+    // not exact, so this rounds the predicted positions differently from REBOUND's form
+    // (by an ulp of the b-terms). Predicted positions only choose where the forces are
+    // evaluated, so that changes the converged b by ∂a/∂x times an ulp: below round-off.
+    let c = [
+        hs / 3.0,
+        hs / 2.0,
+        3.0 * hs / 5.0,
+        2.0 * hs / 3.0,
+        5.0 * hs / 7.0,
+        3.0 * hs / 4.0,
+        7.0 * hs / 9.0,
+    ];
+    let (hv, hx) = (h * hs / 2.0, h * hs);
+    for i in 0..n {
+        let mut inner = b[6][i] * c[6];
+        for j in (0..6).rev() {
+            inner = (inner + b[j][i]) * c[j];
+        }
+        inner += a0[i];
+        let dx = -csx[i] + (inner * hv + v0[i]) * hx;
+        dst[i] = dx + x0[i];
+    }
+}
+
+/// IAS15 workspace (all of it allocated once, in [`Ias15::new`]). Coordinates are stored
+/// planar, `k = c·N + i` (all x, then all y, then all z), matching the particle arrays, so
+/// that copies in and out are slice copies.
 #[derive(Debug, Clone)]
 pub(crate) struct Ias15 {
     params: Ias15Params,
@@ -224,6 +280,9 @@ pub(crate) struct Ias15 {
     at: Vec<f64>,
     csx: Vec<f64>,
     csv: Vec<f64>,
+    /// Scratch for the divided differences of one node.
+    gk: Vec<f64>,
+    delta: Vec<f64>,
     g: Coeffs,
     b: Coeffs,
     e: Coeffs,
@@ -258,6 +317,8 @@ impl Ias15 {
             at: vec![0.0; n3],
             csx: vec![0.0; n3],
             csv: vec![0.0; n3],
+            gk: vec![0.0; n3],
+            delta: vec![0.0; n3],
             g: zeros7(n3),
             b: zeros7(n3),
             e: zeros7(n3),
@@ -269,32 +330,37 @@ impl Ias15 {
         })
     }
 
-    /// Shifts the polynomial of the last step (`sb`, with its prediction `se`) by `ratio`
+    /// Shifts the polynomial of the last step (`br`, with its prediction `er`) by `ratio`
     /// into the prediction `e` and the starting guess `b` of the next step.
-    fn predict(&mut self, ratio: f64, from_saved: bool) {
-        let n3 = self.x0.len();
+    fn predict(&mut self, ratio: f64) {
         if ratio > 20.0 {
-            self.e.iter_mut().for_each(|v| *v = [0.0; 7]);
-            self.b.iter_mut().for_each(|v| *v = [0.0; 7]);
+            self.e.iter_mut().for_each(|v| v.fill(0.0));
+            self.b.iter_mut().for_each(|v| v.fill(0.0));
             return;
         }
+        let n3 = self.x0.len();
         let q: [f64; 7] = std::array::from_fn(|j| ratio.powi(j as i32 + 1));
-        for idx in 0..n3 {
-            let (sb, se): ([f64; 7], [f64; 7]) = if from_saved {
-                (self.br[idx], self.er[idx])
-            } else {
-                (self.b[idx], self.e[idx])
-            };
-            for j in 0..7 {
+        let (sb, se) = (&self.br, &self.er);
+        for j in 0..7 {
+            let (ej, bj) = (&mut self.e[j], &mut self.b[j]);
+            for idx in 0..n3 {
                 let mut s = 0.0;
                 for k in (j..7).rev() {
-                    s += binom(k + 1, j + 1) * sb[k];
+                    s += BINOM[k + 1][j + 1] * sb[k][idx];
                 }
-                let ej = q[j] * s;
-                self.e[idx][j] = ej;
-                self.b[idx][j] = ej + (sb[j] - se[j]);
+                let e = q[j] * s;
+                ej[idx] = e;
+                bj[idx] = e + (sb[j][idx] - se[j][idx]);
             }
         }
+    }
+
+    /// Copies `(x, y, z)` of the particles into the planar array `dst`.
+    fn gather(dst: &mut [f64], x: &[f64], y: &[f64], z: &[f64]) {
+        let n = x.len();
+        dst[..n].copy_from_slice(x);
+        dst[n..2 * n].copy_from_slice(y);
+        dst[2 * n..3 * n].copy_from_slice(z);
     }
 
     /// One step from `t` of at most `min(*dt, h_max)`; adapts `*dt` for the next step.
@@ -331,28 +397,24 @@ impl Ias15 {
     ) -> Result<Option<f64>, GravityError> {
         let n = p.len();
         let n3 = 3 * n;
-        f.compute(p, false);
-        for i in 0..n {
-            let k = 3 * i;
-            self.x0[k] = p.x[i];
-            self.x0[k + 1] = p.y[i];
-            self.x0[k + 2] = p.z[i];
-            self.v0[k] = p.vx[i];
-            self.v0[k + 1] = p.vy[i];
-            self.v0[k + 2] = p.vz[i];
-            self.a0[k] = p.ax[i];
-            self.a0[k + 1] = p.ay[i];
-            self.a0[k + 2] = p.az[i];
+        if self.x0.len() != n3 {
+            // The particle count changed under the workspace: start afresh.
+            *self = Ias15::new(self.params, n)?;
         }
-        self.csb.iter_mut().for_each(|v| *v = [0.0; 7]);
+        f.compute(p, false);
+        Self::gather(&mut self.x0, &p.x, &p.y, &p.z);
+        Self::gather(&mut self.v0, &p.vx, &p.vy, &p.vz);
+        Self::gather(&mut self.a0, &p.ax, &p.ay, &p.az);
+        self.csb.iter_mut().for_each(|v| v.fill(0.0));
         // g = D b
-        for idx in 0..n3 {
-            for j in 0..7 {
-                let mut s = self.b[idx][j];
+        for j in 0..7 {
+            let gj = &mut self.g[j];
+            for idx in 0..n3 {
+                let mut s = self.b[j][idx];
                 for k in j + 1..7 {
-                    s += D_PACKED[tri(k, j)] * self.b[idx][k];
+                    s += D_PACKED[tri(k, j)] * self.b[k][idx];
                 }
-                self.g[idx][j] = s;
+                gj[idx] = s;
             }
         }
 
@@ -377,76 +439,64 @@ impl Ias15 {
             iterations += 1;
             for s in 1..8 {
                 let hs = H[s];
-                for i in 0..n {
-                    for c in 0..3 {
-                        let k = 3 * i + c;
-                        let b = |j: usize| self.b[k][j];
-                        let inner = ((((((b(6) * 7.0 * hs / 9.0 + b(5)) * 3.0 * hs / 4.0
-                            + b(4))
-                            * 5.0
-                            * hs
-                            / 7.0
-                            + b(3))
-                            * 2.0
-                            * hs
-                            / 3.0
-                            + b(2))
-                            * 3.0
-                            * hs
-                            / 5.0
-                            + b(1))
-                            * hs
-                            / 2.0
-                            + b(0))
-                            * hs
-                            / 3.0
-                            + self.a0[k];
-                        let dx = -self.csx[k] + (inner * h * hs / 2.0 + self.v0[k]) * h * hs;
-                        let x = dx + self.x0[k];
-                        match c {
-                            0 => p.x[i] = x,
-                            1 => p.y[i] = x,
-                            _ => p.z[i] = x,
-                        }
-                    }
+                // Predicted positions at node s, coordinate block by block.
+                for (c, dst) in [&mut p.x, &mut p.y, &mut p.z].into_iter().enumerate() {
+                    let r = c * n..(c + 1) * n;
+                    predict_positions(
+                        dst,
+                        std::array::from_fn(|j| &self.b[j][r.clone()]),
+                        &self.a0[r.clone()],
+                        &self.v0[r.clone()],
+                        &self.x0[r.clone()],
+                        &self.csx[r],
+                        h,
+                        hs,
+                    );
                 }
                 f.compute(p, false);
-                for i in 0..n {
-                    self.at[3 * i] = p.ax[i];
-                    self.at[3 * i + 1] = p.ay[i];
-                    self.at[3 * i + 2] = p.az[i];
-                }
+                Self::gather(&mut self.at, &p.ax, &p.ay, &p.az);
                 let j = s - 1;
-                let mut max_a: f64 = 0.0;
-                let mut max_db6: f64 = 0.0;
-                for k in 0..n3 {
-                    // Newton divided difference: g_j = (…((a_s − a₀)/(h_s − h₀) − g₀)/(h_s − h₁) … − g_{j−1})/(h_s − h_j).
-                    let mut gk = (self.at[k] - self.a0[k]) / RR[tri(s, 0)];
-                    for m in 0..j {
-                        gk = (gk - self.g[k][m]) / RR[tri(s, m + 1)];
+                // Newton divided difference, one level at a time over all coordinates:
+                // g_j = (…((a_s − a₀)/(h_s − h₀) − g₀)/(h_s − h₁) … − g_{j−1})/(h_s − h_j).
+                let gk = &mut self.gk;
+                let r0 = RR[tri(s, 0)];
+                for ((g, at), a0) in gk.iter_mut().zip(&self.at).zip(&self.a0) {
+                    *g = (at - a0) / r0;
+                }
+                for m in 0..j {
+                    let rm = RR[tri(s, m + 1)];
+                    for (g, gm) in gk.iter_mut().zip(&self.g[m]) {
+                        *g = (*g - gm) / rm;
                     }
-                    let delta = gk - self.g[k][j];
-                    self.g[k][j] = gk;
-                    for r in 0..j {
-                        add_cs(
-                            &mut self.b[k][r],
-                            &mut self.csb[k][r],
-                            delta * C_PACKED[tri(j, r)],
-                        );
+                }
+                let delta = &mut self.delta;
+                for ((d, g), gj) in delta.iter_mut().zip(gk.iter()).zip(&self.g[j]) {
+                    *d = g - gj;
+                }
+                self.g[j].copy_from_slice(gk);
+                for r in 0..j {
+                    let cr = C_PACKED[tri(j, r)];
+                    for ((b, cs), d) in self.b[r].iter_mut().zip(&mut self.csb[r]).zip(delta.iter())
+                    {
+                        add_cs(b, cs, d * cr);
                     }
-                    add_cs(&mut self.b[k][j], &mut self.csb[k][j], delta);
-                    if s == 7 {
+                }
+                for ((b, cs), d) in self.b[j].iter_mut().zip(&mut self.csb[j]).zip(delta.iter()) {
+                    add_cs(b, cs, *d);
+                }
+                if s == 7 {
+                    let mut max_a: f64 = 0.0;
+                    let mut max_db6: f64 = 0.0;
+                    for k in 0..n3 {
                         let ak = self.at[k].abs();
                         if ak.is_normal() && ak > max_a {
                             max_a = ak;
                         }
-                        let db = delta.abs();
+                        let db = delta[k].abs();
                         if db.is_normal() && db > max_db6 {
                             max_db6 = db;
                         }
                     }
-                }
-                if s == 7 {
                     pc_error = max_db6 / max_a;
                 }
             }
@@ -456,10 +506,12 @@ impl Ias15 {
         let mut dt_new = *dt;
         if self.params.epsilon > 0.0 {
             let mut min_ts2 = f64::INFINITY;
+            let b = &self.b;
             for i in 0..n {
                 let (mut a0i, mut y2, mut y3, mut y4) = (0.0, 0.0, 0.0, 0.0);
-                for k in 3 * i..3 * i + 3 {
-                    let b = |j: usize| self.b[k][j];
+                for c in 0..3 {
+                    let k = c * n + i;
+                    let b = |j: usize| b[j][k];
                     a0i += self.a0[k] * self.a0[k];
                     let t2 = self.a0[k] + b(0) + b(1) + b(2) + b(3) + b(4) + b(5) + b(6);
                     y2 += t2 * t2;
@@ -497,14 +549,12 @@ impl Ias15 {
             }
             if (dt_new / dt_done).abs() < SAFETY {
                 // Reject: restore the start of the step and retry with the smaller step.
-                for i in 0..n {
-                    p.x[i] = self.x0[3 * i];
-                    p.y[i] = self.x0[3 * i + 1];
-                    p.z[i] = self.x0[3 * i + 2];
-                }
+                p.x.copy_from_slice(&self.x0[..n]);
+                p.y.copy_from_slice(&self.x0[n..2 * n]);
+                p.z.copy_from_slice(&self.x0[2 * n..]);
                 *dt = dt_new;
                 if self.dt_last_done != 0.0 {
-                    self.predict(dt_new / self.dt_last_done, true);
+                    self.predict(dt_new / self.dt_last_done);
                 }
                 return Ok(None);
             }
@@ -514,8 +564,9 @@ impl Ias15 {
         }
         *dt = dt_new;
 
+        let b = &self.b;
         for k in 0..n3 {
-            let b = |j: usize| self.b[k][j];
+            let b = |j: usize| b[j][k];
             let (x0, csx) = (&mut self.x0[k], &mut self.csx[k]);
             // (b/c·Δt)·Δt, not b/c·Δt²: a precomputed Δt² rounds the same way every step of a
             // fixed step size and biases the error (Rein & Spiegel 2015).
@@ -538,18 +589,18 @@ impl Ias15 {
             add_cs(v0, csv, b(0) / 2.0 * dt_done);
             add_cs(v0, csv, self.a0[k] * dt_done);
         }
-        for i in 0..n {
-            p.x[i] = self.x0[3 * i];
-            p.y[i] = self.x0[3 * i + 1];
-            p.z[i] = self.x0[3 * i + 2];
-            p.vx[i] = self.v0[3 * i];
-            p.vy[i] = self.v0[3 * i + 1];
-            p.vz[i] = self.v0[3 * i + 2];
-        }
+        p.x.copy_from_slice(&self.x0[..n]);
+        p.y.copy_from_slice(&self.x0[n..2 * n]);
+        p.z.copy_from_slice(&self.x0[2 * n..]);
+        p.vx.copy_from_slice(&self.v0[..n]);
+        p.vy.copy_from_slice(&self.v0[n..2 * n]);
+        p.vz.copy_from_slice(&self.v0[2 * n..]);
         self.dt_last_done = dt_done;
-        self.er.copy_from_slice(&self.e);
-        self.br.copy_from_slice(&self.b);
-        self.predict(*dt / dt_done, false);
+        for j in 0..7 {
+            self.er[j].copy_from_slice(&self.e[j]);
+            self.br[j].copy_from_slice(&self.b[j]);
+        }
+        self.predict(*dt / dt_done);
         Ok(Some(dt_done))
     }
 }
