@@ -13,4 +13,7 @@ pub(crate) struct Memo {
     pub simplify: FxHashMap<Id, Id>,
     /// (expression, variable, total time derivative?) → derivative.
     pub diff: FxHashMap<(Id, Id, bool), Id>,
+    /// Polynomial work units spent by `simplify`'s rational forms since the pool was made (a
+    /// deterministic measure of simplification cost, for regression tests).
+    pub simplify_work: u64,
 }

@@ -19,12 +19,26 @@ use crate::poly::{gcd, Budget, Mono, Poly};
 use crate::pool::{Func, Id, Node, Pool};
 use rustc_hash::FxHashMap;
 
-/// Work allowed per rational-form attempt (polynomial term operations).
-const BUDGET: u64 = 400_000;
+/// Work allowed per rational-form attempt (polynomial term operations). Each unit is a
+/// monomial product and a map insertion (about 1 µs), so an attempt that gives up costs tens
+/// of milliseconds; 400,000 let one fuzzed `pdyn kin` input spend 1.5 s in powers of sums.
+const BUDGET: u64 = 60_000;
+/// Most terms a power of a sum may expand to before it is kept as an atom: `(a + b + ... )^k`
+/// with many terms is rarely simplified by expanding, and expanding it dominated the work.
+const MAX_POWER_TERMS: u64 = 400;
+/// Most terms of an angle whose `sin`/`cos` is expanded into products (`a - b + c` is the
+/// largest that chapter models use).
+const MAX_TRIG_TERMS: usize = 3;
 /// Largest tree handed to the rational normal form.
 const MAX_TREE: usize = 20_000;
 
 impl Pool {
+    /// Polynomial work units (monomial products and insertions) spent by [`Pool::simplify`]
+    /// on this pool so far: a deterministic cost measure for regression tests.
+    pub fn simplify_work(&self) -> u64 {
+        self.memo.simplify_work
+    }
+
     /// Simplifies `e` (see the module documentation). Memoised.
     pub fn simplify(&mut self, e: Id) -> Id {
         if let Some(&r) = self.memo.simplify.get(&e) {
@@ -255,9 +269,12 @@ impl Pool {
     /// does not apply (floating-point coefficients) or exceeds the work budget.
     fn rational_form(&mut self, e: Id, expand_trig: bool) -> Option<Id> {
         let mut cx = RationalForm::new(BUDGET, expand_trig);
-        let (num, den) = cx.convert(self, e)?;
-        let (num, den) = cx.reduce_pythagorean(self, num, den)?;
-        let (num, den) = cx.cancel(num, den)?;
+        let r = cx.convert(self, e).and_then(|(num, den)| {
+            let (num, den) = cx.reduce_pythagorean(self, num, den)?;
+            cx.cancel(num, den)
+        });
+        self.memo.simplify_work += BUDGET - cx.budget.0;
+        let (num, den) = r?;
         let n = cx.to_expr(self, &num);
         let d = cx.to_expr(self, &den);
         Some(self.div(n, d))
@@ -338,6 +355,11 @@ impl RationalForm {
                 match r {
                     Some((num, 1)) => {
                         let base = self.convert(p, b)?;
+                        if power_too_big(&base.0, &base.1, num) {
+                            // Kept whole: an atom is exact, it only hides cancellations
+                            // inside the power.
+                            return Some((self.atom(e), one()));
+                        }
                         self.power(base, num)
                     }
                     Some((num, den)) => {
@@ -371,6 +393,9 @@ impl RationalForm {
     }
 
     fn power(&mut self, (n, d): Frac, k: i64) -> Option<Frac> {
+        if power_too_big(&n, &d, k) {
+            return None;
+        }
         let b = &mut self.budget;
         let m = u32::try_from(k.unsigned_abs()).ok()?;
         if m > 64 {
@@ -476,6 +501,30 @@ impl RationalForm {
     }
 }
 
+/// Whether `(n/d)^k` could have more than [`MAX_POWER_TERMS`] terms in its numerator or
+/// denominator: a sum of `t` terms to the power `k` has at most `C(t + k - 1, k)` (the
+/// monomials of degree `k` in `t` variables), and at most `t^k`.
+fn power_too_big(n: &Poly, d: &Poly, k: i64) -> bool {
+    let k = k.unsigned_abs();
+    let bound = |t: usize| -> u64 {
+        let t = t as u64;
+        if t <= 1 {
+            return 1;
+        }
+        // C(t + k - 1, k) = C(t + k - 1, t - 1), computed incrementally, capped.
+        let (mut c, mut pw) = (1u64, 1u64);
+        for i in 1..=k.min(64) {
+            c = c.saturating_mul(t - 1 + i) / i;
+            pw = pw.saturating_mul(t);
+            if c.min(pw) > MAX_POWER_TERMS {
+                return u64::MAX;
+            }
+        }
+        c.min(pw)
+    };
+    k > 64 || bound(n.terms.len()) > MAX_POWER_TERMS || bound(d.terms.len()) > MAX_POWER_TERMS
+}
+
 /// Replaces `x^k` (k ≥ 2) by `x^(k mod 2) * (1 - y^2)^(k div 2)`, i.e. uses `x^2 = 1 - y^2`.
 fn eliminate_square(poly: &Poly, x: u32, y: u32, b: &mut Budget) -> Option<Poly> {
     let mut one_minus_y2 = Poly::constant(Rational::ONE);
@@ -511,6 +560,9 @@ fn expand_trig_call(p: &mut Pool, f: Func, u: Id) -> Option<Id> {
         return Some(p.div(s, c));
     }
     let (a, b) = match p.node(u).clone() {
+        // An angle of more than MAX_TRIG_TERMS terms would expand into 2^(terms - 1) products
+        // that seldom cancel (a fuzzed 7-term angle cost a second per simplify): kept whole.
+        Node::Add(ts) if ts.len() > MAX_TRIG_TERMS => return None,
         Node::Add(ts) => {
             let a = ts[0];
             let b = p.add(&ts[1..]);
