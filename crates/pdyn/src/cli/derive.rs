@@ -37,6 +37,11 @@ pub struct DeriveArgs {
     /// Largest system eliminated symbolically (larger ones are solved numerically when run).
     #[arg(long, default_value_t = 6)]
     symbolic_limit: usize,
+    /// Eliminate exactly even when it is expensive (explicit accelerations of a 3-link chain
+    /// print as lines of 1,600 characters; without this flag such systems are printed as
+    /// M q'' = f and solved numerically when run).
+    #[arg(long)]
+    solve: bool,
 }
 
 /// `pdyn derive MODEL`.
@@ -49,6 +54,11 @@ pub fn run(a: DeriveArgs) -> Result<String, Error> {
             FormArg::Projected => Form::Projected,
         },
         symbolic_limit: a.symbolic_limit,
+        solve_budget: if a.solve {
+            pdyn_mech::derive::FULL_SOLVE_BUDGET
+        } else {
+            pdyn_mech::derive::CHEAP_SOLVE_BUDGET
+        },
         ..DeriveOptions::default()
     };
     let d = derive(&mut model, &opts).map_err(|error| Error::Derive {
@@ -144,12 +154,18 @@ pub fn run(a: DeriveArgs) -> Result<String, Error> {
             }
         }
         None => {
+            let why = if d.system.cols() > a.symbolic_limit {
+                format!("more than {} unknowns", a.symbolic_limit)
+            } else if a.solve {
+                "exact elimination is over its work budget".to_string()
+            } else {
+                "exact elimination is expensive here; --solve tries it".to_string()
+            };
             out += &format!(
                 "\nThe {}×{} linear system A x = b is solved numerically at each evaluation \
-                 (more than {} unknowns).\n",
+                 ({why}).\n",
                 d.system.rows(),
                 d.system.cols(),
-                a.symbolic_limit
             );
         }
     }
