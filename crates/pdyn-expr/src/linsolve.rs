@@ -139,8 +139,20 @@ impl Pool {
         sys: &LinearSystem,
         check_consistency: bool,
     ) -> Result<Vec<Id>, LinearError> {
+        self.solve_linear_budgeted(sys, check_consistency, SOLVE_BUDGET)
+    }
+
+    /// Like [`Pool::solve_linear_with`], giving up with [`LinearError::TooLarge`] after
+    /// `budget` polynomial term operations (a caller that can solve numerically instead, like
+    /// `pdyn run`, wants exact elimination only when it is cheap).
+    pub fn solve_linear_budgeted(
+        &mut self,
+        sys: &LinearSystem,
+        check_consistency: bool,
+        budget: u64,
+    ) -> Result<Vec<Id>, LinearError> {
         let (m, n) = (sys.rows(), sys.cols());
-        let mut rf = RationalForm::new(SOLVE_BUDGET, false);
+        let mut rf = RationalForm::new(budget, false);
         // Rows of [A | b] as polynomials, each multiplied through by its common denominator.
         let mut rows: Vec<Vec<Poly>> = Vec::with_capacity(m);
         for i in 0..m {

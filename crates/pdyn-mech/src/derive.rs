@@ -46,6 +46,10 @@ pub struct DeriveOptions {
     /// accelerations. A run turns this off: on a 16-link chain it was 95 % of `pdyn run`'s
     /// time. Default: true.
     pub simplify_printed: bool,
+    /// Work budget of exact elimination (polynomial term operations): past it `A x = b` is
+    /// solved numerically at each evaluation and printed by reference. Default
+    /// [`CHEAP_SOLVE_BUDGET`]; `pdyn derive --solve` uses [`FULL_SOLVE_BUDGET`].
+    pub solve_budget: u64,
 }
 
 impl Default for DeriveOptions {
@@ -55,6 +59,7 @@ impl Default for DeriveOptions {
             symbolic_limit: 6,
             simplify: true,
             simplify_printed: true,
+            solve_budget: CHEAP_SOLVE_BUDGET,
         }
     }
 }
@@ -195,6 +200,14 @@ impl Derivation {
         )
     }
 }
+
+/// Work budget (polynomial term operations) of exact elimination on request (`pdyn derive
+/// --solve`): the linear solver's own default.
+pub const FULL_SOLVE_BUDGET: u64 = 4_000_000;
+/// Default work budget of exact elimination: enough for every shipped example (the 3-link
+/// chain included), not for the 4- and 5-link chains, whose elimination took most of
+/// `pdyn derive`/`pdyn run` (3 s of a 3.1 s run at n = 4) and printed 37 KB lines.
+pub const CHEAP_SOLVE_BUDGET: u64 = 200_000;
 
 fn simp(p: &mut Pool, e: Id, on: bool) -> Id {
     if on && p.tree_size(e, 4001) <= 4000 {
@@ -416,7 +429,11 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
     let residual_count = system.rows();
 
     let solution = if unknowns.len() <= opts.symbolic_limit || residual_count > unknowns.len() {
-        match p.solve_linear(&system) {
+        // Exact elimination only when it is cheap (a few reactions, a double pendulum):
+        // otherwise A x = b is solved numerically at each evaluation. On the 4-link chain the
+        // exact solution took 3 s of a 3.1 s `pdyn run` (elimination, then compiling its large
+        // expressions and their Jacobian) and printed unreadable 37 KB lines.
+        match p.solve_linear_budgeted(&system, true, opts.solve_budget) {
             Ok(sol) => Some(sol.into_iter().map(|s| simp(p, s, opts.simplify)).collect()),
             Err(LinearError::Underdetermined { free }) => {
                 let names: Vec<String> = free.iter().map(|&f| p.to_text(f)).collect();

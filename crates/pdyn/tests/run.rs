@@ -521,3 +521,59 @@ fn initial_states_that_violate_a_constraint_are_refused() {
     let mut m = pdyn_mech::load(&pulley, "<test>").unwrap();
     assert!(sim::prepare(&mut m).is_ok());
 }
+
+/// The n-link chain of issue 12 (symbolic masses and lengths, the generator of
+/// `bench/chain_model.py`), with unequal values and a large swing.
+fn chain_source(n: usize) -> String {
+    let mut s =
+        String::from("name = \"chain\"\ngravity = \"[0, -g, 0]\"\n\n[parameters]\ng = 9.81\n");
+    for i in 1..=n {
+        s += &format!(
+            "m{i} = {}\nl{i} = {}\n",
+            0.5 + 0.1 * i as f64,
+            1.2 - 0.05 * i as f64
+        );
+    }
+    s += "\n[coordinates]\n";
+    for i in 1..=n {
+        s += &format!("q{i} = {{ initial = {}, rate = 0.0 }}\n", 0.1 * i as f64);
+    }
+    for i in 1..=n {
+        let pos: Vec<String> = (1..=i)
+            .map(|j| format!("l{j}*[sin(q{j}), -cos(q{j}), 0]"))
+            .collect();
+        s += &format!(
+            "\n[particles.p{i}]\nmass = \"m{i}\"\nposition = \"{}\"\n",
+            pos.join(" + ")
+        );
+    }
+    s + "\n[simulate]\nt_end = 10.0\nrtol = 1e-9\natol = 1e-12\n"
+}
+
+/// `pdyn run` of the 10-link chain (numeric solve of `M q'' = f` at every step) conserves
+/// energy over 10 s to the order of the tolerance, and a coarse tolerance drifts visibly: the
+/// monitor can fail.
+#[test]
+fn ten_link_chain_conserves_energy_over_ten_seconds() {
+    let src = chain_source(10);
+    let res = run_source(&src, |s| {
+        s.t_end = 10.0;
+        s.rtol = Some(1e-9);
+        s.atol = Some(1e-12);
+    });
+    assert!(res.failure.is_none(), "{:?}", res.failure);
+    let e = energy(&res);
+    assert!(e.drift < 1e-6, "drift {}", e.drift);
+    assert!(res.warnings.is_empty(), "{:?}", res.warnings);
+    let coarse = run_source(&src, |s| {
+        s.t_end = 10.0;
+        s.rtol = Some(1e-3);
+        s.atol = Some(1e-3);
+    });
+    assert!(
+        energy(&coarse).drift > 10.0 * e.drift,
+        "coarse {} vs fine {}",
+        energy(&coarse).drift,
+        e.drift
+    );
+}

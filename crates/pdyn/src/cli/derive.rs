@@ -37,6 +37,11 @@ pub struct DeriveArgs {
     /// Largest system eliminated symbolically (larger ones are solved numerically when run).
     #[arg(long, default_value_t = 6)]
     symbolic_limit: usize,
+    /// Eliminate exactly even when it is expensive (explicit accelerations of a 3-link chain
+    /// print as lines of 1,600 characters; without this flag such systems are printed as
+    /// M q'' = f and solved numerically when run).
+    #[arg(long)]
+    solve: bool,
 }
 
 /// `pdyn derive MODEL`.
@@ -49,25 +54,30 @@ pub fn run(a: DeriveArgs) -> Result<String, Error> {
             FormArg::Projected => Form::Projected,
         },
         symbolic_limit: a.symbolic_limit,
+        solve_budget: if a.solve {
+            pdyn_mech::derive::FULL_SOLVE_BUDGET
+        } else {
+            pdyn_mech::derive::CHEAP_SOLVE_BUDGET
+        },
         ..DeriveOptions::default()
     };
     let d = derive(&mut model, &opts).map_err(|error| Error::Derive {
         origin: model.origin.clone(),
         error,
     })?;
-    let exact = if d.solution.is_some() {
+    // A closed form of accelerations too large to print is of no use to a reader, and
+    // attempting it re-derives and formats huge coefficients (32 MB on the 4-link chain).
+    let solution_printable = d
+        .solution
+        .as_ref()
+        .is_some_and(|sol| sol.iter().all(|&s| printable(&model.pool, s, a.latex)));
+    let exact = if solution_printable {
         Some(pdyn::sim::exact::closed_form(&mut model))
     } else {
         None
     };
     let p = &model.pool;
-    let show = |id: Id| -> String {
-        if a.latex {
-            p.to_latex(id)
-        } else {
-            p.to_text(id)
-        }
-    };
+    let show = |id: Id| -> String { bounded(p, id, a.latex) };
     let vec3 = |v: [Id; 3]| -> String {
         let parts: Vec<String> = v.iter().map(|&c| show(c)).collect();
         if a.latex {
@@ -144,12 +154,18 @@ pub fn run(a: DeriveArgs) -> Result<String, Error> {
             }
         }
         None => {
+            let why = if d.system.cols() > a.symbolic_limit {
+                format!("more than {} unknowns", a.symbolic_limit)
+            } else if a.solve {
+                "exact elimination is over its work budget".to_string()
+            } else {
+                "exact elimination is expensive here; --solve tries it".to_string()
+            };
             out += &format!(
                 "\nThe {}×{} linear system A x = b is solved numerically at each evaluation \
-                 (more than {} unknowns).\n",
+                 ({why}).\n",
                 d.system.rows(),
                 d.system.cols(),
-                a.symbolic_limit
             );
         }
     }
@@ -182,10 +198,68 @@ pub fn run(a: DeriveArgs) -> Result<String, Error> {
                 }
             }
         }
-        Some(Err(why)) => out += &format!("\nNo closed form: {why}.\n"),
+        Some(Err(why)) => {
+            let why = why.to_string();
+            if why.len() <= PRINT_CHARS {
+                out += &format!("\nNo closed form: {why}.\n");
+            } else {
+                // The reason names the equation and the symbol (`q1`), then quotes the
+                // coefficient: keep what comes before the coefficient.
+                let head = match why.match_indices('`').nth(1) {
+                    Some((i, _)) => &why[..=i],
+                    None => why.split('`').next().unwrap_or("").trim_end(),
+                };
+                out += &format!(
+                    "\nNo closed form: {head} … ({} characters, over the printing budget of {PRINT_CHARS}).\n",
+                    why.len()
+                );
+            }
+        }
+        None if d.solution.is_some() => {
+            out += "\nNo closed form attempted: the solved accelerations are over the printing budget.\n";
+        }
         None => {}
     }
     Ok(out)
+}
+
+/// Longest expression `pdyn derive` prints, in characters (documented in docs/benchmarks.md):
+/// past it the line names what is omitted and its size instead (`--json` has every expression
+/// whole).
+pub const PRINT_CHARS: usize = 2000;
+/// Expressions larger than this many tree nodes are not even formatted (formatting the 4-link
+/// chain's solution took seconds); any expression within [`PRINT_CHARS`] is far smaller.
+const PRINT_NODES: usize = 4000;
+
+/// Whether `id` prints within the budget.
+fn printable(p: &Pool, id: Id, latex: bool) -> bool {
+    p.tree_size(id, PRINT_NODES + 1) <= PRINT_NODES && render(p, id, latex).len() <= PRINT_CHARS
+}
+
+fn render(p: &Pool, id: Id, latex: bool) -> String {
+    if latex {
+        p.to_latex(id)
+    } else {
+        p.to_text(id)
+    }
+}
+
+/// `id` as text or LaTeX, or a note with its size when it is over the budget.
+fn bounded(p: &Pool, id: Id, latex: bool) -> String {
+    if p.tree_size(id, PRINT_NODES + 1) > PRINT_NODES {
+        return format!(
+            "⟨not printed: over {PRINT_NODES} expression nodes; `pdyn derive --json` gives it whole⟩"
+        );
+    }
+    let text = render(p, id, latex);
+    if text.len() > PRINT_CHARS {
+        format!(
+            "⟨not printed: {} characters, over the budget of {PRINT_CHARS}; `pdyn derive --json` gives it whole⟩",
+            text.len()
+        )
+    } else {
+        text
+    }
 }
 
 fn to_json(model: &pdyn_mech::Model, d: &pdyn_mech::Derivation, p: &Pool) -> serde_json::Value {
