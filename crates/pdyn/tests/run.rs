@@ -577,3 +577,133 @@ fn ten_link_chain_conserves_energy_over_ten_seconds() {
         e.drift
     );
 }
+
+/// The full path's measures: `run`, then each statistic over the measure's values at the rows
+/// (what sweeps computed before `sim::measured`).
+fn measures_from_rows(
+    p: &sim::Prepared,
+    set: &RunSettings,
+    stats: &[pdyn_mech::model::spec::Stat],
+) -> (Vec<f64>, sim::RunResult) {
+    let res = sim::run(p, set).unwrap();
+    let m = p.measures.as_ref().unwrap();
+    let n = p.system.n;
+    let mut series = vec![Vec::new(); m.len()];
+    let mut ts = Vec::new();
+    let (mut input, mut out) = (Vec::new(), vec![0.0; m.len()]);
+    for row in &res.rows {
+        p.system
+            .observation_input(row[0], &row[1..1 + 2 * n], &mut input);
+        m.eval(&input, &mut out);
+        ts.push(row[0]);
+        for (s, &o) in series.iter_mut().zip(&out) {
+            s.push(o);
+        }
+    }
+    let vals = series
+        .iter()
+        .zip(stats)
+        .map(|(s, &st)| sim::sweep::statistic(st, &ts, s))
+        .collect();
+    (vals, res)
+}
+
+/// Every statistic of `of`, as `[sweep.measures]` entries.
+fn all_stats(of: &str) -> String {
+    [
+        "max",
+        "min",
+        "max_abs",
+        "peak_to_peak",
+        "final",
+        "mean",
+        "rms",
+    ]
+    .iter()
+    .map(|s| format!("{s} = {{ of = \"{of}\", stat = \"{s}\" }}\n"))
+    .collect()
+}
+
+/// A sweep's measures-only path gives the full path's results bit for bit: measures (every
+/// statistic), drift reports, warnings, events, status; on the building (dense output at 2001
+/// points, a conserved-free forced system with a monitor) and on the Kremlin stone (a terminal
+/// event, energy conserved, output at every step and at given points).
+#[test]
+fn sweep_measures_equal_the_full_path() {
+    let building = std::fs::read_to_string(format!(
+        "{}/../../examples/building.toml",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let i = building.find("[sweep.measures]").unwrap();
+    let building = format!(
+        "{}[sweep.measures]\n{}",
+        &building[..i],
+        all_stats("y2 - (2*L - 3*m*g/(2*k))")
+    )
+    .replace(
+        "from = 2.0\nto = 30.0\nsteps = 281",
+        "values = [3.0, 8.74, 22.9]",
+    );
+    let kremlin = std::fs::read_to_string(format!(
+        "{}/../../examples/kremlin_stone.toml",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap()
+        + "\n[sweep]\nparameter = \"v0\"\nvalues = [5.0, 11.0, 20.0]\n\n[sweep.measures]\n"
+        + &all_stats("z - x");
+    let (mut checked, mut warned, mut events) = (0, 0, 0);
+    for (src, tweaks) in [
+        (&building, vec![None, Some(1e-300)]),
+        (&kremlin, vec![None, Some(1e-300)]),
+    ] {
+        let mut m = pdyn_mech::load(src, "<test>").unwrap_or_else(|e| panic!("{}", e.render(src)));
+        let spec = m.run.sweep.clone().unwrap();
+        let stats: Vec<_> = spec.measures.iter().map(|x| x.stat).collect();
+        assert_eq!(stats.len(), 7);
+        let prep = sim::prepare(&mut m).unwrap();
+        for drift_tolerance in tweaks {
+            for points in [None, Some(301)] {
+                let mut set = RunSettings::from_spec(&m.run.simulate).unwrap();
+                if let Some(d) = drift_tolerance {
+                    set.drift_tolerance = d;
+                }
+                if points.is_some() {
+                    set.points = points;
+                }
+                let sw = sim::sweep::sweep(&prep, &set, &spec, &stats, false).unwrap();
+                for (k, &v) in spec.values.iter().enumerate() {
+                    let p = prep.with_parameters(&[(spec.parameter, v)]);
+                    let (full, res) = measures_from_rows(&p, &set, &stats);
+                    let fast = sim::measured::measure(&p, &set, &stats).unwrap();
+                    let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+                    assert_eq!(bits(&fast.measures), bits(&full), "{v}: {full:?}");
+                    assert_eq!(bits(&sw.slices[0].table[k]), bits(&full));
+                    assert!(full.iter().all(|x| x.is_finite()), "{full:?}");
+                    assert_eq!(fast.warnings, res.warnings);
+                    assert_eq!(fast.status, res.status);
+                    assert_eq!(fast.failure.is_some(), res.failure.is_some());
+                    assert_eq!(
+                        format!("{:?}", fast.monitors),
+                        format!("{:?}", res.monitors)
+                    );
+                    assert_eq!(format!("{:?}", fast.events), format!("{:?}", res.events));
+                    assert_eq!(format!("{:?}", fast.stats), format!("{:?}", res.stats));
+                    let problem = sw.problems.iter().find(|(at, _)| at[0].1 == v);
+                    assert_eq!(problem.is_some(), !res.warnings.is_empty());
+                    if let Some((_, sim::sweep::RunProblem::Warnings(w))) = problem {
+                        assert_eq!(w, &res.warnings);
+                    }
+                    checked += 1;
+                    warned += usize::from(!res.warnings.is_empty());
+                    events += res.events.len();
+                }
+            }
+        }
+    }
+    assert_eq!(checked, 24);
+    assert!(
+        warned >= 6 && events >= 6,
+        "{warned} runs warned, {events} events"
+    );
+}

@@ -13,11 +13,13 @@
 pub mod compiled;
 mod error;
 pub mod exact;
+pub mod measured;
 pub mod sweep;
 
 pub use error::{ClosedFormError, RunFailure, SimError};
 
 use compiled::{CompiledModel, Observer};
+use measured::report;
 use pdyn_expr::{Id, Pool};
 pub use pdyn_jit::JitMode;
 use pdyn_mech::conservation::conserved_quantities;
@@ -711,6 +713,16 @@ fn non_finite_at(prep: &Prepared, sys: &CompiledModel, t: f64, y: &[f64]) -> Vec
 
 /// Integrates a prepared model.
 pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, SimError> {
+    let (sol, failure) = integrate(prep, set)?;
+    Ok(tabulate(prep, &sol, set, failure))
+}
+
+/// The integration of [`run`], before tabulation: the solver's output points and why it
+/// stopped early, if it did.
+pub(crate) fn integrate(
+    prep: &Prepared,
+    set: &RunSettings,
+) -> Result<(Solution, Option<RunFailure>), SimError> {
     let method = method_by_name(&set.method).ok_or_else(|| SimError::UnknownMethod {
         name: set.method.clone(),
     })?;
@@ -826,7 +838,7 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, SimError> {
             None => return Err(SimError::Integrator(e)),
         },
     };
-    Ok(tabulate(prep, &sol, set, failure))
+    Ok((sol, failure))
 }
 
 /// The scale of each conserved quantity over a run: the larger of its value at the first
@@ -849,14 +861,14 @@ fn conservation_scales(prep: &Prepared, sol: &Solution) -> Vec<f64> {
             series.push(v.abs());
         }
     }
-    per_quantity
-        .into_iter()
-        .map(|mut v| {
-            let first = v[0];
-            v.sort_by(f64::total_cmp);
-            first.max(v[v.len() / 2])
-        })
-        .collect()
+    per_quantity.into_iter().map(scale_of).collect()
+}
+
+/// The larger of the first value and the median of `|Q|` along a run (not empty).
+pub(crate) fn scale_of(mut v: Vec<f64>) -> f64 {
+    let first = v[0];
+    v.sort_by(f64::total_cmp);
+    first.max(v[v.len() / 2])
 }
 
 pub(crate) fn tabulate(
@@ -883,91 +895,34 @@ pub(crate) fn tabulate(
         row.extend_from_slice(&extra);
         rows.push(row);
     }
-    let events = sol
-        .events
-        .iter()
-        .map(|h| EventReport {
-            name: prep
-                .events
-                .get(h.index)
-                .map_or("event".into(), |e| e.name.clone()),
-            t: h.t,
-            state: h.y.clone(),
-            rising: h.direction == Direction::Rising,
-        })
-        .collect();
     let offset = 1 + prep.state_names.len();
-    let scales = conservation_scales(prep, sol);
-    let mut monitors = Vec::new();
-    let mut warnings = Vec::new();
-    for (j, name) in prep.observer.names.iter().enumerate() {
-        let conserved = prep.conserved[j];
-        if !conserved {
-            continue;
-        }
-        let Some(first) = rows.first().map(|r| r[offset + j]) else {
-            continue;
-        };
-        // NaN propagates (f64::max would drop it and call a NaN energy conserved).
-        let dev = rows
-            .iter()
-            .map(|r| (r[offset + j] - first).abs())
-            .fold(0.0, |a: f64, d| {
-                if d.is_nan() || a.is_nan() {
-                    f64::NAN
-                } else {
-                    a.max(d)
-                }
-            });
-        let k = monitors.len();
-        let scale = scales.get(k).copied().unwrap_or(f64::NAN);
-        let relative = scale > 0.0;
-        let drift = if relative { dev / scale } else { dev };
-        if drift.is_nan() {
-            warnings.push(format!(
-                "{name} should be conserved but is not finite (NaN or infinite) along the run: \
-                 this result cannot be trusted; look for a division by zero or a function \
-                 outside its domain in the model"
-            ));
-        } else if drift > set.drift_tolerance {
-            let t_last = rows.last().map_or(0.0, |r| r[0]);
-            warnings.push(format!(
-                "{name} should be conserved but drifted by {drift:.3e} ({}) over t = 0..{t_last}: \
-                 this result cannot be trusted (the First Law of Scientific Computing). Tighten \
-                 the tolerance (e.g. --rtol {:.0e}) or use a symplectic method (--method symplectic --dt ...).",
-                if relative { "relative" } else { "absolute" },
-                (set.rtol.unwrap_or(1e-6) * 1e-3).max(1e-13),
-            ));
-        }
-        monitors.push(MonitorReport {
-            name: name.clone(),
-            initial: first,
-            drift,
-            relative,
-            scale,
-            conserved,
-        });
-    }
-    if rows.iter().any(|r| r.iter().any(|x| !x.is_finite())) && failure.is_none() {
-        warnings.push("some output values are not finite (NaN or infinity)".into());
-    }
-    for miss in &sol.possible_misses {
-        let name = prep
-            .events
-            .get(miss.index)
-            .map_or("event", |e| e.name.as_str());
-        warnings.push(format!(
-            "event `{name}` may have crossed zero twice between t = {:.6e} and t = {:.6e} \
-             unseen (its function came back towards zero and away within one step): limit the \
-             step (--max-step) to be sure",
-            miss.t_from, miss.t_to
-        ));
-    }
-    let status = match (&failure, sol.status) {
-        (Some(_), _) => RunStatus::Failed,
-        (None, pdyn_ode::Status::Finished) => RunStatus::Finished,
-        (None, pdyn_ode::Status::TerminalEvent(k)) => RunStatus::TerminalEvent(k),
+    let drifts: Vec<(f64, f64)> = match rows.first() {
+        None => Vec::new(),
+        Some(first) => (0..prep.observer.len())
+            .filter(|&j| prep.conserved[j])
+            .map(|j| {
+                let first = first[offset + j];
+                // NaN propagates (f64::max would drop it and call a NaN energy conserved).
+                let dev =
+                    rows.iter()
+                        .map(|r| (r[offset + j] - first).abs())
+                        .fold(0.0, |a: f64, d| {
+                            if d.is_nan() || a.is_nan() {
+                                f64::NAN
+                            } else {
+                                a.max(d)
+                            }
+                        });
+                (first, dev)
+            })
+            .collect(),
     };
+    let non_finite = rows.iter().any(|r| r.iter().any(|x| !x.is_finite()));
+    let t_last = rows.last().map_or(0.0, |r| r[0]);
+    let scales = conservation_scales(prep, sol);
+    let (events, monitors, warnings, status) = report(
+        prep, sol, set, &failure, &drifts, &scales, t_last, non_finite,
+    );
     RunResult {
         columns,
         rows,

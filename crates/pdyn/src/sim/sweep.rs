@@ -2,7 +2,8 @@
 //! progress bar (indicatif, on stderr when it is a terminal). A failed run is recorded with its
 //! message; it does not stop the others.
 
-use super::{run, Prepared, RunFailure, RunSettings, SimError};
+use super::measured::measure;
+use super::{Prepared, RunFailure, RunSettings, SimError};
 use indicatif::{ProgressBar, ProgressStyle};
 use pdyn_mech::model::spec::{Stat, SweepSpec};
 use rayon::prelude::*;
@@ -192,42 +193,22 @@ pub fn sweep(
     })
 }
 
-/// One run and its measures.
+/// One run and its measures, without its table (see [`super::measured`]).
 fn measure_run(
     p: &Prepared,
     set: &RunSettings,
     stats: &[Stat],
     n_meas: usize,
 ) -> (Vec<f64>, Option<RunProblem>) {
-    let res = match run(p, set) {
+    let res = match measure(p, set, stats) {
         Err(e) => return (vec![f64::NAN; n_meas], Some(RunProblem::NotRun(e))),
         Ok(r) => r,
     };
-    let mut problem = res.failure.clone().map(RunProblem::Stopped);
+    let mut problem = res.failure.map(RunProblem::Stopped);
     if problem.is_none() && !res.warnings.is_empty() {
-        problem = Some(RunProblem::Warnings(res.warnings.clone()));
+        problem = Some(RunProblem::Warnings(res.warnings));
     }
-    let mut vals = vec![f64::NAN; n_meas];
-    if let Some(m) = &p.measures {
-        let n = p.system.n;
-        let mut series = vec![Vec::with_capacity(res.rows.len()); n_meas];
-        let mut ts = Vec::with_capacity(res.rows.len());
-        let mut input = Vec::new();
-        let mut out = vec![0.0; n_meas];
-        for row in &res.rows {
-            p.system
-                .observation_input(row[0], &row[1..1 + 2 * n], &mut input);
-            m.eval(&input, &mut out);
-            ts.push(row[0]);
-            for (s, &o) in series.iter_mut().zip(&out) {
-                s.push(o);
-            }
-        }
-        for (j, s) in series.iter().enumerate() {
-            vals[j] = statistic(stats[j], &ts, s);
-        }
-    }
-    (vals, problem)
+    (res.measures, problem)
 }
 
 /// Peaks of each measure along the first parameter: `(measure name, [(at, value)])`.

@@ -1,0 +1,205 @@
+//! The measures-only path of sweeps: a run reduced to its `[sweep.measures]` statistics, its
+//! drift check and warnings, without building the output table.
+//!
+//! [`super::run`] tabulates every output point (time, state, every output column) and then
+//! evaluates the conservation scales and, in a sweep, the measures, each from the same state:
+//! three solves for the accelerations and reactions per point, and a row allocated for each.
+//! [`measure`] solves once per output point and feeds the one observation input to the
+//! output columns (the drift check and the non-finite warning need them), the conservation
+//! scales and the measures. The solver, its output points and every evaluation are the same
+//! as the full path's, so the results are the same, bit for bit (`tests/run.rs` checks it).
+
+use super::sweep::statistic;
+use super::{
+    integrate, scale_of, EventReport, MonitorReport, Prepared, RunFailure, RunSettings, RunStatus,
+    SimError,
+};
+use pdyn_mech::model::spec::Stat;
+use pdyn_ode::{Direction, Solution};
+
+/// What a sweep keeps of a run.
+#[derive(Clone, Debug)]
+pub struct Measured {
+    /// The statistic of each measure over the output points (NaN without measures).
+    pub measures: Vec<f64>,
+    /// Events in time order.
+    pub events: Vec<EventReport>,
+    /// Drift of each conserved quantity.
+    pub monitors: Vec<MonitorReport>,
+    /// The warnings [`super::run`] would give.
+    pub warnings: Vec<String>,
+    /// Why the integration stopped early.
+    pub failure: Option<RunFailure>,
+    /// How the run ended.
+    pub status: RunStatus,
+    /// Solver statistics.
+    pub stats: pdyn_ode::Stats,
+}
+
+/// Runs a prepared model and reduces it to its measures (`stats[j]` of measure `j`), the
+/// drift of its conserved quantities and its warnings: what [`super::run`] followed by the
+/// statistics of the measures over its rows gives, without the rows.
+pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Measured, SimError> {
+    let (sol, failure) = integrate(prep, set)?;
+    let sys = &prep.system;
+    let n_meas = prep.measures.as_ref().map_or(0, |m| m.len());
+    let conserved: Vec<usize> = (0..prep.observer.len())
+        .filter(|&j| prep.conserved[j])
+        .collect();
+    let points = sol.len();
+    let mut input = Vec::new();
+    let mut extra = vec![0.0; prep.observer.len()];
+    let mut scale_out = vec![0.0; prep.scales.len()];
+    let mut scale_series = vec![Vec::with_capacity(points); prep.scales.len()];
+    let mut meas_out = vec![0.0; n_meas];
+    let mut series = vec![Vec::with_capacity(points); n_meas];
+    let mut drifts: Vec<(f64, f64)> = Vec::with_capacity(conserved.len());
+    let mut non_finite = false;
+    for k in 0..points {
+        let (t, y) = (sol.t[k], sol.y_at(k));
+        sys.observation_input(t, y, &mut input);
+        prep.observer.eval(&input, &mut extra);
+        non_finite = non_finite
+            || !t.is_finite()
+            || y.iter().any(|x| !x.is_finite())
+            || extra.iter().any(|x| !x.is_finite());
+        if k == 0 {
+            drifts.extend(conserved.iter().map(|&j| (extra[j], 0.0)));
+        }
+        for (d, &j) in drifts.iter_mut().zip(&conserved) {
+            // As the full path's fold: NaN propagates.
+            let dev = (extra[j] - d.0).abs();
+            d.1 = if dev.is_nan() || d.1.is_nan() {
+                f64::NAN
+            } else {
+                d.1.max(dev)
+            };
+        }
+        if !scale_out.is_empty() {
+            prep.scales.eval(&input, &mut scale_out);
+            for (s, &v) in scale_series.iter_mut().zip(&scale_out) {
+                s.push(v.abs());
+            }
+        }
+        if let Some(m) = &prep.measures {
+            m.eval(&input, &mut meas_out);
+            for (s, &o) in series.iter_mut().zip(&meas_out) {
+                s.push(o);
+            }
+        }
+    }
+    let scales: Vec<f64> = if points == 0 {
+        vec![f64::NAN; prep.scales.len()]
+    } else {
+        scale_series.into_iter().map(scale_of).collect()
+    };
+    let t_last = sol.t.last().copied().unwrap_or(0.0);
+    let (events, monitors, warnings, status) = report(
+        prep, &sol, set, &failure, &drifts, &scales, t_last, non_finite,
+    );
+    let mut measures = vec![f64::NAN; n_meas];
+    if prep.measures.is_some() {
+        for (j, s) in series.iter().enumerate() {
+            measures[j] = statistic(stats[j], &sol.t, s);
+        }
+    }
+    Ok(Measured {
+        measures,
+        events,
+        monitors,
+        warnings,
+        failure,
+        status,
+        stats: sol.stats.clone(),
+    })
+}
+
+/// Events, drift reports, warnings and status of a run, shared by the full path
+/// ([`super::tabulate`]) and [`measure`]. `drifts[k]`: the first value and the largest
+/// deviation from it (NaN if any was NaN) of the `k`-th conserved output column, empty when
+/// there is no output point; `scales[k]` its scale; `t_last` the last output time;
+/// `non_finite` whether any output value (time, state, column) is not finite.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn report(
+    prep: &Prepared,
+    sol: &Solution,
+    set: &RunSettings,
+    failure: &Option<RunFailure>,
+    drifts: &[(f64, f64)],
+    scales: &[f64],
+    t_last: f64,
+    non_finite: bool,
+) -> (Vec<EventReport>, Vec<MonitorReport>, Vec<String>, RunStatus) {
+    let events = sol
+        .events
+        .iter()
+        .map(|h| EventReport {
+            name: prep
+                .events
+                .get(h.index)
+                .map_or("event".into(), |e| e.name.clone()),
+            t: h.t,
+            state: h.y.clone(),
+            rising: h.direction == Direction::Rising,
+        })
+        .collect();
+    let mut monitors = Vec::new();
+    let mut warnings = Vec::new();
+    let names = prep
+        .observer
+        .names
+        .iter()
+        .zip(&prep.conserved)
+        .filter(|(_, &c)| c)
+        .map(|(name, _)| name);
+    for (name, &(first, dev)) in names.zip(drifts) {
+        let k = monitors.len();
+        let scale = scales.get(k).copied().unwrap_or(f64::NAN);
+        let relative = scale > 0.0;
+        let drift = if relative { dev / scale } else { dev };
+        if drift.is_nan() {
+            warnings.push(format!(
+                "{name} should be conserved but is not finite (NaN or infinite) along the run: \
+                 this result cannot be trusted; look for a division by zero or a function \
+                 outside its domain in the model"
+            ));
+        } else if drift > set.drift_tolerance {
+            warnings.push(format!(
+                "{name} should be conserved but drifted by {drift:.3e} ({}) over t = 0..{t_last}: \
+                 this result cannot be trusted (the First Law of Scientific Computing). Tighten \
+                 the tolerance (e.g. --rtol {:.0e}) or use a symplectic method (--method symplectic --dt ...).",
+                if relative { "relative" } else { "absolute" },
+                (set.rtol.unwrap_or(1e-6) * 1e-3).max(1e-13),
+            ));
+        }
+        monitors.push(MonitorReport {
+            name: name.clone(),
+            initial: first,
+            drift,
+            relative,
+            scale,
+            conserved: true,
+        });
+    }
+    if non_finite && failure.is_none() {
+        warnings.push("some output values are not finite (NaN or infinity)".into());
+    }
+    for miss in &sol.possible_misses {
+        let name = prep
+            .events
+            .get(miss.index)
+            .map_or("event", |e| e.name.as_str());
+        warnings.push(format!(
+            "event `{name}` may have crossed zero twice between t = {:.6e} and t = {:.6e} \
+             unseen (its function came back towards zero and away within one step): limit the \
+             step (--max-step) to be sure",
+            miss.t_from, miss.t_to
+        ));
+    }
+    let status = match (failure, sol.status) {
+        (Some(_), _) => RunStatus::Failed,
+        (None, pdyn_ode::Status::Finished) => RunStatus::Finished,
+        (None, pdyn_ode::Status::TerminalEvent(k)) => RunStatus::TerminalEvent(k),
+    };
+    (events, monitors, warnings, status)
+}
