@@ -73,6 +73,27 @@ pub fn idents(ast: &Ast, out: &mut Vec<String>) {
     }
 }
 
+/// The names of an expression that become parameters assumed positive: all but `t`, `pi`,
+/// `e`, those `skip` excludes (coordinates, the independent variable), those declared
+/// `--signed`, and those given a value ≤ 0 with `--set`.
+pub fn positive_parameters(
+    names: Vec<String>,
+    skip: impl Fn(&str) -> bool,
+    signed: &[String],
+    set: &[String],
+) -> Vec<String> {
+    let signed_by_set = not_positive_in_set(set);
+    names
+        .into_iter()
+        .filter(|n| {
+            !["t", "pi", "e"].contains(&n.as_str())
+                && !skip(n)
+                && !signed.contains(n)
+                && !signed_by_set.contains(n)
+        })
+        .collect()
+}
+
 /// Names that `--set` gives a value that is not a positive number (`omega=-3`, `c=0`, or an
 /// expression of other names). Parameters are assumed positive while deriving (it decides
 /// `sqrt(R^2) = R` and the signs of discriminants); a value given later that contradicts or

@@ -2,7 +2,7 @@
 //! linear constant-coefficient ODEs and systems, and the 1-D rules of straight-line motion
 //! (`a(v) = -c*v^2`). The command prints a [`DsolveResult`]; Python converts it.
 
-use crate::args::{idents, not_positive_in_set, split_top, subs_all};
+use crate::args::{idents, positive_parameters, split_top, subs_all};
 use crate::Error;
 use pdyn_expr::{FreeScope, Id, Node, Pool, SymId, Value};
 use pdyn_mech::dsolve::rules::{self, Estimate, Given, RuleSolution};
@@ -207,18 +207,7 @@ pub fn dsolve(a: &DsolveInput) -> Result<DsolveResult, Error> {
             idents(r, &mut names);
         }
     }
-    let signed_by_set = not_positive_in_set(&a.set);
-    let params: Vec<String> = names
-        .into_iter()
-        .filter(|n| {
-            !scope.coordinates.contains(n)
-                && n != "t"
-                && n != "pi"
-                && n != "e"
-                && !a.signed.contains(n)
-                && !signed_by_set.contains(n)
-        })
-        .collect();
+    let params = positive_parameters(names, |n| scope.coordinates.contains(n), &a.signed, &a.set);
     scope.positive = params.iter().cloned().collect();
     // Pass 2: lower.
     let mut eqs = Vec::new();
@@ -432,18 +421,7 @@ fn run_rule(a: &DsolveInput, rule: &str) -> Result<DsolveResult, Error> {
     let mut names = Vec::new();
     idents(&ast, &mut names);
     let indep = given.variable();
-    let signed_by_set = not_positive_in_set(&a.set);
-    let params: Vec<String> = names
-        .into_iter()
-        .filter(|n| {
-            n != indep
-                && n != "t"
-                && n != "pi"
-                && n != "e"
-                && !a.signed.contains(n)
-                && !signed_by_set.contains(n)
-        })
-        .collect();
+    let params = positive_parameters(names, |n| n == indep, &a.signed, &a.set);
     let mut scope = FreeScope {
         positive: params.iter().cloned().collect(),
         ..Default::default()

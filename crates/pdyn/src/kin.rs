@@ -3,7 +3,7 @@
 //! normal–tangential and polar components, curvature, values at instants and the maximum of a
 //! quantity over a range. The command prints a [`KinResult`]; Python converts it.
 
-use crate::args::{assignments, idents, not_positive_in_set, split_top, subs_all};
+use crate::args::{assignments, idents, positive_parameters, split_top, subs_all};
 use crate::Error;
 use pdyn_expr::{Binding, FreeScope, Id, Number, Pool, Scope, Value};
 use pdyn_mech::kinematics::{analyze, maximum, solve_time, Kinematics, Maximum, Motion, Quantity};
@@ -288,19 +288,8 @@ pub fn kin(a: &KinInput) -> Result<KinResult, Error> {
     } else {
         a.param.clone()
     };
-    let signed_by_set = not_positive_in_set(&a.set);
-    let params: Vec<String> = names
-        .into_iter()
-        .filter(|n| {
-            n != "t"
-                && n != "pi"
-                && n != "e"
-                && !(a.path.is_some() && *n == path_var)
-                && !scope.coordinates.contains(n)
-                && !a.signed.contains(n)
-                && !signed_by_set.contains(n)
-        })
-        .collect();
+    let skip = |n: &str| (a.path.is_some() && n == path_var) || scope.coordinates.contains(n);
+    let params = positive_parameters(names, skip, &a.signed, &a.set);
     scope.positive = params.iter().cloned().collect();
     let input = read_input(a, &mut pool, &mut scope)?;
     let k = analyze(&mut pool, input.motion).map_err(|error| Error::Kin {
