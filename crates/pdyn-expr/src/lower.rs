@@ -8,7 +8,7 @@
 
 use crate::error::{suggest, ExprError};
 use crate::number::{Number, Rational};
-use crate::pool::{Constant, Func, Id, Pool, SymId};
+use crate::pool::{Constant, Func, Id, Node, Pool, SymId};
 use crate::syntax::{parse, parse_equation, Ast, BinOp};
 use rustc_hash::FxHashSet;
 use std::ops::Range;
@@ -432,12 +432,25 @@ impl Lowerer<'_> {
                 return Err(ExprError::new(rspan, "an exponent must be a scalar"))
             }
         };
-        // Products of big literals grow too (`2^300000 * 2^300000`).
-        if let S(x) = r {
-            if let Some(crate::number::Number::Rat(q)) = p.as_num(x) {
-                if q.bits() > crate::number::MAX_BITS {
-                    let digits = crate::number::bits_to_digits(q.bits());
-                    return Err(too_large(span, "this expression".into(), digits));
+        // Products of big literals grow too (`2^300000 * 2^300000`), also as the coefficient of
+        // a product or the constant of a sum (`94^32400*x*94^32400`, fuzzing found it), which
+        // the printer would write as a literal the parser refuses.
+        let components: Vec<Id> = match r {
+            S(x) => vec![x],
+            V(v) => v.to_vec(),
+        };
+        for x in components {
+            let numbers: Vec<Id> = match p.node(x) {
+                Node::Num(_) => vec![x],
+                Node::Add(ts) | Node::Mul(ts) => ts.iter().take(1).copied().collect(),
+                _ => Vec::new(),
+            };
+            for n in numbers {
+                if let Some(crate::number::Number::Rat(q)) = p.as_num(n) {
+                    if q.bits() > crate::number::MAX_BITS {
+                        let digits = crate::number::bits_to_digits(q.bits());
+                        return Err(too_large(span, "this expression".into(), digits));
+                    }
                 }
             }
         }
@@ -650,5 +663,22 @@ mod tests {
         assert_eq!(text("(2 mm)^2"), "1/250000");
         let e = p.parse_value("2 x").unwrap_err();
         assert!(e.help.unwrap().contains('*'));
+    }
+
+    #[test]
+    fn folded_coefficients_over_the_size_limit_are_refused() {
+        // Fuzzing found a product whose folded coefficient (94^(9 h) twice, h = 3600 s) was
+        // larger than any literal the parser accepts, so its printed form did not parse again.
+        let mut p = Pool::new();
+        for src in [
+            "94^32400*x*94^32400",
+            "99g^3821+94^9.63-9+8g*Zj'*4*mx'*4*mxM*+94^9h/Wh/ xiM*+94^9h/Wh/ xik/m/j'*5/lW*xm",
+        ] {
+            let e = p.parse_value(src).unwrap_err();
+            assert!(e.message.contains("over the limit"), "{src}: {}", e.message);
+        }
+        let ok = p.parse_scalar("94^32400*x + 94^32402").unwrap();
+        let text = p.to_text(ok);
+        assert!(p.parse_scalar(&text).is_ok());
     }
 }
