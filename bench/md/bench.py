@@ -59,7 +59,9 @@ def child_cpu():
 def pdyn_cli(exe, model, threads):
     c0 = child_cpu()
     env = dict(os.environ, RAYON_NUM_THREADS=str(threads))
-    out = subprocess.run([exe, "run", os.path.join(root, "examples", "md", model), "--json"],
+    # n = 20: the in.lj size (32,000 atoms) for both models, whatever their defaults.
+    out = subprocess.run([exe, "run", os.path.join(root, "examples", "md", model), "--json",
+                          "--set", "n=20"],
                          check=True, capture_output=True, text=True, env=env).stdout
     s = json.loads(out)
     return dict(loop=s["loop_seconds"], cpu=child_cpu() - c0, E=s["final"]["total"] / s["atoms"])

@@ -258,6 +258,8 @@ fn a_plummer_sphere_stays_in_virial_equilibrium_and_writes_no_trajectories() {
             "N=400",
             "--t-end",
             "0.1",
+            "--points",
+            "6",
             "--out",
             dir.to_str().unwrap(),
         ],
