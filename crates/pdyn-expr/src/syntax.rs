@@ -262,7 +262,7 @@ impl<'a> Parser<'a> {
         }
     }
 
-    fn expect(&mut self, c: char, what: &str) -> Result<Range<usize>, ExprError> {
+    fn expect_token(&mut self, c: char, what: &str) -> Result<Range<usize>, ExprError> {
         if self.tok == Tok::Op(c) {
             let s = self.span.clone();
             self.bump()?;
@@ -423,7 +423,8 @@ impl<'a> Parser<'a> {
                             args.push(self.expr()?);
                         }
                     }
-                    let close = self.expect(')', &format!("to close the call of `{name}`"))?;
+                    let close =
+                        self.expect_token(')', &format!("to close the call of `{name}`"))?;
                     Ok(Ast::Call {
                         name,
                         name_span: span.clone(),
@@ -437,7 +438,7 @@ impl<'a> Parser<'a> {
             Tok::Op('(') => {
                 self.bump()?;
                 let mut e = self.expr()?;
-                let close = self.expect(')', "to close `(`")?;
+                let close = self.expect_token(')', "to close `(`")?;
                 // The parentheses belong to the term: `2*pi/(120 s)` ends at `)`.
                 e.set_span(span.start..close.end);
                 Ok(e)
@@ -449,7 +450,7 @@ impl<'a> Parser<'a> {
                     self.bump()?;
                     items.push(self.expr()?);
                 }
-                let close = self.expect(']', "to close the vector")?;
+                let close = self.expect_token(']', "to close the vector")?;
                 Ok(Ast::Vector {
                     items,
                     span: span.start..close.end,

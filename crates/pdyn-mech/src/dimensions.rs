@@ -233,7 +233,14 @@ impl Inference {
     }
 
     /// Requires `form` (of the text at `span`) to be `want`, called `what` in the message.
-    pub fn expect(&mut self, form: &Form, want: &Form, span: Range<usize>, what: &str, help: &str) {
+    pub fn require(
+        &mut self,
+        form: &Form,
+        want: &Form,
+        span: Range<usize>,
+        what: &str,
+        help: &str,
+    ) {
         if let Err(pair) = self.unify(form, want) {
             let (got, want) = *pair;
             let message = format!(
@@ -438,9 +445,9 @@ mod tests {
         inf.bind_unknown("c");
         inf.bind_unknown("m");
         let pos = infer(&mut inf, "[x, 0, 0]");
-        inf.expect(&pos, &Dimension::LENGTH.into(), 0..0, "a position", "");
+        inf.require(&pos, &Dimension::LENGTH.into(), 0..0, "a position", "");
         let f = infer(&mut inf, "-k*x - c*x'");
-        inf.expect(&f, &Dimension::FORCE.into(), 0..0, "a force", "");
+        inf.require(&f, &Dimension::FORCE.into(), 0..0, "a force", "");
         assert!(inf.errors.is_empty(), "{:?}", inf.errors);
         assert_eq!(
             inf.describe(&inf.of("c").unwrap()),

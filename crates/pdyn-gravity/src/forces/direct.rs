@@ -86,10 +86,15 @@ fn lane_sum(
     );
     for (((cx, cy), cz), cm) in xc.zip(yc).zip(zc).zip(mc) {
         // Fixed-size views: no bounds checks, so the four lanes become one vector operation.
-        let cx: &[f64; 4] = cx.try_into().expect("chunk of 4");
-        let cy: &[f64; 4] = cy.try_into().expect("chunk of 4");
-        let cz: &[f64; 4] = cz.try_into().expect("chunk of 4");
-        let cm: &[f64; 4] = cm.try_into().expect("chunk of 4");
+        // (`chunks_exact(4)` only yields chunks of 4, so the `else` is never taken.)
+        let (Ok(cx), Ok(cy), Ok(cz), Ok(cm)) = (
+            <&[f64; 4]>::try_from(cx),
+            <&[f64; 4]>::try_from(cy),
+            <&[f64; 4]>::try_from(cz),
+            <&[f64; 4]>::try_from(cm),
+        ) else {
+            continue;
+        };
         let mut f = [0.0f64; 4];
         let mut dx = [0.0f64; 4];
         let mut dy = [0.0f64; 4];

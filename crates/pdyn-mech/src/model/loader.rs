@@ -172,7 +172,7 @@ impl<'a> Loader<'a> {
     /// of loading, and reported only in a model that uses units).
     pub fn want(&mut self, sv: &Sv, want: impl Into<Form>, what: &str) {
         let got = self.last.clone();
-        self.dims.expect(
+        self.dims.require(
             &got,
             &want.into(),
             sv.span(),

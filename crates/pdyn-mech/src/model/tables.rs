@@ -252,7 +252,7 @@ impl Loader<'_> {
             self.dims.has_units = true;
             let want = self.coordinate_form(n, order);
             let what = format!("`{key}` of `{n}`");
-            self.dims.expect(&dim.into(), &want, sv.span(), &what, "");
+            self.dims.require(&dim.into(), &want, sv.span(), &what, "");
             return Ok((q, self.pool.num(Number::Float(q))));
         }
         let ast = pdyn_expr::syntax::parse(&text)
@@ -308,7 +308,7 @@ impl Loader<'_> {
         }
         let want = self.coordinate_form(n, order);
         let what = format!("`{key}` of `{n}`");
-        self.dims.expect(&got, &want, sv.span(), &what, "");
+        self.dims.require(&got, &want, sv.span(), &what, "");
     }
 
     /// `[definitions]`: named expressions.

@@ -130,7 +130,9 @@ pub fn bodies(
             }
             _ => format!("body{index}"),
         };
-        let (_, mass_span) = cell("mass").expect("checked in the header");
+        // The header was checked for a mass column; the row's span is the fallback all the same.
+        let row_span = at..at + line.len().max(1);
+        let mass_span = cell("mass").map_or(row_span.clone(), |(_, s)| s.clone());
         let mass = number("mass", false)?.unwrap_or(0.0);
         if !(mass.is_finite() && mass > 0.0) {
             return Err(err(
@@ -163,7 +165,7 @@ pub fn bodies(
             check_elements(a, e).map_err(|msg| {
                 let c = if msg.starts_with('e') { "e" } else { "a" };
                 err(
-                    cell(c).expect("checked in the header").1.clone(),
+                    cell(c).map_or(row_span.clone(), |(_, s)| s.clone()),
                     format!("body `{name}`: {msg}"),
                 )
             })?;
