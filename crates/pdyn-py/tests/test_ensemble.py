@@ -2,8 +2,6 @@
 
 import math
 import os
-import threading
-import time
 import warnings
 
 import numpy as np
@@ -91,36 +89,12 @@ def test_typed_drift_warning(examples):
     assert w.quantity and w.drift > w.tolerance == 5e-3
 
 
-def test_ensemble_releases_the_gil_and_uses_every_core(examples):
+def test_ensemble_releases_the_gil_and_uses_every_core(examples, gil_probe):
     m = pdyn.Model.from_file(examples / "projectile_drag.toml")
-
-    def timed(runs):
-        c = np.linspace(0.1, 1.0, runs)
-        ticks = []
-        stop = threading.Event()
-
-        def ticker():
-            while not stop.is_set():
-                ticks.append(time.perf_counter())
-                time.sleep(0.001)
-
-        th = threading.Thread(target=ticker)
-        th.start()
-        t0 = time.perf_counter()
-        ens = m.ensemble(params={"c": c})
-        t1 = time.perf_counter()
-        stop.set()
-        th.join()
-        assert len(ens) == runs
-        return ens, t1 - t0, len([t for t in ticks if t0 < t < t1])
-
-    # Enough runs to last a measurable time on a fast idle machine as on a loaded one: the
-    # count doubles until the ensemble takes over 0.2 s (the derivation is cached).
-    runs = 600
-    ens, seconds, ticks = timed(runs)
-    while seconds < 0.2 and runs < 600 * 2**8:
-        runs *= 2
-        ens, seconds, ticks = timed(runs)
+    # (the derivation is cached: only the runs are timed)
+    ens, runs, seconds, ticks = gil_probe(
+        lambda n: m.ensemble(params={"c": np.linspace(0.1, 1.0, n)}), 600)
+    assert len(ens) == runs
     assert seconds > 0.05, "too short to tell"
     # A Python thread kept running (about one tick per ms) while Rust worked.
     assert ticks >= 10, (ticks, seconds)

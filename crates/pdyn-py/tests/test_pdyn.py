@@ -4,8 +4,6 @@ import json
 import math
 import pathlib
 import subprocess
-import threading
-import time
 import warnings
 
 import numpy as np
@@ -244,30 +242,18 @@ def test_sweep_measures_and_pandas(examples):
     assert isinstance(m.run().to_pandas(), pd.DataFrame)
 
 
-def test_sweep_releases_the_gil(examples):
+def test_sweep_releases_the_gil(examples, gil_probe):
     m = pdyn.Model.from_file(examples / "projectile_drag.toml")
-    # 2000 runs: 400 take under 50 ms since sweeps skip the table (sim::measured).
-    values = np.linspace(0.1, 1.0, 2000)
-    ticks = []
-    stop = threading.Event()
 
-    def ticker():
-        while not stop.is_set():
-            ticks.append(time.perf_counter())
-            time.sleep(0.001)
+    def sweep(n):
+        return m.sweep("c", np.linspace(0.1, 1.0, n), measures={"zmin": ("z", "min")},
+                       threads=1)
 
-    th = threading.Thread(target=ticker)
-    th.start()
-    t0 = time.perf_counter()
-    sw = m.sweep("c", values, measures={"zmin": ("z", "min")}, threads=1)
-    t1 = time.perf_counter()
-    stop.set()
-    th.join()
-    during = [t for t in ticks if t0 < t < t1]
-    assert sw.runs == 2000
+    sw, runs, seconds, ticks = gil_probe(sweep, 500)
+    assert sw.runs == runs
     # With the GIL held the ticker could not run at all while the sweep ran.
-    assert t1 - t0 > 0.05, "the sweep is too short to tell"
-    assert len(during) >= 10, (len(during), t1 - t0)
+    assert seconds > 0.05, "the sweep is too short to tell"
+    assert ticks >= 10, (ticks, seconds)
 
 
 def test_from_file_error_names_the_file_and_methods_are_listed(tmp_path):
