@@ -137,6 +137,45 @@ fn chain_accelerations(m: &[f64], l: &[f64], q: &[f64], qd: &[f64], g: f64) -> V
     x
 }
 
+/// The accelerations `eval(q, q', out)` of an n-link chain against the hand derivation at 20
+/// random states, with the masses, lengths and g of the model's parameters.
+fn assert_matches_hand_derivation(
+    model: &Model,
+    n: usize,
+    seed: u64,
+    mut eval: impl FnMut(&[f64], &[f64], &mut [f64]),
+) {
+    let param = |name: &str| {
+        model
+            .parameters
+            .iter()
+            .find(|p| p.name == name)
+            .unwrap()
+            .value
+    };
+    let masses: Vec<f64> = (1..=n).map(|i| param(&format!("m{i}"))).collect();
+    let lengths: Vec<f64> = (1..=n).map(|i| param(&format!("l{i}"))).collect();
+    let g = param("g");
+    let mut seed = seed;
+    let mut rnd = || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
+        ((seed >> 11) as f64 / (1u64 << 53) as f64) * 4.0 - 2.0
+    };
+    for _ in 0..20 {
+        let q: Vec<f64> = (0..n).map(|_| rnd()).collect();
+        let qd: Vec<f64> = (0..n).map(|_| rnd()).collect();
+        let mut out = vec![0.0; n];
+        eval(&q, &qd, &mut out);
+        let expected = chain_accelerations(&masses, &lengths, &q, &qd, g);
+        for (o, e) in out.iter().zip(&expected) {
+            assert!(
+                (o - e).abs() < 1e-9 * (1.0 + e.abs()),
+                "n={n}: {out:?} vs {expected:?}"
+            );
+        }
+    }
+}
+
 fn check_chain(n: usize) {
     let mut model = example(&format!("pendulum_chain_{n}"));
     let opts = DeriveOptions {
@@ -155,37 +194,11 @@ fn check_chain(n: usize) {
     inputs.extend(model.parameters.iter().map(|p| p.id));
     let prog = Program::compile(&mut model.pool, &inputs, &acc).unwrap();
     let mut ws = prog.workspace();
-    let param = |name: &str| {
-        model
-            .parameters
-            .iter()
-            .find(|p| p.name == name)
-            .unwrap()
-            .value
-    };
-    let masses: Vec<f64> = (1..=n).map(|i| param(&format!("m{i}"))).collect();
-    let lengths: Vec<f64> = (1..=n).map(|i| param(&format!("l{i}"))).collect();
-    let g = param("g");
-    let mut seed = 7u64;
-    let mut rnd = || {
-        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
-        ((seed >> 11) as f64 / (1u64 << 53) as f64) * 4.0 - 2.0
-    };
-    for _ in 0..20 {
-        let q: Vec<f64> = (0..n).map(|_| rnd()).collect();
-        let qd: Vec<f64> = (0..n).map(|_| rnd()).collect();
-        let mut input: Vec<f64> = q.iter().chain(&qd).copied().collect();
-        input.extend(model.parameters.iter().map(|p| p.value));
-        let mut out = vec![0.0; n];
-        prog.eval(&input, &mut ws, &mut out);
-        let expected = chain_accelerations(&masses, &lengths, &q, &qd, g);
-        for (o, e) in out.iter().zip(&expected) {
-            assert!(
-                (o - e).abs() < 1e-9 * (1.0 + e.abs()),
-                "n={n}: {out:?} vs {expected:?}"
-            );
-        }
-    }
+    let params: Vec<f64> = model.parameters.iter().map(|p| p.value).collect();
+    assert_matches_hand_derivation(&model, n, 7, |q, qd, out| {
+        let input: Vec<f64> = q.iter().chain(qd).chain(&params).copied().collect();
+        prog.eval(&input, &mut ws, out);
+    });
 }
 
 #[test]
@@ -231,38 +244,17 @@ fn five_link_chain_matches_hand_derivation() {
         let mut sys =
             pdyn_expr::compile::CompiledLinearSystem::new(&mut model.pool, &d.system, &inputs)
                 .unwrap();
-        let param = |name: &str| {
-            model
-                .parameters
+        let params: Vec<f64> = model.parameters.iter().map(|p| p.value).collect();
+        assert_matches_hand_derivation(&model, n, 11, |q, qd, out| {
+            let input: Vec<f64> = [0.0]
                 .iter()
-                .find(|p| p.name == name)
-                .unwrap()
-                .value
-        };
-        let masses: Vec<f64> = (1..=n).map(|i| param(&format!("m{i}"))).collect();
-        let lengths: Vec<f64> = (1..=n).map(|i| param(&format!("l{i}"))).collect();
-        let g = param("g");
-        let mut seed = 11u64;
-        let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 4.0 - 2.0
-        };
-        for _ in 0..20 {
-            let q: Vec<f64> = (0..n).map(|_| rnd()).collect();
-            let qd: Vec<f64> = (0..n).map(|_| rnd()).collect();
-            let mut input = vec![0.0];
-            input.extend(q.iter().chain(&qd));
-            input.extend(model.parameters.iter().map(|p| p.value));
-            let mut out = vec![0.0; n];
-            sys.solve(&input, &mut out).unwrap();
-            let expected = chain_accelerations(&masses, &lengths, &q, &qd, g);
-            for (o, e) in out.iter().zip(&expected) {
-                assert!(
-                    (o - e).abs() < 1e-9 * (1.0 + e.abs()),
-                    "n={n}: {out:?} vs {expected:?}"
-                );
-            }
-        }
+                .chain(q)
+                .chain(qd)
+                .chain(&params)
+                .copied()
+                .collect();
+            sys.solve(&input, out).unwrap();
+        });
     }
 }
 
