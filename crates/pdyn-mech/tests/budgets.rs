@@ -5,11 +5,9 @@
 use pdyn_expr::{Pool, Value};
 use pdyn_mech::kinematics::{analyze, maximum, Motion, Quantity};
 
-/// The fuzz `kin` time-out (docs/reliability.md): this polar angle, with symbols not declared
-/// positive, stalled `simplify` -> `contract_trig` on the unit tangent.
-#[test]
-fn fuzz_kin_timeout_polar_angle_finishes() {
-    let src = "p000-AppU---pix/u-pp-U1-t-te";
+/// A pool with the symbols `pdyn kin` declares positive, and the polar motion `r = R`,
+/// `theta = src`.
+fn polar_motion(src: &str) -> (Pool, Motion) {
     let mut p = Pool::new();
     for s in ["R", "omega", "c", "A", "L", "V"] {
         p.symbol(s, true);
@@ -23,6 +21,15 @@ fn fuzz_kin_timeout_polar_angle_finishes() {
         theta,
         z: Pool::ZERO,
     };
+    (p, motion)
+}
+
+/// The fuzz `kin` time-out (docs/reliability.md): this polar angle, with symbols not declared
+/// positive, stalled `simplify` -> `contract_trig` on the unit tangent.
+#[test]
+fn fuzz_kin_timeout_polar_angle_finishes() {
+    let src = "p000-AppU---pix/u-pp-U1-t-te";
+    let (mut p, motion) = polar_motion(src);
     assert!(analyze(&mut p, motion).is_ok());
     let t = p.time();
     let target = p.parse_scalar("1").unwrap();
@@ -41,19 +48,7 @@ fn fuzz_kin_timeout_polar_angle_finishes() {
 #[test]
 fn fuzz_kin_timeout_powers_of_expanded_sums_stay_cheap() {
     let src = "gj1X-togj1X-t-+t+tt'+X-t-+tp+u*-x";
-    let mut p = Pool::new();
-    for s in ["R", "omega", "c", "A", "L", "V"] {
-        p.symbol(s, true);
-    }
-    let theta = match p.parse_value(src) {
-        Ok(Value::Scalar(theta)) => theta,
-        other => panic!("{other:?}"),
-    };
-    let motion = Motion::Polar {
-        r: p.var("R"),
-        theta,
-        z: Pool::ZERO,
-    };
+    let (mut p, motion) = polar_motion(src);
     let k = analyze(&mut p, motion).unwrap();
     // `pdyn kin` then expands and simplifies every printed quantity.
     for (_, q) in k.named() {
