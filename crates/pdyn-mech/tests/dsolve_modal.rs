@@ -205,3 +205,19 @@ fn resonance_and_repeated_frequencies() {
     assert!(p.pool.to_text(q1).contains("t*"), "{}", p.pool.to_text(q1));
     assert_solves(&mut p, &cf, 3.0);
 }
+
+#[test]
+fn a_badly_scaled_system_is_refused_not_answered_wrongly() {
+    // A mass of 1e300 beside masses of 1: the eigenvectors' small components are lost to
+    // round-off, so the modes would drop the coupling to x2 (x2 = 0 at every t, silently).
+    // The row-by-row residual of K Φ = M Φ Λ catches it.
+    let eqs = vec![
+        "1e300*q1'' + 2e300*q1 - q2 = 0".to_string(),
+        "q2'' - q1 + 2*q2 - q3 = 0".to_string(),
+        "q3'' - q2 + 2*q3 - q4 = 0".to_string(),
+        "q4'' - q3 + q4 = 0".to_string(),
+    ];
+    let mut p = problem(&eqs, 1.0);
+    let r = solve_system(&mut p.pool, &p.eqs, &p.coords, &p.ics);
+    assert!(r.is_err(), "{:?}", r.map(|cf| cf.residual));
+}
