@@ -157,8 +157,8 @@ load of other jobs).
 |---|---|---|---|---|---|---|---|---|
 """
 
-FORMULA_HEAD = """Formula path vs built-in kernel (`pdyn run examples/md/lj_liquid.toml --json` vs
-`lj_formula.toml`, 32,000 atoms, 100 steps, exact rebuild test, `RAYON_NUM_THREADS=1`,
+FORMULA_HEAD = """Formula path vs built-in kernel (`pdyn run examples/md/lj_liquid.toml --json --set n=20`
+vs `lj_formula.toml --json --set n=20`, 32,000 atoms, 100 steps, exact rebuild test, `RAYON_NUM_THREADS=1`,
 alternated; CPU time of the whole process including set-up and JIT compilation):
 
 | run | built-in loop s | formula loop s | ratio (wall) | built-in CPU s | formula CPU s | ratio (CPU) | |ΔE/N| relative |
