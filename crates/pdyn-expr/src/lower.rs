@@ -180,6 +180,29 @@ pub fn literal(text: &str) -> Option<Number> {
     r.map(Number::Rat)
 }
 
+/// The size in digits of an exact number in `x` over [`crate::number::MAX_BITS`]: `x` itself,
+/// the coefficient of a product, or the constant or a term's coefficient of a sum. The
+/// printer writes these as literals, which the parser refuses over the limit; so must the
+/// lowering, or printed text would not parse again (fuzzing found `-m - 249.8/90^31993*m`,
+/// whose collected coefficient of `m` grew past the limit inside the sum).
+fn oversized_number(p: &Pool, x: Id) -> Option<u64> {
+    let leading = |t: Id| match p.node(t) {
+        Node::Num(_) => Some(t),
+        Node::Mul(fs) => fs.first().copied(),
+        _ => None,
+    };
+    let numbers: Vec<Id> = match p.node(x) {
+        Node::Add(ts) => ts.iter().filter_map(|&t| leading(t)).collect(),
+        _ => leading(x).into_iter().collect(),
+    };
+    numbers.into_iter().find_map(|n| match p.as_num(n) {
+        Some(crate::number::Number::Rat(q)) if q.bits() > crate::number::MAX_BITS => {
+            Some(crate::number::bits_to_digits(q.bits()))
+        }
+        _ => None,
+    })
+}
+
 /// Lowers a parsed expression into `pool`, resolving names through `scope`.
 pub fn lower(pool: &mut Pool, ast: &Ast, scope: &mut dyn Scope) -> Result<Value, ExprError> {
     Lowerer { pool, scope }.value(ast)
@@ -365,11 +388,8 @@ impl Lowerer<'_> {
             }
         }
         let r = self.pool.add(&terms);
-        if let Some(crate::number::Number::Rat(q)) = self.pool.as_num(r) {
-            if q.bits() > crate::number::MAX_BITS {
-                let digits = crate::number::bits_to_digits(q.bits());
-                return Err(too_large(ast.span(), "this sum".into(), digits));
-            }
+        if let Some(digits) = oversized_number(self.pool, r) {
+            return Err(too_large(ast.span(), "this sum".into(), digits));
         }
         Ok(Some(Value::Scalar(r)))
     }
@@ -440,18 +460,8 @@ impl Lowerer<'_> {
             V(v) => v.to_vec(),
         };
         for x in components {
-            let numbers: Vec<Id> = match p.node(x) {
-                Node::Num(_) => vec![x],
-                Node::Add(ts) | Node::Mul(ts) => ts.iter().take(1).copied().collect(),
-                _ => Vec::new(),
-            };
-            for n in numbers {
-                if let Some(crate::number::Number::Rat(q)) = p.as_num(n) {
-                    if q.bits() > crate::number::MAX_BITS {
-                        let digits = crate::number::bits_to_digits(q.bits());
-                        return Err(too_large(span, "this expression".into(), digits));
-                    }
-                }
+            if let Some(digits) = oversized_number(p, x) {
+                return Err(too_large(span, "this expression".into(), digits));
             }
         }
         Ok(r)
@@ -673,6 +683,9 @@ mod tests {
         for src in [
             "94^32400*x*94^32400",
             "99g^3821+94^9.63-9+8g*Zj'*4*mx'*4*mxM*+94^9h/Wh/ xiM*+94^9h/Wh/ xik/m/j'*5/lW*xm",
+            // A term's coefficient grown inside a sum: -1 + 249.8/90^31993 has 2 × 62 523
+            // digits as a fraction.
+            "Gt- m -249.8/--- 90\u{c}^31993*m",
         ] {
             let e = p.parse_value(src).unwrap_err();
             assert!(e.message.contains("over the limit"), "{src}: {}", e.message);
