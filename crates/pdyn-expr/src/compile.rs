@@ -12,7 +12,7 @@
 //! Division by zero, `log` of a negative number and the like give `inf`/`NaN`, as IEEE
 //! arithmetic does; they never panic.
 
-use crate::lu::{lu_factor_in_place, lu_solve_in_place, SingularMatrix};
+use crate::lu::{DenseSolver, SingularMatrix};
 use crate::number::Number;
 use crate::pool::{Func, Id, Node, Pool};
 use rustc_hash::FxHashMap;
@@ -503,15 +503,15 @@ impl Pool {
 }
 
 /// A linear system `A x = b` compiled for numeric solution at evaluation time: the entries are
-/// one [`Program`], the solve an in-place LU. Owns its buffers; `solve` allocates nothing.
+/// one [`Program`], the solve a [`DenseSolver`] (Cholesky when `A` is symbolically
+/// symmetric, as a mass matrix is; LU otherwise). Owns its buffers; `solve` allocates nothing.
 #[derive(Clone, Debug)]
 pub struct CompiledLinearSystem {
     program: Program,
     n: usize,
     ws: Vec<f64>,
     ab: Vec<f64>,
-    perm: Vec<usize>,
-    work: Vec<f64>,
+    solver: DenseSolver,
 }
 
 impl CompiledLinearSystem {
@@ -525,6 +525,8 @@ impl CompiledLinearSystem {
         debug_assert_eq!(sys.rows(), n);
         let mut outs = sys.a.clone();
         outs.extend_from_slice(&sys.b);
+        // Hash-consing makes equal entries one node: symmetry is an identity test.
+        let symmetric = (0..n).all(|i| (0..i).all(|j| outs[i * n + j] == outs[j * n + i]));
         let program = Program::compile(pool, inputs, &outs)?;
         let ws = program.workspace();
         Ok(CompiledLinearSystem {
@@ -532,9 +534,14 @@ impl CompiledLinearSystem {
             n,
             ws,
             ab: vec![0.0; n * n + n],
-            perm: vec![0; n],
-            work: vec![0.0; n],
+            solver: DenseSolver::new(n, symmetric),
         })
+    }
+
+    /// A fresh solver for this system's size and structure (for evaluators of the same
+    /// entries, such as native code).
+    pub fn solver(&self) -> DenseSolver {
+        self.solver.clone()
     }
 
     /// The program computing the entries: `n²` matrix entries row-major, then the `n`
@@ -551,12 +558,9 @@ impl CompiledLinearSystem {
     /// Solves for the unknowns at `inputs`, writing them to `x`.
     pub fn solve(&mut self, inputs: &[f64], x: &mut [f64]) -> Result<(), SingularMatrix> {
         let n = self.n;
+        debug_assert_eq!(self.ab.len(), n * n + n);
         self.program.eval(inputs, &mut self.ws, &mut self.ab);
-        let (a, b) = self.ab.split_at_mut(n * n);
-        lu_factor_in_place(a, n, &mut self.perm)?;
-        lu_solve_in_place(a, n, &self.perm, b, &mut self.work);
-        x[..n].copy_from_slice(&b[..n]);
-        Ok(())
+        self.solver.solve(&mut self.ab, x)
     }
 }
 

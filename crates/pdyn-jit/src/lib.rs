@@ -10,8 +10,9 @@
 //! ## What is emitted, and why results agree bit for bit
 //! Functions `extern "C" fn(inputs: *const f64, out: *mut f64, spill: *mut f64)`, one per
 //! chunk of 2,048 instructions, each a single basic block, called in order (values a later
-//! chunk needs pass through the `spill` workspace, bits unchanged; one huge block makes
-//! Cranelift's register allocation superlinear): every instruction of the program becomes one
+//! chunk or a later call-free segment needs pass through the `spill` workspace, bits
+//! unchanged; long live ranges make Cranelift's register allocation superlinear — see
+//! `SpillPlan`): every instruction of the program becomes one
 //! SSA value, in the program's order, so the
 //! arithmetic is the same sequence of IEEE operations as the interpreter's (no reassociation,
 //! no fused multiply-add). `+ − × ÷`, negation, `sqrt`, `abs` and `sign` are native
@@ -42,7 +43,7 @@ use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_jit::{JITBuilder, JITModule};
 use cranelift_module::{default_libcall_names, Linkage, Module};
 use pdyn_expr::compile::{CompiledLinearSystem, Op};
-use pdyn_expr::lu::{lu_factor_in_place, lu_solve_in_place, SingularMatrix};
+use pdyn_expr::lu::{DenseSolver, SingularMatrix};
 use pdyn_expr::Program;
 use std::sync::Arc;
 
@@ -98,6 +99,12 @@ type RawFn = unsafe extern "C" fn(*const f64, *mut f64, *mut f64);
 /// Measured on the 100-link chain's `A x = b` (user CPU of `pdyn run --t-end 0.001`): 3.5 s of
 /// code generation as one function, 2.2 s as chunks of 2,048 (512 gave the same).
 const CHUNK: usize = 2048;
+
+/// Longest run of instructions whose values stay in registers (see `SpillPlan`). Measured on
+/// the 100-link chain's `A x = b` (106,553 instructions, compile time of the test binary at
+/// load ≈ 6): unbounded runs 1.3–4.0 s, 64 0.6–0.8 s, 16 and 32 no better; 64 also kept
+/// the evaluation time (46–77 µs).
+const SEGMENT: usize = 64;
 
 /// The JIT module owning the code memory; freed on drop.
 struct Code {
@@ -173,11 +180,39 @@ fn inline_powi(b: &mut FunctionBuilder, x: Value, k: u32) -> Value {
     acc.unwrap_or_else(|| b.ins().f64const(1.0))
 }
 
-/// Which values cross from one chunk to a later one, and where they are kept meanwhile.
+/// Whether instruction `ins` is emitted as a call (a shim): every XMM register is
+/// caller-saved on the platforms we target, so a value live across a call must be spilled.
+fn is_call(ins: &pdyn_expr::compile::Instr) -> bool {
+    let op = ins.op();
+    match op {
+        Op::Powi => !(0..=MAX_INLINE_POWI).contains(&(ins.b() as i32)),
+        _ => unary_shim(op).is_some() || binary_shim(op).is_some(),
+    }
+}
+
+/// Which values cross from one segment to a later one, and where they are kept meanwhile.
+///
+/// A *segment* is a run of at most `SEGMENT` instructions with no call in it (a call ends its
+/// segment) and no chunk boundary; the outputs, stored after the last instruction, form
+/// segments of `SEGMENT` stores. Every SSA value lives inside one segment: a value read in a
+/// later segment is stored to the spill array right after it is computed and loaded again
+/// where it is needed, and inputs and constants are reloaded per segment. Left to Cranelift,
+/// long live ranges (values across `sin`/`cos` calls, which clobber every XMM register; a
+/// symmetric matrix's entry kept live from its first output to its mirror thousands of stores
+/// later) made its register allocator most of the compile time: 1.7 s of the 100-link
+/// chain's 6.9 s `pdyn run`, and 4–6 s of the chain's JIT compilation under load, now 0.6 s.
+/// The loads and stores cost little next to the arithmetic and calls they sit between.
 struct SpillPlan {
     chunks: usize,
-    /// Spill slot of each temporary (instruction index), `u32::MAX` when it stays in its chunk.
+    /// Spill slot of each temporary (instruction index), `u32::MAX` when it stays in its
+    /// segment.
     slot: Vec<u32>,
+    /// The segment in which each instruction reads its operands.
+    read_segment: Vec<u32>,
+    /// The segment of the first outputs (after the last instruction); see `output_segment`.
+    output_segment: u32,
+    /// Outputs per output segment (`SEGMENT`).
+    max_segment: usize,
     n_slots: usize,
 }
 
@@ -186,27 +221,49 @@ impl SpillPlan {
         let len = prog.len();
         let chunks = len.div_ceil(CHUNK).max(1);
         let first_temp = prog.first_temporary() as u32;
-        // The last chunk that reads each temporary (outputs are read by the last chunk).
-        let mut last_use = vec![0usize; len];
-        let mut read = |r: u32, chunk: usize| {
+        let mut read_segment = Vec::with_capacity(len);
+        let mut def_segment = Vec::with_capacity(len);
+        let mut seg = 0u32;
+        let max_seg = SEGMENT;
+        let mut seg_start = 0usize;
+        for (k, ins) in prog.instructions().iter().enumerate() {
+            if k > 0 && (k % CHUNK == 0 || k - seg_start >= max_seg) {
+                seg += 1;
+                seg_start = k;
+            }
+            read_segment.push(seg);
+            if is_call(ins) {
+                seg += 1;
+                seg_start = k + 1;
+            }
+            def_segment.push(seg);
+        }
+        // Outputs are stored after the last instruction, `SEGMENT` to a segment: a value that
+        // is several outputs (a symmetric matrix's two halves) is loaded again rather than
+        // kept live across thousands of stores (which made the 100-link chain's last chunk
+        // most of the compile time).
+        let output_segment = |i: usize| seg + 1 + (i / max_seg) as u32;
+        // The last segment that reads each temporary.
+        let mut last_use = def_segment.clone();
+        let mut read = |r: u32, s: u32| {
             if r >= first_temp {
                 let k = (r - first_temp) as usize;
-                last_use[k] = last_use[k].max(chunk);
+                last_use[k] = last_use[k].max(s);
             }
         };
         for (k, ins) in prog.instructions().iter().enumerate() {
-            read(ins.a(), k / CHUNK);
+            read(ins.a(), read_segment[k]);
             if ins.op().reads_b() {
-                read(ins.b(), k / CHUNK);
+                read(ins.b(), read_segment[k]);
             }
         }
-        for &r in prog.output_registers() {
-            read(r, chunks - 1);
+        for (i, &r) in prog.output_registers().iter().enumerate() {
+            read(r, output_segment(i));
         }
         let mut slot = vec![u32::MAX; len];
         let mut n_slots = 0;
         for k in 0..len {
-            if last_use[k] > k / CHUNK {
+            if last_use[k] > def_segment[k] {
                 slot[k] = n_slots as u32;
                 n_slots += 1;
             }
@@ -214,6 +271,9 @@ impl SpillPlan {
         SpillPlan {
             chunks,
             slot,
+            read_segment,
+            output_segment: seg + 1,
+            max_segment: max_seg,
             n_slots,
         }
     }
@@ -253,38 +313,41 @@ fn emit_chunk(
     sigi.returns.push(AbiParam::new(types::F64));
     let sigi = b.import_signature(sigi);
 
-    // Registers: inputs loaded on first use, constants materialised on first use, temporaries
-    // of earlier chunks loaded from the spill array on first use, temporaries of this chunk
-    // are the SSA values of its instructions.
+    // Registers, per segment (see `SpillPlan`): inputs loaded and constants materialised on
+    // first use in the segment, temporaries of earlier segments loaded from the spill array,
+    // temporaries of this segment are the SSA values of its instructions.
     let n_in = prog.n_inputs();
     let consts = prog.constants();
     let first_temp = prog.first_temporary();
-    let mut regs: Vec<Option<Value>> = vec![None; first_temp + prog.len()];
+    let mut regs: Vec<Option<(Value, u32)>> = vec![None; first_temp + prog.len()];
     let flags = MemFlags::trusted();
-    let get = |b: &mut FunctionBuilder, regs: &mut Vec<Option<Value>>, r: u32| {
+    let get = |b: &mut FunctionBuilder, regs: &mut Vec<Option<(Value, u32)>>, r: u32, seg: u32| {
         let r = r as usize;
-        if let Some(v) = regs[r] {
-            return v;
+        if let Some((v, s)) = regs[r] {
+            if s == seg {
+                return v;
+            }
         }
         let v = if r < n_in {
             b.ins().load(types::F64, flags, inp, (8 * r) as i32)
         } else if r < first_temp {
             b.ins().f64const(consts[r - n_in])
         } else {
-            // Defined by an earlier chunk, which spilled it (the plan saw this read).
+            // Defined in an earlier segment, which spilled it (the plan saw this read).
             let slot = plan.slot[r - first_temp] as usize;
             b.ins().load(types::F64, flags, spill, (8 * slot) as i32)
         };
-        regs[r] = Some(v);
+        regs[r] = Some((v, seg));
         v
     };
     let start = c * CHUNK;
     let end = (start + CHUNK).min(prog.len());
     for (k, ins) in prog.instructions()[start..end].iter().enumerate() {
         let k = start + k;
-        let a = get(&mut b, &mut regs, ins.a());
+        let seg = plan.read_segment[k];
+        let a = get(&mut b, &mut regs, ins.a(), seg);
         let rb = if ins.op().reads_b() {
-            Some(get(&mut b, &mut regs, ins.b()))
+            Some(get(&mut b, &mut regs, ins.b(), seg))
         } else {
             None
         };
@@ -338,7 +401,8 @@ fn emit_chunk(
                 }
             }
         };
-        regs[first_temp + k] = Some(v);
+        // A call's result belongs to the segment after the call.
+        regs[first_temp + k] = Some((v, seg + u32::from(is_call(ins))));
         let slot = plan.slot[k];
         if slot != u32::MAX {
             b.ins().store(flags, v, spill, (8 * slot as usize) as i32);
@@ -346,7 +410,8 @@ fn emit_chunk(
     }
     if c + 1 == plan.chunks {
         for (i, &r) in prog.output_registers().iter().enumerate() {
-            let v = get(&mut b, &mut regs, r);
+            let seg = plan.output_segment + (i / plan.max_segment) as u32;
+            let v = get(&mut b, &mut regs, r, seg);
             b.ins().store(flags, v, outp, (8 * i) as i32);
         }
     }
@@ -478,7 +543,7 @@ impl JitProgram {
         self.code.funcs.len()
     }
 
-    /// A spill array for [`JitProgram::eval`] (empty for programs of one chunk).
+    /// A spill array for [`JitProgram::eval`] (empty when no value crosses a call or a chunk).
     pub fn workspace(&self) -> Vec<f64> {
         vec![0.0; self.n_spill]
     }
@@ -594,15 +659,14 @@ impl Evaluator {
 }
 
 /// A [`CompiledLinearSystem`] whose entries `A`, `b` are evaluated by an [`Evaluator`], then
-/// solved by the same in-place LU. Owns its buffers; `solve` allocates nothing.
+/// solved by the same [`DenseSolver`]. Owns its buffers; `solve` allocates nothing.
 #[derive(Clone, Debug)]
 pub struct JitLinearSystem {
     eval: Evaluator,
     n: usize,
     ws: Vec<f64>,
     ab: Vec<f64>,
-    perm: Vec<usize>,
-    work: Vec<f64>,
+    solver: DenseSolver,
 }
 
 impl JitLinearSystem {
@@ -615,8 +679,7 @@ impl JitLinearSystem {
             eval,
             n,
             ab: vec![0.0; n * n + n],
-            perm: vec![0; n],
-            work: vec![0.0; n],
+            solver: sys.solver(),
         }
     }
 
@@ -628,13 +691,9 @@ impl JitLinearSystem {
     /// Solves for the unknowns at `inputs`, writing them to `x` (as
     /// [`CompiledLinearSystem::solve`], with the same result bits).
     pub fn solve(&mut self, inputs: &[f64], x: &mut [f64]) -> Result<(), SingularMatrix> {
-        let n = self.n;
         self.eval.eval(inputs, &mut self.ws, &mut self.ab);
-        let (a, b) = self.ab.split_at_mut(n * n);
-        lu_factor_in_place(a, n, &mut self.perm)?;
-        lu_solve_in_place(a, n, &self.perm, b, &mut self.work);
-        x[..n].copy_from_slice(&b[..n]);
-        Ok(())
+        debug_assert_eq!(self.ab.len(), self.n * self.n + self.n);
+        self.solver.solve(&mut self.ab, x)
     }
 }
 
@@ -669,7 +728,7 @@ mod tests {
             let exponent = ((state >> 3) % 40) as i32 - 20;
             let v = mantissa * 10f64.powi(exponent);
             prog.eval(&[v], &mut ws, &mut o1);
-            jit.eval(&[v], &mut [], &mut o2);
+            jit.eval(&[v], &mut jit.workspace(), &mut o2);
             for (k, (a, b)) in o1.iter().zip(&o2).enumerate() {
                 assert!(
                     a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
@@ -745,7 +804,7 @@ mod tests {
         for &a in &specials {
             for &b in &specials {
                 prog.eval(&[a, b], &mut ws, &mut o1);
-                jit.eval(&[a, b], &mut [], &mut o2);
+                jit.eval(&[a, b], &mut jit.workspace(), &mut o2);
                 for k in 0..outs.len() {
                     assert!(
                         same(o1[k], o2[k]),
@@ -790,7 +849,7 @@ mod tests {
                 s.spawn(move || {
                     let mut out = [0.0];
                     let xk = k as f64 * 0.3;
-                    jit.eval(&[xk], &mut [], &mut out);
+                    jit.eval(&[xk], &mut jit.workspace(), &mut out);
                     assert_eq!(out[0].to_bits(), (xk.sin() * xk).to_bits());
                 });
             }
