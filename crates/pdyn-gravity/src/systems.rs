@@ -109,14 +109,16 @@ pub const FIGURE_EIGHT_PRECISE_PERIOD: f64 = 6.32591398292621;
 /// Source: Li & Liao (2017), *More than six hundred new families of Newtonian periodic
 /// planar collisionless three-body orbits*, Sci. China Phys. Mech. Astron. 60, 129511
 /// (arXiv:1705.00527), in this parametrisation to 10 digits: `p₁ = 0.3471168881`,
-/// `p₂ = 0.5327249454`, `T = 6.3259139829`. Those return to 1.8e-11 (relative) after one period; no
-/// source we could read gives more digits, so they were refined here by Gauss–Newton
-/// shooting on the period map `(p₁, p₂, T) ↦ state(T) − state(0)` (12 residuals, Jacobian by
-/// central differences, IAS15 at ε = 1e-9 … 1e-12): one iteration brings the residual (absolute, 3.7e-11 before)
-/// to the integrator's floor, 1e-15 … 2e-14, and further iterations wander within
-/// ±3e-15 in `p` and ±1e-14 in `T`, the digits kept below. The refinement is repeated by
-/// `tests/figure_eight.rs`. (Values to 18 digits circulating in public code,
-/// 0.347116888118926938, 0.532724945388030229, 6.32591398292621168, agree to those bounds.)
+/// `p₂ = 0.5327249454`, `T = 6.3259139829`, which return to 1.8e-11 (relative) after one
+/// period. No source we could read gives more digits, so they were refined here by
+/// Gauss–Newton shooting on the period map `(p₁, p₂, T) ↦ state(T) − state(0)` (least
+/// squares over the state's components, Jacobian by central differences, IAS15 at
+/// ε = 1e-9 … 1e-12): one iteration takes the residual from 3.7e-11 (absolute) to the
+/// integrator's floor, 4e-16 … 2.4e-14, and further iterations wander within ±1.5e-15 in
+/// `p` and ±1.5e-14 in `T`: the digits kept below. The shooting confirms the 10 published
+/// digits (it rounds to them) and is repeated by `tests/figure_eight.rs`. Values to 18
+/// digits circulating in public code (0.347116888118926938, 0.532724945388030229,
+/// 6.32591398292621168) agree within those bounds.
 pub fn figure_eight_precise() -> Simulation {
     figure_eight_euler(0.347116888118927, 0.532724945388030)
 }
