@@ -135,7 +135,7 @@ fn outer_solar_system_run(
         }
         // Window samples (offsets from the window's start that are multiples of the stride):
         // Hann-weighted, so that the great inequality's partial cycle at the window's edges
-        // leaks ~(P/W)² instead of ~P/W into the mean.
+        // leaks ~(P/W)³ instead of ~P/W (a plain mean) into the mean.
         for (w, offset) in [Some(n), (n + window).checked_sub(n_steps)]
             .into_iter()
             .enumerate()
