@@ -92,7 +92,7 @@ fn main() -> Result<()> {
                 .map(|i| format!("[{:e}, {:e}, {:e}]", p.x[i], p.y[i], p.z[i]))
                 .collect();
             println!(
-                "{{\"case\": \"{case}\", \"t\": {:e}, \"positions\": [{}]}}",
+                "{{\"case\": \"{case}\", \"t\": {:e}, \"dt\": {dt:e}, \"positions\": [{}]}}",
                 sim.t(),
                 pos.join(", ")
             );

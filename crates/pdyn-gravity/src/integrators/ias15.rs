@@ -25,8 +25,9 @@
 //!
 //! Step size (PRS23): for each particle, with `y₂ = |a(1)|²`, `y₃ = |ȧ(1) Δt|²`,
 //! `y₄ = |ä(1) Δt²|²` from the polynomial, `τ² = 2 y₂/(y₃ + √(y₂ y₄))`; the new step is
-//! `Δt_new = √(min τ²) Δt (5040 ε)^{1/7}`. A step whose `Δt_new < Δt/4` is rejected and
-//! redone; the step grows by at most 4×. After a step, the `b` of the next step are
+//! `Δt_new = √(min τ²) Δt (5040 ε)^{1/7}`, with `y₂` floored at `10⁻⁴ y₃²/y₄` (not in
+//! PRS23 nor REBOUND: without it a body whose acceleration passes through zero stalls the
+//! steps). A step whose `Δt_new < Δt/4` is rejected and redone; the step grows by at most 4×. After a step, the `b` of the next step are
 //! predicted from the current ones (Taylor-shifting the polynomial by the step ratio).
 
 #![allow(clippy::excessive_precision, clippy::needless_range_loop)]
@@ -157,6 +158,10 @@ const fn tri(hi: usize, lo: usize) -> usize {
 
 /// Maximum growth or shrink factor between consecutive steps.
 const SAFETY: f64 = 0.25;
+/// Floor of `y₂` relative to `y₃²/y₄` in the step-size criterion (see its use): steps near a
+/// zero of a body's acceleration shrink to about `(5040 ε)^{1/7} √(2·ZENO_FLOOR)` times the
+/// jerk/snap timescale instead of to zero.
+const ZENO_FLOOR: f64 = 1e-4;
 const MAX_ITERATIONS: usize = 12;
 
 /// The matrices `C` (g → b) and `D = C⁻¹` (b → g), `C[k][j]` = coefficient of `τ^{k+1}` in
@@ -534,6 +539,19 @@ impl Ias15 {
                 if !f64::is_normal(a0i) {
                     continue;
                 }
+                // A body whose acceleration passes through zero (the middle body of the
+                // figure-eight at every Euler configuration) has y₂ → 0 while its jerk does
+                // not, so τ² ≈ 2 (distance to the zero)²/Δt²: each step covers a fixed
+                // fraction of the remaining distance and the steps never pass the zero
+                // (Zeno) until Δt underflows. The amplitude its jerk and snap imply,
+                // y₃²/y₄ (exact for a sinusoid), floors y₂ at ZENO_FLOOR of it. Kepler orbits
+                // have y₂ of the order of y₃²/y₄ (equal on a circle), far above the floor:
+                // the step counts of tests/ias15.rs, equal to REBOUND's, are unchanged.
+                let y2 = if y4.is_normal() {
+                    y2.max(ZENO_FLOOR * y3 * y3 / y4)
+                } else {
+                    y2
+                };
                 let ts2 = 2.0 * y2 / (y3 + (y4 * y2).sqrt());
                 if ts2.is_normal() && ts2 < min_ts2 {
                     min_ts2 = ts2;
