@@ -157,7 +157,9 @@ impl Compiler<'_> {
             return Ok(r);
         }
         // Children first, iteratively, so deep expressions cannot overflow the stack.
-        for n in self.pool.topo_order(&[id]) {
+        let reg = &self.reg;
+        let order = self.pool.topo_order_pruned(&[id], |n| reg.contains_key(&n));
+        for n in order {
             if !self.reg.contains_key(&n) {
                 let r = self.node(n)?;
                 self.reg.insert(n, r);

@@ -68,6 +68,61 @@ impl Pool {
         Ok(cur)
     }
 
+    /// `∂e/∂v` for every `v` in `vars` (leaves), read off the terms of `e` in one pass when `e`
+    /// is, as built, linear in them: a sum of terms each free of `vars` or the product of one
+    /// of them (to the first power) with factors free of `vars`; velocities are linear in the
+    /// rates this way. `None` otherwise (then use [`Pool::diff`] per variable). The results
+    /// are the canonical expressions `diff` builds for such terms, at O(size of `e`) for all
+    /// variables together instead of O(size) per variable: the partial velocities of the
+    /// 100-link chain took a fifth of `pdyn run`'s preparation by `diff`.
+    pub fn linear_coefficients(&mut self, e: Id, vars: &[Id]) -> Option<Vec<Id>> {
+        let index: FxHashMap<Id, usize> = vars.iter().enumerate().map(|(i, &v)| (v, i)).collect();
+        let order = self.topo_order(&[e]);
+        let mut mentions: FxHashMap<Id, bool> = FxHashMap::default();
+        for &x in &order {
+            let mut m = index.contains_key(&x);
+            self.for_each_child(x, |c| m = m || mentions[&c]);
+            mentions.insert(x, m);
+        }
+        let terms: Vec<Id> = match self.node(e) {
+            Node::Add(ts) => ts.to_vec(),
+            _ => vec![e],
+        };
+        let mut parts: Vec<Vec<Id>> = vec![Vec::new(); vars.len()];
+        for t in terms {
+            if !mentions[&t] {
+                continue;
+            }
+            if let Some(&i) = index.get(&t) {
+                parts[i].push(Pool::ONE);
+                continue;
+            }
+            let Node::Mul(fs) = self.node(t) else {
+                return None;
+            };
+            let fs = fs.to_vec();
+            let mut var = None;
+            for (k, f) in fs.iter().enumerate() {
+                if mentions[f] {
+                    match (var, index.get(f)) {
+                        (None, Some(&i)) => var = Some((k, i)),
+                        _ => return None,
+                    }
+                }
+            }
+            let (k, i) = var?;
+            let rest: Vec<Id> = fs
+                .iter()
+                .enumerate()
+                .filter(|&(j, _)| j != k)
+                .map(|(_, &f)| f)
+                .collect();
+            let c = self.mul(&rest);
+            parts[i].push(c);
+        }
+        Some(parts.iter().map(|ps| self.add(ps)).collect())
+    }
+
     /// Partial derivative with respect to the leaf `var` (a symbol, a coordinate or one of its
     /// derivatives, or `t`). Every other leaf is held constant.
     ///
@@ -231,6 +286,32 @@ impl Pool {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn linear_coefficients_are_the_partial_derivatives() {
+        use crate::pool::{Id, Pool};
+        let mut p = Pool::new();
+        let vars: Vec<Id> = ["u", "v", "w"].iter().map(|n| p.var(n)).collect();
+        for src in [
+            "l1*u*cos(q1) + l2*v*cos(q2) - 3*u*sin(q1)/m + 7",
+            "-u",
+            "u",
+            "2*a*(b + c)*w + u*v^0",
+            "sin(q) + k",
+        ] {
+            let e = p.parse_scalar(src).unwrap();
+            let cs = p.linear_coefficients(e, &vars).expect(src);
+            for (i, &v) in vars.iter().enumerate() {
+                assert_eq!(cs[i], p.diff(e, v), "{src}: d/d{}", p.to_text(v));
+            }
+        }
+        // Not linear as built: a product of two variables, a power, a variable inside a
+        // function or a sum factor.
+        for src in ["u*v", "u^2", "sin(u)", "(u + 1)*a", "a/(u + 1)"] {
+            let e = p.parse_scalar(src).unwrap();
+            assert_eq!(p.linear_coefficients(e, &vars), None, "{src}");
+        }
+    }
 
     #[test]
     fn high_order_derivatives_are_bounded() {

@@ -540,6 +540,12 @@ fn decimal_e(r: &BigRational) -> Option<String> {
     let trimmed = digits.trim_end_matches('0').len();
     exp += (digits.len() - trimmed) as i64;
     digits.truncate(trimmed.max(1));
+    // The parser refuses a literal whose digits plus its exponent pass the limit, which a value
+    // within the limit can reach as a decimal (5^-88000 has 61,000 digits as a fraction, 88,000
+    // as `…e-88000`; fuzzing found one): print such a value as a fraction instead.
+    if exp.unsigned_abs() + digits.len() as u64 > MAX_DIGITS {
+        return None;
+    }
     // digits × 10^exp = d.ddd × 10^(exp + len - 1)
     let e10 = exp + digits.len() as i64 - 1;
     let (head, tail) = digits.split_at(1);

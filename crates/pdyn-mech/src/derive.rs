@@ -618,11 +618,22 @@ fn projected(
     reactions: &[crate::model::Reaction],
 ) -> Result<(Vec<Equation>, Vec<Id>, Vec<Id>), DeriveError> {
     let n = qd.len();
-    // Partial velocities ∂v/∂q_j' = ∂r/∂q_j.
-    let jac: Vec<Vec<[Id; 3]>> = parts
-        .iter()
-        .map(|pk| (0..n).map(|j| pk.v.map(|c| p.diff(c, qd[j]))).collect())
-        .collect();
+    // Partial velocities ∂v/∂q_j' = ∂r/∂q_j, read off the velocity's terms (it is linear in
+    // the rates) when it is built that way, differentiated otherwise.
+    let mut jac: Vec<Vec<[Id; 3]>> = Vec::with_capacity(parts.len());
+    for pk in parts {
+        let comps = pk.v.map(|c| p.linear_coefficients(c, qd));
+        let mut rows = vec![[Pool::ZERO; 3]; n];
+        for (k, comp) in comps.iter().enumerate() {
+            for (j, row) in rows.iter_mut().enumerate() {
+                row[k] = match comp {
+                    Some(cs) => cs[j],
+                    None => p.diff(pk.v[k], qd[j]),
+                };
+            }
+        }
+        jac.push(rows);
+    }
     let zero_acc: FxHashMap<Id, Id> = qdd.iter().map(|&a| (a, Pool::ZERO)).collect();
     // Mass matrix: (j, k) → dot product → masses.
     let mut groups: Vec<FxHashMap<Id, Vec<Id>>> = vec![FxHashMap::default(); n * n];

@@ -114,9 +114,7 @@ impl CompiledModel {
                     .filter(|(s, _)| s.is_ok())
                     .map(|(_, &e)| e)
                     .collect();
-                let separable = !accs
-                    .iter()
-                    .any(|&a| rates.iter().any(|&r| p.contains(a, r)));
+                let separable = !p.contains_any(&accs, &rates);
                 let jac = p.jacobian(&accs, &d.state);
                 let jprog = Program::compile(p, &inputs, &jac)?;
                 let engine = Engine::Exact(Evaluator::new(prog, jit));
@@ -125,12 +123,8 @@ impl CompiledModel {
             None => {
                 let sys = CompiledLinearSystem::new(p, &d.system, &inputs)?;
                 let sys = JitLinearSystem::new(&sys, jit);
-                let depends_on_rates = d
-                    .system
-                    .a
-                    .iter()
-                    .chain(&d.system.b)
-                    .any(|&e| rates.iter().any(|&r| p.contains(e, r)));
+                let entries: Vec<Id> = d.system.a.iter().chain(&d.system.b).copied().collect();
+                let depends_on_rates = p.contains_any(&entries, &rates);
                 (Engine::Numeric, None, Some(sys), !depends_on_rates)
             }
         };
