@@ -148,7 +148,11 @@ impl<P: PairPotential> ForceField<P> {
                 .map(|(s, buf)| {
                     let range = bounds[s]..bounds[s + 1];
                     if batched {
-                        return segment_batched(pos, offsets, neigh, range, buf, p, rc2);
+                        return if unchecked {
+                            segment_batched::<true, _>(pos, offsets, neigh, range, buf, p, rc2)
+                        } else {
+                            segment_batched::<false, _>(pos, offsets, neigh, range, buf, p, rc2)
+                        };
                     }
                     if unchecked {
                         segment::<true>(pos, offsets, neigh, range, buf, e4, e1)
@@ -357,8 +361,8 @@ fn segment<const UNCHECKED: bool>(
 /// gathered, up to `CH` at a time, and evaluated by one [`PairPotential::energy_force_batch`].
 /// Pairs are summed exactly as in [`segment`] (lanes by position modulo 4, the last
 /// `len % 4` one by one after the lanes), so the two loops give the same bits for the same
-/// `(u, f/r)`.
-fn segment_batched<P: PairPotential>(
+/// `(u, f/r)`. `UNCHECKED` as in [`segment`].
+fn segment_batched<const UNCHECKED: bool, P: PairPotential>(
     pos: &[[f64; 3]],
     offsets: &[u32],
     neigh: &[u32],
@@ -371,6 +375,7 @@ fn segment_batched<P: PairPotential>(
     const CH: usize = 64; // a multiple of B: blocks of four never straddle two batches
     buf.iter_mut().for_each(|b| *b = [0.0; 3]);
     let base = range.start;
+    debug_assert!(!UNCHECKED || buf.len() == pos.len() - base);
     let mut ew = [[0.0f64; B]; 2];
     let mut tail = [0.0f64; 2];
     let mut d = [[0.0f64; CH]; 3];
@@ -386,7 +391,12 @@ fn segment_batched<P: PairPotential>(
         for chunk in list.chunks(CH) {
             let m = chunk.len();
             for (k, &j) in chunk.iter().enumerate() {
-                let q = pos[j as usize];
+                let q = if UNCHECKED {
+                    // SAFETY: j < pos.len() (see UNCHECKED in `segment`)
+                    unsafe { *pos.get_unchecked(j as usize) }
+                } else {
+                    pos[j as usize]
+                };
                 d[0][k] = ri[0] - q[0];
                 d[1][k] = ri[1] - q[1];
                 d[2][k] = ri[2] - q[2];
@@ -395,26 +405,35 @@ fn segment_batched<P: PairPotential>(
                 r2m[k] = if r2[k] < rc2 { r2[k] } else { rc2 };
             }
             p.energy_force_batch(&r2m[..m], &mut u[..m], &mut fr[..m]);
-            for k in 0..m {
-                let inside = r2[k] < rc2;
-                u[k] = if inside { u[k] } else { 0.0 };
-                fr[k] = if inside { fr[k] } else { 0.0 };
-            }
             let full = m / B * B;
             for k0 in (0..full).step_by(B) {
                 for l in 0..B {
                     let k = k0 + l;
-                    let fd = [fr[k] * d[0][k], fr[k] * d[1][k], fr[k] * d[2][k]];
+                    let inside = r2[k] < rc2;
+                    let uk = if inside { u[k] } else { 0.0 };
+                    let fk = if inside { fr[k] } else { 0.0 };
+                    let fd = [fk * d[0][k], fk * d[1][k], fk * d[2][k]];
                     fa[0][l] += fd[0];
                     fa[1][l] += fd[1];
                     fa[2][l] += fd[2];
-                    ew[0][l] += u[k];
-                    ew[1][l] += fr[k] * r2[k];
-                    let b = &mut buf[chunk[k] as usize - base];
+                    ew[0][l] += uk;
+                    ew[1][l] += fk * r2[k];
+                    let j = chunk[k] as usize;
+                    let b = if UNCHECKED {
+                        // SAFETY: base ≤ i < j < pos.len() = base + buf.len() (see `segment`)
+                        unsafe { buf.get_unchecked_mut(j - base) }
+                    } else {
+                        &mut buf[j - base]
+                    };
                     b[0] -= fd[0];
                     b[1] -= fd[1];
                     b[2] -= fd[2];
                 }
+            }
+            for k in full..m {
+                let inside = r2[k] < rc2;
+                u[k] = if inside { u[k] } else { 0.0 };
+                fr[k] = if inside { fr[k] } else { 0.0 };
             }
             rest = full..m;
         }
