@@ -24,8 +24,8 @@
 //! the same IEEE operations in the same order (integer powers by `f64::powi`'s
 //! square-and-multiply, transcendental functions through the same `f64` methods), so they give
 //! the same bits (tested on random inputs).
-use super::{binary_shim, codegen, inline_powi, shims, unary_shim, JitError, JitMode};
-use cranelift_codegen::ir::condcodes::{FloatCC, IntCC};
+use super::{binary_shim, codegen, inline_powi, shims, unary_shim, Code, JitError, JitMode, RawFn};
+use cranelift_codegen::ir::condcodes::IntCC;
 use cranelift_codegen::ir::{
     types, AbiParam, BlockArg, Function, InstBuilder, MemFlags, SigRef, Signature, Type, Value,
 };
@@ -396,15 +396,7 @@ fn column(op: Op, a: u32, b: u32, rows: &[f64], out: &mut [f64]) {
         Op::Exp => un(out, f64::exp),
         Op::Ln => un(out, f64::ln),
         Op::Abs => un(out, f64::abs),
-        Op::Sign => un(out, |x| {
-            if x > 0.0 {
-                1.0
-            } else if x < 0.0 {
-                -1.0
-            } else {
-                x * 0.0 // ±0 for ±0, NaN for NaN
-            }
-        }),
+        Op::Sign => un(out, |x| sign(x)),
         Op::Min => bin(out, f64::min),
         Op::Max => bin(out, f64::max),
         // `Steps::new` refuses operations `known` does not list: not reached
@@ -448,32 +440,21 @@ fn powi_column(out: &mut [f64], a: &[f64], k: i32) {
 // Native code
 
 /// The generated loop: `(inputs, outputs, n)`, each of `inputs`/`outputs` an array of column
-/// pointers.
+/// pointers. It lives in the crate's [`Code`] (which owns and frees the code memory), stored
+/// there as a [`RawFn`] and turned back into this type to be called.
 type BatchFn = unsafe extern "C" fn(*const *const f64, *const *mut f64, usize);
 
-/// The JIT module owning a kernel's code memory; freed on drop.
-struct Code {
-    module: Option<JITModule>,
-    func: BatchFn,
-}
-
-impl Drop for Code {
-    fn drop(&mut self) {
-        if let Some(m) = self.module.take() {
-            // SAFETY: `func` points into this module's memory and is only reachable through
-            // this `Code`, which is being dropped: no call can be in flight or follow.
-            unsafe { m.free_memory() };
-        }
+/// `sign` as the interpreter computes it: 1 for x > 0, −1 for x < 0, `x·0` otherwise (±0,
+/// or NaN for NaN); the native kernel calls it lane by lane.
+extern "C" fn sign(x: f64) -> f64 {
+    if x > 0.0 {
+        1.0
+    } else if x < 0.0 {
+        -1.0
+    } else {
+        x * 0.0
     }
 }
-
-// SAFETY: after `finalize_definitions` the module is never mutated again (only freed, in
-// `Drop`, which has exclusive access). The generated loop reads its input columns, writes its
-// output columns and its own stack frame, and calls pure shims: concurrent calls with
-// distinct output columns do not interfere (`run` takes them as `&mut`).
-unsafe impl Send for Code {}
-// SAFETY: see `Send`; `&Code` only allows calling the finished function.
-unsafe impl Sync for Code {}
 
 /// Signatures of the shims a kernel may call.
 struct Shims {
@@ -556,7 +537,7 @@ fn per_lane(
     v.expect("vectors have lanes")
 }
 
-/// A scalar operation without a packed form: `sign` inline, the others through the shims.
+/// A scalar operation without a packed form, through its shim.
 fn scalar_call(
     b: &mut FunctionBuilder,
     op: Op,
@@ -573,15 +554,8 @@ fn scalar_call(
     };
     match op {
         Op::Sign => {
-            // 1 for x > 0, −1 for x < 0, x·0 otherwise (±0, or NaN for NaN)
-            let zero = b.ins().f64const(0.0);
-            let one = b.ins().f64const(1.0);
-            let minus_one = b.ins().f64const(-1.0);
-            let gt = b.ins().fcmp(FloatCC::GreaterThan, x, zero);
-            let lt = b.ins().fcmp(FloatCC::LessThan, x, zero);
-            let xz = b.ins().fmul(x, zero);
-            let r = b.ins().select(lt, minus_one, xz);
-            b.ins().select(gt, one, r)
+            let f = sign as extern "C" fn(f64) -> f64;
+            call(b, f as usize, sigs.unary, &[x])
         }
         Op::Powi => {
             let e = b.ins().iconst(types::I32, exponent as i32 as i64);
@@ -744,12 +718,12 @@ fn compile(steps: &Steps) -> Result<Code, JitError> {
     module.define_function(id, &mut ctx).map_err(codegen)?;
     module.finalize_definitions().map_err(codegen)?;
     let raw = module.get_finalized_function(id);
-    // SAFETY: `raw` is the finalized code of a function with exactly this signature
-    // (three pointer-sized arguments, no result), in the platform's default C convention.
-    let func = unsafe { std::mem::transmute::<*const u8, BatchFn>(raw) };
+    // SAFETY: `raw` is finalized code. It is stored as a `RawFn` (a function pointer of the
+    // same size) and only ever called as the `BatchFn` it is, by `call`.
+    let func = unsafe { std::mem::transmute::<*const u8, RawFn>(raw) };
     Ok(Code {
         module: Some(module),
-        func,
+        funcs: vec![func],
     })
 }
 
@@ -866,12 +840,16 @@ impl BatchKernel {
 /// Calls the native loop on column pointers taken from slices of length ≥ `n`.
 #[inline]
 fn call(code: &Code, ip: &[*const f64], op: &[*mut f64], n: usize) {
-    // SAFETY: the kernel reads `ip[..n_inputs]` and `op[..n_outputs]` (both arrays at least
-    // that long: `run` checked the column counts), then reads `n` values from each input
-    // column and writes `n` values to each output column; `run` took them from slices of
-    // length `n`, the outputs borrowed mutably, so the accesses are in bounds and unaliased.
-    // The code is alive while `code` is.
-    unsafe { (code.func)(ip.as_ptr(), op.as_ptr(), n) }
+    // SAFETY: `compile` stored one function, generated with the signature of `BatchFn`. It
+    // reads `ip[..n_inputs]` and `op[..n_outputs]` (both arrays at least that long: `run`
+    // checked the column counts), then reads `n` values from each input column and writes `n`
+    // values to each output column; `run` took them from slices of length `n`, the outputs
+    // borrowed mutably, so the accesses are in bounds and unaliased. The code is alive while
+    // `code` is.
+    unsafe {
+        let f = std::mem::transmute::<RawFn, BatchFn>(code.funcs[0]);
+        f(ip.as_ptr(), op.as_ptr(), n)
+    }
 }
 
 #[cfg(test)]
@@ -961,49 +939,14 @@ mod tests {
 
     #[test]
     fn native_and_interpreter_agree_bit_for_bit_on_every_operation() {
-        agree(
-            &[
-                "x + y",
-                "x - y",
-                "x*y",
-                "x/y",
-                "-x",
-                "x^2",
-                "x^3",
-                "x^7",
-                "x^12",
-                "x^64",
-                "x^65",
-                "x^(-12)",
-                "x^(-3)",
-                "x^(-65)",
-                "x^(3/2)",
-                "x^y",
-                "x^0.3",
-                "sqrt(x)",
-                "sin(x)",
-                "cos(x)",
-                "tan(x)",
-                "asin(x)",
-                "acos(x)",
-                "atan(x)",
-                "atan2(x, y)",
-                "sinh(x)",
-                "cosh(x)",
-                "tanh(x)",
-                "exp(x)",
-                "log(x)",
-                "abs(x)",
-                "sign(x)",
-                "min(x, y)",
-                "max(x, y)",
-                "3",
-                "x",
-            ],
-            &["x", "y"],
-            false,
-            1e-12,
-        );
+        // every operation, integer powers inlined (≤ 64) and called, negative powers through
+        // the shared reciprocal
+        let ops = "x + y; x - y; x*y; x/y; -x; x^2; x^3; x^7; x^12; x^64; x^65; x^(-12); \
+                   x^(-3); x^(-65); x^(3/2); x^y; x^0.3; sqrt(x); sin(x); cos(x); tan(x); \
+                   asin(x); acos(x); atan(x); atan2(x, y); sinh(x); cosh(x); tanh(x); exp(x); \
+                   log(x); abs(x); sign(x); min(x, y); max(x, y); 3; x";
+        let srcs: Vec<&str> = ops.split("; ").collect();
+        agree(&srcs, &["x", "y"], false, 1e-12);
     }
 
     #[test]
