@@ -407,27 +407,40 @@ fn segment_batched<const UNCHECKED: bool, P: PairPotential>(
             p.energy_force_batch(&r2m[..m], &mut u[..m], &mut fr[..m]);
             let full = m / B * B;
             for k0 in (0..full).step_by(B) {
+                // fixed-size blocks (one bounds check each), so the lanes use packed arithmetic
+                let blk =
+                    |a: &[f64; CH]| -> [f64; B] { a[k0..k0 + B].try_into().expect("a block of B") };
+                let (dx, dy, dz, r2b) = (blk(&d[0]), blk(&d[1]), blk(&d[2]), blk(&r2));
+                let (ub, frb) = (blk(&u), blk(&fr));
+                let mut fd = [[0.0f64; B]; 3];
+                let mut uk = [0.0f64; B];
+                let mut fk = [0.0f64; B];
                 for l in 0..B {
-                    let k = k0 + l;
-                    let inside = r2[k] < rc2;
-                    let uk = if inside { u[k] } else { 0.0 };
-                    let fk = if inside { fr[k] } else { 0.0 };
-                    let fd = [fk * d[0][k], fk * d[1][k], fk * d[2][k]];
-                    fa[0][l] += fd[0];
-                    fa[1][l] += fd[1];
-                    fa[2][l] += fd[2];
-                    ew[0][l] += uk;
-                    ew[1][l] += fk * r2[k];
-                    let j = chunk[k] as usize;
+                    let inside = r2b[l] < rc2;
+                    uk[l] = if inside { ub[l] } else { 0.0 };
+                    fk[l] = if inside { frb[l] } else { 0.0 };
+                    fd[0][l] = fk[l] * dx[l];
+                    fd[1][l] = fk[l] * dy[l];
+                    fd[2][l] = fk[l] * dz[l];
+                }
+                for l in 0..B {
+                    fa[0][l] += fd[0][l];
+                    fa[1][l] += fd[1][l];
+                    fa[2][l] += fd[2][l];
+                    ew[0][l] += uk[l];
+                    ew[1][l] += fk[l] * r2b[l];
+                }
+                for (l, &j) in chunk[k0..k0 + B].iter().enumerate() {
+                    let j = j as usize;
                     let b = if UNCHECKED {
                         // SAFETY: base ≤ i < j < pos.len() = base + buf.len() (see `segment`)
                         unsafe { buf.get_unchecked_mut(j - base) }
                     } else {
                         &mut buf[j - base]
                     };
-                    b[0] -= fd[0];
-                    b[1] -= fd[1];
-                    b[2] -= fd[2];
+                    b[0] -= fd[0][l];
+                    b[1] -= fd[1][l];
+                    b[2] -= fd[2][l];
                 }
             }
             for k in full..m {
