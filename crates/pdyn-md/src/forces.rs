@@ -302,31 +302,7 @@ fn segment<const UNCHECKED: bool>(
                 r2[l] = d[0][l] * d[0][l] + d[1][l] * d[1][l] + d[2][l] * d[2][l];
             }
             let (u, fr) = eval4(i, js, r2);
-            let mut fd = [[0.0f64; B]; 3];
-            for l in 0..B {
-                fd[0][l] = fr[l] * d[0][l];
-                fd[1][l] = fr[l] * d[1][l];
-                fd[2][l] = fr[l] * d[2][l];
-            }
-            for l in 0..B {
-                fa[0][l] += fd[0][l];
-                fa[1][l] += fd[1][l];
-                fa[2][l] += fd[2][l];
-                ew[0][l] += u[l];
-                ew[1][l] += fr[l] * r2[l];
-            }
-            // Newton's third law: every j of i's half list has owner > i ≥ base
-            for l in 0..B {
-                let b = if UNCHECKED {
-                    // SAFETY: base ≤ i < j < pos.len() = base + buf.len() (see UNCHECKED)
-                    unsafe { buf.get_unchecked_mut(js[l] - base) }
-                } else {
-                    &mut buf[js[l] - base]
-                };
-                b[0] -= fd[0][l];
-                b[1] -= fd[1][l];
-                b[2] -= fd[2][l];
-            }
+            add_block::<UNCHECKED>(&d, &r2, &u, &fr, js, base, buf, &mut fa, &mut ew);
         }
         let mut fi = [0.0f64; 3];
         for (f, a) in fi.iter_mut().zip(&fa) {
@@ -354,6 +330,50 @@ fn segment<const UNCHECKED: bool>(
     }
     let lanes = |a: &[f64; B]| (a[0] + a[1]) + (a[2] + a[3]);
     (lanes(&ew[0]) + tail[0], lanes(&ew[1]) + tail[1])
+}
+
+/// One block of four pairs `(i, js[l])` with separations `d`, squared distances `r2` and
+/// `(u, f/r)`: `(f/r)·d` is added to `i`'s lane sums `fa` and subtracted from each `j` in `buf`
+/// (Newton's third law: every `j` of `i`'s half list has owner > i ≥ `base`), `u` and the
+/// virial `(f/r)·r²` to the lane sums `ew`. Shared by [`segment`] and [`segment_batched`], so
+/// the two add the same numbers in the same order. `UNCHECKED` as in [`segment`].
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn add_block<const UNCHECKED: bool>(
+    d: &[[f64; 4]; 3],
+    r2: &[f64; 4],
+    u: &[f64; 4],
+    fr: &[f64; 4],
+    js: [usize; 4],
+    base: usize,
+    buf: &mut [[f64; 3]],
+    fa: &mut [[f64; 4]; 3],
+    ew: &mut [[f64; 4]; 2],
+) {
+    let mut fd = [[0.0f64; 4]; 3];
+    for l in 0..4 {
+        fd[0][l] = fr[l] * d[0][l];
+        fd[1][l] = fr[l] * d[1][l];
+        fd[2][l] = fr[l] * d[2][l];
+    }
+    for l in 0..4 {
+        fa[0][l] += fd[0][l];
+        fa[1][l] += fd[1][l];
+        fa[2][l] += fd[2][l];
+        ew[0][l] += u[l];
+        ew[1][l] += fr[l] * r2[l];
+    }
+    for l in 0..4 {
+        let b = if UNCHECKED {
+            // SAFETY: base ≤ i < j < pos.len() = base + buf.len() (see UNCHECKED in `segment`)
+            unsafe { buf.get_unchecked_mut(js[l] - base) }
+        } else {
+            &mut buf[js[l] - base]
+        };
+        b[0] -= fd[0][l];
+        b[1] -= fd[1][l];
+        b[2] -= fd[2][l];
+    }
 }
 
 /// [`segment`] for one potential that is cheaper called once per batch
@@ -410,38 +430,18 @@ fn segment_batched<const UNCHECKED: bool, P: PairPotential>(
                 // fixed-size blocks (one bounds check each), so the lanes use packed arithmetic
                 let blk =
                     |a: &[f64; CH]| -> [f64; B] { a[k0..k0 + B].try_into().expect("a block of B") };
-                let (dx, dy, dz, r2b) = (blk(&d[0]), blk(&d[1]), blk(&d[2]), blk(&r2));
-                let (ub, frb) = (blk(&u), blk(&fr));
-                let mut fd = [[0.0f64; B]; 3];
+                let db = [blk(&d[0]), blk(&d[1]), blk(&d[2])];
+                let (r2b, ub, frb) = (blk(&r2), blk(&u), blk(&fr));
                 let mut uk = [0.0f64; B];
                 let mut fk = [0.0f64; B];
+                let mut js = [0usize; B];
                 for l in 0..B {
                     let inside = r2b[l] < rc2;
                     uk[l] = if inside { ub[l] } else { 0.0 };
                     fk[l] = if inside { frb[l] } else { 0.0 };
-                    fd[0][l] = fk[l] * dx[l];
-                    fd[1][l] = fk[l] * dy[l];
-                    fd[2][l] = fk[l] * dz[l];
+                    js[l] = chunk[k0 + l] as usize;
                 }
-                for l in 0..B {
-                    fa[0][l] += fd[0][l];
-                    fa[1][l] += fd[1][l];
-                    fa[2][l] += fd[2][l];
-                    ew[0][l] += uk[l];
-                    ew[1][l] += fk[l] * r2b[l];
-                }
-                for (l, &j) in chunk[k0..k0 + B].iter().enumerate() {
-                    let j = j as usize;
-                    let b = if UNCHECKED {
-                        // SAFETY: base ≤ i < j < pos.len() = base + buf.len() (see `segment`)
-                        unsafe { buf.get_unchecked_mut(j - base) }
-                    } else {
-                        &mut buf[j - base]
-                    };
-                    b[0] -= fd[0][l];
-                    b[1] -= fd[1][l];
-                    b[2] -= fd[2][l];
-                }
+                add_block::<UNCHECKED>(&db, &r2b, &uk, &fk, js, base, buf, &mut fa, &mut ew);
             }
             for k in full..m {
                 let inside = r2[k] < rc2;
