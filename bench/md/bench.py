@@ -2,6 +2,7 @@
 
 usage (from the repository root; run.sh makes the venv, builds, then calls this):
   python bench/md/bench.py OUT.md STEPS... [--repeat R] [--pdyn target/release/pdyn]
+  python bench/md/bench.py OUT.md --formula-only --pdyn target/release/pdyn  (no LAMMPS)
 
 For every repetition and step count it runs, one after the other: LAMMPS serial (lj/cut),
 pdyn-md 1 thread (in.lj's `every 20 check no`), LAMMPS lj/cut/omp with 1 and 2 threads,
@@ -70,11 +71,17 @@ def pdyn_cli(exe, model, threads):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("out")
-    ap.add_argument("steps", nargs="+", type=int)
+    ap.add_argument("steps", nargs="*", type=int)
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--pdyn", default=None)
     ap.add_argument("--formula-repeat", type=int, default=3)
+    ap.add_argument("--formula-only", action="store_true",
+                    help="only the formula-vs-built-in comparison (needs --pdyn; no LAMMPS)")
     a = ap.parse_args()
+    if a.formula_only:
+        a.steps = []
+    elif not a.steps:
+        ap.error("give STEPS, or --formula-only")
     load0 = open("/proc/loadavg").read().split()[:3]
     uptime0 = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
     configs = [
@@ -131,7 +138,22 @@ def main():
         f_rows.append(f"| {k + 1} | {b['loop']:.3f} | {f['loop']:.3f} | {f['loop'] / b['loop']:.2f} | "
                       f"{b['cpu']:.3f} | {f['cpu']:.3f} | {f['cpu'] / b['cpu']:.2f} | "
                       f"{abs(f['E'] - b['E']) / abs(b['E']):.1e} |")
+    if formula:
+        best = lambda key, i: min(pair[i][key] for pair in formula)
+        steps_atoms = 100 * N  # both models: 100 steps of 32,000 atoms
+        f_rows.append(
+            f"| min | {best('loop', 0):.3f} | {best('loop', 1):.3f} | "
+            f"{best('loop', 1) / best('loop', 0):.2f} | {best('cpu', 0):.3f} | {best('cpu', 1):.3f} | "
+            f"{best('cpu', 1) / best('cpu', 0):.2f} | |\n\nAtom-steps/s from the minima: built-in "
+            f"{steps_atoms / best('loop', 0):.3g} (loop wall), {steps_atoms / best('cpu', 0):.3g} "
+            f"(process CPU); formula {steps_atoms / best('loop', 1):.3g} (loop wall), "
+            f"{steps_atoms / best('cpu', 1):.3g} (process CPU).")
     with open(a.out, "w") as fh:
+        if a.formula_only:
+            fh.write(f"`uptime` before: `{uptime0}`; after: `{uptime1}`.\n\n")
+            fh.write(FORMULA_HEAD + "\n".join(f_rows) + "\n")
+            print(f"wrote {a.out}", file=sys.stderr)
+            return
         fh.write(TEMPLATE_HEAD.format(load0=" ".join(load0), load1=" ".join(load1),
                                       uptime0=uptime0, uptime1=uptime1,
                                       steps=" ".join(map(str, a.steps)), repeat=a.repeat))

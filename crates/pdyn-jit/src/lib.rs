@@ -47,6 +47,9 @@ use pdyn_expr::lu::{DenseSolver, SingularMatrix};
 use pdyn_expr::Program;
 use std::sync::Arc;
 
+mod batch;
+pub use batch::BatchKernel;
+
 /// Why a program could not be compiled to native code. The interpreter remains usable.
 #[derive(Clone, Debug, PartialEq, Eq)]
 #[non_exhaustive]

@@ -148,7 +148,11 @@ impl<P: PairPotential> ForceField<P> {
                 .map(|(s, buf)| {
                     let range = bounds[s]..bounds[s + 1];
                     if batched {
-                        return segment_batched(pos, offsets, neigh, range, buf, p, rc2);
+                        return if unchecked {
+                            segment_batched::<true, _>(pos, offsets, neigh, range, buf, p, rc2)
+                        } else {
+                            segment_batched::<false, _>(pos, offsets, neigh, range, buf, p, rc2)
+                        };
                     }
                     if unchecked {
                         segment::<true>(pos, offsets, neigh, range, buf, e4, e1)
@@ -298,31 +302,7 @@ fn segment<const UNCHECKED: bool>(
                 r2[l] = d[0][l] * d[0][l] + d[1][l] * d[1][l] + d[2][l] * d[2][l];
             }
             let (u, fr) = eval4(i, js, r2);
-            let mut fd = [[0.0f64; B]; 3];
-            for l in 0..B {
-                fd[0][l] = fr[l] * d[0][l];
-                fd[1][l] = fr[l] * d[1][l];
-                fd[2][l] = fr[l] * d[2][l];
-            }
-            for l in 0..B {
-                fa[0][l] += fd[0][l];
-                fa[1][l] += fd[1][l];
-                fa[2][l] += fd[2][l];
-                ew[0][l] += u[l];
-                ew[1][l] += fr[l] * r2[l];
-            }
-            // Newton's third law: every j of i's half list has owner > i ≥ base
-            for l in 0..B {
-                let b = if UNCHECKED {
-                    // SAFETY: base ≤ i < j < pos.len() = base + buf.len() (see UNCHECKED)
-                    unsafe { buf.get_unchecked_mut(js[l] - base) }
-                } else {
-                    &mut buf[js[l] - base]
-                };
-                b[0] -= fd[0][l];
-                b[1] -= fd[1][l];
-                b[2] -= fd[2][l];
-            }
+            add_block::<UNCHECKED>(&d, &r2, &u, &fr, js, base, buf, &mut fa, &mut ew);
         }
         let mut fi = [0.0f64; 3];
         for (f, a) in fi.iter_mut().zip(&fa) {
@@ -352,13 +332,57 @@ fn segment<const UNCHECKED: bool>(
     (lanes(&ew[0]) + tail[0], lanes(&ew[1]) + tail[1])
 }
 
+/// One block of four pairs `(i, js[l])` with separations `d`, squared distances `r2` and
+/// `(u, f/r)`: `(f/r)·d` is added to `i`'s lane sums `fa` and subtracted from each `j` in `buf`
+/// (Newton's third law: every `j` of `i`'s half list has owner > i ≥ `base`), `u` and the
+/// virial `(f/r)·r²` to the lane sums `ew`. Shared by [`segment`] and [`segment_batched`], so
+/// the two add the same numbers in the same order. `UNCHECKED` as in [`segment`].
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn add_block<const UNCHECKED: bool>(
+    d: &[[f64; 4]; 3],
+    r2: &[f64; 4],
+    u: &[f64; 4],
+    fr: &[f64; 4],
+    js: [usize; 4],
+    base: usize,
+    buf: &mut [[f64; 3]],
+    fa: &mut [[f64; 4]; 3],
+    ew: &mut [[f64; 4]; 2],
+) {
+    let mut fd = [[0.0f64; 4]; 3];
+    for l in 0..4 {
+        fd[0][l] = fr[l] * d[0][l];
+        fd[1][l] = fr[l] * d[1][l];
+        fd[2][l] = fr[l] * d[2][l];
+    }
+    for l in 0..4 {
+        fa[0][l] += fd[0][l];
+        fa[1][l] += fd[1][l];
+        fa[2][l] += fd[2][l];
+        ew[0][l] += u[l];
+        ew[1][l] += fr[l] * r2[l];
+    }
+    for l in 0..4 {
+        let b = if UNCHECKED {
+            // SAFETY: base ≤ i < j < pos.len() = base + buf.len() (see UNCHECKED in `segment`)
+            unsafe { buf.get_unchecked_mut(js[l] - base) }
+        } else {
+            &mut buf[js[l] - base]
+        };
+        b[0] -= fd[0][l];
+        b[1] -= fd[1][l];
+        b[2] -= fd[2][l];
+    }
+}
+
 /// [`segment`] for one potential that is cheaper called once per batch
 /// ([`PairPotential::prefers_batch`], a compiled formula): each particle's neighbours are
 /// gathered, up to `CH` at a time, and evaluated by one [`PairPotential::energy_force_batch`].
 /// Pairs are summed exactly as in [`segment`] (lanes by position modulo 4, the last
 /// `len % 4` one by one after the lanes), so the two loops give the same bits for the same
-/// `(u, f/r)`.
-fn segment_batched<P: PairPotential>(
+/// `(u, f/r)`. `UNCHECKED` as in [`segment`].
+fn segment_batched<const UNCHECKED: bool, P: PairPotential>(
     pos: &[[f64; 3]],
     offsets: &[u32],
     neigh: &[u32],
@@ -371,6 +395,7 @@ fn segment_batched<P: PairPotential>(
     const CH: usize = 64; // a multiple of B: blocks of four never straddle two batches
     buf.iter_mut().for_each(|b| *b = [0.0; 3]);
     let base = range.start;
+    debug_assert!(!UNCHECKED || buf.len() == pos.len() - base);
     let mut ew = [[0.0f64; B]; 2];
     let mut tail = [0.0f64; 2];
     let mut d = [[0.0f64; CH]; 3];
@@ -386,7 +411,12 @@ fn segment_batched<P: PairPotential>(
         for chunk in list.chunks(CH) {
             let m = chunk.len();
             for (k, &j) in chunk.iter().enumerate() {
-                let q = pos[j as usize];
+                let q = if UNCHECKED {
+                    // SAFETY: j < pos.len() (see UNCHECKED in `segment`)
+                    unsafe { *pos.get_unchecked(j as usize) }
+                } else {
+                    pos[j as usize]
+                };
                 d[0][k] = ri[0] - q[0];
                 d[1][k] = ri[1] - q[1];
                 d[2][k] = ri[2] - q[2];
@@ -395,26 +425,28 @@ fn segment_batched<P: PairPotential>(
                 r2m[k] = if r2[k] < rc2 { r2[k] } else { rc2 };
             }
             p.energy_force_batch(&r2m[..m], &mut u[..m], &mut fr[..m]);
-            for k in 0..m {
+            let full = m / B * B;
+            for k0 in (0..full).step_by(B) {
+                // fixed-size blocks (one bounds check each), so the lanes use packed arithmetic
+                let blk =
+                    |a: &[f64; CH]| -> [f64; B] { a[k0..k0 + B].try_into().expect("a block of B") };
+                let db = [blk(&d[0]), blk(&d[1]), blk(&d[2])];
+                let (r2b, ub, frb) = (blk(&r2), blk(&u), blk(&fr));
+                let mut uk = [0.0f64; B];
+                let mut fk = [0.0f64; B];
+                let mut js = [0usize; B];
+                for l in 0..B {
+                    let inside = r2b[l] < rc2;
+                    uk[l] = if inside { ub[l] } else { 0.0 };
+                    fk[l] = if inside { frb[l] } else { 0.0 };
+                    js[l] = chunk[k0 + l] as usize;
+                }
+                add_block::<UNCHECKED>(&db, &r2b, &uk, &fk, js, base, buf, &mut fa, &mut ew);
+            }
+            for k in full..m {
                 let inside = r2[k] < rc2;
                 u[k] = if inside { u[k] } else { 0.0 };
                 fr[k] = if inside { fr[k] } else { 0.0 };
-            }
-            let full = m / B * B;
-            for k0 in (0..full).step_by(B) {
-                for l in 0..B {
-                    let k = k0 + l;
-                    let fd = [fr[k] * d[0][k], fr[k] * d[1][k], fr[k] * d[2][k]];
-                    fa[0][l] += fd[0];
-                    fa[1][l] += fd[1];
-                    fa[2][l] += fd[2];
-                    ew[0][l] += u[k];
-                    ew[1][l] += fr[k] * r2[k];
-                    let b = &mut buf[chunk[k] as usize - base];
-                    b[0] -= fd[0];
-                    b[1] -= fd[1];
-                    b[2] -= fd[2];
-                }
             }
             rest = full..m;
         }

@@ -158,6 +158,20 @@ fn formula_lj_equals_builtin_lj() {
     }
 }
 
+/// `--no-jit` runs the formula in the batch kernel's interpreter, with the native kernel's bits:
+/// the same final state to the last digit (and `formula_native` says which ran).
+#[test]
+fn formula_without_jit_gives_the_same_bits() {
+    let args = ["--set", "n=5", "--t-end", "0.05"];
+    let native = run_json("examples/md/lj_formula.toml", &args);
+    let mut off = args.to_vec();
+    off.push("--no-jit");
+    let interp = run_json("examples/md/lj_formula.toml", &off);
+    assert_eq!(native["formula_native"], true);
+    assert_eq!(interp["formula_native"], false);
+    assert_eq!(native["final"], interp["final"]);
+}
+
 /// NVE, 500 atoms of the in.lj liquid with the energy shifted at the cutoff, 200 steps:
 /// measured max |E − E₀| = 4.4e-5 of the mean kinetic energy, slope 4.5e-5 ε/τ per atom.
 /// Bounds 1e-3 and 1e-3; no drift warning.

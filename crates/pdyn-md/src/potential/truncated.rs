@@ -124,7 +124,8 @@ impl<P: RawPair> PairPotential for Truncated<P> {
                 *u = *u - u_c + (r - rc) * f_c;
                 *f -= f_c / r;
             }
-        } else {
+        } else if u_c != 0.0 {
+            // (`x − 0 = x` bit for bit, −0 included: plain cutoffs skip the pass)
             u.iter_mut().for_each(|u| *u -= u_c);
         }
     }

@@ -123,8 +123,7 @@ pub fn run(a: RunArgs, source: String) -> Result<Outcome, Error> {
         ));
     }
     let base = a.model.parent().unwrap_or(Path::new("."));
-    let mut prep =
-        md::build(&spec, base, pdyn_jit::JitMode::Auto).map_err(|e| model_err(e, &source))?;
+    let mut prep = md::build(&spec, base, a.jit()).map_err(|e| model_err(e, &source))?;
     if let Some(dir) = &a.out {
         std::fs::create_dir_all(dir).map_err(|e| io_error(dir, "create", e))?;
     }

@@ -1,56 +1,29 @@
 //! A pair potential written as a formula in `r`, derived and compiled.
 //!
-//! The text `u(r)` is parsed by pdyn-expr with `r` a positive symbol and every `[parameters]`
-//! name bound to its value; `u'(r)` is the symbolic derivative, and one program computes
-//! `(u, f/r)` with `f/r = −u'(r)/r`, the pair the force loop of pdyn-md expects
-//! ([`pdyn_md::potential::RawPair`]). The program runs as native code through pdyn-jit when
-//! the platform has a Cranelift backend, otherwise in pdyn-expr's interpreter; both give the
-//! same bits. The cutoff modes (shifted energy, shifted force) come from
-//! [`pdyn_md::potential::Truncated`], as for the built-in kernels.
+//! The text `u(r)` is parsed by pdyn-expr with every `[parameters]` name bound to its value
+//! and `r` bound to `√s`, `s = r²` a positive symbol: the force loop of pdyn-md hands over
+//! squared distances, and in `s` most potentials need no square root at all (Lennard-Jones:
+//! `(σ/r)¹² = σ¹² s⁻⁶`). The force follows from the derivative in `s`,
+//! `f/r = −u'(r)/r = −2 du/ds`, and one program computes `(u, f/r)` from `s`, the pair
+//! [`pdyn_md::potential::RawPair`] expects. The cutoff modes (shifted energy, shifted force)
+//! come from [`pdyn_md::potential::Truncated`], as for the built-in kernels.
 //!
-//! The force loop does not call the program pair by pair: it hands over all of a particle's
-//! neighbours at once ([`RawPair::raw_batch`]), and the program runs *column-wise* — each
-//! instruction applied to up to [`LANES`] pairs in a tight loop the compiler vectorises, so
-//! the dispatch of an instruction is paid once per batch instead of once per pair. Before
-//! that the instruction list is rewritten once ([`Columns::new`]): instructions no output
-//! needs are dropped, and divisions share reciprocals — `a / x` becomes `a · (1/x)` with one
-//! `1/x` per `x`, `1/xᵏ` becomes `(1/x)ᵏ` — because a derived potential divides by many
-//! powers of `r` (LJ: five divisions per pair, against one in the built-in kernel), and a
-//! division costs several multiplications. The results then differ from
-//! [`FormulaPair::at`] by a few units in the last place (tested to 1e-13 relative).
+//! The program runs as a pdyn-jit [`BatchKernel`]: one native loop over all of a particle's
+//! neighbours per call ([`RawPair::raw_batch`]), two pairs per iteration in packed registers,
+//! the divisions by powers of `s` sharing one reciprocal; single points ([`FormulaPair::at`])
+//! go through the same kernel. Without a JIT (`--no-jit`, or no Cranelift backend) the
+//! kernel's column interpreter runs the same operations, with the same bits.
 
-use pdyn_expr::compile::Op;
 use pdyn_expr::syntax::Ast;
 use pdyn_expr::{Binding, ExprError, Number, Pool, Program, Scope, Value};
-use pdyn_jit::{Evaluator, JitMode};
+use pdyn_jit::{BatchKernel, JitMode};
 use pdyn_md::potential::RawPair;
-use std::cell::RefCell;
 use std::ops::Range;
 
-/// Pairs per column of the batch evaluator: enough to amortise each instruction's dispatch,
-/// few enough that a program's registers (`LANES` values each) stay in the L1 cache.
-pub const LANES: usize = 64;
-
-thread_local! {
-    /// Register columns of the batch evaluator, per thread (the force loop runs on rayon
-    /// workers; `raw_batch(&self)` must not allocate per call), with the id of the column
-    /// program whose constants they hold.
-    static COLUMNS: RefCell<(u64, Vec<f64>)> = const { RefCell::new((u64::MAX, Vec::new())) };
-}
-
-/// Ids of column programs.
-static NEXT_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-
-/// A compiled `u(r)`: input `r`, outputs `u(r)` and `−u'(r)/r`.
+/// A compiled `u(r)`: input `s = r²`, outputs `u(r)` and `−u'(r)/r`.
 #[derive(Debug, Clone)]
 pub struct FormulaPair {
-    eval: Evaluator,
-    /// The program rewritten for the column-wise batch evaluator (`None` when it has an
-    /// operation the batch evaluator does not know: `raw_batch` then goes pair by pair).
-    columns: Option<Columns>,
-    /// The interpreter's register file with its constants in place (empty for native code):
-    /// copied per call, so that `raw(&self)` can run on any number of threads at once.
-    template: Vec<f64>,
+    kernel: BatchKernel,
     text: String,
 }
 
@@ -174,8 +147,10 @@ impl FormulaPair {
             });
         }
         let mut pool = Pool::new();
-        let rs = pool.symbol("r", true);
-        let r = pool.sym(rs);
+        let ss = pool.symbol("r²", true);
+        let s = pool.sym(ss);
+        let half = pool.num(Number::ratio(1, 2));
+        let r = pool.pow(s, half);
         let mut scope = RScope { r, params };
         let u = match pdyn_expr::lower::lower(&mut pool, &ast, &mut scope)? {
             Value::Scalar(u) => u,
@@ -187,26 +162,27 @@ impl FormulaPair {
                 })
             }
         };
-        let du = pool.diff(u, r);
-        let minus = pool.neg(du);
-        let fr = pool.div(minus, r);
-        let prog = Program::compile(&mut pool, &[r], &[u, fr]).map_err(|e| FormulaError {
+        // f/r = −u'(r)/r = −2 du/ds, since du/ds = u'(r)/(2r)
+        let du = pool.diff(u, s);
+        let fr = pool.scale(Number::int(-2), du);
+        let cannot = |e: String| FormulaError {
             span: ast.span(),
             message: format!("cannot compile the potential: {e}"),
             help: None,
-        })?;
-        let eval = Evaluator::new(prog.clone(), mode);
+        };
+        let prog =
+            Program::compile(&mut pool, &[s], &[u, fr]).map_err(|e| cannot(e.to_string()))?;
+        let kernel = BatchKernel::new(&prog, mode)
+            .ok_or_else(|| cannot("an operation without a batch kernel".into()))?;
         Ok(FormulaPair {
-            columns: Columns::new(&prog),
-            template: eval.workspace(),
-            eval,
+            kernel,
             text: text.to_string(),
         })
     }
 
     /// True when the formula runs as native code.
     pub fn is_native(&self) -> bool {
-        self.eval.is_native()
+        self.kernel.is_native()
     }
 
     /// The formula as written.
@@ -216,399 +192,27 @@ impl FormulaPair {
 
     /// `(u(r), −u'(r)/r)` at distance `r`.
     pub fn at(&self, r: f64) -> (f64, f64) {
-        let mut out = [0.0; 2];
-        if self.template.is_empty() {
-            self.eval.eval(&[r], &mut [], &mut out);
-        } else if self.template.len() <= 256 {
-            let mut ws = [0.0; 256];
-            let ws = &mut ws[..self.template.len()];
-            ws.copy_from_slice(&self.template);
-            self.eval.eval(&[r], ws, &mut out);
-        } else {
-            let mut ws = self.template.clone();
-            self.eval.eval(&[r], &mut ws, &mut out);
-        }
-        (out[0], out[1])
+        self.at_squared(r * r)
     }
 
-    /// `(u, f/r)` at the squared distances `r2` (slices of one length), column-wise; equal to
-    /// [`FormulaPair::at`]`(r2[k].sqrt())` up to the rounding of shared reciprocals. Without a
-    /// column program (an operation the batch evaluator does not know), pair by pair.
+    /// `(u, f/r)` at the squared distance `r2`.
+    pub fn at_squared(&self, r2: f64) -> (f64, f64) {
+        let (mut u, mut fr) = ([0.0], [0.0]);
+        self.kernel.run(&[&[r2]], &mut [&mut u, &mut fr]);
+        (u[0], fr[0])
+    }
+
+    /// `(u, f/r)` at the squared distances `r2` (slices of one length), one call of the
+    /// kernel; the same bits as [`FormulaPair::at_squared`] point by point.
     pub fn at_squared_batch(&self, r2: &[f64], u: &mut [f64], fr: &mut [f64]) {
-        let Some(cp) = &self.columns else {
-            for ((&s, u), f) in r2.iter().zip(u).zip(fr) {
-                (*u, *f) = self.at(s.sqrt());
-            }
-            return;
-        };
-        COLUMNS.with(|cell| {
-            let mut guard = cell.borrow_mut();
-            let (id, regs) = &mut *guard;
-            if regs.len() < cp.rows * LANES {
-                regs.resize(cp.rows * LANES, 0.0);
-                *id = u64::MAX;
-            }
-            let regs = &mut regs[..cp.rows * LANES];
-            if *id != cp.id {
-                // constant rows are never written by a step: filled once per program
-                for &(row, v) in &cp.consts {
-                    regs[row as usize * LANES..][..LANES].fill(v);
-                }
-                *id = cp.id;
-            }
-            for ((r2c, uc), fc) in r2
-                .chunks(LANES)
-                .zip(u.chunks_mut(LANES))
-                .zip(fr.chunks_mut(LANES))
-            {
-                let m = r2c.len();
-                for (x, &s) in regs[..m].iter_mut().zip(r2c) {
-                    *x = s.sqrt();
-                }
-                for st in &cp.steps {
-                    // operands lie below the destination row (`Columns::new` numbers rows so)
-                    let (lo, hi) = regs.split_at_mut(st.dst as usize * LANES);
-                    column(st.op, st.a, st.b, lo, &mut hi[..m]);
-                }
-                let row = |r: u32| &regs[r as usize * LANES..][..m];
-                uc.copy_from_slice(&row(cp.outs[0])[..uc.len().min(m)]);
-                fc.copy_from_slice(&row(cp.outs[1])[..fc.len().min(m)]);
-            }
-        });
-    }
-}
-
-/// One step of a column program: `row[dst] = op(row[a], row[b])` (`b` the exponent for
-/// `Powi`).
-#[derive(Debug, Clone, Copy)]
-struct Step {
-    op: Op,
-    a: u32,
-    b: u32,
-    dst: u32,
-}
-
-/// A [`Program`] rewritten for column-wise evaluation: rows `[inputs | constants |
-/// temporaries | new rows]`, the live instructions only, divisions through shared reciprocals.
-#[derive(Debug, Clone)]
-struct Columns {
-    /// Identifies the program in a thread's [`COLUMNS`], whose constant rows are filled once.
-    id: u64,
-    rows: usize,
-    consts: Vec<(u32, f64)>,
-    steps: Vec<Step>,
-    outs: [u32; 2],
-}
-
-impl Columns {
-    /// The column program of `prog` (one input `r`, two outputs), or `None` when `prog` has an
-    /// operation [`column`] does not evaluate or not two outputs.
-    fn new(prog: &Program) -> Option<Columns> {
-        let ins = prog.instructions();
-        if !ins.iter().all(|i| batchable(i.op())) || prog.output_registers().len() != 2 {
-            return None;
-        }
-        let n_in = prog.n_inputs();
-        let start = prog.first_temporary();
-        let consts = prog.constants();
-        let const_of = |r: u32| {
-            let r = r as usize;
-            (r >= n_in && r < start).then(|| consts[r - n_in])
-        };
-        // liveness, backwards from the outputs
-        let mut live = vec![false; start + ins.len()];
-        for &o in prog.output_registers() {
-            live[o as usize] = true;
-        }
-        for (k, i) in ins.iter().enumerate().rev() {
-            if live[start + k] {
-                live[i.a() as usize] = true;
-                if i.op().reads_b() {
-                    live[i.b() as usize] = true;
-                }
-            }
-        }
-        let mut c = Builder {
-            rows: (start + ins.len()) as u32,
-            consts: consts
-                .iter()
-                .enumerate()
-                .map(|(k, &v)| ((n_in + k) as u32, v))
-                .collect(),
-            steps: vec![],
-            one: None,
-            recip: std::collections::HashMap::new(),
-            power: std::collections::HashMap::new(),
-        };
-        // original register -> row holding its value (a division by the constant 1 becomes
-        // the reciprocal's row)
-        let mut map: Vec<u32> = (0..(start + ins.len()) as u32).collect();
-        for (k, i) in ins.iter().enumerate() {
-            let dst = (start + k) as u32;
-            if !live[dst as usize] {
-                continue;
-            }
-            let a = map[i.a() as usize];
-            let b = if i.op().reads_b() {
-                map[i.b() as usize]
-            } else {
-                i.b()
-            };
-            match i.op() {
-                Op::Div => {
-                    let r = c.recip_of(b);
-                    if const_of(i.a()) == Some(1.0) {
-                        map[dst as usize] = r;
-                    } else {
-                        c.push(Op::Mul, a, r, dst);
-                    }
-                }
-                Op::Powi if (i.b() as i32) < 0 && (i.b() as i32) != i32::MIN => {
-                    let r = c.recip_of(a);
-                    let k = -(i.b() as i32);
-                    c.push(Op::Powi, r, k as u32, dst);
-                    c.power.insert(dst, (r, k));
-                }
-                Op::Powi => {
-                    c.push(Op::Powi, a, i.b(), dst);
-                    if (i.b() as i32) > 0 {
-                        c.power.insert(dst, (a, i.b() as i32));
-                    }
-                }
-                op => c.push(op, a, b, dst),
-            }
-        }
-        let outs = prog.output_registers();
-        let outs = [map[outs[0] as usize], map[outs[1] as usize]];
-        // the rewrite leaves some powers unused (`xᵏ` when only `1/xᵏ` was needed): drop
-        // every step no output depends on
-        let mut need = vec![false; c.rows as usize];
-        for o in outs {
-            need[o as usize] = true;
-        }
-        let mut steps = Vec::with_capacity(c.steps.len());
-        for st in c.steps.iter().rev() {
-            if need[st.dst as usize] {
-                need[st.a as usize] = true;
-                if st.op.reads_b() {
-                    need[st.b as usize] = true;
-                }
-                steps.push(*st);
-            }
-        }
-        steps.reverse();
-        // compact rows: [input | constants used | one row per step, in step order], so that
-        // every step writes a row above its operands (evaluated in place, no copy)
-        let mut row = vec![u32::MAX; c.rows as usize];
-        for (r, x) in row.iter_mut().enumerate().take(n_in) {
-            *x = r as u32;
-        }
-        let mut next = n_in as u32;
-        let mut kept = vec![];
-        for &(r, v) in &c.consts {
-            if need[r as usize] {
-                row[r as usize] = next;
-                kept.push((next, v));
-                next += 1;
-            }
-        }
-        for st in &mut steps {
-            st.a = row[st.a as usize];
-            if st.op.reads_b() {
-                st.b = row[st.b as usize];
-            }
-            row[st.dst as usize] = next;
-            st.dst = next;
-            next += 1;
-        }
-        let outs = [row[outs[0] as usize], row[outs[1] as usize]];
-        if outs.contains(&u32::MAX) {
-            return None; // an output that is neither input, constant nor step: not expected
-        }
-        Some(Columns {
-            id: NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
-            rows: next as usize,
-            consts: kept,
-            steps,
-            outs,
-        })
-    }
-}
-
-/// State of [`Columns::new`].
-struct Builder {
-    rows: u32,
-    consts: Vec<(u32, f64)>,
-    steps: Vec<Step>,
-    /// Row holding the constant 1.
-    one: Option<u32>,
-    /// Row of `1/x` for row `x`.
-    recip: std::collections::HashMap<u32, u32>,
-    /// Rows known to hold `xᵏ`, `k > 0`: `(x, k)`.
-    power: std::collections::HashMap<u32, (u32, i32)>,
-}
-
-impl Builder {
-    fn push(&mut self, op: Op, a: u32, b: u32, dst: u32) {
-        self.steps.push(Step { op, a, b, dst });
-    }
-
-    fn new_row(&mut self) -> u32 {
-        self.rows += 1;
-        self.rows - 1
-    }
-
-    /// The row of `1/x`, made once: `(1/y)ᵏ` when `x = yᵏ`, else one division.
-    fn recip_of(&mut self, x: u32) -> u32 {
-        if let Some(&r) = self.recip.get(&x) {
-            return r;
-        }
-        let r = if let Some(&(y, k)) = self.power.get(&x) {
-            let ry = self.recip_of(y);
-            let r = self.new_row();
-            self.push(Op::Powi, ry, k as u32, r);
-            r
-        } else {
-            let one = match self.one {
-                Some(o) => o,
-                None => {
-                    let o = self.new_row();
-                    self.consts.push((o, 1.0));
-                    self.one = Some(o);
-                    o
-                }
-            };
-            let r = self.new_row();
-            self.push(Op::Div, one, x, r);
-            r
-        };
-        self.recip.insert(x, r);
-        r
-    }
-}
-
-/// One instruction over a column: `out[l] = op(a[l], b[l])` for every lane, with exactly the
-/// operations of `Program::eval`; `lo` holds the rows.
-#[inline]
-fn column(op: Op, a: u32, b: u32, lo: &[f64], out: &mut [f64]) {
-    let m = out.len();
-    let a = &lo[a as usize * LANES..][..m];
-    let rb = || &lo[b as usize * LANES..][..m];
-    let un = |out: &mut [f64], f: fn(f64) -> f64| {
-        for (o, &x) in out.iter_mut().zip(a) {
-            *o = f(x);
-        }
-    };
-    let bin = |out: &mut [f64], f: fn(f64, f64) -> f64| {
-        for ((o, &x), &y) in out.iter_mut().zip(a).zip(rb()) {
-            *o = f(x, y);
-        }
-    };
-    match op {
-        Op::Add => bin(out, |x, y| x + y),
-        Op::Sub => bin(out, |x, y| x - y),
-        Op::Mul => bin(out, |x, y| x * y),
-        Op::Div => bin(out, |x, y| x / y),
-        Op::Neg => un(out, |x| -x),
-        Op::Sqrt => un(out, f64::sqrt),
-        Op::Powi => powi_column(out, a, b as i32),
-        Op::Powf => bin(out, f64::powf),
-        Op::Sin => un(out, f64::sin),
-        Op::Cos => un(out, f64::cos),
-        Op::Tan => un(out, f64::tan),
-        Op::Asin => un(out, f64::asin),
-        Op::Acos => un(out, f64::acos),
-        Op::Atan => un(out, f64::atan),
-        Op::Atan2 => bin(out, f64::atan2),
-        Op::Sinh => un(out, f64::sinh),
-        Op::Cosh => un(out, f64::cosh),
-        Op::Tanh => un(out, f64::tanh),
-        Op::Exp => un(out, f64::exp),
-        Op::Ln => un(out, f64::ln),
-        Op::Abs => un(out, f64::abs),
-        Op::Sign => un(out, |x| {
-            if x > 0.0 {
-                1.0
-            } else if x < 0.0 {
-                -1.0
-            } else {
-                x * 0.0 // 0 for 0, NaN for NaN
-            }
-        }),
-        Op::Min => bin(out, f64::min),
-        Op::Max => bin(out, f64::max),
-        // an operation newer than this evaluator: `compile` then leaves batching off
-        // (`batchable`), so this arm is not reached; NaN rather than a panic if it were
-        _ => out.fill(f64::NAN),
-    }
-}
-
-/// Whether [`column`] evaluates `op` (every operation `Program` had when it was written).
-fn batchable(op: Op) -> bool {
-    matches!(
-        op,
-        Op::Add
-            | Op::Sub
-            | Op::Mul
-            | Op::Div
-            | Op::Neg
-            | Op::Sqrt
-            | Op::Powi
-            | Op::Powf
-            | Op::Sin
-            | Op::Cos
-            | Op::Tan
-            | Op::Asin
-            | Op::Acos
-            | Op::Atan
-            | Op::Atan2
-            | Op::Sinh
-            | Op::Cosh
-            | Op::Tanh
-            | Op::Exp
-            | Op::Ln
-            | Op::Abs
-            | Op::Sign
-            | Op::Min
-            | Op::Max
-    )
-}
-
-/// `out[l] = a[l]^k` by the squarings and products of `f64::powi` (compiler-builtins'
-/// `__powidf2`: multiply in the base for every set bit of `|k|`, square between bits,
-/// reciprocal last for `k < 0`), lane by lane in packed loops.
-fn powi_column(out: &mut [f64], a: &[f64], k: i32) {
-    let m = out.len();
-    let mut base = [0.0f64; LANES];
-    let base = &mut base[..m];
-    base.copy_from_slice(&a[..m]);
-    out.fill(1.0);
-    let mut pow = k.unsigned_abs();
-    loop {
-        if pow & 1 != 0 {
-            for (o, &x) in out.iter_mut().zip(base.iter()) {
-                *o *= x;
-            }
-        }
-        pow >>= 1;
-        if pow == 0 {
-            break;
-        }
-        for x in base.iter_mut() {
-            *x *= *x;
-        }
-    }
-    if k < 0 {
-        for o in out.iter_mut() {
-            *o = 1.0 / *o;
-        }
+        self.kernel.run(&[r2], &mut [u, fr]);
     }
 }
 
 impl RawPair for FormulaPair {
     #[inline]
     fn raw(&self, r2: f64) -> (f64, f64) {
-        self.at(r2.sqrt())
+        self.at_squared(r2)
     }
 
     fn raw_batch(&self, r2: &[f64], u: &mut [f64], fr: &mut [f64]) {
@@ -616,7 +220,7 @@ impl RawPair for FormulaPair {
     }
 
     fn prefers_batch(&self) -> bool {
-        self.columns.is_some()
+        true
     }
 }
 
@@ -698,33 +302,54 @@ mod tests {
         }
     }
 
-    /// The column-wise batch agrees with the point evaluation (native and interpreted) to
-    /// round-off (shared reciprocals), for every operation kind, batch lengths across the
-    /// column size, and negative integer powers.
+    /// The batch, the point evaluation and the two engines (native code, `--no-jit`'s
+    /// interpreter) give the same bits at random distances, for every operation kind and
+    /// batch lengths across the kernel's packing (two pairs) and the interpreter's columns.
     #[test]
-    fn batch_matches_point_evaluation() {
-        for mode in [JitMode::Auto, JitMode::Off] {
-            for text in [
-                LJ,
-                "D*((1 - exp(-a*(r - r0)))^2 - 1)",
-                "eps*exp(-r/sigma)/r + r^(-7) - r^(-3)",
-                "sin(r)^2 + r^3/7 + atan(r) + sqrt(r) + abs(r - 1) + log(r) + cosh(r)",
-                "min(r, 1.5) + max(r^2, 2) + sign(r - 1)*tanh(r) + r^2.5",
-            ] {
-                let f = FormulaPair::compile(text, &params(), mode).unwrap();
-                for n in [1, 3, 4, 63, 64, 65, 130] {
-                    let r2: Vec<f64> = (0..n).map(|k| 0.64 + 0.051 * k as f64).collect();
+    fn batch_point_and_engines_agree_bit_for_bit() {
+        let mut state = 0x853c_49e6_748f_ea9bu64;
+        let r2: Vec<f64> = (0..130)
+            .map(|_| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                0.3 + 8.0 * ((state >> 11) as f64 / (1u64 << 53) as f64)
+            })
+            .collect();
+        for text in [
+            LJ,
+            "D*((1 - exp(-a*(r - r0)))^2 - 1)",
+            "eps*exp(-r/sigma)/r + r^(-7) - r^(-3)",
+            "sin(r)^2 + r^3/7 + atan(r) + sqrt(r) + abs(r - 1) + log(r) + cosh(r)",
+            "min(r, 1.5) + max(r^2, 2) + sign(r - 1)*tanh(r) + r^2.5",
+        ] {
+            let native = FormulaPair::compile(text, &params(), JitMode::Auto).unwrap();
+            assert!(native.is_native(), "this test host has a Cranelift backend");
+            let interp = FormulaPair::compile(text, &params(), JitMode::Off).unwrap();
+            assert!(!interp.is_native());
+            for n in [1, 2, 3, 4, 63, 64, 65, 130] {
+                let batch = |f: &FormulaPair| {
                     let (mut u, mut fr) = (vec![0.0; n], vec![0.0; n]);
-                    f.raw_batch(&r2, &mut u, &mut fr);
-                    for k in 0..n {
-                        let (a, b) = f.raw(r2[k]);
-                        for (x, y) in [(a, u[k]), (b, fr[k])] {
-                            assert!(
-                                (x - y).abs() <= 1e-13 * x.abs().max(1e-300),
-                                "{text} {mode:?} r2 = {}: point {x} vs batch {y}",
-                                r2[k]
-                            );
-                        }
+                    f.raw_batch(&r2[..n], &mut u, &mut fr);
+                    (u, fr)
+                };
+                let (a, b) = (batch(&native), batch(&interp));
+                for (k, &s) in r2[..n].iter().enumerate() {
+                    let p = native.raw(s);
+                    let q = interp.raw(s);
+                    for (x, y) in [
+                        (a.0[k], b.0[k]),
+                        (a.1[k], b.1[k]),
+                        (a.0[k], p.0),
+                        (a.1[k], p.1),
+                        (p.0, q.0),
+                        (p.1, q.1),
+                    ] {
+                        assert_eq!(
+                            x.to_bits(),
+                            y.to_bits(),
+                            "{text}, r2 = {s}, n = {n}: {x:e} vs {y:e}"
+                        );
                     }
                 }
             }

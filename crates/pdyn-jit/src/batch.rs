@@ -1,0 +1,997 @@
+//! Batch kernels: one [`Program`] applied to whole columns of inputs, the loop inside the
+//! machine code.
+//!
+//! [`crate::JitProgram`] evaluates a program at one point per call. A caller that evaluates
+//! the same small program at many points — a pair potential at every neighbour distance —
+//! then pays a call, the loads and stores of its arguments and the loss of packed arithmetic
+//! per point. A [`BatchKernel`] is compiled once into a function
+//! `fn(inputs: *const *const f64, outputs: *const *mut f64, n: usize)` that loops over the `n`
+//! points itself, two points per iteration in packed `f64x2` registers (a scalar iteration
+//! for an odd last point), every intermediate value in a register.
+//!
+//! ## The kernel's program
+//! Before compilation the program is rewritten once into [`Steps`]:
+//! - instructions no output needs are dropped;
+//! - divisions share reciprocals: `a / x` becomes `a · (1/x)` with one `1/x` per `x`, and
+//!   `1/xᵏ` becomes `(1/x)ᵏ` when `xᵏ` is a known power of `x` (a `powi`, or products such as
+//!   `x·x`, `x·x·x`), because a derived potential divides by many powers of its variable
+//!   (Lennard-Jones in `r²`: four divisions, one after the rewrite) and a division costs
+//!   several multiplications.
+//!
+//! The results therefore differ from [`Program::eval`] by a few units in the last place. They
+//! do not differ between the two engines of a kernel: native code and the column interpreter
+//! used without a JIT ([`JitMode::Off`], or no Cranelift backend) run the same [`Steps`] with
+//! the same IEEE operations in the same order (integer powers by `f64::powi`'s
+//! square-and-multiply, transcendental functions through the same `f64` methods), so they give
+//! the same bits (tested on random inputs).
+use super::{binary_shim, codegen, inline_powi, shims, unary_shim, Code, JitError, JitMode, RawFn};
+use cranelift_codegen::ir::condcodes::IntCC;
+use cranelift_codegen::ir::{
+    types, AbiParam, BlockArg, Function, InstBuilder, MemFlags, SigRef, Signature, Type, Value,
+};
+use cranelift_codegen::isa::CallConv;
+use cranelift_codegen::settings::{self, Configurable};
+use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
+use cranelift_jit::{JITBuilder, JITModule};
+use cranelift_module::{default_libcall_names, Linkage, Module};
+use pdyn_expr::compile::Op;
+use pdyn_expr::Program;
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+
+/// Points per column of the interpreter: enough to amortise the dispatch of each step, few
+/// enough that the rows (`LANES` values each) stay in the L1 cache.
+const LANES: usize = 64;
+
+/// One step: `row[dst] = op(row[a], row[b])` (`b` the exponent for `Powi`).
+#[derive(Debug, Clone, Copy)]
+struct Step {
+    op: Op,
+    a: u32,
+    b: u32,
+    dst: u32,
+}
+
+/// A [`Program`] rewritten for batch evaluation: rows `[inputs | constants | one row per
+/// step, in step order]`, so every step writes a row above its operands.
+#[derive(Debug)]
+struct Steps {
+    /// Identifies these steps in a thread's interpreter rows, whose constants are filled once.
+    id: u64,
+    n_inputs: usize,
+    rows: usize,
+    consts: Vec<(u32, f64)>,
+    steps: Vec<Step>,
+    outs: Vec<u32>,
+}
+
+/// Ids of [`Steps`].
+static NEXT_ID: AtomicU64 = AtomicU64::new(0);
+
+/// Whether the kernel evaluates `op` (every operation `Program` had when this was written).
+fn known(op: Op) -> bool {
+    matches!(
+        op,
+        Op::Add
+            | Op::Sub
+            | Op::Mul
+            | Op::Div
+            | Op::Neg
+            | Op::Sqrt
+            | Op::Powi
+            | Op::Powf
+            | Op::Sin
+            | Op::Cos
+            | Op::Tan
+            | Op::Asin
+            | Op::Acos
+            | Op::Atan
+            | Op::Atan2
+            | Op::Sinh
+            | Op::Cosh
+            | Op::Tanh
+            | Op::Exp
+            | Op::Ln
+            | Op::Abs
+            | Op::Sign
+            | Op::Min
+            | Op::Max
+    )
+}
+
+/// State of [`Steps::new`] while it rewrites.
+struct Rewrite {
+    rows: u32,
+    consts: Vec<(u32, f64)>,
+    steps: Vec<Step>,
+    /// Row holding the constant 1.
+    one: Option<u32>,
+    /// Row of `1/x` for row `x`.
+    recip: HashMap<u32, u32>,
+    /// Rows known to hold `yᵏ`, `k > 0`: `(y, k)`.
+    power: HashMap<u32, (u32, i32)>,
+}
+
+impl Rewrite {
+    fn push(&mut self, op: Op, a: u32, b: u32, dst: u32) {
+        self.steps.push(Step { op, a, b, dst });
+    }
+
+    fn new_row(&mut self) -> u32 {
+        self.rows += 1;
+        self.rows - 1
+    }
+
+    /// `(y, k)` with row `x = yᵏ` (`(x, 1)` when nothing better is known).
+    fn as_power(&self, x: u32) -> (u32, i32) {
+        self.power.get(&x).copied().unwrap_or((x, 1))
+    }
+
+    /// Records `dst = a·b` as a power when both are powers of one row.
+    fn note_product(&mut self, a: u32, b: u32, dst: u32) {
+        let ((ya, ka), (yb, kb)) = (self.as_power(a), self.as_power(b));
+        if ya == yb {
+            if let Some(k) = ka.checked_add(kb) {
+                self.power.insert(dst, (ya, k));
+            }
+        }
+    }
+
+    /// The row of `1/x`, made once: `(1/y)ᵏ` when `x = yᵏ`, else one division.
+    fn recip_of(&mut self, x: u32) -> u32 {
+        if let Some(&r) = self.recip.get(&x) {
+            return r;
+        }
+        let r = if let Some(&(y, k)) = self.power.get(&x) {
+            let ry = self.recip_of(y);
+            let r = self.new_row();
+            self.push(Op::Powi, ry, k as u32, r);
+            r
+        } else {
+            let one = match self.one {
+                Some(o) => o,
+                None => {
+                    let o = self.new_row();
+                    self.consts.push((o, 1.0));
+                    self.one = Some(o);
+                    o
+                }
+            };
+            let r = self.new_row();
+            self.push(Op::Div, one, x, r);
+            r
+        };
+        self.recip.insert(x, r);
+        r
+    }
+}
+
+impl Steps {
+    /// The steps of `prog`, or `None` when it has an operation [`known`] does not list.
+    fn new(prog: &Program) -> Option<Steps> {
+        let ins = prog.instructions();
+        if !ins.iter().all(|i| known(i.op())) {
+            return None;
+        }
+        let n_in = prog.n_inputs();
+        let start = prog.first_temporary();
+        let consts = prog.constants();
+        let const_of = |r: u32| {
+            let r = r as usize;
+            (r >= n_in && r < start).then(|| consts[r - n_in])
+        };
+        // liveness, backwards from the outputs
+        let mut live = vec![false; start + ins.len()];
+        for &o in prog.output_registers() {
+            live[o as usize] = true;
+        }
+        for (k, i) in ins.iter().enumerate().rev() {
+            if live[start + k] {
+                live[i.a() as usize] = true;
+                if i.op().reads_b() {
+                    live[i.b() as usize] = true;
+                }
+            }
+        }
+        let mut c = Rewrite {
+            rows: (start + ins.len()) as u32,
+            consts: consts
+                .iter()
+                .enumerate()
+                .map(|(k, &v)| ((n_in + k) as u32, v))
+                .collect(),
+            steps: vec![],
+            one: None,
+            recip: HashMap::new(),
+            power: HashMap::new(),
+        };
+        // original register -> row holding its value (`1/x` becomes the reciprocal's row)
+        let mut map: Vec<u32> = (0..(start + ins.len()) as u32).collect();
+        for (k, i) in ins.iter().enumerate() {
+            let dst = (start + k) as u32;
+            if !live[dst as usize] {
+                continue;
+            }
+            let a = map[i.a() as usize];
+            let b = if i.op().reads_b() {
+                map[i.b() as usize]
+            } else {
+                i.b()
+            };
+            let e = i.b() as i32;
+            match i.op() {
+                Op::Div => {
+                    let r = c.recip_of(b);
+                    if const_of(i.a()) == Some(1.0) {
+                        map[dst as usize] = r;
+                    } else {
+                        c.push(Op::Mul, a, r, dst);
+                    }
+                }
+                Op::Powi if e < 0 && e != i32::MIN => {
+                    let r = c.recip_of(a);
+                    c.push(Op::Powi, r, e.unsigned_abs(), dst);
+                    c.power.insert(dst, (r, -e));
+                }
+                Op::Powi => {
+                    c.push(Op::Powi, a, i.b(), dst);
+                    if e > 0 {
+                        let (y, k) = c.as_power(a);
+                        match k.checked_mul(e) {
+                            Some(k) => c.power.insert(dst, (y, k)),
+                            None => c.power.insert(dst, (a, e)),
+                        };
+                    }
+                }
+                Op::Mul => {
+                    c.push(Op::Mul, a, b, dst);
+                    c.note_product(a, b, dst);
+                }
+                op => c.push(op, a, b, dst),
+            }
+        }
+        let outs: Vec<u32> = prog
+            .output_registers()
+            .iter()
+            .map(|&o| map[o as usize])
+            .collect();
+        // the rewrite leaves some steps unused (`xᵏ` when only `1/xᵏ` was needed): keep only
+        // the steps an output depends on
+        let mut need = vec![false; c.rows as usize];
+        for &o in &outs {
+            need[o as usize] = true;
+        }
+        let mut steps = Vec::with_capacity(c.steps.len());
+        for st in c.steps.iter().rev() {
+            if need[st.dst as usize] {
+                need[st.a as usize] = true;
+                if st.op.reads_b() {
+                    need[st.b as usize] = true;
+                }
+                steps.push(*st);
+            }
+        }
+        steps.reverse();
+        // compact rows: [inputs | constants used | one row per step, in step order]
+        let mut row = vec![u32::MAX; c.rows as usize];
+        for (r, x) in row.iter_mut().enumerate().take(n_in) {
+            *x = r as u32;
+        }
+        let mut next = n_in as u32;
+        let mut kept = vec![];
+        for &(r, v) in &c.consts {
+            if need[r as usize] {
+                row[r as usize] = next;
+                kept.push((next, v));
+                next += 1;
+            }
+        }
+        for st in &mut steps {
+            st.a = row[st.a as usize];
+            if st.op.reads_b() {
+                st.b = row[st.b as usize];
+            }
+            row[st.dst as usize] = next;
+            st.dst = next;
+            next += 1;
+        }
+        let outs: Vec<u32> = outs.iter().map(|&o| row[o as usize]).collect();
+        if outs.contains(&u32::MAX) {
+            return None; // an output that is neither input, constant nor step: not expected
+        }
+        Some(Steps {
+            id: NEXT_ID.fetch_add(1, Ordering::Relaxed),
+            n_inputs: n_in,
+            rows: next as usize,
+            consts: kept,
+            steps,
+            outs,
+        })
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// The interpreter
+
+thread_local! {
+    /// Rows of the interpreter, per thread (kernels run on many threads at once and `run`
+    /// takes `&self`), with the id of the [`Steps`] whose constants they hold.
+    static ROWS: RefCell<(u64, Vec<f64>)> = const { RefCell::new((u64::MAX, Vec::new())) };
+}
+
+impl Steps {
+    /// Evaluates the steps column-wise, [`LANES`] points at a time.
+    fn interpret(&self, inputs: &[&[f64]], outputs: &mut [&mut [f64]], n: usize) {
+        ROWS.with(|cell| {
+            let mut guard = cell.borrow_mut();
+            let (id, regs) = &mut *guard;
+            if regs.len() < self.rows * LANES {
+                regs.resize(self.rows * LANES, 0.0);
+                *id = u64::MAX;
+            }
+            let regs = &mut regs[..self.rows * LANES];
+            if *id != self.id {
+                // constant rows are never written by a step: filled once per kernel
+                for &(row, v) in &self.consts {
+                    regs[row as usize * LANES..][..LANES].fill(v);
+                }
+                *id = self.id;
+            }
+            for lo in (0..n).step_by(LANES) {
+                let m = LANES.min(n - lo);
+                for (k, x) in inputs.iter().enumerate() {
+                    regs[k * LANES..][..m].copy_from_slice(&x[lo..lo + m]);
+                }
+                for st in &self.steps {
+                    // operands lie below the destination row
+                    let (below, above) = regs.split_at_mut(st.dst as usize * LANES);
+                    column(st.op, st.a, st.b, below, &mut above[..m]);
+                }
+                for (o, &r) in outputs.iter_mut().zip(&self.outs) {
+                    o[lo..lo + m].copy_from_slice(&regs[r as usize * LANES..][..m]);
+                }
+            }
+        });
+    }
+}
+
+/// One step over a column: `out[l] = op(a[l], b[l])` for every lane, with the operations of
+/// `Program::eval` (and of the native kernel); `rows` holds the operand rows.
+#[inline]
+fn column(op: Op, a: u32, b: u32, rows: &[f64], out: &mut [f64]) {
+    let m = out.len();
+    let a = &rows[a as usize * LANES..][..m];
+    let rb = || &rows[b as usize * LANES..][..m];
+    let un = |out: &mut [f64], f: fn(f64) -> f64| {
+        for (o, &x) in out.iter_mut().zip(a) {
+            *o = f(x);
+        }
+    };
+    let bin = |out: &mut [f64], f: fn(f64, f64) -> f64| {
+        for ((o, &x), &y) in out.iter_mut().zip(a).zip(rb()) {
+            *o = f(x, y);
+        }
+    };
+    match op {
+        Op::Add => bin(out, |x, y| x + y),
+        Op::Sub => bin(out, |x, y| x - y),
+        Op::Mul => bin(out, |x, y| x * y),
+        Op::Div => bin(out, |x, y| x / y),
+        Op::Neg => un(out, |x| -x),
+        Op::Sqrt => un(out, f64::sqrt),
+        Op::Powi => powi_column(out, a, b as i32),
+        Op::Powf => bin(out, f64::powf),
+        Op::Sin => un(out, f64::sin),
+        Op::Cos => un(out, f64::cos),
+        Op::Tan => un(out, f64::tan),
+        Op::Asin => un(out, f64::asin),
+        Op::Acos => un(out, f64::acos),
+        Op::Atan => un(out, f64::atan),
+        Op::Atan2 => bin(out, f64::atan2),
+        Op::Sinh => un(out, f64::sinh),
+        Op::Cosh => un(out, f64::cosh),
+        Op::Tanh => un(out, f64::tanh),
+        Op::Exp => un(out, f64::exp),
+        Op::Ln => un(out, f64::ln),
+        Op::Abs => un(out, f64::abs),
+        Op::Sign => un(out, |x| sign(x)),
+        Op::Min => bin(out, f64::min),
+        Op::Max => bin(out, f64::max),
+        // `Steps::new` refuses operations `known` does not list: not reached
+        _ => out.fill(f64::NAN),
+    }
+}
+
+/// `out[l] = a[l]^k` by the squarings and products of `f64::powi` (compiler-builtins'
+/// `__powidf2`: multiply in the base for every set bit of `|k|`, square between bits,
+/// reciprocal last for `k < 0`), lane by lane in packed loops; the first factor is taken as
+/// it is (`1·x = x` exactly), as the native kernel does.
+fn powi_column(out: &mut [f64], a: &[f64], k: i32) {
+    let m = out.len();
+    let mut base = [0.0f64; LANES];
+    let base = &mut base[..m];
+    base.copy_from_slice(&a[..m]);
+    out.fill(1.0);
+    let mut pow = k.unsigned_abs();
+    loop {
+        if pow & 1 != 0 {
+            for (o, &x) in out.iter_mut().zip(base.iter()) {
+                *o *= x;
+            }
+        }
+        pow >>= 1;
+        if pow == 0 {
+            break;
+        }
+        for x in base.iter_mut() {
+            *x *= *x;
+        }
+    }
+    if k < 0 {
+        for o in out.iter_mut() {
+            *o = 1.0 / *o;
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Native code
+
+/// The generated loop: `(inputs, outputs, n)`, each of `inputs`/`outputs` an array of column
+/// pointers. It lives in the crate's [`Code`] (which owns and frees the code memory), stored
+/// there as a [`RawFn`] and turned back into this type to be called.
+type BatchFn = unsafe extern "C" fn(*const *const f64, *const *mut f64, usize);
+
+/// `sign` as the interpreter computes it: 1 for x > 0, −1 for x < 0, `x·0` otherwise (±0,
+/// or NaN for NaN); the native kernel calls it lane by lane.
+extern "C" fn sign(x: f64) -> f64 {
+    if x > 0.0 {
+        1.0
+    } else if x < 0.0 {
+        -1.0
+    } else {
+        x * 0.0
+    }
+}
+
+/// Signatures of the shims a kernel may call.
+struct Shims {
+    unary: SigRef,
+    binary: SigRef,
+    powi: SigRef,
+}
+
+/// Emits the steps once for values of type `ty` (`F64` or `F64X2`): `vals` holds the inputs
+/// and constants (rows below the first step) and receives one value per step.
+fn emit_steps(
+    b: &mut FunctionBuilder,
+    steps: &Steps,
+    ty: Type,
+    ptr: Type,
+    sigs: &Shims,
+    vals: &mut Vec<Value>,
+) {
+    for st in &steps.steps {
+        let a = vals[st.a as usize];
+        let rb = if st.op.reads_b() {
+            Some(vals[st.b as usize])
+        } else {
+            None
+        };
+        let bv = || rb.expect("binary operation reads b");
+        let v = match st.op {
+            Op::Add => b.ins().fadd(a, bv()),
+            Op::Sub => b.ins().fsub(a, bv()),
+            Op::Mul => b.ins().fmul(a, bv()),
+            Op::Div => b.ins().fdiv(a, bv()),
+            Op::Neg => b.ins().fneg(a),
+            Op::Sqrt => b.ins().sqrt(a),
+            Op::Abs => b.ins().fabs(a),
+            Op::Powi if st.b == 0 => {
+                let one = b.ins().f64const(1.0);
+                splat(b, ty, one)
+            }
+            Op::Powi if st.b as i32 > 0 && st.b as i32 <= super::MAX_INLINE_POWI => {
+                inline_powi(b, a, st.b)
+            }
+            op => per_lane(b, ty, a, rb, |b, x, y| {
+                scalar_call(b, op, st.b, x, y, ptr, sigs)
+            }),
+        };
+        debug_assert_eq!(vals.len(), st.dst as usize);
+        vals.push(v);
+    }
+}
+
+fn splat(b: &mut FunctionBuilder, ty: Type, x: Value) -> Value {
+    if ty == types::F64 {
+        x
+    } else {
+        b.ins().splat(ty, x)
+    }
+}
+
+/// `f` applied lane by lane (directly for scalars).
+fn per_lane(
+    b: &mut FunctionBuilder,
+    ty: Type,
+    a: Value,
+    rb: Option<Value>,
+    mut f: impl FnMut(&mut FunctionBuilder, Value, Option<Value>) -> Value,
+) -> Value {
+    if ty == types::F64 {
+        return f(b, a, rb);
+    }
+    let mut v = None;
+    for lane in 0..ty.lane_count() as u8 {
+        let x = b.ins().extractlane(a, lane);
+        let y = rb.map(|y| b.ins().extractlane(y, lane));
+        let r = f(b, x, y);
+        v = Some(match v {
+            None => b.ins().splat(ty, r),
+            Some(v) => b.ins().insertlane(v, r, lane),
+        });
+    }
+    v.expect("vectors have lanes")
+}
+
+/// A scalar operation without a packed form, through its shim.
+fn scalar_call(
+    b: &mut FunctionBuilder,
+    op: Op,
+    exponent: u32,
+    x: Value,
+    y: Option<Value>,
+    ptr: Type,
+    sigs: &Shims,
+) -> Value {
+    let call = |b: &mut FunctionBuilder, addr: usize, sig: SigRef, args: &[Value]| {
+        let f = b.ins().iconst(ptr, addr as i64);
+        let c = b.ins().call_indirect(sig, f, args);
+        b.inst_results(c)[0]
+    };
+    match op {
+        Op::Sign => {
+            let f = sign as extern "C" fn(f64) -> f64;
+            call(b, f as usize, sigs.unary, &[x])
+        }
+        Op::Powi => {
+            let e = b.ins().iconst(types::I32, exponent as i32 as i64);
+            let f = shims::powi as extern "C" fn(f64, i32) -> f64;
+            call(b, f as usize, sigs.powi, &[x, e])
+        }
+        op => {
+            if let Some(f) = unary_shim(op) {
+                call(b, f as usize, sigs.unary, &[x])
+            } else if let Some(f) = binary_shim(op) {
+                let y = y.expect("binary operation reads b");
+                call(b, f as usize, sigs.binary, &[x, y])
+            } else {
+                // `Steps::new` refuses operations `known` does not list: not reached
+                b.ins().f64const(f64::NAN)
+            }
+        }
+    }
+}
+
+/// Emits the kernel of `steps` into `func`:
+///
+/// ```text
+/// entry:   load the column pointers; constants (scalar and splat)   → vhead(0)
+/// vhead i: i + 2 ≤ n ? vbody(i) : shead(i)
+/// vbody i: two points packed; store; → vhead(i + 2)
+/// shead i: i < n ? sbody(i) : exit
+/// sbody i: one point; store; → shead(i + 1)
+/// ```
+fn emit_kernel(
+    steps: &Steps,
+    ptr: Type,
+    call_conv: CallConv,
+    func: &mut Function,
+    fctx: &mut FunctionBuilderContext,
+) {
+    const W: i64 = 2;
+    let vty = types::F64X2;
+    let mut b = FunctionBuilder::new(func, fctx);
+    let entry = b.create_block();
+    b.append_block_params_for_function_params(entry);
+    let [vhead, vbody, shead, sbody] = [(); 4].map(|_| {
+        let blk = b.create_block();
+        b.append_block_param(blk, ptr);
+        blk
+    });
+    let exit = b.create_block();
+
+    b.switch_to_block(entry);
+    let params = b.block_params(entry).to_vec();
+    let (inp, outp, n) = (params[0], params[1], params[2]);
+    let mut sig = |params: &[Type]| {
+        let mut s = Signature::new(call_conv);
+        s.params.extend(params.iter().map(|&t| AbiParam::new(t)));
+        s.returns.push(AbiParam::new(types::F64));
+        b.import_signature(s)
+    };
+    let sigs = Shims {
+        unary: sig(&[types::F64]),
+        binary: sig(&[types::F64, types::F64]),
+        powi: sig(&[types::F64, types::I32]),
+    };
+    let table = MemFlags::trusted();
+    // columns are `f64` slices: 8-byte aligned, not 16
+    let data = MemFlags::new().with_notrap();
+    let ins: Vec<Value> = (0..steps.n_inputs)
+        .map(|k| b.ins().load(ptr, table, inp, 8 * k as i32))
+        .collect();
+    let outs: Vec<Value> = (0..steps.outs.len())
+        .map(|k| b.ins().load(ptr, table, outp, 8 * k as i32))
+        .collect();
+    let cs: Vec<Value> = steps
+        .consts
+        .iter()
+        .map(|&(_, v)| b.ins().f64const(v))
+        .collect();
+    let vcs: Vec<Value> = cs.iter().map(|&c| b.ins().splat(vty, c)).collect();
+    let zero = b.ins().iconst(ptr, 0);
+    b.ins().jump(vhead, &[BlockArg::Value(zero)]);
+
+    // one iteration of `ty` at index i: load, steps, store
+    let body = |b: &mut FunctionBuilder, i: Value, ty: Type, consts: &[Value]| {
+        let off = b.ins().ishl_imm(i, 3);
+        let mut vals: Vec<Value> = ins
+            .iter()
+            .map(|&p| {
+                let addr = b.ins().iadd(p, off);
+                b.ins().load(ty, data, addr, 0)
+            })
+            .collect();
+        vals.extend_from_slice(consts);
+        emit_steps(b, steps, ty, ptr, &sigs, &mut vals);
+        for (&p, &r) in outs.iter().zip(&steps.outs) {
+            let addr = b.ins().iadd(p, off);
+            b.ins().store(data, vals[r as usize], addr, 0);
+        }
+    };
+
+    b.switch_to_block(vhead);
+    let i = b.block_params(vhead)[0];
+    let end = b.ins().iadd_imm(i, W);
+    let more = b.ins().icmp(IntCC::UnsignedLessThanOrEqual, end, n);
+    let arg = [BlockArg::Value(i)];
+    b.ins().brif(more, vbody, &arg, shead, &arg);
+
+    b.switch_to_block(vbody);
+    let i = b.block_params(vbody)[0];
+    body(&mut b, i, vty, &vcs);
+    let next = b.ins().iadd_imm(i, W);
+    b.ins().jump(vhead, &[BlockArg::Value(next)]);
+
+    b.switch_to_block(shead);
+    let i = b.block_params(shead)[0];
+    let more = b.ins().icmp(IntCC::UnsignedLessThan, i, n);
+    b.ins().brif(more, sbody, &[BlockArg::Value(i)], exit, &[]);
+
+    b.switch_to_block(sbody);
+    let i = b.block_params(sbody)[0];
+    body(&mut b, i, types::F64, &cs);
+    let next = b.ins().iadd_imm(i, 1);
+    b.ins().jump(shead, &[BlockArg::Value(next)]);
+
+    b.switch_to_block(exit);
+    b.ins().return_(&[]);
+    b.seal_all_blocks();
+    b.finalize();
+}
+
+/// Compiles `steps` to a native loop.
+fn compile(steps: &Steps) -> Result<Code, JitError> {
+    let isa_builder = cranelift_native::builder().map_err(|r| JitError::Unsupported {
+        reason: r.to_string(),
+    })?;
+    let mut flags = settings::builder();
+    for (k, v) in [
+        ("opt_level", "speed"),
+        ("use_colocated_libcalls", "false"),
+        ("is_pic", "false"),
+        // generated from checked `Steps`; the agreement tests run every operation
+        ("enable_verifier", "false"),
+    ] {
+        flags.set(k, v).map_err(codegen)?;
+    }
+    let isa = isa_builder
+        .finish(settings::Flags::new(flags))
+        .map_err(codegen)?;
+    let mut module = JITModule::new(JITBuilder::with_isa(isa, default_libcall_names()));
+    let ptr = module.target_config().pointer_type();
+    let call_conv = module.isa().default_call_conv();
+    let mut ctx = module.make_context();
+    let mut fctx = FunctionBuilderContext::new();
+    ctx.func
+        .signature
+        .params
+        .extend([ptr, ptr, ptr].map(AbiParam::new));
+    emit_kernel(steps, ptr, call_conv, &mut ctx.func, &mut fctx);
+    let id = module
+        .declare_function("pdyn_batch", Linkage::Local, &ctx.func.signature)
+        .map_err(codegen)?;
+    module.define_function(id, &mut ctx).map_err(codegen)?;
+    module.finalize_definitions().map_err(codegen)?;
+    let raw = module.get_finalized_function(id);
+    // SAFETY: `raw` is finalized code. It is stored as a `RawFn` (a function pointer of the
+    // same size) and only ever called as the `BatchFn` it is, by `call`.
+    let func = unsafe { std::mem::transmute::<*const u8, RawFn>(raw) };
+    Ok(Code {
+        module: Some(module),
+        funcs: vec![func],
+    })
+}
+
+// ---------------------------------------------------------------------------------------
+// The public face
+
+/// A [`Program`] evaluated over columns of points; see the module documentation.
+///
+/// Cheap to clone (shared behind `Arc`s), `Send + Sync`: any number of threads may run it at
+/// once.
+#[derive(Clone)]
+pub struct BatchKernel {
+    steps: Arc<Steps>,
+    /// Native code (`None`: the column interpreter).
+    code: Option<Arc<Code>>,
+}
+
+impl std::fmt::Debug for BatchKernel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("BatchKernel")
+            .field("inputs", &self.steps.n_inputs)
+            .field("outputs", &self.steps.outs.len())
+            .field("steps", &self.steps.steps.len())
+            .field("native", &self.code.is_some())
+            .finish()
+    }
+}
+
+impl BatchKernel {
+    /// The kernel of `prog` according to `mode` ([`JitMode::Auto`]: native code when the
+    /// platform has a Cranelift backend, the column interpreter otherwise; the results are
+    /// the same bits). `None` when `prog` has an operation this module does not know (a newer
+    /// `Op`).
+    pub fn new(prog: &Program, mode: JitMode) -> Option<BatchKernel> {
+        let steps = Steps::new(prog)?;
+        let code = match mode {
+            JitMode::Off => None,
+            JitMode::Auto => compile(&steps).ok().map(Arc::new),
+        };
+        Some(BatchKernel {
+            steps: Arc::new(steps),
+            code,
+        })
+    }
+
+    /// True when native code runs.
+    pub fn is_native(&self) -> bool {
+        self.code.is_some()
+    }
+
+    /// Number of input columns.
+    pub fn n_inputs(&self) -> usize {
+        self.steps.n_inputs
+    }
+
+    /// Number of output columns.
+    pub fn n_outputs(&self) -> usize {
+        self.steps.outs.len()
+    }
+
+    /// Number of operations per point after the rewrite.
+    pub fn len(&self) -> usize {
+        self.steps.steps.len()
+    }
+
+    /// True when every output is an input or a constant.
+    pub fn is_empty(&self) -> bool {
+        self.steps.steps.is_empty()
+    }
+
+    /// `outputs[o][k] = output o of the program at inputs[·][k]`, for every `k` below the
+    /// common length `n` of the columns; allocates nothing (the interpreter's rows are
+    /// per thread and kept).
+    ///
+    /// # Panics
+    /// If the number of columns is not [`BatchKernel::n_inputs`] and
+    /// [`BatchKernel::n_outputs`], or the columns differ in length (a programming error).
+    pub fn run(&self, inputs: &[&[f64]], outputs: &mut [&mut [f64]]) {
+        let s = &self.steps;
+        assert!(
+            inputs.len() == s.n_inputs && outputs.len() == s.outs.len(),
+            "BatchKernel::run: {} input and {} output columns given, {} and {} expected",
+            inputs.len(),
+            outputs.len(),
+            s.n_inputs,
+            s.outs.len()
+        );
+        let n = outputs.first().map_or(0, |o| o.len());
+        assert!(
+            inputs.iter().all(|x| x.len() == n) && outputs.iter().all(|o| o.len() == n),
+            "BatchKernel::run: columns of different lengths"
+        );
+        let Some(code) = &self.code else {
+            return s.interpret(inputs, outputs, n);
+        };
+        // column pointers on the stack for the usual few columns
+        const FEW: usize = 8;
+        if inputs.len() <= FEW && outputs.len() <= FEW {
+            let mut ip = [std::ptr::null::<f64>(); FEW];
+            let mut op = [std::ptr::null_mut::<f64>(); FEW];
+            ip.iter_mut().zip(inputs).for_each(|(p, x)| *p = x.as_ptr());
+            op.iter_mut()
+                .zip(outputs.iter_mut())
+                .for_each(|(p, o)| *p = o.as_mut_ptr());
+            call(code, &ip, &op, n);
+        } else {
+            let ip: Vec<*const f64> = inputs.iter().map(|x| x.as_ptr()).collect();
+            let op: Vec<*mut f64> = outputs.iter_mut().map(|o| o.as_mut_ptr()).collect();
+            call(code, &ip, &op, n);
+        }
+    }
+}
+
+/// Calls the native loop on column pointers taken from slices of length ≥ `n`.
+#[inline]
+fn call(code: &Code, ip: &[*const f64], op: &[*mut f64], n: usize) {
+    // SAFETY: `compile` stored one function, generated with the signature of `BatchFn`. It
+    // reads `ip[..n_inputs]` and `op[..n_outputs]` (both arrays at least that long: `run`
+    // checked the column counts), then reads `n` values from each input column and writes `n`
+    // values to each output column; `run` took them from slices of length `n`, the outputs
+    // borrowed mutably, so the accesses are in bounds and unaliased. The code is alive while
+    // `code` is.
+    unsafe {
+        let f = std::mem::transmute::<RawFn, BatchFn>(code.funcs[0]);
+        f(ip.as_ptr(), op.as_ptr(), n)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pdyn_expr::{Id, Pool};
+
+    fn same(a: f64, b: f64) -> bool {
+        a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
+    }
+
+    /// xorshift values over many binades, both signs, with special values mixed in.
+    fn random_inputs(n: usize, seed: u64, positive: bool) -> Vec<f64> {
+        let mut state = seed | 1;
+        let specials = [0.0, -0.0, 1.0, -1.0, f64::NAN, f64::INFINITY, 1e300, 1e-300];
+        (0..n)
+            .map(|k| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                if k % 17 == 5 {
+                    return specials[(state % specials.len() as u64) as usize];
+                }
+                let mantissa = (state >> 11) as f64 / (1u64 << 53) as f64;
+                let exponent = ((state >> 3) % 12) as i32 - 6;
+                let v = (0.05 + mantissa) * 2f64.powi(exponent);
+                if positive || state & 4 == 0 {
+                    v
+                } else {
+                    -v
+                }
+            })
+            .collect()
+    }
+
+    fn kernels(srcs: &[&str], vars: &[&str]) -> (BatchKernel, BatchKernel, Program) {
+        let mut p = Pool::new();
+        let xs: Vec<Id> = vars.iter().map(|v| p.var(v)).collect();
+        let outs: Vec<Id> = srcs.iter().map(|s| p.parse_scalar(s).unwrap()).collect();
+        let prog = Program::compile(&mut p, &xs, &outs).unwrap();
+        let native = BatchKernel::new(&prog, JitMode::Auto).unwrap();
+        assert!(native.is_native(), "this test host has a Cranelift backend");
+        let interp = BatchKernel::new(&prog, JitMode::Off).unwrap();
+        assert!(!interp.is_native());
+        (native, interp, prog)
+    }
+
+    /// Runs both engines on the same random columns and compares every output bit for bit;
+    /// checks against the point interpreter to `tol` relative.
+    fn agree(srcs: &[&str], vars: &[&str], positive: bool, tol: f64) {
+        let (native, interp, prog) = kernels(srcs, vars);
+        for n in [0, 1, 2, 3, 7, 63, 64, 65, 130, 257] {
+            let cols: Vec<Vec<f64>> = (0..vars.len())
+                .map(|k| random_inputs(n, 0x9E37_79B9 + 31 * k as u64 + n as u64, positive))
+                .collect();
+            let ins: Vec<&[f64]> = cols.iter().map(|c| &c[..]).collect();
+            let mut o1 = vec![vec![0.0; n]; srcs.len()];
+            let mut o2 = vec![vec![7.0; n]; srcs.len()];
+            let mut s1: Vec<&mut [f64]> = o1.iter_mut().map(|c| &mut c[..]).collect();
+            native.run(&ins, &mut s1);
+            let mut s2: Vec<&mut [f64]> = o2.iter_mut().map(|c| &mut c[..]).collect();
+            interp.run(&ins, &mut s2);
+            let mut ws = prog.workspace();
+            let mut point = vec![0.0; srcs.len()];
+            for k in 0..n {
+                let x: Vec<f64> = cols.iter().map(|c| c[k]).collect();
+                prog.eval(&x, &mut ws, &mut point);
+                for o in 0..srcs.len() {
+                    let (a, b) = (o1[o][k], o2[o][k]);
+                    assert!(
+                        same(a, b),
+                        "{} at {x:?} (n = {n}): native {a:e}, interpreter {b:e}",
+                        srcs[o]
+                    );
+                    let p = point[o];
+                    if p.is_finite() && p.abs() > 1e-250 && p.abs() < 1e250 {
+                        assert!(
+                            (a - p).abs() <= tol * p.abs(),
+                            "{} at {x:?}: batch {a:e}, point {p:e}",
+                            srcs[o]
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn native_and_interpreter_agree_bit_for_bit_on_every_operation() {
+        // every operation, integer powers inlined (≤ 64) and called, negative powers through
+        // the shared reciprocal
+        let ops = "x + y; x - y; x*y; x/y; -x; x^2; x^3; x^7; x^12; x^64; x^65; x^(-12); \
+                   x^(-3); x^(-65); x^(3/2); x^y; x^0.3; sqrt(x); sin(x); cos(x); tan(x); \
+                   asin(x); acos(x); atan(x); atan2(x, y); sinh(x); cosh(x); tanh(x); exp(x); \
+                   log(x); abs(x); sign(x); min(x, y); max(x, y); 3; x";
+        let srcs: Vec<&str> = ops.split("; ").collect();
+        agree(&srcs, &["x", "y"], false, 1e-12);
+    }
+
+    #[test]
+    fn pair_potentials_in_r_squared_agree_bit_for_bit() {
+        // Lennard-Jones and its −2 du/ds in s = r², Morse in r = sqrt(s), a screened Coulomb
+        agree(
+            &[
+                "4*(1.3*s^(-6) - 0.7*s^(-3))",
+                "-2*4*(-6*1.3*s^(-7) + 3*0.7*s^(-4))",
+                "0.8*((1 - exp(-1.7*(sqrt(s) - 1.1)))^2 - 1)",
+                "exp(-sqrt(s)/0.9)/sqrt(s) + s^(-7/2)",
+            ],
+            &["s"],
+            true,
+            1e-13,
+        );
+    }
+
+    #[test]
+    fn divisions_share_one_reciprocal() {
+        let (native, _, prog) = kernels(&["4*(s^(-6) - s^(-3))", "48*s^(-7) - 24*s^(-4)"], &["s"]);
+        let divs = |ops: &mut dyn Iterator<Item = Op>| ops.filter(|&o| o == Op::Div).count();
+        assert!(divs(&mut prog.instructions().iter().map(|i| i.op())) >= 4);
+        assert_eq!(divs(&mut native.steps.steps.iter().map(|s| s.op)), 1);
+    }
+
+    #[test]
+    fn runs_on_many_threads_with_the_same_bits() {
+        let (native, interp, _) = kernels(&["exp(-x)*x^(-6)", "sin(x)/x"], &["x"]);
+        let x = random_inputs(1000, 7, true);
+        let reference = |k: &BatchKernel| {
+            let (mut a, mut b) = (vec![0.0; x.len()], vec![0.0; x.len()]);
+            k.run(&[&x], &mut [&mut a, &mut b]);
+            (a, b)
+        };
+        let want = reference(&interp);
+        std::thread::scope(|s| {
+            for k in [&native, &interp, &native, &interp] {
+                let (want, reference) = (&want, &reference);
+                s.spawn(move || {
+                    let got = reference(k);
+                    assert!(got.0.iter().zip(&want.0).all(|(a, b)| same(*a, *b)));
+                    assert!(got.1.iter().zip(&want.1).all(|(a, b)| same(*a, *b)));
+                });
+            }
+        });
+    }
+}
