@@ -6,6 +6,9 @@
 use pdyn_expr::budget::{PrintSize, PRINT_CHARS};
 use pdyn_expr::{Id, Pool};
 
+/// What marks a line of prose clipped at the budget (followed by its length).
+pub const CLIPPED: &str = "⟨line clipped";
+
 /// Text being assembled line by line within the budget.
 pub struct Lines<'a> {
     /// The pool the expressions live in.
@@ -39,13 +42,14 @@ impl<'a> Lines<'a> {
     }
 
     /// A line of prose (no expression): clipped at the budget as a last resort, so that no
-    /// line is ever longer (the messages this prints are short by construction).
+    /// line is ever longer. The messages this prints are short by construction; a clipped
+    /// line says so ([`CLIPPED`]), and the tests fail on it.
     pub fn line(&mut self, s: &str) {
         if chars(s) <= PRINT_CHARS {
             self.out += s;
         } else {
-            let keep: String = s.chars().take(PRINT_CHARS - 40).collect();
-            self.out += &format!("{keep} … ({} characters)", chars(s));
+            let keep: String = s.chars().take(PRINT_CHARS - 60).collect();
+            self.out += &format!("{keep} {CLIPPED} ({} characters)⟩", chars(s));
         }
         self.out.push('\n');
     }
