@@ -14,10 +14,12 @@ use crate::derive::{Derivation, UnknownKind};
 use pdyn_expr::factor::Collected;
 use pdyn_expr::{Id, Node, Pool};
 
-/// Entries with more tree nodes than this are not simplified or collected (as in the
-/// derivation's own simplification of printed expressions): they would not print within
-/// [`pdyn_expr::budget::PRINT_CHARS`] anyway.
-pub const TIDY_NODES: usize = 4_000;
+/// Entries with more tree nodes than this are not simplified or collected: their collected
+/// form would not print within [`pdyn_expr::budget::PRINT_CHARS`] anyway.
+pub const TIDY_NODES: usize = 20_000;
+/// Entries with more tree nodes than this are not handed to `simplify` (as in the
+/// derivation's own simplification of printed expressions), only expanded and contracted.
+const SIMPLIFY_NODES: usize = 4_000;
 
 /// One entry of `M` or `f`.
 #[derive(Clone, Debug)]
@@ -118,6 +120,33 @@ fn tidy(p: &mut Pool, e: Id) -> Entry {
             let fs = fs.to_vec();
             let s: Vec<Id> = fs.iter().map(|&f| simplify_factor(p, f)).collect();
             p.mul(&s)
+        }
+        // A sum (a forcing term: every particle's contribution, x and y parts apart) is
+        // expanded and its sines and cosines contracted, which pairs `cos(q1)*sin(q2)` with
+        // `sin(q1)*cos(q2)` across the parts: linear in the expanded size, where `simplify`'s
+        // rational normal form gives up past a 10-link chain. Whichever is smaller is kept.
+        Node::Add(_) => {
+            let simplified = if p.tree_size(e, SIMPLIFY_NODES + 1) <= SIMPLIFY_NODES {
+                p.simplify(e)
+            } else {
+                e
+            };
+            match p.try_expand(e) {
+                Ok(x) => {
+                    // Compared once collected: that is what prints.
+                    let c = p.contract_trig(x);
+                    let collected_size = |p: &mut Pool, id| {
+                        let c = p.collect_by(id, &depends_on_state);
+                        p.tree_size(c, usize::MAX)
+                    };
+                    if collected_size(p, c) < collected_size(p, simplified) {
+                        c
+                    } else {
+                        simplified
+                    }
+                }
+                Err(_) => simplified,
+            }
         }
         _ => p.simplify(e),
     };
