@@ -336,8 +336,22 @@ impl Rendered {
             Some(_) => e.render(p, latex),
             None => String::new(),
         };
+        // A symmetric M's lower triangle is the upper one's text (half the formatting: at
+        // n = 100 the entries are 1.7 MB of text).
+        let n = m.n;
+        let mut mass: Vec<String> = Vec::with_capacity(n * n);
+        for j in 0..n {
+            for k in 0..n {
+                let s = if m.symmetric && k < j {
+                    mass[k * n + j].clone()
+                } else {
+                    show(p, &m.mass[j * n + k])
+                };
+                mass.push(s);
+            }
+        }
         Rendered {
-            mass: m.mass.iter().map(|e| show(p, e)).collect(),
+            mass,
             forcing: m.forcing.iter().map(|e| show(p, e)).collect(),
         }
     }
