@@ -374,6 +374,32 @@ fn matrix_section(o: &mut Lines, m: &MatrixForm, r: &Rendered) {
     let listed = |j: usize, k: usize| -> bool {
         m.mass[j * n + k].expr != Pool::ZERO && !(m.symmetric && k < j)
     };
+    type Name<'n> = Option<&'n dyn Fn(usize, usize) -> String>;
+    // `name = entry` lines for M's listed entries and for f, named (1-based) by `mass_name`
+    // and `f_name` (`None`: not listed).
+    let list = |o: &mut Lines, mass_name: Name, f_name: Option<&dyn Fn(usize) -> String>| {
+        if let Some(name) = mass_name {
+            for j in 0..n {
+                for k in (0..n).filter(|&k| listed(j, k)) {
+                    let name = name(j + 1, k + 1);
+                    let i = j * n + k;
+                    entry(o, &format!("  {name} = "), &name, &m.mass[i], &r.mass[i]);
+                }
+            }
+        }
+        if let Some(name) = f_name {
+            for j in 0..n {
+                let name = name(j + 1);
+                entry(
+                    o,
+                    &format!("  {name} = "),
+                    &name,
+                    &m.forcing[j],
+                    &r.forcing[j],
+                );
+            }
+        }
+    };
     o.line("");
     o.line("Equations of motion (projected on the coordinates), M(q) q'' = f(q, q', t):");
     let accs: Vec<String> = m
@@ -393,30 +419,11 @@ fn matrix_section(o: &mut Lines, m: &MatrixForm, r: &Rendered) {
         if !what.is_empty() {
             o.line(&format!("  ({})", what.join("; ")));
         }
-        for j in 0..n {
-            for k in 0..n {
-                if listed(j, k) {
-                    let name = format!("M[{},{}]", j + 1, k + 1);
-                    entry(
-                        o,
-                        &format!("  {name} = "),
-                        &name,
-                        &m.mass[j * n + k],
-                        &r.mass[j * n + k],
-                    );
-                }
-            }
-        }
-        for j in 0..n {
-            let name = format!("f[{}]", j + 1);
-            entry(
-                o,
-                &format!("  {name} = "),
-                &name,
-                &m.forcing[j],
-                &r.forcing[j],
-            );
-        }
+        list(
+            o,
+            Some(&|j, k| format!("M[{j},{k}]")),
+            Some(&|j| format!("f[{j}]")),
+        );
         return;
     }
     // LaTeX: entries inline when every row fits on its line.
@@ -466,37 +473,14 @@ fn matrix_section(o: &mut Lines, m: &MatrixForm, r: &Rendered) {
         o.line(&format!("    {e}{end}"));
     }
     o.line("  \\end{bmatrix}");
-    if !m_inline {
-        if m.symmetric && n > 1 {
-            o.line("  % M is symmetric: M_{j,k} is listed for j \\le k");
-        }
-        for j in 0..n {
-            for k in 0..n {
-                if listed(j, k) {
-                    let name = format!("M_{{{},{}}}", j + 1, k + 1);
-                    entry(
-                        o,
-                        &format!("  {name} = "),
-                        &name,
-                        &m.mass[j * n + k],
-                        &r.mass[j * n + k],
-                    );
-                }
-            }
-        }
+    if !m_inline && m.symmetric && n > 1 {
+        o.line("  % M is symmetric: M_{j,k} is listed for j \\le k");
     }
-    if !f_inline {
-        for j in 0..n {
-            let name = format!("f_{{{}}}", j + 1);
-            entry(
-                o,
-                &format!("  {name} = "),
-                &name,
-                &m.forcing[j],
-                &r.forcing[j],
-            );
-        }
-    }
+    list(
+        o,
+        (!m_inline).then_some(&|j, k| format!("M_{{{j},{k}}}")),
+        (!f_inline).then_some(&|j| format!("f_{{{j}}}")),
+    );
 }
 
 fn to_json(
