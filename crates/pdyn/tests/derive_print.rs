@@ -7,15 +7,13 @@
 
 #[path = "../../pdyn-mech/tests/common/chain.rs"]
 mod chain;
+#[path = "common/in_root.rs"]
+mod in_root;
 
+use in_root::{pdyn, root};
 use pdyn_expr::budget::PRINT_CHARS;
 use pdyn_expr::{FreeScope, Id, Node, Pool, Program};
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
 
 /// The mechanics examples (`examples/*.toml`; the `[nbody]` and `[md]` ones live in
 /// subdirectories and are refused by `pdyn derive`).
@@ -44,17 +42,13 @@ fn chain_file(n: usize) -> PathBuf {
 /// the model (`rotating_bar_block` is a prescribed motion for `pdyn forces`: 2 equations for 3
 /// unknowns).
 fn derive_output(file: &Path, extra: &[&str]) -> Result<String, String> {
-    let out = Command::new(env!("CARGO_BIN_EXE_pdyn"))
-        .arg("derive")
-        .arg(file)
-        .args(extra)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8(out.stderr).unwrap();
-    match out.status.code() {
-        Some(0) => Ok(String::from_utf8(out.stdout).unwrap()),
-        Some(2) => Err(stderr),
-        other => panic!("{}: exit {other:?}: {stderr}", file.display()),
+    let file_arg = file.to_string_lossy();
+    let mut args = vec!["derive", &file_arg];
+    args.extend(extra);
+    match pdyn(&args) {
+        (0, stdout, _) => Ok(stdout),
+        (2, _, stderr) => Err(stderr),
+        (code, _, stderr) => panic!("{}: exit {code}: {stderr}", file.display()),
     }
 }
 
