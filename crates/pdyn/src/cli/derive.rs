@@ -40,9 +40,9 @@ pub struct DeriveArgs {
     /// Largest system eliminated symbolically (larger ones are solved numerically when run).
     #[arg(long, default_value_t = 6)]
     symbolic_limit: usize,
-    /// Eliminate exactly even when it is expensive (explicit accelerations of a 3-link chain
-    /// print as lines of 1,600 characters; without this flag such systems are printed as
-    /// M q'' = f and solved numerically when run).
+    /// Eliminate exactly even when it is expensive (a 4-link chain), and print explicit
+    /// accelerations up to 2,000 characters (without it: up to 600; larger ones, such as the
+    /// 3-link chain's 1,600-character ones, are written by reference, (M⁻¹ f)_1).
     #[arg(long)]
     solve: bool,
 }
