@@ -81,3 +81,31 @@ impl fmt::Display for BudgetError {
 }
 
 impl std::error::Error for BudgetError {}
+
+/// Longest expression, in characters, that pdyn prints for a person to read (`pdyn derive`'s
+/// lines, messages that quote an expression): past it the text names what is omitted and its
+/// size instead ([`Pool::to_text_within`](crate::Pool::to_text_within)); `--json` output has
+/// every expression whole.
+pub const PRINT_CHARS: usize = 2_000;
+/// Expressions of more tree nodes than this are not even formatted: formatting the 4-link
+/// chain's explicit accelerations took seconds, and any expression that prints within
+/// [`PRINT_CHARS`] has far fewer nodes.
+pub const PRINT_NODES: usize = 4_000;
+
+/// How large an expression too large to print is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PrintSize {
+    /// More than [`PRINT_NODES`] tree nodes (not formatted).
+    Nodes,
+    /// This many characters once formatted.
+    Chars(usize),
+}
+
+impl fmt::Display for PrintSize {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            PrintSize::Nodes => write!(f, "over {PRINT_NODES} expression nodes"),
+            PrintSize::Chars(n) => write!(f, "{n} characters"),
+        }
+    }
+}

@@ -7,7 +7,8 @@
 //!   `dot(a, b)`) into a spanned AST; [`lower`] resolves names and checks shapes;
 //! - [`build`] holds the canonicalising constructors (automatic simplification);
 //! - [`diff`] differentiates (partial, and total in time by the chain rule);
-//! - [`expand`] distributes products and integer powers;
+//! - [`expand`] distributes products and integer powers; [`factor`] collects and factors
+//!   sums for reading (`a*x + b*x = (a + b)*x`);
 //! - [`poly`] and [`simplify`] work on rational functions over "atoms" (the Pythagorean
 //!   identity, trigonometric expansion, polynomial GCD cancellation);
 //! - [`linsolve`] extracts `A x = b` from equations linear in chosen unknowns and solves it,
@@ -33,6 +34,7 @@ pub mod diff;
 pub mod dimension;
 pub mod error;
 pub mod expand;
+pub mod factor;
 pub mod linsolve;
 pub mod lower;
 pub mod lu;

@@ -137,6 +137,32 @@ impl Pool {
         LatexPrinter { pool: self }.expr(id)
     }
 
+    /// Text (or LaTeX) of `id` when it is at most `limit` characters long, its size otherwise
+    /// (without formatting it at all past [`crate::budget::PRINT_NODES`] tree nodes): what
+    /// every printout for a person goes through, with `limit` at most
+    /// [`crate::budget::PRINT_CHARS`].
+    pub fn to_text_within(
+        &self,
+        id: Id,
+        latex: bool,
+        limit: usize,
+    ) -> Result<String, crate::budget::PrintSize> {
+        use crate::budget::{PrintSize, PRINT_NODES};
+        if self.tree_size(id, PRINT_NODES + 1) > PRINT_NODES {
+            return Err(PrintSize::Nodes);
+        }
+        let s = if latex {
+            self.to_latex(id)
+        } else {
+            self.to_text(id)
+        };
+        if s.chars().count() > limit {
+            Err(PrintSize::Chars(s.chars().count()))
+        } else {
+            Ok(s)
+        }
+    }
+
     /// A Rust `f64` expression. `leaf` names symbols, coordinates and `t` (e.g. `|n| ...`);
     /// the default [`Pool::rust_leaf_name`] uses the symbol name, `x_d1` for `x'`, and `t`.
     pub fn to_rust(&self, id: Id, leaf: &dyn Fn(&Pool, &Node) -> String) -> String {

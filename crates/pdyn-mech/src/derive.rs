@@ -551,12 +551,18 @@ fn linear_form(
             residuals.push(r);
             kept.push(e);
         } else if !p.provably_equal(r, Pool::ZERO) {
+            // The message quotes the two sides within the printing budget, else their sizes.
+            let side = |id: Id, which: &str| {
+                let limit = pdyn_expr::budget::PRINT_CHARS / 2 - 100;
+                p.to_text_within(id, false, limit)
+                    .unwrap_or_else(|size| format!("⟨{which} side: {size}⟩"))
+            };
             return Err(derr(
                 format!(
                     "equation `{}` involves no unknown and does not hold: {} = {}",
                     e.label,
-                    p.to_text(e.lhs),
-                    p.to_text(e.rhs)
+                    side(e.lhs, "left"),
+                    side(e.rhs, "right")
                 ),
                 "a force is missing from the free body diagram: declare the reaction that balances it ([[forces]] kind = \"reaction\")",
             ));

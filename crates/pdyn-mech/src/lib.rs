@@ -6,6 +6,7 @@
 //! - [`model`]: model files (TOML) → particles, coordinates, loads, reactions, constraints;
 //! - [`derive`]: F = ma (and ΣM = 0 for massless frames), constraints at acceleration level,
 //!   eliminated to `q'' = f(q, q', t)` with the reactions as functions of state;
+//! - [`matrix_form`]: `M(q) q'' = f` with collected, factored entries, for reading;
 //! - [`dsolve`]: closed-form solutions of linear constant-coefficient equations of motion, and
 //!   the 1-D integration rules of section 3.1.3.
 #![warn(missing_docs)]
@@ -17,6 +18,7 @@ pub mod derive;
 pub mod dimensions;
 pub mod dsolve;
 pub mod kinematics;
+pub mod matrix_form;
 pub mod model;
 pub mod parameters;
 pub mod prescribed;

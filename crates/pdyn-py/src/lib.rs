@@ -548,9 +548,24 @@ impl PyModel {
                     )
                 },
             )?;
+            // `M q'' = f` with entries collected and factored, as `pdyn derive` prints it
+            // (`None` when some unknown is a reaction).
+            let matrix = pdyn_mech::matrix_form::matrix_form(&mut model.pool, &d).map(|m| {
+                let p = &mut model.pool;
+                let mut entry =
+                    |x: &pdyn_mech::matrix_form::Entry| (x.render(p, false), x.render(p, true));
+                let mass: Vec<Vec<(String, String)>> = (0..m.n)
+                    .map(|j| (0..m.n).map(|k| entry(&m.mass[j * m.n + k])).collect())
+                    .collect();
+                let forcing: Vec<(String, String)> = m.forcing.iter().map(&mut entry).collect();
+                (mass, forcing)
+            });
             let p: &Pool = &model.pool;
             let e = |id: Id| (p.to_text(id), p.to_latex(id));
             let out = PyDict::new(py);
+            let (mass, forcing) = matrix.unzip();
+            out.set_item("mass_matrix", mass)?;
+            out.set_item("forcing", forcing)?;
             let eqs: Vec<_> = d
                 .equations
                 .iter()

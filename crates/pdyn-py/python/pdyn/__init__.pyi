@@ -71,6 +71,8 @@ class Derivation:
     state: List[str]
     form: str
     notes: List[str]
+    mass_matrix: Optional[List[List[Expr]]]
+    forcing: Optional[List[Expr]]
 
 class SweepResult:
     parameter: str

@@ -274,7 +274,10 @@ class Derivation:
     * ``unknowns`` -- names of the accelerations and reactions solved for;
     * ``solution`` -- ``None`` (solved numerically at each evaluation) or ``[(unknown, Expr)]``;
     * ``first_order`` -- ``None`` or ``[(state, Expr)]``: ``d/dt state = Expr``;
-    * ``state`` -- names of the state components; ``form``, ``notes``.
+    * ``state`` -- names of the state components; ``form``, ``notes``;
+    * ``mass_matrix`` -- ``None`` (some unknown is a reaction) or the rows of ``M`` in
+      ``M(q) q'' = f(q, q', t)``, each entry an :class:`Expr` collected and factored
+      (``l1*l2*(m2 + m3)*cos(q1 - q2)``); ``forcing`` -- ``None`` or the entries of ``f``.
     """
 
     def __init__(self, raw: Dict[str, Any]):
@@ -287,6 +290,10 @@ class Derivation:
         self.state: List[str] = list(raw["state"])
         self.form: str = raw["form"]
         self.notes: List[str] = list(raw["notes"])
+        mm = raw.get("mass_matrix")
+        self.mass_matrix = None if mm is None else [[_expr(e) for e in row] for row in mm]
+        fo = raw.get("forcing")
+        self.forcing = None if fo is None else [_expr(e) for e in fo]
 
     def __repr__(self) -> str:
         lines = [f"{lab}: {l} = {r}" for lab, l, r in self.equations]

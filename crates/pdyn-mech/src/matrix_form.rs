@@ -1,0 +1,175 @@
+//! The equations of motion in matrix form, `M(q) q'' = f(q, q', t)`, with each entry
+//! collected and factored as a textbook (or SymPy's KanesMethod) prints it:
+//! `M[1,2] = l1*l2*(m2 + m3)*cos(q1 - q2)`,
+//! `f[1] = -g*l1*(m1 + m2 + m3)*sin(q1) - l1*l2*(m2 + m3)*q2'^2*sin(q1 - q2) - …`.
+//!
+//! This is for reading only (`pdyn derive`, its `--json`, Python's `Derivation`): what runs is
+//! the derivation's own `A x = b`. Each entry is simplified when it is small (a product factor
+//! by factor, which keeps the mass sums of a chain's entries as they were assembled) and then
+//! collected over its factors that depend on the state ([`Pool::collect_terms`]); entries over
+//! [`TIDY_NODES`] are left as derived, so the cost is bounded per entry and O(n²) small
+//! entries for `n` coordinates: nothing large is simplified or solved just to be printed.
+
+use crate::derive::{Derivation, UnknownKind};
+use pdyn_expr::factor::Collected;
+use pdyn_expr::{Id, Node, Pool};
+
+/// Entries with more tree nodes than this are not simplified or collected: their collected
+/// form would not print within [`pdyn_expr::budget::PRINT_CHARS`] anyway.
+pub const TIDY_NODES: usize = 20_000;
+/// Entries with more tree nodes than this are not handed to `simplify` (as in the
+/// derivation's own simplification of printed expressions), only expanded and contracted.
+const SIMPLIFY_NODES: usize = 4_000;
+
+/// One entry of `M` or `f`.
+#[derive(Clone, Debug)]
+pub struct Entry {
+    /// The entry, equal to the derivation's (simplified when small).
+    pub expr: Id,
+    /// The entry collected over its state-dependent factors, coefficients factored; `None`
+    /// when it is over [`TIDY_NODES`].
+    pub collected: Option<Collected>,
+}
+
+impl Entry {
+    /// The entry as text (re-parsable in the model's scope) or LaTeX, whole.
+    pub fn render(&self, p: &mut Pool, latex: bool) -> String {
+        match (&self.collected, latex) {
+            (Some(c), false) => c.to_text(p),
+            (Some(c), true) => c.to_latex(p),
+            (None, false) => p.to_text(self.expr),
+            (None, true) => p.to_latex(self.expr),
+        }
+    }
+}
+
+/// `M q'' = f` of a derivation whose unknowns are all accelerations (the projected form, or
+/// Newton's equations without reactions).
+#[derive(Clone, Debug)]
+pub struct MatrixForm {
+    /// Number of coordinates (`M` is `n × n`).
+    pub n: usize,
+    /// The accelerations, in column order.
+    pub accelerations: Vec<Id>,
+    /// `M`, row-major; symmetric in the projected form (`M[j,k]` and `M[k,j]` are one entry).
+    pub mass: Vec<Entry>,
+    /// `f`.
+    pub forcing: Vec<Entry>,
+    /// Whether `M` is symmetric (every `M[j,k]` is the same node as `M[k,j]`).
+    pub symmetric: bool,
+}
+
+/// Whether `f` depends on the state or time: the "main" factors entries are collected over.
+pub fn depends_on_state(p: &Pool, f: Id) -> bool {
+    p.any_node(f, &|n| matches!(n, Node::Coord(..) | Node::Time))
+}
+
+/// The matrix form of `d`, or `None` when some unknown is a reaction (then `A x = b` mixes
+/// accelerations and forces: Newton's equations are printed as they are).
+pub fn matrix_form(p: &mut Pool, d: &Derivation) -> Option<MatrixForm> {
+    if d.unknowns.is_empty()
+        || d.unknowns
+            .iter()
+            .any(|u| !matches!(u.kind, UnknownKind::Acceleration(_)))
+        || d.system.rows() != d.system.cols()
+    {
+        return None;
+    }
+    let n = d.system.cols();
+    let mut mass: Vec<Option<Entry>> = vec![None; n * n];
+    for j in 0..n {
+        for k in 0..n {
+            if mass[j * n + k].is_some() {
+                continue;
+            }
+            let e = tidy(p, d.system.coeff(j, k));
+            if k > j && d.system.coeff(k, j) == d.system.coeff(j, k) {
+                mass[k * n + j] = Some(e.clone());
+            }
+            mass[j * n + k] = Some(e);
+        }
+    }
+    let symmetric = (0..n).all(|j| (0..j).all(|k| d.system.coeff(j, k) == d.system.coeff(k, j)));
+    let forcing = d.system.b.iter().map(|&b| tidy(p, b)).collect();
+    Some(MatrixForm {
+        n,
+        accelerations: d.system.unknowns.clone(),
+        mass: mass.into_iter().flatten().collect(),
+        forcing,
+        symmetric,
+    })
+}
+
+/// Simplifies (when small) and collects one entry.
+fn tidy(p: &mut Pool, e: Id) -> Entry {
+    if p.tree_size(e, TIDY_NODES + 1) > TIDY_NODES {
+        return Entry {
+            expr: e,
+            collected: None,
+        };
+    }
+    // A product is simplified factor by factor: a chain's `(m2 + m3)*(l1*l2*cos(q1)*cos(q2) +
+    // l1*l2*sin(q1)*sin(q2))` becomes `l1*l2*(m2 + m3)*cos(q1 - q2)` without expanding the
+    // mass sum into the trigonometric one (n times more terms to contract). Contracting
+    // products of sines and cosines is enough for most factors and several times cheaper
+    // than `simplify` (which a 100-link chain's 5,050 entries would spend a second on in a
+    // debug build); a factor still a sum of trigonometric terms (`l1^2*sin(q1)^2 +
+    // l1^2*cos(q1)^2`) is simplified.
+    let s = match p.node(e) {
+        Node::Mul(fs) => {
+            let fs = fs.to_vec();
+            let s: Vec<Id> = fs.iter().map(|&f| simplify_factor(p, f)).collect();
+            p.mul(&s)
+        }
+        // A sum (a forcing term: every particle's contribution, x and y parts apart) is
+        // expanded and its sines and cosines contracted, which pairs `cos(q1)*sin(q2)` with
+        // `sin(q1)*cos(q2)` across the parts: linear in the expanded size, where `simplify`'s
+        // rational normal form gives up past a 10-link chain. Whichever is smaller is kept.
+        Node::Add(_) => {
+            let simplified = if p.tree_size(e, SIMPLIFY_NODES + 1) <= SIMPLIFY_NODES {
+                p.simplify(e)
+            } else {
+                e
+            };
+            match p.try_expand(e) {
+                Ok(x) => {
+                    // Compared once collected: that is what prints.
+                    let c = p.contract_trig(x);
+                    let collected_size = |p: &mut Pool, id| {
+                        let c = p.collect_by(id, &depends_on_state);
+                        p.tree_size(c, usize::MAX)
+                    };
+                    if collected_size(p, c) < collected_size(p, simplified) {
+                        c
+                    } else {
+                        simplified
+                    }
+                }
+                Err(_) => simplified,
+            }
+        }
+        _ => p.simplify(e),
+    };
+    let collected = p.collect_terms(s, &depends_on_state);
+    Entry {
+        expr: s,
+        collected: Some(collected),
+    }
+}
+
+/// One factor of an entry, simplified as cheaply as it allows (see [`tidy`]).
+fn simplify_factor(p: &mut Pool, f: Id) -> Id {
+    let c = p.contract_trig(f);
+    let trig_sum = matches!(p.node(c), Node::Add(_))
+        && p.any_node(c, &|n| {
+            matches!(
+                n,
+                Node::Call(pdyn_expr::Func::Sin | pdyn_expr::Func::Cos, _)
+            )
+        });
+    if trig_sum {
+        p.simplify(c)
+    } else {
+        c
+    }
+}
