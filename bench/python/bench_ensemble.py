@@ -2,6 +2,7 @@
 the peak memory it adds, in a fresh process per measurement (ru_maxrss only grows).
 
     target/venv-rel/bin/python bench/python/bench_ensemble.py        # RUNS=1000 REPEAT=3
+    POINTS=20001 target/venv-rel/bin/python bench/python/bench_ensemble.py  # denser output
 
 Each repeat is a new interpreter: warm-up ensemble of 4 runs (derive, compile, thread pool),
 then ru_maxrss, the timed call, ru_maxrss again. Prints the best time, the smallest peak
@@ -24,10 +25,11 @@ def one(runs):
     m = pdyn.Model.from_file("examples/building.toml")
     values = np.linspace(2, 30, runs)
     meas = {"top": ("y2 - (2*L - 3*m*g/(2*k))", "max_abs")}
-    m.ensemble(params={"omega": values[:4]}, measures=meas)  # warm-up
+    kw = {"points": int(os.environ["POINTS"])} if os.environ.get("POINTS") else {}
+    m.ensemble(params={"omega": values[:4]}, measures=meas, **kw)  # warm-up
     rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     t0 = time.perf_counter()
-    ens = m.ensemble(params={"omega": values}, measures=meas)
+    ens = m.ensemble(params={"omega": values}, measures=meas, **kw)
     secs = time.perf_counter() - t0
     rss1 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     h = hashlib.sha256()
@@ -51,7 +53,7 @@ if __name__ == "__main__":
         print(results[-1], flush=True)
     digests = {r["digest"] for r in results}
     best = min(r["secs"] for r in results)
-    print(f"Model.ensemble, building, {runs} runs: best {best:.3f} s "
+    print(f"Model.ensemble, building, {runs} runs, points={os.environ.get('POINTS', 2001)}: best {best:.3f} s "
           f"({runs / best:.0f} runs/s, {results[0]['threads']} threads); "
           f"peak RSS {min(r['peak_kib'] for r in results) / 1024:.1f} MiB, "
           f"added by the call {min(r['added_kib'] for r in results) / 1024:.1f} MiB; "
