@@ -8,6 +8,7 @@
 #![warn(missing_docs)]
 
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pdyn::sim::measured::{measure, NonFinite};
 use pdyn::sim::{self, sweep, Prepared, RunResult, RunSettings};
 use pdyn::Error;
 use pdyn_expr::{Id, Pool, Program};
@@ -329,24 +330,23 @@ fn run_dict(
 /// The output columns of a run that hold NaN or infinity, the first time one does, and the
 /// error `pdyn run` reports for them (`non_finite`, exit code 1); `None` when all are finite.
 fn non_finite_columns(origin: &str, res: &RunResult) -> Option<(Vec<String>, f64, Error)> {
-    let first_t = res
-        .rows
-        .iter()
-        .find(|r| r.iter().any(|x| !x.is_finite()))
-        .map(|r| r[0])?;
-    let bad: Vec<usize> = (0..res.columns.len())
-        .filter(|&c| res.rows.iter().any(|r| !r[c].is_finite()))
-        .collect();
-    let names: Vec<String> = bad.iter().map(|&c| res.columns[c].clone()).collect();
+    let nf = NonFinite::of_rows(&res.rows)?;
+    Some(non_finite_error(origin, &res.columns, &nf))
+}
+
+/// [`non_finite_columns`] from the non-finite columns of a run (table or not).
+fn non_finite_error(origin: &str, columns: &[String], nf: &NonFinite) -> (Vec<String>, f64, Error) {
+    let names: Vec<String> = nf.columns.iter().map(|&c| columns[c].clone()).collect();
     let quoted: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
     let error = Error::NonFinite {
         what: format!(
-            "{origin}: the output column(s) {} (first at t = {first_t:e})",
-            quoted.join(", ")
+            "{origin}: the output column(s) {} (first at t = {:e})",
+            quoted.join(", "),
+            nf.t
         ),
-        components: bad,
+        components: nf.columns.clone(),
     };
-    Some((names, first_t, error))
+    (names, nf.t, error)
 }
 
 fn stats_dict<'py>(py: Python<'py>, s: &pdyn_ode::Stats) -> PyResult<Bound<'py, PyDict>> {
@@ -1038,23 +1038,22 @@ struct RunOut {
     message: Option<String>,
 }
 
-/// Runs one member of an ensemble.
+/// Runs one member of an ensemble, without its table ([`measure`]: the same bits as
+/// `sim::run`'s rows would give).
 fn one_run(p: &Prepared, set: &RunSettings, stats: &[Stat]) -> RunOut {
-    let n_meas = stats.len();
-    let n_ev = p.events.len();
     let n_states = p.state_names.len();
     let mut out = RunOut {
-        measures: vec![f64::NAN; n_meas],
+        measures: vec![f64::NAN; stats.len()],
         t_final: f64::NAN,
         final_state: vec![f64::NAN; n_states],
-        events: vec![None; n_ev],
+        events: vec![None; p.events.len()],
         drifts: Vec::new(),
         drifted: false,
         status: -2,
         nfev: 0,
         message: None,
     };
-    let res = match sim::run(p, set) {
+    let res = match measure(p, set, stats) {
         Ok(r) => r,
         Err(e) => {
             out.message = Some(e.to_string());
@@ -1064,47 +1063,23 @@ fn one_run(p: &Prepared, set: &RunSettings, stats: &[Stat]) -> RunOut {
     out.status = res.status.code();
     out.nfev = res.stats.fevals;
     out.message = res.failure.as_ref().map(|f| f.to_string());
-    if res.failure.is_none() {
-        if let Some((_, _, e)) = non_finite_columns("this run", &res) {
-            out.status = -1;
-            out.message = Some(e.to_string());
-        }
+    if let (None, Some(nf)) = (&res.failure, &res.non_finite) {
+        out.status = -1;
+        out.message = Some(non_finite_error("this run", &p.columns(), nf).2.to_string());
     }
-    if let Some(last) = res.rows.last() {
-        out.t_final = last[0];
-        out.final_state.copy_from_slice(&last[1..1 + n_states]);
+    if let Some((t, y)) = res.last {
+        out.t_final = t;
+        out.final_state.copy_from_slice(&y[..n_states]);
     }
-    for e in &res.events {
-        if let Some(i) = p.events.iter().position(|pe| pe.name == e.name) {
-            if out.events[i].is_none() {
-                out.events[i] = Some((e.t, e.state.clone()));
-            }
-        }
-    }
+    out.events = res.first_hits;
     for m in res.monitors.iter().filter(|m| m.conserved) {
         out.drifts.push(m.drift);
         if m.drift.is_nan() || m.drift > set.drift_tolerance {
             out.drifted = true;
         }
     }
-    if let Some(m) = &p.measures {
-        let n = p.system.n;
-        let mut series = vec![Vec::with_capacity(res.rows.len()); n_meas];
-        let mut ts = Vec::with_capacity(res.rows.len());
-        let mut input = Vec::new();
-        let mut vals = vec![0.0; n_meas];
-        for row in &res.rows {
-            p.system
-                .observation_input(row[0], &row[1..1 + 2 * n], &mut input);
-            m.eval(&input, &mut vals);
-            ts.push(row[0]);
-            for (s, &o) in series.iter_mut().zip(&vals) {
-                s.push(o);
-            }
-        }
-        for (j, s) in series.iter().enumerate() {
-            out.measures[j] = sweep::statistic(stats[j], &ts, s);
-        }
+    if p.measures.is_some() {
+        out.measures = res.measures;
     }
     out
 }

@@ -1,5 +1,7 @@
-//! The measures-only path of sweeps: a run reduced to its `[sweep.measures]` statistics, its
-//! drift check and warnings, without building the output table.
+//! The no-table path of sweeps and ensembles: a run reduced to its `[sweep.measures]`
+//! statistics, its last output point, the first occurrence of each event, its drift check,
+//! warnings, status and where its output stopped being finite, without building the output
+//! table.
 //!
 //! [`super::run`] tabulates every output point (time, state, every output column) and then
 //! evaluates the conservation scales and, in a sweep, the measures, each from the same state:
@@ -17,13 +19,20 @@ use super::{
 use pdyn_mech::model::spec::Stat;
 use pdyn_ode::{Direction, Solution};
 
-/// What a sweep keeps of a run.
+/// What a sweep or an ensemble keeps of a run.
 #[derive(Clone, Debug)]
 pub struct Measured {
     /// The statistic of each measure over the output points (NaN without measures).
     pub measures: Vec<f64>,
+    /// The last output point `(t, state)` (the table's last row's first columns); `None`
+    /// when there is no output point.
+    pub last: Option<(f64, Vec<f64>)>,
     /// Events in time order.
     pub events: Vec<EventReport>,
+    /// `(t, state)` of the first occurrence of each of [`Prepared::events`], by index.
+    pub first_hits: Vec<Option<(f64, Vec<f64>)>>,
+    /// The table's columns ([`Prepared::columns`]) that held NaN or infinity, if any did.
+    pub non_finite: Option<NonFinite>,
     /// Drift of each conserved quantity.
     pub monitors: Vec<MonitorReport>,
     /// The warnings [`super::run`] would give.
@@ -54,15 +63,13 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
     let mut meas_out = vec![0.0; n_meas];
     let mut series = vec![Vec::with_capacity(points); n_meas];
     let mut drifts: Vec<(f64, f64)> = Vec::with_capacity(conserved.len());
-    let mut non_finite = false;
+    let mut non_finite = NonFiniteScan::default();
     for k in 0..points {
         let (t, y) = (sol.t[k], sol.y_at(k));
         sys.observation_input(t, y, &mut input);
         prep.observer.eval(&input, &mut extra);
-        non_finite = non_finite
-            || !t.is_finite()
-            || y.iter().any(|x| !x.is_finite())
-            || extra.iter().any(|x| !x.is_finite());
+        // The row `[t, y, extra]` the full path would tabulate.
+        non_finite.row(t, std::iter::once(&t).chain(y).chain(&extra).copied());
         if k == 0 {
             drifts.extend(conserved.iter().map(|&j| (extra[j], 0.0)));
         }
@@ -94,9 +101,26 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
         scale_series.into_iter().map(scale_of).collect()
     };
     let t_last = sol.t.last().copied().unwrap_or(0.0);
+    let non_finite = non_finite.finish();
     let (events, monitors, warnings, status) = report(
-        prep, &sol, set, &failure, &drifts, &scales, t_last, non_finite,
+        prep,
+        &sol,
+        set,
+        &failure,
+        &drifts,
+        &scales,
+        t_last,
+        non_finite.is_some(),
     );
+    let mut first_hits = vec![None; prep.events.len()];
+    for h in &sol.events {
+        if let Some(slot @ None) = first_hits.get_mut(h.index) {
+            *slot = Some((h.t, h.y.clone()));
+        }
+    }
+    let last = points
+        .checked_sub(1)
+        .map(|k| (sol.t[k], sol.y_at(k).to_vec()));
     let mut measures = vec![f64::NAN; n_meas];
     if prep.measures.is_some() {
         for (j, s) in series.iter().enumerate() {
@@ -105,13 +129,65 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
     }
     Ok(Measured {
         measures,
+        last,
         events,
+        first_hits,
+        non_finite,
         monitors,
         warnings,
         failure,
         status,
         stats: sol.stats.clone(),
     })
+}
+
+/// Where a run's table held NaN or infinity.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NonFinite {
+    /// The first output time whose row holds a value that is not finite.
+    pub t: f64,
+    /// Indices, among the table's columns ([`Prepared::columns`]), of every column that holds
+    /// one, ascending.
+    pub columns: Vec<usize>,
+}
+
+impl NonFinite {
+    /// The non-finite values of a table ([`super::RunResult::rows`]), `None` if all are finite.
+    pub fn of_rows(rows: &[Vec<f64>]) -> Option<NonFinite> {
+        let mut scan = NonFiniteScan::default();
+        for r in rows {
+            scan.row(r[0], r.iter().copied());
+        }
+        scan.finish()
+    }
+}
+
+/// [`NonFinite`] gathered row by row.
+#[derive(Default)]
+struct NonFiniteScan {
+    first_t: Option<f64>,
+    bad: Vec<bool>,
+}
+
+impl NonFiniteScan {
+    /// One row (its time `t` and its cells, `t` first).
+    fn row(&mut self, t: f64, cells: impl Iterator<Item = f64>) {
+        for (j, x) in cells.enumerate() {
+            if !x.is_finite() {
+                if self.bad.len() <= j {
+                    self.bad.resize(j + 1, false);
+                }
+                self.bad[j] = true;
+                self.first_t.get_or_insert(t);
+            }
+        }
+    }
+
+    fn finish(self) -> Option<NonFinite> {
+        let t = self.first_t?;
+        let columns = (0..self.bad.len()).filter(|&j| self.bad[j]).collect();
+        Some(NonFinite { t, columns })
+    }
 }
 
 /// Events, drift reports, warnings and status of a run, shared by the full path

@@ -2,8 +2,9 @@
 //!
 //! [`prepare`] derives and compiles once (equations, events, output columns, conserved
 //! quantities); [`run`] integrates with given settings and returns a table, the events, the
-//! drift of every monitored quantity and warnings. Sweeps call [`run`] many times on clones of
-//! one [`Prepared`].
+//! drift of every monitored quantity and warnings. Sweeps and ensembles run many times on
+//! clones of one [`Prepared`] through [`measured::measure`], which gives what they keep of a
+//! run (measures, last point, first event hits, drifts, status) without the table.
 //!
 //! The First Law of Scientific Computing (chapter 3.3.3): a result that violates a conservation
 //! law is flagged. Energy is monitored when every force derives from a potential (or is a
@@ -261,6 +262,15 @@ pub struct Prepared {
 }
 
 impl Prepared {
+    /// The columns of a run's table ([`RunResult::columns`]): `t`, the state, the output
+    /// columns.
+    pub fn columns(&self) -> Vec<String> {
+        let mut columns = vec!["t".to_string()];
+        columns.extend(self.state_names.iter().cloned());
+        columns.extend(self.observer.names.iter().cloned());
+        columns
+    }
+
     /// Sets every parameter value (in model order, as [`Prepared::parameter_names`]) and
     /// recomputes the initial state from them, in place: one run of an ensemble. The values
     /// are taken as given: recompute the derived ones first with [`Prepared::derived`]. They
@@ -878,9 +888,7 @@ pub(crate) fn tabulate(
     failure: Option<RunFailure>,
 ) -> RunResult {
     let sys = &prep.system;
-    let mut columns = vec!["t".to_string()];
-    columns.extend(prep.state_names.iter().cloned());
-    columns.extend(prep.observer.names.iter().cloned());
+    let columns = prep.columns();
     let mut rows = Vec::with_capacity(sol.len());
     let mut input = Vec::new();
     let mut extra = vec![0.0; prep.observer.len()];
