@@ -480,25 +480,21 @@ fn emit_steps(
         } else {
             None
         };
-        let bv = || rb.expect("binary operation reads b");
-        let v = match st.op {
-            Op::Add => b.ins().fadd(a, bv()),
-            Op::Sub => b.ins().fsub(a, bv()),
-            Op::Mul => b.ins().fmul(a, bv()),
-            Op::Div => b.ins().fdiv(a, bv()),
-            Op::Neg => b.ins().fneg(a),
-            Op::Sqrt => b.ins().sqrt(a),
-            Op::Abs => b.ins().fabs(a),
-            Op::Powi if st.b == 0 => {
-                let one = b.ins().f64const(1.0);
-                splat(b, ty, one)
-            }
-            Op::Powi if st.b as i32 > 0 && st.b as i32 <= super::MAX_INLINE_POWI => {
-                inline_powi(b, a, st.b)
-            }
-            op => per_lane(b, ty, a, rb, |b, x, y| {
-                scalar_call(b, op, st.b, x, y, ptr, sigs)
-            }),
+        let native = super::native_arith(b, st.op, a, rb);
+        let v = match native {
+            Some(v) => v,
+            None => match st.op {
+                Op::Powi if st.b == 0 => {
+                    let one = b.ins().f64const(1.0);
+                    splat(b, ty, one)
+                }
+                Op::Powi if st.b as i32 > 0 && st.b as i32 <= super::MAX_INLINE_POWI => {
+                    inline_powi(b, a, st.b)
+                }
+                op => per_lane(b, ty, a, rb, |b, x, y| {
+                    scalar_call(b, op, st.b, x, y, ptr, sigs)
+                }),
+            },
         };
         debug_assert_eq!(vals.len(), st.dst as usize);
         vals.push(v);

@@ -183,6 +183,23 @@ fn inline_powi(b: &mut FunctionBuilder, x: Value, k: u32) -> Value {
     acc.unwrap_or_else(|| b.ins().f64const(1.0))
 }
 
+/// The operations Cranelift has as instructions, correctly rounded like Rust's (`+ − × ÷`,
+/// negation, `sqrt`, `abs`), on scalars or lanes alike; `None` for the others. Shared by the
+/// chunks and the batch kernel.
+fn native_arith(b: &mut FunctionBuilder, op: Op, a: Value, rb: Option<Value>) -> Option<Value> {
+    let bv = || rb.expect("binary operation reads b");
+    Some(match op {
+        Op::Add => b.ins().fadd(a, bv()),
+        Op::Sub => b.ins().fsub(a, bv()),
+        Op::Mul => b.ins().fmul(a, bv()),
+        Op::Div => b.ins().fdiv(a, bv()),
+        Op::Neg => b.ins().fneg(a),
+        Op::Sqrt => b.ins().sqrt(a),
+        Op::Abs => b.ins().fabs(a),
+        _ => return None,
+    })
+}
+
 /// Whether instruction `ins` is emitted as a call (a shim): every XMM register is
 /// caller-saved on the platforms we target, so a value live across a call must be spilled.
 fn is_call(ins: &pdyn_expr::compile::Instr) -> bool {
@@ -355,54 +372,51 @@ fn emit_chunk(
             None
         };
         let bv = || rb.expect("binary operation reads b");
-        let v = match ins.op() {
-            Op::Add => b.ins().fadd(a, bv()),
-            Op::Sub => b.ins().fsub(a, bv()),
-            Op::Mul => b.ins().fmul(a, bv()),
-            Op::Div => b.ins().fdiv(a, bv()),
-            Op::Neg => b.ins().fneg(a),
-            Op::Sqrt => b.ins().sqrt(a),
-            Op::Abs => b.ins().fabs(a),
-            Op::Sign => {
-                // 1 for a > 0, −1 for a < 0, a·0 otherwise (±0, or NaN for NaN).
-                let zero = b.ins().f64const(0.0);
-                let one = b.ins().f64const(1.0);
-                let minus_one = b.ins().f64const(-1.0);
-                let gt = b.ins().fcmp(FloatCC::GreaterThan, a, zero);
-                let lt = b.ins().fcmp(FloatCC::LessThan, a, zero);
-                let az = b.ins().fmul(a, zero);
-                let r = b.ins().select(lt, minus_one, az);
-                b.ins().select(gt, one, r)
-            }
-            Op::Powi => {
-                let k = ins.b() as i32;
-                if (0..=MAX_INLINE_POWI).contains(&k) {
-                    inline_powi(&mut b, a, k as u32)
-                } else {
-                    let f = b.ins().iconst(
-                        ptr,
-                        shims::powi as extern "C" fn(f64, i32) -> f64 as usize as i64,
-                    );
-                    let e = b.ins().iconst(types::I32, k as i64);
-                    let call = b.ins().call_indirect(sigi, f, &[a, e]);
-                    b.inst_results(call)[0]
+        let native = native_arith(&mut b, ins.op(), a, rb);
+        let v = match native {
+            Some(v) => v,
+            None => match ins.op() {
+                Op::Sign => {
+                    // 1 for a > 0, −1 for a < 0, a·0 otherwise (±0, or NaN for NaN).
+                    let zero = b.ins().f64const(0.0);
+                    let one = b.ins().f64const(1.0);
+                    let minus_one = b.ins().f64const(-1.0);
+                    let gt = b.ins().fcmp(FloatCC::GreaterThan, a, zero);
+                    let lt = b.ins().fcmp(FloatCC::LessThan, a, zero);
+                    let az = b.ins().fmul(a, zero);
+                    let r = b.ins().select(lt, minus_one, az);
+                    b.ins().select(gt, one, r)
                 }
-            }
-            op => {
-                if let Some(s) = unary_shim(op) {
-                    let f = b.ins().iconst(ptr, s as usize as i64);
-                    let call = b.ins().call_indirect(sig1, f, &[a]);
-                    b.inst_results(call)[0]
-                } else if let Some(s) = binary_shim(op) {
-                    let f = b.ins().iconst(ptr, s as usize as i64);
-                    let call = b.ins().call_indirect(sig2, f, &[a, bv()]);
-                    b.inst_results(call)[0]
-                } else {
-                    return Err(JitError::UnsupportedOp {
-                        op: format!("{op:?}"),
-                    });
+                Op::Powi => {
+                    let k = ins.b() as i32;
+                    if (0..=MAX_INLINE_POWI).contains(&k) {
+                        inline_powi(&mut b, a, k as u32)
+                    } else {
+                        let f = b.ins().iconst(
+                            ptr,
+                            shims::powi as extern "C" fn(f64, i32) -> f64 as usize as i64,
+                        );
+                        let e = b.ins().iconst(types::I32, k as i64);
+                        let call = b.ins().call_indirect(sigi, f, &[a, e]);
+                        b.inst_results(call)[0]
+                    }
                 }
-            }
+                op => {
+                    if let Some(s) = unary_shim(op) {
+                        let f = b.ins().iconst(ptr, s as usize as i64);
+                        let call = b.ins().call_indirect(sig1, f, &[a]);
+                        b.inst_results(call)[0]
+                    } else if let Some(s) = binary_shim(op) {
+                        let f = b.ins().iconst(ptr, s as usize as i64);
+                        let call = b.ins().call_indirect(sig2, f, &[a, bv()]);
+                        b.inst_results(call)[0]
+                    } else {
+                        return Err(JitError::UnsupportedOp {
+                            op: format!("{op:?}"),
+                        });
+                    }
+                }
+            },
         };
         // A call's result belongs to the segment after the call.
         regs[first_temp + k] = Some((v, seg + u32::from(is_call(ins))));
