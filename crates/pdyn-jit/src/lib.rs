@@ -109,6 +109,9 @@ const CHUNK: usize = 2048;
 /// the evaluation time (46–77 µs).
 const SEGMENT: usize = 64;
 
+/// Programs up to this length are not cut into segments (see `SpillPlan`).
+const SEGMENTED_FROM: usize = 4 * CHUNK;
+
 /// The JIT module owning the code memory; freed on drop.
 struct Code {
     module: Option<JITModule>,
@@ -212,16 +215,18 @@ fn is_call(ins: &pdyn_expr::compile::Instr) -> bool {
 
 /// Which values cross from one segment to a later one, and where they are kept meanwhile.
 ///
-/// A *segment* is a run of at most `SEGMENT` instructions with no call in it (a call ends its
-/// segment) and no chunk boundary; the outputs, stored after the last instruction, form
-/// segments of `SEGMENT` stores. Every SSA value lives inside one segment: a value read in a
-/// later segment is stored to the spill array right after it is computed and loaded again
-/// where it is needed, and inputs and constants are reloaded per segment. Left to Cranelift,
-/// long live ranges (values across `sin`/`cos` calls, which clobber every XMM register; a
-/// symmetric matrix's entry kept live from its first output to its mirror thousands of stores
-/// later) made its register allocator most of the compile time: 1.7 s of the 100-link
-/// chain's 6.9 s `pdyn run`, and 4–6 s of the chain's JIT compilation under load, now 0.6 s.
-/// The loads and stores cost little next to the arithmetic and calls they sit between.
+/// In programs longer than `SEGMENTED_FROM`, a *segment* is a run of at most `SEGMENT`
+/// instructions with no call in it (a call ends its segment) and no chunk boundary; the
+/// outputs, stored after the last instruction, form segments of `SEGMENT` stores. (Shorter
+/// programs have one segment per chunk.) Every SSA value lives inside one segment: a value
+/// read in a later segment is stored to the spill array right after it is computed and loaded
+/// again where it is needed, and inputs and constants are reloaded per segment. Left to
+/// Cranelift, long live ranges (values across `sin`/`cos` calls, which clobber every XMM
+/// register; a symmetric matrix's entry kept live from its first output to its mirror
+/// thousands of stores later) made its register allocator most of the compile time: 1.7 s of
+/// the 100-link chain's 6.9 s `pdyn run`, and 4–6 s of the chain's JIT compilation under load,
+/// now 0.6 s. In a long program the loads and stores cost little next to the arithmetic and
+/// calls they sit between; in a short one they showed (see `SEGMENTED_FROM`).
 struct SpillPlan {
     chunks: usize,
     /// Spill slot of each temporary (instruction index), `u32::MAX` when it stays in its
@@ -229,9 +234,11 @@ struct SpillPlan {
     slot: Vec<u32>,
     /// The segment in which each instruction reads its operands.
     read_segment: Vec<u32>,
+    /// The segment in which each instruction's result is available.
+    def_segment: Vec<u32>,
     /// The segment of the first outputs (after the last instruction); see `output_segment`.
     output_segment: u32,
-    /// Outputs per output segment (`SEGMENT`).
+    /// Outputs per output segment (`SEGMENT`; unbounded for short programs).
     max_segment: usize,
     n_slots: usize,
 }
@@ -244,7 +251,12 @@ impl SpillPlan {
         let mut read_segment = Vec::with_capacity(len);
         let mut def_segment = Vec::with_capacity(len);
         let mut seg = 0u32;
-        let max_seg = SEGMENT;
+        // Short programs keep every value in registers for the whole chunk: their register
+        // allocation is cheap, and spilling around calls cost the 16-link chain's `M` and `f`
+        // 2.5× the hand-written closure's time instead of 1.0× (and the satellite 1.65×
+        // instead of 1.2×).
+        let segmented = len > SEGMENTED_FROM;
+        let max_seg = if segmented { SEGMENT } else { usize::MAX };
         let mut seg_start = 0usize;
         for (k, ins) in prog.instructions().iter().enumerate() {
             if k > 0 && (k % CHUNK == 0 || k - seg_start >= max_seg) {
@@ -252,7 +264,7 @@ impl SpillPlan {
                 seg_start = k;
             }
             read_segment.push(seg);
-            if is_call(ins) {
+            if segmented && is_call(ins) {
                 seg += 1;
                 seg_start = k + 1;
             }
@@ -262,7 +274,8 @@ impl SpillPlan {
         // is several outputs (a symmetric matrix's two halves) is loaded again rather than
         // kept live across thousands of stores (which made the 100-link chain's last chunk
         // most of the compile time).
-        let output_segment = |i: usize| seg + 1 + (i / max_seg) as u32;
+        let first_output_segment = if segmented { seg + 1 } else { seg };
+        let output_segment = |i: usize| first_output_segment + (i / max_seg) as u32;
         // The last segment that reads each temporary.
         let mut last_use = def_segment.clone();
         let mut read = |r: u32, s: u32| {
@@ -292,7 +305,8 @@ impl SpillPlan {
             chunks,
             slot,
             read_segment,
-            output_segment: seg + 1,
+            def_segment,
+            output_segment: first_output_segment,
             max_segment: max_seg,
             n_slots,
         }
@@ -418,8 +432,8 @@ fn emit_chunk(
                 }
             },
         };
-        // A call's result belongs to the segment after the call.
-        regs[first_temp + k] = Some((v, seg + u32::from(is_call(ins))));
+        // A call's result belongs to the segment after the call (in a segmented program).
+        regs[first_temp + k] = Some((v, plan.def_segment[k]));
         let slot = plan.slot[k];
         if slot != u32::MAX {
             b.ins().store(flags, v, spill, (8 * slot as usize) as i32);
