@@ -177,7 +177,10 @@ pub fn literal(text: &str) -> Option<Number> {
     } else {
         Rational::from_parts(m, p)
     };
-    r.map(Number::Rat)
+    // The digit count above is an estimate; the limit every other exact number meets is in
+    // bits (`9e-99999` passes the first, not the second).
+    r.filter(|q| q.bits() <= crate::number::MAX_BITS)
+        .map(Number::Rat)
 }
 
 /// The size in digits of an exact number in `x` over [`crate::number::MAX_BITS`]: `x` itself,
@@ -205,7 +208,31 @@ fn oversized_number(p: &Pool, x: Id) -> Option<u64> {
 
 /// Lowers a parsed expression into `pool`, resolving names through `scope`.
 pub fn lower(pool: &mut Pool, ast: &Ast, scope: &mut dyn Scope) -> Result<Value, ExprError> {
-    Lowerer { pool, scope }.value(ast)
+    let v = Lowerer {
+        pool: &mut *pool,
+        scope,
+    }
+    .value(ast)?;
+    // Every exact number in the result, however deep (a power's base inside an exponent,
+    // built from unit literals: `333^((33 g^33333)^…)`, fuzzing found it), within the limit
+    // the parser applies to the printed text.
+    let roots: Vec<Id> = match &v {
+        Value::Scalar(x) => vec![*x],
+        Value::Vector(c) => c.to_vec(),
+    };
+    for n in pool.topo_order(&roots) {
+        if let Node::Num(crate::number::Number::Rat(q)) = pool.node(n) {
+            if q.bits() > crate::number::MAX_BITS {
+                let digits = crate::number::bits_to_digits(q.bits());
+                return Err(too_large(
+                    ast.span(),
+                    "a number in this expression".into(),
+                    digits,
+                ));
+            }
+        }
+    }
+    Ok(v)
 }
 
 fn too_large(span: Range<usize>, what: String, digits: u64) -> ExprError {
@@ -686,6 +713,8 @@ mod tests {
             // A term's coefficient grown inside a sum: -1 + 249.8/90^31993 has 2 × 62 523
             // digits as a fraction.
             "Gt- m -249.8/--- 90\u{c}^31993*m",
+            // Deep inside a power's exponent.
+            "\n45^31933g^33*\n46^33042*1933g^33*+333**+33g^33333**+33g^33**336+6",
         ] {
             let e = p.parse_value(src).unwrap_err();
             assert!(e.message.contains("over the limit"), "{src}: {}", e.message);

@@ -825,9 +825,14 @@ mod tests {
         // Fuzzing found `9g^33333` (9 grams to the 33333rd power, 9e-99999 in SI) spending
         // over 35 s in printing: the denominator was divided by 2 and by 5 one at a time.
         let mut p = crate::Pool::new();
-        for (src, want) in [("9 g^33333", "9e-99999"), ("-3e-99990/8", "-3.75e-99991")] {
+        for (src, want) in [("9 g^33332", "9e-99996"), ("-3e-99990/8", "-3.75e-99991")] {
             let e = p.parse_scalar(src).unwrap();
             assert_eq!(p.to_text(e), want);
+        }
+        // One power further is over the limit (4 + 332,190 bits), as a quantity or a literal.
+        for src in ["9 g^33333", "9e-99999"] {
+            let e = p.parse_scalar(src).unwrap_err();
+            assert!(e.message.contains("100000 digits"), "{src}: {}", e.message);
         }
     }
 
