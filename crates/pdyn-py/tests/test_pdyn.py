@@ -145,6 +145,28 @@ def test_derive_gives_expressions(examples):
     assert sympy.simplify(acc.to_sympy() - expected) == 0, acc
 
 
+def test_derive_gives_the_mass_matrix_and_forcing(examples):
+    # The double pendulum's M(q) q'' = f, as a textbook writes it: M symmetric, factored.
+    d = pdyn.Model.from_file(examples / "pendulum_chain_2.toml").derive()
+    mm, f = d.mass_matrix, d.forcing
+    assert len(mm) == 2 and all(len(row) == 2 for row in mm) and len(f) == 2
+    assert all(isinstance(e, pdyn.Expr) for row in mm for e in row)
+    assert str(mm[0][1]) == str(mm[1][0]) == "l1*l2*m2*cos(q1 - q2)"
+    assert str(mm[0][0]) == "l1^2*(m1 + m2)"
+    assert str(mm[1][1]) == "l2^2*m2"
+    sympy = pytest.importorskip("sympy")
+    g, l1, l2, m1, m2, q1, q2, q2d = sympy.symbols("g l1 l2 m1 m2 q1 q2 q2_d")
+    expected = -g * l1 * (m1 + m2) * sympy.sin(q1) - l1 * l2 * m2 * q2d**2 * sympy.sin(q1 - q2)
+    assert sympy.simplify(f[0].to_sympy() - expected) == 0, f[0]
+    # Newton's form: the diagonal m; a model whose unknowns include a reaction (the pulley's
+    # tension) has no mass matrix of the coordinates.
+    n = pdyn.Model.from_file(examples / "projectile_drag.toml").derive()
+    assert [[str(e) for e in row] for row in n.mass_matrix] == [
+        ["m", "0", "0"], ["0", "m", "0"], ["0", "0", "m"]]
+    p = pdyn.Model.from_file(examples / "pulley.toml").derive()
+    assert p.mass_matrix is None and p.forcing is None
+
+
 def arenstorf(t, y):
     mu = 0.012277471
     mp = 1 - mu
