@@ -30,10 +30,8 @@ use cranelift_codegen::ir::{
     types, AbiParam, BlockArg, Function, InstBuilder, MemFlags, SigRef, Signature, Type, Value,
 };
 use cranelift_codegen::isa::CallConv;
-use cranelift_codegen::settings::{self, Configurable};
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
-use cranelift_jit::{JITBuilder, JITModule};
-use cranelift_module::{default_libcall_names, Linkage, Module};
+use cranelift_module::{Linkage, Module};
 use pdyn_expr::compile::Op;
 use pdyn_expr::Program;
 use std::cell::RefCell;
@@ -682,23 +680,7 @@ fn emit_kernel(
 
 /// Compiles `steps` to a native loop.
 fn compile(steps: &Steps) -> Result<Code, JitError> {
-    let isa_builder = cranelift_native::builder().map_err(|r| JitError::Unsupported {
-        reason: r.to_string(),
-    })?;
-    let mut flags = settings::builder();
-    for (k, v) in [
-        ("opt_level", "speed"),
-        ("use_colocated_libcalls", "false"),
-        ("is_pic", "false"),
-        // generated from checked `Steps`; the agreement tests run every operation
-        ("enable_verifier", "false"),
-    ] {
-        flags.set(k, v).map_err(codegen)?;
-    }
-    let isa = isa_builder
-        .finish(settings::Flags::new(flags))
-        .map_err(codegen)?;
-    let mut module = JITModule::new(JITBuilder::with_isa(isa, default_libcall_names()));
+    let mut module = super::new_module()?;
     let ptr = module.target_config().pointer_type();
     let call_conv = module.isa().default_call_conv();
     let mut ctx = module.make_context();

@@ -186,6 +186,33 @@ fn inline_powi(b: &mut FunctionBuilder, x: Value, k: u32) -> Value {
     acc.unwrap_or_else(|| b.ins().f64const(1.0))
 }
 
+/// A JIT module for the host with the settings every generated function uses (the chunks
+/// and the batch kernel).
+fn new_module() -> Result<JITModule, JitError> {
+    let isa_builder = cranelift_native::builder().map_err(|r| JitError::Unsupported {
+        reason: r.to_string(),
+    })?;
+    let mut flags = settings::builder();
+    for (k, v) in [
+        ("opt_level", "speed"),
+        ("use_colocated_libcalls", "false"),
+        ("is_pic", "false"),
+        // The IR is generated here from a checked `Program`, and the agreement tests compare
+        // every example's native code with the interpreter; Cranelift's IR verifier took
+        // about 3 % of a `pdyn run` of the 4-link chain (and it is off in wasmtime too).
+        ("enable_verifier", "false"),
+    ] {
+        flags.set(k, v).map_err(codegen)?;
+    }
+    let isa = isa_builder
+        .finish(settings::Flags::new(flags))
+        .map_err(codegen)?;
+    Ok(JITModule::new(JITBuilder::with_isa(
+        isa,
+        default_libcall_names(),
+    )))
+}
+
 /// The operations Cranelift has as instructions, correctly rounded like Rust's (`+ − × ÷`,
 /// negation, `sqrt`, `abs`), on scalars or lanes alike; `None` for the others. Shared by the
 /// chunks and the batch kernel.
@@ -507,23 +534,7 @@ fn binary_shim(op: Op) -> Option<extern "C" fn(f64, f64) -> f64> {
 impl JitProgram {
     /// Translates `prog` to native code for the host.
     pub fn compile(prog: &Program) -> Result<JitProgram, JitError> {
-        let isa_builder = cranelift_native::builder().map_err(|r| JitError::Unsupported {
-            reason: r.to_string(),
-        })?;
-        let mut flags = settings::builder();
-        flags.set("opt_level", "speed").map_err(codegen)?;
-        flags
-            .set("use_colocated_libcalls", "false")
-            .map_err(codegen)?;
-        flags.set("is_pic", "false").map_err(codegen)?;
-        // The IR is generated here from a checked `Program`, and the agreement tests compare
-        // every example's native code with the interpreter; Cranelift's IR verifier took
-        // about 3 % of a `pdyn run` of the 4-link chain (and it is off in wasmtime too).
-        flags.set("enable_verifier", "false").map_err(codegen)?;
-        let isa = isa_builder
-            .finish(settings::Flags::new(flags))
-            .map_err(codegen)?;
-        let mut module = JITModule::new(JITBuilder::with_isa(isa, default_libcall_names()));
+        let mut module = new_module()?;
         let ptr = module.target_config().pointer_type();
         let call_conv = module.isa().default_call_conv();
 
