@@ -518,17 +518,18 @@ fn per_lane(
     if ty == types::F64 {
         return f(b, a, rb);
     }
-    let mut v = None;
-    for lane in 0..ty.lane_count() as u8 {
+    let mut lane_result = |b: &mut FunctionBuilder, lane: u8| {
         let x = b.ins().extractlane(a, lane);
         let y = rb.map(|y| b.ins().extractlane(y, lane));
-        let r = f(b, x, y);
-        v = Some(match v {
-            None => b.ins().splat(ty, r),
-            Some(v) => b.ins().insertlane(v, r, lane),
-        });
+        f(b, x, y)
+    };
+    let first = lane_result(b, 0);
+    let mut v = b.ins().splat(ty, first);
+    for lane in 1..ty.lane_count() as u8 {
+        let r = lane_result(b, lane);
+        v = b.ins().insertlane(v, r, lane);
     }
-    v.expect("vectors have lanes")
+    v
 }
 
 /// A scalar operation without a packed form, through its shim.
@@ -559,8 +560,7 @@ fn scalar_call(
         op => {
             if let Some(f) = unary_shim(op) {
                 call(b, f as usize, sigs.unary, &[x])
-            } else if let Some(f) = binary_shim(op) {
-                let y = y.expect("binary operation reads b");
+            } else if let (Some(f), Some(y)) = (binary_shim(op), y) {
                 call(b, f as usize, sigs.binary, &[x, y])
             } else {
                 // `Steps::new` refuses operations `known` does not list: not reached

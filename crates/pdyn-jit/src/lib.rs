@@ -217,15 +217,14 @@ fn new_module() -> Result<JITModule, JitError> {
 /// negation, `sqrt`, `abs`), on scalars or lanes alike; `None` for the others. Shared by the
 /// chunks and the batch kernel.
 fn native_arith(b: &mut FunctionBuilder, op: Op, a: Value, rb: Option<Value>) -> Option<Value> {
-    let bv = || rb.expect("binary operation reads b");
-    Some(match op {
-        Op::Add => b.ins().fadd(a, bv()),
-        Op::Sub => b.ins().fsub(a, bv()),
-        Op::Mul => b.ins().fmul(a, bv()),
-        Op::Div => b.ins().fdiv(a, bv()),
-        Op::Neg => b.ins().fneg(a),
-        Op::Sqrt => b.ins().sqrt(a),
-        Op::Abs => b.ins().fabs(a),
+    Some(match (op, rb) {
+        (Op::Add, Some(y)) => b.ins().fadd(a, y),
+        (Op::Sub, Some(y)) => b.ins().fsub(a, y),
+        (Op::Mul, Some(y)) => b.ins().fmul(a, y),
+        (Op::Div, Some(y)) => b.ins().fdiv(a, y),
+        (Op::Neg, _) => b.ins().fneg(a),
+        (Op::Sqrt, _) => b.ins().sqrt(a),
+        (Op::Abs, _) => b.ins().fabs(a),
         _ => return None,
     })
 }
@@ -412,7 +411,6 @@ fn emit_chunk(
         } else {
             None
         };
-        let bv = || rb.expect("binary operation reads b");
         let native = native_arith(&mut b, ins.op(), a, rb);
         let v = match native {
             Some(v) => v,
@@ -447,9 +445,9 @@ fn emit_chunk(
                         let f = b.ins().iconst(ptr, s as usize as i64);
                         let call = b.ins().call_indirect(sig1, f, &[a]);
                         b.inst_results(call)[0]
-                    } else if let Some(s) = binary_shim(op) {
+                    } else if let (Some(s), Some(y)) = (binary_shim(op), rb) {
                         let f = b.ins().iconst(ptr, s as usize as i64);
-                        let call = b.ins().call_indirect(sig2, f, &[a, bv()]);
+                        let call = b.ins().call_indirect(sig2, f, &[a, y]);
                         b.inst_results(call)[0]
                     } else {
                         return Err(JitError::UnsupportedOp {

@@ -428,8 +428,11 @@ fn segment_batched<const UNCHECKED: bool, P: PairPotential>(
             let full = m / B * B;
             for k0 in (0..full).step_by(B) {
                 // fixed-size blocks (one bounds check each), so the lanes use packed arithmetic
-                let blk =
-                    |a: &[f64; CH]| -> [f64; B] { a[k0..k0 + B].try_into().expect("a block of B") };
+                let blk = |a: &[f64; CH]| -> [f64; B] {
+                    let mut o = [0.0; B];
+                    o.copy_from_slice(&a[k0..k0 + B]);
+                    o
+                };
                 let db = [blk(&d[0]), blk(&d[1]), blk(&d[2])];
                 let (r2b, ub, frb) = (blk(&r2), blk(&u), blk(&fr));
                 let mut uk = [0.0f64; B];
