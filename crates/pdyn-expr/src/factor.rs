@@ -54,6 +54,15 @@ impl Pool {
     /// (see the module documentation). A product is factored factor by factor; anything else
     /// is returned as it is. The result is equal to `e`.
     pub fn factor_terms(&mut self, e: Id) -> Id {
+        if let Some(&r) = self.memo.factor.get(&e) {
+            return r;
+        }
+        let r = self.factor_terms_uncached(e);
+        self.memo.factor.insert(e, r);
+        r
+    }
+
+    fn factor_terms_uncached(&mut self, e: Id) -> Id {
         match self.node(e) {
             Node::Add(ts) => {
                 let ts = ts.to_vec();

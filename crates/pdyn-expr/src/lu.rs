@@ -5,7 +5,7 @@
 //!
 //! - LU with partial pivoting, Doolittle elimination `P A = L U` (Golub & Van Loan, *Matrix
 //!   Computations*, alg. 3.4.1), for any nonsingular `A`;
-//! - Cholesky `A = L Lᵀ` (Golub & Van Loan alg. 4.2.1, row by row) for the symmetric matrices
+//! - Cholesky `A = Uᵀ U` (Golub & Van Loan alg. 4.2.2, outer-product form) for the symmetric matrices
 //!   that mass matrices are: half the operations of LU and no pivoting, since a mass matrix is
 //!   positive definite. [`DenseSolver`] tries it first on a symmetric system and falls back to
 //!   LU when `A` turns out not to be positive definite.
@@ -116,47 +116,100 @@ fn dot(x: &[f64], y: &[f64]) -> f64 {
     (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
-/// Factorises the symmetric row-major `n×n` matrix `a` as `L Lᵀ`, reading and overwriting
-/// only its lower triangle and diagonal (the upper triangle is left as it was). Fails at the
-/// first pivot that is not positive (beyond `1e-14 · max|a|`): `a` is not positive definite,
-/// or is singular.
+/// Factorises the symmetric row-major `n×n` matrix `a` as `Uᵀ U` (`U = Lᵀ`, upper
+/// triangular), reading and overwriting only its upper triangle and diagonal (the lower
+/// triangle is left as it was). Fails at the first pivot that is not positive (beyond
+/// `1e-14 · max|a|`): `a` is not positive definite, or is singular.
+///
+/// Right-looking (outer-product) form: once row `k` of `U` is known, every later row `i`
+/// loses `u_ki` times row `k` from its diagonal on. Each update runs along contiguous
+/// memory with no dependence between its elements, so it vectorises; the dot-product
+/// (left-looking) form it replaced waited on one running sum per element and took 2–3× as
+/// long at `n = 100` (a 100-link chain's mass matrix, factorised at every evaluation).
 pub fn cholesky_factor_in_place(a: &mut [f64], n: usize) -> Result<(), SingularMatrix> {
     debug_assert_eq!(a.len(), n * n);
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx") {
+        // SAFETY: the processor has AVX (checked just above).
+        return unsafe { cholesky_factor_avx(a, n) };
+    }
+    cholesky_factor_generic(a, n)
+}
+
+/// [`cholesky_factor_generic`] compiled for AVX: four lanes per instruction instead of two.
+/// The updates are element by element (a multiplication, then a subtraction: no fused
+/// multiply-add, no reordering), so the factor is the same to the last bit on every
+/// processor.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+unsafe fn cholesky_factor_avx(a: &mut [f64], n: usize) -> Result<(), SingularMatrix> {
+    cholesky_factor_generic(a, n)
+}
+
+#[inline(always)]
+fn cholesky_factor_generic(a: &mut [f64], n: usize) -> Result<(), SingularMatrix> {
     let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let tiny = scale * 1e-14;
-    for i in 0..n {
-        let (done, rest) = a.split_at_mut(i * n);
-        let row_i = &mut rest[..n];
-        for j in 0..i {
-            let row_j = &done[j * n..j * n + j + 1];
-            let s = row_i[j] - dot(&row_i[..j], row_j);
-            row_i[j] = s / row_j[j];
-        }
-        let d = row_i[i] - dot(&row_i[..i], &row_i[..i]);
+    // Row `k` of `U` from what the earlier rows left of row `k` of `A`.
+    let finish_row = |row_k: &mut [f64], k: usize| -> Result<(), SingularMatrix> {
+        let d = row_k[k];
         if d.is_nan() || d <= tiny {
-            return Err(SingularMatrix { pivot: i });
+            return Err(SingularMatrix { pivot: k });
         }
-        row_i[i] = d.sqrt();
+        let ukk = d.sqrt();
+        row_k[k] = ukk;
+        let inv = 1.0 / ukk;
+        for x in &mut row_k[k + 1..] {
+            *x *= inv;
+        }
+        Ok(())
+    };
+    // Rows two at a time: each later row is read and written once per pair of rows of `U`
+    // rather than once per row. Each element still loses `u_ki * u_kj`, then
+    // `u_(k+1)i * u_(k+1)j`, in that order: the same bits as one row at a time.
+    let mut k = 0;
+    while k < n {
+        let (done, rest) = a.split_at_mut((k + 1) * n);
+        let row_k = &mut done[k * n..];
+        finish_row(row_k, k)?;
+        let row_k = &row_k[..];
+        if k + 1 == n {
+            break;
+        }
+        let (row_k1, rest) = rest.split_at_mut(n);
+        let u = row_k[k + 1];
+        for (x, &y) in row_k1[k + 1..].iter_mut().zip(&row_k[k + 1..]) {
+            *x -= u * y;
+        }
+        finish_row(row_k1, k + 1)?;
+        let row_k1 = &row_k1[..];
+        for (i, row_i) in (k + 2..n).zip(rest.chunks_exact_mut(n)) {
+            let (u0, u1) = (row_k[i], row_k1[i]);
+            for ((x, &y0), &y1) in row_i[i..].iter_mut().zip(&row_k[i..]).zip(&row_k1[i..]) {
+                *x = (*x - u0 * y0) - u1 * y1;
+            }
+        }
+        k += 2;
     }
     Ok(())
 }
 
 /// Solves `A x = b` given the factor from [`cholesky_factor_in_place`]; `b` is overwritten by
 /// `x`.
-pub fn cholesky_solve_in_place(l: &[f64], n: usize, b: &mut [f64]) {
-    // L y = b, row by row.
-    for i in 0..n {
-        let row = &l[i * n..i * n + i + 1];
-        b[i] = (b[i] - dot(&row[..i], &b[..i])) / row[i];
-    }
-    // Lᵀ x = y: column i of Lᵀ is row i of L.
-    for i in (0..n).rev() {
-        let row = &l[i * n..i * n + i + 1];
-        let xi = b[i] / row[i];
-        b[i] = xi;
-        for (bk, lik) in b[..i].iter_mut().zip(&row[..i]) {
-            *bk -= lik * xi;
+pub fn cholesky_solve_in_place(u: &[f64], n: usize, b: &mut [f64]) {
+    // Uᵀ y = b: column k of Uᵀ is row k of U, subtracted from the rest of b once y_k is known.
+    for k in 0..n {
+        let row = &u[k * n..(k + 1) * n];
+        let yk = b[k] / row[k];
+        b[k] = yk;
+        for (bi, uki) in b[k + 1..].iter_mut().zip(&row[k + 1..]) {
+            *bi -= uki * yk;
         }
+    }
+    // U x = y, row by row from the bottom.
+    for i in (0..n).rev() {
+        let row = &u[i * n..(i + 1) * n];
+        b[i] = (b[i] - dot(&row[i + 1..], &b[i + 1..])) / row[i];
     }
 }
 
@@ -201,11 +254,11 @@ impl DenseSolver {
                 x[..n].copy_from_slice(&b[..n]);
                 return Ok(());
             }
-            // Not positive definite: A is its untouched upper triangle and the saved
+            // Not positive definite: A is its untouched lower triangle and the saved
             // diagonal; let pivoting decide whether it is singular.
             for i in 0..n {
                 a[i * n + i] = self.work[i];
-                for j in 0..i {
+                for j in i + 1..n {
                     a[i * n + j] = a[j * n + i];
                 }
             }
@@ -295,12 +348,33 @@ mod tests {
             let mut solver = DenseSolver::new(n, true);
             solver.solve(&mut ab, &mut x).unwrap();
             assert!(residual(&a, &x, &b) < 1e-12, "n={n}");
-            // And the upper triangle was left as it was.
+            // And the lower triangle was left as it was.
             for i in 0..n {
-                for j in i + 1..n {
+                for j in 0..i {
                     assert_eq!(ab[i * n + j], a[i * n + j]);
                 }
             }
+        }
+    }
+
+    #[test]
+    fn the_dispatched_factor_has_the_generic_factors_bits() {
+        // On a processor with AVX the dispatched factor runs the AVX build: same bits.
+        let mut seed = 11;
+        for n in [1, 2, 3, 6, 7, 31, 64] {
+            let bm = random_matrix(n, &mut seed);
+            let mut a = vec![0.0; n * n];
+            for i in 0..n {
+                for j in 0..n {
+                    a[i * n + j] = (0..n).map(|k| bm[k * n + i] * bm[k * n + j]).sum::<f64>()
+                        + if i == j { 0.1 } else { 0.0 };
+                }
+            }
+            let mut dispatched = a.clone();
+            cholesky_factor_in_place(&mut dispatched, n).unwrap();
+            cholesky_factor_generic(&mut a, n).unwrap();
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&dispatched), bits(&a), "n={n}");
         }
     }
 

@@ -11,6 +11,8 @@ use rustc_hash::FxHashMap;
 pub(crate) struct Memo {
     pub expand: FxHashMap<Id, Id>,
     pub simplify: FxHashMap<Id, Id>,
+    /// `factor_terms`: a chain's mass sums recur in `O(n²)` printed entries.
+    pub factor: FxHashMap<Id, Id>,
     /// (expression, variable, total time derivative?) → derivative.
     pub diff: FxHashMap<(Id, Id, bool), Id>,
     /// Polynomial work units spent by `simplify`'s rational forms since the pool was made (a

@@ -29,7 +29,7 @@ pub struct Poly {
 pub struct Budget(pub u64);
 
 impl Budget {
-    fn spend(&mut self, n: usize) -> Option<()> {
+    pub(crate) fn spend(&mut self, n: usize) -> Option<()> {
         self.0 = self.0.checked_sub(n as u64 + 1)?;
         Some(())
     }
@@ -112,7 +112,7 @@ impl Poly {
         self.terms.iter().next_back().map(|(m, c)| (m, c.clone()))
     }
 
-    fn add_term(&mut self, m: Mono, c: Rational) -> Option<()> {
+    pub(crate) fn add_term(&mut self, m: Mono, c: Rational) -> Option<()> {
         if c == Rational::ZERO {
             return Some(());
         }
@@ -140,6 +140,15 @@ impl Poly {
             out.add_term(m.clone(), c.checked_mul(&k)?)?;
         }
         Some(out)
+    }
+    /// `self += o`, in place: linear in `o`'s size, where [`Poly::add`] copies `self`
+    /// (summing `n` terms one by one with it was quadratic).
+    pub fn add_assign(&mut self, o: &Poly, b: &mut Budget) -> Option<()> {
+        b.spend(o.terms.len())?;
+        for (m, c) in &o.terms {
+            self.add_term(m.clone(), c.clone())?;
+        }
+        Some(())
     }
     /// Sum.
     pub fn add(&self, o: &Poly, b: &mut Budget) -> Option<Poly> {

@@ -63,6 +63,17 @@ impl Pool {
         if best_cost > MAX_TREE {
             return best;
         }
+        if self.plain_polynomial(base) {
+            // Its rational form is itself (see `plain_polynomial`): only the contraction of
+            // sines and cosines can shorten it. A 100-link chain's particle velocities and
+            // accelerations spent 0.3 s being converted to polynomials and back.
+            let c = self.contract_trig(base);
+            return if self.tree_size(c, best_cost) < best_cost {
+                c
+            } else {
+                base
+            };
+        }
         for expand_trig in [false, true] {
             if let Some(c) = self.rational_form(base, expand_trig) {
                 for cand in [c, self.contract_trig(c)] {
@@ -235,6 +246,38 @@ impl Pool {
     }
 
     /// Rebuilds `e` with simplified function arguments and power bases/exponents.
+    /// Whether `e` (canonical, its arguments simplified) is already its own rational normal
+    /// form: a sum of products of atoms with positive integer powers, with no sine, cosine
+    /// or tangent that the trigonometric expansion or the Pythagorean reduction would
+    /// rewrite (an argument that is a sum or a multiple, a power of two or more, a tangent).
+    /// Canonical sums have their like terms combined already, the denominator is 1, so
+    /// `rational_form` would give `e` back.
+    fn plain_polynomial(&self, e: Id) -> bool {
+        let atom = |p: &Pool, a: Id, power: i64| match p.node(a) {
+            Node::Sym(_) | Node::Coord(..) | Node::Const(_) | Node::Time => true,
+            Node::Call(Func::Sin | Func::Cos, args) => {
+                power < 2 && matches!(p.node(args[0]), Node::Sym(_) | Node::Coord(..) | Node::Time)
+            }
+            _ => false,
+        };
+        let factor = |p: &Pool, f: Id| match p.node(f) {
+            Node::Num(Number::Rat(_)) => true,
+            Node::Pow(b, x) => match p.as_num(*x).and_then(|n| n.as_integer()) {
+                Some(k) if k >= 2 => atom(p, *b, k),
+                _ => false,
+            },
+            _ => atom(p, f, 1),
+        };
+        let term = |p: &Pool, t: Id| match p.node(t) {
+            Node::Mul(fs) => fs.iter().all(|&f| factor(p, f)),
+            _ => factor(p, t),
+        };
+        match self.node(e) {
+            Node::Add(ts) => ts.iter().all(|&t| term(self, t)),
+            _ => term(self, e),
+        }
+    }
+
     fn simplify_args(&mut self, e: Id) -> Id {
         match self.node(e).clone() {
             Node::Add(ts) => {
@@ -334,7 +377,12 @@ impl RationalForm {
                 let mut acc: Frac = (Poly::zero(), one());
                 for t in ts.iter() {
                     let f = self.convert(p, *t)?;
-                    acc = self.add(acc, f)?;
+                    if f.1 == acc.1 {
+                        // The common case (polynomial terms): summed in place.
+                        acc.0.add_assign(&f.0, &mut self.budget)?;
+                    } else {
+                        acc = self.add(acc, f)?;
+                    }
                 }
                 Some(acc)
             }
@@ -440,7 +488,17 @@ impl RationalForm {
                 }
             }
         }
+        let squared = |poly: &Poly, x: u32| {
+            poly.terms
+                .keys()
+                .any(|m| m.iter().any(|&(a, e)| a == x && e >= 2))
+        };
         for (s, c) in pairs {
+            // No square of either to rewrite (a chain's sums are linear in each sine and
+            // cosine): nothing to compare, and nothing copied.
+            if ![&num, &den].iter().any(|p| squared(p, s) || squared(p, c)) {
+                continue;
+            }
             let b = &mut self.budget;
             let ns = eliminate_square(&num, s, c, b)?;
             let ds = eliminate_square(&den, s, c, b)?;
@@ -527,18 +585,20 @@ fn power_too_big(n: &Poly, d: &Poly, k: i64) -> bool {
 
 /// Replaces `x^k` (k ≥ 2) by `x^(k mod 2) * (1 - y^2)^(k div 2)`, i.e. uses `x^2 = 1 - y^2`.
 fn eliminate_square(poly: &Poly, x: u32, y: u32, b: &mut Budget) -> Option<Poly> {
+    let power_of_x = |m: &Mono| m.iter().find(|&&(a, _)| a == x).map_or(0, |&(_, e)| e);
+    // Nothing to rewrite (most sums: a chain's velocities are linear in each sine): the
+    // polynomial itself, without rebuilding it term by term.
+    if poly.terms.keys().all(|m| power_of_x(m) < 2) {
+        return Some(poly.clone());
+    }
+    b.spend(poly.terms.len())?;
     let mut one_minus_y2 = Poly::constant(Rational::ONE);
     one_minus_y2 = one_minus_y2.sub(&Poly::atom(y).pow(2, b)?, b)?;
     let mut out = Poly::zero();
     for (m, c) in &poly.terms {
-        let k = m.iter().find(|&&(a, _)| a == x).map_or(0, |&(_, e)| e);
-        let term_poly = |mono: Mono| {
-            let mut t = Poly::zero();
-            t.terms.insert(mono, c.clone());
-            t
-        };
+        let k = power_of_x(m);
         if k < 2 {
-            out = out.add(&term_poly(m.clone()), b)?;
+            out.add_term(m.clone(), c.clone())?;
             continue;
         }
         let mut rest: Mono = m.iter().copied().filter(|&(a, _)| a != x).collect();
@@ -547,7 +607,9 @@ fn eliminate_square(poly: &Poly, x: u32, y: u32, b: &mut Budget) -> Option<Poly>
             rest.sort_by_key(|&(a, _)| std::cmp::Reverse(a));
         }
         let f = one_minus_y2.pow(k / 2, b)?;
-        out = out.add(&term_poly(rest).mul(&f, b)?, b)?;
+        for (fm, fc) in f.mul_term(&rest, c.clone(), b)?.terms {
+            out.add_term(fm, fc)?;
+        }
     }
     Some(out)
 }

@@ -171,6 +171,9 @@ pub struct Derivation {
     /// Declared reactions that the projected form eliminated, recovered from F = m a with the
     /// accelerations substituted: `(name, expression of the state)`.
     pub recovered: Vec<(String, Id)>,
+    /// Whether `system` was assembled collected and contracted term by term (the projected
+    /// form, derived for reading): its entries need only to be collected to print.
+    pub assembled_collected: bool,
 }
 
 impl Derivation {
@@ -378,7 +381,9 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
         other => other,
     };
 
-    // In the projected form without working reactions, `M` and `f` are built directly.
+    // In the projected form without working reactions, `M` and `f` are built directly,
+    // collected (and, for reading, contracted) as they are assembled.
+    let contract = opts.simplify && opts.simplify_printed;
     let mut direct: Option<LinearSystem> = None;
     let (equations, unknowns) = match form {
         Form::Projected => {
@@ -388,7 +393,11 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
                     "use the Newton form (--form newton)",
                 ));
             }
-            let (eqs, mass, forcing) = projected(
+            let crate::projection::Projected {
+                equations: eqs,
+                mass,
+                forcing,
+            } = crate::projection::projected(
                 p,
                 &parts,
                 &qd,
@@ -396,7 +405,8 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
                 &free,
                 &model.coordinates,
                 &model.reactions,
-            )?;
+                contract,
+            );
             // Reactions that survive projection do work: they stay unknown and need equations.
             let mut unk: Vec<Unknown> = acc_unknowns;
             for ru in reaction_unknowns {
@@ -422,6 +432,7 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
         }
     };
 
+    let assembled = direct.is_some();
     let (equations, system) = match direct {
         Some(sys) => (equations, sys),
         None => linear_form(p, equations, &unknowns)?,
@@ -469,11 +480,15 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
             pk.a.map(|c| simp(p, c, opts.simplify && opts.simplify_printed));
         pk.force = pk.force.map(|c| simp(p, c, opts.simplify));
     }
+    // Assembled projected equations are already collected and contracted: simplifying
+    // them again (a rational normal form of every entry) was 80 % of `pdyn derive` on a
+    // 16-link chain and changed nothing a reader sees.
+    let simplify_equations = opts.simplify && opts.simplify_printed && !assembled;
     let equations = equations
         .into_iter()
         .map(|e| Equation {
-            lhs: simp(p, e.lhs, opts.simplify && opts.simplify_printed),
-            rhs: simp(p, e.rhs, opts.simplify && opts.simplify_printed),
+            lhs: simp(p, e.lhs, simplify_equations),
+            rhs: simp(p, e.rhs, simplify_equations),
             label: e.label,
         })
         .collect();
@@ -532,6 +547,7 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
         state_names,
         notes,
         recovered,
+        assembled_collected: assembled && contract,
     })
 }
 
@@ -604,114 +620,4 @@ fn linear_form(
         other => derr(other.to_string(), "check the model's forces"),
     })?;
     Ok((equations, system))
-}
-
-/// Kane's equations: for each free coordinate `q_j`, `Σ_p (m_p a_p − F_p)·∂r_p/∂q_j = 0`,
-/// written as `Σ_k M_jk q_k'' = f_j`. Returns the printable equations, `M` (row-major) and `f`.
-///
-/// `M_jk = Σ_p m_p ∂r_p/∂q_j·∂r_p/∂q_k` is assembled by grouping particles whose partial
-/// velocities give the same dot product (in a chain, every particle below both links), so the
-/// entry is `(Σ m_p) * dot` rather than a sum of `n` products: the work stays O(n³) in cheap
-/// symbol additions and the expressions O(n²).
-#[allow(clippy::type_complexity)]
-fn projected(
-    p: &mut Pool,
-    parts: &[ParticleKinematics],
-    qd: &[Id],
-    qdd: &[Id],
-    free: &[usize],
-    coordinates: &[crate::model::Coordinate],
-    reactions: &[crate::model::Reaction],
-) -> Result<(Vec<Equation>, Vec<Id>, Vec<Id>), DeriveError> {
-    let n = qd.len();
-    // Partial velocities ∂v/∂q_j' = ∂r/∂q_j, read off the velocity's terms (it is linear in
-    // the rates) when it is built that way, differentiated otherwise.
-    let mut jac: Vec<Vec<[Id; 3]>> = Vec::with_capacity(parts.len());
-    for pk in parts {
-        let comps = pk.v.map(|c| p.linear_coefficients(c, qd));
-        let mut rows = vec![[Pool::ZERO; 3]; n];
-        for (k, comp) in comps.iter().enumerate() {
-            for (j, row) in rows.iter_mut().enumerate() {
-                row[k] = match comp {
-                    Some(cs) => cs[j],
-                    None => p.diff(pk.v[k], qd[j]),
-                };
-            }
-        }
-        jac.push(rows);
-    }
-    let zero_acc: FxHashMap<Id, Id> = qdd.iter().map(|&a| (a, Pool::ZERO)).collect();
-    // Mass matrix: (j, k) → dot product → masses.
-    let mut groups: Vec<FxHashMap<Id, Vec<Id>>> = vec![FxHashMap::default(); n * n];
-    let mut dots: FxHashMap<([Id; 3], [Id; 3]), Id> = FxHashMap::default();
-    let mut forcing_terms: Vec<Vec<Id>> = vec![Vec::new(); n];
-    for (pi, pk) in parts.iter().enumerate() {
-        let nz: Vec<usize> = (0..n)
-            .filter(|&j| jac[pi][j].iter().any(|&c| c != Pool::ZERO))
-            .collect();
-        for (a_i, &j) in nz.iter().enumerate() {
-            for &k in &nz[a_i..] {
-                let key = (jac[pi][j], jac[pi][k]);
-                let d = match dots.get(&key) {
-                    Some(&d) => d,
-                    None => {
-                        let d = vector::dot(p, key.0, key.1);
-                        dots.insert(key, d);
-                        d
-                    }
-                };
-                if d != Pool::ZERO {
-                    groups[j * n + k].entry(d).or_default().push(pk.mass);
-                }
-            }
-        }
-        if nz.is_empty() {
-            continue;
-        }
-        // Generalized force minus the velocity-dependent part of m a.
-        let a0 = pk.a.map(|c| p.subs(c, &zero_acc));
-        let ma0 = vector::scale(p, pk.mass, a0);
-        let net = vector::sub(p, pk.force, ma0);
-        for &j in &nz {
-            forcing_terms[j].push(vector::dot(p, net, jac[pi][j]));
-        }
-    }
-    let mut mass = vec![Pool::ZERO; n * n];
-    for j in 0..n {
-        for k in j..n {
-            let mut terms = Vec::new();
-            let mut g: Vec<(Id, Vec<Id>)> = groups[j * n + k].drain().collect();
-            g.sort_by_key(|(d, _)| *d);
-            for (d, ms) in g {
-                let total = p.add(&ms);
-                terms.push(p.mul2(total, d));
-            }
-            let m = p.add(&terms);
-            mass[j * n + k] = m;
-            mass[k * n + j] = m;
-        }
-    }
-    let mut forcing = Vec::with_capacity(n);
-    let mut eqs = Vec::with_capacity(n);
-    for j in 0..n {
-        let mut rhs = p.add(&forcing_terms[j]);
-        // Reactions that do no work in this direction vanish only after simplification.
-        for r in reactions {
-            if p.contains(rhs, r.id) {
-                let c = p.diff(rhs, r.id);
-                if p.provably_equal(c, Pool::ZERO) {
-                    rhs = p.subs1(rhs, r.id, Pool::ZERO);
-                }
-            }
-        }
-        let lhs_terms: Vec<Id> = (0..n).map(|k| p.mul2(mass[j * n + k], qdd[k])).collect();
-        let lhs = p.add(&lhs_terms);
-        forcing.push(rhs);
-        eqs.push(Equation {
-            label: format!("projection on {}", coordinates[free[j]].name),
-            lhs,
-            rhs,
-        });
-    }
-    Ok((eqs, mass, forcing))
 }

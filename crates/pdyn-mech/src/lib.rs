@@ -22,6 +22,7 @@ pub mod matrix_form;
 pub mod model;
 pub mod parameters;
 pub mod prescribed;
+mod projection;
 pub mod units;
 pub mod validity;
 

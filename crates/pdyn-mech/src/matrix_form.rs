@@ -82,7 +82,7 @@ pub fn matrix_form(p: &mut Pool, d: &Derivation) -> Option<MatrixForm> {
             if mass[j * n + k].is_some() {
                 continue;
             }
-            let e = tidy(p, d.system.coeff(j, k));
+            let e = tidy(p, d.system.coeff(j, k), d.assembled_collected);
             if k > j && d.system.coeff(k, j) == d.system.coeff(j, k) {
                 mass[k * n + j] = Some(e.clone());
             }
@@ -90,7 +90,12 @@ pub fn matrix_form(p: &mut Pool, d: &Derivation) -> Option<MatrixForm> {
         }
     }
     let symmetric = (0..n).all(|j| (0..j).all(|k| d.system.coeff(j, k) == d.system.coeff(k, j)));
-    let forcing = d.system.b.iter().map(|&b| tidy(p, b)).collect();
+    let forcing = d
+        .system
+        .b
+        .iter()
+        .map(|&b| tidy(p, b, d.assembled_collected))
+        .collect();
     Some(MatrixForm {
         n,
         accelerations: d.system.unknowns.clone(),
@@ -100,8 +105,15 @@ pub fn matrix_form(p: &mut Pool, d: &Derivation) -> Option<MatrixForm> {
     })
 }
 
-/// Simplifies (when small) and collects one entry.
-fn tidy(p: &mut Pool, e: Id) -> Entry {
+/// Simplifies (when small) and collects one entry; `assembled`: it was collected and
+/// contracted as it was assembled (the projected form), so it is only collected here.
+fn tidy(p: &mut Pool, e: Id, assembled: bool) -> Entry {
+    if assembled {
+        return Entry {
+            expr: e,
+            collected: Some(p.collect_terms(e, &depends_on_state)),
+        };
+    }
     if p.tree_size(e, TIDY_NODES + 1) > TIDY_NODES {
         return Entry {
             expr: e,
@@ -118,7 +130,10 @@ fn tidy(p: &mut Pool, e: Id) -> Entry {
     let s = match p.node(e) {
         Node::Mul(fs) => {
             let fs = fs.to_vec();
-            let s: Vec<Id> = fs.iter().map(|&f| simplify_factor(p, f)).collect();
+            let s: Vec<Id> = fs
+                .iter()
+                .map(|&f| crate::projection::tidy_small(p, f, usize::MAX))
+                .collect();
             p.mul(&s)
         }
         // A sum (a forcing term: every particle's contribution, x and y parts apart) is
@@ -154,22 +169,5 @@ fn tidy(p: &mut Pool, e: Id) -> Entry {
     Entry {
         expr: s,
         collected: Some(collected),
-    }
-}
-
-/// One factor of an entry, simplified as cheaply as it allows (see [`tidy`]).
-fn simplify_factor(p: &mut Pool, f: Id) -> Id {
-    let c = p.contract_trig(f);
-    let trig_sum = matches!(p.node(c), Node::Add(_))
-        && p.any_node(c, &|n| {
-            matches!(
-                n,
-                Node::Call(pdyn_expr::Func::Sin | pdyn_expr::Func::Cos, _)
-            )
-        });
-    if trig_sum {
-        p.simplify(c)
-    } else {
-        c
     }
 }

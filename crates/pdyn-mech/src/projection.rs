@@ -1,0 +1,333 @@
+//! The projected (Kane) form `M(q) q'' = f(q, q', t)`, assembled term by term.
+//!
+//! `M_jk = Σ_p m_p ∂r_p/∂q_j·∂r_p/∂q_k` and `f_j = Σ_p (F_p − m_p a_p|_{q''=0})·∂r_p/∂q_j`.
+//! Summed particle by particle, a chain of `n` links gives entries with `O(n²)` terms each
+//! (`O(n³)` in all) that only an expensive simplification brings back to the textbook's
+//! `l1*l2*(m2 + m3)*cos(q1 - q2)`. Instead, every product is keyed by what does not depend
+//! on the particle — the pair of partial velocities for `M`, the pair (acceleration or
+//! force term, partial-velocity component) for `f` — and the particles' masses are summed
+//! per key: `M_jk = Σ_keys (Σ m_p) * dot`, `f_j = Σ_keys (Σ m_p) * term * component`. In a
+//! chain every particle below both links shares one key, so the entries come out with `O(n)`
+//! terms each, already collected: the work is `O(n³)` hash look-ups and symbol additions
+//! and `O(n²)` expression building.
+//!
+//! For printing (`contract`), each key's product is contracted back into angle differences
+//! (`sin(q1)*cos(q2) − cos(q1)*sin(q2)` → `sin(q1 − q2)`) among terms that share everything
+//! but their sines and cosines: small sums, linear work. A run leaves them as products,
+//! which evaluate with `2n` sines and cosines instead of `n²`.
+
+use crate::derive::{Equation, ParticleKinematics};
+use pdyn_expr::{vector, Func, Id, Node, Pool};
+use rustc_hash::FxHashMap;
+
+/// The projected form of a model's equations.
+pub(crate) struct Projected {
+    /// The printable equations `Σ_k M_jk q_k'' = f_j`, one per free coordinate.
+    pub equations: Vec<Equation>,
+    /// `M`, row-major (symmetric: `M[j,k]` and `M[k,j]` are the same node).
+    pub mass: Vec<Id>,
+    /// `f`.
+    pub forcing: Vec<Id>,
+}
+
+/// `M`, `f` and the equations of the projected form; see the module documentation.
+/// `contract`: contract sines and cosines for reading.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn projected(
+    p: &mut Pool,
+    parts: &[ParticleKinematics],
+    qd: &[Id],
+    qdd: &[Id],
+    free: &[usize],
+    coordinates: &[crate::model::Coordinate],
+    reactions: &[crate::model::Reaction],
+    contract: bool,
+) -> Projected {
+    let n = qd.len();
+    let jac = partial_velocities(p, parts, qd);
+    let zero_acc: FxHashMap<Id, Id> = qdd.iter().map(|&a| (a, Pool::ZERO)).collect();
+    // Mass matrix: (j, k) → dot product → masses; forcing: j → (term, component) → weights.
+    let mut mass_groups: Vec<FxHashMap<Id, Vec<Id>>> = vec![FxHashMap::default(); n * n];
+    let mut dots: FxHashMap<([Id; 3], [Id; 3]), Id> = FxHashMap::default();
+    let mut force_groups: Vec<FxHashMap<(Id, Id), Vec<Id>>> = vec![FxHashMap::default(); n];
+    for (pi, pk) in parts.iter().enumerate() {
+        let nz: Vec<usize> = (0..n)
+            .filter(|&j| jac[pi][j].iter().any(|&c| c != Pool::ZERO))
+            .collect();
+        if nz.is_empty() {
+            continue;
+        }
+        for (a_i, &j) in nz.iter().enumerate() {
+            for &k in &nz[a_i..] {
+                let key = (jac[pi][j], jac[pi][k]);
+                let d = match dots.get(&key) {
+                    Some(&d) => d,
+                    None => {
+                        let d = vector::dot(p, key.0, key.1);
+                        let d = if contract {
+                            tidy_small(p, d, SMALL_NODES)
+                        } else {
+                            d
+                        };
+                        dots.insert(key, d);
+                        d
+                    }
+                };
+                if d != Pool::ZERO {
+                    mass_groups[j * n + k].entry(d).or_default().push(pk.mass);
+                }
+            }
+        }
+        // The generalized force minus the velocity-dependent part of m a, term by term:
+        // `(weight, term)` with `weight * term` the contribution to one component.
+        let a0 = pk.a.map(|c| p.subs(c, &zero_acc));
+        for c in 0..3 {
+            let mut weighted: Vec<(Id, Id)> = Vec::new();
+            for t in addends(p, a0[c]) {
+                let minus_t = p.neg(t);
+                weighted.push((pk.mass, minus_t));
+            }
+            for t in addends(p, pk.force[c]) {
+                weighted.push(split_mass(p, t, pk.mass));
+            }
+            for &j in &nz {
+                let component = jac[pi][j][c];
+                if component == Pool::ZERO {
+                    continue;
+                }
+                for &(w, t) in &weighted {
+                    force_groups[j].entry((t, component)).or_default().push(w);
+                }
+            }
+        }
+    }
+    let mut sums = MassSums::default();
+    let mut mass = vec![Pool::ZERO; n * n];
+    for j in 0..n {
+        for k in j..n {
+            let mut g: Vec<(Id, Vec<Id>)> = mass_groups[j * n + k].drain().collect();
+            g.sort_by_key(|(d, _)| *d);
+            let terms: Vec<Id> = g
+                .into_iter()
+                .map(|(d, ms)| {
+                    let total = sums.sum(p, ms);
+                    p.mul2(total, d)
+                })
+                .collect();
+            let m = p.add(&terms);
+            mass[j * n + k] = m;
+            mass[k * n + j] = m;
+        }
+    }
+    let mut forcing = Vec::with_capacity(n);
+    let mut eqs = Vec::with_capacity(n);
+    for (j, groups) in force_groups.into_iter().enumerate() {
+        let mut rhs = forcing_entry(p, groups, contract, &mut sums);
+        // Reactions that do no work in this direction vanish only after simplification.
+        for r in reactions {
+            if p.contains(rhs, r.id) {
+                let c = p.diff(rhs, r.id);
+                if p.provably_equal(c, Pool::ZERO) {
+                    rhs = p.subs1(rhs, r.id, Pool::ZERO);
+                }
+            }
+        }
+        let lhs_terms: Vec<Id> = (0..n).map(|k| p.mul2(mass[j * n + k], qdd[k])).collect();
+        let lhs = p.add(&lhs_terms);
+        forcing.push(rhs);
+        eqs.push(Equation {
+            label: format!("projection on {}", coordinates[free[j]].name),
+            lhs,
+            rhs,
+        });
+    }
+    Projected {
+        equations: eqs,
+        mass,
+        forcing,
+    }
+}
+
+/// Partial velocities `∂v_p/∂q_j' = ∂r_p/∂q_j` of every particle, `[particle][j]`: read off
+/// the velocity's terms (it is linear in the rates) when it is built that way, differentiated
+/// otherwise.
+fn partial_velocities(p: &mut Pool, parts: &[ParticleKinematics], qd: &[Id]) -> Vec<Vec<[Id; 3]>> {
+    let n = qd.len();
+    let mut jac = Vec::with_capacity(parts.len());
+    for pk in parts {
+        let comps = pk.v.map(|c| p.linear_coefficients(c, qd));
+        let mut rows = vec![[Pool::ZERO; 3]; n];
+        for (k, comp) in comps.iter().enumerate() {
+            for (j, row) in rows.iter_mut().enumerate() {
+                row[k] = match comp {
+                    Some(cs) => cs[j],
+                    None => p.diff(pk.v[k], qd[j]),
+                };
+            }
+        }
+        jac.push(rows);
+    }
+    jac
+}
+
+/// Sums of particle masses, memoised: in a chain the same suffix sums `m_k + … + m_n` weigh
+/// `O(n²)` entries, and building each anew (sorting and interning `O(n)` terms) was most of
+/// the projection's time at `n = 100`.
+#[derive(Default)]
+struct MassSums(FxHashMap<Vec<Id>, Id>);
+
+impl MassSums {
+    fn sum(&mut self, p: &mut Pool, weights: Vec<Id>) -> Id {
+        if let Some(&s) = self.0.get(&weights) {
+            return s;
+        }
+        let s = p.add(&weights);
+        self.0.insert(weights, s);
+        s
+    }
+}
+
+/// The terms of a sum (one term for anything else; none for zero).
+fn addends(p: &Pool, e: Id) -> Vec<Id> {
+    match p.node(e) {
+        Node::Add(ts) => ts.to_vec(),
+        _ if e == Pool::ZERO => Vec::new(),
+        _ => vec![e],
+    }
+}
+
+/// A force term as `(weight, rest)`: the particle's mass taken out when it is a factor
+/// (gravity's `-g*m2` → `(m2, -g)`), so that the particles' weights collect into mass sums
+/// like their inertia does; `(1, term)` otherwise.
+fn split_mass(p: &mut Pool, t: Id, mass: Id) -> (Id, Id) {
+    if p.as_num(mass).is_some() {
+        return (Pool::ONE, t);
+    }
+    if t == mass {
+        return (mass, Pool::ONE);
+    }
+    if let Node::Mul(fs) = p.node(t) {
+        if let Some(at) = fs.iter().position(|&f| f == mass) {
+            let mut rest = fs.to_vec();
+            rest.remove(at);
+            return (mass, p.mul(&rest));
+        }
+    }
+    (Pool::ONE, t)
+}
+
+/// One entry of `f` from its keyed terms: `Σ (Σ weights) * term * component`, terms with
+/// equal total weight gathered, and (for reading) their sines and cosines contracted.
+fn forcing_entry(
+    p: &mut Pool,
+    groups: FxHashMap<(Id, Id), Vec<Id>>,
+    contract: bool,
+    sums: &mut MassSums,
+) -> Id {
+    let mut keyed: Vec<((Id, Id), Vec<Id>)> = groups.into_iter().collect();
+    keyed.sort_by_key(|(k, _)| *k);
+    // Total weight → the products it multiplies, in first-seen order.
+    let mut by_weight: FxHashMap<Id, Vec<Id>> = FxHashMap::default();
+    let mut order: Vec<Id> = Vec::new();
+    for ((t, component), ws) in keyed {
+        let w = sums.sum(p, ws);
+        if w == Pool::ZERO {
+            continue;
+        }
+        let product = p.mul2(t, component);
+        if product == Pool::ZERO {
+            continue;
+        }
+        by_weight
+            .entry(w)
+            .or_insert_with(|| {
+                order.push(w);
+                Vec::new()
+            })
+            .push(product);
+    }
+    let mut terms = Vec::new();
+    for w in order {
+        let products = by_weight.remove(&w).unwrap_or_default();
+        let products = if contract {
+            contract_by_rest(p, &products)
+        } else {
+            products
+        };
+        let sum = p.add(&products);
+        // Distributed, so that each printed term carries its mass sum:
+        // `-g*l2*(m2 + m3)*sin(q2) + l1*l2*(m2 + m3)*q1'^2*sin(q1 - q2)`.
+        for t in addends(p, sum) {
+            terms.push(p.mul2(w, t));
+        }
+    }
+    p.add(&terms)
+}
+
+/// Whether `f` is a sine or cosine (or a power of one).
+fn is_trig(p: &Pool, f: Id) -> bool {
+    match p.node(f) {
+        Node::Call(Func::Sin | Func::Cos, _) => true,
+        Node::Pow(b, _) => matches!(p.node(*b), Node::Call(Func::Sin | Func::Cos, _)),
+        _ => false,
+    }
+}
+
+/// `products` with the ones that differ only in their sines, cosines and numeric coefficient
+/// summed and contracted: `l1*l2*q1'^2*sin(q1)*cos(q2) − l1*l2*q1'^2*cos(q1)*sin(q2)` →
+/// `l1*l2*q1'^2*sin(q1 − q2)`. Each contracted sum is small (the x and y parts of one
+/// product), so the work is linear in the number of products.
+fn contract_by_rest(p: &mut Pool, products: &[Id]) -> Vec<Id> {
+    let mut by_rest: FxHashMap<Id, Vec<Id>> = FxHashMap::default();
+    let mut order: Vec<Id> = Vec::new();
+    for &t in products {
+        let fs: Vec<Id> = match p.node(t) {
+            Node::Mul(fs) => fs.to_vec(),
+            _ => vec![t],
+        };
+        let (trig, rest): (Vec<Id>, Vec<Id>) = fs
+            .into_iter()
+            .partition(|&f| is_trig(p, f) || p.as_num(f).is_some());
+        let rest = p.mul(&rest);
+        let trig = p.mul(&trig);
+        by_rest
+            .entry(rest)
+            .or_insert_with(|| {
+                order.push(rest);
+                Vec::new()
+            })
+            .push(trig);
+    }
+    order
+        .into_iter()
+        .map(|rest| {
+            let trig = by_rest.remove(&rest).unwrap_or_default();
+            let sum = p.add(&trig);
+            let sum = if trig.len() > 1 {
+                tidy_small(p, sum, SMALL_NODES)
+            } else {
+                sum
+            };
+            p.mul2(rest, sum)
+        })
+        .collect()
+}
+
+/// Largest expression the projection hands to `simplify` (a dot product of two partial
+/// velocities of a spatial linkage is a few dozen nodes).
+const SMALL_NODES: usize = 400;
+
+/// A small trigonometric expression (a dot product of two partial velocities, the x and y
+/// parts of one forcing product) contracted, and simplified when a sum of sines and cosines
+/// is left (`l^2*sin(q)^2 + l^2*cos(q)^2` → `l^2`) of at most `max_nodes` tree nodes.
+pub(crate) fn tidy_small(p: &mut Pool, e: Id, max_nodes: usize) -> Id {
+    let c = p.contract_trig(e);
+    let trig_sum = matches!(p.node(c), Node::Add(_))
+        && p.tree_size(c, max_nodes.saturating_add(1)) <= max_nodes
+        && p.any_node(c, &|n| matches!(n, Node::Call(Func::Sin | Func::Cos, _)));
+    if trig_sum {
+        p.simplify(c)
+    } else {
+        c
+    }
+}
