@@ -211,6 +211,13 @@ pub const FULL_SOLVE_BUDGET: u64 = 4_000_000;
 /// chain included), not for the 4- and 5-link chains, whose elimination took most of
 /// `pdyn derive`/`pdyn run` (3 s of a 3.1 s run at n = 4) and printed 37 KB lines.
 pub const CHEAP_SOLVE_BUDGET: u64 = 200_000;
+/// Work budget of exact elimination for a run, which only evaluates the result: a closed
+/// form pays off when it is found quickly (one or two unknowns, Newton's equations with a
+/// few reactions); past this, `A x = b` solved numerically at each evaluation is cheaper
+/// than eliminating, then compiling the large result and its Jacobian. The 3- to 6-link
+/// chains spent 30–60 ms of a 40–60 ms `pdyn run` eliminating; numerically they take
+/// 10 ms or less, so the run's time now grows with `n`.
+pub const RUN_SOLVE_BUDGET: u64 = 20_000;
 
 fn simp(p: &mut Pool, e: Id, on: bool) -> Id {
     if on && p.tree_size(e, 4001) <= 4000 {

@@ -432,6 +432,7 @@ pub fn prepare(model: &mut Model) -> Result<Prepared, SimError> {
 pub fn run_options() -> DeriveOptions {
     DeriveOptions {
         simplify_printed: false,
+        solve_budget: pdyn_mech::derive::RUN_SOLVE_BUDGET,
         ..DeriveOptions::default()
     }
 }
