@@ -207,10 +207,12 @@ impl Derivation {
 /// Work budget (polynomial term operations) of exact elimination on request (`pdyn derive
 /// --solve`): the linear solver's own default.
 pub const FULL_SOLVE_BUDGET: u64 = 4_000_000;
-/// Default work budget of exact elimination: enough for every shipped example (the 3-link
-/// chain included), not for the 4- and 5-link chains, whose elimination took most of
-/// `pdyn derive`/`pdyn run` (3 s of a 3.1 s run at n = 4) and printed 37 KB lines.
-pub const CHEAP_SOLVE_BUDGET: u64 = 200_000;
+/// Default work budget of exact elimination: enough for every shipped example (the 2- and
+/// 3-link chains included, whose mass matrices are contracted for reading), not for longer
+/// chains, whose elimination took most of `pdyn derive` (0.05 s of it at n = 4, when n = 8
+/// took 0.01 s) and gave explicit forms printed by reference anyway. It was 200,000; no
+/// example needed more than 20,000.
+pub const CHEAP_SOLVE_BUDGET: u64 = 20_000;
 /// Work budget of exact elimination for a run, which only evaluates the result: a closed
 /// form pays off when it is found quickly (one or two unknowns, Newton's equations with a
 /// few reactions); past this, `A x = b` solved numerically at each evaluation is cheaper

@@ -197,10 +197,11 @@ fn numeric_linear_solve_matches_the_exact_elimination() {
     use pdyn_ode::OdeSystem;
     for name in ["pendulum_chain_3", "pulley", "bicycle"] {
         let mut exact_model = example(name);
-        // The derivation's default budget eliminates all three exactly (a run's own budget
-        // leaves the 3-link chain to the numeric path).
+        // The full budget eliminates all three exactly (a run's own budget leaves the 3-link
+        // chain to the numeric path).
         let exact_opts = DeriveOptions {
             simplify_printed: false,
+            solve_budget: pdyn_mech::derive::FULL_SOLVE_BUDGET,
             ..DeriveOptions::default()
         };
         let exact = sim::prepare_with(&mut exact_model, &exact_opts).unwrap();
