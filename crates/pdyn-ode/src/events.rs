@@ -393,6 +393,9 @@ impl<'a> Output<'a> {
         match self.t_eval {
             None => sol.push(t0, y0),
             Some(ts) => {
+                // At most one point per requested time (plus a terminal event's).
+                sol.t.reserve(ts.len() + 1);
+                sol.y.reserve((ts.len() + 1) * y0.len());
                 while self.next < ts.len() && ts[self.next] == t0 {
                     sol.push(t0, y0);
                     self.next += 1;

@@ -404,7 +404,20 @@ pub(crate) struct Dop853 {
 
 impl DenseOutput for Dop853 {
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let n = self.n;
+        match self.n {
+            2 => self.interpolate_n::<2>(t, out),
+            4 => self.interpolate_n::<4>(t, out),
+            6 => self.interpolate_n::<6>(t, out),
+            _ => self.interpolate_n::<0>(t, out),
+        }
+    }
+}
+
+impl Dop853 {
+    /// [`DenseOutput::interpolate`]; `N > 0` fixes the dimension at compile time.
+    #[inline(always)]
+    fn interpolate_n<const N: usize>(&self, t: f64, out: &mut [f64]) {
+        let n = if N > 0 { N } else { self.n };
         let s = (t - self.t_old) / self.h;
         let s1 = 1.0 - s;
         let c = &self.cont;
@@ -640,7 +653,40 @@ impl ExplicitRk for Dop853 {
         y_new: &[f64],
         stats: &mut Stats,
     ) {
+        // As `attempt`: the same arithmetic, with loops of compile-time length for the usual
+        // small dimensions (with output at many points this runs at nearly every step).
+        match self.n {
+            1 => self.prepare_dense_n::<S, 1>(sys, t, y, h, y_new, stats),
+            2 => self.prepare_dense_n::<S, 2>(sys, t, y, h, y_new, stats),
+            3 => self.prepare_dense_n::<S, 3>(sys, t, y, h, y_new, stats),
+            4 => self.prepare_dense_n::<S, 4>(sys, t, y, h, y_new, stats),
+            6 => self.prepare_dense_n::<S, 6>(sys, t, y, h, y_new, stats),
+            8 => self.prepare_dense_n::<S, 8>(sys, t, y, h, y_new, stats),
+            _ => self.prepare_dense_n::<S, 0>(sys, t, y, h, y_new, stats),
+        }
+    }
+
+    fn advance(&mut self) {
         let n = self.n;
+        self.k.copy_within(12 * n..13 * n, 0);
+    }
+}
+
+impl Dop853 {
+    /// The dense output of the accepted step; `N > 0` fixes the dimension at compile time
+    /// (`N = 0`: use `self.n`).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn prepare_dense_n<S: OdeSystem + ?Sized, const N: usize>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        y_new: &[f64],
+        stats: &mut Stats,
+    ) {
+        let n = if N > 0 { N } else { self.n };
         self.t_old = t;
         self.h = h;
         let mut ys = std::mem::take(&mut self.y1);
@@ -668,11 +714,6 @@ impl ExplicitRk for Dop853 {
                 self.cont[r * n + i] *= h;
             }
         }
-    }
-
-    fn advance(&mut self) {
-        let n = self.n;
-        self.k.copy_within(12 * n..13 * n, 0);
     }
 }
 
