@@ -388,7 +388,7 @@ pub(crate) fn stage_input(y: &[f64], k: &[f64], n: usize, a_row: &[f64], h: f64,
 }
 
 /// Below this dimension the stage sums run component by component.
-const SMALL: usize = 16;
+pub(crate) const SMALL: usize = 16;
 
 /// `out_j = Σ_m w_m k_{m,j}` over the nonzero `w_m`, accumulated in stage order.
 #[inline(always)]
