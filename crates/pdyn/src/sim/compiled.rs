@@ -62,6 +62,22 @@ pub struct CompiledModel {
     pub observation_inputs: Vec<Id>,
 }
 
+/// `dst.copy_from_slice(src)`, with the copy inlined for the lengths of small models: the
+/// right-hand side copies the state at every evaluation, and a call to `memmove` costs more
+/// than such a copy.
+#[inline(always)]
+fn copy_small(dst: &mut [f64], src: &[f64]) {
+    macro_rules! fixed {
+        ($($k:literal),*) => {
+            match (src.len(), dst.len()) {
+                $(($k, $k) => dst[..$k].copy_from_slice(&src[..$k]),)*
+                _ => dst.copy_from_slice(src),
+            }
+        };
+    }
+    fixed!(1, 2, 3, 4, 6, 8)
+}
+
 /// Leaves `[t, q, q', parameters]` and the unknowns of a derivation.
 pub fn input_leaves(model: &mut Model, d: &Derivation) -> (Vec<Id>, Vec<Id>) {
     let t = model.pool.time();
@@ -202,7 +218,7 @@ impl CompiledModel {
     /// the integrator reports with the time and state.
     fn solve_into(&self, s: &mut Scratch, t: f64, y: &[f64]) {
         s.input[0] = t;
-        s.input[1..1 + 2 * self.n].copy_from_slice(y);
+        copy_small(&mut s.input[1..1 + 2 * self.n], y);
         match &self.engine {
             Engine::Exact(prog) => prog.eval(&s.input, &mut s.ws, &mut s.out),
             Engine::Numeric => {
@@ -248,7 +264,7 @@ impl CompiledModel {
         let base = s.input.len();
         out.resize(base + self.n + self.n_reactions, 0.0);
         out[0] = t;
-        out[1..1 + 2 * self.n].copy_from_slice(&y[..2 * self.n]);
+        copy_small(&mut out[1..1 + 2 * self.n], &y[..2 * self.n]);
         out[1 + 2 * self.n..base].copy_from_slice(&s.input[1 + 2 * self.n..]);
         out[base..].fill(f64::NAN);
     }
@@ -263,7 +279,7 @@ impl OdeSystem for CompiledModel {
         let n = self.n;
         let s = &mut *self.scratch.borrow_mut();
         self.solve_into(s, t, y);
-        dydt[..n].copy_from_slice(&y[n..]);
+        copy_small(&mut dydt[..n], &y[n..]);
         for (k, slot) in self.slots.iter().enumerate() {
             if let Ok(i) = slot {
                 dydt[n + i] = s.out[k];
