@@ -372,6 +372,9 @@ pub(crate) fn brent(
     b
 }
 
+/// Output points [`Output::start`] reserves room for, at most.
+const RESERVED_POINTS: usize = 1 << 16;
+
 /// Output at requested times (`t_eval`) or after every step.
 pub(crate) struct Output<'a> {
     t_eval: Option<&'a [f64]>,
@@ -393,6 +396,12 @@ impl<'a> Output<'a> {
         match self.t_eval {
             None => sol.push(t0, y0),
             Some(ts) => {
+                // At most one point per requested time (plus a terminal event's); reserved
+                // up front, up to a bound (a run stopped early by an event or a failure
+                // should not hold room for millions of points it never reached).
+                let points = ts.len().min(RESERVED_POINTS) + 1;
+                sol.t.reserve(points);
+                sol.y.reserve(points * y0.len());
                 while self.next < ts.len() && ts[self.next] == t0 {
                     sol.push(t0, y0);
                     self.next += 1;

@@ -292,12 +292,6 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
     }
 }
 
-/// `out_j = y_j + h Σ_m a_m k_{m,j}` over the nonzero `a_m` (stage-major `k`).
-///
-/// The sum is accumulated stage by stage over whole vectors (vectorisable inner loops) but per
-/// component in the same order as the Fortran codes, `((a_1 k_1 + a_2 k_2) + …)`, then
-/// `y + h·sum`, so results are bit-identical to Hairer's.
-#[inline(always)]
 /// Hairer's stiffness estimate `ρ = |h| ‖k_s − k_{s−1}‖ / ‖y_{n+1} − y_stage‖` (dopri5.f,
 /// dop853.f): the last two stages were evaluated at nearly the same point, so the quotient
 /// approximates the dominant eigenvalue of the Jacobian times `h`. 0 when the states coincide.
@@ -335,6 +329,14 @@ macro_rules! dispatch_dim {
 }
 pub(crate) use dispatch_dim;
 
+/// `out_j = y_j + h Σ_m a_m k_{m,j}` over the nonzero `a_m` (stage-major `k`).
+///
+/// The sum is accumulated stage by stage over whole vectors (vectorisable inner loops) but per
+/// component in the same order as the Fortran codes, `((a_1 k_1 + a_2 k_2) + …)`, then
+/// `y + h·sum`, so results are bit-identical to Hairer's. Always inlined: called with a
+/// dimension `n` known at compile time (DOP853's dense output for small systems), its loops
+/// unroll.
+#[inline(always)]
 pub(crate) fn stage_input(y: &[f64], k: &[f64], n: usize, a_row: &[f64], h: f64, out: &mut [f64]) {
     let out = &mut out[..n];
     let y = &y[..n];
@@ -386,7 +388,7 @@ pub(crate) fn stage_input(y: &[f64], k: &[f64], n: usize, a_row: &[f64], h: f64,
 }
 
 /// Below this dimension the stage sums run component by component.
-const SMALL: usize = 16;
+pub(crate) const SMALL: usize = 16;
 
 /// `out_j = Σ_m w_m k_{m,j}` over the nonzero `w_m`, accumulated in stage order.
 #[inline(always)]

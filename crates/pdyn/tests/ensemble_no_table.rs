@@ -309,3 +309,34 @@ points = 101
         assert_eq!(fast.status, RunStatus::Finished);
     }
 }
+
+/// The pulley: the cable tension `T` is a reaction, among the output columns and measured, so
+/// the no-table path must solve for the unknowns at each output point; the building's
+/// columns and measures read only the state, so it must not need to (and gives the same bits
+/// without solving). Both are checked against the tabulating path.
+#[test]
+fn reactions_are_solved_for_only_when_read() {
+    let src = with_measures(&example_source("pulley"), "mA", "T");
+    let mut m = pdyn_mech::load(&src, "<test>").unwrap();
+    let prep = sim::prepare(&mut m).unwrap();
+    let base = prep.system.inputs.len();
+    assert!(!prep.observer.reads_only_first(base));
+    assert!(!prep.measures.as_ref().unwrap().reads_only_first(base));
+    for points in [None, Some(101)] {
+        let out = ensemble(&src, "mA", &[2.0, 3.5], |s| s.points = points);
+        for (fast, _) in &out {
+            assert_eq!(fast.status, RunStatus::Finished);
+            // T = 2 mA mB g / (mA + mB) > 0, constant: every statistic but peak-to-peak.
+            assert!(fast.measures.iter().all(|x| x.is_finite()), "{fast:?}");
+            assert!(fast.measures[0] > 1.0, "{:?}", fast.measures);
+        }
+    }
+    let src = with_measures(&example_source("building"), "omega", "y2 - L");
+    let mut m = pdyn_mech::load(&src, "<test>").unwrap();
+    let prep = sim::prepare(&mut m).unwrap();
+    let base = prep.system.inputs.len();
+    assert!(prep.observer.reads_only_first(base));
+    assert!(prep.measures.as_ref().unwrap().reads_only_first(base));
+    // It reads y2, the state's second component (input 2, after t).
+    assert!(!prep.measures.as_ref().unwrap().reads_only_first(2));
+}

@@ -20,7 +20,7 @@
 
 use crate::controller::Controller;
 use crate::events::DenseOutput;
-use crate::explicit::{combine, stage_input, ExplicitRk};
+use crate::explicit::{combine, stage_input, ExplicitRk, SMALL};
 use crate::problem::OdeSystem;
 use crate::solution::Stats;
 use crate::tableau::Tableau;
@@ -316,6 +316,55 @@ const A_DENSE: [[f64; 15]; 3] = [
     ],
 ];
 
+/// Number of nonzero entries of `row`.
+const fn nonzero_count(row: &[f64]) -> usize {
+    let (mut c, mut m) = (0, 0);
+    while m < row.len() {
+        if row[m] != 0.0 {
+            c += 1;
+        }
+        m += 1;
+    }
+    c
+}
+
+/// The nonzero entries of `row` in order: their indices and values (`M` of them).
+const fn nonzero<const M: usize>(row: &[f64]) -> ([usize; M], [f64; M]) {
+    let (mut idx, mut val) = ([0; M], [0.0; M]);
+    let (mut q, mut m) = (0, 0);
+    while m < row.len() {
+        if row[m] != 0.0 {
+            idx[q] = m;
+            val[q] = row[m];
+            q += 1;
+        }
+        m += 1;
+    }
+    assert!(q == M);
+    (idx, val)
+}
+
+/// Nonzero entries per row of [`A_DENSE`] (8 in each).
+const DENSE_NZ: usize = nonzero_count(&A_DENSE[0]);
+
+/// [`A_DENSE`] by its nonzero entries.
+const A_DENSE_NZ: [([usize; DENSE_NZ], [f64; DENSE_NZ]); 3] = [
+    nonzero(&A_DENSE[0]),
+    nonzero(&A_DENSE[1]),
+    nonzero(&A_DENSE[2]),
+];
+
+/// Nonzero entries per row of [`D`] (12 in each).
+const D_ROW_NZ: usize = nonzero_count(&D[0]);
+
+/// [`D`] by its nonzero entries.
+const D_NZ: [([usize; D_ROW_NZ], [f64; D_ROW_NZ]); 4] = [
+    nonzero(&D[0]),
+    nonzero(&D[1]),
+    nonzero(&D[2]),
+    nonzero(&D[3]),
+];
+
 /// Dense-output coefficients (dop853.f D4*, D5*, D6*, D7*) over stages 1–16.
 const D: [[f64; 16]; 4] = [
     [
@@ -404,7 +453,20 @@ pub(crate) struct Dop853 {
 
 impl DenseOutput for Dop853 {
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let n = self.n;
+        match self.n {
+            2 => self.interpolate_n::<2>(t, out),
+            4 => self.interpolate_n::<4>(t, out),
+            6 => self.interpolate_n::<6>(t, out),
+            _ => self.interpolate_n::<0>(t, out),
+        }
+    }
+}
+
+impl Dop853 {
+    /// [`DenseOutput::interpolate`]; `N > 0` fixes the dimension at compile time.
+    #[inline(always)]
+    fn interpolate_n<const N: usize>(&self, t: f64, out: &mut [f64]) {
+        let n = if N > 0 { N } else { self.n };
         let s = (t - self.t_old) / self.h;
         let s1 = 1.0 - s;
         let c = &self.cont;
@@ -640,13 +702,60 @@ impl ExplicitRk for Dop853 {
         y_new: &[f64],
         stats: &mut Stats,
     ) {
+        // As `attempt`: the same arithmetic, with loops of compile-time length for the usual
+        // small dimensions (with output at many points this runs at nearly every step).
+        match self.n {
+            1 => self.prepare_dense_n::<S, 1>(sys, t, y, h, y_new, stats),
+            2 => self.prepare_dense_n::<S, 2>(sys, t, y, h, y_new, stats),
+            3 => self.prepare_dense_n::<S, 3>(sys, t, y, h, y_new, stats),
+            4 => self.prepare_dense_n::<S, 4>(sys, t, y, h, y_new, stats),
+            6 => self.prepare_dense_n::<S, 6>(sys, t, y, h, y_new, stats),
+            8 => self.prepare_dense_n::<S, 8>(sys, t, y, h, y_new, stats),
+            _ => self.prepare_dense_n::<S, 0>(sys, t, y, h, y_new, stats),
+        }
+    }
+
+    fn advance(&mut self) {
         let n = self.n;
+        self.k.copy_within(12 * n..13 * n, 0);
+    }
+}
+
+impl Dop853 {
+    /// The dense output of the accepted step; `N > 0` fixes the dimension at compile time
+    /// (`N = 0`: use `self.n`).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn prepare_dense_n<S: OdeSystem + ?Sized, const N: usize>(
+        &mut self,
+        sys: &S,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        y_new: &[f64],
+        stats: &mut Stats,
+    ) {
+        let n = if N > 0 { N } else { self.n };
         self.t_old = t;
         self.h = h;
         let mut ys = std::mem::take(&mut self.y1);
         for (j, row) in A_DENSE.iter().enumerate() {
             let s = 13 + j;
-            stage_input(y, &self.k, n, &row[..s], h, &mut ys);
+            if N > 0 && N < SMALL {
+                // `stage_input`'s small-dimension arithmetic over the nonzero entries only,
+                // without testing each entry for zero at run time.
+                let (idx, a) = &A_DENSE_NZ[j];
+                let k = &self.k[..16 * n];
+                for i in 0..n {
+                    let mut acc = 0.0;
+                    for q in 0..DENSE_NZ {
+                        acc += a[q] * k[idx[q] * n + i];
+                    }
+                    ys[i] = y[i] + h * acc;
+                }
+            } else {
+                stage_input(y, &self.k, n, &row[..s], h, &mut ys);
+            }
             let (_, rest) = self.k.split_at_mut(s * n);
             sys.rhs(t + C_DENSE[j] * h, &ys, &mut rest[..n]);
         }
@@ -654,7 +763,20 @@ impl ExplicitRk for Dop853 {
         stats.fevals += 3;
         for (r, d) in D.iter().enumerate() {
             let (_, row) = self.cont.split_at_mut((4 + r) * n);
-            combine(&self.k, n, d, &mut row[..n]);
+            if N > 0 {
+                // `combine` over the nonzero entries only (the same sums, in the same order).
+                let (idx, w) = &D_NZ[r];
+                let k = &self.k[..16 * n];
+                for (i, o) in row[..n].iter_mut().enumerate() {
+                    let mut acc = w[0] * k[idx[0] * n + i];
+                    for q in 1..D_ROW_NZ {
+                        acc += w[q] * k[idx[q] * n + i];
+                    }
+                    *o = acc;
+                }
+            } else {
+                combine(&self.k, n, d, &mut row[..n]);
+            }
         }
         let k = &self.k;
         for i in 0..n {
@@ -668,11 +790,6 @@ impl ExplicitRk for Dop853 {
                 self.cont[r * n + i] *= h;
             }
         }
-    }
-
-    fn advance(&mut self) {
-        let n = self.n;
-        self.k.copy_within(12 * n..13 * n, 0);
     }
 }
 
@@ -706,6 +823,68 @@ mod tests {
         for (j, row) in A_DENSE.iter().enumerate() {
             let s: f64 = row.iter().sum();
             assert!((s - C_DENSE[j]).abs() < 1e-14, "stage {}: {s}", 14 + j);
+            // Stage 14 + j reads only the stages before it.
+            assert!(row[13 + j..].iter().all(|&a| a == 0.0));
+        }
+    }
+
+    /// The nonzero-entry tables are the rows, entry for entry.
+    #[test]
+    fn nonzero_tables_match_the_rows() {
+        fn expand<const M: usize>(nz: &([usize; M], [f64; M]), len: usize) -> Vec<f64> {
+            let mut row = vec![0.0; len];
+            for q in 0..M {
+                assert!(nz.1[q] != 0.0);
+                row[nz.0[q]] = nz.1[q];
+            }
+            row
+        }
+        for (row, nz) in A_DENSE.iter().zip(&A_DENSE_NZ) {
+            assert_eq!(expand(nz, row.len()), row.to_vec());
+        }
+        for (row, nz) in D.iter().zip(&D_NZ) {
+            assert_eq!(expand(nz, row.len()), row.to_vec());
+        }
+    }
+
+    /// The dense output prepared with the dimension fixed at compile time gives the same bits
+    /// as with the dimension known at run time (`N = 0`: `stage_input`, `combine`), and so
+    /// does the interpolation.
+    #[test]
+    fn dense_output_is_the_same_for_compile_time_dimensions() {
+        struct Forced;
+        impl OdeSystem for Forced {
+            fn dim(&self) -> usize {
+                4
+            }
+            fn rhs(&self, t: f64, y: &[f64], d: &mut [f64]) {
+                d[0] = y[2];
+                d[1] = y[3];
+                d[2] = (0.2 * (9.0 * t).sin() - 4.0 * y[0] + 2.0 * y[1]) * 100.0;
+                d[3] = (2.0 * y[0] - 2.0 * y[1]) * 100.0;
+            }
+        }
+        let n = 4;
+        let (y, h, t) = ([0.1, 0.3, -0.7, 0.25], 0.037, 1.3);
+        let (mut a, mut b) = (Dop853::new(n), Dop853::new(n));
+        // Stages 1-13 as an attempt leaves them (varied values, some negative).
+        for (m, x) in a.k[..13 * n].iter_mut().enumerate() {
+            *x = ((m as f64 + 1.0) * 0.731).sin() * 10f64.powi(m as i32 % 5 - 2);
+        }
+        b.k.copy_from_slice(&a.k);
+        let y_new = [0.1003, 0.2991, -0.69, 0.2512];
+        let mut stats = Stats::default();
+        a.prepare_dense_n::<_, 4>(&Forced, t, &y, h, &y_new, &mut stats);
+        b.prepare_dense_n::<_, 0>(&Forced, t, &y, h, &y_new, &mut stats);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&a.k), bits(&b.k));
+        assert_eq!(bits(&a.cont), bits(&b.cont));
+        assert!(a.cont.iter().all(|x| x.is_finite()) && a.cont[4 * n..].iter().any(|&x| x != 0.0));
+        let (mut oa, mut ob) = ([0.0; 4], [0.0; 4]);
+        for s in [0.0, 0.3, 0.77, 1.0] {
+            a.interpolate_n::<4>(t + s * h, &mut oa);
+            b.interpolate_n::<0>(t + s * h, &mut ob);
+            assert_eq!(bits(&oa), bits(&ob));
         }
     }
 }

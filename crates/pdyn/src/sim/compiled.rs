@@ -62,6 +62,22 @@ pub struct CompiledModel {
     pub observation_inputs: Vec<Id>,
 }
 
+/// `dst.copy_from_slice(src)`, with the copy inlined for the lengths of small models: the
+/// right-hand side copies the state at every evaluation, and a call to `memmove` costs more
+/// than such a copy.
+#[inline(always)]
+fn copy_small(dst: &mut [f64], src: &[f64]) {
+    macro_rules! fixed {
+        ($($k:literal),*) => {
+            match (src.len(), dst.len()) {
+                $(($k, $k) => dst[..$k].copy_from_slice(&src[..$k]),)*
+                _ => dst.copy_from_slice(src),
+            }
+        };
+    }
+    fixed!(1, 2, 3, 4, 6, 8)
+}
+
 /// Leaves `[t, q, q', parameters]` and the unknowns of a derivation.
 pub fn input_leaves(model: &mut Model, d: &Derivation) -> (Vec<Id>, Vec<Id>) {
     let t = model.pool.time();
@@ -202,7 +218,7 @@ impl CompiledModel {
     /// the integrator reports with the time and state.
     fn solve_into(&self, s: &mut Scratch, t: f64, y: &[f64]) {
         s.input[0] = t;
-        s.input[1..1 + 2 * self.n].copy_from_slice(y);
+        copy_small(&mut s.input[1..1 + 2 * self.n], y);
         match &self.engine {
             Engine::Exact(prog) => prog.eval(&s.input, &mut s.ws, &mut s.out),
             Engine::Numeric => {
@@ -216,16 +232,41 @@ impl CompiledModel {
     }
 
     /// Fills the observation input vector `[t, q, q', parameters, q'', reactions]` at `(t, y)`.
+    /// Allocates only the first time `out` is used (it is resized to
+    /// [`CompiledModel::observation_inputs`]' length and reused).
     pub fn observation_input(&self, t: f64, y: &[f64], out: &mut Vec<f64>) {
-        let n = self.n;
-        let mut acc = vec![0.0; n];
-        let mut reac = vec![0.0; self.n_reactions];
-        self.unknowns(t, y, &mut acc, &mut reac);
-        out.clear();
+        let s = &mut *self.scratch.borrow_mut();
+        self.solve_into(s, t, &y[..2 * self.n]);
+        let base = s.input.len();
+        out.resize(base + self.n + self.n_reactions, 0.0);
+        out[..base].copy_from_slice(&s.input);
+        let (acc, reac) = out[base..].split_at_mut(self.n);
+        for (k, slot) in self.slots.iter().enumerate() {
+            match slot {
+                Ok(i) => acc[*i] = s.out[k],
+                Err(r) => {
+                    if let Some(x) = reac.get_mut(*r) {
+                        *x = s.out[k];
+                    }
+                }
+            }
+        }
+    }
+
+    /// The observation inputs at `(t, y)` without solving for the unknowns: `[t, q, q',
+    /// parameters]` as [`CompiledModel::observation_input`] gives them, the accelerations and
+    /// reactions NaN. For programs that do not read the unknowns
+    /// ([`Observer::reads_only_first`] with [`CompiledModel::inputs`]' length): they then
+    /// compute the same bits as from [`CompiledModel::observation_input`], without the cost
+    /// of a right-hand side evaluation.
+    pub fn observation_input_without_unknowns(&self, t: f64, y: &[f64], out: &mut Vec<f64>) {
         let s = self.scratch.borrow();
-        out.extend_from_slice(&s.input);
-        out.extend_from_slice(&acc);
-        out.extend_from_slice(&reac);
+        let base = s.input.len();
+        out.resize(base + self.n + self.n_reactions, 0.0);
+        out[0] = t;
+        copy_small(&mut out[1..1 + 2 * self.n], &y[..2 * self.n]);
+        out[1 + 2 * self.n..base].copy_from_slice(&s.input[1 + 2 * self.n..]);
+        out[base..].fill(f64::NAN);
     }
 }
 
@@ -238,7 +279,7 @@ impl OdeSystem for CompiledModel {
         let n = self.n;
         let s = &mut *self.scratch.borrow_mut();
         self.solve_into(s, t, y);
-        dydt[..n].copy_from_slice(&y[n..]);
+        copy_small(&mut dydt[..n], &y[n..]);
         for (k, slot) in self.slots.iter().enumerate() {
             if let Ok(i) = slot {
                 dydt[n + i] = s.out[k];
@@ -303,6 +344,9 @@ pub struct Observer {
     pub names: Vec<String>,
     prog: Evaluator,
     ws: RefCell<Vec<f64>>,
+    /// The expressions read at most the first `inputs_read` inputs (one past the largest
+    /// index among the inputs that appear in them; 0 when none does).
+    inputs_read: usize,
 }
 
 impl Observer {
@@ -315,7 +359,25 @@ impl Observer {
     ) -> Result<Observer, CompileError> {
         let prog = Evaluator::Interpreted(Program::compile(pool, inputs, exprs)?);
         let ws = RefCell::new(prog.workspace());
-        Ok(Observer { names, prog, ws })
+        // Every leaf of the expressions is an input (or compilation failed above).
+        let inputs_read = pool
+            .topo_order(exprs)
+            .into_iter()
+            .filter_map(|e| inputs.iter().position(|&i| i == e))
+            .max()
+            .map_or(0, |k| k + 1);
+        Ok(Observer {
+            names,
+            prog,
+            ws,
+            inputs_read,
+        })
+    }
+
+    /// True when no expression reads an input at index `k` or later: it may then be evaluated
+    /// from inputs whose values from `k` on are anything (the results do not depend on them).
+    pub fn reads_only_first(&self, k: usize) -> bool {
+        self.inputs_read <= k
     }
 
     /// Switches to native code (where the JIT is available; else stays interpreted, with the
@@ -353,4 +415,25 @@ pub fn depends_only_on(pool: &Pool, e: Id, inputs: &[Id]) -> bool {
     pool.topo_order(&[e]).into_iter().all(|n| {
         !matches!(pool.node(n), Node::Sym(_) | Node::Coord(..) | Node::Time) || inputs.contains(&n)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `reads_only_first` is bounded by the last input an expression mentions.
+    #[test]
+    fn observer_knows_which_inputs_it_reads() {
+        let mut p = Pool::new();
+        let (a, b, c) = (p.var("a"), p.var("b"), p.var("c"));
+        let inputs = [a, b, c];
+        let ab = p.add(&[a, b]);
+        let two = p.int(2);
+        let cases: [(&[Id], usize); 4] = [(&[ab], 2), (&[c], 3), (&[two], 0), (&[a, ab], 2)];
+        for (exprs, read) in cases {
+            let o = Observer::new(&mut p, &inputs, vec!["x".into(); exprs.len()], exprs).unwrap();
+            assert!(o.reads_only_first(read));
+            assert_eq!(o.reads_only_first(read.saturating_sub(1)), read == 0);
+        }
+    }
 }

@@ -8,8 +8,10 @@
 //! three solves for the accelerations and reactions per point, and a row allocated for each.
 //! [`measure`] solves once per output point and feeds the one observation input to the
 //! output columns (the drift check and the non-finite warning need them), the conservation
-//! scales and the measures. The solver, its output points and every evaluation are the same
-//! as the full path's, so the results are the same, bit for bit (`tests/run.rs` checks it).
+//! scales and the measures; when none of them reads an acceleration or a reaction, it does not
+//! solve at all (the programs read only `[t, q, q', parameters]`). The solver, its output
+//! points and every evaluation are the same as the full path's, so the results are the same,
+//! bit for bit (`tests/run.rs` and `tests/ensemble_no_table.rs` check it).
 
 use super::sweep::statistic;
 use super::{
@@ -64,9 +66,21 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
     let mut series = vec![Vec::with_capacity(points); n_meas];
     let mut drifts: Vec<(f64, f64)> = Vec::with_capacity(conserved.len());
     let mut non_finite = NonFiniteScan::default();
+    // Solve for the accelerations and reactions at each point only when something evaluated
+    // here reads them (a reaction or an acceleration among the output columns, a scale or a
+    // measure); the other programs give the same bits without them.
+    let base = sys.inputs.len();
+    let solve = [&prep.observer, &prep.scales]
+        .into_iter()
+        .chain(prep.measures.as_ref())
+        .any(|o| !o.reads_only_first(base));
     for k in 0..points {
         let (t, y) = (sol.t[k], sol.y_at(k));
-        sys.observation_input(t, y, &mut input);
+        if solve {
+            sys.observation_input(t, y, &mut input);
+        } else {
+            sys.observation_input_without_unknowns(t, y, &mut input);
+        }
         prep.observer.eval(&input, &mut extra);
         // The row `[t, y, extra]` the full path would tabulate.
         non_finite.row(t, std::iter::once(&t).chain(y).chain(&extra).copied());
