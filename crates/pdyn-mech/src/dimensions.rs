@@ -89,6 +89,10 @@ pub struct Inference {
     names: FxHashMap<String, Form>,
     /// Solved unknowns, each written without other solved ones.
     solved: BTreeMap<usize, Form>,
+    /// For each unknown, the solved ones whose solution may mention it (a superset: entries
+    /// are not removed when a solution is rewritten). Solving an unknown rewrites only
+    /// these, where scanning every solution made loading a 100-link chain quadratic.
+    mentioned_in: FxHashMap<usize, Vec<usize>>,
     labels: Vec<String>,
     /// Every inconsistency found, in the order met.
     pub errors: Vec<DimensionError>,
@@ -192,16 +196,27 @@ impl Inference {
         };
         // Earlier solutions that mention v are rewritten with its solution.
         let mut updated = Vec::new();
-        for (k, f) in &self.solved {
+        for k in self.mentioned_in.remove(&v).unwrap_or_default() {
+            let Some(f) = self.solved.get(&k) else {
+                continue;
+            };
             if let Some(p) = f.vars.get(&v) {
                 let mut g = f.clone();
                 g.vars.remove(&v);
                 if let Some(g) = sol.pow(*p).and_then(|s| g.mul(&s)) {
-                    updated.push((*k, g));
+                    updated.push((k, g));
                 }
             }
         }
-        self.solved.extend(updated);
+        for (k, g) in updated {
+            for &u in g.vars.keys() {
+                self.mentioned_in.entry(u).or_default().push(k);
+            }
+            self.solved.insert(k, g);
+        }
+        for &u in sol.vars.keys() {
+            self.mentioned_in.entry(u).or_default().push(v);
+        }
         self.solved.insert(v, sol);
         Ok(())
     }

@@ -226,6 +226,9 @@ fn forcing_entry(
 ) -> Id {
     let mut keyed: Vec<((Id, Id), Vec<Id>)> = groups.into_iter().collect();
     keyed.sort_by_key(|(k, _)| *k);
+    if !contract {
+        return forcing_by_component(p, keyed, sums);
+    }
     // Total weight → the products it multiplies, in first-seen order.
     let mut by_weight: FxHashMap<Id, Vec<Id>> = FxHashMap::default();
     let mut order: Vec<Id> = Vec::new();
@@ -261,6 +264,38 @@ fn forcing_entry(
             terms.push(p.mul2(w, t));
         }
     }
+    p.add(&terms)
+}
+
+/// One entry of `f` for evaluation: `Σ_c component_c * Σ_t (Σ weights) * t`, each
+/// partial-velocity component multiplied once into the sum of the terms it meets (in a chain
+/// `l_j*cos(q_j)` and `l_j*sin(q_j)` for the whole row) rather than into every term: a
+/// third fewer operations per evaluation than the printed form.
+fn forcing_by_component(p: &mut Pool, keyed: Vec<((Id, Id), Vec<Id>)>, sums: &mut MassSums) -> Id {
+    let mut by_component: FxHashMap<Id, Vec<Id>> = FxHashMap::default();
+    let mut order: Vec<Id> = Vec::new();
+    for ((t, component), ws) in keyed {
+        let w = sums.sum(p, ws);
+        let term = p.mul2(w, t);
+        if term == Pool::ZERO || component == Pool::ZERO {
+            continue;
+        }
+        by_component
+            .entry(component)
+            .or_insert_with(|| {
+                order.push(component);
+                Vec::new()
+            })
+            .push(term);
+    }
+    let terms: Vec<Id> = order
+        .into_iter()
+        .map(|c| {
+            let ts = by_component.remove(&c).unwrap_or_default();
+            let sum = p.add(&ts);
+            p.mul2(c, sum)
+        })
+        .collect();
     p.add(&terms)
 }
 
