@@ -312,12 +312,17 @@ fn row(
     }
 }
 
-/// [`row`] compiled for AVX (256-bit vectors: on AMD Zen 3 they double the throughput of
+/// [`row`] compiled for AVX (256-bit vectors: on AMD Zen 3 they raise the throughput of
 /// the square roots and divisions that bound the kernel). The same IEEE operations in the
 /// same order as the baseline build (no fused multiply–add), so the same bits.
+///
+/// # Safety
+///
+/// The CPU must support AVX. (An `unsafe fn`: a safe `#[target_feature]` function needs
+/// Rust 1.86, above the crate's minimum.)
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
-fn row_avx(
+unsafe fn row_avx(
     r: usize,
     size: usize,
     src: Src<'_>,
