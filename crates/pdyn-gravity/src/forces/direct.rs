@@ -12,9 +12,15 @@
 //!   `N`). Row `I` of the block triangle (the pairs within block `I`, then those of block `I`
 //!   with each later block `J`, in order) is one task; it writes every contribution it makes,
 //!   to its own block and to the later ones, into its own buffer. Rayon spreads the rows over
-//!   the threads; then `aᵢ = G Σ_{I ≤ block(i)} bufᵢ[I]`, summed in row order. Within a tile
-//!   the `j` loop runs in four fixed lanes (so it vectorises), the lanes of `i`'s sum added in
-//!   a fixed order at the end of each tile.
+//!   the threads; then `aᵢ = G Σ_{I ≤ block(i)} bufᵢ[I]`, summed in row order. Within a tile,
+//!   `i` against the block `J` is a map over `j` (which the compiler vectorises: it updates
+//!   `j`'s sums and stores `i`'s terms), then `i`'s terms added in four fixed lanes, the lanes
+//!   in a fixed order at the end.
+//!
+//! On x86-64 CPUs with AVX the rows run in a copy of the kernel compiled for AVX (256-bit
+//! vectors; square roots and divisions bound the kernel). It performs the same IEEE
+//! operations in the same order (no fused multiply–add), so results are the same bits with
+//! and without AVX as well.
 
 use pdyn_particles::Particles;
 use rayon::prelude::*;
