@@ -7,13 +7,16 @@ Usage (from the repository root):
     python3 bench/nbody/run.py --quick    # shorter runs (smoke test)
 
 Creates its own venv in bench/nbody/.venv (pip install rebound==5.2.2 numpy), builds
-`cargo build --release -p pdyn-gravity --example bench_nbody`, then times:
+`cargo build --release -p pdyn-gravity --example bench_nbody` and `cargo build --release -p
+pdyn`, then times:
 
 1. outer Solar System (Applegate et al. 1986 ICs, as in REBOUND's outer_solar_system example),
    WHFast, dt = P_Jupiter/20, 17th-order corrector, safe_mode off, 10^6 steps;
 2. the same system with IAS15 (epsilon 1e-9, PRS23 step control in both), over 10^4 years;
 3. N = 1000 Plummer sphere (identical ICs, written by the Rust example), leapfrog with
-   direct summation (REBOUND gravity="basic"), softening 0.01: pdyn on 1 and 2 threads;
+   direct summation (REBOUND gravity="basic"), softening 0.01, 300 steps: pdyn on 1 and 2
+   threads, both the integration alone (bench_nbody) and the whole command
+   `pdyn run bench/nbody/plummer_direct.toml` (process start to exit);
 4. N = 10^5 Plummer sphere, leapfrog with the Barnes-Hut tree, theta = 0.5 (REBOUND
    gravity="tree", opening_angle2 = 0.25; monopole), pdyn monopole and quadrupole.
 
@@ -33,6 +36,7 @@ VENV = os.path.join(HERE, ".venv")
 DATA = os.path.join(HERE, "data")
 OUT = os.path.join(ROOT, "docs", "benchmarks-nbody.md")
 BIN = os.path.join(ROOT, "target", "release", "examples", "bench_nbody")
+PDYN = os.path.join(ROOT, "target", "release", "pdyn")
 # Second build with -C target-cpu=native (AVX2 etc.) for the rows marked "native".
 NATIVE_DIR = os.path.join(ROOT, "target", "native")
 BIN_NATIVE = os.path.join(NATIVE_DIR, "release", "examples", "bench_nbody")
@@ -156,9 +160,25 @@ def plummer_sim(path, gravity):
     return sim
 
 
+def softened_energy(sim, eps):
+    """T + V with the softened potential both codes integrate, −G Σ mᵢmⱼ/√(r² + ε²).
+    (REBOUND's `sim.energy()` leaves the softening out of V: with ε = 0.01 its "error"
+    over 300 steps is −2.0e-4, while this energy changes by 7.9e-8, as pdyn's.)"""
+    a = np.array([[p.m, p.x, p.y, p.z, p.vx, p.vy, p.vz] for p in sim.particles])
+    m, x, v = a[:, 0], a[:, 1:4], a[:, 4:7]
+    kinetic = 0.5 * np.sum(m * np.sum(v * v, axis=1))
+    d = x[:, None, :] - x[None, :, :]
+    iu = np.triu_indices(len(m), 1)
+    r = np.sqrt(np.sum(d * d, axis=2)[iu] + eps * eps)
+    return kinetic - sim.G * np.sum(m[iu[0]] * m[iu[1]] / r)
+
+
 def main():
+    started = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+    load_start = os.getloadavg()
     subprocess.check_call(["cargo", "build", "--release", "-q", "-p", "pdyn-gravity",
                            "--example", "bench_nbody"], cwd=ROOT)
+    subprocess.check_call(["cargo", "build", "--release", "-q", "-p", "pdyn"], cwd=ROOT)
     env = dict(os.environ, RUSTFLAGS="-C target-cpu=native", CARGO_TARGET_DIR=NATIVE_DIR)
     subprocess.check_call(["cargo", "build", "--release", "-q", "-p", "pdyn-gravity",
                            "--example", "bench_nbody"], cwd=ROOT, env=env)
@@ -207,20 +227,51 @@ def main():
     rows.append(("… same, pdyn built native", nat["steps"], sim.steps_done, nat["per_step_us"],
                  1e6 * t / sim.steps_done, 0.8, ""))
 
-    # 3. Direct summation, N = 1000
+    # 3. Direct summation, N = 1000: the kernel (bench_nbody, `integrate` alone) and the
+    # whole user command (`pdyn run` on a model file, process start to exit), on 1 and 2
+    # threads, alternating with REBOUND.
     p1k = os.path.join(DATA, "plummer_1000.bin")
     subprocess.check_call([BIN, "plummer-ics", "1000", "1", p1k])
-    nsteps = 20 if QUICK else 100
-    t, sim = rb_best(lambda: plummer_sim(p1k, "basic"),
-                     lambda s: s.integrate(nsteps * 0.001, exact_finish_time=0))
-    rb_us = 1e6 * t / sim.steps_done
-    for native in (False, True):
+    nsteps = 20 if QUICK else 300
+    model = os.path.join(HERE, "plummer_direct.toml")
+    best = {}
+
+    def keep(key, secs, de):
+        if key not in best or secs < best[key][0]:
+            best[key] = (secs, de)
+
+    for _ in range(REPEAT):
+        sim = plummer_sim(p1k, "basic")
+        e0 = softened_energy(sim, sim.softening)
+        t0 = time.perf_counter()
+        sim.integrate(nsteps * 0.001, exact_finish_time=0)
+        t = time.perf_counter() - t0
+        keep("rebound", t / sim.steps_done, (softened_energy(sim, sim.softening) - e0) / abs(e0))
         for threads in (1, 2):
-            ours = rust("leapfrog-direct", p1k, nsteps, 0.001, 0.01, threads=threads, native=native)
-            rows.append((f"Plummer N = 1000, leapfrog, direct sum, {threads} thread(s)"
-                         + (", pdyn built native" if native else ""), ours["steps"],
-                         sim.steps_done, ours["per_step_us"], rb_us,
-                         0.5 if threads == 2 else None, ""))
+            r = rust("leapfrog-direct", p1k, nsteps, 0.001, 0.01, threads=threads, repeat=1)
+            keep(("kernel", threads), r["seconds"] / r["steps"], r["rel_energy_error"])
+            env = dict(os.environ, RAYON_NUM_THREADS=str(threads))
+            t0 = time.perf_counter()
+            out = subprocess.check_output([PDYN, "run", model, "--json", "--t-end",
+                                           repr(nsteps * 0.001)], env=env, text=True)
+            t = time.perf_counter() - t0
+            summary = json.loads(out)
+            keep(("pdyn run", threads), t / nsteps, summary["energy"]["relative_error"])
+    rb_us, rb_de = 1e6 * best["rebound"][0], best["rebound"][1]
+    for threads in (1, 2):
+        us, de = best[("kernel", threads)]
+        rows.append((f"Plummer N = 1000, leapfrog, direct sum, {threads} thread(s)", nsteps,
+                     nsteps, 1e6 * us, rb_us, None,
+                     f"dE/E: pdyn {de:.2e}, REBOUND {rb_de:.2e}"))
+    for threads in (1, 2):
+        us, de = best[("pdyn run", threads)]
+        rows.append((f"… same, whole `pdyn run bench/nbody/plummer_direct.toml`, {threads} "
+                     "thread(s)", nsteps, nsteps, 1e6 * us, rb_us, 0.5 if threads == 2 else None,
+                     f"dE/E: pdyn {de:.2e} (process start to exit)"))
+    for threads in (1, 2):
+        ours = rust("leapfrog-direct", p1k, nsteps, 0.001, 0.01, threads=threads, native=True)
+        rows.append((f"Plummer N = 1000, leapfrog, direct sum, {threads} thread(s), pdyn "
+                     "built native", ours["steps"], nsteps, ours["per_step_us"], rb_us, None, ""))
 
     # 4. Tree, N = 10^5
     n = 20000 if QUICK else 100000
@@ -238,6 +289,9 @@ def main():
                          f"{'quadrupole' if quad else 'monopole'}, {threads} thread(s)",
                          ours["steps"], sim.steps_done, ours["per_step_us"], rb_us, None, ""))
 
+    load_end = os.getloadavg()
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, text=True,
+                            capture_output=True).stdout.strip()
     cpu = ""
     try:
         with open("/proc/cpuinfo") as f:
@@ -248,13 +302,16 @@ def main():
         "# N-body benchmarks: pdyn-gravity vs REBOUND",
         "",
         "Generated by `python3 bench/nbody/run.py` (from the repository root); the script builds",
-        "`cargo build --release -p pdyn-gravity --example bench_nbody` and installs",
+        "`cargo build --release -p pdyn-gravity --example bench_nbody` and `-p pdyn`, installs",
         f"REBOUND {rebound.__version__} from PyPI into its own venv, then times both in the same run.",
         f"Machine: {cpu or platform.processor()}, {os.cpu_count()} logical CPUs (shared with other",
         f"jobs: best of {REPEAT} runs, the two codes alternating). REBOUND's PyPI build is single-threaded; pdyn's thread count",
         "is set with `RAYON_NUM_THREADS`. Generic x86-64 codegen for both unless a row says",
         "\"built native\" (pdyn with `RUSTFLAGS=\"-C target-cpu=native\"`; REBOUND is always the PyPI",
         "wheel). The tree rows are single runs (they take seconds each).",
+        f"This run: {started} to {time.strftime('%H:%M UTC', time.gmtime())}, commit `{commit}`, "
+        f"load average {load_start[0]:.2f} at the start and {load_end[0]:.2f} at the end "
+        "(2 CPUs: above 1 the second core was busy, and 2-thread rows cannot double).",
         "",
         "| Problem | steps pdyn | steps REBOUND | pdyn µs/step | REBOUND µs/step | ratio | goal | notes |",
         "|---|---:|---:|---:|---:|---:|---:|---|",

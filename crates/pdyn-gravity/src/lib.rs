@@ -14,7 +14,8 @@
 //! Orbital elements convert to and from Cartesian relative to a primary ([`orbit`]).
 //! Collisions and escapes end an integration as an [`Outcome`]; invalid input is a typed
 //! [`GravityError`], never a panic. Results never depend on the number of threads: every
-//! parallel loop computes each particle's sum in a fixed order on one thread.
+//! parallel loop splits its work into pieces fixed by `N` alone, each summed in a fixed order
+//! on one thread, and combines the pieces in a fixed order.
 //!
 //! This crate knows nothing of symbols or model files.
 //!

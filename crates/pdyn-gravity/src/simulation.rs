@@ -110,6 +110,7 @@ impl Simulation {
                 eps2: 0.0,
                 kind: Gravity::Direct,
                 tree: crate::forces::Octree::new(),
+                direct: crate::forces::direct::DirectWorkspace::new(),
             },
             integrator: Integrator::default(),
             events: EventParams::default(),

@@ -25,13 +25,16 @@ pub(crate) struct Forces {
     pub eps2: f64,
     pub kind: Gravity,
     pub tree: Octree,
+    pub direct: direct::DirectWorkspace,
 }
 
 impl Forces {
     /// Fills the accelerations; see [`direct::accelerations`] for `skip_01`.
     pub fn compute(&mut self, p: &mut Particles, skip_01: bool) -> bool {
         match self.kind {
-            Gravity::Direct => direct::accelerations(p, self.g, self.eps2, skip_01),
+            Gravity::Direct => {
+                direct::accelerations_in(&mut self.direct, p, self.g, self.eps2, skip_01)
+            }
             Gravity::Tree(params) => {
                 self.tree.accelerations(p, self.g, self.eps2, params);
                 false
