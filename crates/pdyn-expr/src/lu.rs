@@ -321,6 +321,19 @@ mod tests {
             .collect()
     }
 
+    /// `Bᵀ B + shift·I` for a random `B`: symmetric positive definite.
+    fn spd_matrix(n: usize, seed: &mut u64, shift: f64) -> Vec<f64> {
+        let bm = random_matrix(n, seed);
+        let mut a = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..n {
+                a[i * n + j] = (0..n).map(|k| bm[k * n + i] * bm[k * n + j]).sum::<f64>()
+                    + if i == j { shift } else { 0.0 };
+            }
+        }
+        a
+    }
+
     fn residual(a: &[f64], x: &[f64], b: &[f64]) -> f64 {
         let n = b.len();
         (0..n)
@@ -333,14 +346,7 @@ mod tests {
         // A = Bᵀ B + I is symmetric positive definite; sizes across the 4-wide dot's tails.
         let mut seed = 7;
         for n in [1, 2, 3, 4, 5, 8, 13, 40] {
-            let bm = random_matrix(n, &mut seed);
-            let mut a = vec![0.0; n * n];
-            for i in 0..n {
-                for j in 0..n {
-                    a[i * n + j] = (0..n).map(|k| bm[k * n + i] * bm[k * n + j]).sum::<f64>()
-                        + if i == j { 1.0 } else { 0.0 };
-                }
-            }
+            let a = spd_matrix(n, &mut seed, 1.0);
             let b: Vec<f64> = random_matrix(n, &mut seed)[..n].to_vec();
             let mut ab = a.clone();
             ab.extend_from_slice(&b);
@@ -362,14 +368,7 @@ mod tests {
         // On a processor with AVX the dispatched factor runs the AVX build: same bits.
         let mut seed = 11;
         for n in [1, 2, 3, 6, 7, 31, 64] {
-            let bm = random_matrix(n, &mut seed);
-            let mut a = vec![0.0; n * n];
-            for i in 0..n {
-                for j in 0..n {
-                    a[i * n + j] = (0..n).map(|k| bm[k * n + i] * bm[k * n + j]).sum::<f64>()
-                        + if i == j { 0.1 } else { 0.0 };
-                }
-            }
+            let mut a = spd_matrix(n, &mut seed, 0.1);
             let mut dispatched = a.clone();
             cholesky_factor_in_place(&mut dispatched, n).unwrap();
             cholesky_factor_generic(&mut a, n).unwrap();
@@ -403,14 +402,7 @@ mod tests {
     fn lu_agrees_with_cholesky_on_spd_systems() {
         let mut seed = 99;
         let n = 17;
-        let bm = random_matrix(n, &mut seed);
-        let mut a = vec![0.0; n * n];
-        for i in 0..n {
-            for j in 0..n {
-                a[i * n + j] = (0..n).map(|k| bm[k * n + i] * bm[k * n + j]).sum::<f64>()
-                    + if i == j { 0.5 } else { 0.0 };
-            }
-        }
+        let a = spd_matrix(n, &mut seed, 0.5);
         let mut ab = a.clone();
         ab.extend((0..n).map(|i| i as f64 - 3.0));
         let mut ab2 = ab.clone();
