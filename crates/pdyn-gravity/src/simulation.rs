@@ -318,20 +318,20 @@ impl Simulation {
             self.t = t_end;
             return Ok(Outcome::Reached);
         }
-        if self.workspace.is_none() {
-            self.workspace = Some(Workspace::new(
+        let ws = match &mut self.workspace {
+            Some(ws) => ws,
+            slot @ None => slot.insert(Workspace::new(
                 self.integrator,
                 &self.particles,
                 self.forces.g,
                 self.dt,
                 &mut self.warnings,
-            )?);
-        }
+            )?),
+        };
         let check_collisions = self.events.collisions && self.radii.iter().any(|&r| r > 0.0);
         let mut outcome = Outcome::Reached;
         let tol = 1e-12 * t_end.abs().max(self.dt);
         while t_end - self.t > tol {
-            let ws = self.workspace.as_mut().expect("created above");
             let dt_before = self.dt;
             let h = ws.step(
                 &mut self.particles,

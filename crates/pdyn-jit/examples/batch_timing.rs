@@ -8,15 +8,20 @@ use pdyn_expr::{Id, Pool, Program};
 use pdyn_jit::{BatchKernel, JitMode};
 use std::time::Instant;
 
-fn kernel(vars: &str, srcs: &[&str], mode: JitMode) -> BatchKernel {
+type Error = Box<dyn std::error::Error>;
+
+fn kernel(vars: &str, srcs: &[&str], mode: JitMode) -> Result<BatchKernel, Error> {
     let mut p = Pool::new();
     let x = p.var(vars);
-    let outs: Vec<Id> = srcs.iter().map(|s| p.parse_scalar(s).unwrap()).collect();
-    let prog = Program::compile(&mut p, &[x], &outs).unwrap();
-    BatchKernel::new(&prog, mode).unwrap()
+    let mut outs: Vec<Id> = Vec::with_capacity(srcs.len());
+    for s in srcs {
+        outs.push(p.parse_scalar(s).map_err(|e| format!("{s}: {e:?}"))?);
+    }
+    let prog = Program::compile(&mut p, &[x], &outs).map_err(|e| format!("{e:?}"))?;
+    Ok(BatchKernel::new(&prog, mode).ok_or("an operation the batch kernel does not know")?)
 }
 
-fn main() {
+fn main() -> Result<(), Error> {
     let n = 55;
     let s: Vec<f64> = (0..n).map(|k| 0.8 + 5.4 * k as f64 / n as f64).collect();
     let r: Vec<f64> = s.iter().map(|x| x.sqrt()).collect();
@@ -34,7 +39,7 @@ fn main() {
     ];
     for mode in [JitMode::Auto, JitMode::Off] {
         for (v, srcs, x) in &cases {
-            let k = kernel(v, &srcs.iter().map(|s| &**s).collect::<Vec<_>>(), mode);
+            let k = kernel(v, &srcs.iter().map(|s| &**s).collect::<Vec<_>>(), mode)?;
             let (mut u, mut f) = (vec![0.0; n], vec![0.0; n]);
             let reps = 400_000;
             let mut best = f64::INFINITY;
@@ -53,4 +58,5 @@ fn main() {
             );
         }
     }
+    Ok(())
 }

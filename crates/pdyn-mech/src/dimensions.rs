@@ -474,6 +474,24 @@ mod tests {
     }
 
     #[test]
+    fn a_solution_is_rewritten_when_an_unknown_it_mentions_is_solved() {
+        let mut inf = Inference::default();
+        let a = inf.fresh("a");
+        let b = inf.fresh("b");
+        let c = inf.fresh("c");
+        // b = a·m, then c = b·s (both mention unknowns solved later), then a = kg.
+        inf.unify(&b, &a.mul(&Dimension::LENGTH.into()).unwrap())
+            .unwrap();
+        inf.unify(&c, &b.mul(&Dimension::TIME.into()).unwrap())
+            .unwrap();
+        inf.unify(&a, &Dimension::MASS.into()).unwrap();
+        let mass_length = Dimension::MASS.mul(&Dimension::LENGTH).unwrap();
+        assert_eq!(inf.normalize(&b), Form::from(mass_length));
+        let mass_length_time = mass_length.mul(&Dimension::TIME).unwrap();
+        assert_eq!(inf.normalize(&c), Form::from(mass_length_time));
+    }
+
+    #[test]
     fn a_spring_force_added_to_a_velocity_names_both_terms() {
         let mut inf = Inference::default();
         inf.bind(

@@ -229,34 +229,18 @@ fn forcing_entry(
     if !contract {
         return forcing_by_component(p, keyed, sums);
     }
-    // Total weight → the products it multiplies, in first-seen order.
-    let mut by_weight: FxHashMap<Id, Vec<Id>> = FxHashMap::default();
-    let mut order: Vec<Id> = Vec::new();
+    // Total weight → the products it multiplies.
+    let mut weighted = Vec::with_capacity(keyed.len());
     for ((t, component), ws) in keyed {
         let w = sums.sum(p, ws);
-        if w == Pool::ZERO {
-            continue;
-        }
         let product = p.mul2(t, component);
-        if product == Pool::ZERO {
-            continue;
+        if w != Pool::ZERO && product != Pool::ZERO {
+            weighted.push((w, product));
         }
-        by_weight
-            .entry(w)
-            .or_insert_with(|| {
-                order.push(w);
-                Vec::new()
-            })
-            .push(product);
     }
     let mut terms = Vec::new();
-    for w in order {
-        let products = by_weight.remove(&w).unwrap_or_default();
-        let products = if contract {
-            contract_by_rest(p, &products)
-        } else {
-            products
-        };
+    for (w, products) in grouped(weighted) {
+        let products = contract_by_rest(p, &products);
         let sum = p.add(&products);
         // Distributed, so that each printed term carries its mass sum:
         // `-g*l2*(m2 + m3)*sin(q2) + l1*l2*(m2 + m3)*q1'^2*sin(q1 - q2)`.
@@ -272,31 +256,39 @@ fn forcing_entry(
 /// `l_j*cos(q_j)` and `l_j*sin(q_j)` for the whole row) rather than into every term: a
 /// third fewer operations per evaluation than the printed form.
 fn forcing_by_component(p: &mut Pool, keyed: Vec<((Id, Id), Vec<Id>)>, sums: &mut MassSums) -> Id {
-    let mut by_component: FxHashMap<Id, Vec<Id>> = FxHashMap::default();
-    let mut order: Vec<Id> = Vec::new();
+    let mut by_component = Vec::with_capacity(keyed.len());
     for ((t, component), ws) in keyed {
         let w = sums.sum(p, ws);
         let term = p.mul2(w, t);
-        if term == Pool::ZERO || component == Pool::ZERO {
-            continue;
+        if term != Pool::ZERO && component != Pool::ZERO {
+            by_component.push((component, term));
         }
-        by_component
-            .entry(component)
-            .or_insert_with(|| {
-                order.push(component);
-                Vec::new()
-            })
-            .push(term);
     }
-    let terms: Vec<Id> = order
+    let terms: Vec<Id> = grouped(by_component)
         .into_iter()
-        .map(|c| {
-            let ts = by_component.remove(&c).unwrap_or_default();
+        .map(|(c, ts)| {
             let sum = p.add(&ts);
             p.mul2(c, sum)
         })
         .collect();
     p.add(&terms)
+}
+
+/// `(key, value)` pairs grouped by key, the keys in the order they first appear: the result
+/// depends on the input's order only, never on hashing.
+fn grouped(pairs: Vec<(Id, Id)>) -> Vec<(Id, Vec<Id>)> {
+    let mut index: FxHashMap<Id, usize> = FxHashMap::default();
+    let mut out: Vec<(Id, Vec<Id>)> = Vec::new();
+    for (k, v) in pairs {
+        match index.get(&k) {
+            Some(&i) => out[i].1.push(v),
+            None => {
+                index.insert(k, out.len());
+                out.push((k, vec![v]));
+            }
+        }
+    }
+    out
 }
 
 /// Whether `f` is a sine or cosine (or a power of one).
@@ -313,8 +305,7 @@ fn is_trig(p: &Pool, f: Id) -> bool {
 /// `l1*l2*q1'^2*sin(q1 − q2)`. Each contracted sum is small (the x and y parts of one
 /// product), so the work is linear in the number of products.
 fn contract_by_rest(p: &mut Pool, products: &[Id]) -> Vec<Id> {
-    let mut by_rest: FxHashMap<Id, Vec<Id>> = FxHashMap::default();
-    let mut order: Vec<Id> = Vec::new();
+    let mut by_rest = Vec::with_capacity(products.len());
     for &t in products {
         let fs: Vec<Id> = match p.node(t) {
             Node::Mul(fs) => fs.to_vec(),
@@ -325,18 +316,11 @@ fn contract_by_rest(p: &mut Pool, products: &[Id]) -> Vec<Id> {
             .partition(|&f| is_trig(p, f) || p.as_num(f).is_some());
         let rest = p.mul(&rest);
         let trig = p.mul(&trig);
-        by_rest
-            .entry(rest)
-            .or_insert_with(|| {
-                order.push(rest);
-                Vec::new()
-            })
-            .push(trig);
+        by_rest.push((rest, trig));
     }
-    order
+    grouped(by_rest)
         .into_iter()
-        .map(|rest| {
-            let trig = by_rest.remove(&rest).unwrap_or_default();
+        .map(|(rest, trig)| {
             let sum = p.add(&trig);
             let sum = if trig.len() > 1 {
                 tidy_small(p, sum, SMALL_NODES)
