@@ -14,17 +14,29 @@ use std::path::Path;
 pub fn write_csv(res: &RunResult, path: &Path) -> std::io::Result<()> {
     let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
     writeln!(f, "{}", res.columns.join(","))?;
+    let mut line = String::new();
     for row in &res.rows {
-        let mut line = String::with_capacity(row.len() * 24);
+        line.clear();
         for (i, x) in row.iter().enumerate() {
             if i > 0 {
                 line.push(',');
             }
-            line += &format!("{x:.17e}");
+            push_number(&mut line, *x);
         }
-        writeln!(f, "{line}")?;
+        line.push('\n');
+        f.write_all(line.as_bytes())?;
     }
     f.flush()
+}
+
+/// Appends `x` in the shortest scientific notation that reads back as the same `f64`
+/// (`1e-1`; never more than 17 significant digits). Fixed 18-digit output
+/// (`{:.17e}`) printed digits no reader needs and took a tenth of a 16-link chain's
+/// `pdyn run` (Rust's exact-digit formatting often falls back to bignum arithmetic).
+pub fn push_number(line: &mut String, x: f64) {
+    use std::fmt::Write as _;
+    // Writing to a String cannot fail.
+    let _ = write!(line, "{x:e}");
 }
 
 /// The JSON summary: final state, events, monitor drifts, solver statistics, warnings.
@@ -72,5 +84,54 @@ pub fn json_num(x: f64) -> serde_json::Value {
         json!(x)
     } else {
         json!(x.to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::push_number;
+
+    /// Every number in the table reads back as the same bits, in at most 17 significant
+    /// digits, across binades and at the edges (subnormals, the largest finite, -0).
+    #[test]
+    fn table_numbers_read_back_as_the_same_bits() {
+        let mut x = 0x1234_5678_9abc_def1_u64;
+        let mut samples = vec![
+            0.0,
+            -0.0,
+            0.1,
+            1.0 / 3.0,
+            f64::MAX,
+            f64::MIN_POSITIVE,
+            5e-324,
+        ];
+        for _ in 0..20_000 {
+            // xorshift over every bit pattern of finite doubles
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let v = f64::from_bits(x);
+            if v.is_finite() {
+                samples.push(v);
+            }
+        }
+        let mut s = String::new();
+        for v in samples {
+            s.clear();
+            push_number(&mut s, v);
+            let back: f64 = s.parse().unwrap_or_else(|e| panic!("{s}: {e}"));
+            assert_eq!(back.to_bits(), v.to_bits(), "{s}");
+            let digits = s
+                .split('e')
+                .next()
+                .unwrap()
+                .chars()
+                .filter(char::is_ascii_digit)
+                .count();
+            assert!(digits <= 17, "{s}");
+        }
+        s.clear();
+        push_number(&mut s, f64::NAN);
+        assert_eq!(s, "NaN");
     }
 }

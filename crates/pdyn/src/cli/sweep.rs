@@ -87,12 +87,14 @@ pub fn run(a: SweepArgs) -> Result<Outcome, Error> {
         csv.push('\n');
         for sl in &res.slices {
             for (v, row) in res.values.iter().zip(&sl.table) {
-                csv += &format!("{v:.17e}");
+                pdyn::output::push_number(&mut csv, *v);
                 for (_, x) in &sl.fixed {
-                    csv += &format!(",{x:.17e}");
+                    csv.push(',');
+                    pdyn::output::push_number(&mut csv, *x);
                 }
                 for x in row {
-                    csv += &format!(",{x:.17e}");
+                    csv.push(',');
+                    pdyn::output::push_number(&mut csv, *x);
                 }
                 csv.push('\n');
             }
