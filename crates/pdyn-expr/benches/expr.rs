@@ -125,3 +125,35 @@ fn chain_build_diff_compile(b: Bencher, n: usize) {
         black_box(prog.len())
     });
 }
+
+/// A symmetric positive definite `n×n` matrix and right-hand side (a diagonally dominant
+/// mass-matrix stand-in).
+fn spd(n: usize) -> Vec<f64> {
+    let mut ab = vec![0.0; n * n + n];
+    for i in 0..n {
+        for j in 0..n {
+            ab[i * n + j] = if i == j {
+                n as f64 + 1.0
+            } else {
+                1.0 / (1.0 + (i as f64 - j as f64).abs())
+            };
+        }
+        ab[n * n + i] = 1.0 + i as f64;
+    }
+    ab
+}
+
+/// `DenseSolver::solve` on a symmetric system (Cholesky factor and solve), as a run with
+/// a numeric mass matrix does at every evaluation: library-internal.
+#[divan::bench(args = [16, 100])]
+fn mass_matrix_solve(b: Bencher, n: usize) {
+    let ab0 = spd(n);
+    let mut solver = pdyn_expr::lu::DenseSolver::new(n, true);
+    let mut ab = ab0.clone();
+    let mut x = vec![0.0; n];
+    b.bench_local(|| {
+        ab.copy_from_slice(&ab0);
+        solver.solve(black_box(&mut ab), &mut x).unwrap();
+        black_box(x[0])
+    });
+}

@@ -13,6 +13,7 @@
 //! Division by zero, `log` of a negative number and the like give `inf`/`NaN`, as IEEE
 //! arithmetic does; they never panic.
 
+use crate::hoist::{HoistedInputs, HoistedProgram};
 use crate::lu::{DenseSolver, SingularMatrix};
 use crate::number::Number;
 use crate::pool::{Func, Id, Node, Pool};
@@ -70,6 +71,10 @@ pub struct Instr {
 }
 
 impl Instr {
+    pub(crate) fn new(op: Op, a: u32, b: u32) -> Instr {
+        Instr { op, a, b }
+    }
+
     /// The operation.
     pub fn op(&self) -> Op {
         self.op
@@ -122,22 +127,67 @@ pub struct Program {
     outputs: Vec<u32>,
 }
 
-struct Compiler<'a> {
+pub(crate) struct Compiler<'a> {
     pool: &'a mut Pool,
     reg: FxHashMap<Id, u32>,
     const_regs: FxHashMap<u64, u32>,
-    consts: Vec<f64>,
+    pub(crate) consts: Vec<f64>,
     /// Temporaries before renumbering: (op, a, b) with operands as provisional registers.
-    instrs: Vec<Instr>,
-    n_inputs: u32,
+    pub(crate) instrs: Vec<Instr>,
+    /// For each temporary: whether it depends only on constants and invariant inputs.
+    pub(crate) invariant: Vec<bool>,
+    pub(crate) n_inputs: u32,
+    /// Inputs from this index on keep their values from one evaluation to the next (the
+    /// parameters); `n_inputs` when none is known to.
+    first_invariant: u32,
+    /// Whether products are lowered for hoisting (see `Compiler::product_hoisting`).
+    hoist: bool,
 }
 
 /// Provisional registers: inputs `0..n`, constants `CONST_BASE + k`, temporaries `TEMP_BASE + k`;
 /// renumbered to the dense layout once the number of constants is known.
-const CONST_BASE: u32 = 1 << 30;
-const TEMP_BASE: u32 = 1 << 31;
+pub(crate) const CONST_BASE: u32 = 1 << 30;
+pub(crate) const TEMP_BASE: u32 = 1 << 31;
 
-impl Compiler<'_> {
+impl<'a> Compiler<'a> {
+    /// A compiler of expressions over `inputs`; inputs from `first_invariant` on are the same
+    /// at every evaluation, and with `hoist` products are ordered so that their invariant
+    /// part is one value (see `product_hoisting`).
+    pub(crate) fn new(
+        pool: &'a mut Pool,
+        inputs: &[Id],
+        first_invariant: usize,
+        hoist: bool,
+    ) -> Compiler<'a> {
+        let mut c = Compiler {
+            pool,
+            reg: FxHashMap::default(),
+            const_regs: FxHashMap::default(),
+            consts: Vec::new(),
+            instrs: Vec::new(),
+            invariant: Vec::new(),
+            n_inputs: inputs.len() as u32,
+            first_invariant: first_invariant.min(inputs.len()) as u32,
+            hoist,
+        };
+        for (i, &x) in inputs.iter().enumerate() {
+            c.reg.insert(x, i as u32);
+        }
+        c
+    }
+
+    /// Whether the provisional register `r` holds a value that depends only on constants and
+    /// invariant inputs.
+    pub(crate) fn is_invariant(&self, r: u32) -> bool {
+        if r >= TEMP_BASE {
+            self.invariant[(r - TEMP_BASE) as usize]
+        } else if r >= CONST_BASE {
+            true
+        } else {
+            r >= self.first_invariant
+        }
+    }
+
     fn constant(&mut self, x: f64) -> u32 {
         if let Some(&r) = self.const_regs.get(&x.to_bits()) {
             return r;
@@ -149,11 +199,13 @@ impl Compiler<'_> {
     }
 
     fn emit(&mut self, op: Op, a: u32, b: u32) -> u32 {
+        let inv = self.is_invariant(a) && (!op.reads_b() || self.is_invariant(b));
         self.instrs.push(Instr { op, a, b });
+        self.invariant.push(inv);
         TEMP_BASE + self.instrs.len() as u32 - 1
     }
 
-    fn value(&mut self, id: Id) -> Result<u32, CompileError> {
+    pub(crate) fn value(&mut self, id: Id) -> Result<u32, CompileError> {
         if let Some(&r) = self.reg.get(&id) {
             return Ok(r);
         }
@@ -214,7 +266,11 @@ impl Compiler<'_> {
                         _ => factors.push(f),
                     }
                 }
-                let acc = self.product(&factors)?;
+                let acc = if self.hoist {
+                    self.product_hoisting(&factors)?
+                } else {
+                    self.product(&factors)?
+                };
                 let v = match acc {
                     Some(v) => v,
                     None => self.constant(1.0),
@@ -266,6 +322,39 @@ impl Compiler<'_> {
             });
         }
         Ok(acc)
+    }
+
+    /// A product as (its variant factors) × (its invariant factors), each part a node of its
+    /// own: the invariant part is then computed once per parameter change (hoisted), and the
+    /// variant part is shared by every product with the same variant factors. In the n-link
+    /// chain's forcing, `l_k*S_jk*q_k'^2*cos(q_k)` for every row j becomes one shared
+    /// `q_k'^2*cos(q_k)` times a hoisted `l_k*S_jk`: one multiplication per term, not three.
+    fn product_hoisting(&mut self, fs: &[Id]) -> Result<Option<u32>, CompileError> {
+        let mut invariant = Vec::new();
+        let mut variant = Vec::new();
+        for &f in fs {
+            let r = self.value(f)?;
+            if self.is_invariant(r) {
+                invariant.push(f);
+            } else {
+                variant.push(f);
+            }
+        }
+        if invariant.is_empty() || variant.is_empty() {
+            return self.product(fs);
+        }
+        let part = |c: &mut Compiler, ids: Vec<Id>| -> Result<u32, CompileError> {
+            match ids[..] {
+                [one] => c.value(one),
+                _ => {
+                    let node = c.pool.mul(&ids);
+                    c.value(node)
+                }
+            }
+        };
+        let v = part(self, variant)?;
+        let i = part(self, invariant)?;
+        Ok(Some(self.emit(Op::Mul, v, i)))
     }
 
     fn power(&mut self, b: Id, e: Id) -> Result<u32, CompileError> {
@@ -322,17 +411,7 @@ impl Program {
         inputs: &[Id],
         outputs: &[Id],
     ) -> Result<Program, CompileError> {
-        let mut c = Compiler {
-            pool,
-            reg: FxHashMap::default(),
-            const_regs: FxHashMap::default(),
-            consts: Vec::new(),
-            instrs: Vec::new(),
-            n_inputs: inputs.len() as u32,
-        };
-        for (i, &x) in inputs.iter().enumerate() {
-            c.reg.insert(x, i as u32);
-        }
+        let mut c = Compiler::new(pool, inputs, inputs.len(), false);
         let mut outs = Vec::with_capacity(outputs.len());
         for &o in outputs {
             outs.push(c.value(o)?);
@@ -363,6 +442,21 @@ impl Program {
             instrs,
             outputs: outs.into_iter().map(remap).collect(),
         })
+    }
+
+    /// A program from its renumbered parts (registers `[inputs | constants | temporaries]`).
+    pub(crate) fn from_parts(
+        n_inputs: usize,
+        consts: Vec<f64>,
+        instrs: Vec<Instr>,
+        outputs: Vec<u32>,
+    ) -> Program {
+        Program {
+            n_inputs,
+            consts,
+            instrs,
+            outputs,
+        }
     }
 
     /// Number of instructions (the program's size).
@@ -493,11 +587,12 @@ impl Pool {
 }
 
 /// A linear system `A x = b` compiled for numeric solution at evaluation time: the entries are
-/// one [`Program`], the solve a [`DenseSolver`] (Cholesky when `A` is symbolically
+/// one [`HoistedProgram`], the solve a [`DenseSolver`] (Cholesky when `A` is symbolically
 /// symmetric, as a mass matrix is; LU otherwise). Owns its buffers; `solve` allocates nothing.
 #[derive(Clone, Debug)]
 pub struct CompiledLinearSystem {
-    program: Program,
+    program: HoistedProgram,
+    inputs: HoistedInputs,
     n: usize,
     ws: Vec<f64>,
     ab: Vec<f64>,
@@ -511,15 +606,28 @@ impl CompiledLinearSystem {
         sys: &crate::linsolve::LinearSystem,
         inputs: &[Id],
     ) -> Result<CompiledLinearSystem, CompileError> {
+        CompiledLinearSystem::hoisted(pool, sys, inputs, inputs.len())
+    }
+
+    /// Compiles a square system whose inputs from `first_invariant` on (the parameters) keep
+    /// their values between solves: the work that depends on them only is done once per
+    /// change ([`HoistedProgram`]).
+    pub fn hoisted(
+        pool: &mut Pool,
+        sys: &crate::linsolve::LinearSystem,
+        inputs: &[Id],
+        first_invariant: usize,
+    ) -> Result<CompiledLinearSystem, CompileError> {
         let n = sys.cols();
         debug_assert_eq!(sys.rows(), n);
         let mut outs = sys.a.clone();
         outs.extend_from_slice(&sys.b);
         // Hash-consing makes equal entries one node: symmetry is an identity test.
         let symmetric = (0..n).all(|i| (0..i).all(|j| outs[i * n + j] == outs[j * n + i]));
-        let program = Program::compile(pool, inputs, &outs)?;
-        let ws = program.workspace();
+        let program = HoistedProgram::compile(pool, inputs, first_invariant, &outs)?;
+        let ws = program.main().workspace();
         Ok(CompiledLinearSystem {
+            inputs: HoistedInputs::new(&program),
             program,
             n,
             ws,
@@ -536,7 +644,7 @@ impl CompiledLinearSystem {
 
     /// The program computing the entries: `n²` matrix entries row-major, then the `n`
     /// right-hand sides.
-    pub fn program(&self) -> &Program {
+    pub fn program(&self) -> &HoistedProgram {
         &self.program
     }
 
@@ -549,7 +657,8 @@ impl CompiledLinearSystem {
     pub fn solve(&mut self, inputs: &[f64], x: &mut [f64]) -> Result<(), SingularMatrix> {
         let n = self.n;
         debug_assert_eq!(self.ab.len(), n * n + n);
-        self.program.eval(inputs, &mut self.ws, &mut self.ab);
+        let ext = self.inputs.update(&self.program, inputs);
+        self.program.main().eval(ext, &mut self.ws, &mut self.ab);
         self.solver.solve(&mut self.ab, x)
     }
 }

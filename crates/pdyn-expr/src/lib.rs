@@ -35,6 +35,7 @@ pub mod dimension;
 pub mod error;
 pub mod expand;
 pub mod factor;
+pub mod hoist;
 pub mod linsolve;
 pub mod lower;
 pub mod lu;

@@ -43,6 +43,7 @@ use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_jit::{JITBuilder, JITModule};
 use cranelift_module::{default_libcall_names, Linkage, Module};
 use pdyn_expr::compile::{CompiledLinearSystem, Op};
+use pdyn_expr::hoist::{HoistedInputs, HoistedProgram};
 use pdyn_expr::lu::{DenseSolver, SingularMatrix};
 use pdyn_expr::Program;
 use std::sync::Arc;
@@ -698,10 +699,14 @@ impl Evaluator {
     }
 }
 
-/// A [`CompiledLinearSystem`] whose entries `A`, `b` are evaluated by an [`Evaluator`], then
-/// solved by the same [`DenseSolver`]. Owns its buffers; `solve` allocates nothing.
+/// A [`CompiledLinearSystem`] whose entries `A`, `b` are evaluated by an [`Evaluator`] (the
+/// main part of its [`HoistedProgram`]; the parameter-only prelude is interpreted, once per
+/// parameter change), then solved by the same [`DenseSolver`]. Owns its buffers; `solve`
+/// allocates nothing.
 #[derive(Clone, Debug)]
 pub struct JitLinearSystem {
+    program: HoistedProgram,
+    inputs: HoistedInputs,
     eval: Evaluator,
     n: usize,
     ws: Vec<f64>,
@@ -713,8 +718,11 @@ impl JitLinearSystem {
     /// Builds the evaluator of `sys`'s entries according to `mode`.
     pub fn new(sys: &CompiledLinearSystem, mode: JitMode) -> JitLinearSystem {
         let n = sys.n();
-        let eval = Evaluator::new(sys.program().clone(), mode);
+        let program = sys.program().clone();
+        let eval = Evaluator::new(program.main().clone(), mode);
         JitLinearSystem {
+            inputs: HoistedInputs::new(&program),
+            program,
             ws: eval.workspace(),
             eval,
             n,
@@ -731,7 +739,8 @@ impl JitLinearSystem {
     /// Solves for the unknowns at `inputs`, writing them to `x` (as
     /// [`CompiledLinearSystem::solve`], with the same result bits).
     pub fn solve(&mut self, inputs: &[f64], x: &mut [f64]) -> Result<(), SingularMatrix> {
-        self.eval.eval(inputs, &mut self.ws, &mut self.ab);
+        let ext = self.inputs.update(&self.program, inputs);
+        self.eval.eval(ext, &mut self.ws, &mut self.ab);
         debug_assert_eq!(self.ab.len(), self.n * self.n + self.n);
         self.solver.solve(&mut self.ab, x)
     }

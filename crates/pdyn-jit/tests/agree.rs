@@ -91,7 +91,7 @@ fn check_model(name: &str, src: &str, opts: &DeriveOptions) -> Option<usize> {
         }
     }
     let sys = CompiledLinearSystem::new(&mut m.pool, &d.system, &inp).unwrap();
-    checked += check(&format!("{name} system"), sys.program(), 200);
+    checked += check(&format!("{name} system"), sys.program().main(), 200);
     // The solved system too: the JIT's A, b go through the same LU.
     let mut interp = sys.clone();
     let mut native = JitLinearSystem::new(&sys, JitMode::Auto);
@@ -185,13 +185,13 @@ fn programs_longer_than_one_chunk_are_split_and_still_agree() {
     let all: Vec<Id> = d.system.a.iter().chain(&d.system.b).copied().collect();
     let inp = inputs(&mut m, &d.state, &all);
     let sys = CompiledLinearSystem::new(&mut m.pool, &d.system, &inp).unwrap();
-    let jit = JitProgram::compile(sys.program()).unwrap();
+    let jit = JitProgram::compile(sys.program().main()).unwrap();
     // The 16-link chain's A and b take several thousand instructions: several chunks, with
     // values crossing between them through the spill array.
     assert!(jit.chunks() >= 2, "{jit:?}");
     assert!(!jit.workspace().is_empty());
     assert_eq!(
-        check("chain 16 system", sys.program(), 50),
+        check("chain 16 system", sys.program().main(), 50),
         50 * (16 * 16 + 16)
     );
 }

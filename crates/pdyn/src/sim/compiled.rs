@@ -137,7 +137,9 @@ impl CompiledModel {
                 (engine, Some(Evaluator::new(jprog, jit)), None, separable)
             }
             None => {
-                let sys = CompiledLinearSystem::new(p, &d.system, &inputs)?;
+                // The parameters (inputs from 1 + 2n on) keep their values between
+                // evaluations: the entries' parameter-only work is hoisted.
+                let sys = CompiledLinearSystem::hoisted(p, &d.system, &inputs, 1 + 2 * n)?;
                 let sys = JitLinearSystem::new(&sys, jit);
                 let entries: Vec<Id> = d.system.a.iter().chain(&d.system.b).copied().collect();
                 let depends_on_rates = p.contains_any(&entries, &rates);
