@@ -142,6 +142,22 @@ pub(crate) struct Compiler<'a> {
     first_invariant: u32,
     /// Whether products are lowered for hoisting (see `Compiler::product_hoisting`).
     hoist: bool,
+    /// The sums compiled so far (node, register), by [`term_set_hash`] of their terms.
+    sums: FxHashMap<u64, Vec<(Id, u32)>>,
+}
+
+/// A hash of a set of terms that is the sum of the terms' hashes (wrapping), so that the
+/// hash of the set without one term is one subtraction away.
+fn term_set_hash(ts: &[Id]) -> u64 {
+    ts.iter().fold(0u64, |h, &t| h.wrapping_add(term_hash(t)))
+}
+
+fn term_hash(t: Id) -> u64 {
+    // SplitMix64's finaliser: distinct ids spread over all 64 bits.
+    let mut z = (t.index() as u64).wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
 }
 
 /// Provisional registers: inputs `0..n`, constants `CONST_BASE + k`, temporaries `TEMP_BASE + k`;
@@ -169,6 +185,7 @@ impl<'a> Compiler<'a> {
             n_inputs: inputs.len() as u32,
             first_invariant: first_invariant.min(inputs.len()) as u32,
             hoist,
+            sums: FxHashMap::default(),
         };
         for (i, &x) in inputs.iter().enumerate() {
             c.reg.insert(x, i as u32);
@@ -232,8 +249,14 @@ impl<'a> Compiler<'a> {
                 })
             }
             Node::Add(ts) => {
-                let mut acc: Option<u32> = None;
-                for &t in ts.iter() {
+                // A sum that is a sum already computed plus one term continues from it: a
+                // chain's particle positions and velocities are each the previous one's plus
+                // a term, n additions instead of n²/2 (the 100-link chain's output columns).
+                let (mut acc, rest) = match self.sum_minus_one_term(&ts) {
+                    Some((r, j)) => (Some(r), vec![ts[j]]),
+                    None => (None, ts.to_vec()),
+                };
+                for &t in rest.iter() {
                     let (c, rest) = self.pool.split_coeff(t);
                     let (neg, term) = if c.is_negative() && rest != Pool::ONE {
                         let pos = self.pool.scale(c.neg(), rest);
@@ -249,7 +272,12 @@ impl<'a> Compiler<'a> {
                         (Some(a), true) => self.emit(Op::Sub, a, v),
                     });
                 }
-                acc.unwrap_or_else(|| self.constant(0.0))
+                let r = acc.unwrap_or_else(|| self.constant(0.0));
+                self.sums
+                    .entry(term_set_hash(&ts))
+                    .or_default()
+                    .push((id, r));
+                r
             }
             Node::Mul(fs) => {
                 // A factor `b^(-e)` is already compiled (children first) as the reciprocal
@@ -322,6 +350,33 @@ impl<'a> Compiler<'a> {
             });
         }
         Ok(acc)
+    }
+
+    /// A sum compiled earlier whose terms are `ts` but one: its register and the index of
+    /// the missing term. One hash lookup per term, the match then checked term by term.
+    fn sum_minus_one_term(&self, ts: &[Id]) -> Option<(u32, usize)> {
+        if ts.len() < 3 || self.sums.is_empty() {
+            return None;
+        }
+        let whole = term_set_hash(ts);
+        for (j, &t) in ts.iter().enumerate() {
+            let Some(found) = self.sums.get(&whole.wrapping_sub(term_hash(t))) else {
+                continue;
+            };
+            for &(id, r) in found {
+                if let Node::Add(us) = self.pool.node(id) {
+                    let same = us.len() + 1 == ts.len()
+                        && us
+                            .iter()
+                            .zip(ts.iter().enumerate().filter(|&(k, _)| k != j))
+                            .all(|(u, (_, t))| u == t);
+                    if same {
+                        return Some((r, j));
+                    }
+                }
+            }
+        }
+        None
     }
 
     /// A product as (its variant factors) × (its invariant factors), each part a node of its
@@ -666,6 +721,35 @@ impl CompiledLinearSystem {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Partial sums (a chain's positions `x_i = l_1 sin q_1 + … + l_i sin q_i`) are each the
+    /// previous one plus a term: n additions, not n²/2, and the bits of the plain left fold.
+    #[test]
+    fn partial_sums_continue_from_the_previous_one() {
+        let mut p = Pool::new();
+        let n = 40;
+        let qs: Vec<Id> = (1..=n).map(|i| p.var(&format!("q{i}"))).collect();
+        let terms: Vec<Id> = (1..=n)
+            .map(|i| p.parse_scalar(&format!("{i}*sin(q{i})")).unwrap())
+            .collect();
+        let sums: Vec<Id> = (1..=n).map(|i| p.add(&terms[..i])).collect();
+        let prog = Program::compile(&mut p, &qs, &sums).unwrap();
+        let adds = prog
+            .instructions()
+            .iter()
+            .filter(|i| i.op() == Op::Add)
+            .count();
+        assert_eq!(adds, n - 1);
+        let x: Vec<f64> = (0..n).map(|i| 0.3 + 0.17 * i as f64).collect();
+        let mut out = vec![0.0; n];
+        prog.eval(&x, &mut prog.workspace(), &mut out);
+        let mut acc = 0.0;
+        for i in 0..n {
+            let t = (i + 1) as f64 * x[i].sin();
+            acc = if i == 0 { t } else { acc + t };
+            assert_eq!(out[i].to_bits(), acc.to_bits(), "x_{}", i + 1);
+        }
+    }
 
     #[test]
     fn evaluates_and_shares_subexpressions() {

@@ -64,3 +64,38 @@ fn check(opts: &DeriveOptions) {
         "compiled instructions grow {ri:.3}x from n=20 to 40"
     );
 }
+
+/// A run evaluates `[A | b]` thousands of times with the same parameters: the parameter-only
+/// work (the chain's mass sums `m_k + … + m_n`, the products `l_j*l_k*(m_k + … + m_n)`) is
+/// hoisted out of the per-evaluation program ([`pdyn_expr::hoist::HoistedProgram`]), which
+/// must lose a fixed share of its instructions and still grow as n².
+#[test]
+fn the_run_s_evaluation_leaves_the_parameter_work_to_the_prelude() {
+    let opts = DeriveOptions {
+        simplify_printed: false,
+        solve_budget: pdyn_mech::derive::RUN_SOLVE_BUDGET,
+        ..DeriveOptions::default()
+    };
+    let sizes = |n: usize| {
+        let mut m = load(&chain_toml(n), "chain.toml").unwrap();
+        let d = derive(&mut m, &opts).unwrap();
+        let mut inputs: Vec<Id> = vec![m.pool.time()];
+        inputs.extend(&d.state);
+        inputs.extend(m.parameters.iter().map(|p| p.id));
+        let plain = CompiledLinearSystem::new(&mut m.pool, &d.system, &inputs).unwrap();
+        let first_parameter = 1 + d.state.len();
+        let hoisted =
+            CompiledLinearSystem::hoisted(&mut m.pool, &d.system, &inputs, first_parameter)
+                .unwrap();
+        let h = hoisted.program();
+        (plain.program().len(), h.main().len(), h.prelude().len())
+    };
+    let (plain20, main20, pre20) = sizes(20);
+    let (plain40, main40, pre40) = sizes(40);
+    eprintln!("n=20: plain {plain20}, main {main20}, prelude {pre20}");
+    eprintln!("n=40: plain {plain40}, main {main40}, prelude {pre40}");
+    for (plain, main) in [(plain20, main20), (plain40, main40)] {
+        assert!((main as f64) < 0.8 * plain as f64, "main {main} of {plain}");
+    }
+    assert!(main40 as f64 <= 4.5 * main20 as f64, "{main20} -> {main40}");
+}
