@@ -144,6 +144,8 @@ pub(crate) struct Compiler<'a> {
     hoist: bool,
     /// The sums compiled so far (node, register), by [`term_set_hash`] of their terms.
     sums: FxHashMap<u64, Vec<(Id, u32)>>,
+    /// Memo of `Compiler::split_sum`.
+    split_sums: FxHashMap<Id, Option<(Id, Id)>>,
 }
 
 /// A hash of a set of terms that is the sum of the terms' hashes (wrapping), so that the
@@ -186,6 +188,7 @@ impl<'a> Compiler<'a> {
             first_invariant: first_invariant.min(inputs.len()) as u32,
             hoist,
             sums: FxHashMap::default(),
+            split_sums: FxHashMap::default(),
         };
         for (i, &x) in inputs.iter().enumerate() {
             c.reg.insert(x, i as u32);
@@ -249,6 +252,13 @@ impl<'a> Compiler<'a> {
                 })
             }
             Node::Add(ts) => {
+                if self.hoist {
+                    if let Some((variant, invariant)) = self.split_sum(id)? {
+                        let v = self.value(variant)?;
+                        let i = self.value(invariant)?;
+                        return Ok(self.emit(Op::Mul, v, i));
+                    }
+                }
                 // A sum that is a sum already computed plus one term continues from it: a
                 // chain's particle positions and velocities are each the previous one's plus
                 // a term, n additions instead of n²/2 (the 100-link chain's output columns).
@@ -379,6 +389,54 @@ impl<'a> Compiler<'a> {
         None
     }
 
+    /// A sum whose terms all have the same invariant part `C` (their parameter-only factors,
+    /// coefficient included) next to a variant part: `(Σ variant parts, C)`. `Σ C·v_i` is
+    /// then computed as `C·Σ v_i`, and a product with the sum as a factor folds `C` into its
+    /// hoisted part: the 100-link chain's mass-matrix entries
+    /// `(l_j*l_k*sin(q_j)*sin(q_k) + l_j*l_k*cos(q_j)*cos(q_k))*(m_k + … + m_n)` take four
+    /// operations per evaluation instead of six. Memoised; `None` for anything else.
+    fn split_sum(&mut self, id: Id) -> Result<Option<(Id, Id)>, CompileError> {
+        if let Some(&s) = self.split_sums.get(&id) {
+            return Ok(s);
+        }
+        let mut result = None;
+        if let Node::Add(ts) = self.pool.node(id).clone() {
+            let mut common: Option<Id> = None;
+            let mut parts = Vec::with_capacity(ts.len());
+            for &t in ts.iter() {
+                let Node::Mul(fs) = self.pool.node(t).clone() else {
+                    break;
+                };
+                let (mut invariant, mut variant) = (Vec::new(), Vec::new());
+                for &f in fs.iter() {
+                    let r = self.value(f)?;
+                    if self.is_invariant(r) {
+                        invariant.push(f);
+                    } else {
+                        variant.push(f);
+                    }
+                }
+                if invariant.is_empty() || variant.is_empty() {
+                    break;
+                }
+                let c = self.pool.mul(&invariant);
+                if common.is_some_and(|x| x != c) {
+                    break;
+                }
+                common = Some(c);
+                parts.push(match variant[..] {
+                    [one] => one,
+                    _ => self.pool.mul(&variant),
+                });
+            }
+            if let (Some(c), true) = (common, parts.len() == ts.len()) {
+                result = Some((self.pool.add(&parts), c));
+            }
+        }
+        self.split_sums.insert(id, result);
+        Ok(result)
+    }
+
     /// A product as (its variant factors) × (its invariant factors), each part a node of its
     /// own: the invariant part is then computed once per parameter change (hoisted), and the
     /// variant part is shared by every product with the same variant factors. In the n-link
@@ -387,15 +445,20 @@ impl<'a> Compiler<'a> {
     fn product_hoisting(&mut self, fs: &[Id]) -> Result<Option<u32>, CompileError> {
         let mut invariant = Vec::new();
         let mut variant = Vec::new();
+        let mut split = false;
         for &f in fs {
             let r = self.value(f)?;
             if self.is_invariant(r) {
                 invariant.push(f);
+            } else if let Some((v, i)) = self.split_sum(f)? {
+                variant.push(v);
+                invariant.push(i);
+                split = true;
             } else {
                 variant.push(f);
             }
         }
-        if invariant.is_empty() || variant.is_empty() {
+        if !split && (invariant.is_empty() || variant.is_empty()) {
             return self.product(fs);
         }
         let part = |c: &mut Compiler, ids: Vec<Id>| -> Result<u32, CompileError> {

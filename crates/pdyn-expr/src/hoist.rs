@@ -48,10 +48,33 @@ impl HoistedProgram {
         let n_consts = c.consts.len() as u32;
         let n_temps = c.instrs.len();
 
+        // Instructions whose values no output needs are dropped: lowering a sum as
+        // `C·Σ v_i` leaves its terms' products `C·v_i` unread.
+        let mut live = vec![false; n_temps];
+        let mark = |r: u32, live: &mut Vec<bool>| {
+            if r >= TEMP_BASE {
+                live[(r - TEMP_BASE) as usize] = true;
+            }
+        };
+        for &o in &outs {
+            mark(o, &mut live);
+        }
+        for k in (0..n_temps).rev() {
+            if live[k] {
+                let ins = &c.instrs[k];
+                mark(ins.a(), &mut live);
+                if ins.op().reads_b() {
+                    mark(ins.b(), &mut live);
+                }
+            }
+        }
         // Prelude temporaries, numbered in order; main temporaries likewise.
         let mut index = vec![0u32; n_temps];
         let (mut n_pre, mut n_main) = (0u32, 0u32);
         for (k, &inv) in c.invariant.iter().enumerate() {
+            if !live[k] {
+                continue;
+            }
             if inv {
                 index[k] = n_pre;
                 n_pre += 1;
@@ -74,7 +97,7 @@ impl HoistedProgram {
             }
         };
         for (k, ins) in c.instrs.iter().enumerate() {
-            if !c.invariant[k] {
+            if live[k] && !c.invariant[k] {
                 need(ins.a(), &mut slot);
                 if ins.op().reads_b() {
                     need(ins.b(), &mut slot);
@@ -120,20 +143,16 @@ impl HoistedProgram {
             };
             Instr::new(ins.op(), f(ins.a()), b)
         };
-        let pre_instrs = c
-            .instrs
-            .iter()
-            .zip(&c.invariant)
-            .filter(|(_, &inv)| inv)
-            .map(|(ins, _)| remap_instr(ins, &pre_remap))
-            .collect();
-        let main_instrs = c
-            .instrs
-            .iter()
-            .zip(&c.invariant)
-            .filter(|(_, &inv)| !inv)
-            .map(|(ins, _)| remap_instr(ins, &main_remap))
-            .collect();
+        let kept = |prelude: bool| {
+            c.instrs
+                .iter()
+                .zip(&c.invariant)
+                .zip(&live)
+                .filter(move |((_, &inv), &l)| l && inv == prelude)
+                .map(|((ins, _), _)| ins)
+        };
+        let pre_instrs = kept(true).map(|i| remap_instr(i, &pre_remap)).collect();
+        let main_instrs = kept(false).map(|i| remap_instr(i, &main_remap)).collect();
         let prelude = Program::from_parts(
             n_in as usize,
             c.consts.clone(),

@@ -99,3 +99,51 @@ fn the_run_s_evaluation_leaves_the_parameter_work_to_the_prelude() {
     }
     assert!(main40 as f64 <= 4.5 * main20 as f64, "{main20} -> {main40}");
 }
+
+/// The hoisted system solves to the plain one's accelerations (to rounding: products and
+/// sums are associated differently) at random states and parameters, including after the
+/// parameters change between solves.
+#[test]
+fn the_hoisted_system_solves_like_the_plain_one() {
+    let opts = DeriveOptions {
+        simplify_printed: false,
+        solve_budget: 0,
+        ..DeriveOptions::default()
+    };
+    let n = 6;
+    let mut m = load(&chain_toml(n), "chain.toml").unwrap();
+    let d = derive(&mut m, &opts).unwrap();
+    assert!(d.solution.is_none(), "solved numerically");
+    let mut inputs: Vec<Id> = vec![m.pool.time()];
+    inputs.extend(&d.state);
+    inputs.extend(m.parameters.iter().map(|p| p.id));
+    let mut plain = CompiledLinearSystem::new(&mut m.pool, &d.system, &inputs).unwrap();
+    let mut hoisted =
+        CompiledLinearSystem::hoisted(&mut m.pool, &d.system, &inputs, 1 + 2 * n).unwrap();
+    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+    let mut rand = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut x1, mut x2) = (vec![0.0; n], vec![0.0; n]);
+    let mut params: Vec<f64> = m.parameters.iter().map(|p| p.value).collect();
+    for trial in 0..40 {
+        if trial % 10 == 0 {
+            params = params.iter().map(|_| 0.5 + rand()).collect();
+        }
+        let mut input = vec![rand()];
+        input.extend((0..2 * n).map(|_| 4.0 * rand() - 2.0));
+        input.extend(&params);
+        plain.solve(&input, &mut x1).unwrap();
+        hoisted.solve(&input, &mut x2).unwrap();
+        let scale = x1.iter().fold(1.0f64, |s, x| s.max(x.abs()));
+        for (a, b) in x1.iter().zip(&x2) {
+            assert!(
+                (a - b).abs() <= 1e-10 * scale,
+                "trial {trial}: {x1:?} vs {x2:?}"
+            );
+        }
+    }
+}
