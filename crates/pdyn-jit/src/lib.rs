@@ -110,6 +110,12 @@ const CHUNK: usize = 2048;
 /// the evaluation time (46–77 µs).
 const SEGMENT: usize = 64;
 
+/// An input is loaded again in each window of this many instructions rather than kept in a
+/// register from its first use to its last: a run's hoisted programs read thousands of
+/// precomputed parameter products as inputs (`pdyn_expr::hoist`), and kept live across a
+/// whole chunk they made register allocation 34 % of the 16-link chain's `pdyn run`.
+const INPUT_WINDOW: usize = 64;
+
 /// Programs up to this length are not cut into segments (see `SpillPlan`).
 const SEGMENTED_FROM: usize = 4 * CHUNK;
 
@@ -380,12 +386,23 @@ fn emit_chunk(
     let n_in = prog.n_inputs();
     let consts = prog.constants();
     let first_temp = prog.first_temporary();
-    let mut regs: Vec<Option<(Value, u32)>> = vec![None; first_temp + prog.len()];
+    // Each register's SSA value with the segment it belongs to; an input's also with the
+    // window of `INPUT_WINDOW` instructions in which it was loaded (see there).
+    let mut regs: Vec<Option<(Value, u32, u32)>> = vec![None; first_temp + prog.len()];
     let flags = MemFlags::trusted();
-    let get = |b: &mut FunctionBuilder, regs: &mut Vec<Option<(Value, u32)>>, r: u32, seg: u32| {
+    let get = |b: &mut FunctionBuilder,
+               regs: &mut Vec<Option<(Value, u32, u32)>>,
+               r: u32,
+               seg: u32,
+               at: usize| {
         let r = r as usize;
-        if let Some((v, s)) = regs[r] {
-            if s == seg {
+        let window = if r < n_in {
+            (at / INPUT_WINDOW) as u32
+        } else {
+            0
+        };
+        if let Some((v, s, w)) = regs[r] {
+            if s == seg && w == window {
                 return v;
             }
         }
@@ -398,7 +415,7 @@ fn emit_chunk(
             let slot = plan.slot[r - first_temp] as usize;
             b.ins().load(types::F64, flags, spill, (8 * slot) as i32)
         };
-        regs[r] = Some((v, seg));
+        regs[r] = Some((v, seg, window));
         v
     };
     let start = c * CHUNK;
@@ -406,9 +423,9 @@ fn emit_chunk(
     for (k, ins) in prog.instructions()[start..end].iter().enumerate() {
         let k = start + k;
         let seg = plan.read_segment[k];
-        let a = get(&mut b, &mut regs, ins.a(), seg);
+        let a = get(&mut b, &mut regs, ins.a(), seg, k);
         let rb = if ins.op().reads_b() {
-            Some(get(&mut b, &mut regs, ins.b(), seg))
+            Some(get(&mut b, &mut regs, ins.b(), seg, k))
         } else {
             None
         };
@@ -459,7 +476,7 @@ fn emit_chunk(
             },
         };
         // A call's result belongs to the segment after the call (in a segmented program).
-        regs[first_temp + k] = Some((v, plan.def_segment[k]));
+        regs[first_temp + k] = Some((v, plan.def_segment[k], 0));
         let slot = plan.slot[k];
         if slot != u32::MAX {
             b.ins().store(flags, v, spill, (8 * slot as usize) as i32);
@@ -468,7 +485,7 @@ fn emit_chunk(
     if c + 1 == plan.chunks {
         for (i, &r) in prog.output_registers().iter().enumerate() {
             let seg = plan.output_segment + (i / plan.max_segment) as u32;
-            let v = get(&mut b, &mut regs, r, seg);
+            let v = get(&mut b, &mut regs, r, seg, prog.len() + i);
             b.ins().store(flags, v, outp, (8 * i) as i32);
         }
     }
