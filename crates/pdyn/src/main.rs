@@ -109,12 +109,6 @@ fn install_panic_hook(json: bool) {
     }));
 }
 
-// Symbolic work allocates and frees many small nodes and vectors: with mimalloc the 100-link
-// chain's `pdyn derive` took 0.84–1.02 s against 1.05–1.38 s with the system allocator (best
-// of 5, interleaved, load ≈ 3); `pdyn run` of the 16-link chain was unchanged.
-#[global_allocator]
-static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
 fn main() -> ExitCode {
     let json = wants_json();
     install_panic_hook(json);
