@@ -680,7 +680,7 @@ fn emit_kernel(
 
 /// Compiles `steps` to a native loop.
 fn compile(steps: &Steps) -> Result<Code, JitError> {
-    let mut module = super::new_module()?;
+    let mut module = super::new_module(true)?;
     let ptr = module.target_config().pointer_type();
     let call_conv = module.isa().default_call_conv();
     let mut ctx = module.make_context();
