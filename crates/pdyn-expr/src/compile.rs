@@ -401,8 +401,11 @@ impl<'a> Compiler<'a> {
         }
         let mut result = None;
         if let Node::Add(ts) = self.pool.node(id).clone() {
-            let mut common: Option<Id> = None;
-            let mut parts = Vec::with_capacity(ts.len());
+            // Each term's invariant and variant factors; the invariant lists must be equal
+            // (factors are in canonical order, so equal parts have equal lists), which is
+            // checked before any node is made: most sums fail at their second term.
+            let mut common: Option<Vec<Id>> = None;
+            let mut variants: Vec<Vec<Id>> = Vec::with_capacity(ts.len());
             for &t in ts.iter() {
                 let Node::Mul(fs) = self.pool.node(t).clone() else {
                     break;
@@ -419,18 +422,21 @@ impl<'a> Compiler<'a> {
                 if invariant.is_empty() || variant.is_empty() {
                     break;
                 }
-                let c = self.pool.mul(&invariant);
-                if common.is_some_and(|x| x != c) {
+                if common.as_ref().is_some_and(|c| *c != invariant) {
                     break;
                 }
-                common = Some(c);
-                parts.push(match variant[..] {
-                    [one] => one,
-                    _ => self.pool.mul(&variant),
-                });
+                common = Some(invariant);
+                variants.push(variant);
             }
-            if let (Some(c), true) = (common, parts.len() == ts.len()) {
-                result = Some((self.pool.add(&parts), c));
+            if let (Some(c), true) = (common, variants.len() == ts.len()) {
+                let parts: Vec<Id> = variants
+                    .iter()
+                    .map(|v| match v[..] {
+                        [one] => one,
+                        _ => self.pool.mul(v),
+                    })
+                    .collect();
+                result = Some((self.pool.add(&parts), self.pool.mul(&c)));
             }
         }
         self.split_sums.insert(id, result);
