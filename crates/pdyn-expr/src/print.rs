@@ -188,13 +188,22 @@ impl TextPrinter<'_> {
             Node::Add(ts) => {
                 let mut s = String::new();
                 for (i, &t) in ts.iter().enumerate() {
-                    let (neg, body) = self.term(t);
-                    match (i, neg) {
-                        (0, true) => s += &format!("-{body}"),
-                        (0, false) => s += &body,
-                        (_, true) => s += &format!(" - {body}"),
-                        (_, false) => s += &format!(" + {body}"),
-                    }
+                    // A bare symbol (most terms of a chain's mass sums `m2 + … + m100`) is
+                    // its name: no product view to build.
+                    let (neg, body) = match p.node(t) {
+                        Node::Sym(x) => (false, std::borrow::Cow::Borrowed(p.name(*x))),
+                        _ => {
+                            let (neg, body) = self.term(t);
+                            (neg, std::borrow::Cow::Owned(body))
+                        }
+                    };
+                    s += match (i, neg) {
+                        (0, true) => "-",
+                        (0, false) => "",
+                        (_, true) => " - ",
+                        (_, false) => " + ",
+                    };
+                    s += &body;
                 }
                 s
             }
