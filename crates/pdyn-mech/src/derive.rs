@@ -50,6 +50,13 @@ pub struct DeriveOptions {
     /// solved numerically at each evaluation and printed by reference. Default
     /// [`CHEAP_SOLVE_BUDGET`]; `pdyn derive --solve` uses [`FULL_SOLVE_BUDGET`].
     pub solve_budget: u64,
+    /// Count the simplification of the exact solution against
+    /// [`DeriveOptions::solve_budget`] too: past it, no exact solution (`A x = b` is solved
+    /// numerically), as when the elimination alone is over it. For a caller that prints the
+    /// solution, like `pdyn derive`, whose cost then grows with the system. Default false:
+    /// the solution found within the budget is simplified whatever that costs (a run
+    /// evaluates it).
+    pub simplify_solution_within_budget: bool,
 }
 
 impl Default for DeriveOptions {
@@ -60,6 +67,7 @@ impl Default for DeriveOptions {
             simplify: true,
             simplify_printed: true,
             solve_budget: CHEAP_SOLVE_BUDGET,
+            simplify_solution_within_budget: false,
         }
     }
 }
@@ -453,7 +461,12 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
         // otherwise A x = b is solved numerically at each evaluation. On the 4-link chain the
         // exact solution took 3 s of a 3.1 s `pdyn run` (elimination, then compiling its large
         // expressions and their Jacobian) and printed unreadable 37 KB lines.
-        match p.solve_linear_budgeted(&system, true, opts.solve_budget) {
+        let solved = if opts.simplify_solution_within_budget {
+            p.solve_linear_within(&system, true, opts.solve_budget)
+        } else {
+            p.solve_linear_budgeted(&system, true, opts.solve_budget)
+        };
+        match solved {
             Ok(sol) => Some(sol.into_iter().map(|s| simp(p, s, opts.simplify)).collect()),
             Err(LinearError::Underdetermined { free }) => {
                 let names: Vec<String> = free.iter().map(|&f| p.to_text(f)).collect();

@@ -68,6 +68,10 @@ pub fn run(a: DeriveArgs) -> Result<String, Error> {
         } else {
             pdyn_mech::derive::CHEAP_SOLVE_BUDGET
         },
+        // The solution is printed, and only when it is short: simplifying it is worth the
+        // solve budget's remainder, not more (the 3-link chain's cost more than the whole
+        // `pdyn derive` of 4 or 8 links, to be printed by reference).
+        simplify_solution_within_budget: true,
         ..DeriveOptions::default()
     };
     let d = derive(&mut model, &opts).map_err(|error| Error::Derive {
