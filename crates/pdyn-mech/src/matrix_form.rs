@@ -34,6 +34,15 @@ pub struct Entry {
 }
 
 impl Entry {
+    /// [`Entry::render`] as text, sharing `memo`'s texts of long sums (a chain's mass sums)
+    /// with the other entries.
+    pub fn render_text_memo(&self, p: &mut Pool, memo: &pdyn_expr::print::TextMemo) -> String {
+        match &self.collected {
+            Some(c) => c.to_text_memo(p, memo),
+            None => p.to_text_memo(self.expr, memo),
+        }
+    }
+
     /// The entry as text (re-parsable in the model's scope) or LaTeX, whole.
     pub fn render(&self, p: &mut Pool, latex: bool) -> String {
         match (&self.collected, latex) {

@@ -341,8 +341,10 @@ struct Rendered {
 impl Rendered {
     fn new(p: &mut Pool, m: &MatrixForm, latex: bool) -> Rendered {
         // An entry too large to collect is over the budget: its size is what prints.
+        let memo = pdyn_expr::print::TextMemo::default();
         let show = |p: &mut Pool, e: &pdyn_mech::matrix_form::Entry| match &e.collected {
-            Some(_) => e.render(p, latex),
+            Some(_) if latex => e.render(p, latex),
+            Some(_) => e.render_text_memo(p, &memo),
             None => String::new(),
         };
         // A symmetric M's lower triangle is the upper one's text (half the formatting: at
