@@ -221,6 +221,14 @@ pub const FULL_SOLVE_BUDGET: u64 = 4_000_000;
 /// took 0.01 s) and gave explicit forms printed by reference anyway. It was 200,000; no
 /// example needed more than 20,000.
 pub const CHEAP_SOLVE_BUDGET: u64 = 20_000;
+/// Work budget of exact elimination and of simplifying its result together
+/// ([`DeriveOptions::simplify_solution_within_budget`]) for `pdyn derive` without `--solve`:
+/// what the shipped examples' printed solutions need (the double pendulum's 8,361 units the
+/// most; the others under 5,000). Half of [`CHEAP_SOLVE_BUDGET`], so that the 3- to 6-link
+/// chains give up on elimination sooner: at 20,000 the 3-link chain, whose elimination
+/// fits, spent more than the 4- or 8-link chain on all of `pdyn derive` (28.7 against 24.3
+/// and 22.2 million instructions).
+pub const PRINT_SOLVE_BUDGET: u64 = 10_000;
 /// Work budget of exact elimination for a run, which only evaluates the result: a closed
 /// form pays off when it is found quickly (one or two unknowns, Newton's equations with a
 /// few reactions); past this, `A x = b` solved numerically at each evaluation is cheaper

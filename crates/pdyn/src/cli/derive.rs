@@ -66,7 +66,7 @@ pub fn run(a: DeriveArgs) -> Result<String, Error> {
         solve_budget: if a.solve {
             pdyn_mech::derive::FULL_SOLVE_BUDGET
         } else {
-            pdyn_mech::derive::CHEAP_SOLVE_BUDGET
+            pdyn_mech::derive::PRINT_SOLVE_BUDGET
         },
         // The solution is printed, and only when it is short: simplifying it is worth the
         // solve budget's remainder, not more (the 3-link chain's cost more than the whole
