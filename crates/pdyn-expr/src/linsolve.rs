@@ -213,7 +213,7 @@ impl Pool {
         for k in 0..n {
             let mut found = None;
             for (i, row) in rows.iter().enumerate().skip(r) {
-                if !self.poly_is_zero(&rf, &row[k]) {
+                if !self.poly_is_zero(&mut rf, &row[k], within)? {
                     found = Some(i);
                     break;
                 }
@@ -246,7 +246,7 @@ impl Pool {
             return Err(LinearError::Underdetermined { free });
         }
         for i in n..m {
-            if check_consistency && !self.poly_is_zero(&rf, &rows[i][n]) {
+            if check_consistency && !self.poly_is_zero(&mut rf, &rows[i][n], within)? {
                 return Err(LinearError::Inconsistent {
                     equation: origin[i],
                 });
@@ -293,16 +293,33 @@ impl Pool {
             .collect()
     }
 
-    fn poly_is_zero(&mut self, rf: &RationalForm, p: &Poly) -> bool {
+    /// Whether `p` is zero, by an identity if need be (`sin^2 + cos^2 - 1`); `within`: the
+    /// simplification this takes is paid from `rf`'s budget ([`Pool::solve_linear_within`]),
+    /// [`LinearError::TooLarge`] past it (on the 3-link chain these pivot tests cost as much
+    /// as the elimination itself).
+    fn poly_is_zero(
+        &mut self,
+        rf: &mut RationalForm,
+        p: &Poly,
+        within: bool,
+    ) -> Result<bool, LinearError> {
         if p.is_zero() {
-            return true;
+            return Ok(true);
         }
         if p.as_constant().is_some() {
-            return false;
+            return Ok(false);
         }
         // Nonzero as a polynomial, but possibly zero by an identity (sin^2 + cos^2 - 1).
         let e = rf.to_expr(self, p);
-        self.simplify(e) == Pool::ZERO
+        if !within {
+            return Ok(self.simplify(e) == Pool::ZERO);
+        }
+        let mut left = rf.budget.0;
+        let s = self
+            .simplify_within(e, &mut left)
+            .ok_or(LinearError::TooLarge)?;
+        rf.budget.0 = left;
+        Ok(s == Pool::ZERO)
     }
 }
 
