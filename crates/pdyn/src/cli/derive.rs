@@ -40,9 +40,10 @@ pub struct DeriveArgs {
     /// Largest system eliminated symbolically (larger ones are solved numerically when run).
     #[arg(long, default_value_t = 6)]
     symbolic_limit: usize,
-    /// Eliminate exactly even when it is expensive (a 4-link chain), and print explicit
-    /// accelerations up to 2,000 characters (without it: up to 600; larger ones, such as the
-    /// 3-link chain's 1,600-character ones, are written by reference, (M⁻¹ f)_1).
+    /// Eliminate exactly even when it is expensive (the 3-link chain), and print
+    /// explicit accelerations up to 2,000 characters (without it: elimination and
+    /// simplification within a small work budget, explicit forms up to 600 characters, larger
+    /// ones written by reference, (M⁻¹ f)_1).
     #[arg(long)]
     solve: bool,
 }
