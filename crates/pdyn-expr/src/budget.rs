@@ -87,6 +87,11 @@ impl std::error::Error for BudgetError {}
 /// size instead ([`Pool::to_text_within`](crate::Pool::to_text_within)); `--json` output has
 /// every expression whole.
 pub const PRINT_CHARS: usize = 2_000;
+/// Longest expression a message quotes inline (`its coefficient `cos(x)` depends on …`):
+/// past it the message names the expression and gives its size (`its coefficient, 1012
+/// characters, …`), which is what a reader can use in a sentence; a 1,000-character
+/// coefficient quoted whole buries the reason it was given for.
+pub const QUOTE_CHARS: usize = 120;
 /// Expressions of more tree nodes than this are not even formatted: formatting the 4-link
 /// chain's explicit accelerations took seconds, and any expression that prints within
 /// [`PRINT_CHARS`] has far fewer nodes.

@@ -358,6 +358,21 @@ impl Pool {
         let Node::Add(ts) = self.node(sum) else {
             return None;
         };
+        if ts.len() < crate::memo::CONTENT_MEMO_TERMS {
+            return self.add_content_uncached(sum);
+        }
+        if let Some(known) = self.memo.content.get(&sum) {
+            return known.clone();
+        }
+        let r = self.add_content_uncached(sum);
+        self.memo.content.insert(sum, r.clone());
+        r
+    }
+
+    fn add_content_uncached(&mut self, sum: Id) -> Option<(Number, Id)> {
+        let Node::Add(ts) = self.node(sum) else {
+            return None;
+        };
         let ts = ts.to_vec();
         let mut num_gcd: i64 = 0;
         let mut den_lcm: i64 = 1;

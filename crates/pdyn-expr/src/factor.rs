@@ -219,17 +219,26 @@ impl Collected {
 
     /// Plain text (re-parsable). (`&mut`: a negative coefficient's magnitude is a node.)
     pub fn to_text(&self, p: &mut Pool) -> String {
-        self.render(p, false)
+        self.render(p, false, None)
+    }
+
+    /// [`Collected::to_text`] sharing `memo`'s texts of long sums with other expressions.
+    pub fn to_text_memo(&self, p: &mut Pool, memo: &crate::print::TextMemo) -> String {
+        self.render(p, false, Some(memo))
     }
 
     /// LaTeX.
     pub fn to_latex(&self, p: &mut Pool) -> String {
-        self.render(p, true)
+        self.render(p, true, None)
     }
 
-    fn render(&self, p: &mut Pool, latex: bool) -> String {
+    fn render(&self, p: &mut Pool, latex: bool, memo: Option<&crate::print::TextMemo>) -> String {
+        let text = |p: &Pool, id: Id| match memo {
+            Some(memo) => p.to_text_memo(id, memo),
+            None => p.to_text(id),
+        };
         let show = |p: &Pool, id: Id| {
-            let s = if latex { p.to_latex(id) } else { p.to_text(id) };
+            let s = if latex { p.to_latex(id) } else { text(p, id) };
             match (p.node(id), latex) {
                 (Node::Add(_), true) => format!("\\left({s}\\right)"),
                 (Node::Add(_), false) => format!("({s})"),
@@ -250,7 +259,7 @@ impl Collected {
                 (_, true) => " - ",
             };
             if m == Pool::ONE {
-                out += &if latex { p.to_latex(c) } else { p.to_text(c) };
+                out += &if latex { p.to_latex(c) } else { text(p, c) };
             } else if c == Pool::ONE {
                 out += &show(p, m);
             } else {

@@ -151,6 +151,33 @@ impl Pool {
         check_consistency: bool,
         budget: u64,
     ) -> Result<Vec<Id>, LinearError> {
+        self.solve_exact(sys, check_consistency, budget, false)
+    }
+
+    /// Like [`Pool::solve_linear_budgeted`], with the simplification of the quotients
+    /// `y_i / det` paid from what is left of the same `budget`: [`LinearError::TooLarge`]
+    /// when the two together do not fit. For a caller that prints the solution, and prints
+    /// it only when it is short (`pdyn derive`): the 3-link chain's elimination fits the
+    /// cheap budget, but simplifying its result cost five times as much, which made `pdyn
+    /// derive` of 3 links slower than of 4 or 8 (whose elimination gives up or is not tried)
+    /// for accelerations then printed by reference.
+    pub fn solve_linear_within(
+        &mut self,
+        sys: &LinearSystem,
+        check_consistency: bool,
+        budget: u64,
+    ) -> Result<Vec<Id>, LinearError> {
+        self.solve_exact(sys, check_consistency, budget, true)
+    }
+
+    /// Bareiss elimination and back substitution; `within`: see [`Pool::solve_linear_within`].
+    fn solve_exact(
+        &mut self,
+        sys: &LinearSystem,
+        check_consistency: bool,
+        budget: u64,
+        within: bool,
+    ) -> Result<Vec<Id>, LinearError> {
         let (m, n) = (sys.rows(), sys.cols());
         let mut rf = RationalForm::new(budget, false);
         // Rows of [A | b] as polynomials, each multiplied through by its common denominator.
@@ -186,7 +213,7 @@ impl Pool {
         for k in 0..n {
             let mut found = None;
             for (i, row) in rows.iter().enumerate().skip(r) {
-                if !self.poly_is_zero(&rf, &row[k]) {
+                if !self.poly_is_zero(&mut rf, &row[k], within)? {
                     found = Some(i);
                     break;
                 }
@@ -219,7 +246,7 @@ impl Pool {
             return Err(LinearError::Underdetermined { free });
         }
         for i in n..m {
-            if check_consistency && !self.poly_is_zero(&rf, &rows[i][n]) {
+            if check_consistency && !self.poly_is_zero(&mut rf, &rows[i][n], within)? {
                 return Err(LinearError::Inconsistent {
                     equation: origin[i],
                 });
@@ -246,25 +273,53 @@ impl Pool {
             };
         }
         let det_e = rf.to_expr(self, &det);
-        let mut out = Vec::with_capacity(n);
-        for yi in &y {
-            let ye = rf.to_expr(self, yi);
-            let q = self.div(ye, det_e);
-            out.push(self.simplify(q));
+        let quotients: Vec<Id> = y
+            .iter()
+            .map(|yi| {
+                let ye = rf.to_expr(self, yi);
+                self.div(ye, det_e)
+            })
+            .collect();
+        if !within {
+            return Ok(quotients.iter().map(|&q| self.simplify(q)).collect());
         }
-        Ok(out)
+        let mut left = rf.budget.0;
+        quotients
+            .iter()
+            .map(|&q| {
+                self.simplify_within(q, &mut left)
+                    .ok_or(LinearError::TooLarge)
+            })
+            .collect()
     }
 
-    fn poly_is_zero(&mut self, rf: &RationalForm, p: &Poly) -> bool {
+    /// Whether `p` is zero, by an identity if need be (`sin^2 + cos^2 - 1`); `within`: the
+    /// simplification this takes is paid from `rf`'s budget ([`Pool::solve_linear_within`]),
+    /// [`LinearError::TooLarge`] past it (on the 3-link chain these pivot tests cost as much
+    /// as the elimination itself).
+    fn poly_is_zero(
+        &mut self,
+        rf: &mut RationalForm,
+        p: &Poly,
+        within: bool,
+    ) -> Result<bool, LinearError> {
         if p.is_zero() {
-            return true;
+            return Ok(true);
         }
         if p.as_constant().is_some() {
-            return false;
+            return Ok(false);
         }
         // Nonzero as a polynomial, but possibly zero by an identity (sin^2 + cos^2 - 1).
         let e = rf.to_expr(self, p);
-        self.simplify(e) == Pool::ZERO
+        if !within {
+            return Ok(self.simplify(e) == Pool::ZERO);
+        }
+        let mut left = rf.budget.0;
+        let s = self
+            .simplify_within(e, &mut left)
+            .ok_or(LinearError::TooLarge)?;
+        rf.budget.0 = left;
+        Ok(s == Pool::ZERO)
     }
 }
 

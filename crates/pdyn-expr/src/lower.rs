@@ -390,10 +390,14 @@ impl Lowerer<'_> {
         self.binary(*op, a, b, span.clone(), lhs.span(), rhs.span())
     }
 
-    /// The whole tree of `+` and `-` under `ast` as one canonical sum, when every term is a
-    /// scalar; `None` otherwise (vectors and shape errors take the pairwise path).
+    /// The whole tree of `+` and `-` under `ast` as one canonical sum (per component for
+    /// vectors: a particle position `l1*[sin(q1), -cos(q1), 0] + … + l100*[…]` added pairwise
+    /// re-sorted the sum so far at every `+`, most of loading a 100-link chain), when the
+    /// terms are all scalars or all vectors; `None` otherwise (a shape error, which the
+    /// pairwise path reports with the spans of the two sides).
     fn sum(&mut self, ast: &Ast) -> Result<Option<Value>, ExprError> {
-        let mut terms = Vec::new();
+        let mut scalars = Vec::new();
+        let mut vectors: [Vec<Id>; 3] = Default::default();
         let mut stack = vec![(ast, false)];
         while let Some((a, negated)) = stack.pop() {
             match a {
@@ -408,17 +412,33 @@ impl Lowerer<'_> {
                     stack.push((lhs, negated));
                 }
                 _ => match self.value(a)? {
-                    Value::Scalar(x) if negated => terms.push(self.pool.neg(x)),
-                    Value::Scalar(x) => terms.push(x),
-                    Value::Vector(_) => return Ok(None),
+                    Value::Scalar(_) if !vectors[0].is_empty() => return Ok(None),
+                    Value::Vector(_) if !scalars.is_empty() => return Ok(None),
+                    Value::Scalar(x) if negated => scalars.push(self.pool.neg(x)),
+                    Value::Scalar(x) => scalars.push(x),
+                    Value::Vector(v) => {
+                        for (terms, x) in vectors.iter_mut().zip(v) {
+                            terms.push(if negated { self.pool.neg(x) } else { x });
+                        }
+                    }
                 },
             }
         }
-        let r = self.pool.add(&terms);
-        if let Some(digits) = oversized_number(self.pool, r) {
-            return Err(too_large(ast.span(), "this sum".into(), digits));
+        let value = if vectors[0].is_empty() {
+            Value::Scalar(self.pool.add(&scalars))
+        } else {
+            Value::Vector(vectors.map(|terms| self.pool.add(&terms)))
+        };
+        let components = match &value {
+            Value::Scalar(x) => vec![*x],
+            Value::Vector(v) => v.to_vec(),
+        };
+        for r in components {
+            if let Some(digits) = oversized_number(self.pool, r) {
+                return Err(too_large(ast.span(), "this sum".into(), digits));
+            }
         }
-        Ok(Some(Value::Scalar(r)))
+        Ok(Some(value))
     }
 
     fn binary(

@@ -7,6 +7,9 @@
 use crate::pool::Id;
 use rustc_hash::FxHashMap;
 
+/// Smaller sums' content is computed each time (as cheap as looking it up).
+pub(crate) const CONTENT_MEMO_TERMS: usize = 8;
+
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Memo {
     pub expand: FxHashMap<Id, Id>,
@@ -15,6 +18,10 @@ pub(crate) struct Memo {
     pub factor: FxHashMap<Id, Id>,
     /// (expression, variable, total time derivative?) → derivative.
     pub diff: FxHashMap<(Id, Id, bool), Id>,
+    /// `add_content` of sums of [`CONTENT_MEMO_TERMS`] terms or more: every product with a
+    /// sum as a factor asks for it (a 100-link chain's mass sums, in tens of thousands of
+    /// products).
+    pub content: FxHashMap<Id, Option<(crate::number::Number, Id)>>,
     /// Polynomial work units spent by `simplify`'s rational forms since the pool was made (a
     /// deterministic measure of simplification cost, for regression tests).
     pub simplify_work: u64,

@@ -124,12 +124,36 @@ fn precedence(p: &Pool, id: Id) -> u8 {
 /// Text printer (the format the parser reads).
 pub struct TextPrinter<'a> {
     pool: &'a Pool,
+    /// Texts of long sums printed before (see [`TextMemo`]).
+    memo: Option<&'a TextMemo>,
 }
+
+/// The texts of long sums already printed, for printing many expressions that share them:
+/// the 100-link chain's `M` and `f` carry a hundred mass sums `m_k + … + m_100` in 15,000
+/// places, which formatting anew was most of rendering them.
+#[derive(Debug, Default)]
+pub struct TextMemo(std::cell::RefCell<rustc_hash::FxHashMap<Id, String>>);
+
+/// Sums of fewer terms are formatted each time (copying is no cheaper).
+const MEMO_TERMS: usize = 8;
 
 impl Pool {
     /// Plain text, re-parsable to the same expression: `-g*m*sin(theta) + m*r*omega^2`.
     pub fn to_text(&self, id: Id) -> String {
-        TextPrinter { pool: self }.expr(id)
+        TextPrinter {
+            pool: self,
+            memo: None,
+        }
+        .expr(id)
+    }
+
+    /// [`Pool::to_text`], reusing (and adding to) `memo`'s texts of long sums: the same text.
+    pub fn to_text_memo(&self, id: Id, memo: &TextMemo) -> String {
+        TextPrinter {
+            pool: self,
+            memo: Some(memo),
+        }
+        .expr(id)
     }
 
     /// LaTeX (math mode, without delimiters): `\frac{g m \cos\left(\theta\right)}{\sin\left(\phi\right)}`.
@@ -183,18 +207,41 @@ impl Pool {
 
 impl TextPrinter<'_> {
     fn expr(&self, id: Id) -> String {
+        if let (Some(memo), Node::Add(ts)) = (self.memo, self.pool.node(id)) {
+            if ts.len() >= MEMO_TERMS {
+                if let Some(s) = memo.0.borrow().get(&id) {
+                    return s.clone();
+                }
+                let s = self.expr_uncached(id);
+                memo.0.borrow_mut().insert(id, s.clone());
+                return s;
+            }
+        }
+        self.expr_uncached(id)
+    }
+
+    fn expr_uncached(&self, id: Id) -> String {
         let p = self.pool;
         match p.node(id) {
             Node::Add(ts) => {
                 let mut s = String::new();
                 for (i, &t) in ts.iter().enumerate() {
-                    let (neg, body) = self.term(t);
-                    match (i, neg) {
-                        (0, true) => s += &format!("-{body}"),
-                        (0, false) => s += &body,
-                        (_, true) => s += &format!(" - {body}"),
-                        (_, false) => s += &format!(" + {body}"),
-                    }
+                    // A bare symbol (most terms of a chain's mass sums `m2 + … + m100`) is
+                    // its name: no product view to build.
+                    let (neg, body) = match p.node(t) {
+                        Node::Sym(x) => (false, std::borrow::Cow::Borrowed(p.name(*x))),
+                        _ => {
+                            let (neg, body) = self.term(t);
+                            (neg, std::borrow::Cow::Owned(body))
+                        }
+                    };
+                    s += match (i, neg) {
+                        (0, true) => "-",
+                        (0, false) => "",
+                        (_, true) => " - ",
+                        (_, false) => " + ",
+                    };
+                    s += &body;
                 }
                 s
             }

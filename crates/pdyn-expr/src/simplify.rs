@@ -44,38 +44,76 @@ impl Pool {
         if let Some(&r) = self.memo.simplify.get(&e) {
             return r;
         }
-        let r = self.simplify_uncached(e);
+        let r = self.simplify_uncached_unlimited(e);
         self.memo.simplify.insert(e, r);
         self.memo.simplify.insert(r, r);
         r
     }
 
-    fn simplify_uncached(&mut self, e: Id) -> Id {
+    /// [`Pool::simplify`] spending at most `*budget` polynomial work units (taken from it) on
+    /// rational normal forms, or `None` (and the budget spent) when that is not enough: a
+    /// caller that only may print the result (an exact solution that `pdyn derive` writes by
+    /// reference unless it is short) stops where its own work budget ends. Whenever it
+    /// returns, the result is [`Pool::simplify`]'s (memoised ones cost nothing).
+    pub fn simplify_within(&mut self, e: Id, budget: &mut u64) -> Option<Id> {
+        if let Some(&r) = self.memo.simplify.get(&e) {
+            return Some(r);
+        }
+        let r = self.simplify_uncached(e, Some(budget))?;
+        self.memo.simplify.insert(e, r);
+        self.memo.simplify.insert(r, r);
+        Some(r)
+    }
+
+    /// [`Pool::simplify`] without its memo.
+    fn simplify_uncached_unlimited(&mut self, e: Id) -> Id {
+        // Without a limit nothing fails: `e` is only a fallback the types ask for.
+        self.simplify_uncached(e, None).unwrap_or(e)
+    }
+
+    /// `limit`: the caller's work budget ([`Pool::simplify_within`]), `None` for none (then
+    /// the result is never `None`).
+    fn simplify_uncached(&mut self, e: Id, mut limit: Option<&mut u64>) -> Option<Id> {
         if matches!(
             self.node(e),
             Node::Num(_) | Node::Const(_) | Node::Time | Node::Sym(_) | Node::Coord(..)
         ) {
-            return e;
+            return Some(e);
         }
         let base = self.simplify_args(e);
         let mut best = base;
         let mut best_cost = self.tree_size(base, usize::MAX);
         if best_cost > MAX_TREE {
-            return best;
+            return Some(best);
         }
         if self.plain_polynomial(base) {
             // Its rational form is itself (see `plain_polynomial`): only the contraction of
             // sines and cosines can shorten it. A 100-link chain's particle velocities and
             // accelerations spent 0.3 s being converted to polynomials and back.
             let c = self.contract_trig(base);
-            return if self.tree_size(c, best_cost) < best_cost {
+            return Some(if self.tree_size(c, best_cost) < best_cost {
                 c
             } else {
                 base
-            };
+            });
         }
         for expand_trig in [false, true] {
-            if let Some(c) = self.rational_form(base, expand_trig) {
+            // Each attempt has its own budget; under a caller's limit, an attempt that gets
+            // less than that and fails might have succeeded: give up rather than return
+            // something `simplify` would not.
+            let allowed = match &limit {
+                Some(left) => BUDGET.min(**left),
+                None => BUDGET,
+            };
+            let (form, spent) = self.rational_form(base, expand_trig, allowed);
+            if let Some(left) = limit.as_deref_mut() {
+                if form.is_none() && allowed < BUDGET {
+                    *left = 0;
+                    return None;
+                }
+                *left -= spent.min(*left);
+            }
+            if let Some(c) = form {
                 for cand in [c, self.contract_trig(c)] {
                     let cost = self.tree_size(cand, best_cost + 1);
                     if cost < best_cost {
@@ -85,7 +123,7 @@ impl Pool {
                 }
             }
         }
-        best
+        Some(best)
     }
 
     /// Contracts products of sines and cosines back into angle sums, in every sum of `e`:
@@ -112,6 +150,13 @@ impl Pool {
     /// The contraction and whether the work bound was reached.
     fn contract_trig_counted(&mut self, e: Id) -> (Id, bool) {
         let mut work = 0usize;
+        // A sum with no other sum below it (a dot product of two partial velocities, the x
+        // and y parts of a forcing term: 15,000 of them in a 100-link chain) is contracted
+        // as the rewrite below would, without walking and indexing its tree first.
+        if matches!(self.node(e), Node::Add(_)) && self.no_sum_below(e) {
+            let r = self.contract_sum(e, &mut work);
+            return (r, work > MAX_CONTRACT_WORK);
+        }
         let r = self.rewrite(
             e,
             |_, _| None,
@@ -124,6 +169,30 @@ impl Pool {
             },
         );
         (r, work > MAX_CONTRACT_WORK)
+    }
+
+    /// Whether the sum `e` is small (at most 64 nodes below it, counted as a tree) and has no
+    /// other sum below it: then the rewrite of `contract_trig_counted` changes nothing but
+    /// `e` itself.
+    fn no_sum_below(&self, e: Id) -> bool {
+        let Node::Add(ts) = self.node(e) else {
+            return false;
+        };
+        let mut stack: Vec<Id> = ts.to_vec();
+        let mut visited = 0;
+        while let Some(x) = stack.pop() {
+            visited += 1;
+            if visited > 64 {
+                return false;
+            }
+            match self.node(x) {
+                Node::Add(_) => return false,
+                Node::Mul(cs) | Node::Call(_, cs) => stack.extend(cs.iter().copied()),
+                Node::Pow(b, x) => stack.extend([*b, *x]),
+                _ => {}
+            }
+        }
+        true
     }
 
     /// One sum: repeatedly merges a matching pair of terms, counting the views built and the
@@ -309,18 +378,22 @@ impl Pool {
     }
 
     /// `e` as a reduced ratio of polynomials, converted back to an expression; `None` when it
-    /// does not apply (floating-point coefficients) or exceeds the work budget.
-    fn rational_form(&mut self, e: Id, expand_trig: bool) -> Option<Id> {
-        let mut cx = RationalForm::new(BUDGET, expand_trig);
+    /// does not apply (floating-point coefficients) or exceeds `budget` work units. Also
+    /// returns the work spent.
+    fn rational_form(&mut self, e: Id, expand_trig: bool, budget: u64) -> (Option<Id>, u64) {
+        let mut cx = RationalForm::new(budget, expand_trig);
         let r = cx.convert(self, e).and_then(|(num, den)| {
             let (num, den) = cx.reduce_pythagorean(self, num, den)?;
             cx.cancel(num, den)
         });
-        self.memo.simplify_work += BUDGET - cx.budget.0;
-        let (num, den) = r?;
+        let spent = budget - cx.budget.0;
+        self.memo.simplify_work += spent;
+        let Some((num, den)) = r else {
+            return (None, spent);
+        };
         let n = cx.to_expr(self, &num);
         let d = cx.to_expr(self, &den);
-        Some(self.div(n, d))
+        (Some(self.div(n, d)), spent)
     }
 
     /// Simplifies both sides' difference and reports whether it is zero: a sound but
@@ -666,6 +739,28 @@ mod tests {
         let e = p.parse_scalar(src).unwrap();
         let s = p.simplify(e);
         p.to_text(s)
+    }
+
+    /// Within a budget: `simplify`'s result when it fits (same node), `None` when it does not,
+    /// the budget spent either way; the memoised result is free.
+    #[test]
+    fn simplify_within_a_budget_gives_simplify_or_nothing() {
+        let src = "(a^2*sin(x)^2 + a^2*cos(x)^2 + a*b)/(a*b + a^2)";
+        let mut p = Pool::new();
+        let e = p.parse_scalar(src).unwrap();
+        let mut tiny = 3;
+        assert_eq!(p.simplify_within(e, &mut tiny), None);
+        assert_eq!(tiny, 0);
+        let mut q = Pool::new();
+        let f = q.parse_scalar(src).unwrap();
+        let want = q.simplify(f);
+        let mut ample = 1_000_000;
+        let got = p.simplify_within(e, &mut ample).unwrap();
+        assert_eq!(p.to_text(got), q.to_text(want));
+        assert_eq!(p.to_text(got), "1");
+        assert!(ample < 1_000_000);
+        let mut none = 0;
+        assert_eq!(p.simplify_within(e, &mut none), Some(got));
     }
 
     #[test]

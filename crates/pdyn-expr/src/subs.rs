@@ -30,24 +30,33 @@ impl Pool {
                 Some(v) => v,
                 None => {
                     let get = |x: &Id| done[x];
-                    let rebuilt = match self.node(n).clone() {
-                        Node::Add(ts) => {
-                            let ts: Vec<Id> = ts.iter().map(get).collect();
-                            self.add(&ts)
-                        }
-                        Node::Mul(fs) => {
-                            let fs: Vec<Id> = fs.iter().map(get).collect();
-                            self.mul(&fs)
-                        }
-                        Node::Pow(b, x) => {
-                            let (b, x) = (get(&b), get(&x));
-                            self.pow(b, x)
-                        }
-                        Node::Call(f, args) => {
-                            let args: Vec<Id> = args.iter().map(get).collect();
-                            self.call(f, &args)
-                        }
-                        _ => n,
+                    // A node whose children are all unchanged is itself: it was built by the
+                    // same canonical constructors (most of a tree that a contraction or a
+                    // substitution touches in a few places; rebuilding it anyway was most of
+                    // `contract_trig` on a 100-link chain's entries).
+                    let same = |xs: &[Id]| xs.iter().all(|x| done[x] == *x);
+                    let rebuilt = match self.node(n) {
+                        Node::Add(ts) | Node::Mul(ts) | Node::Call(_, ts) if same(ts) => n,
+                        Node::Pow(b, x) if done[b] == *b && done[x] == *x => n,
+                        node => match node.clone() {
+                            Node::Add(ts) => {
+                                let ts: Vec<Id> = ts.iter().map(get).collect();
+                                self.add(&ts)
+                            }
+                            Node::Mul(fs) => {
+                                let fs: Vec<Id> = fs.iter().map(get).collect();
+                                self.mul(&fs)
+                            }
+                            Node::Pow(b, x) => {
+                                let (b, x) = (get(&b), get(&x));
+                                self.pow(b, x)
+                            }
+                            Node::Call(f, args) => {
+                                let args: Vec<Id> = args.iter().map(get).collect();
+                                self.call(f, &args)
+                            }
+                            _ => n,
+                        },
                     };
                     finish(self, rebuilt)
                 }

@@ -50,6 +50,13 @@ pub struct DeriveOptions {
     /// solved numerically at each evaluation and printed by reference. Default
     /// [`CHEAP_SOLVE_BUDGET`]; `pdyn derive --solve` uses [`FULL_SOLVE_BUDGET`].
     pub solve_budget: u64,
+    /// Count the simplification of the exact solution against
+    /// [`DeriveOptions::solve_budget`] too: past it, no exact solution (`A x = b` is solved
+    /// numerically), as when the elimination alone is over it. For a caller that prints the
+    /// solution, like `pdyn derive`, whose cost then grows with the system. Default false:
+    /// the solution found within the budget is simplified whatever that costs (a run
+    /// evaluates it).
+    pub simplify_solution_within_budget: bool,
 }
 
 impl Default for DeriveOptions {
@@ -60,6 +67,7 @@ impl Default for DeriveOptions {
             simplify: true,
             simplify_printed: true,
             solve_budget: CHEAP_SOLVE_BUDGET,
+            simplify_solution_within_budget: false,
         }
     }
 }
@@ -213,6 +221,14 @@ pub const FULL_SOLVE_BUDGET: u64 = 4_000_000;
 /// took 0.01 s) and gave explicit forms printed by reference anyway. It was 200,000; no
 /// example needed more than 20,000.
 pub const CHEAP_SOLVE_BUDGET: u64 = 20_000;
+/// Work budget of exact elimination and of simplifying its result together
+/// ([`DeriveOptions::simplify_solution_within_budget`]) for `pdyn derive` without `--solve`:
+/// what the shipped examples' printed solutions need (the double pendulum's 8,361 units the
+/// most; the others under 5,000). Half of [`CHEAP_SOLVE_BUDGET`], so that the 3- to 6-link
+/// chains give up on elimination sooner: at 20,000 the 3-link chain, whose elimination
+/// fits, spent more than the 4- or 8-link chain on all of `pdyn derive` (28.7 against 24.3
+/// and 22.2 million instructions).
+pub const PRINT_SOLVE_BUDGET: u64 = 10_000;
 /// Work budget of exact elimination for a run, which only evaluates the result: a closed
 /// form pays off when it is found quickly (one or two unknowns, Newton's equations with a
 /// few reactions); past this, `A x = b` solved numerically at each evaluation is cheaper
@@ -453,7 +469,12 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
         // otherwise A x = b is solved numerically at each evaluation. On the 4-link chain the
         // exact solution took 3 s of a 3.1 s `pdyn run` (elimination, then compiling its large
         // expressions and their Jacobian) and printed unreadable 37 KB lines.
-        match p.solve_linear_budgeted(&system, true, opts.solve_budget) {
+        let solved = if opts.simplify_solution_within_budget {
+            p.solve_linear_within(&system, true, opts.solve_budget)
+        } else {
+            p.solve_linear_budgeted(&system, true, opts.solve_budget)
+        };
+        match solved {
             Ok(sol) => Some(sol.into_iter().map(|s| simp(p, s, opts.simplify)).collect()),
             Err(LinearError::Underdetermined { free }) => {
                 let names: Vec<String> = free.iter().map(|&f| p.to_text(f)).collect();

@@ -13,6 +13,8 @@
 use crate::derive::{Derivation, UnknownKind};
 use pdyn_expr::factor::Collected;
 use pdyn_expr::{Id, Node, Pool};
+use rustc_hash::FxHashMap;
+use std::cell::RefCell;
 
 /// Entries with more tree nodes than this are not simplified or collected: their collected
 /// form would not print within [`pdyn_expr::budget::PRINT_CHARS`] anyway.
@@ -32,6 +34,15 @@ pub struct Entry {
 }
 
 impl Entry {
+    /// [`Entry::render`] as text, sharing `memo`'s texts of long sums (a chain's mass sums)
+    /// with the other entries.
+    pub fn render_text_memo(&self, p: &mut Pool, memo: &pdyn_expr::print::TextMemo) -> String {
+        match &self.collected {
+            Some(c) => c.to_text_memo(p, memo),
+            None => p.to_text_memo(self.expr, memo),
+        }
+    }
+
     /// The entry as text (re-parsable in the model's scope) or LaTeX, whole.
     pub fn render(&self, p: &mut Pool, latex: bool) -> String {
         match (&self.collected, latex) {
@@ -61,7 +72,37 @@ pub struct MatrixForm {
 
 /// Whether `f` depends on the state or time: the "main" factors entries are collected over.
 pub fn depends_on_state(p: &Pool, f: Id) -> bool {
-    p.any_node(f, &|n| matches!(n, Node::Coord(..) | Node::Time))
+    match p.node(f) {
+        Node::Coord(..) | Node::Time => true,
+        Node::Sym(_) | Node::Num(_) | Node::Const(_) => false,
+        _ => p.any_node(f, &|n| matches!(n, Node::Coord(..) | Node::Time)),
+    }
+}
+
+/// [`depends_on_state`] remembering its answers for sums and calls: the 100-link chain's
+/// entries share a hundred mass sums `m_k + … + m_100` that every term of `f` carries, and
+/// walking them again for each term was most of collecting `f`.
+struct StateTest(RefCell<FxHashMap<Id, bool>>);
+
+impl StateTest {
+    fn new() -> StateTest {
+        StateTest(RefCell::new(FxHashMap::default()))
+    }
+
+    fn test(&self, p: &Pool, f: Id) -> bool {
+        match p.node(f) {
+            Node::Coord(..) | Node::Time => true,
+            Node::Sym(_) | Node::Num(_) | Node::Const(_) => false,
+            _ => {
+                if let Some(&known) = self.0.borrow().get(&f) {
+                    return known;
+                }
+                let r = depends_on_state(p, f);
+                self.0.borrow_mut().insert(f, r);
+                r
+            }
+        }
+    }
 }
 
 /// The matrix form of `d`, or `None` when some unknown is a reaction (then `A x = b` mixes
@@ -76,13 +117,15 @@ pub fn matrix_form(p: &mut Pool, d: &Derivation) -> Option<MatrixForm> {
         return None;
     }
     let n = d.system.cols();
+    let state = StateTest::new();
+    let main = |p: &Pool, f: Id| state.test(p, f);
     let mut mass: Vec<Option<Entry>> = vec![None; n * n];
     for j in 0..n {
         for k in 0..n {
             if mass[j * n + k].is_some() {
                 continue;
             }
-            let e = tidy(p, d.system.coeff(j, k), d.assembled_collected);
+            let e = tidy(p, d.system.coeff(j, k), d.assembled_collected, &main);
             if k > j && d.system.coeff(k, j) == d.system.coeff(j, k) {
                 mass[k * n + j] = Some(e.clone());
             }
@@ -94,7 +137,7 @@ pub fn matrix_form(p: &mut Pool, d: &Derivation) -> Option<MatrixForm> {
         .system
         .b
         .iter()
-        .map(|&b| tidy(p, b, d.assembled_collected))
+        .map(|&b| tidy(p, b, d.assembled_collected, &main))
         .collect();
     Some(MatrixForm {
         n,
@@ -107,11 +150,12 @@ pub fn matrix_form(p: &mut Pool, d: &Derivation) -> Option<MatrixForm> {
 
 /// Simplifies (when small) and collects one entry; `assembled`: it was collected and
 /// contracted as it was assembled (the projected form), so it is only collected here.
-fn tidy(p: &mut Pool, e: Id, assembled: bool) -> Entry {
+/// `main`: [`depends_on_state`].
+fn tidy(p: &mut Pool, e: Id, assembled: bool, main: &dyn Fn(&Pool, Id) -> bool) -> Entry {
     if assembled {
         return Entry {
             expr: e,
-            collected: Some(p.collect_terms(e, &depends_on_state)),
+            collected: Some(p.collect_terms(e, main)),
         };
     }
     if p.tree_size(e, TIDY_NODES + 1) > TIDY_NODES {
@@ -151,7 +195,7 @@ fn tidy(p: &mut Pool, e: Id, assembled: bool) -> Entry {
                     // Compared once collected: that is what prints.
                     let c = p.contract_trig(x);
                     let collected_size = |p: &mut Pool, id| {
-                        let c = p.collect_by(id, &depends_on_state);
+                        let c = p.collect_by(id, main);
                         p.tree_size(c, usize::MAX)
                     };
                     if collected_size(p, c) < collected_size(p, simplified) {
@@ -165,7 +209,7 @@ fn tidy(p: &mut Pool, e: Id, assembled: bool) -> Entry {
         }
         _ => p.simplify(e),
     };
-    let collected = p.collect_terms(s, &depends_on_state);
+    let collected = p.collect_terms(s, main);
     Entry {
         expr: s,
         collected: Some(collected),

@@ -147,3 +147,60 @@ fn the_hoisted_system_solves_like_the_plain_one() {
         }
     }
 }
+
+/// `pdyn derive`'s options: the printing solve budget, which must pay for simplifying the
+/// exact solution too.
+fn printing_options() -> DeriveOptions {
+    DeriveOptions {
+        solve_budget: pdyn_mech::derive::PRINT_SOLVE_BUDGET,
+        simplify_solution_within_budget: true,
+        ..DeriveOptions::default()
+    }
+}
+
+/// (simplification work units, pool nodes) of deriving the `n`-link chain with `opts`.
+fn work(n: usize, opts: &DeriveOptions) -> (u64, usize) {
+    let mut m = load(&chain_toml(n), "chain.toml").unwrap();
+    derive(&mut m, opts).unwrap();
+    (m.pool.simplify_work(), m.pool.len())
+}
+
+/// Monotone in n (issue 12): the 3-link chain's exact elimination fits the cheap budget, and
+/// simplifying its solution (for accelerations printed by reference anyway) cost over
+/// 100,000 work units, more than deriving the 4- or 8-link chain. Counted, not timed: the
+/// simplification stays within the solve budget (the 3-link chain is solved numerically,
+/// like the 4-link one), and the pool grows with n.
+#[test]
+fn derivation_for_printing_is_monotone_in_n() {
+    let opts = printing_options();
+    let counts: Vec<(usize, (u64, usize))> =
+        [2, 3, 4, 8].iter().map(|&n| (n, work(n, &opts))).collect();
+    eprintln!("(n, (simplification work, pool nodes)): {counts:?}");
+    for &(n, (simplify_work, _)) in &counts {
+        assert!(
+            simplify_work <= opts.solve_budget,
+            "n = {n}: {simplify_work} simplification work units, over the solve budget of {}",
+            opts.solve_budget
+        );
+    }
+    let nodes = |n: usize| counts.iter().find(|c| c.0 == n).map(|c| c.1 .1).unwrap();
+    assert!(
+        nodes(2) <= nodes(3) && nodes(3) <= nodes(4) && nodes(4) <= nodes(8),
+        "{counts:?}"
+    );
+    // The double pendulum's solution fits, and is simplified as before (it is printed).
+    let mut m = load(&chain_toml(2), "chain.toml").unwrap();
+    let d = derive(&mut m, &opts).unwrap();
+    let mut r = load(&chain_toml(2), "chain.toml").unwrap();
+    let e = derive(&mut r, &DeriveOptions::default()).unwrap();
+    let text = |p: &pdyn_expr::Pool, s: &[Id]| s.iter().map(|&x| p.to_text(x)).collect::<Vec<_>>();
+    assert_eq!(
+        text(&m.pool, d.solution.as_deref().unwrap()),
+        text(&r.pool, e.solution.as_deref().unwrap())
+    );
+    // Without the option (a run's), the 3-link solution is found and simplified whatever it
+    // costs: the count this test bounds.
+    let (unbounded, _) = work(3, &DeriveOptions::default());
+    eprintln!("n = 3 without the option: {unbounded} work units");
+    assert!(unbounded > opts.solve_budget);
+}

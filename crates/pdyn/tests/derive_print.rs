@@ -233,3 +233,32 @@ fn no_line_of_derive_output_on_the_100_link_chain_is_over_the_budget() {
     assert_lines_within_budget(&f, &["--latex"]);
     let _ = std::fs::remove_file(f);
 }
+
+/// The "No closed form" reason quotes a short coefficient (the satellite's, 70 characters)
+/// and names a long one with its size (the double pendulum's, 738 characters, was quoted
+/// whole): the equation, the symbol and the size, never the long expression.
+#[test]
+fn no_closed_form_names_a_long_coefficient_by_its_size() {
+    let reason = |name: &str| -> String {
+        let text = derive_output(&root().join(format!("examples/{name}.toml")), &[]).unwrap();
+        text.lines()
+            .find(|l| l.starts_with("No closed form:"))
+            .unwrap_or_else(|| panic!("{name}: no 'No closed form' line:\n{text}"))
+            .to_string()
+    };
+    let chain = reason("pendulum_chain_2");
+    assert!(
+        chain.contains("equation 1 is not linear in `q1`")
+            && chain.contains("its coefficient, ")
+            && chain.contains(" characters, depends on the coordinates"),
+        "{chain}"
+    );
+    // Nothing quoted: no expression of the pendulum (its sines) in the line.
+    assert!(!chain.contains("sin("), "{chain}");
+    assert!(chain.chars().count() < 250, "{chain}");
+    let satellite = reason("satellite");
+    assert!(
+        satellite.contains("its coefficient `-3*GM*x^2/(x^2 + y^2)^(5/2) + GM/(x^2 + y^2)^(3/2)`"),
+        "{satellite}"
+    );
+}

@@ -45,6 +45,16 @@ fn leaf_name(pool: &Pool, s: SymId, k: usize) -> String {
     format!("{}{}", pool.name(s), "'".repeat(k))
 }
 
+/// `what` quoted when it is short (`its coefficient `cos(x)``), else named with its size
+/// (`its coefficient, 1012 characters,`): a message never carries a long expression (the
+/// double pendulum's coefficient is 1,000 characters, the figure-eight's 40 KB).
+pub(crate) fn quoted(pool: &Pool, what: &str, e: Id) -> String {
+    match pool.to_text_within(e, false, pdyn_expr::budget::QUOTE_CHARS) {
+        Ok(text) => format!("{what} `{text}`"),
+        Err(size) => format!("{what}, {size},"),
+    }
+}
+
 /// Writes `equations` (each `= 0`) as `Σ_k A_k q^(k) = f(t)`, checking that they are linear in
 /// the coordinates with coefficients free of `t`.
 pub fn analyze(
@@ -109,18 +119,21 @@ pub fn analyze(
                 let a = pool.expand(a);
                 if has_coord(pool, a) {
                     return Err(no_closed_form(format!(
-                        "equation {} is not linear in `{}` (its coefficient `{}` depends on the coordinates)",
+                        "equation {} is not linear in `{}` ({} depends on the coordinates)",
                         i + 1,
                         leaf_name(pool, c, k),
-                        pool.to_text(a)
+                        quoted(pool, "its coefficient", a)
                     )));
                 }
                 if has_time(pool, a) {
                     return Err(no_closed_form(format!(
-                        "equation {} has a variable coefficient: the factor multiplying `{}` is `{}`, which depends on t",
+                        "equation {} has a variable coefficient: {} which depends on t",
                         i + 1,
-                        leaf_name(pool, c, k),
-                        pool.to_text(a)
+                        quoted(
+                            pool,
+                            &format!("the factor multiplying `{}` is", leaf_name(pool, c, k)),
+                            a
+                        )
                     )));
                 }
                 rest = pool.subs1(rest, leaf, Pool::ZERO);
@@ -220,8 +233,8 @@ fn hyperbolic_to_exp(pool: &mut Pool, e: Id) -> Id {
 
 fn unsupported(pool: &Pool, term: Id) -> DsolveError {
     no_closed_form(format!(
-        "the forcing term `{}` is not a sum of products of powers of t, exponentials and sines/cosines of a linear function of t",
-        pool.to_text(term)
+        "{} is not a sum of products of powers of t, exponentials and sines/cosines of a linear function of t",
+        quoted(pool, "the forcing term", term)
     ))
 }
 

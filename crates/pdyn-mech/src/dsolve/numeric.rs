@@ -29,10 +29,14 @@ struct BasisFn {
 
 fn value(pool: &mut Pool, e: Id, what: &dyn Fn(&Pool) -> String) -> Result<f64, DsolveError> {
     const_value(pool, e).ok_or_else(|| {
+        // Quoted when short, else named with its size (a message never carries a long
+        // expression).
+        let what = match pool.to_text_within(e, false, pdyn_expr::budget::QUOTE_CHARS) {
+            Ok(text) => format!("{} is `{text}`,", what(pool)),
+            Err(size) => format!("{} ({size}) is", what(pool)),
+        };
         no_closed_form(format!(
-            "{} is `{}`, not a number; systems and equations whose characteristic polynomial has degree ≥ 3 are solved with numeric coefficients only (give values with --set)",
-            what(pool),
-            pool.to_text(e)
+            "{what} not a number; systems and equations whose characteristic polynomial has degree ≥ 3 are solved with numeric coefficients only (give values with --set)"
         ))
     })
 }

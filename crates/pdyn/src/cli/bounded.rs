@@ -83,18 +83,22 @@ impl<'a> Lines<'a> {
     /// `{indent}{name} = [x, y, z]` on one line when it fits, else one line per component
     /// (`{name}.x = …`), each within the budget.
     pub fn vector(&mut self, indent: &str, name: &str, v: [Id; 3]) {
-        let parts: Option<Vec<String>> = v
+        // Each component formatted once: the per-component lines reuse it (formatting the
+        // 100-link chain's accelerations twice, to find them too long, was a tenth of `pdyn
+        // derive`).
+        let parts: Vec<Result<String, PrintSize>> = v
             .iter()
-            .map(|&c| self.pool.to_text_within(c, self.latex, PRINT_CHARS).ok())
+            .map(|&c| self.pool.to_text_within(c, self.latex, PRINT_CHARS))
             .collect();
-        if let Some(parts) = parts {
+        if parts.iter().all(|p| p.is_ok()) {
+            let texts: Vec<&str> = parts.iter().flatten().map(String::as_str).collect();
             let joined = if self.latex {
                 format!(
                     "\\begin{{bmatrix}} {} \\end{{bmatrix}}",
-                    parts.join(" \\\\ ")
+                    texts.join(" \\\\ ")
                 )
             } else {
-                format!("[{}]", parts.join(", "))
+                format!("[{}]", texts.join(", "))
             };
             let line = format!("{indent}{name} = {joined}");
             if chars(&line) <= PRINT_CHARS {
@@ -102,12 +106,16 @@ impl<'a> Lines<'a> {
                 return;
             }
         }
-        for (c, axis) in v.iter().zip(["x", "y", "z"]) {
-            self.expr(
-                &format!("{indent}{name}.{axis} = "),
-                &format!("{name}.{axis}"),
-                *c,
-            );
+        for (part, axis) in parts.into_iter().zip(["x", "y", "z"]) {
+            let prefix = format!("{indent}{name}.{axis} = ");
+            let what = format!("{name}.{axis}");
+            // As `expr` would print it: the text when the line fits, else its size.
+            let body = match part {
+                Ok(text) if chars(&prefix) + chars(&text) <= PRINT_CHARS => text,
+                Ok(text) => omitted(&what, PrintSize::Chars(chars(&text))),
+                Err(size) => omitted(&what, size),
+            };
+            self.line(&format!("{prefix}{body}"));
         }
     }
 

@@ -40,9 +40,10 @@ pub struct DeriveArgs {
     /// Largest system eliminated symbolically (larger ones are solved numerically when run).
     #[arg(long, default_value_t = 6)]
     symbolic_limit: usize,
-    /// Eliminate exactly even when it is expensive (a 4-link chain), and print explicit
-    /// accelerations up to 2,000 characters (without it: up to 600; larger ones, such as the
-    /// 3-link chain's 1,600-character ones, are written by reference, (M⁻¹ f)_1).
+    /// Eliminate exactly even when it is expensive (the 3-link chain), and print
+    /// explicit accelerations up to 2,000 characters (without it: elimination and
+    /// simplification within a small work budget, explicit forms up to 600 characters, larger
+    /// ones written by reference, (M⁻¹ f)_1).
     #[arg(long)]
     solve: bool,
 }
@@ -66,8 +67,12 @@ pub fn run(a: DeriveArgs) -> Result<String, Error> {
         solve_budget: if a.solve {
             pdyn_mech::derive::FULL_SOLVE_BUDGET
         } else {
-            pdyn_mech::derive::CHEAP_SOLVE_BUDGET
+            pdyn_mech::derive::PRINT_SOLVE_BUDGET
         },
+        // The solution is printed, and only when it is short: simplifying it is worth the
+        // solve budget's remainder, not more (the 3-link chain's cost more than the whole
+        // `pdyn derive` of 4 or 8 links, to be printed by reference).
+        simplify_solution_within_budget: true,
         ..DeriveOptions::default()
     };
     let d = derive(&mut model, &opts).map_err(|error| Error::Derive {
@@ -303,7 +308,12 @@ pub fn run(a: DeriveArgs) -> Result<String, Error> {
         }
         None => {}
     }
-    Ok(o.out)
+    let out = o.out;
+    // The process ends after printing: freeing the pool's millions of nodes and memo tables
+    // one by one was 5 % of `pdyn derive` on the 100-link chain, for memory the exit returns
+    // anyway.
+    std::mem::forget((model, d, matrix, rendered, exact));
+    Ok(out)
 }
 
 /// `lhs = rhs` under its label: on one line when it fits, else the two sides on two lines,
@@ -332,8 +342,10 @@ struct Rendered {
 impl Rendered {
     fn new(p: &mut Pool, m: &MatrixForm, latex: bool) -> Rendered {
         // An entry too large to collect is over the budget: its size is what prints.
+        let memo = pdyn_expr::print::TextMemo::default();
         let show = |p: &mut Pool, e: &pdyn_mech::matrix_form::Entry| match &e.collected {
-            Some(_) => e.render(p, latex),
+            Some(_) if latex => e.render(p, latex),
+            Some(_) => e.render_text_memo(p, &memo),
             None => String::new(),
         };
         // A symmetric M's lower triangle is the upper one's text (half the formatting: at
