@@ -235,12 +235,7 @@ impl TextPrinter<'_> {
                             (neg, std::borrow::Cow::Owned(body))
                         }
                     };
-                    s += match (i, neg) {
-                        (0, true) => "-",
-                        (0, false) => "",
-                        (_, true) => " - ",
-                        (_, false) => " + ",
-                    };
+                    s += term_separator(i, neg);
                     s += &body;
                 }
                 s
@@ -402,6 +397,17 @@ struct LatexPrinter<'a> {
     pool: &'a Pool,
 }
 
+/// What goes before term `i` of a printed sum whose sign is `neg`: `-` or nothing for the
+/// first, ` - ` or ` + ` between terms (text and LaTeX alike).
+fn term_separator(i: usize, neg: bool) -> &'static str {
+    match (i, neg) {
+        (0, true) => "-",
+        (0, false) => "",
+        (_, true) => " - ",
+        (_, false) => " + ",
+    }
+}
+
 impl LatexPrinter<'_> {
     fn expr(&self, id: Id) -> String {
         let p = self.pool;
@@ -410,12 +416,7 @@ impl LatexPrinter<'_> {
                 let mut s = String::new();
                 for (i, &t) in ts.iter().enumerate() {
                     let (neg, body) = self.term(t);
-                    s += match (i, neg) {
-                        (0, true) => "-",
-                        (0, false) => "",
-                        (_, true) => " - ",
-                        (_, false) => " + ",
-                    };
+                    s += term_separator(i, neg);
                     s += &body;
                 }
                 s
