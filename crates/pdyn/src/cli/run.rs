@@ -202,6 +202,10 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
     } else {
         text_report(&model, &res, &set, a.out.as_ref())
     };
+    // The process ends after printing: the pool's nodes, the compiled programs and the table
+    // are returned by the exit; freeing them one by one was measurable on large models (as
+    // in `pdyn derive`).
+    std::mem::forget((model, prep, res));
     Ok(Outcome {
         stdout,
         stderr,
