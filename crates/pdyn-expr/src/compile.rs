@@ -9,7 +9,10 @@
 //!
 //! Lowering choices: subtraction instead of multiplying by −1, one division per distinct
 //! negative power (`b^(-e)` is `1/b^e`, shared by every product that has the factor, which
-//! then multiplies by it), `x^2 = x*x`, `x^(k/2)` through `sqrt`.
+//! then multiplies by it), `x^2 = x*x`, `x^(k/2)` through `sqrt`, a sum that is an already
+//! compiled sum plus one term continues from it (partial sums of a chain's positions). With
+//! invariant inputs ([`crate::hoist`]) products are lowered as variant × invariant part and
+//! sums with a common invariant factor as that factor times the rest.
 //! Division by zero, `log` of a negative number and the like give `inf`/`NaN`, as IEEE
 //! arithmetic does; they never panic.
 
@@ -155,7 +158,9 @@ fn term_set_hash(ts: &[Id]) -> u64 {
 }
 
 fn term_hash(t: Id) -> u64 {
-    // SplitMix64's finaliser: distinct ids spread over all 64 bits.
+    // SplitMix64's finaliser: distinct ids spread over all 64 bits. A linear hash (Fx's
+    // multiply) would not do: the sum of the hashes would be a multiple of the sum of the
+    // ids, and sets with equal id sums would collide.
     let mut z = (t.index() as u64).wrapping_add(0x9e37_79b9_7f4a_7c15);
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
@@ -263,10 +268,10 @@ impl<'a> Compiler<'a> {
                 // chain's particle positions and velocities are each the previous one's plus
                 // a term, n additions instead of n²/2 (the 100-link chain's output columns).
                 let (mut acc, rest) = match self.sum_minus_one_term(&ts) {
-                    Some((r, j)) => (Some(r), vec![ts[j]]),
-                    None => (None, ts.to_vec()),
+                    Some((r, j)) => (Some(r), std::slice::from_ref(&ts[j])),
+                    None => (None, &ts[..]),
                 };
-                for &t in rest.iter() {
+                for &t in rest {
                     let (c, rest) = self.pool.split_coeff(t);
                     let (neg, term) = if c.is_negative() && rest != Pool::ONE {
                         let pos = self.pool.scale(c.neg(), rest);

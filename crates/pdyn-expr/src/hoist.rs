@@ -228,7 +228,11 @@ impl HoistedInputs {
 
     /// The main program's inputs for `inputs` (length [`HoistedProgram::n_inputs`]): copies
     /// them, and computes the hoisted values again when an invariant input differs, bit for
-    /// bit, from the previous call's.
+    /// bit, from the previous call's (NaN parameters included: their bits are compared).
+    ///
+    /// # Panics
+    /// If `inputs` is shorter than [`HoistedProgram::n_inputs`] (a programming error, as for
+    /// [`Program::eval`]; the callers build the input vector from the same leaves).
     #[inline]
     pub fn update(&mut self, h: &HoistedProgram, inputs: &[f64]) -> &[f64] {
         let (n, k) = (h.n_inputs, h.first_invariant);
