@@ -8,7 +8,10 @@
 //!   derived by pdyn-mech (projected form, numeric path: 256 + 16 outputs), and a hand-written
 //!   O(n²) closure computing the same `M` and `f`. `main` checks that the hand-written
 //!   equations give the same `q''` as the derived ones before timing anything.
-//! - `chain16_jit_compile`: the one-off cost of generating the native code.
+//! - `chain16_jit_compile`, `chain100_jit_compile`: the one-off cost of generating the native
+//!   code (the 100-link chain's chunks on several threads).
+//! - `chain100_mf_*`: the same for the 100-link chain (10,100 outputs), whose run evaluates
+//!   them about 7,000 times.
 
 use divan::{black_box, Bencher};
 use pdyn_expr::compile::CompiledLinearSystem;
@@ -19,17 +22,17 @@ use pdyn_jit::JitProgram;
 use pdyn_mech::derive::Form;
 use pdyn_mech::{derive, load, DeriveOptions};
 
-const N: usize = 16;
-
 fn main() {
-    check_handwritten_chain();
-    let c = chain();
-    println!(
-        "chain n = {N}: {} instructions, {} outputs; satellite: {} instructions",
-        c.prog.len(),
-        c.prog.n_outputs(),
-        satellite().len()
-    );
+    check_handwritten_chain::<16>();
+    check_handwritten_chain::<100>();
+    for c in [chain::<16>(), chain::<100>()] {
+        println!(
+            "chain: {} instructions, {} outputs",
+            c.prog.len(),
+            c.prog.n_outputs(),
+        );
+    }
+    println!("satellite: {} instructions", satellite().len());
     divan::main();
 }
 
@@ -108,7 +111,7 @@ struct Chain {
 }
 
 /// The derived chain's `[A | b]` program, as `pdyn run` compiles it, at a fixed state.
-fn chain() -> Chain {
+fn chain<const N: usize>() -> Chain {
     let mut m = load(&chain_toml(N), "chain.toml").unwrap();
     let opts = DeriveOptions {
         form: Form::Projected,
@@ -142,7 +145,7 @@ fn chain() -> Chain {
 /// `f_i = l_i Σ_j μ_max(i,j) l_j q_j'² sin(q_j − q_i) − g l_i μ_i sin q_i`,
 /// with the cosine and sine of differences expanded so each angle needs one `sin` and `cos`.
 #[inline(never)]
-fn chain_handwritten(input: &[f64], out: &mut [f64]) {
+fn chain_handwritten<const N: usize>(input: &[f64], out: &mut [f64]) {
     let q = &input[1..1 + N];
     let v = &input[1 + N..1 + 2 * N];
     let par = &input[1 + 2 * N..];
@@ -177,8 +180,8 @@ fn chain_handwritten(input: &[f64], out: &mut [f64]) {
 
 /// The hand-written `M`, `f` and the derived ones give the same `q''` (so the comparison
 /// is between equivalent computations).
-fn check_handwritten_chain() {
-    let c = chain();
+fn check_handwritten_chain<const N: usize>() {
+    let c = chain::<N>();
     let solve = |ab: &mut [f64]| {
         let (a, b) = ab.split_at_mut(N * N);
         let mut perm = vec![0; N];
@@ -189,7 +192,7 @@ fn check_handwritten_chain() {
     let mut derived = vec![0.0; N * N + N];
     c.prog.eval(&c.ext, &mut c.prog.workspace(), &mut derived);
     let mut hand = vec![0.0; N * N + N];
-    chain_handwritten(&c.input, &mut hand);
+    chain_handwritten::<N>(&c.input, &mut hand);
     let (x1, x2) = (solve(&mut derived), solve(&mut hand));
     for (a, b) in x1.iter().zip(&x2) {
         assert!(
@@ -201,7 +204,30 @@ fn check_handwritten_chain() {
 
 #[divan::bench]
 fn chain16_mf_interpreter(b: Bencher) {
-    let c = chain();
+    mf_interpreter(b, chain::<16>());
+}
+
+#[divan::bench]
+fn chain16_mf_jit(b: Bencher) {
+    mf_jit(b, chain::<16>());
+}
+
+#[divan::bench]
+fn chain16_mf_handwritten(b: Bencher) {
+    mf_handwritten::<16>(b);
+}
+
+#[divan::bench]
+fn chain100_mf_jit(b: Bencher) {
+    mf_jit(b, chain::<100>());
+}
+
+#[divan::bench]
+fn chain100_mf_handwritten(b: Bencher) {
+    mf_handwritten::<100>(b);
+}
+
+fn mf_interpreter(b: Bencher, c: Chain) {
     let mut ws = c.prog.workspace();
     let mut out = vec![0.0; c.prog.n_outputs()];
     b.bench_local(|| {
@@ -210,9 +236,7 @@ fn chain16_mf_interpreter(b: Bencher) {
     });
 }
 
-#[divan::bench]
-fn chain16_mf_jit(b: Bencher) {
-    let c = chain();
+fn mf_jit(b: Bencher, c: Chain) {
     let jit = JitProgram::compile(&c.prog).unwrap();
     let mut out = vec![0.0; c.prog.n_outputs()];
     let mut ws = jit.workspace();
@@ -222,18 +246,23 @@ fn chain16_mf_jit(b: Bencher) {
     });
 }
 
-#[divan::bench]
-fn chain16_mf_handwritten(b: Bencher) {
-    let c = chain();
+fn mf_handwritten<const N: usize>(b: Bencher) {
+    let c = chain::<N>();
     let mut out = vec![0.0; N * N + N];
     b.bench_local(|| {
-        chain_handwritten(black_box(&c.input), &mut out);
+        chain_handwritten::<N>(black_box(&c.input), &mut out);
         black_box(out[0])
     });
 }
 
 #[divan::bench(sample_count = 10, sample_size = 1)]
 fn chain16_jit_compile(b: Bencher) {
-    let c = chain();
+    let c = chain::<16>();
+    b.bench_local(|| JitProgram::compile(black_box(&c.prog)).unwrap().len());
+}
+
+#[divan::bench(sample_count = 5, sample_size = 1)]
+fn chain100_jit_compile(b: Bencher) {
+    let c = chain::<100>();
     b.bench_local(|| JitProgram::compile(black_box(&c.prog)).unwrap().len());
 }

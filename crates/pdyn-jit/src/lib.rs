@@ -36,16 +36,20 @@
 //! of threads may call it at once. The code memory is freed when the last clone is dropped.
 #![warn(missing_docs)]
 
+use cranelift_codegen::control::ControlPlane;
 use cranelift_codegen::ir::condcodes::FloatCC;
 use cranelift_codegen::ir::{types, AbiParam, InstBuilder, MemFlags, Signature, Value};
+use cranelift_codegen::isa::TargetIsa;
 use cranelift_codegen::settings::{self, Configurable};
+use cranelift_codegen::Context;
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_jit::{JITBuilder, JITModule};
-use cranelift_module::{default_libcall_names, Linkage, Module};
+use cranelift_module::{default_libcall_names, FuncId, Linkage, Module, ModuleReloc};
 use pdyn_expr::compile::{CompiledLinearSystem, Op};
 use pdyn_expr::hoist::{HoistedInputs, HoistedProgram};
 use pdyn_expr::lu::{DenseSolver, SingularMatrix};
 use pdyn_expr::Program;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
 mod batch;
@@ -281,11 +285,17 @@ struct SpillPlan {
     read_segment: Vec<u32>,
     /// The segment in which each instruction's result is available.
     def_segment: Vec<u32>,
-    /// The segment of the first outputs (after the last instruction); see `output_segment`.
+    /// The segment of the first outputs stored after the last instruction (those that are
+    /// inputs or constants); see `output_segment`.
     output_segment: u32,
     /// Outputs per output segment (`SEGMENT`; unbounded for short programs).
     max_segment: usize,
     n_slots: usize,
+    /// `(instruction, output)` for every output that is an instruction's value, by
+    /// instruction: stored as soon as the value is computed.
+    stored_at_definition: Vec<(u32, u32)>,
+    /// Outputs that are inputs or constants, stored after the last instruction.
+    stored_at_end: Vec<u32>,
 }
 
 impl SpillPlan {
@@ -314,12 +324,22 @@ impl SpillPlan {
             }
             def_segment.push(seg);
         }
-        // Outputs are stored after the last instruction, `SEGMENT` to a segment: a value that
-        // is several outputs (a symmetric matrix's two halves) is loaded again rather than
-        // kept live across thousands of stores (which made the 100-link chain's last chunk
-        // most of the compile time).
+        // An output that is an instruction's value is stored when it is computed (a
+        // symmetric matrix's two halves, both then): kept for the end, each would be spilled,
+        // loaded again and stored, three memory accesses instead of one, and the 100-link
+        // chain's M has 10,000 of them. Outputs that are inputs or constants are stored after
+        // the last instruction, `SEGMENT` to a segment.
+        let mut stored_at_definition = Vec::new();
+        let mut stored_at_end = Vec::new();
+        for (i, &r) in prog.output_registers().iter().enumerate() {
+            if r >= first_temp {
+                stored_at_definition.push((r - first_temp, i as u32));
+            } else {
+                stored_at_end.push(i as u32);
+            }
+        }
+        stored_at_definition.sort_unstable();
         let first_output_segment = if segmented { seg + 1 } else { seg };
-        let output_segment = |i: usize| first_output_segment + (i / max_seg) as u32;
         // The last segment that reads each temporary.
         let mut last_use = def_segment.clone();
         let mut read = |r: u32, s: u32| {
@@ -333,9 +353,6 @@ impl SpillPlan {
             if ins.op().reads_b() {
                 read(ins.b(), read_segment[k]);
             }
-        }
-        for (i, &r) in prog.output_registers().iter().enumerate() {
-            read(r, output_segment(i));
         }
         let mut slot = vec![u32::MAX; len];
         let mut n_slots = 0;
@@ -353,6 +370,8 @@ impl SpillPlan {
             output_segment: first_output_segment,
             max_segment: max_seg,
             n_slots,
+            stored_at_definition,
+            stored_at_end,
         }
     }
 }
@@ -431,6 +450,8 @@ fn emit_chunk(
     };
     let start = c * CHUNK;
     let end = (start + CHUNK).min(prog.len());
+    let defined_here = &plan.stored_at_definition;
+    let mut next_output = defined_here.partition_point(|&(k, _)| (k as usize) < start);
     for (k, ins) in prog.instructions()[start..end].iter().enumerate() {
         let k = start + k;
         let seg = plan.read_segment[k];
@@ -492,12 +513,20 @@ fn emit_chunk(
         if slot != u32::MAX {
             b.ins().store(flags, v, spill, (8 * slot as usize) as i32);
         }
+        while let Some(&(_, i)) = defined_here
+            .get(next_output)
+            .filter(|&&(d, _)| d as usize == k)
+        {
+            b.ins().store(flags, v, outp, (8 * i as usize) as i32);
+            next_output += 1;
+        }
     }
     if c + 1 == plan.chunks {
-        for (i, &r) in prog.output_registers().iter().enumerate() {
-            let seg = plan.output_segment + (i / plan.max_segment) as u32;
-            let v = get(&mut b, &mut regs, r, seg, prog.len() + i);
-            b.ins().store(flags, v, outp, (8 * i) as i32);
+        for (j, &i) in plan.stored_at_end.iter().enumerate() {
+            let seg = plan.output_segment + (j / plan.max_segment) as u32;
+            let r = prog.output_registers()[i as usize];
+            let v = get(&mut b, &mut regs, r, seg, prog.len() + j);
+            b.ins().store(flags, v, outp, (8 * i as usize) as i32);
         }
     }
     b.ins().return_(&[]);
@@ -558,32 +587,125 @@ fn binary_shim(op: Op) -> Option<extern "C" fn(f64, f64) -> f64> {
     })
 }
 
+/// One chunk's machine code, compiled away from the module (see [`compile_chunks`]).
+struct MachineCode {
+    bytes: Vec<u8>,
+    alignment: u64,
+    relocs: Vec<ModuleReloc>,
+}
+
+/// Most threads that compile one program's chunks.
+const MAX_COMPILE_THREADS: usize = 4;
+
+/// Machine code of every chunk of `prog`, in order. Chunks are independent functions, so a
+/// program of several is compiled on several threads (up to the processors available): code
+/// generation was a quarter of the 100-link chain's preparation for `pdyn run`. Each chunk's
+/// code is the same whichever thread compiles it.
+fn compile_chunks(
+    prog: &Program,
+    plan: &SpillPlan,
+    isa: &dyn TargetIsa,
+    sig: &Signature,
+    ids: &[FuncId],
+) -> Result<Vec<MachineCode>, JitError> {
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(MAX_COMPILE_THREADS)
+        .min(plan.chunks);
+    let compile_from = |next: &AtomicUsize| -> Vec<(usize, Result<MachineCode, JitError>)> {
+        let mut ctx = Context::new();
+        let mut fctx = FunctionBuilderContext::new();
+        let mut done = Vec::new();
+        loop {
+            let c = next.fetch_add(1, Ordering::Relaxed);
+            if c >= plan.chunks {
+                return done;
+            }
+            done.push((
+                c,
+                compile_chunk(prog, plan, c, isa, sig, ids[c], &mut ctx, &mut fctx),
+            ));
+        }
+    };
+    let next = AtomicUsize::new(0);
+    let mut results = if threads <= 1 {
+        compile_from(&next)
+    } else {
+        std::thread::scope(|scope| {
+            let workers: Vec<_> = (1..threads)
+                .map(|_| scope.spawn(|| compile_from(&next)))
+                .collect();
+            let mut all = compile_from(&next);
+            for w in workers {
+                // A worker panicking is a bug in code generation: let it propagate.
+                all.extend(w.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
+            }
+            all
+        })
+    };
+    results.sort_unstable_by_key(|(c, _)| *c);
+    results.into_iter().map(|(_, code)| code).collect()
+}
+
+/// Chunk `c` of `prog` compiled to machine code for `isa`.
+#[allow(clippy::too_many_arguments)]
+fn compile_chunk(
+    prog: &Program,
+    plan: &SpillPlan,
+    c: usize,
+    isa: &dyn TargetIsa,
+    sig: &Signature,
+    id: FuncId,
+    ctx: &mut Context,
+    fctx: &mut FunctionBuilderContext,
+) -> Result<MachineCode, JitError> {
+    ctx.clear();
+    ctx.func.signature = sig.clone();
+    let ptr = isa.pointer_type();
+    emit_chunk(prog, plan, c, ptr, sig.call_conv, &mut ctx.func, fctx)?;
+    let alignment = ctx
+        .compile(isa, &mut ControlPlane::default())
+        .map_err(|e| codegen(e.inner))?
+        .buffer
+        .alignment as u64;
+    let code = ctx
+        .compiled_code()
+        .ok_or_else(|| codegen("no code after compilation"))?;
+    let relocs = code
+        .buffer
+        .relocs()
+        .iter()
+        .map(|r| ModuleReloc::from_mach_reloc(r, &ctx.func, id))
+        .collect();
+    Ok(MachineCode {
+        bytes: code.code_buffer().to_vec(),
+        alignment,
+        relocs,
+    })
+}
+
 impl JitProgram {
     /// Translates `prog` to native code for the host.
     pub fn compile(prog: &Program) -> Result<JitProgram, JitError> {
         let mut module = new_module(prog.len() < UNOPTIMIZED_FROM)?;
         let ptr = module.target_config().pointer_type();
-        let call_conv = module.isa().default_call_conv();
-
+        let mut sig = Signature::new(module.isa().default_call_conv());
+        for _ in 0..3 {
+            sig.params.push(AbiParam::new(ptr));
+        }
         let plan = SpillPlan::new(prog);
-        let mut ids = Vec::new();
-        let mut ctx = module.make_context();
-        let mut fctx = FunctionBuilderContext::new();
-        for c in 0..plan.chunks {
-            for _ in 0..3 {
-                ctx.func.signature.params.push(AbiParam::new(ptr));
-            }
-            emit_chunk(prog, &plan, c, ptr, call_conv, &mut ctx.func, &mut fctx)?;
-            let id = module
-                .declare_function(
-                    &format!("pdyn_chunk{c}"),
-                    Linkage::Local,
-                    &ctx.func.signature,
-                )
+        let ids = (0..plan.chunks)
+            .map(|c| {
+                module
+                    .declare_function(&format!("pdyn_chunk{c}"), Linkage::Local, &sig)
+                    .map_err(codegen)
+            })
+            .collect::<Result<Vec<FuncId>, _>>()?;
+        let machine = compile_chunks(prog, &plan, module.isa(), &sig, &ids)?;
+        for (&id, code) in ids.iter().zip(&machine) {
+            module
+                .define_function_bytes(id, code.alignment, &code.bytes, &code.relocs)
                 .map_err(codegen)?;
-            module.define_function(id, &mut ctx).map_err(codegen)?;
-            module.clear_context(&mut ctx);
-            ids.push(id);
         }
         module.finalize_definitions().map_err(codegen)?;
         let funcs = ids
@@ -813,6 +935,58 @@ mod tests {
                     k + 4
                 );
             }
+        }
+    }
+
+    /// Outputs of every kind in a program of several chunks and segments: instruction values
+    /// (stored when computed, some twice, like a symmetric matrix's halves, some also read
+    /// by later instructions), inputs and constants (stored after the last instruction).
+    #[test]
+    fn outputs_of_every_kind_land_in_place_in_a_long_program() {
+        let mut p = Pool::new();
+        let xs: Vec<Id> = (0..40).map(|i| p.var(&format!("x{i}"))).collect();
+        let mut outs = Vec::new();
+        for i in 0..40 {
+            for j in i..40 {
+                let e = p
+                    .parse_scalar(&format!("x{i}*sin(x{j}) + {}*x{j}^2", i + 1))
+                    .unwrap();
+                outs.push(e);
+                if i != j {
+                    outs.push(e);
+                }
+            }
+        }
+        let last = *outs.last().unwrap();
+        let total = p.parse_scalar("x0*x39 + 3").unwrap();
+        let uses_an_output = p.add(&[last, total]);
+        let constant = p.parse_scalar("2.5").unwrap();
+        outs.extend([xs[7], constant, uses_an_output, xs[7], last]);
+        let prog = Program::compile(&mut p, &xs, &outs).unwrap();
+        let jit = JitProgram::compile(&prog).unwrap();
+        assert!(
+            prog.len() > SEGMENTED_FROM && jit.chunks() >= 2,
+            "{}",
+            prog.len()
+        );
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let (mut o1, mut o2) = (vec![0.0; outs.len()], vec![f64::NAN; outs.len()]);
+        for _ in 0..20 {
+            let input: Vec<f64> = (0..40)
+                .map(|_| {
+                    state ^= state << 13;
+                    state ^= state >> 7;
+                    state ^= state << 17;
+                    (state >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0
+                })
+                .collect();
+            prog.eval(&input, &mut prog.workspace(), &mut o1);
+            jit.eval(&input, &mut jit.workspace(), &mut o2);
+            for (k, (a, b)) in o1.iter().zip(&o2).enumerate() {
+                assert!(same(*a, *b), "output {k}: interpreter {a:e}, jit {b:e}");
+            }
+            assert_eq!(o2[o2.len() - 5], input[7]);
+            assert_eq!(o2[o2.len() - 4], 2.5);
         }
     }
 
