@@ -4,10 +4,13 @@
 
 use super::ClosedFormError;
 use super::{tabulate, Prepared, RunResult, RunSettings};
+use pdyn_expr::number::Number;
 use pdyn_expr::{Id, Program};
+use pdyn_mech::derive::{Derivation, UnknownKind};
 use pdyn_mech::dsolve::{solve_system, ClosedForm, Relation};
 use pdyn_mech::model::CoordinateKind;
 use pdyn_mech::{derive, DeriveOptions, Model};
+use rustc_hash::FxHashMap;
 
 /// The closed-form solution of a model, with the case that applies to its parameter values.
 pub struct ExactSolution {
@@ -19,25 +22,54 @@ pub struct ExactSolution {
     program: Program,
     /// Number of free coordinates.
     n: usize,
+    /// The parameter values the solution was found at, when it holds for those only (a system
+    /// solved numerically, see [`closed_form`]); `None` when it holds for any values.
+    pub fixed_parameters: Option<Vec<f64>>,
 }
 
 /// Solves the model's equations of motion in closed form, when they are linear with constant
 /// coefficients. The error says why not otherwise.
+///
+/// Accelerations solved symbolically give a closed form in the parameters' symbols. A system
+/// left to the numeric solve (more unknowns than the symbolic limit: a 10-storey building, a
+/// 50-mass chain) is solved at the parameters' values instead, `M q'' = f` with numbers for
+/// the parameters, which dsolve takes by the eigen-decomposition of `M` and `K`; that
+/// solution holds for those values only (see [`ExactSolution::fixed_parameters`]).
 pub fn closed_form(model: &mut Model) -> Result<ExactSolution, ClosedFormError> {
     let d = derive(model, &DeriveOptions::default()).map_err(ClosedFormError::Derive)?;
-    let acc = d.accelerations().ok_or(ClosedFormError::NotSolved)?;
-    let p = &mut model.pool;
     let n = d.free.len();
-    let mut equations = Vec::with_capacity(n);
+    let values: Vec<f64> = model.parameters.iter().map(|q| q.value).collect();
+    let (equations, at_values) = match d.accelerations() {
+        Some(acc) => {
+            let p = &mut model.pool;
+            let equations = d
+                .free
+                .iter()
+                .zip(&acc)
+                .map(|(&ci, &a)| {
+                    let qdd = p.coord(model.coordinates[ci].sym, 2);
+                    p.sub(qdd, a)
+                })
+                .collect();
+            (equations, None)
+        }
+        None => (
+            equations_at_values(model, &d)?,
+            Some(parameter_numbers(model)),
+        ),
+    };
+    let p = &mut model.pool;
     let mut coords = Vec::with_capacity(n);
     let mut initial = Vec::with_capacity(2 * n);
-    for (k, &ci) in d.free.iter().enumerate() {
+    for &ci in &d.free {
         let c = &model.coordinates[ci];
-        let qdd = p.coord(c.sym, 2);
-        equations.push(p.sub(qdd, acc[k]));
         coords.push(c.sym);
         if let CoordinateKind::Free { .. } = c.kind {
             if let Some(&(_, ie, re)) = model.initial_exprs.iter().find(|(i, _, _)| *i == ci) {
+                let (ie, re) = match &at_values {
+                    Some(map) => (p.subs(ie, map), p.subs(re, map)),
+                    None => (ie, re),
+                };
                 initial.push((p.coord(c.sym, 0), ie));
                 initial.push((p.coord(c.sym, 1), re));
             }
@@ -46,7 +78,6 @@ pub fn closed_form(model: &mut Model) -> Result<ExactSolution, ClosedFormError> 
     let closed = solve_system(p, &equations, &coords, &initial).map_err(ClosedFormError::Dsolve)?;
     // With numeric parameter values, the right case is the one whose condition holds.
     let params: Vec<Id> = model.parameters.iter().map(|q| q.id).collect();
-    let values: Vec<f64> = model.parameters.iter().map(|q| q.value).collect();
     let mut case = 0;
     for (k, c) in closed.cases.iter().enumerate() {
         let Some(cond) = c.condition else {
@@ -76,7 +107,48 @@ pub fn closed_form(model: &mut Model) -> Result<ExactSolution, ClosedFormError> 
         case,
         program,
         n,
+        fixed_parameters: at_values.map(|_| values),
     })
+}
+
+/// Each parameter's leaf mapped to its value as a number.
+fn parameter_numbers(model: &mut Model) -> FxHashMap<Id, Id> {
+    let p = &mut model.pool;
+    model
+        .parameters
+        .iter()
+        .map(|q| (q.id, p.num(Number::Float(q.value))))
+        .collect()
+}
+
+/// `Σ_j A_ij q_j'' − b_i` for each row of the derived `A x = b`, with the parameters'
+/// values for their symbols. Only when every unknown is an acceleration: reactions would
+/// first have to be eliminated.
+fn equations_at_values(model: &mut Model, d: &Derivation) -> Result<Vec<Id>, ClosedFormError> {
+    let columns = d
+        .unknowns
+        .iter()
+        .map(|u| match u.kind {
+            UnknownKind::Acceleration(ci) => Ok(model.coordinates[ci].sym),
+            UnknownKind::Reaction(_) => Err(ClosedFormError::NotSolved),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let map = parameter_numbers(model);
+    let p = &mut model.pool;
+    let accelerations: Vec<Id> = columns.iter().map(|&s| p.coord(s, 2)).collect();
+    let m = columns.len();
+    let mut equations = Vec::with_capacity(m);
+    for i in 0..m {
+        let mut terms = Vec::with_capacity(m + 1);
+        for (j, &qdd) in accelerations.iter().enumerate() {
+            let a = p.subs(d.system.a[i * m + j], &map);
+            terms.push(p.mul(&[a, qdd]));
+        }
+        let b = p.subs(d.system.b[i], &map);
+        terms.push(p.neg(b));
+        equations.push(p.add(&terms));
+    }
+    Ok(equations)
 }
 
 impl ExactSolution {
