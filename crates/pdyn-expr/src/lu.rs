@@ -129,41 +129,17 @@ fn dot(x: &[f64], y: &[f64]) -> f64 {
 pub fn cholesky_factor_in_place(a: &mut [f64], n: usize) -> Result<(), SingularMatrix> {
     debug_assert_eq!(a.len(), n * n);
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx") {
-        // SAFETY: the processor has AVX (checked just above).
-        return unsafe { cholesky_factor_avx(a, n) };
+    if n >= 4 && a.len() == n * n && std::arch::is_x86_feature_detected!("avx") {
+        // SAFETY: the processor has AVX, `a` holds `n²` elements and `n >= 4` (checked just
+        // above).
+        return unsafe { avx::cholesky_factor(a, n) };
     }
     cholesky_factor_generic(a, n)
 }
 
-/// [`cholesky_factor_generic`] compiled for AVX: four lanes per instruction instead of two.
-/// The updates are element by element (a multiplication, then a subtraction: no fused
-/// multiply-add, no reordering), so the factor is the same to the last bit on every
-/// processor.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx")]
-unsafe fn cholesky_factor_avx(a: &mut [f64], n: usize) -> Result<(), SingularMatrix> {
-    cholesky_factor_generic(a, n)
-}
-
-#[inline(always)]
 fn cholesky_factor_generic(a: &mut [f64], n: usize) -> Result<(), SingularMatrix> {
     let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let tiny = scale * 1e-14;
-    // Row `k` of `U` from what the earlier rows left of row `k` of `A`.
-    let finish_row = |row_k: &mut [f64], k: usize| -> Result<(), SingularMatrix> {
-        let d = row_k[k];
-        if d.is_nan() || d <= tiny {
-            return Err(SingularMatrix { pivot: k });
-        }
-        let ukk = d.sqrt();
-        row_k[k] = ukk;
-        let inv = 1.0 / ukk;
-        for x in &mut row_k[k + 1..] {
-            *x *= inv;
-        }
-        Ok(())
-    };
     // Rows in panels of four: each later row is read and written once per four rows of `U`
     // rather than once per row (the 100-link chain's 80 KB matrix does not stay in L1, and
     // one row at a time the update waited on memory). Each element still loses `u_ki * u_kj`
@@ -173,20 +149,8 @@ fn cholesky_factor_generic(a: &mut [f64], n: usize) -> Result<(), SingularMatrix
     while k < n {
         let b = PANEL.min(n - k);
         let (done, rest) = a.split_at_mut((k + b) * n);
-        let panel = &mut done[k * n..];
-        // The panel's own rows: row `r` loses the panel rows above it, then is finished.
-        for r in 0..b {
-            let (above, row_r) = panel.split_at_mut(r * n);
-            let row_r = &mut row_r[..n];
-            let col = k + r;
-            for row_j in above.chunks_exact(n) {
-                let u = row_j[col];
-                for (x, &y) in row_r[col..].iter_mut().zip(&row_j[col..]) {
-                    *x -= u * y;
-                }
-            }
-            finish_row(row_r, col)?;
-        }
+        // The panel's own rows, then the rows below it.
+        factor_block(&mut done[k * n..], n, k, tiny)?;
         let panel = &done[k * n..];
         if b == PANEL {
             let (r0, r1, r2, r3) = (
@@ -220,6 +184,218 @@ fn cholesky_factor_generic(a: &mut [f64], n: usize) -> Result<(), SingularMatrix
 /// Rows of `U` finished before the rows below them are updated (see
 /// [`cholesky_factor_in_place`]).
 const PANEL: usize = 4;
+
+/// Row `k` of `U` from what the earlier rows left of row `k` of `A` (`row_k` is that whole
+/// row): fails when the pivot is not above `tiny` (or is NaN).
+fn finish_row(row_k: &mut [f64], k: usize, tiny: f64) -> Result<(), SingularMatrix> {
+    let d = row_k[k];
+    if d.is_nan() || d <= tiny {
+        return Err(SingularMatrix { pivot: k });
+    }
+    let ukk = d.sqrt();
+    row_k[k] = ukk;
+    let inv = 1.0 / ukk;
+    for x in &mut row_k[k + 1..] {
+        *x *= inv;
+    }
+    Ok(())
+}
+
+/// Rows `i0..i0 + b` of `U` (`b = rows.len() / n`, `rows` those rows of `a`), once every
+/// earlier row of `U` has been subtracted from them: row `i0 + r` loses the block's rows
+/// above it, one at a time, then is finished.
+fn factor_block(rows: &mut [f64], n: usize, i0: usize, tiny: f64) -> Result<(), SingularMatrix> {
+    for r in 0..rows.len() / n {
+        let (above, row_r) = rows.split_at_mut(r * n);
+        let row_r = &mut row_r[..n];
+        let col = i0 + r;
+        for row_j in above.chunks_exact(n) {
+            let u = row_j[col];
+            for (x, &y) in row_r[col..].iter_mut().zip(&row_j[col..]) {
+                *x -= u * y;
+            }
+        }
+        finish_row(row_r, col, tiny)?;
+    }
+    Ok(())
+}
+
+/// The factor in blocks of four rows held in AVX registers.
+///
+/// Left-looking by blocks: rows `i0..i0 + 4` of `A` lose every earlier row of `U` at once,
+/// `u_pi * u_pj` for p = 0, 1, …, i0 − 1 in that order, then the block's own rows
+/// ([`factor_block`]). Every element thus loses `u_ki * u_kj` for k = 0, 1, 2, … in order, a
+/// multiplication then a subtraction (no fused multiply-add): the same bits as the generic
+/// factor. What changes is where the partial results live: a tile of four rows by eight
+/// columns stays in eight registers while p runs over all the rows above it, so each element
+/// of `A` is loaded and stored once, and each step costs two loads and four broadcasts for
+/// sixteen multiplications and subtractions (the panel form loaded and stored every element
+/// once per four rows of `U` and loaded four of `U` per element).
+#[cfg(target_arch = "x86_64")]
+mod avx {
+    use super::{factor_block, SingularMatrix};
+    use std::arch::x86_64::*;
+
+    /// `MASKS[m]` selects lanes `m..4` (all bits set in a selected lane, for `blendv`).
+    static MASKS: [[u64; 4]; 4] = [
+        [!0, !0, !0, !0],
+        [0, !0, !0, !0],
+        [0, 0, !0, !0],
+        [0, 0, 0, !0],
+    ];
+
+    /// # Safety
+    /// The processor must have AVX; `a.len() == n * n` and `n >= 4`.
+    #[target_feature(enable = "avx")]
+    pub(super) unsafe fn cholesky_factor(a: &mut [f64], n: usize) -> Result<(), SingularMatrix> {
+        let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let tiny = scale * 1e-14;
+        let mut i0 = 0;
+        while i0 < n {
+            let b = (n - i0).min(4);
+            // SAFETY: AVX is present, `a` holds `n²` elements, `n >= 4` and `i0 + b <= n`
+            // (this function's contract and the loop bounds).
+            unsafe {
+                match b {
+                    4 => update_rows::<4>(a.as_mut_ptr(), n, i0),
+                    3 => update_rows::<3>(a.as_mut_ptr(), n, i0),
+                    2 => update_rows::<2>(a.as_mut_ptr(), n, i0),
+                    _ => update_rows::<1>(a.as_mut_ptr(), n, i0),
+                }
+            }
+            factor_block(&mut a[i0 * n..(i0 + b) * n], n, i0, tiny)?;
+            i0 += b;
+        }
+        Ok(())
+    }
+
+    /// Rows `i0..i0 + R` of `a` lose `u_pi * u_pj` for p = 0, …, i0 − 1 in order, on and right
+    /// of their diagonal. Lanes left of the diagonal are computed, then their old bits are
+    /// stored back: the lower triangle keeps its values.
+    ///
+    /// # Safety
+    /// AVX; `a` points to `n * n` elements; `n >= 4`; `1 <= R <= 4` and `i0 + R <= n`.
+    #[target_feature(enable = "avx")]
+    unsafe fn update_rows<const R: usize>(a: *mut f64, n: usize, i0: usize) {
+        if i0 == 0 {
+            return;
+        }
+        // SAFETY (for every call below): each window of columns lies in `0..n` and each row
+        // in `0..n`, so every load and store is inside the `n * n` elements.
+        unsafe {
+            if i0 + 4 > n {
+                // Fewer than four columns from the diagonal on (then R = n - i0): the one
+                // window is the last four columns; row t starts at lane t + i0 - (n - 4).
+                let c = n - 4;
+                let acc = tile::<R, 1>(a, n, i0, c);
+                for (t, acc) in acc.iter().enumerate() {
+                    store_from_lane(a.add((i0 + t) * n + c), acc[0], t + i0 - c);
+                }
+                return;
+            }
+            // The diagonal window: row t from lane t.
+            let acc = tile::<R, 1>(a, n, i0, i0);
+            for (t, acc) in acc.iter().enumerate() {
+                store_from_lane(a.add((i0 + t) * n + i0), acc[0], t);
+            }
+            let mut c = i0 + 4;
+            while c + 8 <= n {
+                store_tile(a, n, i0, c, tile::<R, 2>(a, n, i0, c));
+                c += 8;
+            }
+            if c + 4 <= n {
+                store_tile(a, n, i0, c, tile::<R, 1>(a, n, i0, c));
+                c += 4;
+            }
+            if c < n {
+                // One to three columns left: the window of the last four, whose first lanes
+                // were done above.
+                let first = 4 - (n - c);
+                let acc = tile::<R, 1>(a, n, i0, n - 4);
+                for (t, acc) in acc.iter().enumerate() {
+                    store_from_lane(a.add((i0 + t) * n + n - 4), acc[0], first);
+                }
+            }
+        }
+    }
+
+    /// Rows `i0..i0 + R`, columns `c..c + 4V` of `a`, less `u_pi * u_pj` for p = 0, …,
+    /// i0 − 1 in order (a multiplication then a subtraction per term).
+    ///
+    /// # Safety
+    /// AVX; rows `0..i0 + R` and columns `c..c + 4V` lie within the `n * n` elements at `a`.
+    #[inline]
+    #[target_feature(enable = "avx")]
+    unsafe fn tile<const R: usize, const V: usize>(
+        a: *const f64,
+        n: usize,
+        i0: usize,
+        c: usize,
+    ) -> [[__m256d; V]; R] {
+        // SAFETY: every pointer is to row < i0 + R, column < c + 4V (the contract).
+        unsafe {
+            let mut acc = [[_mm256_setzero_pd(); V]; R];
+            for (t, acc) in acc.iter_mut().enumerate() {
+                for (v, acc) in acc.iter_mut().enumerate() {
+                    *acc = _mm256_loadu_pd(a.add((i0 + t) * n + c + 4 * v));
+                }
+            }
+            let mut row_p = a;
+            for _ in 0..i0 {
+                let mut y = [_mm256_setzero_pd(); V];
+                for (v, y) in y.iter_mut().enumerate() {
+                    *y = _mm256_loadu_pd(row_p.add(c + 4 * v));
+                }
+                for (t, acc) in acc.iter_mut().enumerate() {
+                    let u = _mm256_broadcast_sd(&*row_p.add(i0 + t));
+                    for (acc, &y) in acc.iter_mut().zip(&y) {
+                        *acc = _mm256_sub_pd(*acc, _mm256_mul_pd(u, y));
+                    }
+                }
+                row_p = row_p.add(n);
+            }
+            acc
+        }
+    }
+
+    /// Stores a tile computed by [`tile`] back where it came from.
+    ///
+    /// # Safety
+    /// AVX; as for [`tile`].
+    #[inline]
+    #[target_feature(enable = "avx")]
+    unsafe fn store_tile<const R: usize, const V: usize>(
+        a: *mut f64,
+        n: usize,
+        i0: usize,
+        c: usize,
+        acc: [[__m256d; V]; R],
+    ) {
+        for (t, acc) in acc.iter().enumerate() {
+            for (v, &acc) in acc.iter().enumerate() {
+                // SAFETY: the element range the tile was loaded from (the contract).
+                unsafe { _mm256_storeu_pd(a.add((i0 + t) * n + c + 4 * v), acc) };
+            }
+        }
+    }
+
+    /// Stores lanes `first..4` of `acc` at `dst`, storing back the old bits of the lanes
+    /// before them.
+    ///
+    /// # Safety
+    /// AVX; `dst..dst + 4` are valid elements; `first < 4`.
+    #[inline]
+    #[target_feature(enable = "avx")]
+    unsafe fn store_from_lane(dst: *mut f64, acc: __m256d, first: usize) {
+        // SAFETY: `dst..dst + 4` are valid (the contract); `MASKS[first]` is four `u64`s,
+        // read as four `f64` bit patterns.
+        unsafe {
+            let mask = _mm256_loadu_pd(MASKS[first].as_ptr().cast());
+            let old = _mm256_loadu_pd(dst);
+            _mm256_storeu_pd(dst, _mm256_blendv_pd(old, acc, mask));
+        }
+    }
+}
 
 /// Solves `A x = b` given the factor from [`cholesky_factor_in_place`]; `b` is overwritten by
 /// `x`.
