@@ -266,7 +266,7 @@ fn max_abs(a: &[f64]) -> f64 {
 /// four rows of `U` and loaded four elements of `U` per element).
 #[cfg(target_arch = "x86_64")]
 mod avx {
-    use super::{factor_block, max_abs, SingularMatrix};
+    use super::{max_abs, SingularMatrix};
     use std::arch::x86_64::*;
 
     /// `MASKS[m]` selects lanes `m..4` (all bits set in a selected lane, for `blendv`).
@@ -319,27 +319,29 @@ mod avx {
         // The diagonal window: its first four columns, or the last four when fewer are left
         // (then R = n - i0); row t starts at lane t + i0 - cd.
         let cd = if i0 + 4 <= n { i0 } else { n - 4 };
+        let off = i0 - cd;
         let p = a.as_mut_ptr();
+        let mut w = [[0.0; 4]; R];
         // SAFETY: rows `..i0 + R` and columns `cd..cd + 4` lie within the `n * n` elements.
         unsafe {
             let acc = tile::<R, 1>(p, n, i0, cd);
-            for (t, acc) in acc.iter().enumerate() {
-                store_from_lane(p.add((i0 + t) * n + cd), acc[0], t + i0 - cd);
+            for (w, acc) in w.iter_mut().zip(&acc) {
+                _mm256_storeu_pd(w.as_mut_ptr(), acc[0]);
             }
         }
-        factor_block(&mut a[i0 * n..(i0 + R) * n], n, i0, cd + 4, tiny)?;
+        let inv = finish_triangle(&mut w, off, i0, tiny)?;
+        // SAFETY: as above.
+        unsafe {
+            for (t, w) in w.iter().enumerate() {
+                let row = _mm256_loadu_pd(w.as_ptr());
+                store_from_lane(p.add((i0 + t) * n + cd), row, t + off);
+            }
+        }
         if cd + 4 == n {
             return Ok(());
         }
-        // The block's multipliers for the later windows: `u[q][r] = u_(i0+q, i0+r)`.
-        let mut u = [[0.0; 4]; R];
-        let mut inv = [0.0; R];
-        for r in 0..R {
-            inv[r] = 1.0 / a[(i0 + r) * n + i0 + r];
-            for q in 0..r {
-                u[q][r] = a[(i0 + q) * n + i0 + r];
-            }
-        }
+        // Here off = 0: `w[q][r] = u_(i0+q, i0+r)`, the block's multipliers.
+        let u = w;
         let p = a.as_mut_ptr();
         // SAFETY (for every window below): columns `c..c + 4V` lie in `cd + 4..n` and rows
         // in `..i0 + R`, so every access is inside the `n * n` elements.
@@ -369,6 +371,45 @@ mod avx {
             }
         }
         Ok(())
+    }
+
+    /// The block's diagonal triangle, rows `i0..i0 + R` in a window of four columns where
+    /// row r starts at lane `r + off`, once every earlier row has been subtracted: row r
+    /// loses the block's rows above it, one at a time, then is finished (the pivot checked,
+    /// its square root taken, the rest multiplied by its inverse), as [`factor_block`](super::factor_block) does
+    /// along a whole row. In scalar code on a copy in registers: this is the factor's
+    /// critical path (a square root and a division per row), so it has no loop or bounds
+    /// overhead. Returns the inverses `1 / u_rr`.
+    #[inline(always)]
+    fn finish_triangle<const R: usize>(
+        w: &mut [[f64; 4]; R],
+        off: usize,
+        i0: usize,
+        tiny: f64,
+    ) -> Result<[f64; R], SingularMatrix> {
+        let mut inv = [0.0; R];
+        for (r, inv_r) in inv.iter_mut().enumerate() {
+            let (above, row_r) = w.split_at_mut(r);
+            let row_r = &mut row_r[0];
+            let d = r + off;
+            for row_q in above.iter() {
+                let m = row_q[d];
+                for (x, &y) in row_r[d..].iter_mut().zip(&row_q[d..]) {
+                    *x -= m * y;
+                }
+            }
+            let pivot = row_r[d];
+            if pivot.is_nan() || pivot <= tiny {
+                return Err(SingularMatrix { pivot: i0 + r });
+            }
+            let ukk = pivot.sqrt();
+            row_r[d] = ukk;
+            *inv_r = 1.0 / ukk;
+            for x in &mut row_r[d + 1..] {
+                *x *= *inv_r;
+            }
+        }
+        Ok(inv)
     }
 
     /// Rows `i0..i0 + R`, columns `c..c + 4V` of `a`, less `u_pi * u_pj` for p = 0, …,
@@ -412,7 +453,7 @@ mod avx {
 
     /// The block's own rows on a tile that has lost every earlier row: row r loses
     /// `u[q][r]` times (finished) row q for q = 0, …, r − 1 in order, then is multiplied by
-    /// `inv[r] = 1 / u_rr`, as [`factor_block`] does.
+    /// `inv[r] = 1 / u_rr`, as [`factor_block`](super::factor_block) does.
     ///
     /// # Safety
     /// AVX.
