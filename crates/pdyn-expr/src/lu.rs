@@ -330,7 +330,12 @@ mod avx {
                 _mm256_storeu_pd(w.as_mut_ptr(), acc[0]);
             }
         }
-        let inv = finish_triangle(&mut w, off, i0, tiny)?;
+        // `off` is 0 but in the last block: a constant there lets the triangle's loops unroll.
+        let inv = if off == 0 {
+            finish_triangle(&mut w, 0, i0, tiny)?
+        } else {
+            finish_triangle(&mut w, off, i0, tiny)?
+        };
         // SAFETY: as above.
         unsafe {
             for (t, w) in w.iter().enumerate() {
