@@ -130,7 +130,7 @@ fn dot(x: &[f64], y: &[f64]) -> f64 {
 /// rows held in registers (module `avx`); otherwise panels of four rows
 /// (`cholesky_factor_generic`). The dot-product form that came first waited on one running
 /// sum per element, and took 2–3× as long as the panels at `n = 100` (a 100-link chain's
-/// mass matrix, factorised at every evaluation); the AVX blocks take about 0.55× the
+/// mass matrix, factorised at every evaluation); the AVX blocks take about half the
 /// panels' time there.
 pub fn cholesky_factor_in_place(a: &mut [f64], n: usize) -> Result<(), SingularMatrix> {
     debug_assert_eq!(a.len(), n * n);
