@@ -262,9 +262,10 @@ fn max_abs(a: &[f64]) -> f64 {
 /// `1 / u_ii`: the same bits as the generic factor. What changes is where the partial results
 /// live: a tile of four rows by eight columns stays in eight registers while p runs over all
 /// the rows above it and the block's own rows are applied, so each element of `A` is loaded
-/// and stored once, and each step costs two loads and four broadcasts for sixteen
-/// multiplications and subtractions (the panel form loaded and stored every element once per
-/// four rows of `U` and loaded four elements of `U` per element).
+/// and stored once, and each step of p costs two loads and four broadcasts for eight
+/// four-lane multiplications and eight subtractions, 32 element updates (the panel form
+/// loaded and stored every element once per four rows of `U`, and loaded four elements of
+/// `U` per element).
 #[cfg(target_arch = "x86_64")]
 mod avx {
     use super::{max_abs, SingularMatrix};
