@@ -145,7 +145,7 @@ fn spd(n: usize) -> Vec<f64> {
 
 /// `DenseSolver::solve` on a symmetric system (Cholesky factor and solve), as a run with
 /// a numeric mass matrix does at every evaluation: library-internal.
-#[divan::bench(args = [16, 100])]
+#[divan::bench(args = [16, 50, 100])]
 fn mass_matrix_solve(b: Bencher, n: usize) {
     let ab0 = spd(n);
     let mut solver = pdyn_expr::lu::DenseSolver::new(n, true);
@@ -155,5 +155,34 @@ fn mass_matrix_solve(b: Bencher, n: usize) {
         ab.copy_from_slice(&ab0);
         solver.solve(black_box(&mut ab), &mut x).unwrap();
         black_box(x[0])
+    });
+}
+
+/// The Cholesky factor alone (`cholesky_factor_in_place`, after copying the matrix back in),
+/// at the sizes of `mass_matrix_solve`: library-internal.
+#[divan::bench(args = [16, 50, 100])]
+fn mass_matrix_factor(b: Bencher, n: usize) {
+    let a0 = spd(n)[..n * n].to_vec();
+    let mut a = a0.clone();
+    b.bench_local(|| {
+        a.copy_from_slice(&a0);
+        pdyn_expr::lu::cholesky_factor_in_place(black_box(&mut a), n).unwrap();
+        black_box(a[n * n - 1])
+    });
+}
+
+/// The two triangular solves alone (`cholesky_solve_in_place` with a factor computed once):
+/// library-internal.
+#[divan::bench(args = [16, 50, 100])]
+fn mass_matrix_triangular_solves(b: Bencher, n: usize) {
+    let ab = spd(n);
+    let mut u = ab[..n * n].to_vec();
+    pdyn_expr::lu::cholesky_factor_in_place(&mut u, n).unwrap();
+    let rhs0 = ab[n * n..].to_vec();
+    let mut rhs = rhs0.clone();
+    b.bench_local(|| {
+        rhs.copy_from_slice(&rhs0);
+        pdyn_expr::lu::cholesky_solve_in_place(black_box(&u), n, &mut rhs);
+        black_box(rhs[0])
     });
 }
