@@ -25,4 +25,9 @@ pub(crate) struct Memo {
     /// Polynomial work units spent by `simplify`'s rational forms since the pool was made (a
     /// deterministic measure of simplification cost, for regression tests).
     pub simplify_work: u64,
+    /// The value of `simplify_work` past which `simplify` stops simplifying, while a
+    /// [`Pool::with_simplify_budget`](crate::Pool::with_simplify_budget) runs.
+    pub simplify_ceiling: Option<u64>,
+    /// Whether `simplify` met the ceiling (and returned an expression unsimplified).
+    pub simplify_exceeded: bool,
 }

@@ -44,6 +44,13 @@ impl Pool {
         if let Some(&r) = self.memo.simplify.get(&e) {
             return r;
         }
+        if let Some(ceiling) = self.memo.simplify_ceiling {
+            let mut left = ceiling.saturating_sub(self.memo.simplify_work);
+            return self.simplify_within(e, &mut left).unwrap_or_else(|| {
+                self.memo.simplify_exceeded = true;
+                e
+            });
+        }
         let r = self.simplify_uncached_unlimited(e);
         self.memo.simplify.insert(e, r);
         self.memo.simplify.insert(r, r);
@@ -63,6 +70,40 @@ impl Pool {
         self.memo.simplify.insert(e, r);
         self.memo.simplify.insert(r, r);
         Some(r)
+    }
+
+    /// Runs `f` with at most `work` polynomial work units for every [`Pool::simplify`] inside
+    /// it together (on top of any enclosing budget), and says whether that was enough. Past
+    /// the budget, `simplify` returns its argument as it is (and remembers nothing), so `f`
+    /// finishes quickly with a valid but unsimplified result that the caller should discard
+    /// when the budget ran out: an algorithm whose intermediate expressions swell (the
+    /// closed form of two coupled oscillators with four symbolic parameters: 1.75 M units,
+    /// 0.5–2 s) gives up instead of making its caller wait; it can stop early by checking
+    /// [`Pool::simplify_budget_exhausted`].
+    pub fn with_simplify_budget<R>(
+        &mut self,
+        work: u64,
+        f: impl FnOnce(&mut Pool) -> R,
+    ) -> (R, bool) {
+        let (outer_ceiling, outer_exceeded) =
+            (self.memo.simplify_ceiling, self.memo.simplify_exceeded);
+        let mine = self.memo.simplify_work.saturating_add(work);
+        let ceiling = outer_ceiling.map_or(mine, |c| c.min(mine));
+        self.memo.simplify_ceiling = Some(ceiling);
+        self.memo.simplify_exceeded = false;
+        let r = f(self);
+        let exceeded = self.memo.simplify_exceeded;
+        self.memo.simplify_ceiling = outer_ceiling;
+        // The enclosing budget ran out too when it was the tighter one.
+        self.memo.simplify_exceeded =
+            outer_exceeded || (exceeded && outer_ceiling.is_some_and(|c| c <= mine));
+        (r, !exceeded)
+    }
+
+    /// Whether the innermost [`Pool::with_simplify_budget`] has run out: a long computation
+    /// inside one checks it between steps and stops, its result being discarded anyway.
+    pub fn simplify_budget_exhausted(&self) -> bool {
+        self.memo.simplify_exceeded
     }
 
     /// [`Pool::simplify`] without its memo.
@@ -761,6 +802,28 @@ mod tests {
         assert!(ample < 1_000_000);
         let mut none = 0;
         assert_eq!(p.simplify_within(e, &mut none), Some(got));
+    }
+
+    #[test]
+    fn a_scoped_budget_stops_simplify_and_says_so() {
+        let src = "(a^2*sin(x)^2 + a^2*cos(x)^2 + a*b)/(a*b + a^2)";
+        let mut p = Pool::new();
+        let e = p.parse_scalar(src).unwrap();
+        // Too little: the expression comes back as it is, not remembered as simplified.
+        let (r, enough) = p.with_simplify_budget(3, |p| p.simplify(e));
+        assert!(!enough);
+        assert_eq!(r, e);
+        // Nested inside a tight outer budget, the outer one also runs out.
+        let ((_, inner_enough), outer_enough) =
+            p.with_simplify_budget(3, |p| p.with_simplify_budget(1_000_000, |p| p.simplify(e)));
+        assert!(!inner_enough && !outer_enough);
+        // Enough: the same answer as without a budget, and the budget is gone afterwards.
+        let (r, enough) = p.with_simplify_budget(1_000_000, |p| p.simplify(e));
+        assert!(enough);
+        assert_eq!(p.to_text(r), "1");
+        let f = p.parse_scalar("(x^2 - 1)/(x - 1)").unwrap();
+        let g = p.simplify(f);
+        assert_eq!(p.to_text(g), "1 + x");
     }
 
     #[test]

@@ -203,6 +203,10 @@ pub(crate) fn solve_by_elimination(
     let t = pool.time();
     let mut per_coord: Vec<ClosedForm> = Vec::with_capacity(n);
     for (j, &c) in ode.coords.iter().enumerate() {
+        // Under an exhausted simplification budget the result would be discarded.
+        if pool.simplify_budget_exhausted() {
+            return Ok(None);
+        }
         // Right-hand side Σ_i adj(P)_{ji}(D) f_i, adj(P)_{ji} = C_{ij}.
         let mut rhs = Vec::new();
         for i in 0..n {

@@ -140,6 +140,10 @@ pub(crate) fn solve_scalar(
     let t = pool.time();
     let mut cases = Vec::new();
     for (cond, modes) in cases_modes {
+        // Under an exhausted simplification budget the result would be discarded.
+        if pool.simplify_budget_exhausted() {
+            return Ok(None);
+        }
         let mut particular = Pool::ZERO;
         for g in &groups {
             let m = resonance(pool, &modes, g.rate, g.freq);

@@ -91,7 +91,7 @@ pub fn run(a: DeriveArgs) -> Result<String, Error> {
         })
     });
     let exact = if solution_printable {
-        Some(pdyn::sim::exact::closed_form(&mut model))
+        Some(pdyn::sim::exact::symbolic_closed_form(&mut model))
     } else {
         None
     };

@@ -85,6 +85,11 @@ pub enum ClosedFormError {
     Dsolve(DsolveError),
     /// The solution could not be compiled.
     Compile(CompileError),
+    /// Solving in symbols needed more than `work` units of simplification.
+    TooCostly {
+        /// The budget that ran out.
+        work: u64,
+    },
 }
 
 impl fmt::Display for ClosedFormError {
@@ -96,6 +101,13 @@ impl fmt::Display for ClosedFormError {
             }
             ClosedFormError::Dsolve(e) => write!(f, "{e}"),
             ClosedFormError::Compile(e) => write!(f, "{e}"),
+            ClosedFormError::TooCostly { work } => write!(
+                f,
+                "solving the equations in symbols exceeds its budget ({work} simplification \
+                 units; the solution would be too large to read): `pdyn check` and \
+                 `pdyn run --method exact` solve them at the parameter values, and `pdyn \
+                 dsolve` on the equations gives the symbolic solution in full"
+            ),
         }
     }
 }

@@ -28,18 +28,34 @@ pub struct ExactSolution {
 }
 
 /// Solves the model's equations of motion in closed form, when they are linear with constant
-/// coefficients. The error says why not otherwise.
+/// coefficients, for `pdyn check` and `pdyn run --method exact`. The error says why not
+/// otherwise.
 ///
-/// Accelerations solved symbolically give a closed form in the parameters' symbols. A system
-/// left to the numeric solve (more unknowns than the symbolic limit: a 10-storey building, a
-/// 50-mass chain) is solved at the parameters' values instead, `M q'' = f` with numbers for
-/// the parameters, which dsolve takes by the eigen-decomposition of `M` and `K`; that
-/// solution holds for those values only (see [`ExactSolution::fixed_parameters`]).
+/// Accelerations solved symbolically give a closed form in the parameters' symbols, when
+/// that takes at most [`CLOSED_FORM_WORK`]. Otherwise (more unknowns than the symbolic limit:
+/// a 10-storey building, a 50-mass chain; or an elimination that swells: two coupled
+/// oscillators with four symbolic parameters) `M q'' = f` is solved with numbers for the
+/// parameters, which dsolve takes by the eigen-decomposition of `M` and `K`; that solution
+/// holds for those values only (see [`ExactSolution::fixed_parameters`]).
 pub fn closed_form(model: &mut Model) -> Result<ExactSolution, ClosedFormError> {
+    closed_form_with(model, true)
+}
+
+/// The closed form in the parameters' symbols only (what `pdyn derive` prints): as
+/// [`closed_form`], without solving at the parameter values.
+pub fn symbolic_closed_form(model: &mut Model) -> Result<ExactSolution, ClosedFormError> {
+    closed_form_with(model, false)
+}
+
+/// Most simplification work (see [`pdyn_expr::Pool::simplify_work`]) for a closed form in
+/// symbols. The chapter's 2-storey building (symbols m, k) takes 120,000 units (20 ms), the
+/// other examples under 2,000; a 2-storey building with its own m and k per storey took
+/// 1.75 million (0.5–2 s) for a solution far too large to print.
+pub const CLOSED_FORM_WORK: u64 = 400_000;
+
+fn closed_form_with(model: &mut Model, at_values: bool) -> Result<ExactSolution, ClosedFormError> {
     let d = derive(model, &DeriveOptions::default()).map_err(ClosedFormError::Derive)?;
-    let n = d.free.len();
-    let values: Vec<f64> = model.parameters.iter().map(|q| q.value).collect();
-    let (equations, at_values) = match d.accelerations() {
+    match d.accelerations() {
         Some(acc) => {
             let p = &mut model.pool;
             let equations = d
@@ -51,13 +67,30 @@ pub fn closed_form(model: &mut Model) -> Result<ExactSolution, ClosedFormError> 
                     p.sub(qdd, a)
                 })
                 .collect();
-            (equations, None)
+            match solve_equations(model, &d, equations, None) {
+                Err(ClosedFormError::TooCostly { .. }) if at_values => {}
+                r => return r,
+            }
         }
-        None => (
-            equations_at_values(model, &d)?,
-            Some(parameter_numbers(model)),
-        ),
-    };
+        None if !at_values => return Err(ClosedFormError::NotSolved),
+        None => {}
+    }
+    let map = parameter_numbers(model);
+    let equations = equations_at_values(model, &d, &map)?;
+    solve_equations(model, &d, equations, Some(map))
+}
+
+/// dsolve on `equations` (the model's, `= 0`) with the model's initial conditions; in symbols
+/// under [`CLOSED_FORM_WORK`] when `at_values` is `None`, else with the parameters' values
+/// substituted by that map.
+fn solve_equations(
+    model: &mut Model,
+    d: &Derivation,
+    equations: Vec<Id>,
+    at_values: Option<FxHashMap<Id, Id>>,
+) -> Result<ExactSolution, ClosedFormError> {
+    let n = d.free.len();
+    let values: Vec<f64> = model.parameters.iter().map(|q| q.value).collect();
     let p = &mut model.pool;
     let mut coords = Vec::with_capacity(n);
     let mut initial = Vec::with_capacity(2 * n);
@@ -75,7 +108,20 @@ pub fn closed_form(model: &mut Model) -> Result<ExactSolution, ClosedFormError> 
             }
         }
     }
-    let closed = solve_system(p, &equations, &coords, &initial).map_err(ClosedFormError::Dsolve)?;
+    let closed = if at_values.is_some() {
+        solve_system(p, &equations, &coords, &initial)
+    } else {
+        let (closed, enough) = p.with_simplify_budget(CLOSED_FORM_WORK, |p| {
+            solve_system(p, &equations, &coords, &initial)
+        });
+        if !enough {
+            return Err(ClosedFormError::TooCostly {
+                work: CLOSED_FORM_WORK,
+            });
+        }
+        closed
+    }
+    .map_err(ClosedFormError::Dsolve)?;
     // With numeric parameter values, the right case is the one whose condition holds.
     let params: Vec<Id> = model.parameters.iter().map(|q| q.id).collect();
     let mut case = 0;
@@ -124,7 +170,11 @@ fn parameter_numbers(model: &mut Model) -> FxHashMap<Id, Id> {
 /// `Σ_j A_ij q_j'' − b_i` for each row of the derived `A x = b`, with the parameters'
 /// values for their symbols. Only when every unknown is an acceleration: reactions would
 /// first have to be eliminated.
-fn equations_at_values(model: &mut Model, d: &Derivation) -> Result<Vec<Id>, ClosedFormError> {
+fn equations_at_values(
+    model: &mut Model,
+    d: &Derivation,
+    map: &FxHashMap<Id, Id>,
+) -> Result<Vec<Id>, ClosedFormError> {
     let columns = d
         .unknowns
         .iter()
@@ -133,7 +183,6 @@ fn equations_at_values(model: &mut Model, d: &Derivation) -> Result<Vec<Id>, Clo
             UnknownKind::Reaction(_) => Err(ClosedFormError::NotSolved),
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let map = parameter_numbers(model);
     let p = &mut model.pool;
     let accelerations: Vec<Id> = columns.iter().map(|&s| p.coord(s, 2)).collect();
     let m = columns.len();
@@ -141,10 +190,10 @@ fn equations_at_values(model: &mut Model, d: &Derivation) -> Result<Vec<Id>, Clo
     for i in 0..m {
         let mut terms = Vec::with_capacity(m + 1);
         for (j, &qdd) in accelerations.iter().enumerate() {
-            let a = p.subs(d.system.a[i * m + j], &map);
+            let a = p.subs(d.system.a[i * m + j], map);
             terms.push(p.mul(&[a, qdd]));
         }
-        let b = p.subs(d.system.b[i], &map);
+        let b = p.subs(d.system.b[i], map);
         terms.push(p.neg(b));
         equations.push(p.add(&terms));
     }
