@@ -47,9 +47,9 @@ pub(crate) fn projected(
     let jac = partial_velocities(p, parts, qd);
     let zero_acc: FxHashMap<Id, Id> = qdd.iter().map(|&a| (a, Pool::ZERO)).collect();
     // Mass matrix: (j, k) → dot product → masses; forcing: j → (term, component) → weights.
-    let mut mass_groups: Vec<FxHashMap<Id, Vec<Id>>> = vec![FxHashMap::default(); n * n];
+    let mut mass_groups: Vec<Grouped<Id>> = (0..n * n).map(|_| Grouped::default()).collect();
     let mut dots: FxHashMap<([Id; 3], [Id; 3]), Id> = FxHashMap::default();
-    let mut force_groups: Vec<FxHashMap<(Id, Id), Vec<Id>>> = vec![FxHashMap::default(); n];
+    let mut force_groups: Vec<Grouped<(Id, Id)>> = (0..n).map(|_| Grouped::default()).collect();
     for (pi, pk) in parts.iter().enumerate() {
         let nz: Vec<usize> = (0..n)
             .filter(|&j| jac[pi][j].iter().any(|&c| c != Pool::ZERO))
@@ -74,7 +74,7 @@ pub(crate) fn projected(
                     }
                 };
                 if d != Pool::ZERO {
-                    mass_groups[j * n + k].entry(d).or_default().push(pk.mass);
+                    mass_groups[j * n + k].push(d, pk.mass);
                 }
             }
         }
@@ -95,7 +95,7 @@ pub(crate) fn projected(
                     continue;
                 }
                 for &(w, t) in &weighted {
-                    force_groups[j].entry((t, component)).or_default().push(w);
+                    force_groups[j].push((t, component), w);
                 }
             }
         }
@@ -104,7 +104,7 @@ pub(crate) fn projected(
     let mut mass = vec![Pool::ZERO; n * n];
     for j in 0..n {
         for k in j..n {
-            let mut g: Vec<(Id, Vec<Id>)> = mass_groups[j * n + k].drain().collect();
+            let mut g = std::mem::take(&mut mass_groups[j * n + k]).into_groups();
             g.sort_by_key(|(d, _)| *d);
             let terms: Vec<Id> = g
                 .into_iter()
@@ -167,6 +167,53 @@ fn partial_velocities(p: &mut Pool, parts: &[ParticleKinematics], qd: &[Id]) -> 
         jac.push(rows);
     }
     jac
+}
+
+/// Values pushed under keys, all in one list: `O(n³)` pushes for a chain of `n` links into a
+/// vector per key (each grown from empty) were a tenth of the projection.
+struct Grouped<K> {
+    index: FxHashMap<K, u32>,
+    keys: Vec<K>,
+    items: Vec<(u32, Id)>,
+}
+
+impl<K> Default for Grouped<K> {
+    fn default() -> Self {
+        Grouped {
+            index: FxHashMap::default(),
+            keys: Vec::new(),
+            items: Vec::new(),
+        }
+    }
+}
+
+impl<K: Copy + Eq + std::hash::Hash> Grouped<K> {
+    fn push(&mut self, key: K, value: Id) {
+        let next = self.keys.len() as u32;
+        let at = *self.index.entry(key).or_insert(next);
+        if at == next {
+            self.keys.push(key);
+        }
+        self.items.push((at, value));
+    }
+
+    /// Each key (in order of first push) with its values (in order of push).
+    fn into_groups(self) -> Vec<(K, Vec<Id>)> {
+        let mut counts = vec![0usize; self.keys.len()];
+        for &(k, _) in &self.items {
+            counts[k as usize] += 1;
+        }
+        let mut out: Vec<(K, Vec<Id>)> = self
+            .keys
+            .into_iter()
+            .zip(counts)
+            .map(|(k, c)| (k, Vec::with_capacity(c)))
+            .collect();
+        for (k, v) in self.items {
+            out[k as usize].1.push(v);
+        }
+        out
+    }
 }
 
 /// Sums of particle masses, memoised: in a chain the same suffix sums `m_k + … + m_n` weigh
@@ -260,11 +307,11 @@ fn split_mass(p: &mut Pool, t: Id, mass: Id) -> (Id, Id) {
 /// equal total weight gathered, and (for reading) their sines and cosines contracted.
 fn forcing_entry(
     p: &mut Pool,
-    groups: FxHashMap<(Id, Id), Vec<Id>>,
+    groups: Grouped<(Id, Id)>,
     contract: bool,
     sums: &mut MassSums,
 ) -> Id {
-    let mut keyed: Vec<((Id, Id), Vec<Id>)> = groups.into_iter().collect();
+    let mut keyed = groups.into_groups();
     keyed.sort_by_key(|(k, _)| *k);
     if !contract {
         return forcing_by_component(p, keyed, sums);
