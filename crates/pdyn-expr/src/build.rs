@@ -100,7 +100,7 @@ impl Pool {
         // of the cost of a sum, and only terms that actually combine need either.
         let mut like: Vec<Like> = Vec::with_capacity(flat.len());
         {
-            let mut index = KeyIndex::default();
+            let mut index = KeyIndex::new(flat.len());
             for &t in &flat {
                 if let Node::Num(n) = self.node(t) {
                     constant = constant.add(n);
@@ -228,7 +228,7 @@ impl Pool {
         // vector per base (allocations that were a fifth of `mul`).
         let mut pairs = self.spare.pairs.take();
         let mut bases = self.spare.bases.take();
-        let mut index = KeyIndex::default();
+        let mut index = KeyIndex::new(flat.len());
         for &f in &flat {
             let (b, e) = match self.node(f) {
                 Node::Num(n) => {
@@ -501,9 +501,7 @@ impl Pool {
         for t in ts {
             let (c, rest) = self.split_coeff(t);
             // Rational and small: checked above.
-            let Some(r) = c.as_rational().cloned() else {
-                return None;
-            };
+            let r = c.as_rational().cloned()?;
             parts.push((r, rest));
         }
         let mut terms = Vec::with_capacity(parts.len());
@@ -761,9 +759,17 @@ enum Key<'a> {
 
 /// Finds the entry of a key among entries pushed in order: by scanning while they are few,
 /// through a hash map once there are more (a sum of a hundred terms).
-#[derive(Default)]
 struct KeyIndex<'a> {
     map: Option<FxHashMap<Key<'a>, usize>>,
+    /// How many entries there may be in all: the map is made that large at once (growing
+    /// it key by key rehashed it several times in every long sum).
+    most: usize,
+}
+
+impl KeyIndex<'_> {
+    fn new(most: usize) -> Self {
+        KeyIndex { map: None, most }
+    }
 }
 
 /// Entries up to which a scan is cheaper than hashing.
@@ -781,13 +787,12 @@ impl<'a> KeyIndex<'a> {
         }
         let found = entries.iter().position(|e| key_of(e) == key);
         if found.is_none() && entries.len() >= SCAN_LIMIT {
-            self.map = Some(
-                entries
-                    .iter()
-                    .enumerate()
-                    .map(|(i, e)| (key_of(e), i))
-                    .collect(),
+            let mut map = FxHashMap::with_capacity_and_hasher(
+                self.most.max(entries.len() + 1),
+                Default::default(),
             );
+            map.extend(entries.iter().enumerate().map(|(i, e)| (key_of(e), i)));
+            self.map = Some(map);
         }
         found
     }
@@ -826,6 +831,74 @@ mod tests {
         assert_eq!(d, x);
         let q = p.div(x2, x);
         assert_eq!(q, x);
+    }
+
+    /// Sums and products long enough to switch from scanning to hashing collect like terms
+    /// and bases exactly as sums and products built two at a time do.
+    #[test]
+    fn long_sums_and_products_collect_like_short_ones() {
+        let mut p = Pool::new();
+        let xs: Vec<Id> = (0..40).map(|i| p.var(&format!("x{i}"))).collect();
+        let c = p.num(Number::Float(0.1));
+        // Every symbol twice, the second time with a float coefficient, and a constant.
+        let mut terms = Vec::new();
+        for &x in &xs {
+            terms.push(x);
+        }
+        for &x in xs.iter().rev() {
+            terms.push(p.mul2(c, x));
+            terms.push(c);
+        }
+        let at_once = p.add(&terms);
+        let pairwise = terms[1..].iter().fold(terms[0], |acc, &t| p.add2(acc, t));
+        assert_eq!(at_once, pairwise);
+        let Node::Add(ts) = p.node(at_once) else {
+            panic!("a sum")
+        };
+        assert_eq!(ts.len(), xs.len() + 1);
+        // Exact coefficients that cancel leave the constant alone.
+        let three = p.int(3);
+        let mut all: Vec<Id> = xs.iter().map(|&x| p.mul2(three, x)).collect();
+        all.push(three);
+        for &x in &xs {
+            let minus = p.neg(x);
+            all.extend([minus, minus, minus]);
+        }
+        assert_eq!(p.add(&all), three);
+
+        let mut factors = xs.clone();
+        factors.extend(xs.iter().rev());
+        let two = p.int(2);
+        factors.push(two);
+        let at_once = p.mul(&factors);
+        let pairwise = factors[1..]
+            .iter()
+            .fold(factors[0], |acc, &f| p.mul2(acc, f));
+        assert_eq!(at_once, pairwise);
+        let squares: Vec<Id> = xs.iter().map(|&x| p.powi(x, 2)).collect();
+        let mut expected = squares;
+        expected.push(two);
+        assert_eq!(at_once, p.mul(&expected));
+    }
+
+    /// A single term is its own sum; sums with a common factor keep their content out.
+    #[test]
+    fn single_terms_and_contents() {
+        let mut p = Pool::new();
+        let t = p.parse_scalar("3*a*sin(b)").unwrap();
+        assert_eq!(p.add(&[t]), t);
+        let s = p.parse_scalar("2*a + 4*b").unwrap();
+        let (c, prim) = p.add_content(s).unwrap();
+        assert_eq!(c, Number::int(2));
+        assert_eq!(prim, p.parse_scalar("a + 2*b").unwrap());
+        let q = p.parse_scalar("a + b").unwrap();
+        assert!(p.add_content(q).is_none());
+        // Float coefficients are left alone.
+        let half = p.num(Number::Float(0.5));
+        let (a, b) = (p.var("a"), p.var("b"));
+        let ha = p.mul2(half, a);
+        let f = p.add2(ha, b);
+        assert!(p.add_content(f).is_none());
     }
 
     #[test]

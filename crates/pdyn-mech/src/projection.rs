@@ -80,13 +80,13 @@ pub(crate) fn projected(
         }
         // The generalized force minus the velocity-dependent part of m a, term by term:
         // `(weight, term)` with `weight * term` the contribution to one component.
-        for c in 0..3 {
+        for (c, (&a_c, &force_c)) in pk.a.iter().zip(&pk.force).enumerate() {
             let mut weighted: Vec<(Id, Id)> = Vec::new();
-            for t in addends_at_rest(p, pk.a[c], &zero_acc) {
+            for t in addends_at_rest(p, a_c, &zero_acc) {
                 let minus_t = p.neg(t);
                 weighted.push((pk.mass, minus_t));
             }
-            for t in addends(p, pk.force[c]) {
+            for t in addends(p, force_c) {
                 weighted.push(split_mass(p, t, pk.mass));
             }
             for &j in &nz {
@@ -436,5 +436,51 @@ pub(crate) fn tidy_small(p: &mut Pool, e: Id, max_nodes: usize) -> Id {
         p.simplify(c)
     } else {
         c
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Dropping the terms with an acceleration factor agrees with substituting zero, and a
+    /// term that holds one otherwise goes through substitution.
+    #[test]
+    fn addends_at_rest_agree_with_substitution() {
+        let mut p = Pool::new();
+        let q = p.symbol("q", false);
+        let (qd, qdd) = (p.coord(q, 1), p.coord(q, 2));
+        let zero_acc: FxHashMap<Id, Id> = [(qdd, Pool::ZERO)].into_iter().collect();
+        for text in [
+            "l*q''*cos(q) - l*q'^2*sin(q)",
+            "l*q''*cos(q) - l*q'^2*sin(q) + 3",
+            "q''",
+            "2*q''^2 + q'",
+            "l*q''*cos(q) + sin(q''*q) - q'",
+            "g",
+            "0",
+        ] {
+            let a = p.parse_scalar(text).unwrap();
+            let by_subs = p.subs(a, &zero_acc);
+            let expected = addends(&p, by_subs);
+            assert_eq!(addends_at_rest(&mut p, a, &zero_acc), expected, "{text}");
+        }
+        assert!(mentions_any(&p, qdd, &zero_acc));
+        assert!(!mentions_any(&p, qd, &zero_acc));
+    }
+
+    #[test]
+    fn grouped_keeps_first_appearance_and_push_order() {
+        let mut p = Pool::new();
+        let ids: Vec<Id> = (0..4).map(|i| p.var(&format!("m{i}"))).collect();
+        let mut g: Grouped<u8> = Grouped::default();
+        g.push(7, ids[0]);
+        g.push(3, ids[1]);
+        g.push(7, ids[2]);
+        g.push(7, ids[3]);
+        assert_eq!(
+            g.into_groups(),
+            vec![(7, vec![ids[0], ids[2], ids[3]]), (3, vec![ids[1]])]
+        );
     }
 }
