@@ -82,43 +82,115 @@ impl Pool {
 
     /// Canonical sum of `terms`.
     pub fn add(&mut self, terms: &[Id]) -> Id {
+        if let [t] = terms {
+            // A single canonical term other than a sum or a number is its own sum.
+            if !matches!(self.node(*t), Node::Add(_) | Node::Num(_)) && !self.rest_is_sum(*t) {
+                return *t;
+            }
+        }
+        let mut flat = self.spare.ids.take();
+        self.flatten(terms, &mut flat, |n| match n {
+            Node::Add(ts) => Some(ts),
+            _ => None,
+        });
         let mut constant = Number::ZERO;
-        let mut coeffs: FxHashMap<Id, Number> = FxHashMap::default();
-        let mut order: Vec<Id> = Vec::new();
-        let mut stack: Vec<Id> = terms.iter().rev().copied().collect();
-        while let Some(t) = stack.pop() {
-            match self.node(t) {
-                Node::Add(ts) => stack.extend(ts.iter().rev().copied()),
-                Node::Num(n) => constant = constant.add(n),
-                _ => {
-                    let (c, rest) = self.split_coeff(t);
-                    match coeffs.get_mut(&rest) {
-                        Some(acc) => *acc = acc.add(&c),
-                        None => {
-                            coeffs.insert(rest, c);
-                            order.push(rest);
-                        }
+        // Like terms, keyed by their factors other than the numeric coefficient, in order of
+        // first appearance. The keys are read from the terms' own nodes: interning each
+        // term's rest (as `split_coeff` does) and then the term again (`scale_term`) was most
+        // of the cost of a sum, and only terms that actually combine need either.
+        let mut like: Vec<Like> = Vec::with_capacity(flat.len());
+        {
+            let mut index = KeyIndex::new(flat.len());
+            for &t in &flat {
+                if let Node::Num(n) = self.node(t) {
+                    constant = constant.add(n);
+                    continue;
+                }
+                let (c, key) = self.coeff_key(t);
+                match index.find(key, &like, |l| self.coeff_key(l.first).1) {
+                    Some(i) => {
+                        let l = &mut like[i];
+                        l.coeff = l.coeff.add(c.unwrap_or(&Number::ONE));
+                        l.count += 1;
+                    }
+                    None => {
+                        index.insert(key, like.len());
+                        like.push(Like {
+                            first: t,
+                            coeff: c.cloned().unwrap_or(Number::ONE),
+                            count: 1,
+                        });
                     }
                 }
             }
         }
-        let mut out: Vec<Id> = Vec::with_capacity(order.len() + 1);
-        for rest in order {
-            let c = coeffs.remove(&rest).unwrap_or(Number::ZERO);
-            if !c.is_zero() {
-                let term = self.scale_term(c, rest);
-                out.push(term);
+        self.spare.ids.put(flat);
+        let mut out = self.spare.ids.take();
+        for l in like {
+            if l.coeff.is_zero() {
+                continue;
             }
+            if l.count == 1 && !self.rest_is_sum(l.first) {
+                // Alone, the term is already `coeff * rest` in canonical form.
+                out.push(l.first);
+                continue;
+            }
+            let (_, rest) = self.split_coeff(l.first);
+            let term = self.scale_term(l.coeff, rest);
+            out.push(term);
         }
         out.sort_by(|a, b| self.order(*a, *b));
         if !constant.is_zero() {
             let c = self.num(constant);
             out.insert(0, c);
         }
-        match out.len() {
+        let r = match out.len() {
             0 => Pool::ZERO,
             1 => out[0],
-            _ => self.intern(Node::Add(out.into_boxed_slice())),
+            _ => self.intern(Node::Add(out.as_slice().into())),
+        };
+        self.spare.ids.put(out);
+        r
+    }
+
+    /// `items` with every node that `children` opens (a sum's terms, a product's factors)
+    /// replaced by its children, recursively, left to right.
+    fn flatten(&self, items: &[Id], out: &mut Vec<Id>, children: fn(&Node) -> Option<&[Id]>) {
+        for &x in items {
+            match children(self.node(x)) {
+                Some(kids) => self.flatten(kids, out, children),
+                None => out.push(x),
+            }
+        }
+    }
+
+    /// A term's numeric coefficient (none for 1) and the key of its other factors, as
+    /// [`Pool::split_coeff`] would split it but without building the rest.
+    fn coeff_key(&self, t: Id) -> (Option<&Number>, Key<'_>) {
+        match self.node(t) {
+            Node::Mul(fs) => {
+                let (c, rest) = match self.node(fs[0]) {
+                    Node::Num(c) => (Some(c), &fs[1..]),
+                    _ => (None, &fs[..]),
+                };
+                match rest {
+                    [one] => (c, Key::One(*one)),
+                    _ => (c, Key::Many(rest)),
+                }
+            }
+            _ => (None, Key::One(t)),
+        }
+    }
+
+    /// Whether the rest of a term after its coefficient is a sum (never, for a canonical
+    /// term: a number times a sum is distributed; checked so that such a term is rebuilt
+    /// exactly as before).
+    fn rest_is_sum(&self, t: Id) -> bool {
+        match self.node(t) {
+            Node::Mul(fs) if fs.len() == 2 => {
+                matches!(self.node(fs[0]), Node::Num(_)) && matches!(self.node(fs[1]), Node::Add(_))
+            }
+            _ => false,
         }
     }
 
@@ -144,16 +216,21 @@ impl Pool {
 
     /// Canonical product of `factors`.
     pub fn mul(&mut self, factors: &[Id]) -> Id {
+        let mut flat = self.spare.ids.take();
+        self.flatten(factors, &mut flat, |n| match n {
+            Node::Mul(fs) => Some(fs),
+            _ => None,
+        });
         let mut coeff = Number::ONE;
-        let mut exps: FxHashMap<Id, Vec<Id>> = FxHashMap::default();
-        let mut bases: Vec<Id> = Vec::new();
-        let mut stack: Vec<Id> = factors.iter().rev().copied().collect();
-        while let Some(f) = stack.pop() {
+        // `(base, exponent)` of every factor in order, and the distinct bases in order of
+        // first appearance with the position of their first factor and their count: a
+        // product's factors are few, so a scan finds a base faster than a hash map with a
+        // vector per base (allocations that were a fifth of `mul`).
+        let mut pairs = self.spare.pairs.take();
+        let mut bases = self.spare.bases.take();
+        let mut index = KeyIndex::new(flat.len());
+        for &f in &flat {
             let (b, e) = match self.node(f) {
-                Node::Mul(fs) => {
-                    stack.extend(fs.iter().rev().copied());
-                    continue;
-                }
                 Node::Num(n) => {
                     coeff = coeff.mul(n);
                     continue;
@@ -168,31 +245,36 @@ impl Pool {
                 },
                 _ => (f, Pool::ONE),
             };
-            match exps.get_mut(&b) {
-                Some(v) => v.push(e),
+            match index.find(Key::One(b), &bases, |&(base, _, _)| Key::One(base)) {
+                Some(i) => bases[i].2 += 1,
                 None => {
-                    exps.insert(b, vec![e]);
-                    bases.push(b);
+                    index.insert(Key::One(b), bases.len());
+                    bases.push((b, pairs.len(), 1));
                 }
             }
+            pairs.push((b, e));
         }
+        self.spare.ids.put(flat);
         if coeff.is_zero() {
             return Pool::ZERO;
         }
-        let mut out: Vec<Id> = Vec::with_capacity(bases.len() + 1);
+        let mut out = self.spare.ids.take();
         let mut reflatten = false;
-        for b in bases {
-            let es = &exps[&b];
-            let p = if es.len() == 1 {
-                if es[0] == Pool::ONE {
+        for &(b, first, count) in &bases {
+            let p = if count == 1 {
+                let e = pairs[first].1;
+                if e == Pool::ONE {
                     b
                 } else {
                     // Already a canonical Pow node unless the base is a number (2^(1/2)).
-                    let e = es[0];
                     self.pow(b, e)
                 }
             } else {
-                let es = es.clone();
+                let es: Vec<Id> = pairs[first..]
+                    .iter()
+                    .filter(|&&(x, _)| x == b)
+                    .map(|&(_, e)| e)
+                    .collect();
                 let e = self.add(&es);
                 self.pow(b, e)
             };
@@ -209,10 +291,14 @@ impl Pool {
                 _ => out.push(p),
             }
         }
+        self.spare.pairs.put(pairs);
+        self.spare.bases.put(bases);
         if reflatten {
             let c = self.num(coeff);
             out.push(c);
-            return self.mul(&out);
+            let r = self.mul(&out);
+            self.spare.ids.put(out);
+            return r;
         }
         if coeff.is_zero() {
             return Pool::ZERO;
@@ -247,7 +333,9 @@ impl Pool {
             let c = self.num(coeff);
             out.insert(0, c);
         }
-        self.intern(Node::Mul(out.into_boxed_slice()))
+        let r = self.intern(Node::Mul(out.as_slice().into()));
+        self.spare.ids.put(out);
+        r
     }
 
     /// Canonical power `b^e`.
@@ -259,7 +347,13 @@ impl Pool {
             return b;
         }
         let en = self.as_num(e);
-        match (self.node(b).clone(), en) {
+        // The arms below read a sum base's terms from the pool, not from this copy: copying
+        // them (a chain's mass sums, 100 terms) at every power was a needless allocation.
+        let node = match self.node(b) {
+            Node::Add(_) => Node::Add(Box::new([])),
+            other => other.clone(),
+        };
+        match (node, en) {
             (Node::Num(x), Some(y)) => {
                 if let Some(r) = x.pow(&y) {
                     return self.num(r);
@@ -373,24 +467,26 @@ impl Pool {
         let Node::Add(ts) = self.node(sum) else {
             return None;
         };
-        let ts = ts.to_vec();
         let mut num_gcd: i64 = 0;
         let mut den_lcm: i64 = 1;
         let mut sign_neg = None;
-        let mut parts = Vec::with_capacity(ts.len());
-        for &t in &ts {
-            let (c, rest) = self.split_coeff(t);
+        // The coefficients are read from the terms' nodes: most sums have content 1, and
+        // splitting every term (interning its rest) only to find that out was most of the
+        // cost of multiplying by a sum.
+        for &t in ts.iter() {
+            let (c, constant) = match self.node(t) {
+                Node::Num(n) => (n, true),
+                _ => (self.coeff_key(t).0.unwrap_or(&Number::ONE), false),
+            };
             // Sums with big coefficients are left as they are (a normalisation, not needed
             // for correctness; the machine-integer gcd keeps the common case cheap).
-            let r = c.as_rational()?.clone();
-            let (n, d) = r.small()?;
-            if rest != Pool::ONE && sign_neg.is_none() {
+            let (n, d) = c.as_rational()?.small()?;
+            if !constant && sign_neg.is_none() {
                 sign_neg = Some(n < 0);
             }
             num_gcd = gcd_i64(num_gcd, n);
             let g = gcd_i64(den_lcm, d);
             den_lcm = (den_lcm / g).checked_mul(d)?;
-            parts.push((r, rest));
         }
         let mut content = crate::number::Rational::new(num_gcd as i128, den_lcm as i128)?;
         if sign_neg == Some(true) {
@@ -400,6 +496,14 @@ impl Pool {
             return None;
         }
         let inv = content.recip()?;
+        let ts = ts.to_vec();
+        let mut parts = Vec::with_capacity(ts.len());
+        for t in ts {
+            let (c, rest) = self.split_coeff(t);
+            // Rational and small: checked above.
+            let r = c.as_rational().cloned()?;
+            parts.push((r, rest));
+        }
         let mut terms = Vec::with_capacity(parts.len());
         for (r, rest) in parts {
             let c = Number::Rat(r.mul(&inv));
@@ -600,6 +704,107 @@ impl Pool {
     }
 }
 
+/// Working lists of the constructors, kept between calls: each product allocated four
+/// (its factors, their bases and exponents, the result) and each sum three, a fifth of the
+/// cost of `mul`. A nested call finds the list taken and makes its own.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Spare {
+    ids: SpareLists<Id>,
+    pairs: SpareLists<(Id, Id)>,
+    bases: SpareLists<(Id, usize, u32)>,
+}
+
+/// Emptied vectors of one kind, ready for reuse.
+#[derive(Clone, Debug)]
+struct SpareLists<T>(Vec<Vec<T>>);
+
+impl<T> Default for SpareLists<T> {
+    fn default() -> Self {
+        SpareLists(Vec::new())
+    }
+}
+
+impl<T> SpareLists<T> {
+    /// An empty vector, with the capacity of an earlier one when there is one.
+    fn take(&mut self) -> Vec<T> {
+        self.0.pop().unwrap_or_default()
+    }
+
+    /// Keeps `v` for reuse (a few at most: nesting is shallow).
+    fn put(&mut self, mut v: Vec<T>) {
+        if self.0.len() < 8 {
+            v.clear();
+            self.0.push(v);
+        }
+    }
+}
+
+/// A like term of a sum being built: its first occurrence, the sum of the coefficients of
+/// every occurrence, and how many there were.
+struct Like {
+    first: Id,
+    coeff: Number,
+    count: u32,
+}
+
+/// What makes terms alike (their factors but the numeric coefficient), or factors
+/// combinable (their base), read from the pool without building a node.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+enum Key<'a> {
+    /// A single factor.
+    One(Id),
+    /// Two factors or more, in canonical order.
+    Many(&'a [Id]),
+}
+
+/// Finds the entry of a key among entries pushed in order: by scanning while they are few,
+/// through a hash map once there are more (a sum of a hundred terms).
+struct KeyIndex<'a> {
+    map: Option<FxHashMap<Key<'a>, usize>>,
+    /// How many entries there may be in all: the map is made that large at once (growing
+    /// it key by key rehashed it several times in every long sum).
+    most: usize,
+}
+
+impl KeyIndex<'_> {
+    fn new(most: usize) -> Self {
+        KeyIndex { map: None, most }
+    }
+}
+
+/// Entries up to which a scan is cheaper than hashing.
+const SCAN_LIMIT: usize = 16;
+
+impl<'a> KeyIndex<'a> {
+    fn find<T>(
+        &mut self,
+        key: Key<'a>,
+        entries: &[T],
+        key_of: impl Fn(&T) -> Key<'a>,
+    ) -> Option<usize> {
+        if let Some(map) = &self.map {
+            return map.get(&key).copied();
+        }
+        let found = entries.iter().position(|e| key_of(e) == key);
+        if found.is_none() && entries.len() >= SCAN_LIMIT {
+            let mut map = FxHashMap::with_capacity_and_hasher(
+                self.most.max(entries.len() + 1),
+                Default::default(),
+            );
+            map.extend(entries.iter().enumerate().map(|(i, e)| (key_of(e), i)));
+            self.map = Some(map);
+        }
+        found
+    }
+
+    /// Records that `key` is the entry at `at` (after a [`KeyIndex::find`] that missed).
+    fn insert(&mut self, key: Key<'a>, at: usize) {
+        if let Some(map) = &mut self.map {
+            map.insert(key, at);
+        }
+    }
+}
+
 fn gcd_i64(a: i64, b: i64) -> i64 {
     let g = crate::number::gcd(a.unsigned_abs().into(), b.unsigned_abs().into());
     g.min(i64::MAX as u128) as i64
@@ -626,6 +831,74 @@ mod tests {
         assert_eq!(d, x);
         let q = p.div(x2, x);
         assert_eq!(q, x);
+    }
+
+    /// Sums and products long enough to switch from scanning to hashing collect like terms
+    /// and bases exactly as sums and products built two at a time do.
+    #[test]
+    fn long_sums_and_products_collect_like_short_ones() {
+        let mut p = Pool::new();
+        let xs: Vec<Id> = (0..40).map(|i| p.var(&format!("x{i}"))).collect();
+        let c = p.num(Number::Float(0.1));
+        // Every symbol twice, the second time with a float coefficient, and a constant.
+        let mut terms = Vec::new();
+        for &x in &xs {
+            terms.push(x);
+        }
+        for &x in xs.iter().rev() {
+            terms.push(p.mul2(c, x));
+            terms.push(c);
+        }
+        let at_once = p.add(&terms);
+        let pairwise = terms[1..].iter().fold(terms[0], |acc, &t| p.add2(acc, t));
+        assert_eq!(at_once, pairwise);
+        let Node::Add(ts) = p.node(at_once) else {
+            panic!("a sum")
+        };
+        assert_eq!(ts.len(), xs.len() + 1);
+        // Exact coefficients that cancel leave the constant alone.
+        let three = p.int(3);
+        let mut all: Vec<Id> = xs.iter().map(|&x| p.mul2(three, x)).collect();
+        all.push(three);
+        for &x in &xs {
+            let minus = p.neg(x);
+            all.extend([minus, minus, minus]);
+        }
+        assert_eq!(p.add(&all), three);
+
+        let mut factors = xs.clone();
+        factors.extend(xs.iter().rev());
+        let two = p.int(2);
+        factors.push(two);
+        let at_once = p.mul(&factors);
+        let pairwise = factors[1..]
+            .iter()
+            .fold(factors[0], |acc, &f| p.mul2(acc, f));
+        assert_eq!(at_once, pairwise);
+        let squares: Vec<Id> = xs.iter().map(|&x| p.powi(x, 2)).collect();
+        let mut expected = squares;
+        expected.push(two);
+        assert_eq!(at_once, p.mul(&expected));
+    }
+
+    /// A single term is its own sum; sums with a common factor keep their content out.
+    #[test]
+    fn single_terms_and_contents() {
+        let mut p = Pool::new();
+        let t = p.parse_scalar("3*a*sin(b)").unwrap();
+        assert_eq!(p.add(&[t]), t);
+        let s = p.parse_scalar("2*a + 4*b").unwrap();
+        let (c, prim) = p.add_content(s).unwrap();
+        assert_eq!(c, Number::int(2));
+        assert_eq!(prim, p.parse_scalar("a + 2*b").unwrap());
+        let q = p.parse_scalar("a + b").unwrap();
+        assert!(p.add_content(q).is_none());
+        // Float coefficients are left alone.
+        let half = p.num(Number::Float(0.5));
+        let (a, b) = (p.var("a"), p.var("b"));
+        let ha = p.mul2(half, a);
+        let f = p.add2(ha, b);
+        assert!(p.add_content(f).is_none());
     }
 
     #[test]

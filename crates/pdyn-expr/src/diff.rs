@@ -138,11 +138,12 @@ impl Pool {
             return d;
         }
         // Iterative post-order over the DAG so that deep expressions cannot overflow the stack.
-        let order = self.topo_order(&[e]);
+        // What is memoised was derived with everything below it: walking it again made the
+        // velocities and accelerations of a chain's particles, which share all but their last
+        // link, quadratic in its length.
+        let memo = &self.memo.diff;
+        let order = self.topo_order_pruned(&[e], |n| memo.contains_key(&(n, var, total)));
         for &n in &order {
-            if self.memo.diff.contains_key(&(n, var, total)) {
-                continue;
-            }
             let d = self.derive_node(n, var, total);
             self.memo.diff.insert((n, var, total), d);
         }

@@ -160,6 +160,7 @@ pub struct Pool {
     symbols: Vec<Symbol>,
     symbol_ids: FxHashMap<String, SymId>,
     pub(crate) memo: crate::memo::Memo,
+    pub(crate) spare: crate::build::Spare,
 }
 
 impl Default for Pool {
@@ -177,6 +178,7 @@ impl Pool {
             symbols: Vec::new(),
             symbol_ids: FxHashMap::default(),
             memo: Default::default(),
+            spare: Default::default(),
         };
         p.intern(Node::Num(Number::ZERO));
         p.intern(Node::Num(Number::ONE));
@@ -193,13 +195,16 @@ impl Pool {
 
     /// Interns a node that is already canonical. Use the constructors in [`crate::build`].
     pub(crate) fn intern(&mut self, node: Node) -> Id {
-        if let Some(&id) = self.interned.get(&node) {
-            return id;
+        // One hash and probe for a lookup and an insertion alike.
+        match self.interned.entry(node) {
+            std::collections::hash_map::Entry::Occupied(e) => *e.get(),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                let id = Id(self.nodes.len() as u32);
+                self.nodes.push(e.key().clone());
+                e.insert(id);
+                id
+            }
         }
-        let id = Id(self.nodes.len() as u32);
-        self.nodes.push(node.clone());
-        self.interned.insert(node, id);
-        id
     }
 
     /// The node behind an id.

@@ -423,8 +423,13 @@ impl<'a> Parser<'a> {
                             args.push(self.expr()?);
                         }
                     }
-                    let close =
-                        self.expect_token(')', &format!("to close the call of `{name}`"))?;
+                    // The message is written only when it is needed (a chain's positions
+                    // have ten thousand calls).
+                    let close = if self.tok == Tok::Op(')') {
+                        self.expect_token(')', "")?
+                    } else {
+                        self.expect_token(')', &format!("to close the call of `{name}`"))?
+                    };
                     Ok(Ast::Call {
                         name,
                         name_span: span.clone(),

@@ -47,9 +47,9 @@ pub(crate) fn projected(
     let jac = partial_velocities(p, parts, qd);
     let zero_acc: FxHashMap<Id, Id> = qdd.iter().map(|&a| (a, Pool::ZERO)).collect();
     // Mass matrix: (j, k) → dot product → masses; forcing: j → (term, component) → weights.
-    let mut mass_groups: Vec<FxHashMap<Id, Vec<Id>>> = vec![FxHashMap::default(); n * n];
+    let mut mass_groups: Vec<Grouped<Id>> = (0..n * n).map(|_| Grouped::default()).collect();
     let mut dots: FxHashMap<([Id; 3], [Id; 3]), Id> = FxHashMap::default();
-    let mut force_groups: Vec<FxHashMap<(Id, Id), Vec<Id>>> = vec![FxHashMap::default(); n];
+    let mut force_groups: Vec<Grouped<(Id, Id)>> = (0..n).map(|_| Grouped::default()).collect();
     for (pi, pk) in parts.iter().enumerate() {
         let nz: Vec<usize> = (0..n)
             .filter(|&j| jac[pi][j].iter().any(|&c| c != Pool::ZERO))
@@ -74,20 +74,19 @@ pub(crate) fn projected(
                     }
                 };
                 if d != Pool::ZERO {
-                    mass_groups[j * n + k].entry(d).or_default().push(pk.mass);
+                    mass_groups[j * n + k].push(d, pk.mass);
                 }
             }
         }
         // The generalized force minus the velocity-dependent part of m a, term by term:
         // `(weight, term)` with `weight * term` the contribution to one component.
-        let a0 = pk.a.map(|c| p.subs(c, &zero_acc));
-        for c in 0..3 {
+        for (c, (&a_c, &force_c)) in pk.a.iter().zip(&pk.force).enumerate() {
             let mut weighted: Vec<(Id, Id)> = Vec::new();
-            for t in addends(p, a0[c]) {
+            for t in addends_at_rest(p, a_c, &zero_acc) {
                 let minus_t = p.neg(t);
                 weighted.push((pk.mass, minus_t));
             }
-            for t in addends(p, pk.force[c]) {
+            for t in addends(p, force_c) {
                 weighted.push(split_mass(p, t, pk.mass));
             }
             for &j in &nz {
@@ -96,7 +95,7 @@ pub(crate) fn projected(
                     continue;
                 }
                 for &(w, t) in &weighted {
-                    force_groups[j].entry((t, component)).or_default().push(w);
+                    force_groups[j].push((t, component), w);
                 }
             }
         }
@@ -105,7 +104,7 @@ pub(crate) fn projected(
     let mut mass = vec![Pool::ZERO; n * n];
     for j in 0..n {
         for k in j..n {
-            let mut g: Vec<(Id, Vec<Id>)> = mass_groups[j * n + k].drain().collect();
+            let mut g = std::mem::take(&mut mass_groups[j * n + k]).into_groups();
             g.sort_by_key(|(d, _)| *d);
             let terms: Vec<Id> = g
                 .into_iter()
@@ -170,6 +169,53 @@ fn partial_velocities(p: &mut Pool, parts: &[ParticleKinematics], qd: &[Id]) -> 
     jac
 }
 
+/// Values pushed under keys, all in one list: `O(n³)` pushes for a chain of `n` links into a
+/// vector per key (each grown from empty) were a tenth of the projection.
+struct Grouped<K> {
+    index: FxHashMap<K, u32>,
+    keys: Vec<K>,
+    items: Vec<(u32, Id)>,
+}
+
+impl<K> Default for Grouped<K> {
+    fn default() -> Self {
+        Grouped {
+            index: FxHashMap::default(),
+            keys: Vec::new(),
+            items: Vec::new(),
+        }
+    }
+}
+
+impl<K: Copy + Eq + std::hash::Hash> Grouped<K> {
+    fn push(&mut self, key: K, value: Id) {
+        let next = self.keys.len() as u32;
+        let at = *self.index.entry(key).or_insert(next);
+        if at == next {
+            self.keys.push(key);
+        }
+        self.items.push((at, value));
+    }
+
+    /// Each key (in order of first push) with its values (in order of push).
+    fn into_groups(self) -> Vec<(K, Vec<Id>)> {
+        let mut counts = vec![0usize; self.keys.len()];
+        for &(k, _) in &self.items {
+            counts[k as usize] += 1;
+        }
+        let mut out: Vec<(K, Vec<Id>)> = self
+            .keys
+            .into_iter()
+            .zip(counts)
+            .map(|(k, c)| (k, Vec::with_capacity(c)))
+            .collect();
+        for (k, v) in self.items {
+            out[k as usize].1.push(v);
+        }
+        out
+    }
+}
+
 /// Sums of particle masses, memoised: in a chain the same suffix sums `m_k + … + m_n` weigh
 /// `O(n²)` entries, and building each anew (sorting and interning `O(n)` terms) was most of
 /// the projection's time at `n = 100`.
@@ -196,6 +242,47 @@ fn addends(p: &Pool, e: Id) -> Vec<Id> {
     }
 }
 
+/// The terms of `a` with the accelerations `qdd` set to zero: those of
+/// `p.subs(a, zero_acc)`, found without rebuilding the sum (substitution rebuilt each
+/// particle's acceleration, `O(n)` terms, a seventh of the projection of a 100-link chain).
+/// A term with an acceleration as a factor vanishes; a term that mentions one otherwise
+/// (under a function or a power) is left to substitution.
+fn addends_at_rest(p: &mut Pool, a: Id, zero_acc: &FxHashMap<Id, Id>) -> Vec<Id> {
+    let terms = addends(p, a);
+    let mut kept = Vec::with_capacity(terms.len());
+    for &t in &terms {
+        let factor_is_acceleration = match p.node(t) {
+            Node::Mul(fs) => fs.iter().any(|f| zero_acc.contains_key(f)),
+            _ => zero_acc.contains_key(&t),
+        };
+        if factor_is_acceleration {
+            continue;
+        }
+        if mentions_any(p, t, zero_acc) {
+            let at_rest = p.subs(a, zero_acc);
+            return addends(p, at_rest);
+        }
+        kept.push(t);
+    }
+    kept
+}
+
+/// Whether a key of `leaves` occurs in `e`: [`Pool::contains_any`] with the set of leaves
+/// made once, not for every term (making it was most of the cost on a term of a few nodes).
+fn mentions_any(p: &Pool, e: Id, leaves: &FxHashMap<Id, Id>) -> bool {
+    let mut seen = rustc_hash::FxHashSet::default();
+    let mut stack = vec![e];
+    while let Some(x) = stack.pop() {
+        if leaves.contains_key(&x) {
+            return true;
+        }
+        if seen.insert(x) {
+            p.for_each_child(x, |c| stack.push(c));
+        }
+    }
+    false
+}
+
 /// A force term as `(weight, rest)`: the particle's mass taken out when it is a factor
 /// (gravity's `-g*m2` → `(m2, -g)`), so that the particles' weights collect into mass sums
 /// like their inertia does; `(1, term)` otherwise.
@@ -220,11 +307,11 @@ fn split_mass(p: &mut Pool, t: Id, mass: Id) -> (Id, Id) {
 /// equal total weight gathered, and (for reading) their sines and cosines contracted.
 fn forcing_entry(
     p: &mut Pool,
-    groups: FxHashMap<(Id, Id), Vec<Id>>,
+    groups: Grouped<(Id, Id)>,
     contract: bool,
     sums: &mut MassSums,
 ) -> Id {
-    let mut keyed: Vec<((Id, Id), Vec<Id>)> = groups.into_iter().collect();
+    let mut keyed = groups.into_groups();
     keyed.sort_by_key(|(k, _)| *k);
     if !contract {
         return forcing_by_component(p, keyed, sums);
@@ -349,5 +436,51 @@ pub(crate) fn tidy_small(p: &mut Pool, e: Id, max_nodes: usize) -> Id {
         p.simplify(c)
     } else {
         c
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Dropping the terms with an acceleration factor agrees with substituting zero, and a
+    /// term that holds one otherwise goes through substitution.
+    #[test]
+    fn addends_at_rest_agree_with_substitution() {
+        let mut p = Pool::new();
+        let q = p.symbol("q", false);
+        let (qd, qdd) = (p.coord(q, 1), p.coord(q, 2));
+        let zero_acc: FxHashMap<Id, Id> = [(qdd, Pool::ZERO)].into_iter().collect();
+        for text in [
+            "l*q''*cos(q) - l*q'^2*sin(q)",
+            "l*q''*cos(q) - l*q'^2*sin(q) + 3",
+            "q''",
+            "2*q''^2 + q'",
+            "l*q''*cos(q) + sin(q''*q) - q'",
+            "g",
+            "0",
+        ] {
+            let a = p.parse_scalar(text).unwrap();
+            let by_subs = p.subs(a, &zero_acc);
+            let expected = addends(&p, by_subs);
+            assert_eq!(addends_at_rest(&mut p, a, &zero_acc), expected, "{text}");
+        }
+        assert!(mentions_any(&p, qdd, &zero_acc));
+        assert!(!mentions_any(&p, qd, &zero_acc));
+    }
+
+    #[test]
+    fn grouped_keeps_first_appearance_and_push_order() {
+        let mut p = Pool::new();
+        let ids: Vec<Id> = (0..4).map(|i| p.var(&format!("m{i}"))).collect();
+        let mut g: Grouped<u8> = Grouped::default();
+        g.push(7, ids[0]);
+        g.push(3, ids[1]);
+        g.push(7, ids[2]);
+        g.push(7, ids[3]);
+        assert_eq!(
+            g.into_groups(),
+            vec![(7, vec![ids[0], ids[2], ids[3]]), (3, vec![ids[1]])]
+        );
     }
 }
