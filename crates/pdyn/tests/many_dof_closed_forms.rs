@@ -147,7 +147,10 @@ fn the_closed_form_follows_the_parameter_values() {
 /// chapter's 2-storey building, masses m and stiffnesses k: 120,000 units of the budget).
 #[test]
 fn small_structures_keep_symbolic_closed_forms() {
-    let path = format!("{}/../../examples/building.toml", env!("CARGO_MANIFEST_DIR"));
+    let path = format!(
+        "{}/../../examples/building.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
     let mut m = load(&std::fs::read_to_string(path).unwrap());
     let exact = sim::exact::closed_form(&mut m).unwrap();
     assert!(exact.fixed_parameters.is_none());
