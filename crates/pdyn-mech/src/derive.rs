@@ -463,8 +463,26 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
         None => linear_form(p, equations, &unknowns)?,
     };
     let residual_count = system.rows();
+    // A diagonal A (each equation has one unknown: a building's floors, a chain of masses on
+    // springs) is solved exactly whatever its size: x_i = b_i / a_ii, as short as b. (Small
+    // systems go through the general elimination, as before, for the same printed forms.)
+    let m = unknowns.len();
+    let diagonal = m > opts.symbolic_limit
+        && residual_count == m
+        && (0..m).all(|i| {
+            system.a[i * m + i] != Pool::ZERO
+                && (0..m).all(|j| i == j || system.a[i * m + j] == Pool::ZERO)
+        });
 
-    let solution = if unknowns.len() <= opts.symbolic_limit || residual_count > unknowns.len() {
+    let solution = if diagonal {
+        // Not simplified: a rational normal form would put an N-body force sum over one
+        // common denominator, whose powers of masses and distances overflow in SI units.
+        Some(
+            (0..m)
+                .map(|i| p.div(system.b[i], system.a[i * m + i]))
+                .collect(),
+        )
+    } else if m <= opts.symbolic_limit || residual_count > m {
         // Exact elimination only when it is cheap (a few reactions, a double pendulum):
         // otherwise A x = b is solved numerically at each evaluation. On the 4-link chain the
         // exact solution took 3 s of a 3.1 s `pdyn run` (elimination, then compiling its large

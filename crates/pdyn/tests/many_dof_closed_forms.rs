@@ -176,3 +176,34 @@ fn a_symbolic_solution_that_swells_gives_way_to_the_parameter_values() {
     );
     assert_closed_form_matches_integration(load(&building(2)), 5.0);
 }
+
+/// A diagonal mass matrix is solved exactly whatever its size (x_i'' = f_i / m_i): `pdyn
+/// derive` prints the accelerations of the 10-storey building, and `pdyn run` evaluates
+/// them instead of factorising a 10×10 matrix.
+#[test]
+fn diagonal_mass_matrices_are_solved_whatever_their_size() {
+    let mut m = load(&building(10));
+    let d = pdyn_mech::derive(&mut m, &pdyn_mech::DeriveOptions::default()).unwrap();
+    let acc = d.accelerations().expect("solved");
+    assert_eq!(acc.len(), 10);
+    let last = m.pool.to_text(acc[9]);
+    assert!(last.ends_with("/m10"), "{last}");
+    // A coupled (non-diagonal) system of that size is still left to the numeric solve.
+    let mut chain = pdyn_mech::load(
+        &std::fs::read_to_string(format!(
+            "{}/../../examples/pendulum_chain_3.toml",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .unwrap(),
+        "chain",
+    )
+    .unwrap();
+    let opts = pdyn_mech::DeriveOptions {
+        symbolic_limit: 2,
+        ..pdyn_mech::DeriveOptions::default()
+    };
+    assert!(pdyn_mech::derive(&mut chain, &opts)
+        .unwrap()
+        .solution
+        .is_none());
+}

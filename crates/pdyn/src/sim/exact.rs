@@ -68,7 +68,20 @@ fn closed_form_with(model: &mut Model, at_values: bool) -> Result<ExactSolution,
                 })
                 .collect();
             match solve_equations(model, &d, equations, None) {
-                Err(ClosedFormError::TooCostly { .. }) if at_values => {}
+                // In symbols the numeric solvers do not apply either (a 50-mass chain with a
+                // mass and a stiffness symbol each): with the values they may.
+                Err(why @ (ClosedFormError::TooCostly { .. } | ClosedFormError::Dsolve(_)))
+                    if at_values && !model.parameters.is_empty() =>
+                {
+                    let map = parameter_numbers(model);
+                    let equations = equations_at_values(model, &d, &map)?;
+                    return match solve_equations(model, &d, equations, Some(map)) {
+                        Ok(exact) => Ok(exact),
+                        // Not linear, say: the reason given in symbols reads better.
+                        Err(_) if !matches!(why, ClosedFormError::TooCostly { .. }) => Err(why),
+                        Err(e) => Err(e),
+                    };
+                }
                 r => return r,
             }
         }
