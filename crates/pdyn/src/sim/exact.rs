@@ -73,24 +73,26 @@ fn closed_form_with(model: &mut Model, at_values: bool) -> Result<ExactSolution,
                 Err(why @ (ClosedFormError::TooCostly { .. } | ClosedFormError::Dsolve(_)))
                     if at_values && !model.parameters.is_empty() =>
                 {
-                    let map = parameter_numbers(model);
-                    let equations = equations_at_values(model, &d, &map)?;
-                    return match solve_equations(model, &d, equations, Some(map)) {
+                    match solve_at_values(model, &d) {
                         Ok(exact) => Ok(exact),
                         // Not linear, say: the reason given in symbols reads better.
                         Err(_) if !matches!(why, ClosedFormError::TooCostly { .. }) => Err(why),
                         Err(e) => Err(e),
-                    };
+                    }
                 }
-                r => return r,
+                r => r,
             }
         }
-        None if !at_values => return Err(ClosedFormError::NotSolved),
-        None => {}
+        None if !at_values => Err(ClosedFormError::NotSolved),
+        None => solve_at_values(model, &d),
     }
+}
+
+/// `M q'' = f` solved with the parameters' values for their symbols.
+fn solve_at_values(model: &mut Model, d: &Derivation) -> Result<ExactSolution, ClosedFormError> {
     let map = parameter_numbers(model);
-    let equations = equations_at_values(model, &d, &map)?;
-    solve_equations(model, &d, equations, Some(map))
+    let equations = equations_at_values(model, d, &map)?;
+    solve_equations(model, d, equations, Some(map))
 }
 
 /// dsolve on `equations` (the model's, `= 0`) with the model's initial conditions; in symbols
@@ -214,7 +216,8 @@ fn equations_at_values(
 }
 
 impl ExactSolution {
-    /// The state `[q, q']` at time `t` (parameters in model order).
+    /// The state `[q, q']` at time `t` (parameters in model order; those of
+    /// [`ExactSolution::fixed_parameters`] when it is set).
     pub fn state(&self, t: f64, params: &[f64], ws: &mut Vec<f64>, y: &mut [f64]) {
         if ws.is_empty() {
             *ws = self.program.workspace();
@@ -249,6 +252,12 @@ pub fn run_exact(
         .unwrap_or_default()
     });
     let params = prep.system.parameters();
+    // A solution found at the parameter values holds for those only; `prep` comes from the
+    // same model, after the same `--set`.
+    debug_assert!(exact
+        .fixed_parameters
+        .as_ref()
+        .is_none_or(|fixed| *fixed == params));
     let n2 = 2 * exact.n;
     let mut sol = pdyn_ode::Solution {
         method: pdyn_ode::Method::Auto,
@@ -344,6 +353,12 @@ pub fn check(
     }
     let run = super::run(prep, &set)?;
     let params = prep.system.parameters();
+    // A solution found at the parameter values holds for those only; `prep` comes from the
+    // same model, after the same `--set`.
+    debug_assert!(exact
+        .fixed_parameters
+        .as_ref()
+        .is_none_or(|fixed| *fixed == params));
     let n2 = 2 * exact.n;
     let mut ws = Vec::new();
     let mut y = vec![0.0; n2];
