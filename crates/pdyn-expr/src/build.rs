@@ -9,7 +9,7 @@
 //! argument (`cos(b - a) = cos(a - b)`), and exact values at `0` and multiples of `pi/2` fold.
 
 use crate::number::Number;
-use crate::pool::{Constant, Func, Id, Node, Pool};
+use crate::pool::{Constant, Func, Id, Node, NodeRef, Pool};
 use rustc_hash::FxHashMap;
 
 impl Pool {
@@ -63,7 +63,7 @@ impl Pool {
                     let rest = if rest.len() == 1 {
                         rest[0]
                     } else {
-                        self.intern(Node::Mul(rest.into_boxed_slice()))
+                        self.intern_parts(NodeRef::Mul(&rest))
                     };
                     (c, rest)
                 } else {
@@ -147,7 +147,7 @@ impl Pool {
         let r = match out.len() {
             0 => Pool::ZERO,
             1 => out[0],
-            _ => self.intern(Node::Add(out.as_slice().into())),
+            _ => self.intern_parts(NodeRef::Add(&out)),
         };
         self.spare.ids.put(out);
         r
@@ -206,11 +206,11 @@ impl Pool {
                 let mut v = Vec::with_capacity(fs.len() + 1);
                 v.push(cid);
                 v.extend_from_slice(fs);
-                self.intern(Node::Mul(v.into_boxed_slice()))
+                self.intern_parts(NodeRef::Mul(&v))
             }
             // A number times a sum is distributed by `mul`; do the same here for consistency.
             Node::Add(_) => self.mul(&[cid, rest]),
-            _ => self.intern(Node::Mul(Box::new([cid, rest]))),
+            _ => self.intern_parts(NodeRef::Mul(&[cid, rest])),
         }
     }
 
@@ -333,7 +333,7 @@ impl Pool {
             let c = self.num(coeff);
             out.insert(0, c);
         }
-        let r = self.intern(Node::Mul(out.as_slice().into()));
+        let r = self.intern_parts(NodeRef::Mul(&out));
         self.spare.ids.put(out);
         r
     }
@@ -700,7 +700,7 @@ impl Pool {
             }
             Func::Acos => {}
         }
-        self.intern(Node::Call(f, args.to_vec().into_boxed_slice()))
+        self.intern_parts(NodeRef::Call(f, args))
     }
 }
 

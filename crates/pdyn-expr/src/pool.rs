@@ -120,6 +120,42 @@ impl Func {
     }
 }
 
+/// A node's parts, borrowed: what the node table hashes and compares, so that a lookup needs
+/// no allocated node (most lookups find one).
+#[derive(PartialEq, Hash)]
+pub(crate) enum NodeRef<'a> {
+    Num(&'a Number),
+    Const(Constant),
+    Time,
+    Sym(SymId),
+    Coord(SymId, u8),
+    Add(&'a [Id]),
+    Mul(&'a [Id]),
+    Pow(Id, Id),
+    Call(Func, &'a [Id]),
+}
+
+impl Node {
+    pub(crate) fn parts(&self) -> NodeRef<'_> {
+        match self {
+            Node::Num(n) => NodeRef::Num(n),
+            Node::Const(c) => NodeRef::Const(*c),
+            Node::Time => NodeRef::Time,
+            Node::Sym(s) => NodeRef::Sym(*s),
+            Node::Coord(s, k) => NodeRef::Coord(*s, *k),
+            Node::Add(ts) => NodeRef::Add(ts),
+            Node::Mul(fs) => NodeRef::Mul(fs),
+            Node::Pow(b, e) => NodeRef::Pow(*b, *e),
+            Node::Call(f, args) => NodeRef::Call(*f, args),
+        }
+    }
+}
+
+fn parts_hash(r: &NodeRef<'_>) -> u64 {
+    use std::hash::BuildHasher;
+    rustc_hash::FxBuildHasher.hash_one(r)
+}
+
 /// One node of the expression DAG.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub enum Node {
@@ -156,7 +192,9 @@ pub struct Symbol {
 #[derive(Clone, Debug)]
 pub struct Pool {
     nodes: Vec<Node>,
-    interned: FxHashMap<Node, Id>,
+    /// Every node's id, found by the node's parts (`NodeRef`): each node is stored once, in
+    /// `nodes`.
+    interned: hashbrown::HashTable<Id>,
     symbols: Vec<Symbol>,
     symbol_ids: FxHashMap<String, SymId>,
     pub(crate) memo: crate::memo::Memo,
@@ -174,7 +212,7 @@ impl Pool {
     pub fn new() -> Pool {
         let mut p = Pool {
             nodes: Vec::new(),
-            interned: FxHashMap::default(),
+            interned: hashbrown::HashTable::new(),
             symbols: Vec::new(),
             symbol_ids: FxHashMap::default(),
             memo: Default::default(),
@@ -195,16 +233,51 @@ impl Pool {
 
     /// Interns a node that is already canonical. Use the constructors in [`crate::build`].
     pub(crate) fn intern(&mut self, node: Node) -> Id {
-        // One hash and probe for a lookup and an insertion alike.
-        match self.interned.entry(node) {
-            std::collections::hash_map::Entry::Occupied(e) => *e.get(),
-            std::collections::hash_map::Entry::Vacant(e) => {
-                let id = Id(self.nodes.len() as u32);
-                self.nodes.push(e.key().clone());
-                e.insert(id);
-                id
-            }
+        let hash = parts_hash(&node.parts());
+        match self.find_or_vacant(hash, &node.parts()) {
+            Ok(id) => id,
+            Err(()) => self.push_new(hash, node),
         }
+    }
+
+    /// Interns the node with these parts (already canonical), allocating it only when it is
+    /// new: a sum's or product's terms come from a reused buffer, and most lookups of a long
+    /// derivation find the node.
+    pub(crate) fn intern_parts(&mut self, parts: NodeRef<'_>) -> Id {
+        let hash = parts_hash(&parts);
+        if let Ok(id) = self.find_or_vacant(hash, &parts) {
+            return id;
+        }
+        let node = match parts {
+            NodeRef::Add(ts) => Node::Add(ts.into()),
+            NodeRef::Mul(fs) => Node::Mul(fs.into()),
+            NodeRef::Call(f, args) => Node::Call(f, args.into()),
+            NodeRef::Num(n) => Node::Num(n.clone()),
+            NodeRef::Const(c) => Node::Const(c),
+            NodeRef::Time => Node::Time,
+            NodeRef::Sym(s) => Node::Sym(s),
+            NodeRef::Coord(s, k) => Node::Coord(s, k),
+            NodeRef::Pow(b, e) => Node::Pow(b, e),
+        };
+        self.push_new(hash, node)
+    }
+
+    /// The id of the node with these parts, if interned.
+    fn find_or_vacant(&self, hash: u64, parts: &NodeRef<'_>) -> Result<Id, ()> {
+        self.interned
+            .find(hash, |&id| self.nodes[id.index()].parts() == *parts)
+            .copied()
+            .ok_or(())
+    }
+
+    /// Stores a node known not to be interned.
+    fn push_new(&mut self, hash: u64, node: Node) -> Id {
+        let id = Id(self.nodes.len() as u32);
+        self.nodes.push(node);
+        let nodes = &self.nodes;
+        self.interned
+            .insert_unique(hash, id, |&k| parts_hash(&nodes[k.index()].parts()));
+        id
     }
 
     /// The node behind an id.
@@ -564,6 +637,29 @@ impl Pool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A node interned from its parts and the same node interned whole get one id, and the
+    /// node is stored once.
+    #[test]
+    fn nodes_are_found_by_their_parts() {
+        let mut p = Pool::new();
+        let (x, y) = (p.var("x"), p.var("y"));
+        let before = p.len();
+        let by_parts = p.intern_parts(NodeRef::Add(&[x, y]));
+        assert_eq!(p.len(), before + 1);
+        let whole = p.intern(Node::Add(Box::new([x, y])));
+        assert_eq!(by_parts, whole);
+        assert_eq!(p.len(), before + 1);
+        // Other kinds and orders are other nodes.
+        let product = p.intern_parts(NodeRef::Mul(&[x, y]));
+        let reversed = p.intern_parts(NodeRef::Add(&[y, x]));
+        assert!(product != by_parts && reversed != by_parts);
+        let sin = p.intern_parts(NodeRef::Call(Func::Sin, &[x]));
+        assert_eq!(sin, p.intern(Node::Call(Func::Sin, Box::new([x]))));
+        assert_eq!(p.len(), before + 4);
+        // The canonical constructors meet the same nodes.
+        assert_eq!(p.add(&[x, y]), by_parts);
+    }
 
     #[test]
     fn contains_any_agrees_with_contains_on_every_pair() {
