@@ -238,3 +238,25 @@ fn a_redundant_constraint_is_named_as_such() {
         "{e}"
     );
 }
+
+/// A sweep's `steps` is checked before its values are made: the fuzzer's
+/// `steps = 810000002071` asked for 6.5 TB (a crash under the sanitizer, an abort without).
+#[test]
+fn absurd_sweep_steps_are_refused_before_allocating() {
+    let main =
+        format!("{GOOD}\n[sweep]\nparameter = \"m\"\nfrom = 1\nto = 2\nsteps = 810000002071\n");
+    let e = load_err(&main);
+    assert!(
+        e.contains("`steps` = 810000002071 is more than a sweep may run"),
+        "{e}"
+    );
+    assert!(e.contains("model.toml:"), "{e}");
+    let also = format!(
+        "{GOOD}\n[sweep]\nparameter = \"m\"\nvalues = [1, 2]\n\n[sweep.also]\ng = {{ from = 1, to = 2, steps = 1e30 }}\n"
+    );
+    let e = load_err(&also);
+    assert!(e.contains("is more than a sweep may run"), "{e}");
+    // Within the limit it loads.
+    let fine = format!("{GOOD}\n[sweep]\nparameter = \"m\"\nfrom = 1\nto = 2\nsteps = 1000\n");
+    assert!(load(&fine, "model.toml").is_ok());
+}

@@ -8,6 +8,11 @@ use pdyn_expr::error::suggest;
 use pdyn_expr::{Id, Value};
 use std::ops::Range;
 
+/// Most values one swept parameter may take (`steps` of `from`/`to`): the values are made
+/// before the runs, so an absurd `steps` must be refused, not allocated. Equal to the runs a
+/// whole sweep may ask for (`pdyn::sim::sweep::MAX_SWEEP_RUNS`).
+pub const MAX_SWEEP_VALUES: usize = 10_000_000;
+
 /// `[simulate]`. Every field is optional; command-line options override it.
 #[derive(Clone, Debug, Default)]
 pub struct SimulateSpec {
@@ -385,6 +390,16 @@ pub(super) fn read(
             if n < 2 {
                 return Err(ld.err(steps.span(), "`steps` must be at least 2"));
             }
+            if n as u64 > MAX_SWEEP_VALUES as u64 {
+                return Err(ld
+                    .err(
+                        steps.span(),
+                        format!(
+                            "`steps` = {n} is more than a sweep may run ({MAX_SWEEP_VALUES} values)"
+                        ),
+                    )
+                    .help("sweep a coarser grid, or split the range into several sweeps"));
+            }
             (0..n)
                 .map(|k| a + (b - a) * k as f64 / (n - 1) as f64)
                 .collect()
@@ -459,6 +474,19 @@ pub(super) fn read(
                         }
                     };
                     match (num("from"), num("to"), num("steps")) {
+                        (Some(_), Some(_), Some(n)) if n > MAX_SWEEP_VALUES as f64 => {
+                            return Err(ld
+                                .err(
+                                    sv.span(),
+                                    format!(
+                                        "`steps` = {n} is more than a sweep may run \
+                                         ({MAX_SWEEP_VALUES} values)"
+                                    ),
+                                )
+                                .help(
+                                    "sweep a coarser grid, or split the range into several sweeps",
+                                ));
+                        }
                         (Some(a), Some(b), Some(n)) if n >= 2.0 => {
                             let n = n as usize;
                             (0..n)
