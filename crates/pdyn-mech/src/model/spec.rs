@@ -9,8 +9,8 @@ use pdyn_expr::{Id, Value};
 use std::ops::Range;
 
 /// Most values one swept parameter may take (`steps` of `from`/`to`): the values are made
-/// before the runs, so an absurd `steps` must be refused, not allocated. Equal to the runs a
-/// whole sweep may ask for (`pdyn::sim::sweep::MAX_SWEEP_RUNS`).
+/// before the runs, so an absurd `steps` must be refused, not allocated. `pdyn` bounds a
+/// whole sweep's runs (every combination) by the same number.
 pub const MAX_SWEEP_VALUES: usize = 10_000_000;
 
 /// `[simulate]`. Every field is optional; command-line options override it.

@@ -30,8 +30,9 @@ pub struct SweepResult {
     pub threads: usize,
 }
 
-/// Largest number of runs one sweep may ask for (the product of the swept values' counts).
-pub const MAX_SWEEP_RUNS: usize = 10_000_000;
+/// Largest number of runs one sweep may ask for (the product of the swept values' counts):
+/// the same bound as one parameter's values, checked when the model is loaded.
+pub const MAX_SWEEP_RUNS: usize = pdyn_mech::model::spec::MAX_SWEEP_VALUES;
 
 /// What went wrong with one run of a sweep (the others go on).
 #[derive(Clone, Debug)]
