@@ -321,9 +321,10 @@ pub fn newton_equations(
     }
     let mut constraint_eqs = Vec::new();
     for c in &model.constraints {
-        let acc = p.dt_n(c.equation, 2);
+        let acc = p.dt_n(c.equation, c.derivatives);
+        let how = if c.derivatives == 1 { "once" } else { "twice" };
         constraint_eqs.push(Equation {
-            label: format!("constraint {} (differentiated twice)", c.label),
+            label: format!("constraint {} (differentiated {how})", c.label),
             lhs: acc,
             rhs: Pool::ZERO,
         });

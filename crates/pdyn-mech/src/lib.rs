@@ -17,6 +17,7 @@ mod constraint_rank;
 pub mod derive;
 pub mod dimensions;
 pub mod dsolve;
+pub mod hybrid;
 pub mod kinematics;
 pub mod matrix_form;
 pub mod model;

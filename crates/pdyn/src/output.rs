@@ -74,6 +74,37 @@ pub fn summary(res: &RunResult, model_name: &str, state_names: &[String]) -> ser
         },
         "outputs": res.rows.len(),
         "warnings": res.warnings,
+        "hybrid": res.hybrid.as_ref().map(hybrid_summary),
+    })
+}
+
+/// The mode timeline, switches, impacts, Zeno accumulations, event actions and energy
+/// accounting of a hybrid run, for `summary.json`.
+pub fn hybrid_summary(h: &crate::sim::hybrid::HybridReport) -> serde_json::Value {
+    json!({
+        "timeline": h.timeline.iter().map(|iv| json!({
+            "t_from": json_num(iv.t_from), "t_to": json_num(iv.t_to),
+            "modes": iv.modes.iter().map(|(c, m)| (c.clone(), json!(m))).collect::<serde_json::Map<_, _>>(),
+        })).collect::<Vec<_>>(),
+        "switches": h.switches.iter().map(|sw| json!({
+            "t": json_num(sw.t), "contact": sw.contact, "from": sw.from, "to": sw.to, "reason": sw.reason,
+        })).collect::<Vec<_>>(),
+        "impacts": h.impacts.iter().map(|im| json!({
+            "t": json_num(im.t), "contact": im.contact,
+            "normal_speed_before": json_num(im.normal_speed_before),
+            "normal_speed_after": json_num(im.normal_speed_after),
+            "impulse": json_num(im.impulse), "energy_lost": json_num(im.energy_lost),
+        })).collect::<Vec<_>>(),
+        "zeno": h.zeno.iter().map(|z| json!({
+            "contact": z.contact, "t_accumulation": json_num(z.t_accumulation),
+            "ratio": json_num(z.ratio), "bounces": z.bounces,
+        })).collect::<Vec<_>>(),
+        "actions": h.actions.iter().map(|(t, name, texts)| json!({
+            "t": json_num(*t), "event": name, "set": texts,
+        })).collect::<Vec<_>>(),
+        "work_contacts": json_num(h.work_contacts),
+        "dissipated_friction": json_num(h.dissipated_friction),
+        "dissipated_impacts": json_num(h.dissipated_impacts),
     })
 }
 

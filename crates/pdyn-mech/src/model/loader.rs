@@ -49,6 +49,8 @@ pub(crate) struct Loader<'a> {
     /// Whether that value was a bare number (`mass = 2`), which takes the dimension its field
     /// needs.
     pub last_bare: bool,
+    /// The coordinates read so far: name and whether it is free (not prescribed).
+    pub coordinate_names: Vec<(String, bool)>,
 }
 
 impl<'a> Loader<'a> {
@@ -63,7 +65,25 @@ impl<'a> Loader<'a> {
             dims: Inference::default(),
             last: Form::default(),
             last_bare: false,
+            coordinate_names: Vec::new(),
         }
+    }
+
+    /// The index of coordinate `name` in the model and whether it is free.
+    pub fn coordinate_index(&self, name: &str) -> Option<(usize, bool)> {
+        self.coordinate_names
+            .iter()
+            .position(|(n, _)| n == name)
+            .map(|k| (k, self.coordinate_names[k].1))
+    }
+
+    /// The names of the free coordinates, and of their rates.
+    pub fn free_coordinate_names(&self) -> Vec<String> {
+        let free = self.coordinate_names.iter().filter(|c| c.1);
+        free.clone()
+            .map(|c| c.0.clone())
+            .chain(free.map(|c| format!("{}'", c.0)))
+            .collect()
     }
 
     pub fn err(&self, span: Range<usize>, msg: impl Into<String>) -> ModelError {

@@ -8,12 +8,14 @@
 //! the file, line and column of the offending text.
 
 pub mod constants;
+mod contacts;
 mod forces;
 mod loader;
 pub(crate) mod raw;
 pub mod spec;
 mod tables;
 
+pub use contacts::Contact;
 pub(crate) use loader::Loader;
 use pdyn_expr::error::render_diagnostic;
 use pdyn_expr::{Id, Pool, SymId, Value};
@@ -171,8 +173,12 @@ pub struct Reaction {
 pub struct Constraint {
     /// Name or the equation's text.
     pub label: String,
-    /// `f(q, t)` meaning `f = 0`.
+    /// `f(q, t)` meaning `f = 0` (or `f(q, q', t) = 0` when `derivatives` is 1).
     pub equation: Id,
+    /// How often it is differentiated to enter the equations at acceleration level: 2 for a
+    /// relation among coordinates, 1 for one among rates (a contact that sticks: its slip
+    /// velocity is zero).
+    pub derivatives: usize,
     /// Where it is written in the model file.
     pub span: Range<usize>,
 }
@@ -227,6 +233,9 @@ pub struct Model {
     pub reactions: Vec<Reaction>,
     /// Constraint equations.
     pub constraints: Vec<Constraint>,
+    /// `[[contacts]]` and Coulomb `friction` forces: what may open, close, stick, slide and
+    /// collide ([`crate::hybrid`]).
+    pub contacts: Vec<Contact>,
     /// Potential energies of the conservative forces.
     pub potentials: Vec<PotentialTerm>,
     /// True when every force has a potential or is a reaction (energy is then conserved
@@ -271,12 +280,15 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
     let frames = ld.read_frames(&raw, &particles)?;
     let forces::Built {
         friction_forces,
+        contacts: mut friction_contacts,
         loads,
         reactions,
         potentials,
         conservative,
     } = ld.read_forces(&raw, &particles, &frames, &points)?;
     let constraints = ld.read_constraints(&raw)?;
+    friction_contacts.extend(ld.read_contacts(&raw, &particles, &reactions)?);
+    let contacts = friction_contacts;
     let params = ld.params.clone();
     let run = spec::read(&mut ld, &raw, &params)?;
     let checks = spec::read_checks(&mut ld, &raw)?;
@@ -304,6 +316,7 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
         loads,
         reactions,
         constraints,
+        contacts,
         potentials,
         conservative,
     })

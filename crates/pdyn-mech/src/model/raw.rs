@@ -35,6 +35,8 @@ pub struct RawModel {
     pub forces: Vec<Spanned<RawForce>>,
     #[serde(default)]
     pub constraints: Vec<Spanned<RawConstraint>>,
+    #[serde(default)]
+    pub contacts: Vec<Spanned<RawContact>>,
     pub simulate: Option<Spanned<RawSimulate>>,
     #[serde(default)]
     pub events: Vec<Spanned<RawEvent>>,
@@ -93,6 +95,8 @@ pub struct RawEvent {
     pub when: Option<Sv>,
     pub direction: Option<Name>,
     pub terminal: Option<Spanned<toml::Value>>,
+    /// Assignments made when the event fires: `["y' = -e*y'", "thrust = 0"]`.
+    pub set: Option<Spanned<Vec<Sv>>>,
 }
 
 /// `[sweep]`: runs over parameter values, with response measures.
@@ -164,10 +168,33 @@ pub struct RawForce {
     pub strength: Option<Sv>,
     pub potential: Option<Sv>,
     pub mu: Option<Sv>,
+    pub mu_s: Option<Sv>,
+    pub mu_k: Option<Sv>,
     pub normal: Option<Sv>,
     pub tangent: Option<Sv>,
     pub mode: Option<Name>,
     pub opposes: Option<Sv>,
+    pub surface_velocity: Option<Sv>,
+    pub normal_force: Option<Name>,
+    pub friction_force: Option<Name>,
+}
+
+/// `[[contacts]]`: a particle against a surface, or two particles, that may touch, separate,
+/// stick, slide and collide.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawContact {
+    pub name: Option<Name>,
+    pub on: Option<Name>,
+    pub between: Option<Spanned<Vec<Name>>>,
+    /// `phi(r)`: apart where it is positive, touching where it is zero.
+    pub surface: Option<Sv>,
+    /// For `between`: the centre distance at contact (the sum of the radii).
+    pub distance: Option<Sv>,
+    pub e: Option<Sv>,
+    pub mu: Option<Sv>,
+    pub mu_s: Option<Sv>,
+    pub mu_k: Option<Sv>,
     pub surface_velocity: Option<Sv>,
     pub normal_force: Option<Name>,
     pub friction_force: Option<Name>,

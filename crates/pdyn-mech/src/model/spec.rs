@@ -60,6 +60,32 @@ pub struct EventSpec {
     pub direction: Crossing,
     /// Stop at the n-th occurrence (`terminal = true` is 1).
     pub terminal: Option<usize>,
+    /// Assignments made when it fires (`set = ["y' = -e*y'"]`), all right-hand sides
+    /// evaluated before any is made.
+    pub actions: Vec<EventAction>,
+}
+
+/// What an event action assigns to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ActionTarget {
+    /// The value of the free coordinate with this index in `Model::coordinates`.
+    Coordinate(usize),
+    /// Its rate.
+    Rate(usize),
+    /// The parameter with this index in `Model::parameters`.
+    Parameter(usize),
+}
+
+/// One assignment `target = value` of an event's `set`.
+#[derive(Clone, Debug)]
+pub struct EventAction {
+    /// What changes.
+    pub target: ActionTarget,
+    /// Its new value (an expression of the state just before the event, the parameters and
+    /// `t`).
+    pub value: Id,
+    /// The text of the assignment, for reports.
+    pub text: String,
 }
 
 /// A named expression evaluated along the trajectory.
@@ -327,11 +353,16 @@ pub(super) fn read(
                 )),
             },
         };
+        let actions = match &e.set {
+            None => Vec::new(),
+            Some(list) => event_actions(ld, list.get_ref())?,
+        };
         spec.events.push(EventSpec {
             name,
             when,
             direction,
             terminal,
+            actions,
         });
     }
     for (name, sv) in &raw.monitors {
@@ -516,4 +547,104 @@ pub(super) fn read(
         });
     }
     Ok(spec)
+}
+
+/// The assignments of an event's `set`: `"x' = -e*x'"` (a free coordinate's value or rate) or
+/// `"thrust = 0"` (a parameter).
+fn event_actions(ld: &mut Loader, list: &[Sv]) -> Result<Vec<EventAction>, ModelError> {
+    let mut out: Vec<EventAction> = Vec::new();
+    for sv in list {
+        let toml::Value::String(text) = sv.get_ref() else {
+            return Err(ld
+                .err(
+                    sv.span(),
+                    "an event action is a string \"target = expression\"",
+                )
+                .help("set = [\"y' = -e*y'\", \"thrust = 0\"]"));
+        };
+        let (_, off) = ld.expr_text(sv)?;
+        let (lhs, rhs) = pdyn_expr::syntax::parse_equation(text).map_err(|e| ld.located(e, off))?;
+        let Some(rhs) = rhs else {
+            return Err(ld
+                .err(sv.span(), format!("`{text}` is not an assignment"))
+                .help("write target = expression, e.g. \"y' = -e*y'\""));
+        };
+        let (name, primes, lspan) = match &lhs {
+            pdyn_expr::syntax::Ast::Ident { name, span } => (name.clone(), 0u8, span.clone()),
+            pdyn_expr::syntax::Ast::Prime { expr, count, span } => match expr.as_ref() {
+                pdyn_expr::syntax::Ast::Ident { name, .. } => (name.clone(), *count, span.clone()),
+                _ => return Err(not_assignable(ld, sv, off, lhs.span())),
+            },
+            _ => return Err(not_assignable(ld, sv, off, lhs.span())),
+        };
+        let lspan = lspan.start + off..lspan.end + off;
+        let target = if let Some(k) = ld.params.iter().position(|p| p.name == name) {
+            if primes > 0 {
+                return Err(ld
+                    .err(
+                        lspan,
+                        format!("`{name}` is a parameter: it has no rate to set"),
+                    )
+                    .help(format!("set the parameter itself: \"{name} = ...\"")));
+            }
+            ActionTarget::Parameter(k)
+        } else {
+            match ld.coordinate_index(&name) {
+                Some((k, true)) if primes == 0 => ActionTarget::Coordinate(k),
+                Some((k, true)) if primes == 1 => ActionTarget::Rate(k),
+                Some((_, true)) => {
+                    return Err(ld
+                        .err(lspan, format!("an event sets a coordinate (`{name}`) or its rate (`{name}'`), not a higher derivative"))
+                        .help("accelerations follow from the forces; change a force's parameter instead"))
+                }
+                Some((_, false)) => {
+                    return Err(ld
+                        .err(lspan, format!("`{name}` is prescribed as a function of time: an event cannot change it"))
+                        .help("only free coordinates, their rates and parameters can be set"))
+                }
+                None => {
+                    let mut names: Vec<String> = ld.params.iter().map(|p| p.name.clone()).collect();
+                    names.extend(ld.free_coordinate_names());
+                    let e = ld.err(lspan, format!("`{name}` is not a free coordinate or a parameter: an event cannot set it"));
+                    return Err(match suggest(&name, names.iter().map(|s| s.as_str())) {
+                        Some(s) => e.help(format!("did you mean `{s}`?")),
+                        None => e.help(format!("an event sets one of: {}", names.join(", "))),
+                    });
+                }
+            }
+        };
+        if out.iter().any(|a| a.target == target) {
+            return Err(ld
+                .err(
+                    lspan,
+                    format!(
+                        "`{}` is set twice by this event",
+                        ld.source[sv.span()].trim_matches('"')
+                    ),
+                )
+                .help("each target may be set once per event"));
+        }
+        let v = pdyn_expr::lower::lower(&mut ld.pool, &rhs, &mut ld.scope)
+            .map_err(|e| ld.located(e, off))?;
+        let Value::Scalar(value) = v else {
+            return Err(ld.err(sv.span(), format!("`{text}` assigns a vector to a scalar")));
+        };
+        out.push(EventAction {
+            target,
+            value,
+            text: text.clone(),
+        });
+    }
+    Ok(out)
+}
+
+fn not_assignable(ld: &Loader, sv: &Sv, off: usize, span: Range<usize>) -> ModelError {
+    ld.err(
+        span.start + off..span.end + off,
+        "an event sets a free coordinate, its rate or a parameter",
+    )
+    .help(format!(
+        "write \"x = ...\", \"x' = ...\" or \"k = ...\" (in {})",
+        ld.source[sv.span()].trim()
+    ))
 }

@@ -133,6 +133,8 @@ impl Loader<'_> {
                 CoordinateKind::Prescribed { expr } => Binding::Value(Value::Scalar(*expr)),
             };
             self.declare(n, name.span(), "coordinate", binding)?;
+            self.coordinate_names
+                .push((n.clone(), matches!(kind, CoordinateKind::Free { .. })));
             out.coordinates.push(Coordinate {
                 name: n.clone(),
                 sym,
@@ -475,6 +477,20 @@ impl Loader<'_> {
             fb.force(self, f)?;
         }
         let built = fb.finish();
+        let friction_names = built.contacts.iter().flat_map(|c| {
+            let (n, ids) = &c.friction_force;
+            [(n.clone(), ids[0]), (format!("{n}_2"), ids[1])]
+        });
+        let friction_names: Vec<(String, Id)> = friction_names.collect();
+        for (name, id) in friction_names {
+            if !self.scope.names.contains_key(&name) {
+                self.scope.order.push(name.clone());
+                self.scope.names.insert(
+                    name.clone(),
+                    (Binding::Value(Value::Scalar(id)), 0..0, "reaction"),
+                );
+            }
+        }
         for r in &built.reactions {
             if !self.scope.names.contains_key(&r.name) {
                 self.scope.order.push(r.name.clone());
@@ -529,6 +545,7 @@ impl Loader<'_> {
             constraints.push(Constraint {
                 label,
                 equation: e,
+                derivatives: 2,
                 span: eq.span(),
             });
         }

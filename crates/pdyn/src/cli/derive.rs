@@ -57,6 +57,13 @@ pub const EXPLICIT_CHARS: usize = 600;
 /// `pdyn derive MODEL`.
 pub fn run(a: DeriveArgs) -> Result<String, Error> {
     let mut model = load_model(&a.model)?;
+    // A model with contacts is printed in one mode of its contacts, named in a note.
+    let mut hybrid_note = None;
+    if pdyn_mech::hybrid::is_hybrid(&model) && !model.contacts.is_empty() {
+        let (m, note) = pdyn_mech::hybrid::reference_model(&model);
+        model = m;
+        hybrid_note = Some(note);
+    }
     let opts = DeriveOptions {
         form: match a.form {
             FormArg::Auto => Form::Auto,
@@ -75,10 +82,11 @@ pub fn run(a: DeriveArgs) -> Result<String, Error> {
         simplify_solution_within_budget: true,
         ..DeriveOptions::default()
     };
-    let d = derive(&mut model, &opts).map_err(|error| Error::Derive {
+    let mut d = derive(&mut model, &opts).map_err(|error| Error::Derive {
         origin: model.origin.clone(),
         error,
     })?;
+    d.notes.extend(hybrid_note);
     // A closed form of accelerations too large to print is of no use to a reader, and
     // attempting it re-derives and formats huge coefficients (32 MB on the 4-link chain).
     let explicit_chars = if a.solve { PRINT_CHARS } else { EXPLICIT_CHARS };

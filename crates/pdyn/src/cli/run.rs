@@ -272,6 +272,9 @@ fn text_report(
             );
         }
     }
+    if let Some(h) = &res.hybrid {
+        s += &hybrid_text(h);
+    }
     if !res.monitors.is_empty() {
         s += "\nconserved quantities:\n";
         for m in &res.monitors {
@@ -292,6 +295,72 @@ fn text_report(
             dir.display()
         );
     }
+    s
+}
+
+/// Most lines of each list (mode intervals, switches, impacts) in the text report; the whole
+/// lists are in `summary.json`.
+const HYBRID_LINES: usize = 12;
+
+/// The mode timeline, impacts, Zeno accumulations, event actions and energy accounting of a
+/// hybrid run.
+fn hybrid_text(h: &sim::hybrid::HybridReport) -> String {
+    let mut s = String::new();
+    let more = |s: &mut String, total: usize| {
+        if total > HYBRID_LINES {
+            *s += &format!("  ... {} more in summary.json\n", total - HYBRID_LINES);
+        }
+    };
+    if !h.timeline.is_empty() {
+        s += "\ncontact modes:\n";
+        for iv in h.timeline.iter().take(HYBRID_LINES) {
+            let modes: Vec<String> = iv.modes.iter().map(|(c, m)| format!("{c} {m}")).collect();
+            s += &format!(
+                "  t = {:.9e} .. {:.9e}  {}\n",
+                iv.t_from,
+                iv.t_to,
+                modes.join(", ")
+            );
+        }
+        more(&mut s, h.timeline.len());
+    }
+    if !h.switches.is_empty() {
+        s += "\nswitches:\n";
+        for sw in h.switches.iter().take(HYBRID_LINES) {
+            s += &format!(
+                "  t = {:.12e}  {}: {} -> {} ({})\n",
+                sw.t, sw.contact, sw.from, sw.to, sw.reason
+            );
+        }
+        more(&mut s, h.switches.len());
+    }
+    if !h.impacts.is_empty() {
+        s += &format!("\nimpacts ({}):\n", h.impacts.len());
+        for im in h.impacts.iter().take(HYBRID_LINES) {
+            s += &format!(
+                "  t = {:.12e}  {}: normal speed {:.6e} -> {:.6e}, impulse {:.6e}, energy lost {:.6e}\n",
+                im.t, im.contact, im.normal_speed_before, im.normal_speed_after, im.impulse, im.energy_lost
+            );
+        }
+        more(&mut s, h.impacts.len());
+    }
+    for z in &h.zeno {
+        s += &format!(
+            "\nZeno: the bounces at `{}` accumulate at t = {:.12e} (ratio {:.9}, {} bounces integrated): resting contact from there\n",
+            z.contact, z.t_accumulation, z.ratio, z.bounces
+        );
+    }
+    if !h.actions.is_empty() {
+        s += "\nevent actions:\n";
+        for (t, name, texts) in h.actions.iter().take(HYBRID_LINES) {
+            s += &format!("  t = {t:.12e}  {name}: {}\n", texts.join("; "));
+        }
+        more(&mut s, h.actions.len());
+    }
+    s += &format!(
+        "\nenergy: work of the contact forces {:.9e}, dissipated by friction {:.9e}, lost in impacts {:.9e}\n",
+        h.work_contacts, h.dissipated_friction, h.dissipated_impacts
+    );
     s
 }
 

@@ -62,6 +62,12 @@ pub enum SimError {
         /// The size of the constraint's terms (what the residual is compared with).
         scale: f64,
     },
+    /// A contact that cannot start or go on: penetrated at t = 0, coefficients out of range
+    /// after `--set`, modes that contradict their own forces.
+    Contact {
+        /// What is wrong, naming the contact and the time.
+        message: String,
+    },
     /// A run setting outside its valid range (named as on the command line).
     InvalidOption {
         /// The option, e.g. `--dt`.
@@ -85,6 +91,9 @@ pub enum ClosedFormError {
     Dsolve(DsolveError),
     /// The solution could not be compiled.
     Compile(CompileError),
+    /// The model has contacts or event actions: its motion switches between sets of
+    /// equations, and no one closed form describes it.
+    Hybrid,
     /// Solving in symbols needed more than `work` units of simplification.
     TooCostly {
         /// The budget that ran out.
@@ -100,6 +109,11 @@ impl fmt::Display for ClosedFormError {
                 f.write_str("the equations were not solved for the accelerations symbolically")
             }
             ClosedFormError::Dsolve(e) => write!(f, "{e}"),
+            ClosedFormError::Hybrid => f.write_str(
+                "the model has contacts or event actions: its motion switches between sets of \
+                 equations at its impacts and mode changes, so no one closed form describes it \
+                 (`pdyn run` follows it through the switches)",
+            ),
             ClosedFormError::Compile(e) => write!(f, "{e}"),
             ClosedFormError::TooCostly { work } => write!(
                 f,
@@ -157,6 +171,7 @@ impl fmt::Display for SimError {
                 value,
                 requirement,
             } => write!(f, "{option} must be {requirement}, got {value}"),
+            SimError::Contact { message } => f.write_str(message),
         }
     }
 }

@@ -54,6 +54,9 @@ pub fn symbolic_closed_form(model: &mut Model) -> Result<ExactSolution, ClosedFo
 pub const CLOSED_FORM_WORK: u64 = 400_000;
 
 fn closed_form_with(model: &mut Model, at_values: bool) -> Result<ExactSolution, ClosedFormError> {
+    if pdyn_mech::hybrid::is_hybrid(model) {
+        return Err(ClosedFormError::Hybrid);
+    }
     let d = derive(model, &DeriveOptions::default()).map_err(ClosedFormError::Derive)?;
     match d.accelerations() {
         Some(acc) => {

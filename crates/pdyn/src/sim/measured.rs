@@ -51,6 +51,9 @@ pub struct Measured {
 /// drift of its conserved quantities and its warnings: what [`super::run`] followed by the
 /// statistics of the measures over its rows gives, without the rows.
 pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Measured, SimError> {
+    if let Some(h) = &prep.hybrid {
+        return measure_hybrid(prep, h, set, stats);
+    }
     let (sol, failure) = integrate(prep, set)?;
     let sys = &prep.system;
     let n_meas = prep.measures.as_ref().map_or(0, |m| m.len());
@@ -152,6 +155,61 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
         failure,
         status,
         stats: sol.stats.clone(),
+    })
+}
+
+/// [`measure`] of a hybrid model: the run with its table (a run switches between modes,
+/// each with its own programs), reduced to what a sweep keeps; the measures are evaluated at
+/// each row's time and state ([`super::hybrid::Hybrid::measures`]).
+fn measure_hybrid(
+    prep: &Prepared,
+    h: &super::hybrid::Hybrid,
+    set: &RunSettings,
+    stats: &[Stat],
+) -> Result<Measured, SimError> {
+    let res = super::hybrid::run(prep, h, set)?;
+    let n_state = prep.state_names.len();
+    let params = prep.system.parameters();
+    let mut measures = Vec::new();
+    if let Some(m) = h.measures() {
+        let mut series = vec![Vec::with_capacity(res.rows.len()); m.len()];
+        let mut out = vec![0.0; m.len()];
+        let mut input = Vec::new();
+        for r in &res.rows {
+            input.clear();
+            input.extend_from_slice(&r[..1 + n_state]);
+            input.extend_from_slice(&params);
+            m.eval(&input, &mut out);
+            for (s, &o) in series.iter_mut().zip(&out) {
+                s.push(o);
+            }
+        }
+        let ts: Vec<f64> = res.rows.iter().map(|r| r[0]).collect();
+        measures = series
+            .iter()
+            .zip(stats)
+            .map(|(s, &st)| statistic(st, &ts, s))
+            .collect();
+    }
+    let mut first_hits = vec![None; prep.events.len()];
+    for e in &res.events {
+        if let Some(k) = prep.events.iter().position(|p| p.name == e.name) {
+            if first_hits[k].is_none() {
+                first_hits[k] = Some((e.t, e.state.clone()));
+            }
+        }
+    }
+    Ok(Measured {
+        measures,
+        last: res.rows.last().map(|r| (r[0], r[1..1 + n_state].to_vec())),
+        events: res.events.clone(),
+        first_hits,
+        non_finite: NonFinite::of_rows(&res.rows),
+        monitors: res.monitors.clone(),
+        warnings: res.warnings.clone(),
+        failure: res.failure.clone(),
+        status: res.status,
+        stats: res.stats.clone(),
     })
 }
 

@@ -14,6 +14,7 @@
 pub mod compiled;
 mod error;
 pub mod exact;
+pub mod hybrid;
 pub mod measured;
 pub mod sweep;
 
@@ -259,6 +260,9 @@ pub struct Prepared {
     pub parameter_names: Vec<String>,
     /// Parameters defined by others (`m = "4/3*pi*a^3*rho"`), recomputed for each sweep run.
     pub derived: DerivedParameters,
+    /// Contacts and event actions: the run switches between modes ([`hybrid`]); `system`
+    /// and `observer` are then those of one reference mode, for the names and initial state.
+    pub hybrid: Option<Box<hybrid::Hybrid>>,
 }
 
 impl Prepared {
@@ -267,7 +271,10 @@ impl Prepared {
     pub fn columns(&self) -> Vec<String> {
         let mut columns = vec!["t".to_string()];
         columns.extend(self.state_names.iter().cloned());
-        columns.extend(self.observer.names.iter().cloned());
+        match &self.hybrid {
+            Some(h) => columns.extend(h.column_names.iter().cloned()),
+            None => columns.extend(self.observer.names.iter().cloned()),
+        }
         columns
     }
 
@@ -398,6 +405,8 @@ pub struct RunResult {
     pub failure: Option<RunFailure>,
     /// How the run ended (SciPy's `status`: 0, 1, -1).
     pub status: RunStatus,
+    /// The mode timeline, switches, impacts and energy balance of a hybrid run.
+    pub hybrid: Option<hybrid::HybridReport>,
 }
 
 /// How a run ended.
@@ -450,6 +459,18 @@ pub fn prepare_with_jit(
     opts: &DeriveOptions,
     jit: JitMode,
 ) -> Result<Prepared, SimError> {
+    // A hybrid model is prepared in a reference mode (its held contacts touching, the others
+    // open); the run derives the other modes as it meets them.
+    let mut hybrid = None;
+    let mut reference_model;
+    let model = if pdyn_mech::hybrid::is_hybrid(model) {
+        let (h, _) = hybrid::Hybrid::new(model, jit)?;
+        reference_model = pdyn_mech::hybrid::reference_model(model).0;
+        hybrid = Some(Box::new(h));
+        &mut reference_model
+    } else {
+        model
+    };
     // The chapter's steps: equations of motion, solved for the accelerations...
     let d = derive(model, opts).map_err(SimError::Derive)?;
     // ... as a first-order system the integrators can step...
@@ -464,7 +485,9 @@ pub fn prepare_with_jit(
     let values: Vec<f64> = model.parameters.iter().map(|q| q.value).collect();
     let mut y0 = vec![0.0; d.state.len()];
     initial_conditions.eval(&values, &mut y0);
-    check_constraints_at_start(model, &system, &y0)?;
+    if hybrid.is_none() {
+        check_constraints_at_start(model, &system, &y0)?;
+    }
     Ok(Prepared {
         system,
         observer,
@@ -479,6 +502,7 @@ pub fn prepare_with_jit(
         initial_conditions,
         parameter_names: model.parameters.iter().map(|q| q.name.clone()).collect(),
         derived: DerivedParameters::compile(model),
+        hybrid,
     })
 }
 
@@ -724,6 +748,9 @@ fn non_finite_at(prep: &Prepared, sys: &CompiledModel, t: f64, y: &[f64]) -> Vec
 
 /// Integrates a prepared model.
 pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, SimError> {
+    if let Some(h) = &prep.hybrid {
+        return hybrid::run(prep, h, set);
+    }
     let (sol, failure) = integrate(prep, set)?;
     Ok(tabulate(prep, &sol, set, failure))
 }
@@ -942,5 +969,6 @@ pub(crate) fn tabulate(
         method: Solver::Ode(sol.method),
         failure,
         status,
+        hybrid: None,
     }
 }

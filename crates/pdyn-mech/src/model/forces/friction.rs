@@ -3,8 +3,17 @@
 //! `-mu N s` (`mode = "slip"`, `s` the unit sliding direction: `opposes`, or the velocity of
 //! the contact point minus `surface_velocity`, without its normal part). Slip is not
 //! conservative.
+//!
+//! `mode = "coulomb"` (the default when `mu_s` or `mu_k` is given), and `"slip"` without
+//! `opposes`, are Coulomb friction that sticks and slips: the sliding load is what `pdyn
+//! derive` and `pdyn forces` show, and the entry is also a held contact
+//! ([`crate::model::Contact`]) whose modes `pdyn run` switches between
+//! ([`crate::hybrid`]): stuck while the force needed to stick is within `mu_s N`, sliding
+//! against the slip with `mu_k N` otherwise.
 
-use super::{vector, Entry, ForceBuilder, Kind, Load, Loader, ModelError};
+use super::{vector, Entry, ForceBuilder, Kind, Load, Loader, ModelError, Target};
+use crate::model::Contact;
+use pdyn_expr::Id;
 
 pub(super) const FRICTION: Kind = Kind {
     name: "friction",
@@ -28,6 +37,8 @@ fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelEr
         .as_ref()
         .map_or("T".to_string(), |n| n.get_ref().clone());
     let n_id = b.reaction(ld, &n_name, e.span_or_kind(&raw.normal_force))?;
+    let n_span = e.span_or_kind(&raw.normal_force);
+    b.directed(ld, &n_name, &target, normal, n_span, "friction")?;
     let n_form = ld.dims.of(&n_name).unwrap_or_default();
     ld.want_times(
         nsv,
@@ -41,7 +52,27 @@ fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelEr
         target: target.clone(),
         force: nforce,
     });
-    let mode = raw.mode.as_ref().map_or("stick", |m| m.get_ref().as_str());
+    let coulomb_default = raw.mu_s.is_some() || raw.mu_k.is_some();
+    let mode = raw
+        .mode
+        .as_ref()
+        .map_or(if coulomb_default { "coulomb" } else { "stick" }, |m| {
+            m.get_ref().as_str()
+        });
+    if mode != "coulomb" {
+        if let Some(sv) = raw.mu_s.as_ref().or(raw.mu_k.as_ref()) {
+            return Err(ld
+                .err(
+                    sv.span(),
+                    format!(
+                        "`mu_s` and `mu_k` belong to Coulomb friction, not to mode = \"{mode}\""
+                    ),
+                )
+                .help(
+                    "use mode = \"coulomb\" (sticks and slips), or mu = ... with mode = \"slip\"",
+                ));
+        }
+    }
     match mode {
         "stick" => {
             let tsv = e.need(
@@ -66,14 +97,8 @@ fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelEr
                 force: tforce,
             });
         }
-        "slip" => {
-            let musv = e.need(ld, &raw.mu, "mu")?;
-            let mu = ld.scalar(musv, "`mu`")?;
-            ld.want(
-                musv,
-                pdyn_expr::Dimension::NONE,
-                "the friction coefficient `mu`",
-            );
+        "slip" | "coulomb" => {
+            let (mu, mu_s) = coefficients(ld, e, mode)?;
             let dir = match &raw.opposes {
                 Some(s) => {
                     let s = ld.vector(s, "`opposes`")?;
@@ -107,19 +132,106 @@ fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelEr
             let mag = ld.pool.mul2(mu, n_id);
             let neg = ld.pool.neg(mag);
             let tforce = vector::scale(&mut ld.pool, neg, dir);
+            let slip_load = b.loads.len();
             b.loads.push(Load {
                 label: format!("sliding friction mu*{n_name}"),
-                target,
+                target: target.clone(),
                 force: tforce,
             });
             b.conservative = false;
+            if raw.opposes.is_none() {
+                let Target::Particle(a) = target else {
+                    return Err(ld
+                        .err(e.kind_span.clone(), "friction that sticks and slips acts on a particle, not on a frame")
+                        .help("put `on` on the particle at the contact, or give the sliding direction with `opposes` and mode = \"slip\""));
+                };
+                let surface_velocity = match &raw.surface_velocity {
+                    Some(s) => ld.vector(s, "`surface_velocity`")?,
+                    None => [pdyn_expr::Pool::ZERO; 3],
+                };
+                let unit_normal = vector::unit(&mut ld.pool, normal);
+                let f1 = ld.pool.symbol(&t_name, false);
+                let f2 = ld.pool.symbol(&format!("{t_name}_2"), false);
+                let fs = [ld.pool.sym(f1), ld.pool.sym(f2)];
+                b.contacts.push(Contact {
+                    name: e.label.clone(),
+                    span: e.f.span(),
+                    a,
+                    b: None,
+                    gap: pdyn_expr::Pool::ZERO,
+                    normal: unit_normal,
+                    held: true,
+                    restitution: pdyn_expr::Pool::ZERO,
+                    friction: Some((mu_s, mu)),
+                    surface_velocity,
+                    normal_force: (n_name.clone(), n_id),
+                    friction_force: (t_name.clone(), fs),
+                    normal_in_model: true,
+                    replaces_loads: vec![slip_load],
+                    value_spans: [e.f.span(), e.f.span(), e.f.span()],
+                });
+            }
         }
         other => {
             let m = e.span_or_kind(&raw.mode);
             return Err(ld
                 .err(m, format!("unknown friction mode `{other}`"))
-                .help("mode is \"stick\" (friction force unknown) or \"slip\" (T = mu*N opposing sliding)"));
+                .help("mode is \"stick\" (friction force unknown), \"slip\" (T = mu*N opposing sliding) or \"coulomb\" (sticks and slips: mu_s, mu_k)"));
         }
     }
     Ok(())
+}
+
+/// `(mu_k, mu_s)`: `mu` for both, or `mu_s` and `mu_k` (Coulomb mode), each a pure number of
+/// the parameters, `>= 0`, with `mu_k <= mu_s`.
+fn coefficients(ld: &mut Loader, e: &Entry, mode: &str) -> Result<(Id, Id), ModelError> {
+    let raw = e.raw;
+    let read = |ld: &mut Loader, sv: &super::Sv, what: &str| -> Result<(Id, f64), ModelError> {
+        let x = ld.scalar(sv, what)?;
+        ld.want(sv, pdyn_expr::Dimension::NONE, what);
+        let v = ld.constant(x, sv.span(), what)?;
+        if v < 0.0 {
+            return Err(ld
+                .err(sv.span(), format!("{what} is {v}; it must be at least 0"))
+                .help("friction coefficients are >= 0 (0: a smooth contact)"));
+        }
+        Ok((x, v))
+    };
+    match (&raw.mu, &raw.mu_s, &raw.mu_k) {
+        (Some(m), None, None) => {
+            let (x, _) = read(ld, m, "the friction coefficient `mu`")?;
+            Ok((x, x))
+        }
+        (Some(_), Some(sv), _) | (Some(_), _, Some(sv)) => Err(ld
+            .err(
+                sv.span(),
+                "`mu` sets both coefficients: give `mu`, or `mu_s` and `mu_k`",
+            )
+            .help("mu = 0.3 (static = kinetic), or mu_s = 0.4 and mu_k = 0.3")),
+        (None, s, k) if mode == "coulomb" && (s.is_some() || k.is_some()) => {
+            let s = s
+                .as_ref()
+                .map(|sv| read(ld, sv, "the static friction coefficient `mu_s`"))
+                .transpose()?;
+            let k = k
+                .as_ref()
+                .map(|sv| read(ld, sv, "the kinetic friction coefficient `mu_k`"))
+                .transpose()?;
+            let zero = (pdyn_expr::Pool::ZERO, 0.0);
+            let (s, k) = (s.or(k).unwrap_or(zero), k.or(s).unwrap_or(zero));
+            if k.1 > s.1 {
+                let span = raw.mu_k.as_ref().map_or(e.f.span(), |sv| sv.span());
+                return Err(ld
+                    .err(span, format!("mu_k = {} is larger than mu_s = {}: kinetic friction cannot exceed static friction", k.1, s.1))
+                    .help("a body that can slide against mu_k*N could not have been held by mu_s*N: make mu_k <= mu_s"));
+            }
+            Ok((k.0, s.0))
+        }
+        _ => Err(ld
+            .err(
+                e.f.span(),
+                format!("a `friction` force in mode \"{mode}\" needs `mu`"),
+            )
+            .help("add mu = ... (or mu_s and mu_k for mode = \"coulomb\")")),
+    }
 }

@@ -133,6 +133,8 @@ type End = (Endpoint, [Id; 3], String);
 
 pub(super) struct Built {
     pub friction_forces: Vec<String>,
+    /// Coulomb `friction` forces, as held contacts.
+    pub contacts: Vec<super::Contact>,
     pub loads: Vec<Load>,
     pub reactions: Vec<Reaction>,
     pub potentials: Vec<PotentialTerm>,
@@ -148,6 +150,19 @@ pub(super) struct ForceBuilder<'a> {
     potentials: Vec<PotentialTerm>,
     conservative: bool,
     friction_forces: Vec<String>,
+    contacts: Vec<super::Contact>,
+    /// Unknown forces `name * direction` pushed so far, by `reaction` and by `friction`'s
+    /// normal force, to refuse one unknown declared twice on one body along one line.
+    directed: Vec<Directed>,
+}
+
+/// An unknown force `name * direction` on a body, and which entry declared it.
+struct Directed {
+    name: String,
+    target: Target,
+    direction: [Id; 3],
+    span: Range<usize>,
+    kind: &'static str,
 }
 
 impl<'a> ForceBuilder<'a> {
@@ -165,12 +180,15 @@ impl<'a> ForceBuilder<'a> {
             potentials: Vec::new(),
             conservative: true,
             friction_forces: Vec::new(),
+            contacts: Vec::new(),
+            directed: Vec::new(),
         }
     }
 
     pub fn finish(self) -> Built {
         Built {
             friction_forces: self.friction_forces,
+            contacts: self.contacts,
             loads: self.loads,
             reactions: self.reactions,
             potentials: self.potentials,
@@ -376,6 +394,42 @@ impl<'a> ForceBuilder<'a> {
             id,
         });
         Ok(id)
+    }
+
+    /// Records the unknown force `name * direction` on `target`, declared by a `kind` entry
+    /// at `span`; refuses it when an entry of the other kind (`reaction` and `friction`)
+    /// already applies the same unknown to the same body along the same line: a free body
+    /// diagram that draws the normal force both as a reaction and as a friction's normal
+    /// force would count it twice (and halve it).
+    fn directed(
+        &mut self,
+        ld: &mut Loader,
+        name: &str,
+        target: &Target,
+        direction: [Id; 3],
+        span: Range<usize>,
+        kind: &'static str,
+    ) -> Result<(), ModelError> {
+        for d in &self.directed {
+            if d.name != name || &d.target != target || d.kind == kind {
+                continue;
+            }
+            let c = vector::cross(&mut ld.pool, d.direction, direction);
+            if c.iter().all(|&x| ld.pool.provably_equal(x, Pool::ZERO)) {
+                let (line, _) = pdyn_expr::error::line_col(ld.source, d.span.start);
+                return Err(ld
+                    .err(span, format!("`{name}` already acts on this body along the same line (the {} on line {line}): declared twice, it would be counted twice", d.kind))
+                    .help("a `friction` force applies its own normal force `normal_force` (default N): remove the `reaction`, or give the two forces different names"));
+            }
+        }
+        self.directed.push(Directed {
+            name: name.to_string(),
+            target: target.clone(),
+            direction,
+            span,
+            kind,
+        });
+        Ok(())
     }
 
     fn with_local<T>(

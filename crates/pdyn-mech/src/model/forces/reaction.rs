@@ -19,6 +19,7 @@ fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelEr
         Some(d) => {
             let dir = ld.vector(d, "`direction`")?;
             let n = b.reaction(ld, name.get_ref(), name.span())?;
+            b.directed(ld, name.get_ref(), &target, dir, name.span(), "reaction")?;
             let n_form = ld.dims.of(name.get_ref()).unwrap_or_default();
             let what = format!("the reaction `{}` times its `direction`", name.get_ref());
             ld.want_times(d, &n_form, pdyn_expr::Dimension::FORCE, &what);
