@@ -324,6 +324,14 @@ fn run_dict(
     d.set_item("warnings", res.warnings)?;
     d.set_item("stats", stats_dict(py, &res.stats)?)?;
     d.set_item("method", res.method.to_string())?;
+    // The mode timeline, switches, impacts and energy accounting of a hybrid run, as the
+    // `hybrid` object of `summary.json` (the Python layer reads it with `json`).
+    d.set_item(
+        "hybrid_json",
+        res.hybrid
+            .as_ref()
+            .map(|h| pdyn::output::hybrid_summary(h).to_string()),
+    )?;
     Ok(d.into_any().unbind())
 }
 

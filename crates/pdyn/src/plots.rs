@@ -2,7 +2,8 @@
 //!
 //! A run gives `trajectory` (each particle's path: in the plane of motion with equal axes, or in
 //! 3-D), `coordinates` (each coordinate against time, one panel each, events marked) and, when
-//! pdyn monitors conserved quantities, `conservation` (their relative drift against time). A
+//! pdyn monitors conserved quantities, `conservation` (their relative drift against time); a
+//! hybrid run's mode switches and impacts are marked on the time plots and the trajectory. A
 //! sweep gives `sweep` (each response measure against the parameter, peaks marked). Each is
 //! written as SVG and PNG.
 
@@ -43,11 +44,32 @@ pub fn write_run_plots(
         return Err(Error::argument("--plot", "too few output points to plot"));
     }
     let t = column(res, "t").unwrap_or_default();
-    let markers: Vec<Marker> = res
+    let mut markers: Vec<Marker> = res
         .events
         .iter()
         .map(|e| Marker::vline(e.t, e.name.clone()))
         .collect();
+    // A hybrid run's switches (labelled with the new mode) and impacts (the first labelled:
+    // a bouncing ball has dozens), at their times; on the trajectory, where they happen.
+    let mut switch_times = Vec::new();
+    if let Some(h) = &res.hybrid {
+        for sw in &h.switches {
+            markers.push(Marker::vline(sw.t, format!("{} {}", sw.contact, sw.to)));
+            switch_times.push((sw.t, format!("{} {}", sw.contact, sw.to)));
+        }
+        for (k, im) in h.impacts.iter().enumerate() {
+            let label = if k == 0 {
+                "impact".to_string()
+            } else {
+                String::new()
+            };
+            markers.push(Marker::vline(im.t, label.clone()));
+            // An impact that ends in contact is marked once, by its switch.
+            if !h.switches.iter().any(|sw| sw.t == im.t) {
+                switch_times.push((im.t, label));
+            }
+        }
+    }
 
     // Trajectory: the components that vary.
     let mut planar = Vec::new();
@@ -86,6 +108,30 @@ pub fn write_run_plots(
         both(dir, "trajectory", |p| save3(&fig, p))?;
     } else if used.len() == 2 {
         let (a, b) = (used[0], used[1]);
+        // The particles' positions at each switch, interpolated between the output rows
+        // around it (the positions are continuous through every switch).
+        let mut at_switches = Vec::new();
+        for (ts, label) in &switch_times {
+            let k = t.partition_point(|x| x <= ts);
+            if k == 0 || k > t.len() {
+                continue;
+            }
+            let (k0, k1) = (k - 1, k.min(t.len() - 1));
+            let w = if t[k1] > t[k0] {
+                (ts - t[k0]) / (t[k1] - t[k0])
+            } else {
+                0.0
+            };
+            let at = |v: &[f64]| v[k0] + w * (v[k1] - v[k0]);
+            for (name, c) in &planar {
+                let label = if planar.len() > 1 && !label.is_empty() {
+                    format!("{name}: {label}")
+                } else {
+                    label.clone()
+                };
+                at_switches.push(Marker::point(at(&c[a]), at(&c[b]), label));
+            }
+        }
         let fig = Figure {
             title: format!("{}: trajectory", model.name),
             x_label: names[a].into(),
@@ -95,6 +141,7 @@ pub fn write_run_plots(
                 .map(|(n, c)| Series::new(n.clone(), c[a].clone(), c[b].clone()))
                 .collect(),
             equal_aspect: true,
+            markers: at_switches,
             ..Default::default()
         };
         both(dir, "trajectory", |p| save(&fig, p))?;

@@ -535,3 +535,122 @@ fn penetration_and_tension_are_not_silent() {
         res.warnings
     );
 }
+
+const CRATE: &str = r#"
+name = "crate at rest, friction drawn by hand"
+gravity = "[0, -g, 0]"
+[parameters]
+g = 9.81
+[coordinates]
+x = { initial = 0, rate = 0 }
+[particles.crate]
+mass = 5
+position = "[x, 0, 0]"
+[[forces]]
+kind = "friction"
+on = "crate"
+normal = "[0, 1, 0]"
+mode = "slip"
+mu = 0.3
+FIELD
+[simulate]
+t_end = 2.0
+"#;
+
+/// Friction drawn with a fixed `opposes` on a crate at rest pushes it backwards: the run says
+/// so loudly. Without `opposes`, the same friction is Coulomb's: the crate stays put.
+#[test]
+fn friction_doing_positive_work_is_not_silent() {
+    let wrong = CRATE.replace("FIELD", "opposes = \"[1, 0, 0]\"");
+    let res = run(&wrong, &[], |_| {});
+    assert!(res.rows.last().unwrap()[col(&res, "x")] < -1.0);
+    assert!(
+        res.warnings
+            .iter()
+            .any(|w| w.contains("positive work") && w.contains("friction")),
+        "{:?}",
+        res.warnings
+    );
+    let right = CRATE.replace("FIELD", "");
+    let res = run(&right, &[], |_| {});
+    assert!(res.hybrid.is_some());
+    for r in &res.rows {
+        assert_eq!(r[col(&res, "x")], 0.0, "a crate at rest stays at rest");
+    }
+    assert!(res.warnings.is_empty(), "{:?}", res.warnings);
+}
+
+/// On a moving belt the mass sticks until the spring pulls mu_s m g, then slips for
+/// (pi + 2 asin(V/(A w)))/w, A the amplitude about mu_k m g/k; the belt's work feeds the
+/// friction's dissipation and the balance closes.
+#[test]
+fn belt_stick_slip_phases() {
+    let res = run(&example("belt.toml"), &[], |_| {});
+    let h = res.hybrid.as_ref().unwrap();
+    let (g, m, k, v, mu_s, mu_k) = (9.81f64, 1.0f64, 50.0f64, 0.2, 0.6, 0.4);
+    let w = (k / m).sqrt();
+    close(
+        h.switches[0].t,
+        mu_s * m * g / (k * v),
+        1e-9,
+        "first stick phase",
+    );
+    let d = (mu_s - mu_k) * m * g / k;
+    let a = (d * d + (v / w).powi(2)).sqrt();
+    let slip = (std::f64::consts::PI + 2.0 * (v / (a * w)).asin()) / w;
+    close(h.switches[1].t - h.switches[0].t, slip, 1e-9, "slip phase");
+    // It sticks again at mu_k m g/k - d (the slip is symmetric about mu_k m g/k), and the
+    // belt carries it back to mu_s m g/k = mu_k m g/k + d.
+    close(
+        h.switches[2].t - h.switches[1].t,
+        2.0 * d / v,
+        1e-9,
+        "later stick phases",
+    );
+    assert!(h.work_contacts > 0.0 || h.dissipated_friction > 0.0);
+    balance_closes(&res, 1e-8);
+}
+
+const PUCK: &str = r#"
+name = "puck on a rough table, sliding in two directions"
+gravity = "[0, -g, 0]"
+[parameters]
+g = 9.81
+vx = 3.0
+vz = -4.0
+[coordinates]
+x = { initial = 0, rate = "vx" }
+z = { initial = 0, rate = "vz" }
+[particles.puck]
+mass = 0.2
+position = "[x, 0, z]"
+[[contacts]]
+name = "table"
+on = "puck"
+surface = "r.y"
+mu = 0.25
+[simulate]
+t_end = 3.0
+rtol = 1e-11
+atol = 1e-12
+"#;
+
+/// In a tangent plane the slip is a direction: the puck decelerates at mu g along its
+/// velocity, stops at |v0|/(mu g) after |v0|²/(2 mu g) on its initial line, and stays.
+#[test]
+fn slip_in_a_tangent_plane_stops_on_its_line() {
+    let res = run(PUCK, &[], |_| {});
+    let h = res.hybrid.as_ref().unwrap();
+    let (g, mu, v0) = (9.81f64, 0.25, 5.0);
+    let stop = h
+        .switches
+        .iter()
+        .find(|s| s.to == "stuck")
+        .unwrap_or_else(|| panic!("{:?}", h.switches));
+    close(stop.t, v0 / (mu * g), 1e-9, "time to rest");
+    let last = res.rows.last().unwrap();
+    let dist = v0 * v0 / (2.0 * mu * g);
+    close(last[col(&res, "x")], dist * 3.0 / 5.0, 1e-9, "x at rest");
+    close(last[col(&res, "z")], -dist * 4.0 / 5.0, 1e-9, "z at rest");
+    balance_closes(&res, 1e-9);
+}

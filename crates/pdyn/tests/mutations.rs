@@ -83,8 +83,10 @@ fn mutated_examples_never_panic_or_hang() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
     let dir = std::env::temp_dir().join(format!("pdyn-mutations-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let mut models: Vec<_> = std::fs::read_dir(&root)
-        .unwrap()
+    // The top-level examples, and the hybrid ones (contacts, impacts, friction that sticks).
+    let mut models: Vec<_> = [root.clone(), root.join("contact")]
+        .iter()
+        .flat_map(|d| std::fs::read_dir(d).unwrap())
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|x| x == "toml"))
         .collect();

@@ -252,6 +252,10 @@ pub struct Model {
     pub checks: Vec<spec::CheckSpec>,
     /// Names of the unknown (sticking) friction forces.
     pub friction_forces: Vec<String>,
+    /// `(label, F·v_slip, |F| |v_slip|)` of each sliding friction whose direction was drawn
+    /// by hand (`opposes`): a run warns when the power turns positive (friction driving the
+    /// motion).
+    pub friction_power: Vec<(String, Id, Id)>,
     /// `(coordinate index, initial value, initial rate)` as expressions of the parameters, so
     /// that a sweep over a parameter recomputes the initial conditions that depend on it.
     pub initial_exprs: Vec<(usize, Id, Id)>,
@@ -281,6 +285,7 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
     let forces::Built {
         friction_forces,
         contacts: mut friction_contacts,
+        friction_power,
         loads,
         reactions,
         potentials,
@@ -303,6 +308,7 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
         known_accelerations,
         checks,
         friction_forces,
+        friction_power,
         name: raw.name.clone().unwrap_or_else(|| origin.to_string()),
         origin: origin.to_string(),
         source: source.to_string(),

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import json
 import warnings
 from typing import Any, Dict, List, Optional, Tuple
 
@@ -29,7 +30,14 @@ class OdeResult(dict):
       name; a model's columns take precedence over SciPy's keys, so ``sol["y"]`` is a
       coordinate ``y`` when there is one, ``sol.y`` always the states), :meth:`column`,
       ``monitors`` (conserved quantities with their drift), ``warnings``,
-      ``method``, :meth:`to_pandas`.
+      ``method``, :meth:`to_pandas`;
+    * for a model with contacts or event actions, ``hybrid``: a dict with ``timeline`` (intervals
+      of constant contact modes: ``t_from``, ``t_to``, ``modes``), ``switches`` (``t``,
+      ``contact``, ``from``, ``to``, ``reason``), ``impacts`` (``t``, ``contact``,
+      ``normal_speed_before``, ``normal_speed_after``, ``impulse``, ``energy_lost``), ``zeno``
+      (``contact``, ``t_accumulation``, ``ratio``, ``bounces``), ``actions``, and the energy
+      accounting ``work_contacts``, ``dissipated_friction``, ``dissipated_impacts``
+      (``None`` for other models).
     """
 
     def __getattr__(self, name: str) -> Any:
@@ -173,6 +181,7 @@ def _from_run(raw: Dict[str, Any], event_names: List[str]) -> OdeResult:
         method=raw["method"],
         non_finite=list(raw.get("non_finite", [])),
         non_finite_t=raw.get("non_finite_t"),
+        hybrid=json.loads(raw["hybrid_json"]) if raw.get("hybrid_json") else None,
         _table=table,
         **_stats_counts(raw["stats"]),
     )

@@ -839,7 +839,20 @@ impl State<'_> {
         let plastic = zeno.is_some() || e * u <= self.v_tol();
         let target = if plastic { 0.0 } else { e * u };
         let t_before = self.kinetic(t, &self.y)[0];
-        let impulse = self.project(&closed, t, Some((c, target)))?;
+        let y_before = self.y.clone();
+        let mut impulse = self.project(&closed, t, Some((c, target)))?;
+        // Friction at the impact: sliding, its impulse is mu_k times the normal one against
+        // the slip; if that would reverse the slip, the contact sticks during the impact
+        // instead (its tangential velocity becomes zero, within mu_s of the normal impulse).
+        if let ContactMode::Sliding(_) = closed[c] {
+            let before = probes[c];
+            let after = self.probe(t, &self.y)[c];
+            if before[2] * after[2] + before[3] * after[3] < 0.0 {
+                self.y = y_before;
+                closed[c] = ContactMode::Stuck;
+                impulse = self.project(&closed, t, Some((c, target)))?;
+            }
+        }
         let t_after = self.kinetic(t, &self.y)[0];
         self.w_impacts += t_after - t_before;
         if t_after - t_before > 1e-9 * t_before.abs().max(1e-300)
@@ -1033,6 +1046,8 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
         opts.max_steps = m;
     }
     let t_end = set.t_end;
+    let step_budget = opts.max_steps;
+    let mut steps_used = 0usize;
     let output_times = set.output_times();
     let columns = {
         let mut c = vec!["t".to_string()];
@@ -1209,8 +1224,11 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
                 .filter(|&x| if first { x >= t0 } else { x > t0 })
                 .collect()
         });
+        // `max_steps` bounds the whole run: every segment takes at least one step.
+        let mut seg_opts = opts.clone();
+        seg_opts.max_steps = step_budget.saturating_sub(steps_used).max(1);
         let result =
-            pdyn_ode::solve_with_events(method, &aug, (t0, t_end), &st.y, &opts, &ode_events);
+            pdyn_ode::solve_with_events(method, &aug, (t0, t_end), &st.y, &seg_opts, &ode_events);
         let (sol, fail) = match result {
             Ok(s) => (s, None),
             Err(e) => match e.failure_point() {
@@ -1313,9 +1331,34 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
             break;
         }
         first = false;
+        steps_used += sol.stats.steps.max(1);
         let Status::TerminalEvent(idx) = sol.status else {
             break;
         };
+        if steps_used >= step_budget {
+            let state = prep
+                .state_names
+                .iter()
+                .cloned()
+                .zip(st.y.iter().copied())
+                .collect();
+            failure = Some(RunFailure {
+                t: sol.t.last().copied().unwrap_or(t0),
+                state,
+                error: OdeError::MaxSteps {
+                    max_steps: step_budget,
+                    at: pdyn_ode::FailurePoint {
+                        t: sol.t.last().copied().unwrap_or(t0),
+                        y: st.y[..2 * n].to_vec(),
+                        partial: Box::new(sol.clone()),
+                    },
+                },
+                stiff_at: None,
+                non_finite: Vec::new(),
+            });
+            status = RunStatus::Failed;
+            break;
+        }
         let Some((te, ye)) = sol.last() else { break };
         st.t = te;
         st.y = ye.to_vec();
@@ -1531,7 +1574,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
         });
         if drift.is_nan() || drift > set.drift_tolerance {
             warnings.push(format!(
-                "the energy balance (energy - work of the contact forces - energy change in impacts and event actions) should hold but is off by {drift:.3e} (relative) over t = 0..{:.6e}: this result cannot be trusted (the First Law of Scientific Computing). Tighten the tolerance (e.g. --rtol 1e-9)",
+                "energy_balance should be conserved but drifted by {drift:.3e} (relative) over t = 0..{:.6e}: the energy minus the work of the contact forces and the energy changed at impacts and event actions must stay constant, so this result cannot be trusted (the First Law of Scientific Computing). Tighten the tolerance (e.g. --rtol 1e-9)",
                 rows.last().map_or(0.0, |r| r[0])
             ));
         }

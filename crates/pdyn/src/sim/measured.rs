@@ -76,7 +76,9 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
     let solve = [&prep.observer, &prep.scales]
         .into_iter()
         .chain(prep.measures.as_ref())
+        .chain(prep.friction_power.as_ref())
         .any(|o| !o.reads_only_first(base));
+    let mut watch = super::FrictionWatch::default();
     for k in 0..points {
         let (t, y) = (sol.t[k], sol.y_at(k));
         if solve {
@@ -85,6 +87,7 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
             sys.observation_input_without_unknowns(t, y, &mut input);
         }
         prep.observer.eval(&input, &mut extra);
+        watch.check(prep, &input, t);
         // The row `[t, y, extra]` the full path would tabulate.
         non_finite.row(t, std::iter::once(&t).chain(y).chain(&extra).copied());
         if k == 0 {
@@ -119,7 +122,7 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
     };
     let t_last = sol.t.last().copied().unwrap_or(0.0);
     let non_finite = non_finite.finish();
-    let (events, monitors, warnings, status) = report(
+    let (events, monitors, mut warnings, status) = report(
         prep,
         &sol,
         set,
@@ -129,6 +132,7 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
         t_last,
         non_finite.is_some(),
     );
+    warnings.extend(watch.warnings(prep));
     let mut first_hits = vec![None; prep.events.len()];
     for h in &sol.events {
         if let Some(slot @ None) = first_hits.get_mut(h.index) {

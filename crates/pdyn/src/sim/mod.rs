@@ -260,6 +260,9 @@ pub struct Prepared {
     pub parameter_names: Vec<String>,
     /// Parameters defined by others (`m = "4/3*pi*a^3*rho"`), recomputed for each sweep run.
     pub derived: DerivedParameters,
+    /// `(F·v_slip, |F| |v_slip|)` of each sliding friction drawn with `opposes`, over the
+    /// observation inputs: a run warns when one does positive work on the slip.
+    pub friction_power: Option<Observer>,
     /// Contacts and event actions: the run switches between modes ([`hybrid`]); `system`
     /// and `observer` are then those of one reference mode, for the names and initial state.
     pub hybrid: Option<Box<hybrid::Hybrid>>,
@@ -481,6 +484,7 @@ pub fn prepare_with_jit(
     // ... when to stop or record, what a sweep measures, and where it starts.
     let events = compile_events(model, &system)?;
     let measures = compile_measures(model, &system)?;
+    let friction_power = compile_friction_power(model, &system)?;
     let initial_conditions = compile_initial_conditions(model, &d)?;
     let values: Vec<f64> = model.parameters.iter().map(|q| q.value).collect();
     let mut y0 = vec![0.0; d.state.len()];
@@ -502,6 +506,7 @@ pub fn prepare_with_jit(
         initial_conditions,
         parameter_names: model.parameters.iter().map(|q| q.name.clone()).collect(),
         derived: DerivedParameters::compile(model),
+        friction_power,
         hybrid,
     })
 }
@@ -646,6 +651,79 @@ fn compile_events(
         });
     }
     Ok(events)
+}
+
+/// The power of each sliding friction drawn with `opposes` on the slip, and its size.
+fn compile_friction_power(
+    model: &mut Model,
+    system: &CompiledModel,
+) -> Result<Option<Observer>, SimError> {
+    if model.friction_power.is_empty() {
+        return Ok(None);
+    }
+    let mut names = Vec::new();
+    let mut exprs = Vec::new();
+    for (label, power, size) in &model.friction_power {
+        names.push(label.clone());
+        names.push(label.clone());
+        exprs.push(*power);
+        exprs.push(*size);
+    }
+    Observer::new(&mut model.pool, &system.observation_inputs, names, &exprs)
+        .map(Some)
+        .map_err(|error| compile_error("friction power", error))
+}
+
+/// Watches the power of hand-directed sliding friction along a run: friction must take
+/// energy out of the slip, and a sliding direction drawn by hand (`opposes`) that turns out
+/// wrong makes it drive the motion instead, silently (issue 31: a crate at rest pushed 4 m
+/// backwards by its own friction).
+#[derive(Default)]
+pub(crate) struct FrictionWatch {
+    out: Vec<f64>,
+    /// Per friction: the first time and power where it did positive work, and the largest
+    /// power.
+    first: Vec<Option<(f64, f64, f64)>>,
+}
+
+impl FrictionWatch {
+    /// Evaluates the powers at one output point.
+    pub(crate) fn check(&mut self, prep: &Prepared, input: &[f64], t: f64) {
+        let Some(obs) = &prep.friction_power else {
+            return;
+        };
+        self.out.resize(obs.len(), 0.0);
+        self.first.resize(obs.len() / 2, None);
+        obs.eval(input, &mut self.out);
+        for (k, pair) in self.out.chunks(2).enumerate() {
+            let (power, size) = (pair[0], pair[1]);
+            // -cos of the angle between friction and slip: 1 when friction opposes it.
+            if power > 1e-6 * size && power > 0.0 {
+                match &mut self.first[k] {
+                    Some(f) => f.2 = f.2.max(power),
+                    slot @ None => *slot = Some((t, power, power)),
+                }
+            }
+        }
+    }
+
+    /// One loud warning per friction that did positive work.
+    pub(crate) fn warnings(&self, prep: &Prepared) -> Vec<String> {
+        let Some(obs) = &prep.friction_power else {
+            return Vec::new();
+        };
+        self.first
+            .iter()
+            .enumerate()
+            .filter_map(|(k, f)| {
+                let (t, p, max) = (*f)?;
+                Some(format!(
+                    "friction `{}` does positive work on the slip from t = {t:.6e} (power {p:.3e} W there, up to {max:.3e} W): it drives the motion instead of opposing it, so this result is wrong. Its `opposes` direction says which way the body slides, but it slides the other way: drop `opposes` (friction then follows the slip, and sticks and slips: mode = \"coulomb\")",
+                    obs.names[2 * k]
+                ))
+            })
+            .collect()
+    }
 }
 
 /// The `[sweep.measures]` over the observation inputs.
@@ -920,11 +998,13 @@ pub(crate) fn tabulate(
     let mut rows = Vec::with_capacity(sol.len());
     let mut input = Vec::new();
     let mut extra = vec![0.0; prep.observer.len()];
+    let mut watch = FrictionWatch::default();
     for k in 0..sol.len() {
         let t = sol.t[k];
         let y = sol.y_at(k);
         sys.observation_input(t, y, &mut input);
         prep.observer.eval(&input, &mut extra);
+        watch.check(prep, &input, t);
         let mut row = Vec::with_capacity(columns.len());
         row.push(t);
         row.extend_from_slice(y);
@@ -956,9 +1036,10 @@ pub(crate) fn tabulate(
     let non_finite = rows.iter().any(|r| r.iter().any(|x| !x.is_finite()));
     let t_last = rows.last().map_or(0.0, |r| r[0]);
     let scales = conservation_scales(prep, sol);
-    let (events, monitors, warnings, status) = report(
+    let (events, monitors, mut warnings, status) = report(
         prep, sol, set, &failure, &drifts, &scales, t_last, non_finite,
     );
+    warnings.extend(watch.warnings(prep));
     RunResult {
         columns,
         rows,

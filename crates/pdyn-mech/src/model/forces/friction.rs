@@ -99,39 +99,45 @@ fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelEr
         }
         "slip" | "coulomb" => {
             let (mu, mu_s) = coefficients(ld, e, mode)?;
+            // Sliding velocity: velocity of the contact point relative to the surface,
+            // without its normal part.
+            let v = at.map(|c| ld.pool.dt(c));
+            let v = match &raw.surface_velocity {
+                Some(ssv) => {
+                    let s = ld.vector(ssv, "`surface_velocity`")?;
+                    ld.want(
+                        ssv,
+                        pdyn_expr::Dimension::VELOCITY,
+                        "the `surface_velocity`",
+                    );
+                    vector::sub(&mut ld.pool, v, s)
+                }
+                None => v,
+            };
+            let nn = vector::dot(&mut ld.pool, normal, normal);
+            let vn = vector::dot(&mut ld.pool, v, normal);
+            let k = ld.pool.div(vn, nn);
+            let along = vector::scale(&mut ld.pool, k, normal);
+            let slide = vector::sub(&mut ld.pool, v, along);
             let dir = match &raw.opposes {
                 Some(s) => {
                     let s = ld.vector(s, "`opposes`")?;
                     vector::unit(&mut ld.pool, s)
                 }
-                None => {
-                    // Sliding velocity: velocity of the contact point relative to the
-                    // surface, without its normal part.
-                    let v = at.map(|c| ld.pool.dt(c));
-                    let v = match &raw.surface_velocity {
-                        Some(s) => {
-                            let ssv = s;
-                            let s = ld.vector(ssv, "`surface_velocity`")?;
-                            ld.want(
-                                ssv,
-                                pdyn_expr::Dimension::VELOCITY,
-                                "the `surface_velocity`",
-                            );
-                            vector::sub(&mut ld.pool, v, s)
-                        }
-                        None => v,
-                    };
-                    let nn = vector::dot(&mut ld.pool, normal, normal);
-                    let vn = vector::dot(&mut ld.pool, v, normal);
-                    let k = ld.pool.div(vn, nn);
-                    let along = vector::scale(&mut ld.pool, k, normal);
-                    let slide = vector::sub(&mut ld.pool, v, along);
-                    vector::unit(&mut ld.pool, slide)
-                }
+                None => vector::unit(&mut ld.pool, slide),
             };
             let mag = ld.pool.mul2(mu, n_id);
             let neg = ld.pool.neg(mag);
             let tforce = vector::scale(&mut ld.pool, neg, dir);
+            if raw.opposes.is_some() {
+                // A direction drawn by hand can be wrong: the run checks that this friction's
+                // power on the slip, F·v_slip, never turns positive.
+                let power = vector::dot(&mut ld.pool, tforce, slide);
+                let fm = vector::norm(&mut ld.pool, tforce);
+                let vm = vector::norm(&mut ld.pool, slide);
+                let size = ld.pool.mul2(fm, vm);
+                b.friction_power.push((e.label.clone(), power, size));
+            }
             let slip_load = b.loads.len();
             b.loads.push(Load {
                 label: format!("sliding friction mu*{n_name}"),

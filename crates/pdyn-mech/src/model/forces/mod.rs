@@ -135,6 +135,8 @@ pub(super) struct Built {
     pub friction_forces: Vec<String>,
     /// Coulomb `friction` forces, as held contacts.
     pub contacts: Vec<super::Contact>,
+    /// `(label, F·v_slip, |F| |v_slip|)` of each sliding friction drawn with `opposes`.
+    pub friction_power: Vec<(String, Id, Id)>,
     pub loads: Vec<Load>,
     pub reactions: Vec<Reaction>,
     pub potentials: Vec<PotentialTerm>,
@@ -151,6 +153,7 @@ pub(super) struct ForceBuilder<'a> {
     conservative: bool,
     friction_forces: Vec<String>,
     contacts: Vec<super::Contact>,
+    friction_power: Vec<(String, Id, Id)>,
     /// Unknown forces `name * direction` pushed so far, by `reaction` and by `friction`'s
     /// normal force, to refuse one unknown declared twice on one body along one line.
     directed: Vec<Directed>,
@@ -181,6 +184,7 @@ impl<'a> ForceBuilder<'a> {
             conservative: true,
             friction_forces: Vec::new(),
             contacts: Vec::new(),
+            friction_power: Vec::new(),
             directed: Vec::new(),
         }
     }
@@ -189,6 +193,7 @@ impl<'a> ForceBuilder<'a> {
         Built {
             friction_forces: self.friction_forces,
             contacts: self.contacts,
+            friction_power: self.friction_power,
             loads: self.loads,
             reactions: self.reactions,
             potentials: self.potentials,
