@@ -654,3 +654,63 @@ fn slip_in_a_tangent_plane_stops_on_its_line() {
     close(last[col(&res, "z")], -dist * 4.0 / 5.0, 1e-9, "z at rest");
     balance_closes(&res, 1e-9);
 }
+
+/// A sweep over a contact model runs each member through the hybrid loop (not the reference
+/// mode alone): the block's slide distance is v0²/(2 mu_k g) for every mu_k.
+#[test]
+fn sweeps_run_hybrid_models_through_their_switches() {
+    let src = example("block_sliding.toml")
+        + "\n[sweep]\nparameter = \"mu_k\"\nvalues = [0.1, 0.2, 0.3, 0.4]\n[sweep.measures]\ndistance = { of = \"x\", stat = \"final\" }\n";
+    let mut m = pdyn_mech::load(&src, "<t>").unwrap_or_else(|e| panic!("{}", e.render(&src)));
+    let set = RunSettings::from_spec(&m.run.simulate).unwrap();
+    let spec = m.run.sweep.clone().unwrap();
+    let stats: Vec<_> = spec.measures.iter().map(|x| x.stat).collect();
+    let prep = sim::prepare(&mut m).unwrap();
+    let res = sim::sweep::sweep(&prep, &set, &spec, &stats, false).unwrap();
+    assert!(res.problems.is_empty(), "{:?}", res.problems);
+    for (row, mu_k) in res.slices[0].table.iter().zip([0.1, 0.2, 0.3, 0.4]) {
+        // mu_k = 0.1 slides 4.6 m and stops at 3.06 s: after t_end = 2, still sliding.
+        let t = (3.0f64 / (mu_k * 9.81)).min(2.0);
+        let want = 3.0 * t - 0.5 * mu_k * 9.81 * t * t;
+        close(row[0], want, 1e-9, &format!("distance at mu_k = {mu_k}"));
+    }
+}
+
+/// A reaction declared one-sided that has to pull (a car over a hump too fast, held to the
+/// road by its coordinates) is a loud warning; the same reaction pushing is silent.
+#[test]
+fn one_sided_reaction_that_pulls_warns() {
+    let hump = |v: f64| {
+        format!(
+            r#"
+gravity = "[0, -9.81, 0]"
+[coordinates]
+s = {{ initial = 0, rate = {v} }}
+[particles.car]
+mass = 1000
+position = "[20*sin(s/20), 20*cos(s/20), 0]"    # over the top of a hump of radius 20 m
+[[forces]]
+kind = "reaction"
+name = "N"
+on = "car"
+direction = "[sin(s/20), cos(s/20), 0]"
+one_sided = true
+[simulate]
+t_end = 1.0
+"#
+        )
+    };
+    // N = m (g cos - v²/R) at the top: pulls above sqrt(g R) = 14.0 m/s.
+    let res = run(&hump(10.0), &[], |_| {});
+    assert!(res.warnings.is_empty(), "{:?}", res.warnings);
+    let res = run(&hump(16.0), &[], |_| {});
+    assert!(
+        res.warnings
+            .iter()
+            .any(|w| w.contains("one-sided") && w.contains("`N`")),
+        "{:?}",
+        res.warnings
+    );
+    let e = load_err(&hump(10.0).replace("direction = \"[sin(s/20), cos(s/20), 0]\"\n", ""));
+    assert!(e.contains("needs the `direction`"), "{e}");
+}

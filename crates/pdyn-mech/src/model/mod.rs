@@ -256,6 +256,8 @@ pub struct Model {
     /// by hand (`opposes`): a run warns when the power turns positive (friction driving the
     /// motion).
     pub friction_power: Vec<(String, Id, Id)>,
+    /// Reactions that can only push (`one_sided = true`): a run warns when one pulls.
+    pub one_sided: Vec<String>,
     /// `(coordinate index, initial value, initial rate)` as expressions of the parameters, so
     /// that a sweep over a parameter recomputes the initial conditions that depend on it.
     pub initial_exprs: Vec<(usize, Id, Id)>,
@@ -286,6 +288,7 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
         friction_forces,
         contacts: mut friction_contacts,
         friction_power,
+        one_sided,
         loads,
         reactions,
         potentials,
@@ -309,6 +312,7 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
         checks,
         friction_forces,
         friction_power,
+        one_sided,
         name: raw.name.clone().unwrap_or_else(|| origin.to_string()),
         origin: origin.to_string(),
         source: source.to_string(),

@@ -177,6 +177,8 @@ pub struct RawForce {
     pub surface_velocity: Option<Sv>,
     pub normal_force: Option<Name>,
     pub friction_force: Option<Name>,
+    /// A reaction that can only push (a normal force): a run warns when it pulls.
+    pub one_sided: Option<Spanned<bool>>,
 }
 
 /// `[[contacts]]`: a particle against a surface, or two particles, that may touch, separate,

@@ -1066,6 +1066,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
     let mut first = true;
     let mut sol_method;
     let mut scales: Vec<f64> = Vec::new();
+    let mut push = super::PushWatch::default();
     let balance_index = columns.len() - 1;
     loop {
         let t0 = st.t;
@@ -1266,6 +1267,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
             let (w, dfr) = (yy[2 * n], yy[2 * n + 1]);
             let energy = out[out.len() - 1 - h.model.run.monitors.len()];
             row.extend([w, dfr, 0.0 - st.w_impacts, energy - w - st.w_impacts]);
+            push.check(prep, t, &row[1 + 2 * n..]);
             let mut sc = [0.0; 2];
             h.kinetic.eval(&st.base_input(t, yy), &mut sc);
             scales.push(sc[1]);
@@ -1591,6 +1593,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
             ));
         }
     }
+    warnings.extend(push.warnings(prep));
     if let Some(f) = &failure {
         warnings.push(format!("{f}"));
     }

@@ -79,6 +79,7 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
         .chain(prep.friction_power.as_ref())
         .any(|o| !o.reads_only_first(base));
     let mut watch = super::FrictionWatch::default();
+    let mut push = super::PushWatch::default();
     for k in 0..points {
         let (t, y) = (sol.t[k], sol.y_at(k));
         if solve {
@@ -88,6 +89,7 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
         }
         prep.observer.eval(&input, &mut extra);
         watch.check(prep, &input, t);
+        push.check(prep, t, &extra);
         // The row `[t, y, extra]` the full path would tabulate.
         non_finite.row(t, std::iter::once(&t).chain(y).chain(&extra).copied());
         if k == 0 {
@@ -133,6 +135,7 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
         non_finite.is_some(),
     );
     warnings.extend(watch.warnings(prep));
+    warnings.extend(push.warnings(prep));
     let mut first_hits = vec![None; prep.events.len()];
     for h in &sol.events {
         if let Some(slot @ None) = first_hits.get_mut(h.index) {

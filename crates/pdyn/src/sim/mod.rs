@@ -263,6 +263,9 @@ pub struct Prepared {
     /// `(F·v_slip, |F| |v_slip|)` of each sliding friction drawn with `opposes`, over the
     /// observation inputs: a run warns when one does positive work on the slip.
     pub friction_power: Option<Observer>,
+    /// Reactions declared `one_sided`: name and index among the output columns after `t`
+    /// and the state.
+    pub one_sided: Vec<(String, usize)>,
     /// Contacts and event actions: the run switches between modes ([`hybrid`]); `system`
     /// and `observer` are then those of one reference mode, for the names and initial state.
     pub hybrid: Option<Box<hybrid::Hybrid>>,
@@ -492,6 +495,17 @@ pub fn prepare_with_jit(
     if hybrid.is_none() {
         check_constraints_at_start(model, &system, &y0)?;
     }
+    let one_sided = {
+        let names = match &hybrid {
+            Some(h) => &h.column_names,
+            None => &observer.names,
+        };
+        model
+            .one_sided
+            .iter()
+            .filter_map(|n| Some((n.clone(), names.iter().position(|c| c == n)?)))
+            .collect()
+    };
     Ok(Prepared {
         system,
         observer,
@@ -507,6 +521,7 @@ pub fn prepare_with_jit(
         parameter_names: model.parameters.iter().map(|q| q.name.clone()).collect(),
         derived: DerivedParameters::compile(model),
         friction_power,
+        one_sided,
         hybrid,
     })
 }
@@ -720,6 +735,43 @@ impl FrictionWatch {
                 Some(format!(
                     "friction `{}` does positive work on the slip from t = {t:.6e} (power {p:.3e} W there, up to {max:.3e} W): it drives the motion instead of opposing it, so this result is wrong. Its `opposes` direction says which way the body slides, but it slides the other way: drop `opposes` (friction then follows the slip, and sticks and slips: mode = \"coulomb\")",
                     obs.names[2 * k]
+                ))
+            })
+            .collect()
+    }
+}
+
+/// Watches the reactions declared `one_sided` along a run: a normal force can push, never
+/// pull; one that pulls means the body would leave the surface, which the model's coordinates
+/// do not let it do.
+#[derive(Default)]
+pub(crate) struct PushWatch {
+    /// Per reaction: the first `(t, value)` where it pulled, and its largest magnitude.
+    seen: Vec<(Option<(f64, f64)>, f64)>,
+}
+
+impl PushWatch {
+    /// One output point: `columns` are the output columns after `t` and the state.
+    pub(crate) fn check(&mut self, prep: &Prepared, t: f64, columns: &[f64]) {
+        self.seen.resize(prep.one_sided.len(), (None, 0.0));
+        for ((_, j), s) in prep.one_sided.iter().zip(&mut self.seen) {
+            let v = columns[*j];
+            s.1 = s.1.max(v.abs());
+            if v < 0.0 && s.0.is_none() {
+                s.0 = Some((t, v));
+            }
+        }
+    }
+
+    /// A loud warning per one-sided reaction that pulled by more than round-off.
+    pub(crate) fn warnings(&self, prep: &Prepared) -> Vec<String> {
+        prep.one_sided
+            .iter()
+            .zip(&self.seen)
+            .filter_map(|((name, _), (first, largest))| {
+                let (t, v) = (*first)?;
+                (v < -1e-9 * largest).then(|| format!(
+                    "reaction `{name}` is one-sided (it can only push) but pulls from t = {t:.6e} ({name} = {v:.6e}): the body would leave the surface there, and the model's coordinates keep it on; this motion is wrong from then on. Model the contact with [[contacts]] (it opens and closes), or give the body a coordinate to leave by"
                 ))
             })
             .collect()
@@ -999,12 +1051,14 @@ pub(crate) fn tabulate(
     let mut input = Vec::new();
     let mut extra = vec![0.0; prep.observer.len()];
     let mut watch = FrictionWatch::default();
+    let mut push = PushWatch::default();
     for k in 0..sol.len() {
         let t = sol.t[k];
         let y = sol.y_at(k);
         sys.observation_input(t, y, &mut input);
         prep.observer.eval(&input, &mut extra);
         watch.check(prep, &input, t);
+        push.check(prep, t, &extra);
         let mut row = Vec::with_capacity(columns.len());
         row.push(t);
         row.extend_from_slice(y);
@@ -1040,6 +1094,7 @@ pub(crate) fn tabulate(
         prep, sol, set, &failure, &drifts, &scales, t_last, non_finite,
     );
     warnings.extend(watch.warnings(prep));
+    warnings.extend(push.warnings(prep));
     RunResult {
         columns,
         rows,

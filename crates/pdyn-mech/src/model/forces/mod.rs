@@ -137,6 +137,8 @@ pub(super) struct Built {
     pub contacts: Vec<super::Contact>,
     /// `(label, F·v_slip, |F| |v_slip|)` of each sliding friction drawn with `opposes`.
     pub friction_power: Vec<(String, Id, Id)>,
+    /// Reactions declared `one_sided`.
+    pub one_sided: Vec<String>,
     pub loads: Vec<Load>,
     pub reactions: Vec<Reaction>,
     pub potentials: Vec<PotentialTerm>,
@@ -154,6 +156,7 @@ pub(super) struct ForceBuilder<'a> {
     friction_forces: Vec<String>,
     contacts: Vec<super::Contact>,
     friction_power: Vec<(String, Id, Id)>,
+    one_sided: Vec<String>,
     /// Unknown forces `name * direction` pushed so far, by `reaction` and by `friction`'s
     /// normal force, to refuse one unknown declared twice on one body along one line.
     directed: Vec<Directed>,
@@ -185,6 +188,7 @@ impl<'a> ForceBuilder<'a> {
             friction_forces: Vec::new(),
             contacts: Vec::new(),
             friction_power: Vec::new(),
+            one_sided: Vec::new(),
             directed: Vec::new(),
         }
     }
@@ -194,6 +198,7 @@ impl<'a> ForceBuilder<'a> {
             friction_forces: self.friction_forces,
             contacts: self.contacts,
             friction_power: self.friction_power,
+            one_sided: self.one_sided,
             loads: self.loads,
             reactions: self.reactions,
             potentials: self.potentials,
