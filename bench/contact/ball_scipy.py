@@ -1,15 +1,16 @@
 #!/usr/bin/env python3
-"""The bouncing ball of examples/contact/bouncing_ball.toml with SciPy: solve_ivp (RK45,
+"""The bouncing ball of examples/contact/bouncing_ball.toml with SciPy: solve_ivp (RK45 or DOP853,
 rtol 1e-10, atol 1e-12) from bounce to bounce with a terminal event at the floor, the
 velocity reversed and scaled by e at each restart; the bounces end in resting contact when
 the remaining time of the geometric sequence falls below 1e-10 of the elapsed time (pdyn's
-rule). Writes every solver point to a CSV, as pdyn run --out does. Usage: ball_scipy.py OUT.csv"""
+rule). Writes every solver point to a CSV, as pdyn run --out does. Usage: ball_scipy.py OUT.csv [METHOD (RK45, DOP853)]"""
 import sys
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
 g, h, e, t_end = 9.81, 1.0, 0.5, 2.0
+METHOD = sys.argv[2] if len(sys.argv) > 2 else "RK45"
 
 
 def rhs(t, y):
@@ -26,7 +27,7 @@ floor.direction = -1
 t, y = 0.0, np.array([h, 0.0])
 ts, ys, bounces = [], [], []
 while t < t_end:
-    sol = solve_ivp(rhs, (t, t_end), y, rtol=1e-10, atol=1e-12, events=floor)
+    sol = solve_ivp(rhs, (t, t_end), y, rtol=1e-10, atol=1e-12, events=floor, method=METHOD)
     ts.append(sol.t)
     ys.append(sol.y.T)
     if sol.status != 1:

@@ -47,14 +47,22 @@ def main():
     out = tempfile.mkdtemp()
     # The first stick phase lasts mu_s m g/(k V); each later cycle cycle_time().
     t_end = MU_S * M * G / (K * V) + (CYCLES - 1) * cycle_time() + 0.5 * cycle_time()
-    cases = [
-        ("bouncing ball to rest (e = 0.5)",
-         [PDYN, "run", os.path.join(ROOT, "examples", "contact", "bouncing_ball.toml"), "--out", out],
-         [sys.executable, os.path.join(HERE, "ball_scipy.py"), os.path.join(out, "ball.csv")], 11, 5),
-        (f"{CYCLES} stick-slip cycles on a belt",
-         [PDYN, "run", os.path.join(ROOT, "examples", "contact", "belt.toml"), "--t-end", repr(t_end), "--out", out],
-         [sys.executable, os.path.join(HERE, "belt_scipy.py"), os.path.join(out, "belt.csv"), str(CYCLES)], 5, 3),
-    ]
+    # The same method family on both sides: pdyn's dopri5 (`auto`'s) against SciPy's RK45 (the
+    # same Dormand-Prince 5(4) pair), pdyn's dop853 against SciPy's DOP853.
+    cases = []
+    for pm, sm in (("dopri5", "RK45"), ("dop853", "DOP853")):
+        cases += [
+            (f"bouncing ball to rest (e = 0.5), pdyn {pm} vs SciPy {sm}",
+             [PDYN, "run", os.path.join(ROOT, "examples", "contact", "bouncing_ball.toml"),
+              "--method", pm, "--out", out],
+             [sys.executable, os.path.join(HERE, "ball_scipy.py"), os.path.join(out, "ball.csv"), sm],
+             11, 5),
+            (f"{CYCLES} stick-slip cycles on a belt, pdyn {pm} vs SciPy {sm}",
+             [PDYN, "run", os.path.join(ROOT, "examples", "contact", "belt.toml"), "--t-end", repr(t_end),
+              "--method", pm, "--out", out],
+             [sys.executable, os.path.join(HERE, "belt_scipy.py"), os.path.join(out, "belt.csv"),
+              str(CYCLES), sm], 5, 3),
+        ]
     for name, pdyn_cmd, py_cmd, np_, ns in cases:
         p_best, p_med = best_of(pdyn_cmd, np_)
         s_best, s_med = best_of(py_cmd, ns)
@@ -66,7 +74,8 @@ def main():
               f"{summary['stats']['accepted']} steps, balance drift {summary['monitors'][0]['drift']:.1e})")
         print(f"  scipy solve_ivp   best {s_best*1e3:9.1f} ms  median {s_med*1e3:9.1f} ms")
         print(f"  ratio (best)      {s_best / p_best:.0f}x   (median) {s_med / p_med:.0f}x")
-        print("  " + subprocess.run(py_cmd, capture_output=True, text=True).stdout.strip())
+        print("  " + subprocess.run(py_cmd, capture_output=True, text=True).stdout.strip()
+              + f" ({sum(1 for _ in open(py_cmd[2])) - 1} rows; pdyn {summary['outputs']} rows)")
 
 
 if __name__ == "__main__":
