@@ -311,3 +311,84 @@ t_end = 1
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("not finite at that state: x'', a.y"), "{err}");
 }
+
+/// Runs `pdyn` with arguments that may not be UTF-8: (exit code, stdout, stderr).
+#[cfg(unix)]
+fn pdyn_os(args: &[std::ffi::OsString]) -> (i32, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pdyn"))
+        .args(args)
+        .current_dir(in_root::root())
+        .output()
+        .expect("run pdyn");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A non-UTF-8 byte anywhere on the command line (an expression, an option's value, `--set`,
+/// `--json` beside it) is bad input, exit 2 with the argument named, never a panic (it was
+/// `std::env::args`, which panics on such bytes, exit 101).
+#[cfg(unix)]
+#[test]
+fn a_non_utf8_argument_is_bad_input_not_a_panic() {
+    use std::ffi::OsString;
+    use std::os::unix::ffi::OsStringExt;
+    let bad = |prefix: &str| {
+        let mut b = prefix.as_bytes().to_vec();
+        b.push(0xFF);
+        OsString::from_vec(b)
+    };
+    let s = |t: &str| OsString::from(t);
+    let cases: Vec<Vec<OsString>> = vec![
+        vec![s("simplify"), bad("x")],
+        vec![s("simplify"), bad("x"), s("--json")],
+        vec![s("diff"), s("x^2"), s("--wrt"), bad("")],
+        vec![s("eval"), s("x"), s("--at"), bad("x=")],
+        vec![s("kin"), bad("[t, t"), s("--json")],
+        vec![
+            s("run"),
+            s("examples/satellite.toml"),
+            s("--set"),
+            bad("m="),
+        ],
+        vec![bad("simplify")],
+    ];
+    for args in cases {
+        let (code, out, err) = pdyn_os(&args);
+        assert_eq!(code, 2, "{args:?}: exit {code}\n{err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        // An unknown subcommand is clap's "unrecognized subcommand"; any other argument is named.
+        if args.len() > 1 {
+            assert!(err.contains("not valid UTF-8"), "{args:?}: {err}");
+        }
+        if args.iter().any(|a| a == "--json") {
+            assert_eq!(json_error(&out)["kind"], "argument", "{args:?}: {out}");
+        }
+    }
+}
+
+/// A file name is any bytes: a model file whose name is not UTF-8 is read; a missing one is an
+/// I/O error (exit 2) naming it.
+#[cfg(unix)]
+#[test]
+fn a_non_utf8_file_name_is_a_file_name() {
+    use std::ffi::OsString;
+    use std::os::unix::ffi::OsStringExt;
+    let dir = std::env::temp_dir().join(format!("pdyn-utf8-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut name = dir.as_os_str().to_os_string().into_vec();
+    name.extend_from_slice(b"/sat\xFF.toml");
+    let path = std::path::PathBuf::from(OsString::from_vec(name));
+    std::fs::copy(in_root::root().join("examples/satellite.toml"), &path).unwrap();
+    let (code, out, err) = pdyn_os(&["derive".into(), path.clone().into_os_string()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("Satellite"), "{out}");
+    let mut missing = dir.as_os_str().to_os_string().into_vec();
+    missing.extend_from_slice(b"/none\xFE.toml");
+    let (code, _, err) = pdyn_os(&["run".into(), OsString::from_vec(missing)]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("none") && err.contains("cannot read"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
