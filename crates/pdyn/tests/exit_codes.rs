@@ -190,7 +190,8 @@ fn run_options_are_validated_where_read_and_named() {
 
 #[test]
 fn non_finite_results_are_flagged_never_printed_as_if_right() {
-    let (code, out, err) = pdyn(&["eval", "[1/0, 2, log(-1)]", "--json"]);
+    // (`1/0` written out is now a located division-by-zero error, exit 2: an overflow here.)
+    let (code, out, err) = pdyn(&["eval", "[exp(1000), 2, log(-1)]", "--json"]);
     assert_eq!(code, 1, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(v["value"], serde_json::json!(["inf", 2.0, "NaN"]));
@@ -390,5 +391,134 @@ fn a_non_utf8_file_name_is_a_file_name() {
     let (code, _, err) = pdyn_os(&["run".into(), OsString::from_vec(missing)]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("none") && err.contains("cannot read"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `simplify`, `eval` and `diff` refuse a division by zero with its location (exit 2): where it
+/// is written (`1/0`, `x/(x-x)`), or the whole expression when simplification reveals it.
+/// They printed `1/0`, `1/0*x` and `-1/0` with exit 0.
+#[test]
+fn a_division_by_zero_is_a_located_error() {
+    for (args, column) in [
+        (vec!["simplify", "1/0"], 3),
+        (vec!["simplify", "x/(x-x)"], 3),
+        (vec!["simplify", "2 + 0^-1"], 5),
+        (vec!["simplify", "1/((x+1)^2 - x^2 - 2*x - 1)"], 1),
+        (vec!["simplify", "[x, 1/((x+1)^2 - x^2 - 2*x - 1), 0]"], 1),
+        (vec!["diff", "sin(x)/(x-x)", "--wrt", "x"], 8),
+        (vec!["eval", "1/(2-2)"], 3),
+    ] {
+        let mut a = args.clone();
+        a.push("--json");
+        let (code, out, err) = pdyn(&a);
+        assert_eq!(code, 2, "{args:?}: exit {code}\n{out}{err}");
+        let e = json_error(&out);
+        assert_eq!(e["kind"], "expression", "{args:?}: {e}");
+        assert!(err.contains("division by zero"), "{args:?}: {err}");
+        assert_eq!(e["location"]["column"], column, "{args:?}: {e}");
+    }
+    let (code, out, _) = pdyn(&["simplify", "x/(x-y) + 0/x"]);
+    assert_eq!((code, out.trim()), (0, "x/(x - y)"));
+}
+
+/// A model file with bytes that are not UTF-8 is a model error at the first of them (line and
+/// column), for every kind of model file and every command that reads one; it was "cannot
+/// read the model file: stream did not contain valid UTF-8" with no place.
+#[test]
+fn non_utf8_bytes_in_a_model_file_are_located() {
+    let dir = std::env::temp_dir().join(format!("pdyn-bytes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let root = in_root::root();
+    let cases = [
+        ("examples/satellite.toml", "derive"),
+        ("examples/satellite.toml", "run"),
+        ("examples/nbody/figure_eight.toml", "run"),
+        ("examples/md/lj_liquid.toml", "run"),
+    ];
+    for (k, (example, command)) in cases.iter().enumerate() {
+        let text = std::fs::read_to_string(root.join(example)).unwrap();
+        // A Latin-1 byte at the end of the third line.
+        let lines: Vec<&str> = text.lines().collect();
+        let mut bytes = Vec::new();
+        for (i, l) in lines.iter().enumerate() {
+            bytes.extend_from_slice(l.as_bytes());
+            if i == 2 {
+                bytes.extend_from_slice(b" # caf\xE9");
+            }
+            bytes.push(b'\n');
+        }
+        let path = dir.join(format!("m{k}.toml"));
+        std::fs::write(&path, &bytes).unwrap();
+        let p = path.to_str().unwrap();
+        let (code, out, err) = pdyn(&[command, p, "--json"]);
+        assert_eq!(code, 2, "{example}: {err}");
+        let e = json_error(&out);
+        assert_eq!(e["kind"], "model", "{example}: {e}");
+        assert_eq!(e["location"]["line"], 3, "{example}: {e}");
+        assert_eq!(
+            e["location"]["column"],
+            lines[2].chars().count() + 7,
+            "{example}: {e}"
+        );
+        assert!(err.contains("0xE9") && err.contains("UTF-8"), "{err}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A bad `t_end`, `output_dt`, `dt`, `points` in `[simulate]` is shown at its key (it was
+/// "t_end must be a positive time, got -5" or "--output-dt must be ..." with no place); the
+/// same value given on the command line is still named by its option.
+#[test]
+fn bad_simulate_values_in_a_model_file_are_located_at_their_key() {
+    let root = in_root::root();
+    let text = std::fs::read_to_string(root.join("examples/projectile_drag.toml")).unwrap();
+    let dir = std::env::temp_dir().join(format!("pdyn-sim-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (k, (key, value)) in [
+        ("t_end", "-5"),
+        ("t_end", "0"),
+        ("t_end", "\"-2 s\""),
+        ("output_dt", "1e-12"),
+        ("output_dt", "-1"),
+        ("output_dt", "0"),
+        ("dt", "1e-15"),
+        ("points", "100000000"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut lines: Vec<String> = text
+            .lines()
+            .filter(|l| !l.starts_with(&format!("{key} =")))
+            .map(str::to_string)
+            .collect();
+        let at = lines.iter().position(|l| l == "[simulate]").unwrap() + 1;
+        lines.insert(at, format!("{key} = {value}"));
+        let path = dir.join(format!("s{k}.toml"));
+        std::fs::write(&path, lines.join("\n")).unwrap();
+        let p = path.to_str().unwrap();
+        let (code, out, err) = pdyn(&["run", p, "--json", "--out", dir.to_str().unwrap()]);
+        assert_eq!(code, 2, "{key} = {value}: {err}");
+        let e = json_error(&out);
+        assert_eq!(e["kind"], "model", "{key} = {value}: {e}");
+        assert_eq!(e["location"]["line"], at + 1, "{key} = {value}: {e}");
+        assert_eq!(
+            e["location"]["column"],
+            key.len() + 4,
+            "{key} = {value}: {e}"
+        );
+        assert!(err.contains(&format!("`{key}`")), "{err}");
+    }
+    // On the command line: the option is named.
+    let (code, _, err) = pdyn(&[
+        "run",
+        "examples/projectile_drag.toml",
+        "--output-dt",
+        "1e-13",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--output-dt must be"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
