@@ -798,3 +798,47 @@ fn mutated_nbody_examples_never_panic_or_hang() {
     std::fs::remove_dir_all(&dir).ok();
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// Every `[nbody]` Plummer sphere starts in standard Hénon units, whatever the seed: with
+/// `softening = 0` the initial energy the run reports is `−G mass²/(4 scale)` to round-off
+/// (it was −0.264 on average over 24 seeds of 1,000 stars, never −1/4), and the virial ratio
+/// after one tiny step is 1; `rescale = false` keeps the sample as drawn; a bad `rescale` is a
+/// located error.
+#[test]
+fn plummer_spheres_start_in_standard_henon_units() {
+    let dir = scratch("plummer-units");
+    let model = |seed: u64, extra: &str| {
+        format!(
+            "name = \"p\"\n[nbody]\nunits = \"nbody\"\nplummer = {{ n = 300, seed = {seed}{extra} }}\n\
+             integrator = \"leapfrog\"\ndt = 1e-6\nt_end = 1e-6\npoints = 2\n"
+        )
+    };
+    let run = |text: String, name: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        let out = dir.join(format!("{name}-out"));
+        run_ok(path.to_str().unwrap(), &["--out", out.to_str().unwrap()])
+    };
+    let mut natural = Vec::new();
+    for seed in 1..=6 {
+        for (extra, e_want) in [("", -0.25), (", mass = 2, scale = 3", -1.0 / 3.0)] {
+            let sum = run(model(seed, extra), &format!("s{seed}.toml"));
+            let e0 = sum["energy"]["initial"].as_f64().unwrap();
+            assert!((e0 - e_want).abs() < 1e-12, "seed {seed}{extra}: E = {e0}");
+            let q = sum["virial_ratio"].as_f64().unwrap();
+            assert!((q - 1.0).abs() < 1e-6, "seed {seed}{extra}: 2T/|W| = {q}");
+        }
+        let sum = run(model(seed, ", rescale = false"), &format!("n{seed}.toml"));
+        natural.push(sum["energy"]["initial"].as_f64().unwrap());
+    }
+    assert!(
+        natural.iter().all(|e| (e + 0.25).abs() > 1e-6),
+        "{natural:?}"
+    );
+    let path = dir.join("bad.toml");
+    std::fs::write(&path, model(1, ", rescale = \"yes\"")).unwrap();
+    let (code, out, err) = pdyn(&["run", path.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(json(&out)["error"]["location"]["line"], 4, "{out}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -60,6 +60,7 @@ struct RawPlummer {
     seed: Option<Spanned<i64>>,
     mass: Option<Sv>,
     scale: Option<Sv>,
+    rescale: Option<Spanned<bool>>,
 }
 
 #[derive(Deserialize)]
@@ -212,6 +213,10 @@ pub struct PlummerSpec {
     /// Length scale: positions are the Hénon-unit sphere's times `scale` (default 1, which
     /// is the virial radius), velocities times `√(G mass/scale)`.
     pub scale: f64,
+    /// Whether each realization is rescaled exactly to standard Hénon units (`E = −1/4`,
+    /// virial ratio 1) before `mass` and `scale` apply (`rescale = true`, the default), or
+    /// kept as drawn (`rescale = false`).
+    pub rescale: bool,
     /// Where it was declared.
     pub origin: Origin,
 }
@@ -744,6 +749,7 @@ impl Reader<'_> {
             seed,
             mass: mass.unwrap_or(1.0),
             scale: scale.unwrap_or(1.0),
+            rescale: raw.rescale.as_ref().is_none_or(|r| *r.get_ref()),
             origin: Origin {
                 file: origin.to_string(),
                 span: p.span(),
