@@ -368,17 +368,14 @@ pub fn check(a: CheckArgs) -> Result<Outcome, Error> {
     })?;
     let prep = prepare(&mut model, &a)?;
     let rep = sim::exact::check(&prep, &exact, &set).map_err(|e| sim_error(&model, "", e))?;
-    let worst = rep
-        .errors
-        .iter()
-        .map(|e| e.1 / e.2.max(1e-300))
-        .fold(0.0, f64::max);
+    let (scales, relative) = (rep.scales(), rep.relative_errors());
+    let worst = relative.iter().copied().fold(0.0, f64::max);
     if a.json {
         let v = serde_json::json!({
             "model": model.name,
             "method": rep.run.method.to_string(),
             "rows": rep.run.rows.len(),
-            "errors": rep.errors.iter().map(|(n, e, s)| serde_json::json!({"name": n, "max_abs_error": e, "max_abs_value": s})).collect::<Vec<_>>(),
+            "errors": rep.errors.iter().zip(scales.iter().zip(&relative)).map(|((n, e, s), (scale, rel))| serde_json::json!({"name": n, "max_abs_error": e, "max_abs_value": s, "scale": scale, "relative_error": rel})).collect::<Vec<_>>(),
             "max_relative_error": worst,
         });
         let failure = rep.run.failure.clone().map(|failure| Error::Integration {
@@ -398,10 +395,15 @@ pub fn check(a: CheckArgs) -> Result<Outcome, Error> {
         rep.run.rows.len(),
         set.t_end
     );
-    for (n, e, s) in &rep.errors {
-        out += &format!("  {n:<12} max |error| {e:.3e}   (max |value| {s:.3e})\n");
+    for ((n, e, s), rel) in rep.errors.iter().zip(&relative) {
+        out += &format!(
+            "  {n:<12} max |error| {e:.3e}   (max |value| {s:.3e})   relative {rel:.3e}\n"
+        );
     }
-    out += &format!("largest error relative to the size of the solution: {worst:.3e}\n");
+    out += &format!(
+        "largest error relative to the size of the solution: {worst:.3e}\n\
+         (each column against the largest max |value| of its order: coordinates together, rates together)\n"
+    );
     let failure = rep.run.failure.clone().map(|failure| Error::Integration {
         origin: model.origin.clone(),
         failure: Box::new(failure),
