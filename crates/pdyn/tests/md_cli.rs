@@ -620,3 +620,68 @@ fn two_species_from_xyz_and_lammps_data() {
         "no pair potential between A and B",
     );
 }
+
+/// `rdf_frames` sets how many frames the RDF averages: exactly `min(rdf_frames, R)`, with `R`
+/// the thermo records of the second half of the run (here steps 100, 102, …, 200: 51), as
+/// `summary.json` reports; the default stays "up to 20"; a count out of range is located.
+#[test]
+fn rdf_frames_sets_the_number_of_frames_averaged() {
+    let base = lj()
+        .replace("steps = 100", "steps = 200")
+        .replace("thermo_every = 50", "thermo_every = 2\nrdf = true");
+    let records = 51;
+    for frames in [
+        None,
+        Some(1),
+        Some(5),
+        Some(7),
+        Some(50),
+        Some(51),
+        Some(200),
+    ] {
+        let text = match frames {
+            Some(f) => base.replace("rdf = true", &format!("rdf = true\nrdf_frames = {f}")),
+            None => base.clone(),
+        };
+        let d = scratch(&format!("rdf{frames:?}"));
+        let f = d.join("m.toml");
+        std::fs::write(&f, text).unwrap();
+        let (code, out, err) = pdyn(&[
+            "run",
+            f.to_str().unwrap(),
+            "--set",
+            "n=4",
+            "--json",
+            "--out",
+            d.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{frames:?}: {err}");
+        let v = json(&out);
+        let want = frames.unwrap_or(20).min(records) as u64;
+        assert_eq!(v["rdf_frames"], want, "{frames:?}");
+        let warned = v["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| w.as_str().unwrap().contains("rdf_frames"));
+        assert_eq!(
+            warned,
+            frames.is_some_and(|f| f > records),
+            "{frames:?}: {v}"
+        );
+        assert!(d.join("rdf.csv").exists());
+    }
+    for bad_value in ["0", "1000000", "\"many\"", "-3"] {
+        let text = base.replace(
+            "rdf = true",
+            &format!("rdf = true\nrdf_frames = {bad_value}"),
+        );
+        let line = line_of(&text, "rdf_frames");
+        assert_located(
+            "rdf_frames",
+            bad("rdf_frames", &text, &["--set", "n=4"]),
+            line,
+            "",
+        );
+    }
+}

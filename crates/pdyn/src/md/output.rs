@@ -67,6 +67,7 @@ pub fn summary(prep: &Prepared, res: &MdResult) -> serde_json::Value {
         "thermo_every": spec.thermo_every,
         "neighbor_builds": res.builds,
         "trajectory_frames": res.frames,
+        "rdf_frames": res.rdf.as_ref().map(|_| res.rdf_frames),
         "formula_native": prep.native,
         "minimized": prep.minimized.map(|m| json!({
             "iterations": m.iterations, "energy": json_num(m.energy),
