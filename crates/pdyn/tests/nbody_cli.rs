@@ -842,3 +842,34 @@ fn plummer_spheres_start_in_standard_henon_units() {
     assert_eq!(json(&out)["error"]["location"]["line"], 4, "{out}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Mutations of the figure-eight that IAS15 cannot follow (`vx3` = 10¹⁶ … 10³⁰⁰) end with
+/// exit 1, the time, the partial output and what to do; `vx3 = 1e20` ran for more than a
+/// minute without a word.
+#[test]
+fn an_ias15_run_that_cannot_advance_ends_with_a_clear_error() {
+    for v in ["1e16", "1e20", "1e300"] {
+        let dir = scratch(&format!("collapse-{v}"));
+        let (code, out, err) = pdyn(&[
+            "run",
+            "examples/nbody/figure_eight.toml",
+            "--set",
+            &format!("vx3={v}"),
+            "--t-end",
+            "0.01",
+            "--out",
+            dir.to_str().unwrap(),
+            "--json",
+        ]);
+        assert_eq!(code, 1, "vx3 = {v}: {err}");
+        assert!(
+            err.contains("step size fell to") && err.contains("check the initial state"),
+            "{err}"
+        );
+        let sum = json(&out);
+        let t = sum["t_reached"].as_f64().unwrap();
+        assert!(t < 0.01, "{t}");
+        assert!(dir.join("summary.json").exists());
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
