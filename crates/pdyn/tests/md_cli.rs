@@ -685,3 +685,54 @@ fn rdf_frames_sets_the_number_of_frames_averaged() {
         );
     }
 }
+
+/// A model too large for the memory is refused before anything is allocated, at its
+/// `[md.lattice]`, with the atoms, the estimate (200 + 156·ghosts + 8·pairs bytes per atom,
+/// recomputed here from the lattice) and the limit; under the limit it runs. The limit is set
+/// by PDYN_MEMORY_LIMIT here (MemAvailable otherwise). It died with "memory allocation of
+/// 128000000 bytes failed" at 32 million atoms.
+#[test]
+fn a_model_larger_than_the_memory_is_refused_with_both_sizes() {
+    use in_root::pdyn_env;
+    for (kind, basis) in [("sc", 1u64), ("bcc", 2), ("fcc", 4)] {
+        let cells = 30u64;
+        let text = lj()
+            .replace("kind = \"fcc\"", &format!("kind = \"{kind}\""))
+            .replace("cells = \"n\"", &format!("cells = {cells}"));
+        let d = scratch(&format!("mem-{kind}"));
+        let f = d.join("m.toml");
+        std::fs::write(&f, &text).unwrap();
+        let args = [
+            "run",
+            f.to_str().unwrap(),
+            "--json",
+            "--t-end",
+            "0.005",
+            "--out",
+            d.to_str().unwrap(),
+        ];
+        let (code, out, err) = pdyn_env(&args, &[("PDYN_MEMORY_LIMIT", "10M")]);
+        assert_eq!(code, 2, "{kind}: {err}");
+        let e = json(&out)["error"].clone();
+        assert_eq!(e["location"]["line"], line_of(&text, "[md.lattice]"), "{e}");
+        let atoms = basis * cells.pow(3);
+        let msg = e["message"].as_str().unwrap();
+        assert!(msg.contains(&format!("{atoms} atoms need about")), "{msg}");
+        assert!(
+            msg.contains("10.5 MB available (PDYN_MEMORY_LIMIT)"),
+            "{msg}"
+        );
+        // bytes per atom, from the lattice: edge = cells·(basis/ρ)^(1/3), reach 2.5 + 0.3
+        let edge = cells as f64 * (basis as f64 / 0.8442).cbrt();
+        let ghosts = ((edge + 5.6) / edge).powi(3);
+        let pairs = 2.0 * std::f64::consts::PI / 3.0 * 0.8442 * 2.8f64.powi(3);
+        let per_atom = 200.0 + 156.0 * ghosts + 8.0 * pairs;
+        assert!(
+            msg.contains(&format!("({per_atom:.0} bytes per atom)")),
+            "{msg}"
+        );
+        // Enough memory: it runs.
+        let (code, _, err) = pdyn_env(&args, &[("PDYN_MEMORY_LIMIT", "4G")]);
+        assert_eq!(code, 0, "{kind}: {err}");
+    }
+}
