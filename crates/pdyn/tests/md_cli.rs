@@ -736,3 +736,42 @@ fn a_model_larger_than_the_memory_is_refused_with_both_sizes() {
         assert_eq!(code, 0, "{kind}: {err}");
     }
 }
+
+/// The thermo plot's axes carry the units of the model (`energy per atom [ε]`, `T [ε/k_B]`,
+/// `P [ε/σ³]` in LJ units; kcal/mol, K, atm in real units): they were `energy / atom`, `T`, `P`.
+#[test]
+fn thermo_plot_axes_carry_the_units_of_the_model() {
+    for (file, t_end, energy, temperature, pressure) in [
+        ("examples/md/lj_liquid.toml", "0.05", "ε", "ε/k_B", "ε/σ³"),
+        (
+            "examples/md/argon_melting.toml",
+            "200",
+            "kcal/mol",
+            "K",
+            "atm",
+        ),
+    ] {
+        let d = scratch(&format!("axes-{}", file.len()));
+        let (code, _, err) = pdyn(&[
+            "run",
+            file,
+            "--set",
+            "n=4",
+            "--t-end",
+            t_end,
+            "--out",
+            d.to_str().unwrap(),
+            "--plot",
+        ]);
+        assert_eq!(code, 0, "{file}: {err}");
+        let svg = std::fs::read_to_string(d.join("thermo.svg"))
+            .unwrap_or_else(|e| panic!("{file}: no thermo.svg ({e})"));
+        for label in [
+            format!("energy per atom [{energy}]"),
+            format!("T [{temperature}]"),
+            format!("P [{pressure}]"),
+        ] {
+            assert!(svg.contains(&label), "{file}: no `{label}`");
+        }
+    }
+}

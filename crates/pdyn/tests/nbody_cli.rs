@@ -873,3 +873,68 @@ fn an_ias15_run_that_cannot_advance_ends_with_a_clear_error() {
         std::fs::remove_dir_all(&dir).ok();
     }
 }
+
+/// Every plot's axes carry the units of the model's unit system (they were bare `t`, `x`,
+/// `a`): `t [yr]`, `x [AU]`, `a [AU]` in au-year-msun, `t [days]` in au-day-msun, `t [s]`
+/// and `x [m]` in SI, the model's own units in N-body units.
+#[test]
+fn plot_axes_carry_the_units_of_the_model() {
+    for (units, length, time, scale) in [
+        ("au-year-msun", "AU", "yr", "1"),
+        ("au-day-msun", "AU", "days", "365.25"),
+        ("si", "m", "s", "3.15576e7"),
+        ("nbody", "N-body length", "N-body time", "1"),
+    ] {
+        let dir = scratch(&format!("units-{units}"));
+        let path = dir.join("m.toml");
+        // A planet on a circle about a star, in whatever units: a 2-body problem.
+        let text = format!(
+            "name = \"units\"\n[parameters]\nS = {scale}\n[nbody]\nunits = \"{units}\"\n\
+             integrator = \"ias15\"\nt_end = \"S/10\"\npoints = 5\n\
+             [[nbody.bodies]]\nname = \"Star\"\nmass = 1\nposition = [0, 0, 0]\nvelocity = [0, 0, 0]\n\
+             [[nbody.bodies]]\nname = \"P\"\nmass = 1e-3\nprimary = \"Star\"\na = 1\ne = 0.1\n"
+        )
+        .replace(
+            "mass = 1\nposition",
+            if units == "si" {
+                "mass = 2e30\nposition"
+            } else {
+                "mass = 1\nposition"
+            },
+        )
+        .replace(
+            "mass = 1e-3\nprimary = \"Star\"\na = 1\n",
+            if units == "si" {
+                "mass = 2e27\nprimary = \"Star\"\na = 1.5e11\n"
+            } else {
+                "mass = 1e-3\nprimary = \"Star\"\na = 1\n"
+            },
+        );
+        std::fs::write(&path, text).unwrap();
+        let out = dir.join("out");
+        let (code, _, err) = pdyn(&[
+            "run",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--plot",
+        ]);
+        assert_eq!(code, 0, "{units}: {err}");
+        let svg = |f: &str| std::fs::read_to_string(out.join(f)).unwrap();
+        let (t, x, a) = (
+            format!("t [{time}]"),
+            format!("x [{length}]"),
+            format!("a [{length}]"),
+        );
+        assert!(svg("orbits.svg").contains(&x), "{units}: orbits");
+        assert!(
+            svg("elements.svg").contains(&t) && svg("elements.svg").contains(&a),
+            "{units}"
+        );
+        assert!(
+            svg("conservation.svg").contains(&t),
+            "{units}: conservation"
+        );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

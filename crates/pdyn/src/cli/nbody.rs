@@ -233,7 +233,7 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
         write("conservation.csv", &|p| output::write_conservation(&res, p))?;
         write("summary.json", &|p| std::fs::write(p, format!("{sum:#}\n")))?;
         if a.plot {
-            nbody::plots::write(&spec.name, &res, dir)?;
+            nbody::plots::write(&spec.name, &res, &spec.units, dir)?;
         }
     } else if a.plot {
         return Err(Error::argument(

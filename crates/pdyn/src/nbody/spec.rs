@@ -104,6 +104,20 @@ pub struct UnitsSpec {
     pub label: &'static str,
 }
 
+impl UnitsSpec {
+    /// The units of length and time for axis labels and reports: `("AU", "days")`, `("m",
+    /// "s")`; for `G = 1` (Hénon) and a custom `G`, the model's own units.
+    pub fn length_time(&self) -> (&'static str, &'static str) {
+        match self.units {
+            pdyn_gravity::Units::AuDaySolarMass => ("AU", "days"),
+            pdyn_gravity::Units::AuYearSolarMass => ("AU", "yr"),
+            pdyn_gravity::Units::Si => ("m", "s"),
+            pdyn_gravity::Units::GEqualsOne => ("N-body length", "N-body time"),
+            _ => ("length unit", "time unit"),
+        }
+    }
+}
+
 /// The unit systems `units = "..."` accepts: name, engine units, SI, label.
 pub const UNIT_SYSTEMS: &[(&str, pdyn_gravity::Units, bool)] = &[
     ("nbody", pdyn_gravity::Units::GEqualsOne, false),
