@@ -683,6 +683,13 @@ impl Pool {
     }
 }
 
+/// A division by zero where it is written (`1/0`, `x/(x - x)`, `0^-1`): the divisor, once
+/// lowered to canonical form, is the number zero. It is an error, not `1/0` carried along.
+fn division_by_zero(span: Range<usize>, message: &str) -> ExprError {
+    ExprError::new(span, format!("division by zero: {message}"))
+        .with_help("the expression is undefined; check the denominator")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -781,11 +788,4 @@ mod tests {
             assert!(again.is_ok(), "{src}: {}", again.unwrap_err().message);
         }
     }
-}
-
-/// A division by zero where it is written (`1/0`, `x/(x - x)`, `0^-1`): the divisor, once
-/// lowered to canonical form, is the number zero. It is an error, not `1/0` carried along.
-fn division_by_zero(span: Range<usize>, message: &str) -> ExprError {
-    ExprError::new(span, format!("division by zero: {message}"))
-        .with_help("the expression is undefined; check the denominator")
 }

@@ -409,6 +409,9 @@ pub fn kin(a: &KinInput) -> Result<KinResult, Error> {
 
 type InstantValues = Vec<(&'static str, Quantity, Option<Vec<f64>>)>;
 
+/// An instant resolved: its header, the values there, and the substitutions that make it.
+type Instant = (String, InstantValues, Vec<(Id, Id)>);
+
 /// Whether `e`, at the instant, is zero: exactly, or numerically zero to the last bits.
 fn zero_there(pool: &mut Pool, e: [Id; 3], map: &[(Id, Id)]) -> ([Id; 3], bool) {
     let x = e.map(|c| {
@@ -520,7 +523,7 @@ fn instant(
     set: &[(Id, Id)],
     spec: &str,
     scope: &mut FreeScope,
-) -> Result<(String, InstantValues, Vec<(Id, Id)>), Error> {
+) -> Result<Instant, Error> {
     let t = pool.time();
     let mut map: Vec<(Id, Id)> = set.to_vec();
     let mut header = Vec::new();
