@@ -462,6 +462,32 @@ fn non_utf8_bytes_in_a_model_file_are_located() {
         );
         assert!(err.contains("0xE9") && err.contains("UTF-8"), "{err}");
     }
+    // The bodies file of an N-body model: located in the CSV.
+    std::fs::copy(
+        root.join("examples/nbody/outer_solar_system_csv.toml"),
+        dir.join("csv.toml"),
+    )
+    .unwrap();
+    let csv = std::fs::read(root.join("examples/nbody/outer_solar_system.csv")).unwrap();
+    let mut lines: Vec<Vec<u8>> = csv.split(|&b| b == b'\n').map(<[u8]>::to_vec).collect();
+    let col = lines[2].len() + 1;
+    lines[2].push(0xFE);
+    std::fs::write(dir.join("outer_solar_system.csv"), lines.join(&b'\n')).unwrap();
+    let (code, out, err) = pdyn(&["run", dir.join("csv.toml").to_str().unwrap(), "--json"]);
+    assert_eq!(code, 2, "{err}");
+    let e = json_error(&out);
+    assert!(
+        e["location"]["file"].as_str().unwrap().ends_with(".csv"),
+        "{e}"
+    );
+    assert_eq!(
+        (
+            e["location"]["line"].clone(),
+            e["location"]["column"].clone()
+        ),
+        (3.into(), col.into()),
+        "{e}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -381,7 +381,7 @@ pub fn parse(
     if let Some(file) = &nb.bodies_file {
         let dir = Path::new(origin).parent().unwrap_or(Path::new(""));
         let path: PathBuf = dir.join(file.get_ref());
-        let text = std::fs::read_to_string(&path).map_err(|e| {
+        let bytes = std::fs::read(&path).map_err(|e| {
             in_model(
                 ModelError::new(
                     origin,
@@ -392,6 +392,19 @@ pub fn parse(
             )
         })?;
         let csv_origin = path.display().to_string();
+        // Bytes that are not UTF-8: an error at the first of them, in the CSV.
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let at = e.utf8_error().valid_up_to();
+            let byte = e.as_bytes()[at];
+            Box::new(SetOrSpecError::Spec(SpecError {
+                error: ModelError::new(
+                    &csv_origin,
+                    at..at + char::REPLACEMENT_CHARACTER.len_utf8(),
+                    format!("the byte 0x{byte:02X} is not UTF-8: a bodies file must be UTF-8 text"),
+                ),
+                source: String::from_utf8_lossy(e.as_bytes()).into_owned(),
+            }))
+        })?;
         let first = spec.bodies.len();
         let csv_bodies =
             super::csv::bodies(&text, &csv_origin, r.units, &spec.bodies).map_err(|error| {
