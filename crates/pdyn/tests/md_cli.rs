@@ -619,6 +619,23 @@ fn two_species_from_xyz_and_lammps_data() {
         line_of(&text, "[md]"),
         "no pair potential between A and B",
     );
+    // A configuration read from a file is sized once read, before anything else is built:
+    // over the memory limit it is refused at its `file`.
+    for file in ["mix.xyz", "mix.data"] {
+        let text = model(file, true);
+        let f = d.join("mix.toml");
+        std::fs::write(&f, &text).unwrap();
+        let (code, out, err) = in_root::pdyn_env(
+            &["run", f.to_str().unwrap(), "--json"],
+            &[("PDYN_MEMORY_LIMIT", "10K")],
+        );
+        assert_located(
+            "mix",
+            (code, json(&out)["error"].clone(), err),
+            line_of(&text, "file = "),
+            "64 atoms need about",
+        );
+    }
 }
 
 /// `rdf_frames` sets how many frames the RDF averages: exactly `min(rdf_frames, R)`, with `R`

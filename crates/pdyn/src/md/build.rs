@@ -114,7 +114,7 @@ fn fits_in_memory(
                 human(have as f64),
             ),
         )
-        .help("use fewer cells (a smaller system), or set PDYN_MEMORY_LIMIT if the estimate is too cautious (docs/md.md)"));
+        .help("use a smaller system (fewer cells or atoms), or set PDYN_MEMORY_LIMIT if the estimate is too cautious (docs/md.md)"));
     }
     Ok(())
 }
