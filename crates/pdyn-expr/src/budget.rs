@@ -48,7 +48,17 @@ pub enum BudgetError {
         /// The derivative being computed when the limit was reached.
         order: usize,
     },
+    /// A time derivative would give a coordinate of order above [`MAX_COORD_ORDER`]
+    /// (`x` with 256 primes).
+    CoordinateOrder {
+        /// The order the derivative would need.
+        order: usize,
+    },
 }
+
+/// Highest order of a coordinate's time derivative an expression can hold (`x` followed by
+/// 255 primes): the order is stored in a byte. Past it is an error, never a saturated order.
+pub const MAX_COORD_ORDER: usize = u8::MAX as usize;
 
 impl fmt::Display for BudgetError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -75,6 +85,11 @@ impl fmt::Display for BudgetError {
                 "derivative {order} has coefficients over the limit of {} digits for exact \
                  numbers: differentiate fewer times, or evaluate numerically",
                 crate::number::MAX_DIGITS
+            ),
+            BudgetError::CoordinateOrder { order } => write!(
+                f,
+                "this needs a coordinate's time derivative of order {order}, over the limit of \
+                 {MAX_COORD_ORDER}: differentiate fewer times"
             ),
         }
     }

@@ -32,6 +32,14 @@ impl Pool {
         var: Option<Id>,
         n: usize,
     ) -> Result<Id, BudgetError> {
+        // In time, each derivative raises the order of the coordinates (`t^2` has none: its
+        // derivatives may go on).
+        if var.is_none() && self.has_coord(e) {
+            let order = self.max_coord_order(e).saturating_add(n);
+            if order > crate::budget::MAX_COORD_ORDER {
+                return Err(BudgetError::CoordinateOrder { order });
+            }
+        }
         let start = self.len();
         // Each derivative seen, with its order: a repeat means the sequence is periodic from
         // there on (sin → cos → -sin → -cos → sin; exp → exp; 0 → 0).

@@ -386,6 +386,54 @@ impl Pool {
         id == Pool::ZERO
     }
 
+    /// The highest order of a coordinate in `id` (0 when it has none or only `x`).
+    pub fn max_coord_order(&self, id: Id) -> usize {
+        let mut order = 0;
+        self.visit_once(id, |n| {
+            if let Node::Coord(_, k) = n {
+                order = order.max(*k as usize);
+            }
+        });
+        order
+    }
+
+    /// Whether `id` contains a coordinate (`x`, `x'`, …).
+    pub fn has_coord(&self, id: Id) -> bool {
+        let mut found = false;
+        self.visit_once(id, |n| found |= matches!(n, Node::Coord(..)));
+        found
+    }
+
+    /// Calls `f` on every node of `id` once (the expression is a DAG).
+    fn visit_once(&self, id: Id, mut f: impl FnMut(&Node)) {
+        let mut seen = rustc_hash::FxHashSet::default();
+        let mut stack = vec![id];
+        while let Some(x) = stack.pop() {
+            if seen.insert(x) {
+                f(self.node(x));
+                self.for_each_child(x, |c| stack.push(c));
+            }
+        }
+    }
+
+    /// Whether `id` contains a division by zero: a power of the number zero with a negative
+    /// exponent (`1/0`), or a number that is not finite (expansion folds `1/0` into an
+    /// infinite float), as simplification can leave them (`1/((x+1)^2 - x^2 - 2*x - 1)`).
+    pub fn divides_by_zero(&self, id: Id) -> bool {
+        let mut found = false;
+        self.visit_once(id, |n| {
+            found |= match n {
+                Node::Pow(b, e) => {
+                    matches!(self.node(*b), Node::Num(n) if n.is_zero())
+                        && matches!(self.node(*e), Node::Num(n) if n.is_negative())
+                }
+                Node::Num(Number::Float(f)) => !f.is_finite(),
+                _ => false,
+            }
+        });
+        found
+    }
+
     /// Calls `f` on each child of `id`.
     pub fn for_each_child(&self, id: Id, mut f: impl FnMut(Id)) {
         match self.node(id) {

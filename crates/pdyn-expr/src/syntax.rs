@@ -357,13 +357,23 @@ impl<'a> Parser<'a> {
             match &self.tok {
                 Tok::Prime => {
                     let start = e.span().start;
-                    let mut count = 0u8;
+                    let mut count = 0usize;
                     let mut end = self.span.end;
                     while self.tok == Tok::Prime {
-                        count = count.saturating_add(1);
+                        count += 1;
                         end = self.span.end;
                         self.bump()?;
                     }
+                    let Ok(count) = u8::try_from(count) else {
+                        return Err(ExprError::new(
+                            start..end,
+                            format!(
+                                "{count} primes: a time derivative of order at most {} can be \
+                                 written",
+                                crate::budget::MAX_COORD_ORDER
+                            ),
+                        ));
+                    };
                     e = Ast::Prime {
                         expr: Box::new(e),
                         count,

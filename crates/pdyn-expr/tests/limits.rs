@@ -91,3 +91,102 @@ fn long_sums_and_products_are_near_linear_and_shallow() {
         assert_eq!(q, r);
     });
 }
+
+/// A division by zero where it is written is an error at the divisor (or at the power of zero),
+/// whatever the divisor looks like before it is put in canonical form; never `1/0` carried on.
+#[test]
+fn a_division_by_zero_is_an_error_at_the_divisor() {
+    for (src, located) in [
+        ("1/0", "0"),
+        ("x/(x-x)", "(x-x)"),
+        ("x/0.0", "0.0"),
+        ("sin(t)/(2*y - y - y)", "(2*y - y - y)"),
+        ("[1, 2, 3]/(a - a)", "(a - a)"),
+        ("1/(0*x)", "(0*x)"),
+        ("1/sin(0)", "sin(0)"),
+        ("x + 3/(t^2 - t*t)", "(t^2 - t*t)"),
+        ("0^-1", "0^-1"),
+        ("(x - x)^(-2)", "(x - x)^(-2)"),
+        ("(y-y)^(-1/2)", "(y-y)^(-1/2)"),
+    ] {
+        let mut p = Pool::new();
+        let err = p.parse_scalar(src).expect_err(src);
+        assert!(
+            err.message.contains("division by zero"),
+            "{src}: {}",
+            err.message
+        );
+        assert_eq!(&src[err.span.clone()], located, "{src}: {err:?}");
+    }
+    // Zero in a numerator, a positive power of zero, a divisor that is zero only at some
+    // points: all fine.
+    let mut p = Pool::new();
+    for src in ["0/x", "0^2", "1/x", "1/(x - 1)", "x/(x - y)", "(x-x)^2"] {
+        p.parse_scalar(src)
+            .unwrap_or_else(|e| panic!("{src}: {e:?}"));
+    }
+}
+
+/// A division by zero that only simplification reveals is seen by `divides_by_zero` (the
+/// check `pdyn simplify` makes on its result); ordinary results are not flagged.
+#[test]
+fn a_zero_denominator_revealed_by_simplification_is_detected() {
+    let mut p = Pool::new();
+    for src in [
+        "1/((x+1)^2 - x^2 - 2*x - 1)",
+        "y + 2/((a-b)^2 - a^2 + 2*a*b - b^2)",
+    ] {
+        let e = p.parse_scalar(src).unwrap();
+        let e = p.expand(e);
+        let s = p.simplify(e);
+        assert!(p.divides_by_zero(s), "{src} -> {}", p.to_text(s));
+    }
+    for src in [
+        "1/x",
+        "1/((x+1)^2 - x^2)",
+        "0^2 + 1/(x - 1)",
+        "sin(x)/cos(x)",
+    ] {
+        let e = p.parse_scalar(src).unwrap();
+        let e = p.expand(e);
+        let s = p.simplify(e);
+        assert!(!p.divides_by_zero(s), "{src} -> {}", p.to_text(s));
+    }
+}
+
+/// A coordinate's derivative order is a byte: 256 primes or more, written or reached by
+/// differentiating in time, is an error naming the order, never a saturated `x` with 255
+/// primes (which made `x` differentiated 300 times equal to `x` differentiated 255 times).
+#[test]
+fn time_derivatives_past_order_255_are_refused() {
+    let primes = |n: usize| "'".repeat(n);
+    let mut p = Pool::new();
+    // Up to 255 primes is fine.
+    let ok = p.parse_scalar(&format!("x{}", primes(255))).unwrap();
+    assert!(matches!(p.node(ok), Node::Coord(_, 255)));
+    for src in [
+        format!("x{}", primes(256)),
+        format!("x{}", primes(300)),
+        format!("2*y{} + 1", primes(1000)),
+        format!("(x{}){}", primes(200), primes(56)),
+        format!("(x{} + t){}", primes(255), primes(1)),
+    ] {
+        let err = p.parse_scalar(&src).expect_err(&src);
+        assert!(err.message.contains("255"), "{}", err.message);
+        assert!(!err.span.is_empty() && src[err.span.clone()].contains('\''));
+    }
+    // Differentiating in time past the order is a budget error; `t^2` has no coordinate.
+    for (src, n) in [("x(t)", 256usize), ("x''", 254), ("sin(x(t))*y'", 255)] {
+        let e = p.parse_scalar(src).unwrap();
+        let err = p.try_derivative_n(e, None, n).expect_err(src);
+        assert!(
+            matches!(err, pdyn_expr::budget::BudgetError::CoordinateOrder { .. }),
+            "{src}: {err:?}"
+        );
+    }
+    let x = p.parse_scalar("x(t)").unwrap();
+    let d = p.try_derivative_n(x, None, 255).unwrap();
+    assert!(matches!(p.node(d), Node::Coord(_, 255)));
+    let t2 = p.parse_scalar("t^2").unwrap();
+    assert_eq!(p.try_derivative_n(t2, None, 1000).unwrap(), Pool::ZERO);
+}

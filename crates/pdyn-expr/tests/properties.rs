@@ -63,6 +63,15 @@ fn parse(s: &mut Setup, text: &str) -> Id {
     }
 }
 
+/// Whether the random text divides by zero where it is written (`(t - t)^(-1)`): such text is
+/// refused by the parser (a located error), so the properties skip it.
+fn divides_by_zero(text: &str) -> bool {
+    let mut scope = FreeScope::with_coordinates(["x"]);
+    Pool::new()
+        .parse_in(text, &mut scope)
+        .is_err_and(|e| e.message.starts_with("division by zero"))
+}
+
 fn eval(s: &mut Setup, e: Id, point: &[f64; 6]) -> f64 {
     let prog = Program::compile(&mut s.pool, &s.inputs, &[e]).unwrap();
     let mut ws = prog.workspace();
@@ -92,6 +101,7 @@ proptest! {
     #[test]
     fn partial_derivative_matches_finite_difference(text in expr_text(true), pt in point()) {
         let mut s = setup();
+        prop_assume!(!divides_by_zero(&text));
         let e = parse(&mut s, &text);
         let a = s.inputs[0];
         let d = s.pool.diff(e, a);
@@ -110,6 +120,7 @@ proptest! {
     #[test]
     fn time_derivative_matches_finite_difference(text in expr_text(true), pt in point()) {
         let mut s = setup();
+        prop_assume!(!divides_by_zero(&text));
         let e = parse(&mut s, &text);
         let d = s.pool.dt(e);
         // Along the path x(τ) = x0 + v τ + acc τ²/2 around the point.
@@ -132,6 +143,7 @@ proptest! {
     #[test]
     fn printed_text_reparses_to_the_same_node(text in expr_text(false)) {
         let mut s = setup();
+        prop_assume!(!divides_by_zero(&text));
         let e = parse(&mut s, &text);
         let printed = s.pool.to_text(e);
         let again = parse(&mut s, &printed);
@@ -144,7 +156,9 @@ proptest! {
         let mut pool = Pool::new();
         let mut scope = FreeScope::with_coordinates(["x"]);
         scope.positive = ["a".to_string(), "b".to_string()].into_iter().collect();
-        let e = pool.parse_in(&text, &mut scope).unwrap().scalar().unwrap();
+        let parsed = pool.parse_in(&text, &mut scope);
+        prop_assume!(!parsed.as_ref().is_err_and(|e| e.message.starts_with("division by zero")));
+        let e = parsed.unwrap().scalar().unwrap();
         let printed = pool.to_text(e);
         let again = pool.parse_in(&printed, &mut scope).unwrap().scalar().unwrap();
         prop_assert_eq!(again, e, "{} printed as {}", text, printed);
@@ -153,6 +167,7 @@ proptest! {
     #[test]
     fn simplify_and_expand_preserve_values(text in expr_text(false), pt in point()) {
         let mut s = setup();
+        prop_assume!(!divides_by_zero(&text));
         let e = parse(&mut s, &text);
         let v = eval(&mut s, e, &pt);
         prop_assume!(v.is_finite() && v.abs() < 1e8);

@@ -152,7 +152,19 @@ impl fmt::Display for GravityError {
                 "t = {t}: close encounter of body {body} (perturbation/Kepler = {ratio:.3}); \
                  WHFast cannot resolve it, use IAS15"
             ),
-            StepSizeUnderflow { t, dt } => write!(f, "t = {t}: IAS15 step size underflow ({dt})"),
+            StepSizeUnderflow { t, dt } => write!(
+                f,
+                "t = {}: the IAS15 step size fell to {dt:e}, too small to advance the time \
+                 (the integration would not end): usually a body far outside the others' scale \
+                 (a speed or distance many orders of magnitude larger: check the initial \
+                 state) or an unresolved close encounter (use collisions, softening or \
+                 escape_distance)",
+                if *t == 0.0 || (1e-4..1e7).contains(&t.abs()) {
+                    t.to_string()
+                } else {
+                    format!("{t:e}")
+                }
+            ),
             NonFinite { t, index } => write!(f, "t = {t}: body {index} has a non-finite state"),
         }
     }

@@ -55,5 +55,7 @@ pub use forces::{Gravity, TreeParams};
 pub use integrators::{Ias15Params, Integrator, WhFastParams};
 pub use orbit::{Anomaly, Elements, Orbit};
 pub use pdyn_particles::{Particle, Particles, Vec3};
-pub use simulation::{EventParams, Outcome, Primary, Simulation};
+pub use simulation::{
+    EventParams, Outcome, Primary, Simulation, MAX_CRAWL_STEPS, MIN_RELATIVE_STEP,
+};
 pub use units::Units;

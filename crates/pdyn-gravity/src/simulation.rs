@@ -71,6 +71,13 @@ impl Default for EventParams {
     }
 }
 
+/// A step of an adaptive integrator at most this fraction of the time (the larger of the
+/// current and the end time) is a crawl: 10¹² of them to double `t`. A close encounter takes a
+/// few; [`MAX_CRAWL_STEPS`] in a row stop the run ([`GravityError::StepSizeUnderflow`]).
+pub const MIN_RELATIVE_STEP: f64 = 1e-12;
+/// Consecutive steps below [`MIN_RELATIVE_STEP`] that stop a run.
+pub const MAX_CRAWL_STEPS: u64 = 10_000;
+
 /// A self-gravitating system of point masses and how to integrate it.
 #[derive(Debug, Clone)]
 pub struct Simulation {
@@ -85,6 +92,8 @@ pub struct Simulation {
     workspace: Option<Workspace>,
     warnings: Vec<Warning>,
     steps: u64,
+    /// Consecutive adaptive steps of at most [`MIN_RELATIVE_STEP`] of the time.
+    crawl: u64,
     /// Fixed-step time keeping: `t = t_origin + n_fixed · dt` (no accumulated round-off).
     t_origin: f64,
     n_fixed: u64,
@@ -117,6 +126,7 @@ impl Simulation {
             workspace: None,
             warnings: Vec::new(),
             steps: 0,
+            crawl: 0,
             t_origin: 0.0,
             n_fixed: 0,
         }
@@ -307,7 +317,10 @@ impl Simulation {
         Ok(())
     }
 
-    /// Integrates to `t_end` (≥ the current time), stopping early at an event. Fixed-step
+    /// Integrates to `t_end` (≥ the current time), stopping early at an event. An adaptive
+    /// integrator whose step stays at [`MIN_RELATIVE_STEP`] of the time or less for
+    /// [`MAX_CRAWL_STEPS`] steps in a row is stopped with
+    /// [`GravityError::StepSizeUnderflow`]. Fixed-step
     /// integrators shorten their last step to land on `t_end` exactly. On return the
     /// particles are synchronised to [`Simulation::t`].
     pub fn integrate(&mut self, t_end: f64) -> Result<Outcome, GravityError> {
@@ -355,6 +368,23 @@ impl Simulation {
                 self.n_fixed = 0;
             }
             self.steps += 1;
+            // An adaptive step that stays collapsed near the round-off of the time cannot
+            // finish: at 10⁻¹² of t it would take 10¹² steps to double t (the figure-eight
+            // with vx3 = 1e20 crawled on for minutes at steps of 10⁻²⁴ with t ≈ 10⁻⁸). A close
+            // encounter takes such steps too, briefly: only a long run of them stops.
+            if !ws.is_fixed_step()
+                && self.dt.abs() <= MIN_RELATIVE_STEP * self.t.abs().max(t_end.abs())
+            {
+                self.crawl += 1;
+                if self.crawl > MAX_CRAWL_STEPS {
+                    return Err(GravityError::StepSizeUnderflow {
+                        t: self.t,
+                        dt: self.dt,
+                    });
+                }
+            } else {
+                self.crawl = 0;
+            }
             if let Some(i) = first_non_finite_pos(&self.particles) {
                 return Err(GravityError::NonFinite {
                     t: self.t,

@@ -155,3 +155,55 @@ fn outer_solar_system_energy() {
     assert!(da[0] > 3e-4 && da[0] < 1e-3, "{da:?}");
     assert!(da[1] > 1e-3 && da[1] < 3e-3, "{da:?}");
 }
+
+/// The figure-eight with `vx3 = v` (10¹⁶ … 10³⁰⁰: a binary moving at v/2, its separation of
+/// 1 far below the round-off of its position after a moment): IAS15's step collapses to the
+/// round-off of `t`. It crawled on at steps of 10⁻²⁴ for minutes (10²⁰); now the run stops
+/// with `StepSizeUnderflow` once `MAX_CRAWL_STEPS` steps in a row are below
+/// `MIN_RELATIVE_STEP` of the time: a bounded number of steps, at a time before the end. A fast but representable body (10³)
+/// still runs to the end.
+#[test]
+fn a_step_collapsed_to_the_round_off_of_t_stops_the_run() {
+    let run = |v: f64| {
+        let mut sim = Simulation::new(Units::GEqualsOne);
+        // As `--set vx3=v` makes it: the pair moves at −v/2 together, the third at v.
+        let (x1, y1, vy3) = (0.97000436, -0.24308753, -0.86473146);
+        for (pos, vel) in [
+            ([x1, y1], [-v / 2.0, -vy3 / 2.0]),
+            ([-x1, -y1], [-v / 2.0, -vy3 / 2.0]),
+            ([0.0, 0.0], [v, vy3]),
+        ] {
+            sim.add(Particle {
+                mass: 1.0,
+                pos: Vec3::new(pos[0], pos[1], 0.0),
+                vel: Vec3::new(vel[0], vel[1], 0.0),
+            })
+            .unwrap();
+        }
+        sim.set_integrator(Integrator::Ias15(Ias15Params::default()))
+            .unwrap();
+        sim.set_dt(1e-3).unwrap();
+        let mut result = Ok(pdyn_gravity::Outcome::Reached);
+        for k in 1..=100 {
+            result = sim.integrate(0.01 * k as f64 / 100.0);
+            if result.is_err() {
+                break;
+            }
+        }
+        (result, sim.steps())
+    };
+    for v in [1e16, 1e18, 1e20, 1e50, 1e300] {
+        let (result, steps) = run(v);
+        match result {
+            Err(pdyn_gravity::GravityError::StepSizeUnderflow { t, dt }) => {
+                assert!(t < 0.01 && dt <= pdyn_gravity::MIN_RELATIVE_STEP * 0.01);
+                // The crawl, and the steps before it (548 for the whole run at v = 1e3).
+                let bound = pdyn_gravity::MAX_CRAWL_STEPS + 20_000;
+                assert!(steps < bound, "v = {v}: {steps} steps before stopping");
+            }
+            other => panic!("v = {v}: {other:?} after {steps} steps"),
+        }
+    }
+    let (result, _) = run(1e3);
+    assert!(result.is_ok(), "{result:?}");
+}

@@ -232,6 +232,73 @@ pub(crate) fn fit_font(text: &str, px: f64, max_w: f64) -> f64 {
     }
 }
 
+/// Most lines a title is wrapped into; the rest is cut with `…`.
+pub(crate) const MAX_TITLE_LINES: usize = 3;
+
+/// A title laid out to fit `max_w` pixels: on one line at `px` when it fits, or shrunk down to
+/// 3/4 of `px`; otherwise wrapped at spaces into at most [`MAX_TITLE_LINES`] lines at 3/4 of
+/// `px` (a word longer than a line is broken; text beyond the last line is cut with `…`).
+/// Never wider than `max_w`: a long title was shrunk to at most 0.55·px and then clipped at the
+/// image's edge. Returns the lines and the font size.
+pub(crate) fn title_lines(text: &str, px: f64, max_w: f64) -> (Vec<String>, f64) {
+    let text = text.trim();
+    let fits = |t: &str, px: f64| (text_size(t, px).0 as f64) <= max_w;
+    let one = fit_font(text, px, max_w).max(0.75 * px);
+    if fits(text, one) || max_w <= 0.0 {
+        return (vec![text.to_string()], one);
+    }
+    let px = 0.75 * px;
+    let mut lines: Vec<String> = Vec::new();
+    let mut line = String::new();
+    for word in text.split_whitespace() {
+        let candidate = if line.is_empty() {
+            word.to_string()
+        } else {
+            format!("{line} {word}")
+        };
+        if fits(&candidate, px) {
+            line = candidate;
+            continue;
+        }
+        if !line.is_empty() {
+            lines.push(std::mem::take(&mut line));
+        }
+        // A word wider than a line: broken by characters.
+        let mut rest = word.to_string();
+        while !fits(&rest, px) {
+            let mut cut = rest.chars().count() - 1;
+            while cut > 1 && !fits(&rest.chars().take(cut).collect::<String>(), px) {
+                cut -= 1;
+            }
+            lines.push(rest.chars().take(cut).collect());
+            rest = rest.chars().skip(cut).collect();
+        }
+        line = rest;
+    }
+    if !line.is_empty() {
+        lines.push(line);
+    }
+    if lines.len() > MAX_TITLE_LINES {
+        lines.truncate(MAX_TITLE_LINES);
+        let last = &mut lines[MAX_TITLE_LINES - 1];
+        loop {
+            let with = format!("{last}…");
+            if fits(&with, px) || last.is_empty() {
+                *last = with;
+                break;
+            }
+            last.pop();
+        }
+    }
+    (lines, px)
+}
+
+/// Height of a title's lines at `px`, with the line spacing the renderers use.
+pub(crate) fn title_height(lines: &[String], px: f64) -> u32 {
+    let line = lines.iter().map(|l| text_size(l, px).1).max().unwrap_or(0);
+    line * lines.len() as u32 + (0.25 * px) as u32 * lines.len().saturating_sub(1) as u32
+}
+
 fn max_width(labels: &[String], px: f64) -> u32 {
     labels.iter().map(|l| text_size(l, px).0).max().unwrap_or(0)
 }
@@ -284,8 +351,8 @@ pub(crate) fn layout_with(
     let title_h = if fig.title.trim().is_empty() {
         gap
     } else {
-        let px = fit_font(&fig.title, th.title, w as f64 - 2.0 * gap as f64);
-        text_size(&fig.title, px).1 + 2 * gap
+        let (lines, px) = title_lines(&fig.title, th.title, w as f64 - 2.0 * gap as f64);
+        title_height(&lines, px) + 2 * gap
     }
     .max(floors.title_h);
     let tick_h = text_size("0123456789", th.tick).1.max(1);
@@ -439,6 +506,39 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A title too long for one line, even shrunk, is wrapped into lines that each fit the
+    /// width, keeping every word (up to the line limit), never clipped.
+    #[test]
+    fn long_titles_wrap_within_the_width() {
+        crate::font::ensure().unwrap();
+        let words = "Lennard-Jones liquid at the triple point, heated from 40 K to 240 K by a \
+                     Langevin ramp: energy per atom";
+        for (width, px) in [(500.0, 24.0), (300.0, 24.0), (800.0, 30.0)] {
+            let (lines, size) = title_lines(words, px, width);
+            for l in &lines {
+                assert!(
+                    text_size(l, size).0 as f64 <= width,
+                    "{l:?} at {size} > {width}"
+                );
+            }
+            assert!(lines.len() > 1, "{lines:?}");
+            if lines.len() < MAX_TITLE_LINES {
+                assert_eq!(lines.join(" "), words);
+            }
+        }
+        // Short titles are untouched; a word longer than a line is broken; too many lines end
+        // with an ellipsis.
+        assert_eq!(
+            title_lines("energy", 24.0, 500.0),
+            (vec!["energy".to_string()], 24.0)
+        );
+        let (lines, size) = title_lines(&"x".repeat(400), 24.0, 300.0);
+        assert!(lines.iter().all(|l| text_size(l, size).0 as f64 <= 300.0));
+        let (lines, _) = title_lines(&"word ".repeat(200), 24.0, 300.0);
+        assert_eq!(lines.len(), MAX_TITLE_LINES);
+        assert!(lines.last().unwrap().ends_with('…'));
     }
 
     #[test]

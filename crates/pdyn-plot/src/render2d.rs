@@ -5,7 +5,10 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::font::{desc, text_size};
-use crate::layout::{fit_font, layout_with, vline_labels, vline_row_height, Floors, Layout, Theme};
+use crate::layout::{
+    fit_font, layout_with, title_height, title_lines, vline_labels, vline_row_height, Floors,
+    Layout, Theme,
+};
 use crate::output;
 use crate::ticks::{map_linear, Axis, Ticks};
 use crate::{clean2, Figure, Marker, PlotError, Style};
@@ -306,26 +309,28 @@ fn draw_figure<DB: DrawingBackend>(
 
     let (title_area, rest) = area.split_vertically(lay.title_h);
     if !fig.title.trim().is_empty() {
-        let px = fit_font(&fig.title, th.title, w as f64 - 2.0 * th.gap as f64);
+        let (lines, px) = title_lines(&fig.title, th.title, w as f64 - 2.0 * th.gap as f64);
         let style = desc(px)
             .color(&INK)
             .pos(Pos::new(HPos::Center, VPos::Center));
-        // Centred over the plotting area, but kept inside the image.
-        let tw = text_size(fig.title.trim(), px).0 as f64;
-        let cx = (lay.margin[2] + lay.y_area) as f64 + lay.plot_size.0 as f64 / 2.0;
-        let half = tw / 2.0 + th.gap as f64;
-        let cx = if w as f64 >= 2.0 * half {
-            cx.clamp(half, w as f64 - half)
-        } else {
-            w as f64 / 2.0
-        };
-        title_area
-            .draw_text(
-                fig.title.trim(),
-                &style,
-                (cx as i32, lay.title_h as i32 / 2 + th.gap as i32 / 2),
-            )
-            .map_err(err)?;
+        let line_h = lines.iter().map(|l| text_size(l, px).1).max().unwrap_or(0) as f64;
+        let step = line_h + (0.25 * px).floor();
+        let block = title_height(&lines, px) as f64;
+        let top = lay.title_h as f64 / 2.0 + th.gap as f64 / 2.0 - block / 2.0 + line_h / 2.0;
+        for (k, line) in lines.iter().enumerate() {
+            // Centred over the plotting area, but kept inside the image.
+            let tw = text_size(line, px).0 as f64;
+            let cx = (lay.margin[2] + lay.y_area) as f64 + lay.plot_size.0 as f64 / 2.0;
+            let half = tw / 2.0 + th.gap as f64;
+            let cx = if w as f64 >= 2.0 * half {
+                cx.clamp(half, w as f64 - half)
+            } else {
+                w as f64 / 2.0
+            };
+            title_area
+                .draw_text(line, &style, (cx as i32, (top + k as f64 * step) as i32))
+                .map_err(err)?;
+        }
     }
 
     let mut chart = build_chart(&rest, &lay)?;

@@ -10,7 +10,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::FontTransform;
 
 use crate::font::{desc, text_size};
-use crate::layout::{fit_font, padded, Theme};
+use crate::layout::{padded, title_height, title_lines, Theme};
 use crate::output;
 use crate::render2d::{
     check_size, draw_legend, err, samples_along, svg_display_size, GRID, INK, MARK, PALETTE,
@@ -85,24 +85,30 @@ fn draw3<DB: DrawingBackend>(
     root.fill(&WHITE).map_err(err)?;
     let (w, _) = root.dim_in_pixel();
     let gap = th.gap as f64;
-    let title_px = fit_font(&fig.title, th.title, w as f64 - 2.0 * gap);
+    let (lines, title_px) = title_lines(&fig.title, th.title, w as f64 - 2.0 * gap);
     let title_h = if fig.title.trim().is_empty() {
         th.gap
     } else {
-        text_size(&fig.title, title_px).1 + 2 * th.gap
+        title_height(&lines, title_px) + 2 * th.gap
     };
     let (title_area, rest) = root.split_vertically(title_h);
     if !fig.title.trim().is_empty() {
         let style = desc(title_px)
             .color(&INK)
             .pos(Pos::new(HPos::Center, VPos::Center));
-        title_area
-            .draw_text(
-                fig.title.trim(),
-                &style,
-                (w as i32 / 2, title_h as i32 / 2 + th.gap as i32 / 2),
-            )
-            .map_err(err)?;
+        let line_h = lines
+            .iter()
+            .map(|l| text_size(l, title_px).1)
+            .max()
+            .unwrap_or(0) as f64;
+        let step = line_h + (0.25 * title_px).floor();
+        let block = title_height(&lines, title_px) as f64;
+        let top = title_h as f64 / 2.0 + gap / 2.0 - block / 2.0 + line_h / 2.0;
+        for (k, line) in lines.iter().enumerate() {
+            title_area
+                .draw_text(line, &style, (w as i32 / 2, (top + k as f64 * step) as i32))
+                .map_err(err)?;
+        }
     }
 
     let all = || clean.iter().flat_map(|s| s.runs.iter().flatten());

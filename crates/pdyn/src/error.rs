@@ -246,6 +246,35 @@ impl Error {
         }
     }
 
+    /// Reads a model file as text. Bytes that are not UTF-8 are a model error at the first
+    /// of them (the line and column shown, the byte named), not an I/O error without a place.
+    pub fn read_model_file(path: &std::path::Path) -> Result<String, Error> {
+        let bytes = std::fs::read(path).map_err(|e| Error::Io {
+            path: path.to_path_buf(),
+            action: "read the model file",
+            error: Arc::new(e),
+        })?;
+        match String::from_utf8(bytes) {
+            Ok(text) => Ok(text),
+            Err(e) => {
+                let at = e.utf8_error().valid_up_to();
+                let byte = e.as_bytes()[at];
+                // The text shown: the bytes up to the bad one are the same, so is the span.
+                let source = String::from_utf8_lossy(e.as_bytes()).into_owned();
+                let error = ModelError::new(
+                    &path.display().to_string(),
+                    at..at + char::REPLACEMENT_CHARACTER.len_utf8(),
+                    format!("the byte 0x{byte:02X} is not UTF-8: a model file must be UTF-8 text"),
+                )
+                .help("save the file as UTF-8 (e.g. `iconv -f latin1 -t utf-8`)");
+                Err(Error::Model {
+                    error,
+                    source: source.into(),
+                })
+            }
+        }
+    }
+
     /// An argument error.
     pub fn argument(argument: impl Into<String>, message: impl Into<String>) -> Error {
         Error::Argument {

@@ -52,9 +52,61 @@ pub struct KinInstant {
     pub spec: String,
     /// The instant as resolved (`theta = pi (t = sqrt(pi))`).
     pub resolved: String,
-    /// Every quantity there: name, exact value, numeric value when it has no free symbol.
+    /// Every quantity there that is defined: name, exact value, numeric value when it has no
+    /// free symbol.
     pub values: Vec<(&'static str, Quantity, Option<Vec<f64>>)>,
+    /// The quantities that are undefined there and why (the tangent where the point is at
+    /// rest, the polar unit vectors at the origin); they are not in `values`.
+    pub undefined: Vec<(&'static str, &'static str)>,
+    /// Where `dr/d(variable)` is zero: the limit of the tangent, when it exists.
+    pub at_rest: Option<AtRest>,
 }
+
+/// The tangent where the point is at rest (`dr/d(variable) = 0`): its limit as the variable
+/// increases to the instant is the direction of the first derivative of `r` that is not
+/// zero there, `r⁽ᵏ⁾` (Taylor: `r' ≈ r⁽ᵏ⁾ hᵏ⁻¹/(k−1)!`); from below it is the same for odd
+/// `k` and reversed for even `k` (a cusp: the point stops and turns back).
+#[derive(Clone, Debug)]
+pub struct AtRest {
+    /// `k`, the order of the first derivative of `r` that is not zero; `None` when every
+    /// derivative up to [`AT_REST_ORDERS`] is zero (or cannot be decided).
+    pub order: Option<usize>,
+    /// The limiting tangent `r⁽ᵏ⁾/|r⁽ᵏ⁾|` (exact) and its value, when `order` is known.
+    pub tangent: Option<([Id; 3], Option<[f64; 3]>)>,
+    /// Whether the tangent reverses through the instant (even `k`).
+    pub reverses: bool,
+    /// The limits of `a_t = a·T` and `a_n = |a − (a·T)T|` as the variable increases to the
+    /// instant, when the acceleration there and the limiting tangent are numbers.
+    pub a_t: Option<f64>,
+    /// See `a_t`.
+    pub a_n: Option<f64>,
+}
+
+/// How many derivatives of `r` are tried for the limiting tangent at rest.
+pub const AT_REST_ORDERS: usize = 8;
+
+/// The quantities built on the unit tangent: undefined where the point is at rest.
+const ON_THE_TANGENT: [&str; 8] = [
+    "tangent",
+    "normal",
+    "curvature",
+    "radius",
+    "a_t",
+    "a_n",
+    "tangent_polar",
+    "normal_polar",
+];
+
+/// The quantities built on the polar unit vectors: undefined at the origin.
+const ON_POLAR_AXES: [&str; 7] = [
+    "e_r",
+    "e_theta",
+    "r_polar",
+    "v_polar",
+    "a_polar",
+    "tangent_polar",
+    "normal_polar",
+];
 
 /// The maximum asked for with `max`/`over`.
 #[derive(Clone, Debug)]
@@ -313,11 +365,15 @@ pub fn kin(a: &KinInput) -> Result<KinResult, Error> {
     let named: Vec<(&'static str, Quantity)> = k.named();
     let mut instants = Vec::new();
     for spec in &a.at {
-        let (resolved, values) = instant(&mut pool, &k, &input, &named, &set, spec, &mut scope)?;
+        let (resolved, values, map) =
+            instant(&mut pool, &k, &input, &named, &set, spec, &mut scope)?;
+        let (values, undefined, at_rest) = undefined_there(&mut pool, &k, &map, values);
         instants.push(KinInstant {
             spec: spec.clone(),
             resolved,
             values,
+            undefined,
+            at_rest,
         });
     }
     let max = if let Some(expr) = &a.max {
@@ -353,6 +409,111 @@ pub fn kin(a: &KinInput) -> Result<KinResult, Error> {
 
 type InstantValues = Vec<(&'static str, Quantity, Option<Vec<f64>>)>;
 
+/// An instant resolved: its header, the values there, and the substitutions that make it.
+type Instant = (String, InstantValues, Vec<(Id, Id)>);
+
+/// Whether `e`, at the instant, is zero: exactly, or numerically zero to the last bits.
+fn zero_there(pool: &mut Pool, e: [Id; 3], map: &[(Id, Id)]) -> ([Id; 3], bool) {
+    let x = e.map(|c| {
+        let s = subs_all(pool, c, map);
+        tidy(pool, s)
+    });
+    let zero = x.iter().all(|&c| c == Pool::ZERO)
+        || x.iter()
+            .all(|&c| numeric(pool, c).is_some_and(|v| v.abs() < 1e-300));
+    (x, zero)
+}
+
+/// Splits the values of an instant into the defined ones and those undefined there: the
+/// tangent and what is built on it where `dr/d(variable) = 0` (with its limit, see
+/// [`AtRest`]), the polar components at the origin. They were printed as `0` or NaN.
+fn undefined_there(
+    pool: &mut Pool,
+    k: &Kinematics,
+    map: &[(Id, Id)],
+    values: InstantValues,
+) -> (
+    InstantValues,
+    Vec<(&'static str, &'static str)>,
+    Option<AtRest>,
+) {
+    let var = k.variable;
+    let mut undefined: Vec<(&'static str, &'static str)> = Vec::new();
+    let mut d = k.position.map(|c| pool.diff(c, var));
+    let (_, at_rest) = zero_there(pool, d, map);
+    let at_rest = at_rest.then(|| {
+        for name in ON_THE_TANGENT {
+            undefined.push((
+                name,
+                "the point is at rest here (dr/dt = 0): no direction of motion",
+            ));
+        }
+        let mut found = None;
+        for order in 2..=AT_REST_ORDERS {
+            d = d.map(|c| pool.diff(c, var));
+            let (x, zero) = zero_there(pool, d, map);
+            if !zero {
+                found = Some((order, x));
+                break;
+            }
+        }
+        let Some((order, x)) = found else {
+            return AtRest {
+                order: None,
+                tangent: None,
+                reverses: false,
+                a_t: None,
+                a_n: None,
+            };
+        };
+        let sq: Vec<Id> = x.iter().map(|&c| pool.powi(c, 2)).collect();
+        let n2 = pool.add(&sq);
+        let n = pool.sqrt(n2);
+        let dir = x.map(|c| {
+            let q = pool.div(c, n);
+            tidy(pool, q)
+        });
+        let value = {
+            let v: Option<Vec<f64>> = dir.iter().map(|&c| numeric(pool, c)).collect();
+            v.map(|v| [v[0], v[1], v[2]])
+        };
+        let (a, _) = zero_there(pool, k.acceleration, map);
+        let a: Option<Vec<f64>> = a.iter().map(|&c| numeric(pool, c)).collect();
+        let (a_t, a_n) = match (&a, value) {
+            (Some(a), Some(t)) => {
+                let at = a[0] * t[0] + a[1] * t[1] + a[2] * t[2];
+                let an = (0..3)
+                    .map(|i| (a[i] - at * t[i]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                (Some(at), Some(an))
+            }
+            _ => (None, None),
+        };
+        AtRest {
+            order: Some(order),
+            tangent: Some((dir, value)),
+            reverses: order % 2 == 0,
+            a_t,
+            a_n,
+        }
+    });
+    // The polar unit vectors need the point off the origin (in the plane of motion).
+    let planar = [k.position[0], k.position[1], Pool::ZERO];
+    if zero_there(pool, planar, map).1 {
+        for name in ON_POLAR_AXES {
+            if !undefined.iter().any(|(n, _)| *n == name) {
+                undefined.push((name, "the point is at the origin here: no radial direction"));
+            }
+        }
+    }
+    let values = values
+        .into_iter()
+        .filter(|(n, _, _)| !undefined.iter().any(|(u, _)| u == n))
+        .collect();
+    (values, undefined, at_rest)
+}
+
 /// Resolves one `--at` spec and evaluates every quantity there.
 fn instant(
     pool: &mut Pool,
@@ -362,7 +523,7 @@ fn instant(
     set: &[(Id, Id)],
     spec: &str,
     scope: &mut FreeScope,
-) -> Result<(String, InstantValues), Error> {
+) -> Result<Instant, Error> {
     let t = pool.time();
     let mut map: Vec<(Id, Id)> = set.to_vec();
     let mut header = Vec::new();
@@ -439,7 +600,7 @@ fn instant(
         };
         values.push((*n, q2, nums));
     }
-    Ok((header.join(", "), values))
+    Ok((header.join(", "), values, map))
 }
 
 /// `--max EXPR --over VAR=LO..HI`: the expression in the names of the quantities, the range

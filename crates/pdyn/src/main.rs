@@ -74,7 +74,36 @@ fn dispatch(command: Command) -> Result<Outcome, Error> {
 /// Whether the command line asks for JSON (decided before parsing, so that even a usage error
 /// answers in JSON).
 fn wants_json() -> bool {
-    std::env::args().skip(1).any(|a| a == "--json")
+    // `args_os`: an argument that is not UTF-8 must not panic here (clap reports it, exit 2).
+    std::env::args_os().skip(1).any(|a| a == "--json")
+}
+
+/// The error for a command-line argument that is not UTF-8 (clap refuses it for every
+/// option that is text: expressions, names, numbers; file names may be any bytes): which
+/// argument it is, shown with the bad bytes replaced by U+FFFD, and at which byte.
+fn invalid_utf8_argument() -> Error {
+    let bad = std::env::args_os()
+        .enumerate()
+        .skip(1)
+        .find_map(|(i, a)| a.to_str().is_none().then_some((i, a)));
+    let Some((index, arg)) = bad else {
+        return Error::argument("", "an argument is not valid UTF-8 text");
+    };
+    let bytes = arg.as_encoded_bytes();
+    let at = std::str::from_utf8(bytes)
+        .err()
+        .map_or(0, |e| e.valid_up_to());
+    Error::argument(
+        "",
+        format!(
+            "argument {index} (`{}`) is not valid UTF-8 (byte {} at offset {at}); expressions, \
+             names and numbers must be UTF-8 text (file names may be any bytes)",
+            arg.to_string_lossy(),
+            bytes
+                .get(at)
+                .map_or(String::new(), |b| format!("0x{b:02X}")),
+        ),
+    )
 }
 
 /// The one place where failures are rendered: the message on stderr, the JSON error object on
@@ -90,7 +119,9 @@ fn report(error: &Error, json: bool) -> ExitCode {
 /// Last resort: a bug must not end in a raw backtrace. Print what was being run, and exit 3.
 fn install_panic_hook(json: bool) {
     std::panic::set_hook(Box::new(move |info| {
-        let args: Vec<String> = std::env::args().collect();
+        let args: Vec<String> = std::env::args_os()
+            .map(|a| a.to_string_lossy().into_owned())
+            .collect();
         let place = info
             .location()
             .map(|l| format!(" at {}:{}", l.file(), l.line()))
@@ -122,6 +153,10 @@ fn main() -> ExitCode {
             // --help and --version.
             let _ = e.print();
             return ExitCode::SUCCESS;
+        }
+        Err(e) if e.kind() == clap::error::ErrorKind::InvalidUtf8 => {
+            // Clap says only "invalid UTF-8 was detected in one or more arguments": name it.
+            return report(&invalid_utf8_argument(), json);
         }
         Err(e) => {
             if json {

@@ -150,3 +150,131 @@ fn a_negative_rate_given_later_is_not_assumed_positive() {
         );
     }
 }
+
+type Curve = fn(f64) -> [f64; 3];
+
+/// Where the speed is zero the tangent (and the normal, curvature, a_t, a_n) is undefined:
+/// it was printed as `[0, 0, 0]` or NaN. `kin` now says so and gives the limit of the tangent
+/// as t increases to the instant, which here is checked against the direction of the velocity
+/// just after it, `v(t0 + h)/|v(t0 + h)|` from the velocity written by hand; "reverses" is
+/// checked against the direction just before; the limits of a_t and a_n against `a·T` and
+/// `|a − (a·T)T|` at t0 + h.
+#[test]
+fn at_zero_speed_the_tangent_is_undefined_and_its_limit_is_given() {
+    let cases: Vec<(&str, &str, f64, Curve, Curve)> = vec![
+        (
+            "[t^2, t^3, 0]",
+            "t=0",
+            0.0,
+            |t| [2.0 * t, 3.0 * t * t, 0.0],
+            |t| [2.0, 6.0 * t, 0.0],
+        ),
+        (
+            "[t^3, 2*t^3, 0]",
+            "t=0",
+            0.0,
+            |t| [3.0 * t * t, 6.0 * t * t, 0.0],
+            |t| [6.0 * t, 12.0 * t, 0.0],
+        ),
+        (
+            "[t - sin(t), 1 - cos(t), 0]",
+            "t=2*pi",
+            2.0 * std::f64::consts::PI,
+            |t| [1.0 - t.cos(), t.sin(), 0.0],
+            |t| [t.sin(), t.cos(), 0.0],
+        ),
+        (
+            "[(t-1)^2, 3*(t-1)^2, (t-1)^3]",
+            "t=1",
+            1.0,
+            |t| [2.0 * (t - 1.0), 6.0 * (t - 1.0), 3.0 * (t - 1.0).powi(2)],
+            |t| [2.0, 6.0, 6.0 * (t - 1.0)],
+        ),
+        (
+            "[2 + (t-1)^5, -(t-1)^5, 3]",
+            "t=1",
+            1.0,
+            |t| [5.0 * (t - 1.0).powi(4), -5.0 * (t - 1.0).powi(4), 0.0],
+            |t| [20.0 * (t - 1.0).powi(3), -20.0 * (t - 1.0).powi(3), 0.0],
+        ),
+    ];
+    let unit = |v: [f64; 3]| {
+        let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        v.map(|c| c / n)
+    };
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    for (r, at, t0, v, a) in cases {
+        let (ok, out, err) = pdyn(&["kin", r, "--at", at, "--json"]);
+        assert!(ok, "{r}: {err}");
+        let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+        let i = &j["at"][0];
+        for name in ["tangent", "normal", "curvature", "radius", "a_t", "a_n"] {
+            assert!(
+                i["undefined"][name].is_string(),
+                "{r}: {name} not undefined: {i}"
+            );
+            assert!(
+                i["values"][name].is_null(),
+                "{r}: {name} still has a value: {i}"
+            );
+        }
+        let h = 1e-4;
+        let after = unit(v(t0 + h));
+        let before = unit(v(t0 - h));
+        let limit: Vec<f64> = i["at_rest"]["tangent"]["value"]
+            .as_array()
+            .unwrap_or_else(|| panic!("{r}: no limiting tangent: {i}"))
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        let limit = [limit[0], limit[1], limit[2]];
+        assert!(
+            dot(limit, after) > 1.0 - 1e-6,
+            "{r}: {limit:?} vs {after:?}"
+        );
+        assert_eq!(
+            i["at_rest"]["reverses"].as_bool().unwrap(),
+            dot(before, after) < 0.0,
+            "{r}: {i}"
+        );
+        let (aa, tt) = (a(t0 + 1e-7), unit(v(t0 + 1e-7)));
+        let at_ = dot(aa, tt);
+        let an = (0..3)
+            .map(|k| (aa[k] - at_ * tt[k]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let got_at = i["at_rest"]["a_t"].as_f64().unwrap();
+        let got_an = i["at_rest"]["a_n"].as_f64().unwrap();
+        assert!(
+            (got_at - at_).abs() < 1e-3 * (1.0 + at_.abs()),
+            "{r}: a_t {got_at} vs {at_}"
+        );
+        assert!(
+            (got_an - an).abs() < 1e-3 * (1.0 + an.abs()),
+            "{r}: a_n {got_an} vs {an}"
+        );
+        // The text says it too.
+        let (_, text, _) = pdyn(&["kin", r, "--at", at]);
+        assert!(text.contains("undefined — the point is at rest"), "{text}");
+        assert!(text.contains("limiting tangent as t increases"), "{text}");
+        assert!(!text.contains("NaN"), "{text}");
+    }
+    // Every derivative tried is zero: said so.
+    let (ok, text, err) = pdyn(&["kin", "[(t-1)^9, 0, 0]", "--at", "t=1"]);
+    assert!(ok, "{err}");
+    assert!(text.contains("no limiting tangent found"), "{text}");
+    // Moving: nothing undefined. Through the origin: only the polar components are.
+    let (_, out, _) = pdyn(&["kin", "[cos(t), sin(t), 0]", "--at", "t=1", "--json"]);
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(j["at"][0]["undefined"].is_null(), "{out}");
+    assert!(j["at"][0]["values"]["tangent"].is_object(), "{out}");
+    let (_, out, _) = pdyn(&["kin", "[1 + cos(t), sin(t), 0]", "--at", "t=pi", "--json"]);
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let i = &j["at"][0];
+    assert!(
+        i["values"]["tangent"].is_object() && i["values"]["a_n"].is_object(),
+        "{i}"
+    );
+    assert!(i["undefined"]["e_r"].is_string(), "{i}");
+    assert!(i["at_rest"].is_null(), "{i}");
+}

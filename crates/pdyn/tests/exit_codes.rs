@@ -190,7 +190,8 @@ fn run_options_are_validated_where_read_and_named() {
 
 #[test]
 fn non_finite_results_are_flagged_never_printed_as_if_right() {
-    let (code, out, err) = pdyn(&["eval", "[1/0, 2, log(-1)]", "--json"]);
+    // (`1/0` written out is now a located division-by-zero error, exit 2: an overflow here.)
+    let (code, out, err) = pdyn(&["eval", "[exp(1000), 2, log(-1)]", "--json"]);
     assert_eq!(code, 1, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(v["value"], serde_json::json!(["inf", 2.0, "NaN"]));
@@ -310,4 +311,240 @@ t_end = 1
     let (code, _, err) = pdyn(&["run", path.to_str().unwrap()]);
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("not finite at that state: x'', a.y"), "{err}");
+}
+
+/// Runs `pdyn` with arguments that may not be UTF-8: (exit code, stdout, stderr).
+#[cfg(unix)]
+fn pdyn_os(args: &[std::ffi::OsString]) -> (i32, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pdyn"))
+        .args(args)
+        .current_dir(in_root::root())
+        .output()
+        .expect("run pdyn");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A non-UTF-8 byte anywhere on the command line (an expression, an option's value, `--set`,
+/// `--json` beside it) is bad input, exit 2 with the argument named, never a panic (it was
+/// `std::env::args`, which panics on such bytes, exit 101).
+#[cfg(unix)]
+#[test]
+fn a_non_utf8_argument_is_bad_input_not_a_panic() {
+    use std::ffi::OsString;
+    use std::os::unix::ffi::OsStringExt;
+    let bad = |prefix: &str| {
+        let mut b = prefix.as_bytes().to_vec();
+        b.push(0xFF);
+        OsString::from_vec(b)
+    };
+    let s = |t: &str| OsString::from(t);
+    let cases: Vec<Vec<OsString>> = vec![
+        vec![s("simplify"), bad("x")],
+        vec![s("simplify"), bad("x"), s("--json")],
+        vec![s("diff"), s("x^2"), s("--wrt"), bad("")],
+        vec![s("eval"), s("x"), s("--at"), bad("x=")],
+        vec![s("kin"), bad("[t, t"), s("--json")],
+        vec![
+            s("run"),
+            s("examples/satellite.toml"),
+            s("--set"),
+            bad("m="),
+        ],
+        vec![bad("simplify")],
+    ];
+    for args in cases {
+        let (code, out, err) = pdyn_os(&args);
+        assert_eq!(code, 2, "{args:?}: exit {code}\n{err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        // An unknown subcommand is clap's "unrecognized subcommand"; any other argument is named.
+        if args.len() > 1 {
+            assert!(err.contains("not valid UTF-8"), "{args:?}: {err}");
+        }
+        if args.iter().any(|a| a == "--json") {
+            assert_eq!(json_error(&out)["kind"], "argument", "{args:?}: {out}");
+        }
+    }
+}
+
+/// A file name is any bytes: a model file whose name is not UTF-8 is read; a missing one is an
+/// I/O error (exit 2) naming it.
+#[cfg(unix)]
+#[test]
+fn a_non_utf8_file_name_is_a_file_name() {
+    use std::ffi::OsString;
+    use std::os::unix::ffi::OsStringExt;
+    let dir = std::env::temp_dir().join(format!("pdyn-utf8-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut name = dir.as_os_str().to_os_string().into_vec();
+    name.extend_from_slice(b"/sat\xFF.toml");
+    let path = std::path::PathBuf::from(OsString::from_vec(name));
+    std::fs::copy(in_root::root().join("examples/satellite.toml"), &path).unwrap();
+    let (code, out, err) = pdyn_os(&["derive".into(), path.clone().into_os_string()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("Satellite"), "{out}");
+    let mut missing = dir.as_os_str().to_os_string().into_vec();
+    missing.extend_from_slice(b"/none\xFE.toml");
+    let (code, _, err) = pdyn_os(&["run".into(), OsString::from_vec(missing)]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("none") && err.contains("cannot read"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `simplify`, `eval` and `diff` refuse a division by zero with its location (exit 2): where it
+/// is written (`1/0`, `x/(x-x)`), or the whole expression when simplification reveals it.
+/// They printed `1/0`, `1/0*x` and `-1/0` with exit 0.
+#[test]
+fn a_division_by_zero_is_a_located_error() {
+    for (args, column) in [
+        (vec!["simplify", "1/0"], 3),
+        (vec!["simplify", "x/(x-x)"], 3),
+        (vec!["simplify", "2 + 0^-1"], 5),
+        (vec!["simplify", "1/((x+1)^2 - x^2 - 2*x - 1)"], 1),
+        (vec!["simplify", "[x, 1/((x+1)^2 - x^2 - 2*x - 1), 0]"], 1),
+        (vec!["diff", "sin(x)/(x-x)", "--wrt", "x"], 8),
+        (vec!["eval", "1/(2-2)"], 3),
+    ] {
+        let mut a = args.clone();
+        a.push("--json");
+        let (code, out, err) = pdyn(&a);
+        assert_eq!(code, 2, "{args:?}: exit {code}\n{out}{err}");
+        let e = json_error(&out);
+        assert_eq!(e["kind"], "expression", "{args:?}: {e}");
+        assert!(err.contains("division by zero"), "{args:?}: {err}");
+        assert_eq!(e["location"]["column"], column, "{args:?}: {e}");
+    }
+    let (code, out, _) = pdyn(&["simplify", "x/(x-y) + 0/x"]);
+    assert_eq!((code, out.trim()), (0, "x/(x - y)"));
+}
+
+/// A model file with bytes that are not UTF-8 is a model error at the first of them (line and
+/// column), for every kind of model file and every command that reads one; it was "cannot
+/// read the model file: stream did not contain valid UTF-8" with no place.
+#[test]
+fn non_utf8_bytes_in_a_model_file_are_located() {
+    let dir = std::env::temp_dir().join(format!("pdyn-bytes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let root = in_root::root();
+    let cases = [
+        ("examples/satellite.toml", "derive"),
+        ("examples/satellite.toml", "run"),
+        ("examples/nbody/figure_eight.toml", "run"),
+        ("examples/md/lj_liquid.toml", "run"),
+    ];
+    for (k, (example, command)) in cases.iter().enumerate() {
+        let text = std::fs::read_to_string(root.join(example)).unwrap();
+        // A Latin-1 byte at the end of the third line.
+        let lines: Vec<&str> = text.lines().collect();
+        let mut bytes = Vec::new();
+        for (i, l) in lines.iter().enumerate() {
+            bytes.extend_from_slice(l.as_bytes());
+            if i == 2 {
+                bytes.extend_from_slice(b" # caf\xE9");
+            }
+            bytes.push(b'\n');
+        }
+        let path = dir.join(format!("m{k}.toml"));
+        std::fs::write(&path, &bytes).unwrap();
+        let p = path.to_str().unwrap();
+        let (code, out, err) = pdyn(&[command, p, "--json"]);
+        assert_eq!(code, 2, "{example}: {err}");
+        let e = json_error(&out);
+        assert_eq!(e["kind"], "model", "{example}: {e}");
+        assert_eq!(e["location"]["line"], 3, "{example}: {e}");
+        assert_eq!(
+            e["location"]["column"],
+            lines[2].chars().count() + 7,
+            "{example}: {e}"
+        );
+        assert!(err.contains("0xE9") && err.contains("UTF-8"), "{err}");
+    }
+    // The bodies file of an N-body model: located in the CSV.
+    std::fs::copy(
+        root.join("examples/nbody/outer_solar_system_csv.toml"),
+        dir.join("csv.toml"),
+    )
+    .unwrap();
+    let csv = std::fs::read(root.join("examples/nbody/outer_solar_system.csv")).unwrap();
+    let mut lines: Vec<Vec<u8>> = csv.split(|&b| b == b'\n').map(<[u8]>::to_vec).collect();
+    let col = lines[2].len() + 1;
+    lines[2].push(0xFE);
+    std::fs::write(dir.join("outer_solar_system.csv"), lines.join(&b'\n')).unwrap();
+    let (code, out, err) = pdyn(&["run", dir.join("csv.toml").to_str().unwrap(), "--json"]);
+    assert_eq!(code, 2, "{err}");
+    let e = json_error(&out);
+    assert!(
+        e["location"]["file"].as_str().unwrap().ends_with(".csv"),
+        "{e}"
+    );
+    assert_eq!(
+        (
+            e["location"]["line"].clone(),
+            e["location"]["column"].clone()
+        ),
+        (3.into(), col.into()),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A bad `t_end`, `output_dt`, `dt`, `points` in `[simulate]` is shown at its key (it was
+/// "t_end must be a positive time, got -5" or "--output-dt must be ..." with no place); the
+/// same value given on the command line is still named by its option.
+#[test]
+fn bad_simulate_values_in_a_model_file_are_located_at_their_key() {
+    let root = in_root::root();
+    let text = std::fs::read_to_string(root.join("examples/projectile_drag.toml")).unwrap();
+    let dir = std::env::temp_dir().join(format!("pdyn-sim-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (k, (key, value)) in [
+        ("t_end", "-5"),
+        ("t_end", "0"),
+        ("t_end", "\"-2 s\""),
+        ("output_dt", "1e-12"),
+        ("output_dt", "-1"),
+        ("output_dt", "0"),
+        ("dt", "1e-15"),
+        ("points", "100000000"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut lines: Vec<String> = text
+            .lines()
+            .filter(|l| !l.starts_with(&format!("{key} =")))
+            .map(str::to_string)
+            .collect();
+        let at = lines.iter().position(|l| l == "[simulate]").unwrap() + 1;
+        lines.insert(at, format!("{key} = {value}"));
+        let path = dir.join(format!("s{k}.toml"));
+        std::fs::write(&path, lines.join("\n")).unwrap();
+        let p = path.to_str().unwrap();
+        let (code, out, err) = pdyn(&["run", p, "--json", "--out", dir.to_str().unwrap()]);
+        assert_eq!(code, 2, "{key} = {value}: {err}");
+        let e = json_error(&out);
+        assert_eq!(e["kind"], "model", "{key} = {value}: {e}");
+        assert_eq!(e["location"]["line"], at + 1, "{key} = {value}: {e}");
+        assert_eq!(
+            e["location"]["column"],
+            key.len() + 4,
+            "{key} = {value}: {e}"
+        );
+        assert!(err.contains(&format!("`{key}`")), "{err}");
+    }
+    // On the command line: the option is named.
+    let (code, _, err) = pdyn(&[
+        "run",
+        "examples/projectile_drag.toml",
+        "--output-dt",
+        "1e-13",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--output-dt must be"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
 }

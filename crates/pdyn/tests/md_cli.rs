@@ -619,4 +619,176 @@ fn two_species_from_xyz_and_lammps_data() {
         line_of(&text, "[md]"),
         "no pair potential between A and B",
     );
+    // A configuration read from a file is sized once read, before anything else is built:
+    // over the memory limit it is refused at its `file`.
+    for file in ["mix.xyz", "mix.data"] {
+        let text = model(file, true);
+        let f = d.join("mix.toml");
+        std::fs::write(&f, &text).unwrap();
+        let (code, out, err) = in_root::pdyn_env(
+            &["run", f.to_str().unwrap(), "--json"],
+            &[("PDYN_MEMORY_LIMIT", "10K")],
+        );
+        assert_located(
+            "mix",
+            (code, json(&out)["error"].clone(), err),
+            line_of(&text, "file = "),
+            "64 atoms need about",
+        );
+    }
+}
+
+/// `rdf_frames` sets how many frames the RDF averages: exactly `min(rdf_frames, R)`, with `R`
+/// the thermo records of the second half of the run (here steps 100, 102, …, 200: 51), as
+/// `summary.json` reports; the default stays "up to 20"; a count out of range is located.
+#[test]
+fn rdf_frames_sets_the_number_of_frames_averaged() {
+    let base = lj()
+        .replace("steps = 100", "steps = 200")
+        .replace("thermo_every = 50", "thermo_every = 2\nrdf = true");
+    let records = 51;
+    for frames in [
+        None,
+        Some(1),
+        Some(5),
+        Some(7),
+        Some(50),
+        Some(51),
+        Some(200),
+    ] {
+        let text = match frames {
+            Some(f) => base.replace("rdf = true", &format!("rdf = true\nrdf_frames = {f}")),
+            None => base.clone(),
+        };
+        let d = scratch(&format!("rdf{frames:?}"));
+        let f = d.join("m.toml");
+        std::fs::write(&f, text).unwrap();
+        let (code, out, err) = pdyn(&[
+            "run",
+            f.to_str().unwrap(),
+            "--set",
+            "n=4",
+            "--json",
+            "--out",
+            d.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{frames:?}: {err}");
+        let v = json(&out);
+        let want = frames.unwrap_or(20).min(records) as u64;
+        assert_eq!(v["rdf_frames"], want, "{frames:?}");
+        let warned = v["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| w.as_str().unwrap().contains("rdf_frames"));
+        assert_eq!(
+            warned,
+            frames.is_some_and(|f| f > records),
+            "{frames:?}: {v}"
+        );
+        assert!(d.join("rdf.csv").exists());
+    }
+    for bad_value in ["0", "1000000", "\"many\"", "-3"] {
+        let text = base.replace(
+            "rdf = true",
+            &format!("rdf = true\nrdf_frames = {bad_value}"),
+        );
+        let line = line_of(&text, "rdf_frames");
+        assert_located(
+            "rdf_frames",
+            bad("rdf_frames", &text, &["--set", "n=4"]),
+            line,
+            "",
+        );
+    }
+}
+
+/// A model too large for the memory is refused before anything is allocated, at its
+/// `[md.lattice]`, with the atoms, the estimate (200 + 156·ghosts + 8·pairs bytes per atom,
+/// recomputed here from the lattice) and the limit; under the limit it runs. The limit is set
+/// by PDYN_MEMORY_LIMIT here (MemAvailable otherwise). It died with "memory allocation of
+/// 128000000 bytes failed" at 32 million atoms.
+#[test]
+fn a_model_larger_than_the_memory_is_refused_with_both_sizes() {
+    use in_root::pdyn_env;
+    for (kind, basis) in [("sc", 1u64), ("bcc", 2), ("fcc", 4)] {
+        let cells = 30u64;
+        let text = lj()
+            .replace("kind = \"fcc\"", &format!("kind = \"{kind}\""))
+            .replace("cells = \"n\"", &format!("cells = {cells}"));
+        let d = scratch(&format!("mem-{kind}"));
+        let f = d.join("m.toml");
+        std::fs::write(&f, &text).unwrap();
+        let args = [
+            "run",
+            f.to_str().unwrap(),
+            "--json",
+            "--t-end",
+            "0.005",
+            "--out",
+            d.to_str().unwrap(),
+        ];
+        let (code, out, err) = pdyn_env(&args, &[("PDYN_MEMORY_LIMIT", "10M")]);
+        assert_eq!(code, 2, "{kind}: {err}");
+        let e = json(&out)["error"].clone();
+        assert_eq!(e["location"]["line"], line_of(&text, "[md.lattice]"), "{e}");
+        let atoms = basis * cells.pow(3);
+        let msg = e["message"].as_str().unwrap();
+        assert!(msg.contains(&format!("{atoms} atoms need about")), "{msg}");
+        assert!(
+            msg.contains("10.5 MB available (PDYN_MEMORY_LIMIT)"),
+            "{msg}"
+        );
+        // bytes per atom, from the lattice: edge = cells·(basis/ρ)^(1/3), reach 2.5 + 0.3
+        let edge = cells as f64 * (basis as f64 / 0.8442).cbrt();
+        let ghosts = ((edge + 5.6) / edge).powi(3);
+        let pairs = 2.0 * std::f64::consts::PI / 3.0 * 0.8442 * 2.8f64.powi(3);
+        let per_atom = 200.0 + 156.0 * ghosts + 8.0 * pairs;
+        assert!(
+            msg.contains(&format!("({per_atom:.0} bytes per atom)")),
+            "{msg}"
+        );
+        // Enough memory: it runs.
+        let (code, _, err) = pdyn_env(&args, &[("PDYN_MEMORY_LIMIT", "4G")]);
+        assert_eq!(code, 0, "{kind}: {err}");
+    }
+}
+
+/// The thermo plot's axes carry the units of the model (`energy per atom [ε]`, `T [ε/k_B]`,
+/// `P [ε/σ³]` in LJ units; kcal/mol, K, atm in real units): they were `energy / atom`, `T`, `P`.
+#[test]
+fn thermo_plot_axes_carry_the_units_of_the_model() {
+    for (file, t_end, energy, temperature, pressure) in [
+        ("examples/md/lj_liquid.toml", "0.05", "ε", "ε/k_B", "ε/σ³"),
+        (
+            "examples/md/argon_melting.toml",
+            "200",
+            "kcal/mol",
+            "K",
+            "atm",
+        ),
+    ] {
+        let d = scratch(&format!("axes-{}", file.len()));
+        let (code, _, err) = pdyn(&[
+            "run",
+            file,
+            "--set",
+            "n=4",
+            "--t-end",
+            t_end,
+            "--out",
+            d.to_str().unwrap(),
+            "--plot",
+        ]);
+        assert_eq!(code, 0, "{file}: {err}");
+        let svg = std::fs::read_to_string(d.join("thermo.svg"))
+            .unwrap_or_else(|e| panic!("{file}: no thermo.svg ({e})"));
+        for label in [
+            format!("energy per atom [{energy}]"),
+            format!("T [{temperature}]"),
+            format!("P [{pressure}]"),
+        ] {
+            assert!(svg.contains(&label), "{file}: no `{label}`");
+        }
+    }
 }

@@ -798,3 +798,143 @@ fn mutated_nbody_examples_never_panic_or_hang() {
     std::fs::remove_dir_all(&dir).ok();
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// Every `[nbody]` Plummer sphere starts in standard Hénon units, whatever the seed: with
+/// `softening = 0` the initial energy the run reports is `−G mass²/(4 scale)` to round-off
+/// (it was −0.264 on average over 24 seeds of 1,000 stars, never −1/4), and the virial ratio
+/// after one tiny step is 1; `rescale = false` keeps the sample as drawn; a bad `rescale` is a
+/// located error.
+#[test]
+fn plummer_spheres_start_in_standard_henon_units() {
+    let dir = scratch("plummer-units");
+    let model = |seed: u64, extra: &str| {
+        format!(
+            "name = \"p\"\n[nbody]\nunits = \"nbody\"\nplummer = {{ n = 300, seed = {seed}{extra} }}\n\
+             integrator = \"leapfrog\"\ndt = 1e-6\nt_end = 1e-6\npoints = 2\n"
+        )
+    };
+    let run = |text: String, name: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        let out = dir.join(format!("{name}-out"));
+        run_ok(path.to_str().unwrap(), &["--out", out.to_str().unwrap()])
+    };
+    let mut natural = Vec::new();
+    for seed in 1..=6 {
+        for (extra, e_want) in [("", -0.25), (", mass = 2, scale = 3", -1.0 / 3.0)] {
+            let sum = run(model(seed, extra), &format!("s{seed}.toml"));
+            let e0 = sum["energy"]["initial"].as_f64().unwrap();
+            assert!((e0 - e_want).abs() < 1e-12, "seed {seed}{extra}: E = {e0}");
+            let q = sum["virial_ratio"].as_f64().unwrap();
+            assert!((q - 1.0).abs() < 1e-6, "seed {seed}{extra}: 2T/|W| = {q}");
+        }
+        let sum = run(model(seed, ", rescale = false"), &format!("n{seed}.toml"));
+        natural.push(sum["energy"]["initial"].as_f64().unwrap());
+    }
+    assert!(
+        natural.iter().all(|e| (e + 0.25).abs() > 1e-6),
+        "{natural:?}"
+    );
+    let path = dir.join("bad.toml");
+    std::fs::write(&path, model(1, ", rescale = \"yes\"")).unwrap();
+    let (code, out, err) = pdyn(&["run", path.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(json(&out)["error"]["location"]["line"], 4, "{out}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Mutations of the figure-eight that IAS15 cannot follow (`vx3` = 10¹⁶ … 10³⁰⁰) end with
+/// exit 1, the time, the partial output and what to do; `vx3 = 1e20` ran for more than a
+/// minute without a word.
+#[test]
+fn an_ias15_run_that_cannot_advance_ends_with_a_clear_error() {
+    for v in ["1e16", "1e20", "1e300"] {
+        let dir = scratch(&format!("collapse-{v}"));
+        let (code, out, err) = pdyn(&[
+            "run",
+            "examples/nbody/figure_eight.toml",
+            "--set",
+            &format!("vx3={v}"),
+            "--t-end",
+            "0.01",
+            "--out",
+            dir.to_str().unwrap(),
+            "--json",
+        ]);
+        assert_eq!(code, 1, "vx3 = {v}: {err}");
+        assert!(
+            err.contains("step size fell to") && err.contains("check the initial state"),
+            "{err}"
+        );
+        let sum = json(&out);
+        let t = sum["t_reached"].as_f64().unwrap();
+        assert!(t < 0.01, "{t}");
+        assert!(dir.join("summary.json").exists());
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
+
+/// Every plot's axes carry the units of the model's unit system (they were bare `t`, `x`,
+/// `a`): `t [yr]`, `x [AU]`, `a [AU]` in au-year-msun, `t [days]` in au-day-msun, `t [s]`
+/// and `x [m]` in SI, the model's own units in N-body units.
+#[test]
+fn plot_axes_carry_the_units_of_the_model() {
+    for (units, length, time, scale) in [
+        ("au-year-msun", "AU", "yr", "1"),
+        ("au-day-msun", "AU", "days", "365.25"),
+        ("si", "m", "s", "3.15576e7"),
+        ("nbody", "N-body length", "N-body time", "1"),
+    ] {
+        let dir = scratch(&format!("units-{units}"));
+        let path = dir.join("m.toml");
+        // A planet on a circle about a star, in whatever units: a 2-body problem.
+        let text = format!(
+            "name = \"units\"\n[parameters]\nS = {scale}\n[nbody]\nunits = \"{units}\"\n\
+             integrator = \"ias15\"\nt_end = \"S/10\"\npoints = 5\n\
+             [[nbody.bodies]]\nname = \"Star\"\nmass = 1\nposition = [0, 0, 0]\nvelocity = [0, 0, 0]\n\
+             [[nbody.bodies]]\nname = \"P\"\nmass = 1e-3\nprimary = \"Star\"\na = 1\ne = 0.1\n"
+        )
+        .replace(
+            "mass = 1\nposition",
+            if units == "si" {
+                "mass = 2e30\nposition"
+            } else {
+                "mass = 1\nposition"
+            },
+        )
+        .replace(
+            "mass = 1e-3\nprimary = \"Star\"\na = 1\n",
+            if units == "si" {
+                "mass = 2e27\nprimary = \"Star\"\na = 1.5e11\n"
+            } else {
+                "mass = 1e-3\nprimary = \"Star\"\na = 1\n"
+            },
+        );
+        std::fs::write(&path, text).unwrap();
+        let out = dir.join("out");
+        let (code, _, err) = pdyn(&[
+            "run",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--plot",
+        ]);
+        assert_eq!(code, 0, "{units}: {err}");
+        let svg = |f: &str| std::fs::read_to_string(out.join(f)).unwrap();
+        let (t, x, a) = (
+            format!("t [{time}]"),
+            format!("x [{length}]"),
+            format!("a [{length}]"),
+        );
+        assert!(svg("orbits.svg").contains(&x), "{units}: orbits");
+        assert!(
+            svg("elements.svg").contains(&t) && svg("elements.svg").contains(&a),
+            "{units}"
+        );
+        assert!(
+            svg("conservation.svg").contains(&t),
+            "{units}: conservation"
+        );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

@@ -171,6 +171,9 @@ pub struct RunSpec {
     pub monitors: Vec<Monitor>,
     /// `[sweep]`.
     pub sweep: Option<SweepSpec>,
+    /// Where each key of `[simulate]` is written, by the command-line option that overrides
+    /// it (`--t-end`, `--output-dt`, ...): a value the runner refuses is shown at its key.
+    pub simulate_spans: Vec<(&'static str, Range<usize>)>,
 }
 
 /// A `[[checks]]` entry: `condition` (an equation) solved for a parameter, possibly over a
@@ -277,8 +280,11 @@ fn number(ld: &mut Loader, sv: &Sv, what: &str) -> Result<f64, ModelError> {
 fn positive(ld: &mut Loader, sv: &Option<Sv>, what: &str) -> Result<Option<f64>, ModelError> {
     let Some(sv) = sv else { return Ok(None) };
     let x = number(ld, sv, what)?;
-    if x <= 0.0 {
-        return Err(ld.err(sv.span(), format!("{what} must be positive, it is {x}")));
+    if !(x > 0.0 && x.is_finite()) {
+        return Err(ld.err(
+            sv.span(),
+            format!("{what} must be positive and finite, it is {x}"),
+        ));
     }
     Ok(Some(x))
 }
@@ -292,10 +298,7 @@ pub(super) fn read(
     if let Some(s) = &raw.simulate {
         let r = s.get_ref();
         let sim = &mut spec.simulate;
-        sim.t_end = match &r.t_end {
-            Some(sv) => Some(number(ld, sv, "`t_end`")?),
-            None => None,
-        };
+        sim.t_end = positive(ld, &r.t_end, "`t_end`")?;
         sim.method = r.method.as_ref().map(|m| (m.get_ref().clone(), m.span()));
         sim.rtol = positive(ld, &r.rtol, "`rtol`")?;
         sim.atol = positive(ld, &r.atol, "`atol`")?;
@@ -303,6 +306,23 @@ pub(super) fn read(
         sim.max_step = positive(ld, &r.max_step, "`max_step`")?;
         sim.output_dt = positive(ld, &r.output_dt, "`output_dt`")?;
         sim.drift_tolerance = positive(ld, &r.drift_tolerance, "`drift_tolerance`")?;
+        for (option, sv) in [
+            ("--t-end", &r.t_end),
+            ("--rtol", &r.rtol),
+            ("--atol", &r.atol),
+            ("--dt", if r.dt.is_some() { &r.dt } else { &r.h0 }),
+            ("--max-step", &r.max_step),
+            ("--output-dt", &r.output_dt),
+        ] {
+            if let Some(sv) = sv {
+                spec.simulate_spans.push((option, sv.span()));
+            }
+        }
+        for (option, v) in [("--points", &r.points), ("--max-steps", &r.max_steps)] {
+            if let Some(v) = v {
+                spec.simulate_spans.push((option, v.span()));
+            }
+        }
         for (field, v, dst) in [
             ("max_steps", &r.max_steps, &mut sim.max_steps),
             ("points", &r.points, &mut sim.points),

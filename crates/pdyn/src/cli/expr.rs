@@ -3,7 +3,7 @@
 use super::{value_json, Format};
 use clap::Args;
 use pdyn::Error;
-use pdyn_expr::{FreeScope, Id, Pool, Program, Value};
+use pdyn_expr::{ExprError, FreeScope, Id, Pool, Program, Value};
 use serde_json::json;
 
 /// Options shared by the expression commands.
@@ -99,6 +99,24 @@ fn show_value(pool: &Pool, v: Value, f: Format) -> String {
     f.show_value(pool, v)
 }
 
+/// A result that divides by zero (simplification can reveal a zero denominator that lowering
+/// did not see: `1/(sin(x)^2 + cos(x)^2 - 1)`) is an error located at the whole expression.
+fn refuse_division_by_zero(pool: &Pool, v: Value, src: &str) -> Result<(), Error> {
+    let parts = match v {
+        Value::Scalar(x) => vec![x],
+        Value::Vector(c) => c.to_vec(),
+    };
+    if parts.iter().any(|&x| pool.divides_by_zero(x)) {
+        let e = ExprError::new(
+            0..src.len(),
+            "division by zero: once simplified, a denominator of this expression is zero",
+        )
+        .with_help("the expression is undefined everywhere; check the denominator");
+        return Err(Error::expr("<expr>", src, e));
+    }
+    Ok(())
+}
+
 /// `pdyn simplify EXPR`.
 pub fn simplify(a: SimplifyArgs) -> Result<String, Error> {
     let mut pool = Pool::new();
@@ -125,6 +143,7 @@ pub fn simplify(a: SimplifyArgs) -> Result<String, Error> {
             pool.simplify(e)
         })
     };
+    refuse_division_by_zero(&pool, r, &a.expr)?;
     Ok(if a.common.json {
         format!(
             "{}\n",

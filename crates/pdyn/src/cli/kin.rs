@@ -4,7 +4,7 @@
 
 use super::Format;
 use clap::Args;
-use pdyn::kin::{kin, value, KinInput, KinMax, KinResult};
+use pdyn::kin::{kin, value, KinInput, KinInstant, KinMax, KinResult};
 use pdyn::Error;
 use pdyn_expr::Pool;
 use pdyn_mech::kinematics::{Maximum, Quantity};
@@ -109,6 +109,7 @@ fn to_text(r: &KinResult, format: Format) -> String {
             };
             out += &format!("  {n} = {}{num_text}\n", show_q(pool, *q, format));
         }
+        out += &undefined_text(r, i, format);
     }
     if let Some(m) = &r.max {
         out += &max_text(pool, m, format);
@@ -120,6 +121,77 @@ fn to_text(r: &KinResult, format: Format) -> String {
         );
     }
     out
+}
+
+/// The quantities undefined at an instant, grouped by reason, and the limiting tangent at rest.
+fn undefined_text(r: &KinResult, i: &KinInstant, format: Format) -> String {
+    let pool = &r.pool;
+    let mut out = String::new();
+    let mut reasons: Vec<&str> = i.undefined.iter().map(|(_, why)| *why).collect();
+    reasons.dedup();
+    for why in reasons {
+        let names: Vec<&str> = i
+            .undefined
+            .iter()
+            .filter(|(_, w)| *w == why)
+            .map(|(n, _)| *n)
+            .collect();
+        out += &format!("  {}: undefined — {why}\n", names.join(", "));
+    }
+    let Some(rest) = &i.at_rest else {
+        return out;
+    };
+    let var = &r.variable;
+    match (rest.order, &rest.tangent) {
+        (Some(k), Some((dir, value))) => {
+            let num = value.map_or(String::new(), |v| {
+                format!("  ≈ [{}, {}, {}]", v[0], v[1], v[2])
+            });
+            out += &format!(
+                "  limiting tangent as {var} increases to this instant: {}{num} (the direction of \
+                 the derivative of r of order {k}, the first that is not zero here)\n",
+                show_q(pool, Quantity::Vector(*dir), format)
+            );
+            out += if rest.reverses {
+                "  the direction reverses through this instant (a cusp: the point stops and turns back)\n"
+            } else {
+                "  the direction is the same on both sides of this instant\n"
+            };
+            if let (Some(at), Some(an)) = (rest.a_t, rest.a_n) {
+                out += &format!(
+                    "  limits as {var} increases to this instant: a_t → {at}, a_n → {an}\n"
+                );
+            }
+        }
+        _ => {
+            out += &format!(
+                "  no limiting tangent found: the derivatives of r up to order {} are zero here\n",
+                pdyn::kin::AT_REST_ORDERS
+            );
+        }
+    }
+    out
+}
+
+fn at_rest_json(r: &KinResult, i: &KinInstant) -> serde_json::Value {
+    let undefined: serde_json::Map<String, serde_json::Value> = i
+        .undefined
+        .iter()
+        .map(|(n, why)| (n.to_string(), json!(why)))
+        .collect();
+    let rest = i.at_rest.as_ref().map(|a| {
+        json!({
+            "order": a.order,
+            "tangent": a.tangent.as_ref().map(|(dir, value)| json!({
+                "exact": json_q(&r.pool, Quantity::Vector(*dir)),
+                "value": value,
+            })),
+            "reverses": a.reverses,
+            "a_t": a.a_t,
+            "a_n": a.a_n,
+        })
+    });
+    json!({"undefined": undefined, "at_rest": rest})
 }
 
 fn to_json(r: &KinResult) -> String {
@@ -148,7 +220,13 @@ fn to_json(r: &KinResult) -> String {
                         )
                     })
                     .collect();
-                json!({"at": i.spec, "resolved": i.resolved, "values": vals})
+                let mut o = json!({"at": i.spec, "resolved": i.resolved, "values": vals});
+                if !i.undefined.is_empty() {
+                    let extra = at_rest_json(r, i);
+                    o["undefined"] = extra["undefined"].clone();
+                    o["at_rest"] = extra["at_rest"].clone();
+                }
+                o
             })
             .collect();
         js.insert("at".into(), json!(instants_json));

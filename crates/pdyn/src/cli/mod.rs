@@ -20,7 +20,6 @@ use clap::ValueEnum;
 use pdyn::Error;
 use pdyn_expr::{Id, Pool, Value};
 use std::path::Path;
-use std::sync::Arc;
 
 /// What a command produced.
 #[derive(Debug, Default)]
@@ -103,11 +102,7 @@ pub fn both(pool: &Pool, id: Id) -> serde_json::Value {
 
 /// Loads a model file; errors keep the file's text so that they can show the offending line.
 pub fn load_model(path: &Path) -> Result<pdyn_mech::Model, Error> {
-    let source = std::fs::read_to_string(path).map_err(|e| Error::Io {
-        path: path.to_path_buf(),
-        action: "read the model file",
-        error: Arc::new(e),
-    })?;
+    let source = Error::read_model_file(path)?;
     if let Some(span) = pdyn::nbody::spec::nbody_table_span(&source) {
         let error = pdyn_mech::ModelError::new(&path.display().to_string(), span, "N-body model: use `pdyn run`")
             .help("an [nbody] table is integrated by pdyn run; it has no symbolic equations (docs/nbody.md)");

@@ -64,8 +64,7 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
             ));
         }
     }
-    let source = std::fs::read_to_string(&a.model)
-        .map_err(|e| io_error(&a.model, "read the model file", e))?;
+    let source = Error::read_model_file(&a.model)?;
     let origin = a.model.display().to_string();
     let set = numeric_pairs(&a.set, "--set")?;
     let mut spec = nbody::load(&source, &origin, &set)?;
@@ -234,7 +233,7 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
         write("conservation.csv", &|p| output::write_conservation(&res, p))?;
         write("summary.json", &|p| std::fs::write(p, format!("{sum:#}\n")))?;
         if a.plot {
-            nbody::plots::write(&spec.name, &res, dir)?;
+            nbody::plots::write(&spec.name, &res, &spec.units, dir)?;
         }
     } else if a.plot {
         return Err(Error::argument(

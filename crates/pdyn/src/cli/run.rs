@@ -120,7 +120,58 @@ pub fn settings(model: &pdyn_mech::Model, a: &RunArgs) -> Result<RunSettings, Er
         drift_tolerance: a.drift_tolerance,
     };
     let t_eval = (!a.t_eval.is_empty()).then(|| a.t_eval.clone());
-    RunSettings::resolve(s, &overrides, t_eval).map_err(|e| sim_error(model, "", e))
+    let set = RunSettings::resolve(s, &overrides, t_eval).map_err(|e| sim_error(model, "", e))?;
+    file_value_error(model, a, set.validate())?;
+    Ok(set)
+}
+
+/// A setting the runner refuses that was written in the file, not on the command line, is
+/// shown at its key in `[simulate]` (it named `--output-dt`, with no place).
+fn file_value_error(
+    model: &pdyn_mech::Model,
+    a: &RunArgs,
+    checked: Result<(), SimError>,
+) -> Result<(), Error> {
+    let Err(error) = checked else { return Ok(()) };
+    let (option, message) = match &error {
+        SimError::InvalidOption {
+            option,
+            value,
+            requirement,
+        } => (*option, format!("must be {requirement}, got {value}")),
+        SimError::InvalidEndTime(t) => ("--t-end", format!("must be a positive time, got {t}")),
+        _ => return Err(sim_error(model, "", error)),
+    };
+    let from_file = match option {
+        "--t-end" => a.t_end.is_none(),
+        "--rtol" => a.rtol.is_none(),
+        "--atol" => a.atol.is_none(),
+        "--dt" => a.dt.is_none(),
+        "--max-step" => a.max_step.is_none(),
+        "--output-dt" => a.output_dt.is_none(),
+        "--points" => a.points.is_none(),
+        "--max-steps" => a.max_steps.is_none(),
+        _ => false,
+    };
+    let span = model.run.simulate_spans.iter().find(|(o, _)| *o == option);
+    match span {
+        Some((_, span)) if from_file => {
+            let key = option.trim_start_matches("--").replace('-', "_");
+            let error = pdyn_mech::ModelError::new(
+                &model.origin,
+                span.clone(),
+                format!("`{key}` in [simulate] {message}"),
+            )
+            .help(format!(
+                "change it in the file, or override it with {option}"
+            ));
+            Err(Error::Model {
+                error,
+                source: model.source.as_str().into(),
+            })
+        }
+        _ => Err(sim_error(model, "", error)),
+    }
 }
 
 /// A simulation error located in the model file, with what was being attempted.
@@ -386,17 +437,14 @@ pub fn check(a: CheckArgs) -> Result<Outcome, Error> {
     })?;
     let prep = prepare(&mut model, &a)?;
     let rep = sim::exact::check(&prep, &exact, &set).map_err(|e| sim_error(&model, "", e))?;
-    let worst = rep
-        .errors
-        .iter()
-        .map(|e| e.1 / e.2.max(1e-300))
-        .fold(0.0, f64::max);
+    let (scales, relative) = (rep.scales(), rep.relative_errors());
+    let worst = relative.iter().copied().fold(0.0, f64::max);
     if a.json {
         let v = serde_json::json!({
             "model": model.name,
             "method": rep.run.method.to_string(),
             "rows": rep.run.rows.len(),
-            "errors": rep.errors.iter().map(|(n, e, s)| serde_json::json!({"name": n, "max_abs_error": e, "max_abs_value": s})).collect::<Vec<_>>(),
+            "errors": rep.errors.iter().zip(scales.iter().zip(&relative)).map(|((n, e, s), (scale, rel))| serde_json::json!({"name": n, "max_abs_error": e, "max_abs_value": s, "scale": scale, "relative_error": rel})).collect::<Vec<_>>(),
             "max_relative_error": worst,
         });
         let failure = rep.run.failure.clone().map(|failure| Error::Integration {
@@ -416,10 +464,15 @@ pub fn check(a: CheckArgs) -> Result<Outcome, Error> {
         rep.run.rows.len(),
         set.t_end
     );
-    for (n, e, s) in &rep.errors {
-        out += &format!("  {n:<12} max |error| {e:.3e}   (max |value| {s:.3e})\n");
+    for ((n, e, s), rel) in rep.errors.iter().zip(&relative) {
+        out += &format!(
+            "  {n:<12} max |error| {e:.3e}   (max |value| {s:.3e})   relative {rel:.3e}\n"
+        );
     }
-    out += &format!("largest error relative to the size of the solution: {worst:.3e}\n");
+    out += &format!(
+        "largest error relative to the size of the solution: {worst:.3e}\n\
+         (each column against the largest max |value| of its order: coordinates together, rates together)\n"
+    );
     let failure = rep.run.failure.clone().map(|failure| Error::Integration {
         origin: model.origin.clone(),
         failure: Box::new(failure),

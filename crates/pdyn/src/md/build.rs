@@ -90,6 +90,35 @@ pub struct Prepared {
     pub cutoff: f64,
 }
 
+/// Refuses a model whose estimated memory ([`super::memory::estimate`]) exceeds the limit
+/// ([`super::memory::limit`]), at the table of its configuration, naming both sizes.
+fn fits_in_memory(
+    spec: &MdSpec,
+    atoms: u64,
+    edges: [f64; 3],
+    cutoff: f64,
+    span: &Range<usize>,
+) -> Result<(), ModelError> {
+    use super::memory::{estimate, human, limit};
+    let need = estimate(atoms, edges, cutoff + spec.skin.value, spec.msd);
+    let (have, source) = limit();
+    if need.bytes > have as f64 {
+        return Err(ModelError::new(
+            &spec.origin,
+            span.clone(),
+            format!(
+                "{atoms} atoms need about {} ({:.0} bytes per atom), more than the {} available \
+                 ({source})",
+                human(need.bytes),
+                need.per_atom,
+                human(have as f64),
+            ),
+        )
+        .help("use a smaller system (fewer cells or atoms), or set PDYN_MEMORY_LIMIT if the estimate is too cautious (docs/md.md)"));
+    }
+    Ok(())
+}
+
 /// Builds the simulation; `source` is the file's text (for located errors only) and `base` the
 /// directory relative to which `[md.read] file` is found.
 pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, ModelError> {
@@ -186,6 +215,15 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
                 LatticeKind::Fcc => pdyn_md::Lattice::Fcc,
             };
             let c = cells.map(|c| c as usize);
+            // Before the lattice is generated: does the model fit in memory?
+            let basis = match kind {
+                LatticeKind::Sc => 1.0,
+                LatticeKind::Bcc => 2.0,
+                LatticeKind::Fcc => 4.0,
+            };
+            let a = (basis / density.value).cbrt();
+            let atoms = cells.iter().product::<u64>() * basis as u64;
+            fits_in_memory(spec, atoms, cells.map(|c| c as f64 * a), cutoff, span)?;
             let (p, bx) = pdyn_md::lattice(
                 k,
                 density.value,
@@ -256,6 +294,10 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
             &start_span,
             "the initial configuration has no atoms".into(),
         ));
+    }
+    if matches!(spec.start, Start::File { .. }) {
+        let l = system.sim_box.l;
+        fits_in_memory(spec, n as u64, l, cutoff, &start_span)?;
     }
 
     // Bonds: consecutive atoms in chains of `chain_length`.

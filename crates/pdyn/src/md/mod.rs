@@ -11,6 +11,7 @@
 
 pub mod build;
 pub mod formula;
+pub mod memory;
 pub mod output;
 pub mod pair;
 pub mod run;

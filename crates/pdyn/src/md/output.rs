@@ -41,19 +41,51 @@ fn avg_json(a: Option<Average>) -> serde_json::Value {
     }
 }
 
+/// The names of a unit system's units, for the summary and the axes of the plots.
+pub struct UnitNames {
+    /// `lj` or `real`.
+    pub name: &'static str,
+    /// Energy.
+    pub energy: &'static str,
+    /// Length.
+    pub length: &'static str,
+    /// Time.
+    pub time: &'static str,
+    /// Temperature.
+    pub temperature: &'static str,
+    /// Pressure.
+    pub pressure: &'static str,
+}
+
+/// The units of `units` by name.
+pub fn unit_names(units: Units) -> UnitNames {
+    match units {
+        Units::Lj => UnitNames {
+            name: "lj",
+            energy: "ε",
+            length: "σ",
+            time: "τ",
+            temperature: "ε/k_B",
+            pressure: "ε/σ³",
+        },
+        Units::Real => UnitNames {
+            name: "real",
+            energy: "kcal/mol",
+            length: "Å",
+            time: "fs",
+            temperature: "K",
+            pressure: "atm",
+        },
+    }
+}
+
 /// The JSON summary of a run.
 pub fn summary(prep: &Prepared, res: &MdResult) -> serde_json::Value {
     let spec = &prep.spec;
     let n = res.atoms.max(1) as f64;
     let last = res.records.last();
-    let units = match spec.units {
-        Units::Lj => {
-            json!({"name": "lj", "energy": "ε", "length": "σ", "time": "τ", "temperature": "ε/k_B", "pressure": "ε/σ³"})
-        }
-        Units::Real => {
-            json!({"name": "real", "energy": "kcal/mol", "length": "Å", "time": "fs", "temperature": "K", "pressure": "atm"})
-        }
-    };
+    let u = unit_names(spec.units);
+    let units = json!({"name": u.name, "energy": u.energy, "length": u.length, "time": u.time, "temperature": u.temperature, "pressure": u.pressure});
     json!({
         "model": spec.name,
         "engine": "md",
@@ -67,6 +99,7 @@ pub fn summary(prep: &Prepared, res: &MdResult) -> serde_json::Value {
         "thermo_every": spec.thermo_every,
         "neighbor_builds": res.builds,
         "trajectory_frames": res.frames,
+        "rdf_frames": res.rdf.as_ref().map(|_| res.rdf_frames),
         "formula_native": prep.native,
         "minimized": prep.minimized.map(|m| json!({
             "iterations": m.iterations, "energy": json_num(m.energy),
@@ -134,10 +167,11 @@ pub fn write_plots(prep: &Prepared, res: &MdResult, dir: &Path) -> Result<(), Er
     let col = |f: &dyn Fn(&pdyn_md::ThermoRecord) -> f64| -> Vec<f64> {
         res.records.iter().map(f).collect()
     };
+    let u = unit_names(prep.spec.units);
     let energy = Figure {
         title: format!("{}: energy per atom", prep.spec.name),
         x_label: "step".into(),
-        y_label: "energy / atom".into(),
+        y_label: format!("energy per atom [{}]", u.energy),
         series: vec![
             Series::new("kinetic", step.clone(), col(&|r| r.kinetic / n)),
             Series::new("potential", step.clone(), col(&|r| r.potential / n)),
@@ -148,14 +182,14 @@ pub fn write_plots(prep: &Prepared, res: &MdResult, dir: &Path) -> Result<(), Er
     let temp = Figure {
         title: "temperature".into(),
         x_label: "step".into(),
-        y_label: "T".into(),
+        y_label: format!("T [{}]", u.temperature),
         series: vec![Series::new("T", step.clone(), col(&|r| r.temperature))],
         ..Default::default()
     };
     let pressure = Figure {
         title: "pressure".into(),
         x_label: "step".into(),
-        y_label: "P".into(),
+        y_label: format!("P [{}]", u.pressure),
         series: vec![Series::new("P", step, col(&|r| r.pressure))],
         ..Default::default()
     };

@@ -21,9 +21,6 @@ use std::sync::Arc;
 /// Largest system for the RDF (an all-pairs histogram, `O(N²)` per frame).
 pub const RDF_MAX_ATOMS: usize = 100_000;
 
-/// Frames the RDF averages over at most (taken from the second half of the run).
-pub const RDF_MAX_FRAMES: usize = 20;
-
 /// What a run is asked to do besides stepping.
 #[derive(Debug, Clone, Default)]
 pub struct RunOptions {
@@ -82,6 +79,8 @@ pub struct MdResult {
     pub frames: u64,
     /// `(r, g(r))` when asked for.
     pub rdf: Option<(Vec<f64>, Vec<f64>)>,
+    /// Frames the RDF averaged.
+    pub rdf_frames: u64,
     /// `(step, time, msd)` at every record when asked for.
     pub msd: Vec<[f64; 3]>,
     /// Energy conservation (NVE, Nosé–Hoover).
@@ -255,7 +254,18 @@ fn run_sim<P: PairPotential>(
             "rdf = true ignored: {n} atoms is more than {RDF_MAX_ATOMS} for the all-pairs histogram"
         ));
     }
-    let rdf_every = (spec.steps / spec.thermo_every.max(1) / 2 / RDF_MAX_FRAMES as u64).max(1);
+    // At most `rdf_frames` frames, equally spaced over the records of the second half.
+    let second_half_records = {
+        let te = spec.thermo_every.max(1);
+        let (first, last) = ((spec.steps / 2).div_ceil(te).max(1), spec.steps / te);
+        (last + 1).saturating_sub(first)
+    };
+    // Record j of the R is taken when (j·F mod R) < F: exactly min(F, R) of them, spread
+    // evenly (Bresenham), the first included.
+    let rdf_take = |j: u64| {
+        let (f, r) = (spec.rdf_frames as u64, second_half_records.max(1));
+        (j % r) * (f % r) % r < f || f >= r
+    };
     let mut records: Vec<ThermoRecord> = vec![];
     let mut msd = vec![];
     let mut rdf_seen = 0u64;
@@ -293,7 +303,7 @@ fn run_sim<P: PairPotential>(
             }
             if let Some(h) = &mut rdf {
                 if r.step >= half && r.step > 0 {
-                    if rdf_seen % rdf_every == 0 {
+                    if rdf_take(rdf_seen) {
                         // the box is fixed, so `add` cannot refuse r_max here
                         let _ = h.add(s);
                         rdf_frames += 1;
@@ -337,7 +347,7 @@ fn run_sim<P: PairPotential>(
             msd.push([c.step as f64, c.time, m.value(&sim.system)]);
         }
         if let Some(h) = &mut rdf {
-            if c.step > 0 {
+            if c.step > 0 && (rdf_frames as usize) < spec.rdf_frames {
                 let _ = h.add(&sim.system);
                 rdf_frames += 1;
             }
@@ -346,6 +356,15 @@ fn run_sim<P: PairPotential>(
     if spec.rdf && rdf.is_some() && rdf_frames == 0 {
         warnings.push("rdf = true: no frame to average (the run has no steps)".into());
         rdf = None;
+    }
+    // Said when the file asked for a count (the default is "up to 20").
+    let asked = spec.rdf_frames != super::spec::RDF_FRAMES;
+    if asked && rdf.is_some() && failure.is_none() && (rdf_frames as usize) < spec.rdf_frames {
+        warnings.push(format!(
+            "the RDF averages {rdf_frames} frames, fewer than rdf_frames = {}: the second half \
+             of the run has only that many thermo records (lower thermo_every or run longer)",
+            spec.rdf_frames
+        ));
     }
     if let Some((w, path)) = &mut traj {
         w.flush().map_err(|e| io_err(path, "write", e))?;
@@ -393,6 +412,7 @@ fn run_sim<P: PairPotential>(
         builds,
         atoms: n,
         frames,
+        rdf_frames: if rdf.is_some() { rdf_frames } else { 0 },
         rdf: rdf.map(|h| h.result()),
         msd,
         drift,

@@ -18,6 +18,12 @@ type Sv = Spanned<toml::Value>;
 /// A name with its span.
 type Name = Spanned<String>;
 
+/// Frames the RDF averages by default (`rdf_frames`).
+pub const RDF_FRAMES: usize = 20;
+/// Most frames `rdf_frames` may ask for: each is an all-pairs histogram of up to
+/// [`super::run::RDF_MAX_ATOMS`] atoms.
+pub const MAX_RDF_FRAMES: u64 = 100_000;
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 #[allow(dead_code)] // `description` is read by serde only
@@ -42,6 +48,7 @@ struct RawMd {
     minimize: Option<Spanned<bool>>,
     rdf: Option<Spanned<bool>>,
     rdf_bins: Option<Sv>,
+    rdf_frames: Option<Sv>,
     msd: Option<Spanned<bool>>,
     equilibrate: Option<Sv>,
     #[serde(default)]
@@ -358,6 +365,9 @@ pub struct MdSpec {
     pub rdf: bool,
     /// Histogram bins of the RDF.
     pub rdf_bins: usize,
+    /// Frames the RDF averages, equally spaced over the thermo records of the second half of
+    /// the run (`rdf_frames`, default [`RDF_FRAMES`]; fewer when there are fewer records).
+    pub rdf_frames: usize,
     /// Mean-squared displacement post-processing.
     pub msd: bool,
     /// Records before this step are left out of the averages (equilibration).
@@ -483,6 +493,18 @@ pub fn parse(
         .transpose()?;
     let rdf_bins = r.count_or(&m.rdf_bins, "rdf_bins", &mspan, Some(100), 1 << 20)? as usize;
     let rdf_bins = rdf_bins.max(1);
+    let rdf_frames = r.count_or(
+        &m.rdf_frames,
+        "rdf_frames",
+        &mspan,
+        Some(RDF_FRAMES as u64),
+        MAX_RDF_FRAMES,
+    )?;
+    if rdf_frames == 0 {
+        let sv = m.rdf_frames.as_ref().expect("0 is only read from the file");
+        return Err(r.err(sv.span(), "`rdf_frames` must be at least 1"));
+    }
+    let rdf_frames = rdf_frames as usize;
     let equilibrate = r.count_or(&m.equilibrate, "equilibrate", &mspan, Some(0), MAX_STEPS)?;
 
     if m.species.is_empty() {
@@ -965,6 +987,7 @@ pub fn parse(
         minimize: m.minimize.as_ref().is_some_and(|b| *b.get_ref()),
         rdf: m.rdf.as_ref().is_some_and(|b| *b.get_ref()),
         rdf_bins,
+        rdf_frames,
         msd: m.msd.as_ref().is_some_and(|b| *b.get_ref()),
         equilibrate,
         species,

@@ -171,7 +171,13 @@ pub fn build(spec: &NbodySpec) -> Result<Built, BuildError> {
         });
     }
     if let Some(p) = &spec.plummer {
-        let stars = pdyn_gravity::plummer::plummer(p.n, p.seed, MAX_BODIES)
+        use pdyn_gravity::plummer::{plummer_scaled, Scaling};
+        let scaling = if p.rescale {
+            Scaling::Henon
+        } else {
+            Scaling::Natural
+        };
+        let stars = plummer_scaled(p.n, p.seed, MAX_BODIES, scaling)
             .map_err(|e| BuildError::at(&p.origin, e.to_string()))?;
         let g = config.units.g();
         let vscale = (g * p.mass / p.scale).sqrt();

@@ -5,6 +5,7 @@
 //! `conservation` and `positions` (the final x–y positions as dots).
 
 use super::run::NbodyResult;
+use super::spec::UnitsSpec;
 use crate::plots::both;
 use crate::Error;
 use pdyn_plot::{save, save3, save_grid, Figure, Figure3, Marker, Series, Series3, Style};
@@ -13,8 +14,16 @@ use std::path::Path;
 /// Most bodies drawn as individual curves (the rest would make an unreadable legend).
 const MAX_CURVES: usize = 20;
 
-/// Writes the plots of `res` into `dir`.
-pub fn write(title: &str, res: &NbodyResult, dir: &Path) -> Result<(), Error> {
+/// Writes the plots of `res` into `dir`; axes carry the units of `units` (`x [AU]`,
+/// `t [days]`).
+pub fn write(title: &str, res: &NbodyResult, units: &UnitsSpec, dir: &Path) -> Result<(), Error> {
+    let (length, time) = units.length_time();
+    let (lx, ly, lz, lt) = (
+        format!("x [{length}]"),
+        format!("y [{length}]"),
+        format!("z [{length}]"),
+        format!("t [{time}]"),
+    );
     if res.times.len() < 2 {
         return Err(Error::argument("--plot", "too few output points to plot"));
     }
@@ -42,8 +51,8 @@ pub fn write(title: &str, res: &NbodyResult, dir: &Path) -> Result<(), Error> {
             .collect();
         let fig = Figure {
             title: format!("{title}: orbits (x-y projection)"),
-            x_label: "x".into(),
-            y_label: "y".into(),
+            x_label: lx.clone(),
+            y_label: ly.clone(),
             series: planar,
             equal_aspect: true,
             ..Default::default()
@@ -62,7 +71,7 @@ pub fn write(title: &str, res: &NbodyResult, dir: &Path) -> Result<(), Error> {
         if zhi - zlo > 1e-3 * scale {
             let fig = Figure3 {
                 title: format!("{title}: orbits"),
-                labels: ["x".into(), "y".into(), "z".into()],
+                labels: [lx.clone(), ly.clone(), lz],
                 series: xyz
                     .iter()
                     .zip(&res.names)
@@ -73,9 +82,10 @@ pub fn write(title: &str, res: &NbodyResult, dir: &Path) -> Result<(), Error> {
             both(dir, "orbits_3d", |p| save3(&fig, p))?;
         }
         let mut panels = Vec::new();
+        let a_label = format!("a [{length}]");
         for (label, get) in [
             (
-                "a",
+                a_label.as_str(),
                 (|o: &pdyn_gravity::Orbit| o.a) as fn(&pdyn_gravity::Orbit) -> f64,
             ),
             ("e", |o| o.e),
@@ -96,7 +106,7 @@ pub fn write(title: &str, res: &NbodyResult, dir: &Path) -> Result<(), Error> {
             if !series.is_empty() {
                 panels.push(Figure {
                     title: format!("{label} against time"),
-                    x_label: "t".into(),
+                    x_label: lt.clone(),
                     y_label: label.into(),
                     series,
                     markers: markers.clone(),
@@ -109,7 +119,7 @@ pub fn write(title: &str, res: &NbodyResult, dir: &Path) -> Result<(), Error> {
         }
     } else {
         let (x, y) = res.final_positions.iter().map(|p| (p[0], p[1])).unzip();
-        write_positions(title, x, y, dir)?;
+        write_positions(title, x, y, (&lx, &ly), dir)?;
     }
     let t: Vec<f64> = res.conservation.iter().map(|r| r.t).collect();
     let e0 = res.conservation[0].energy;
@@ -126,7 +136,7 @@ pub fn write(title: &str, res: &NbodyResult, dir: &Path) -> Result<(), Error> {
     let panels = vec![
         Figure {
             title: "relative energy error".into(),
-            x_label: "t".into(),
+            x_label: lt.clone(),
             y_label: "(E - E0)/|E0|".into(),
             series: vec![Series::new("energy", t.clone(), de)],
             markers: markers.clone(),
@@ -134,7 +144,7 @@ pub fn write(title: &str, res: &NbodyResult, dir: &Path) -> Result<(), Error> {
         },
         Figure {
             title: "virial ratio".into(),
-            x_label: "t".into(),
+            x_label: lt,
             y_label: "2T/|V|".into(),
             series: vec![Series::new("2T/|V|", t, virial)],
             markers,
@@ -146,11 +156,17 @@ pub fn write(title: &str, res: &NbodyResult, dir: &Path) -> Result<(), Error> {
 }
 
 /// The final positions of a large-N run, as dots (x–y projection).
-fn write_positions(title: &str, x: Vec<f64>, y: Vec<f64>, dir: &Path) -> Result<(), Error> {
+fn write_positions(
+    title: &str,
+    x: Vec<f64>,
+    y: Vec<f64>,
+    (lx, ly): (&str, &str),
+    dir: &Path,
+) -> Result<(), Error> {
     let fig = Figure {
         title: format!("{title}: positions at the end (x-y projection)"),
-        x_label: "x".into(),
-        y_label: "y".into(),
+        x_label: lx.into(),
+        y_label: ly.into(),
         series: vec![Series::new("bodies", x, y)],
         style: Style::Points,
         equal_aspect: true,

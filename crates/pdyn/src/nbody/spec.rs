@@ -60,6 +60,7 @@ struct RawPlummer {
     seed: Option<Spanned<i64>>,
     mass: Option<Sv>,
     scale: Option<Sv>,
+    rescale: Option<Spanned<bool>>,
 }
 
 #[derive(Deserialize)]
@@ -101,6 +102,20 @@ pub struct UnitsSpec {
     pub si: bool,
     /// Name printed in reports (`au-day-msun`, `G = 1`...).
     pub label: &'static str,
+}
+
+impl UnitsSpec {
+    /// The units of length and time for axis labels and reports: `("AU", "days")`, `("m",
+    /// "s")`; for `G = 1` (Hénon) and a custom `G`, the model's own units.
+    pub fn length_time(&self) -> (&'static str, &'static str) {
+        match self.units {
+            pdyn_gravity::Units::AuDaySolarMass => ("AU", "days"),
+            pdyn_gravity::Units::AuYearSolarMass => ("AU", "yr"),
+            pdyn_gravity::Units::Si => ("m", "s"),
+            pdyn_gravity::Units::GEqualsOne => ("N-body length", "N-body time"),
+            _ => ("length unit", "time unit"),
+        }
+    }
 }
 
 /// The unit systems `units = "..."` accepts: name, engine units, SI, label.
@@ -212,6 +227,10 @@ pub struct PlummerSpec {
     /// Length scale: positions are the Hénon-unit sphere's times `scale` (default 1, which
     /// is the virial radius), velocities times `√(G mass/scale)`.
     pub scale: f64,
+    /// Whether each realization is rescaled exactly to standard Hénon units (`E = −1/4`,
+    /// virial ratio 1) before `mass` and `scale` apply (`rescale = true`, the default), or
+    /// kept as drawn (`rescale = false`).
+    pub rescale: bool,
     /// Where it was declared.
     pub origin: Origin,
 }
@@ -362,7 +381,7 @@ pub fn parse(
     if let Some(file) = &nb.bodies_file {
         let dir = Path::new(origin).parent().unwrap_or(Path::new(""));
         let path: PathBuf = dir.join(file.get_ref());
-        let text = std::fs::read_to_string(&path).map_err(|e| {
+        let bytes = std::fs::read(&path).map_err(|e| {
             in_model(
                 ModelError::new(
                     origin,
@@ -373,6 +392,19 @@ pub fn parse(
             )
         })?;
         let csv_origin = path.display().to_string();
+        // Bytes that are not UTF-8: an error at the first of them, in the CSV.
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let at = e.utf8_error().valid_up_to();
+            let byte = e.as_bytes()[at];
+            Box::new(SetOrSpecError::Spec(SpecError {
+                error: ModelError::new(
+                    &csv_origin,
+                    at..at + char::REPLACEMENT_CHARACTER.len_utf8(),
+                    format!("the byte 0x{byte:02X} is not UTF-8: a bodies file must be UTF-8 text"),
+                ),
+                source: String::from_utf8_lossy(e.as_bytes()).into_owned(),
+            }))
+        })?;
         let first = spec.bodies.len();
         let csv_bodies =
             super::csv::bodies(&text, &csv_origin, r.units, &spec.bodies).map_err(|error| {
@@ -744,6 +776,7 @@ impl Reader<'_> {
             seed,
             mass: mass.unwrap_or(1.0),
             scale: scale.unwrap_or(1.0),
+            rescale: raw.rescale.as_ref().is_none_or(|r| *r.get_ref()),
             origin: Origin {
                 file: origin.to_string(),
                 span: p.span(),

@@ -344,6 +344,37 @@ pub struct CheckReport {
     pub run: RunResult,
 }
 
+impl CheckReport {
+    /// The scale each state column's error is measured against: the largest `max |exact|`
+    /// among the columns of the same derivative order (the coordinates together, the rates
+    /// together) — the size of the whole state, not of the column alone. A column that stays
+    /// near zero throughout (a node of a mode, at round-off) was compared with its own
+    /// round-off and reported a relative error of 1.
+    pub fn scales(&self) -> Vec<f64> {
+        let order = |name: &str| name.len() - name.trim_end_matches('\'').len();
+        self.errors
+            .iter()
+            .map(|(n, _, _)| {
+                self.errors
+                    .iter()
+                    .filter(|(m, _, _)| order(m) == order(n))
+                    .map(|e| e.2)
+                    .fold(0.0, f64::max)
+            })
+            .collect()
+    }
+
+    /// Each column's `max |error|` relative to its [scale](CheckReport::scales) (0 when
+    /// both are 0; the absolute error when the whole group is 0).
+    pub fn relative_errors(&self) -> Vec<f64> {
+        self.errors
+            .iter()
+            .zip(self.scales())
+            .map(|((_, e, _), s)| if s > 0.0 { e / s } else { *e })
+            .collect()
+    }
+}
+
 /// `pdyn check`: integrates with `set` at the exact solution's sampling and compares.
 pub fn check(
     prep: &Prepared,
