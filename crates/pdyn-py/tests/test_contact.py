@@ -50,3 +50,21 @@ def test_friction_doing_work_warns(examples):
         warnings.simplefilter("always")
         m.run()
     assert any("pull" in str(x.message) for x in w)
+
+
+def test_contacts_and_event_actions_built_in_code():
+    m = pdyn.Model("ball built in code")
+    m.coordinate("y", initial=2.0, rate=0.0)
+    m.particle("ball", mass=1.0, position="[0, y, 0]")
+    m.gravity("[0, -g, 0]")
+    m.parameters(g=9.81)
+    m.contact("floor", on="ball", surface="r.y", e=1.0)
+    m.event("top", when="y'", direction="falling", set=["g = 2*g"])
+    m.simulate(t_end=3.0, rtol=1e-10, atol=1e-12)
+    sol = m.run()
+    h = sol.hybrid
+    t1 = math.sqrt(2 * 2.0 / 9.81)
+    assert h["impacts"][0]["t"] == pytest.approx(t1, rel=1e-9)
+    # e = 1: back to the top at 2 t1, where gravity doubles; the next fall takes t1/sqrt(2).
+    assert h["actions"][0]["t"] == pytest.approx(2 * t1, rel=1e-9)
+    assert h["impacts"][1]["t"] == pytest.approx(2 * t1 + t1 / math.sqrt(2), rel=1e-9)

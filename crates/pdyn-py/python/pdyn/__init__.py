@@ -195,11 +195,22 @@ class Model:
         self._edit().setdefault("forces", []).append(entry)
 
     def event(self, name: str, when: Any, direction: str = "both",
-              terminal: bool = False) -> None:
-        """Adds an ``[[events]]`` entry: the zeros of ``when``."""
-        self._edit().setdefault("events", []).append(
-            {"name": name, "when": _text(when), "direction": direction,
-             "terminal": bool(terminal)})
+              terminal: bool = False, set: Optional[Sequence[Any]] = None) -> None:
+        """Adds an ``[[events]]`` entry: the zeros of ``when``; ``set``: assignments made when
+        it fires (``["y' = -0.8*y'"]``: free coordinates, their rates, parameters)."""
+        entry = {"name": name, "when": _text(when), "direction": direction,
+                 "terminal": bool(terminal)}
+        if set is not None:
+            entry["set"] = [_text(a) for a in set]
+        self._edit().setdefault("events", []).append(entry)
+
+    def contact(self, name: str, **fields: Any) -> None:
+        """Adds a ``[[contacts]]`` entry: ``m.contact("floor", on="ball", surface="r.y",
+        e=0.8, mu_s=0.5, mu_k=0.4)`` (a particle against a surface, or ``between=["A",
+        "B"]`` with ``distance``; fields as in docs/model-format.md)."""
+        entry = {"name": name}
+        entry.update({k: _field(v) for k, v in fields.items()})
+        self._edit().setdefault("contacts", []).append(entry)
 
     def monitor(self, name: str, expr: Any) -> None:
         """Tabulates ``expr`` as a column of every run."""

@@ -157,6 +157,10 @@ struct CompiledMode {
     columns: Observer,
     /// Contact power, friction dissipation.
     rates: Observer,
+    /// When the mode's equations are solved in closed form: `[q'', power, dissipation]` as
+    /// one program of `[t, q, q', parameters]`, the whole augmented right-hand side in one
+    /// evaluation.
+    fused: Option<pdyn_jit::Evaluator>,
     /// Per contact: N, F_1, F_2.
     forces: Observer,
     /// Per model event: its function in this mode.
@@ -471,12 +475,41 @@ impl Hybrid {
                     .map_err(|e| compile_error(&format!("event `{}`", ev.name), e))?,
             );
         }
+        let fused = match &d.solution {
+            Some(sol) => {
+                let p = &mut m.pool;
+                let solved: rustc_hash::FxHashMap<Id, Id> = d
+                    .unknowns
+                    .iter()
+                    .zip(sol)
+                    .map(|(u, &x)| (u.id, x))
+                    .collect();
+                let mut outs: Vec<Id> = d
+                    .free
+                    .iter()
+                    .map(|&ci| {
+                        d.unknowns
+                            .iter()
+                            .zip(sol)
+                            .find(|(u, _)| u.kind == UnknownKind::Acceleration(ci))
+                            .map_or(Pool::ZERO, |(_, &x)| x)
+                    })
+                    .collect();
+                outs.push(p.subs(power, &solved));
+                outs.push(p.subs(diss, &solved));
+                pdyn_expr::Program::compile(p, &self.base_inputs, &outs)
+                    .ok()
+                    .map(|prog| pdyn_jit::Evaluator::new(prog, self.jit))
+            }
+            None => None,
+        };
         let impulse = impulse_form(&mut m, &d, &self.base_inputs)?;
         Ok(CompiledMode {
             modes: modes.to_vec(),
             system,
             columns,
             rates,
+            fused,
             forces,
             user_events,
             impulse,
@@ -568,6 +601,26 @@ struct Augmented<'a> {
     n: usize,
     input: RefCell<Vec<f64>>,
     rates: RefCell<[f64; 2]>,
+    /// `[t, q, q', parameters]`, workspace and outputs of the fused program.
+    fused: RefCell<(Vec<f64>, Vec<f64>, Vec<f64>)>,
+}
+
+impl<'a> Augmented<'a> {
+    fn new(mode: &'a CompiledMode, n: usize, params: &[f64]) -> Augmented<'a> {
+        let mut base = vec![0.0; 1 + 2 * n];
+        base.extend_from_slice(params);
+        let (ws, out) = match &mode.fused {
+            Some(f) => (f.workspace(), vec![0.0; f.n_outputs()]),
+            None => (Vec::new(), Vec::new()),
+        };
+        Augmented {
+            mode,
+            n,
+            input: RefCell::new(Vec::new()),
+            rates: RefCell::new([0.0; 2]),
+            fused: RefCell::new((base, ws, out)),
+        }
+    }
 }
 
 impl OdeSystem for Augmented<'_> {
@@ -577,6 +630,16 @@ impl OdeSystem for Augmented<'_> {
 
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
         let n = self.n;
+        if let Some(f) = &self.mode.fused {
+            let mut b = self.fused.borrow_mut();
+            let (base, ws, out) = &mut *b;
+            base[0] = t;
+            base[1..1 + 2 * n].copy_from_slice(&y[..2 * n]);
+            f.eval(base, ws, out);
+            dydt[..n].copy_from_slice(&y[n..2 * n]);
+            dydt[n..2 * n + 2].copy_from_slice(&out[..n + 2]);
+            return;
+        }
         let mut input = self.input.borrow_mut();
         self.mode
             .system
@@ -1137,12 +1200,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
         let cache = h.cache.borrow();
         let cm = &cache[mode_index];
         cm.system.set_parameters(&st.params);
-        let aug = Augmented {
-            mode: cm,
-            n,
-            input: RefCell::new(Vec::new()),
-            rates: RefCell::new([0.0; 2]),
-        };
+        let aug = Augmented::new(cm, n, &st.params);
         // Event functions of this segment.
         let mut triggers: Vec<(Trigger, Direction)> = Vec::new();
         for (c, contact) in h.model.contacts.iter().enumerate() {
@@ -1295,7 +1353,9 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
                 },
             };
             add_stats(&mut stats, &sol.stats);
-            let penetrated = (0..sol.len()).find(|&i| {
+            // The segment's end tells: a flight stepped over ends below the surface (a dip
+            // and back within a step is the event locator's to find).
+            let penetrated = sol.len().checked_sub(1).filter(|&i| {
                 let p = st.probe(sol.t[i], sol.y_at(i));
                 h.model.contacts.iter().enumerate().any(|(c, contact)| {
                     !contact.held && st.modes[c] == ContactMode::Open && p[c][0] < -st.x_tol()
