@@ -105,6 +105,7 @@ pub fn hybrid_summary(h: &crate::sim::hybrid::HybridReport) -> serde_json::Value
         "work_contacts": json_num(h.work_contacts),
         "dissipated_friction": json_num(h.dissipated_friction),
         "dissipated_impacts": json_num(h.dissipated_impacts),
+        "energy_actions": json_num(h.energy_actions),
     })
 }
 

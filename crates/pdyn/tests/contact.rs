@@ -717,3 +717,79 @@ t_end = 1.0
     let e = load_err(&hump(10.0).replace("direction = \"[sin(s/20), cos(s/20), 0]\"\n", ""));
     assert!(e.contains("needs the `direction`"), "{e}");
 }
+
+const INCLINE_PULLEY: &str = r#"
+name = "block on a rough incline, tied over a pulley to a hanging mass"
+gravity = "[0, -g, 0]"
+[parameters]
+g = 9.81
+mA = 10.0
+mB = 4.0
+alpha = "pi/6"
+mu_s = 0.2
+mu_k = 0.1
+[coordinates]
+s = { initial = 0, rate = 0 }       # A up the slope
+yB = { initial = 0, rate = 0 }      # B's height
+[particles.A]
+mass = "mA"
+position = "s*[cos(alpha), sin(alpha), 0]"
+[particles.B]
+mass = "mB"
+position = "[5, yB, 0]"
+[[forces]]
+kind = "reaction"
+name = "T"
+on = "A"
+direction = "[cos(alpha), sin(alpha), 0]"
+[[forces]]
+kind = "reaction"
+name = "T"
+on = "B"
+direction = "[0, 1, 0]"
+[[constraints]]
+equation = "s + yB = 0"
+[[contacts]]
+name = "slope"
+on = "A"
+surface = "dot(r, [-sin(alpha), cos(alpha), 0])"
+mu_s = "mu_s"
+mu_k = "mu_k"
+[simulate]
+t_end = 2.0
+rtol = 1e-11
+atol = 1e-12
+"#;
+
+/// An incline with a pulley (a constraint and a cable tension besides the contact): static
+/// friction holds the pair when |mB g - mA g sin a| <= mu_s mA g cos a, with the friction
+/// it needs; otherwise A slides down at (mA g sin a - mB g - mu_k mA g cos a)/(mA + mB).
+#[test]
+fn incline_and_pulley_held_by_static_friction_or_sliding() {
+    let (g, ma, mb, a) = (9.81f64, 10.0, 4.0, std::f64::consts::PI / 6.0);
+    let res = run(INCLINE_PULLEY, &[], |_| {});
+    let h = res.hybrid.as_ref().unwrap();
+    assert!(h.switches.is_empty(), "{:?}", h.switches);
+    assert_eq!(h.timeline[0].modes[0].1, "stuck");
+    let last = res.rows.last().unwrap();
+    assert!(last[col(&res, "s")].abs() < 1e-12);
+    // The friction the slope supplies along its tangent holds mA g sin a - mB g = 9.81 N.
+    close(
+        last[col(&res, "F_slope")].abs(),
+        ma * g * a.sin() - mb * g,
+        1e-9,
+        "friction needed",
+    );
+    close(last[col(&res, "T")], mb * g, 1e-9, "tension");
+    // mu_s = 0.1 cannot hold it: it slides down the slope, friction pointing up-slope.
+    let res = run(INCLINE_PULLEY, &[("mu_s", 0.1)], |_| {});
+    let acc = (ma * g * a.sin() - mb * g - 0.1 * ma * g * a.cos()) / (ma + mb);
+    let last = res.rows.last().unwrap();
+    close(last[col(&res, "s")], -0.5 * acc * 4.0, 1e-9, "slid down");
+    close(last[col(&res, "s'")], -acc * 2.0, 1e-9, "speed down-slope");
+    assert!(res
+        .rows
+        .iter()
+        .all(|r| r[col(&res, "dissipated.friction")] >= 0.0));
+    balance_closes(&res, 1e-9);
+}

@@ -409,9 +409,13 @@ fn hybrid_text(h: &sim::hybrid::HybridReport) -> String {
         more(&mut s, h.actions.len());
     }
     s += &format!(
-        "\nenergy: work of the contact forces {:.9e}, dissipated by friction {:.9e}, lost in impacts {:.9e}\n",
+        "\nenergy: work of the contact forces {:.9e}, dissipated by friction {:.9e}, lost in impacts {:.9e}",
         h.work_contacts, h.dissipated_friction, h.dissipated_impacts
     );
+    if h.energy_actions != 0.0 {
+        s += &format!(", added by event actions {:.9e}", h.energy_actions);
+    }
+    s += "\n";
     s
 }
 

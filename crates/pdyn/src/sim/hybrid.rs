@@ -118,6 +118,8 @@ pub struct HybridReport {
     pub dissipated_friction: f64,
     /// Kinetic energy lost in impacts.
     pub dissipated_impacts: f64,
+    /// Energy added by event actions (negative: taken out).
+    pub energy_actions: f64,
     /// `(t, event name, assignments)` of every event that changed the state or a parameter.
     pub actions: Vec<(f64, String, Vec<String>)>,
 }
@@ -259,11 +261,13 @@ impl Hybrid {
             scale_terms.push(p.call(Func::Abs, &[v.energy]));
         }
         let scale_e = p.add(&scale_terms);
+        let potentials: Vec<Id> = model.potentials.iter().map(|v| v.energy).collect();
+        let potential_e = p.add(&potentials);
         let kinetic = Observer::new(
             p,
             &base_inputs,
-            vec!["T".into(), "scale".into()],
-            &[kinetic_e, scale_e],
+            vec!["T".into(), "scale".into(), "V".into()],
+            &[kinetic_e, scale_e, potential_e],
         )
         .map_err(|e| compile_error("kinetic energy", e))?;
         let explicit_time = model.particles.iter().any(|pt| {
@@ -684,6 +688,8 @@ struct State<'h> {
     t: f64,
     y: Vec<f64>,
     w_impacts: f64,
+    /// Energy added by event actions (a burn, a parameter of a potential changed).
+    w_actions: f64,
     report: HybridReport,
     warnings: Vec<String>,
     /// Per contact: the times of its impacts in the current bounce sequence.
@@ -744,8 +750,9 @@ impl State<'_> {
         Ok(out.chunks(3).map(|c| [c[0], c[1], c[2]]).collect())
     }
 
-    fn kinetic(&self, t: f64, y: &[f64]) -> [f64; 2] {
-        let mut out = [0.0; 2];
+    /// Kinetic energy, the energy's scale and the potential energy at (t, y).
+    fn kinetic(&self, t: f64, y: &[f64]) -> [f64; 3] {
+        let mut out = [0.0; 3];
         self.h.kinetic.eval(&self.base_input(t, y), &mut out);
         out
     }
@@ -1094,6 +1101,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
         speed_scale: scale(&y[n..2 * n]).max(1e-3),
         y,
         w_impacts: 0.0,
+        w_actions: 0.0,
         report: HybridReport::default(),
         warnings: Vec::new(),
         bounces: vec![Vec::new(); k],
@@ -1161,6 +1169,8 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
     let mut status = RunStatus::Finished;
     let mut user_counts = vec![0usize; h.model.run.events.len()];
     let mut segment_start = 0.0;
+    // The user event that ended the previous segment and whether it rose through zero.
+    let mut last_fired: Option<(usize, bool)> = None;
     let mut same_time_switches = 0usize;
     let mut first = true;
     let mut sol_method;
@@ -1247,6 +1257,19 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
         let probes = &h.probes;
         // One scratch for every event function of the segment: they are called after each
         // step and many times while a crossing is located, and must not allocate.
+        // The event that ended the last segment restarts at its zero, on either side of it
+        // by round-off: one still on the side it came from would fire again at once (and an
+        // action doubling g would double it forever). Its function is shifted so that the
+        // segment starts on the side it crossed to; a later crossing is then a new one.
+        let rearm: Option<(usize, f64)> = last_fired.and_then(|(j, rising)| {
+            let mut obs = Vec::new();
+            cm.system.observation_input(t0, &st.y[..2 * n], &mut obs);
+            let mut out = [0.0];
+            cm.user_events[j].eval(&obs, &mut out);
+            let g0 = out[0];
+            let before_side = if rising { g0 < 0.0 } else { g0 > 0.0 };
+            before_side.then_some((j, 2.0 * g0))
+        });
         let scratch = RefCell::new(EventScratch::default());
         let scratch = &scratch;
         let g_fns: Vec<Box<EventFn<'_>>> = triggers
@@ -1297,7 +1320,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
                             cm.system.observation_input(t, &y[..2 * n], &mut sc.obs);
                             let mut out = [0.0];
                             cm.user_events[j].eval(&sc.obs, &mut out);
-                            out[0]
+                            out[0] - rearm.filter(|r| r.0 == j).map_or(0.0, |r| r.1)
                         }
                     }
                 });
@@ -1420,9 +1443,14 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
             row.extend_from_slice(&out);
             let (w, dfr) = (yy[2 * n], yy[2 * n + 1]);
             let energy = out[out.len() - 1 - h.model.run.monitors.len()];
-            row.extend([w, dfr, 0.0 - st.w_impacts, energy - w - st.w_impacts]);
+            row.extend([
+                w,
+                dfr,
+                0.0 - st.w_impacts,
+                energy - w - st.w_impacts - st.w_actions,
+            ]);
             push.check(prep, t, &row[1 + 2 * n..]);
-            let mut sc = [0.0; 2];
+            let mut sc = [0.0; 3];
             h.kinetic.eval(&st.base_input(t, yy), &mut sc);
             scales.push(sc[1]);
             rows.push(row);
@@ -1544,6 +1572,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
             break;
         }
         let trig = triggers[idx].0;
+        last_fired = None;
         let res = match trig {
             Trigger::Touch(c) => st.touch(c, te),
             Trigger::Release(c) => {
@@ -1620,6 +1649,12 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
             Trigger::User(j) => {
                 let ev = &h.model.run.events[j];
                 user_counts[j] += 1;
+                last_fired = Some((
+                    j,
+                    sol.events
+                        .last()
+                        .is_some_and(|e| e.direction == Direction::Rising),
+                ));
                 events.push(EventReport {
                     name: ev.name.clone(),
                     t: te,
@@ -1643,7 +1678,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
                         })
                         .map(|(i, _)| i)
                         .collect();
-                    let t_before = st.kinetic(te, &st.y)[0];
+                    let [k0, _, v0] = st.kinetic(te, &st.y);
                     for (a, &v) in ev.actions.iter().zip(&vals) {
                         match a.target {
                             ActionTarget::Coordinate(ci) => {
@@ -1659,10 +1694,12 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
                             ActionTarget::Parameter(pi) => st.params[pi] = v,
                         }
                     }
-                    // A state jump changes the energy: booked with the impacts' work so the
-                    // balance still closes (an impulsive burn adds energy on purpose).
-                    let t_after = st.kinetic(te, &st.y)[0];
-                    st.w_impacts += t_after - t_before;
+                    // A state jump changes the energy: booked apart so the balance still
+                    // closes (an impulsive burn adds energy on purpose).
+                    // The energy after, with the new state and parameters (a parameter of
+                    // a potential changes it too).
+                    let [k1, _, v1] = st.kinetic(te, &st.y);
+                    st.w_actions += (k1 + v1) - (k0 + v0);
                     let texts = ev
                         .actions
                         .iter()
@@ -1740,6 +1777,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
         st.report.work_contacts = last[j];
         st.report.dissipated_friction = last[j + 1];
         st.report.dissipated_impacts = 0.0 - st.w_impacts;
+        st.report.energy_actions = st.w_actions;
         if last[j + 1] < -1e-9 * scales.iter().fold(0.0f64, |a, &b| a.max(b)) {
             warnings.push(format!(
                 "friction did positive work on the slip ({:.6e} over the run): friction must oppose sliding, so this result is wrong",
