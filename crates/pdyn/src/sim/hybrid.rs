@@ -136,6 +136,9 @@ pub struct Hybrid {
     n: usize,
     /// Per contact: gap, gap rate, slip along tangents 1 and 2 (0 where there is none).
     probes: Observer,
+    /// Their expressions, compiled again in each mode (whose programs go native when used
+    /// long).
+    probe_exprs: Vec<Id>,
     /// Per contact: e, mu_s, mu_k.
     coefficients: Observer,
     /// Kinetic energy, and the scale of the energy (`T + Σ|V|`).
@@ -165,6 +168,11 @@ struct CompiledMode {
     fused: Option<pdyn_jit::Evaluator>,
     /// Per contact: N, F_1, F_2.
     forces: Observer,
+    /// The same as one program of `[t, q, q', parameters]` when the mode is solved in closed
+    /// form (the event functions' contact forces without a solve).
+    fused_forces: Option<pdyn_jit::Evaluator>,
+    /// Per contact: gap, gap rate, slips (the hybrid's probes, compiled for this mode).
+    probes: Observer,
     /// Per model event: its function in this mode.
     user_events: Vec<Observer>,
     impulse: Option<Impulse>,
@@ -185,6 +193,7 @@ impl CompiledMode {
         self.rates.make_native();
         self.forces.make_native();
         self.columns.make_native();
+        self.probes.make_native();
         for e in &mut self.user_events {
             e.make_native();
         }
@@ -240,7 +249,7 @@ impl Hybrid {
             let (mu_s, mu_k) = c.friction.unwrap_or((Pool::ZERO, Pool::ZERO));
             coef_exprs.extend([c.restitution, mu_s, mu_k]);
         }
-        let probes = Observer::new(p, &base_inputs, probe_names, &probe_exprs)
+        let probes = Observer::new(p, &base_inputs, probe_names, &probe_exprs.clone())
             .map_err(|e| compile_error("contact", e))?;
         let coefficients = Observer::new(
             p,
@@ -371,6 +380,7 @@ impl Hybrid {
         Ok((
             Hybrid {
                 measures,
+                probe_exprs,
                 model,
                 layout,
                 jit,
@@ -456,7 +466,19 @@ impl Hybrid {
         for mon in &m.run.monitors {
             cols.push(p.subs(mon.expr, known));
         }
-        let names = self.column_names[..cols.len()].to_vec();
+        let mut names = self.column_names[..cols.len()].to_vec();
+        // After the columns, not one of them: the energy's scale, T + Σ|V|, of each row.
+        let mut scale = Vec::new();
+        for (part, pk) in m.particles.iter().zip(&d.particles) {
+            let v2 = vector::dot(p, pk.v, pk.v);
+            let half = p.num(Number::ratio(1, 2));
+            scale.push(p.mul(&[half, part.mass, v2]));
+        }
+        for v in &m.potentials {
+            scale.push(p.call(Func::Abs, &[v.energy]));
+        }
+        cols.push(p.add(&scale));
+        names.push("energy scale".into());
         let columns =
             Observer::new(p, &obs, names, &cols).map_err(|e| compile_error("output column", e))?;
         let power = p.add(&mm.power);
@@ -471,6 +493,25 @@ impl Hybrid {
         }
         let forces = Observer::new(p, &obs, vec![String::new(); fexprs.len()], &fexprs)
             .map_err(|e| compile_error("contact force", e))?;
+        let fused_forces = d.solution.as_ref().and_then(|sol| {
+            let solved: rustc_hash::FxHashMap<Id, Id> = d
+                .unknowns
+                .iter()
+                .zip(sol)
+                .map(|(u, &x)| (u.id, x))
+                .collect();
+            let outs: Vec<Id> = fexprs.iter().map(|&f| p.subs(f, &solved)).collect();
+            pdyn_expr::Program::compile(p, &self.base_inputs, &outs)
+                .ok()
+                .map(|prog| pdyn_jit::Evaluator::new(prog, self.jit))
+        });
+        let probes = Observer::new(
+            p,
+            &self.base_inputs,
+            vec![String::new(); self.probe_exprs.len()],
+            &self.probe_exprs,
+        )
+        .map_err(|e| compile_error("contact", e))?;
         let mut user_events = Vec::new();
         for ev in &m.run.events {
             let g = p.subs(ev.when, known);
@@ -515,6 +556,8 @@ impl Hybrid {
             rates,
             fused,
             forces,
+            fused_forces,
+            probes,
             user_events,
             impulse,
             uses: std::cell::Cell::new(0),
@@ -664,6 +707,7 @@ struct EventScratch {
     base: Vec<f64>,
     obs: Vec<f64>,
     out: Vec<f64>,
+    ws: Vec<f64>,
 }
 
 /// What ends a segment.
@@ -1254,7 +1298,6 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
         let params = st.params.clone();
         let coef = st.coef.clone();
         let slip_dir = st.slip_dir.clone();
-        let probes = &h.probes;
         // One scratch for every event function of the segment: they are called after each
         // step and many times while a crossing is located, and must not allocate.
         // The event that ended the last segment restarts at its zero, on either side of it
@@ -1270,7 +1313,13 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
             let before_side = if rising { g0 < 0.0 } else { g0 > 0.0 };
             before_side.then_some((j, 2.0 * g0))
         });
-        let scratch = RefCell::new(EventScratch::default());
+        let scratch = RefCell::new(EventScratch {
+            ws: cm
+                .fused_forces
+                .as_ref()
+                .map_or_else(Vec::new, |f| f.workspace()),
+            ..EventScratch::default()
+        });
         let scratch = &scratch;
         let g_fns: Vec<Box<EventFn<'_>>> = triggers
             .iter()
@@ -1286,8 +1335,8 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
                         sc.base.push(t);
                         sc.base.extend_from_slice(&y[..2 * n]);
                         sc.base.extend_from_slice(&params);
-                        sc.out.resize(probes.len(), 0.0);
-                        probes.eval(&sc.base, &mut sc.out);
+                        sc.out.resize(cm.probes.len(), 0.0);
+                        cm.probes.eval(&sc.base, &mut sc.out);
                         let o = &sc.out[4 * c..4 * c + 4];
                         [o[0], o[1], o[2], o[3]]
                     };
@@ -1306,9 +1355,20 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
                             p[2] * slip_dir[c][0] + p[3] * slip_dir[c][1] - 0.5 * p[2].hypot(p[3])
                         }
                         Trigger::Release(c) | Trigger::Tensile(c) | Trigger::Breakaway(c) => {
-                            cm.system.observation_input(t, &y[..2 * n], &mut sc.obs);
                             sc.out.resize(cm.forces.len(), 0.0);
-                            cm.forces.eval(&sc.obs, &mut sc.out);
+                            match &cm.fused_forces {
+                                Some(f) => {
+                                    sc.base.clear();
+                                    sc.base.push(t);
+                                    sc.base.extend_from_slice(&y[..2 * n]);
+                                    sc.base.extend_from_slice(&params);
+                                    f.eval(&sc.base, &mut sc.ws, &mut sc.out);
+                                }
+                                None => {
+                                    cm.system.observation_input(t, &y[..2 * n], &mut sc.obs);
+                                    cm.forces.eval(&sc.obs, &mut sc.out);
+                                }
+                            }
                             let f = &sc.out[3 * c..3 * c + 3];
                             if matches!(trig, Trigger::Breakaway(_)) {
                                 f[1].hypot(f[2]) - coef[c][1] * f[0]
@@ -1440,7 +1500,8 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
             let mut row = Vec::with_capacity(columns.len());
             row.push(t);
             row.extend_from_slice(&yy[..2 * n]);
-            row.extend_from_slice(&out);
+            let (scale_of_row, out) = out.split_last().map_or((0.0, &out[..]), |(s, o)| (*s, o));
+            row.extend_from_slice(out);
             let (w, dfr) = (yy[2 * n], yy[2 * n + 1]);
             let energy = out[out.len() - 1 - h.model.run.monitors.len()];
             row.extend([
@@ -1450,9 +1511,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
                 energy - w - st.w_impacts - st.w_actions,
             ]);
             push.check(prep, t, &row[1 + 2 * n..]);
-            let mut sc = [0.0; 3];
-            h.kinetic.eval(&st.base_input(t, yy), &mut sc);
-            scales.push(sc[1]);
+            scales.push(scale_of_row);
             rows.push(row);
         }
         for miss in &sol.possible_misses {
