@@ -10,7 +10,9 @@
 //! each term of each sum homogeneous, positions lengths, masses masses, forces forces, the
 //! arguments of `sin` and `exp` pure numbers — makes every term of the derived F = m a a force.
 //!
-//! Literal zeros take any dimension (`[x, 0, 0]`); other plain numbers are pure numbers.
+//! Literal zeros take any dimension (`[x, 0, 0]`); other plain numbers take the dimension their
+//! context needs when they stand as a whole term (`[2, y, 0]`, `y - 2`) and are pure numbers
+//! when they multiply or divide (`2*x`).
 
 use num_traits::{CheckedAdd, CheckedMul};
 use pdyn_expr::dimension::{Dimension, Exponent};
@@ -319,24 +321,37 @@ impl Inference {
 
     /// The dimension of an expression; [`Inference::has_units`] is set when it contains a unit.
     pub fn infer(&mut self, ast: &Ast, src: Source) -> Form {
-        match self.walk(ast, src) {
+        self.infer_as(ast, src, true)
+    }
+
+    /// [`Inference::infer`] of an expression standing as a whole term (`term`: a summand, a
+    /// vector component, a whole field) or as a factor.
+    fn infer_as(&mut self, ast: &Ast, src: Source, term: bool) -> Form {
+        match self.walk(ast, src, term) {
             Some(f) => f,
             None => self.fresh("?"),
         }
     }
 
-    fn walk(&mut self, ast: &Ast, src: Source) -> Option<Form> {
+    fn walk(&mut self, ast: &Ast, src: Source, term: bool) -> Option<Form> {
         Some(match ast {
+            // A number without a unit that stands as a whole term (`[2, y, 0]`, `y - 2`,
+            // `x + 0.5`) has an unknown unit and takes the dimension its context needs, as
+            // in Modelica's unit checking: engineers write SI values bare. A number that
+            // multiplies or divides (`2*x`, `x/3`) is a pure scale factor. Zero is anything.
             Ast::Num { text, .. } => {
-                if pdyn_expr::lower::literal(text).is_some_and(|n| n.is_zero()) {
-                    self.fresh("0")
+                if term || pdyn_expr::lower::literal(text).is_some_and(|n| n.is_zero()) {
+                    self.fresh(text)
                 } else {
                     Form::from(Dimension::NONE)
                 }
             }
             Ast::Quantity { unit, .. } => {
-                self.has_units = true;
-                Form::from(unit.dimension()?)
+                let d = unit.dimension()?;
+                // An angle alone (`30 deg`) is a pure number: it does not make a model
+                // written in plain numbers strict.
+                self.has_units |= d != Dimension::NONE;
+                Form::from(d)
             }
             Ast::Ident { name, .. } => match name.as_str() {
                 "t" => Form::from(Dimension::TIME),
@@ -346,21 +361,22 @@ impl Inference {
                     None => self.fresh(name),
                 },
             },
-            Ast::Neg { expr, .. } => self.walk(expr, src)?,
+            Ast::Neg { expr, .. } => self.walk(expr, src, term)?,
             Ast::Binary { op, lhs, rhs, .. } => {
-                let a = self.infer(lhs, src);
+                let additive = matches!(op, BinOp::Add | BinOp::Sub);
+                let a = self.infer_as(lhs, src, additive);
                 match op {
                     BinOp::Add | BinOp::Sub => {
-                        let b = self.infer(rhs, src);
+                        let b = self.infer_as(rhs, src, true);
                         self.mismatch(src, (lhs, &a), (rhs, &b), "");
                         a
                     }
-                    BinOp::Mul => a.mul(&self.infer(rhs, src))?,
-                    BinOp::Div => a.div(&self.infer(rhs, src))?,
+                    BinOp::Mul => a.mul(&self.infer_as(rhs, src, false))?,
+                    BinOp::Div => a.div(&self.infer_as(rhs, src, false))?,
                     BinOp::Pow => match constant_exponent(rhs) {
                         Some(p) => a.pow(p)?,
                         None => {
-                            let b = self.infer(rhs, src);
+                            let b = self.infer_as(rhs, src, false);
                             self.must_be_number(src, rhs, &b, "an exponent");
                             self.must_be_number(src, lhs, &a, "the base of a symbolic power");
                             Form::from(Dimension::NONE)
@@ -370,7 +386,7 @@ impl Inference {
             }
             Ast::Call { name, args, .. } => self.call(name, args, src)?,
             Ast::Vector { items, .. } => {
-                let forms: Vec<Form> = items.iter().map(|i| self.infer(i, src)).collect();
+                let forms: Vec<Form> = items.iter().map(|i| self.infer_as(i, src, true)).collect();
                 for k in 1..items.len() {
                     self.mismatch(
                         src,
@@ -382,16 +398,19 @@ impl Inference {
                 forms.into_iter().next()?
             }
             Ast::Prime { expr, count, .. } => {
-                let f = self.walk(expr, src)?;
+                let f = self.walk(expr, src, false)?;
                 let t = Form::from(Dimension::TIME).pow((*count as i64).into())?;
                 f.div(&t)?
             }
-            Ast::Component { expr, .. } => self.walk(expr, src)?,
+            Ast::Component { expr, .. } => self.walk(expr, src, false)?,
         })
     }
 
     fn call(&mut self, name: &str, args: &[Ast], src: Source) -> Option<Form> {
-        let forms: Vec<Form> = args.iter().map(|a| self.infer(a, src)).collect();
+        // `min(x, 0.5)`, `abs(2)`: the arguments of the functions that keep a dimension are
+        // terms; those of `sin`, `sqrt`... are factors (a pure number there stays one).
+        let keeps = matches!(name, "abs" | "min" | "max" | "atan2" | "norm");
+        let forms: Vec<Form> = args.iter().map(|a| self.infer_as(a, src, keeps)).collect();
         let first = || forms.first().cloned();
         Some(match name {
             "sqrt" => first()?.pow(Exponent::new(1, 2))?,

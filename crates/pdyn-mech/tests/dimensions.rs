@@ -198,3 +198,89 @@ fn quantities_inside_expressions_are_exact() {
     let omega = m.parameters.iter().find(|p| p.name == "omega").unwrap();
     assert_eq!(omega.value, std::f64::consts::PI / 60.0);
 }
+
+/// Modelica's rule (issue 34): a bare number standing as a whole term takes the dimension
+/// its context needs, so engineers' SI models that mix bare numbers with units load, and an
+/// angle unit alone makes nothing strict. Each model here is correct.
+#[test]
+fn bare_numbers_beside_units_take_their_context_dimension() {
+    let with = |params: &str, coords: &str, position: &str, extra: &str| {
+        format!(
+            "gravity = \"[0, -9.81 m/s^2, 0]\"\n[parameters]\nm = \"2 kg\"\nk = \"100 N/m\"\n{params}\n[coordinates]\n{coords}\n[points]\nO = \"[0, 0, 0]\"\n[particles.p]\nmass = \"m\"\nposition = \"{position}\"\n[[forces]]\nkind = \"spring\"\nbetween = [\"p\", \"O\"]\nk = \"k\"\nl0 = 0.5\n{extra}"
+        )
+    };
+    let cases = [
+        // a bare component beside a coordinate
+        with("", "y = { initial = 1, rate = 0 }", "[2, y, 0]", ""),
+        // a bare initial value and parameter beside a stiffness in N/m
+        with(
+            "x0 = 0.5",
+            "x = { initial = \"x0\", rate = 0 }",
+            "[x, 0, 0]",
+            "",
+        ),
+        // bare numbers in an event function and a monitor
+        with(
+            "",
+            "y = { initial = 3, rate = 0 }",
+            "[0, y, 0]",
+            "[[events]]\nname = \"low\"\nwhen = \"y - 2\"\n[monitors]\nabove = \"y - 1.5\"\n",
+        ),
+        // an offset in a position, a bare number added to a length
+        with("", "x = { initial = 1, rate = 0 }", "[x + 0.25, 0, 0]", ""),
+        // a scale factor stays a pure number
+        with("", "x = { initial = 1, rate = 0 }", "[2*x, 0, 0]", ""),
+        // min/max with a bare number
+        with(
+            "",
+            "x = { initial = 1, rate = 0 }",
+            "[max(x, 0.1), 0, 0]",
+            "",
+        ),
+        // a bare rate beside units
+        with(
+            "",
+            "x = { initial = \"10 cm\", rate = 0.3 }",
+            "[x, 0, 0]",
+            "",
+        ),
+        // a bare number beside a quantity inside one expression
+        with(
+            "",
+            "x = { initial = 1, rate = 0 }",
+            "[x - 2 + 3 cm, 0, 0]",
+            "",
+        ),
+        // an applied force with a bare constant term
+        with(
+            "",
+            "x = { initial = 1, rate = 0 }",
+            "[x, 0, 0]",
+            "[[forces]]\nkind = \"applied\"\non = \"p\"\nforce = \"[-k*x + 5, 0, 0]\"\n",
+        ),
+        // a vector of bare numbers as a point
+        with("", "x = { initial = 1, rate = 0 }", "[x, 1.5, -2]", ""),
+    ];
+    for src in &cases {
+        load(src, "model.toml").unwrap_or_else(|e| panic!("{}\n{src}", e.render(src)));
+    }
+    // An angle alone does not make a plain-number model strict.
+    let angle = "[parameters]\ntheta0 = \"30 deg\"\nm = 2\n[coordinates]\nx = { initial = \"theta0\", rate = 0 }\n[particles.p]\nmass = \"m\"\nposition = \"[2, x, 0]\"\n[[forces]]\nkind = \"applied\"\non = \"p\"\nforce = \"[0, -m*9.81 + x', 0]\"\n";
+    load(angle, "model.toml").unwrap_or_else(|e| panic!("{}", e.render(angle)));
+    // Two quantities whose dimensions are both known still conflict.
+    let e = load_err(&with(
+        "",
+        "x = { initial = 1, rate = 0 }",
+        "[x + 2 s, 0, 0]",
+        "",
+    ));
+    assert!(e.contains("s (time)") && e.contains("m (length)"), "{e}");
+    // A scale factor does not soak up a dimension: 2*x (a length) plus x' (a velocity).
+    let e = load_err(&with(
+        "",
+        "x = { initial = 1, rate = 0 }",
+        "[x, 0, 0]",
+        "[[forces]]\nkind = \"applied\"\non = \"p\"\nforce = \"[-k*x + 2*m*x', 0, 0]\"\n",
+    ));
+    assert!(e.contains("dimension mismatch"), "{e}");
+}

@@ -166,7 +166,8 @@ impl<'a> Loader<'a> {
                 me.help = e.help;
                 me
             })?;
-            self.dims.has_units = true;
+            // An angle alone (`"30 deg"`) does not make the model strict.
+            self.dims.has_units |= dim != pdyn_expr::Dimension::NONE;
             self.last = dim.into();
             self.last_bare = false;
             return Ok(Value::Scalar(self.pool.num(Number::Float(x))));

@@ -251,7 +251,7 @@ impl Loader<'_> {
         if looks_like_quantity(&text) {
             let (q, dim) = parse_quantity_with_dimension(&text)
                 .map_err(|e| self.err(sv.span(), format!("in `{key}`: {}", e.message)))?;
-            self.dims.has_units = true;
+            self.dims.has_units |= dim != Dimension::NONE;
             let want = self.coordinate_form(n, order);
             let what = format!("`{key}` of `{n}`");
             self.dims.require(&dim.into(), &want, sv.span(), &what, "");
