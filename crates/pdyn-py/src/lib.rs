@@ -328,9 +328,7 @@ fn run_dict(
     // `hybrid` object of `summary.json` (the Python layer reads it with `json`).
     d.set_item(
         "hybrid_json",
-        res.hybrid
-            .as_ref()
-            .map(|h| pdyn::output::hybrid_summary(h).to_string()),
+        res.hybrid.as_ref().map(pdyn::output::hybrid_json),
     )?;
     Ok(d.into_any().unbind())
 }

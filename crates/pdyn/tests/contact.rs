@@ -409,7 +409,7 @@ fn event_action_applies_an_impulsive_burn() {
     let h = res.hybrid.as_ref().unwrap();
     assert_eq!(h.actions.len(), 1, "{:?}", h.actions);
     close(
-        h.actions[0].0,
+        h.actions[0].t,
         std::f64::consts::FRAC_PI_2,
         1e-9,
         "burn time",

@@ -238,7 +238,8 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
         let csv = dir.join("trajectory.csv");
         write_csv(&res, &csv).map_err(|e| io_error(&csv, "write", e))?;
         let js = dir.join("summary.json");
-        std::fs::write(&js, format!("{sum:#}\n")).map_err(|e| io_error(&js, "write", e))?;
+        let text = pdyn::output::summary_text(&sum, res.hybrid.as_ref());
+        std::fs::write(&js, text).map_err(|e| io_error(&js, "write", e))?;
         if a.plot {
             pdyn::plots::write_run_plots(&model, &prep, &res, dir)?;
         }
@@ -249,7 +250,7 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
         ));
     }
     let stdout = if a.json {
-        format!("{sum:#}\n")
+        pdyn::output::summary_text(&sum, res.hybrid.as_ref())
     } else {
         text_report(&model, &res, &set, a.out.as_ref())
     };
@@ -403,8 +404,8 @@ fn hybrid_text(h: &sim::hybrid::HybridReport) -> String {
     }
     if !h.actions.is_empty() {
         s += "\nevent actions:\n";
-        for (t, name, texts) in h.actions.iter().take(HYBRID_LINES) {
-            s += &format!("  t = {t:.12e}  {name}: {}\n", texts.join("; "));
+        for a in h.actions.iter().take(HYBRID_LINES) {
+            s += &format!("  t = {:.12e}  {}: {}\n", a.t, a.event, a.set.join("; "));
         }
         more(&mut s, h.actions.len());
     }

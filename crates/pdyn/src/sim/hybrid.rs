@@ -45,7 +45,7 @@ use pdyn_ode::{Direction, Event, MethodKind, OdeError, OdeSystem, Options, Statu
 use std::cell::RefCell;
 
 /// A switch of one contact's mode.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize)]
 pub struct Switch {
     /// When.
     pub t: f64,
@@ -60,7 +60,7 @@ pub struct Switch {
 }
 
 /// An impact.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize)]
 pub struct Impact {
     /// When.
     pub t: f64,
@@ -78,7 +78,7 @@ pub struct Impact {
 }
 
 /// Bounces accumulating in finite time, ended in resting contact.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize)]
 pub struct Zeno {
     /// Which contact.
     pub contact: String,
@@ -91,18 +91,38 @@ pub struct Zeno {
 }
 
 /// One interval of constant modes.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize)]
 pub struct ModeInterval {
     /// Start.
     pub t_from: f64,
     /// End.
     pub t_to: f64,
     /// Each contact's mode, by contact name.
+    #[serde(serialize_with = "modes_as_map")]
     pub modes: Vec<(String, &'static str)>,
 }
 
-/// What a hybrid run adds to a [`RunResult`].
-#[derive(Clone, Debug, Default)]
+/// `[(contact, mode)]` as the JSON object `{contact: mode}`.
+fn modes_as_map<S: serde::Serializer>(
+    modes: &[(String, &'static str)],
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    s.collect_map(modes.iter().map(|(c, m)| (c, m)))
+}
+
+/// An event that changed the state or a parameter.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Action {
+    /// When.
+    pub t: f64,
+    /// Which `[[events]]` entry.
+    pub event: String,
+    /// Its assignments with the values they made (`x' = -e*x' → 1.2`).
+    pub set: Vec<String>,
+}
+
+/// What a hybrid run adds to a [`RunResult`] (serialized as `summary.json`'s `hybrid`).
+#[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct HybridReport {
     /// Intervals of constant modes, in time order.
     pub timeline: Vec<ModeInterval>,
@@ -120,8 +140,8 @@ pub struct HybridReport {
     pub dissipated_impacts: f64,
     /// Energy added by event actions (negative: taken out).
     pub energy_actions: f64,
-    /// `(t, event name, assignments)` of every event that changed the state or a parameter.
-    pub actions: Vec<(f64, String, Vec<String>)>,
+    /// Every event that changed the state or a parameter.
+    pub actions: Vec<Action>,
 }
 
 /// The parts of a hybrid model compiled once: contact probes, coefficients, kinetic energy,
@@ -1765,7 +1785,11 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
                         .zip(&vals)
                         .map(|(a, v)| format!("{} → {v:.9e}", a.text))
                         .collect();
-                    st.report.actions.push((te, ev.name.clone(), texts));
+                    st.report.actions.push(Action {
+                        t: te,
+                        event: ev.name.clone(),
+                        set: texts,
+                    });
                 }
                 if ev.terminal.is_some_and(|k| user_counts[j] >= k) {
                     status = RunStatus::TerminalEvent(j);
