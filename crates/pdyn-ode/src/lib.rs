@@ -469,15 +469,8 @@ fn auto<S: OdeSystem + ?Sized>(
         sol.y.extend_from_slice(&r.y[skip * r.n..]);
         sol.events.append(&mut r.events);
         sol.possible_misses.append(&mut r.possible_misses);
-        let (a, b) = (&mut sol.stats, &r.stats);
-        a.steps += b.steps;
-        a.accepted += b.accepted;
-        a.rejected += b.rejected;
-        a.fevals += b.fevals;
-        a.jac_fevals += b.jac_fevals;
-        a.jacobians += b.jacobians;
-        a.lu_decompositions += b.lu_decompositions;
-        a.linear_solves += b.linear_solves;
+        // The stiffness detection that caused the switch stays the first one recorded.
+        sol.stats.add(&r.stats);
         sol.status = r.status;
         sol.method = Method::Radau5;
     };

@@ -28,6 +28,24 @@ pub struct Stats {
     pub stiffness_detected_at: Option<f64>,
 }
 
+impl Stats {
+    /// Adds the counts of another solve (a method switch, a restart after an event); the
+    /// first stiffness detection is kept.
+    pub fn add(&mut self, other: &Stats) {
+        self.steps += other.steps;
+        self.accepted += other.accepted;
+        self.rejected += other.rejected;
+        self.fevals += other.fevals;
+        self.jac_fevals += other.jac_fevals;
+        self.jacobians += other.jacobians;
+        self.lu_decompositions += other.lu_decompositions;
+        self.linear_solves += other.linear_solves;
+        if self.stiffness_detected_at.is_none() {
+            self.stiffness_detected_at = other.stiffness_detected_at;
+        }
+    }
+}
+
 /// Direction of a zero crossing of an event function.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Direction {

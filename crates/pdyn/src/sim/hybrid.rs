@@ -1455,7 +1455,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
                     None => return Err(SimError::Integrator(e)),
                 },
             };
-            add_stats(&mut stats, &sol.stats);
+            stats.add(&sol.stats);
             // The segment's end tells: a flight stepped over ends below the surface (a dip
             // and back within a step is the event locator's to find).
             let penetrated = sol.len().checked_sub(1).filter(|&i| {
@@ -1632,21 +1632,12 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
         }
         segment_start = te;
         if same_time_switches > 100 {
-            let state = prep
-                .state_names
-                .iter()
-                .cloned()
-                .zip(st.y.iter().copied())
-                .collect();
-            failure = Some(RunFailure {
-                t: te,
-                state,
-                error: OdeError::InvalidInput {
-                    reason: "the contact modes switch back and forth without time advancing (chattering): the model's friction or contact data contradict each other here".into(),
-                },
-                stiff_at: None,
-                non_finite: Vec::new(),
-            });
+            failure = Some(stopped(
+                prep,
+                te,
+                &st.y,
+                "the contact modes switch back and forth without time advancing (chattering): the model's friction or contact data contradict each other here".into(),
+            ));
             status = RunStatus::Failed;
             break;
         }
@@ -1802,21 +1793,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
             }
         };
         if let Err(e) = res {
-            let state = prep
-                .state_names
-                .iter()
-                .cloned()
-                .zip(st.y.iter().copied())
-                .collect();
-            failure = Some(RunFailure {
-                t: te,
-                state,
-                error: OdeError::InvalidInput {
-                    reason: e.to_string(),
-                },
-                stiff_at: None,
-                non_finite: Vec::new(),
-            });
+            failure = Some(stopped(prep, te, &st.y, e.to_string()));
             status = RunStatus::Failed;
             break;
         }
@@ -1886,16 +1863,19 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
     })
 }
 
-fn add_stats(total: &mut pdyn_ode::Stats, s: &pdyn_ode::Stats) {
-    total.steps += s.steps;
-    total.accepted += s.accepted;
-    total.rejected += s.rejected;
-    total.fevals += s.fevals;
-    total.jac_fevals += s.jac_fevals;
-    total.jacobians += s.jacobians;
-    total.lu_decompositions += s.lu_decompositions;
-    total.linear_solves += s.linear_solves;
-    if total.stiffness_detected_at.is_none() {
-        total.stiffness_detected_at = s.stiffness_detected_at;
+/// A hybrid run stopped at `t` in state `y` for `reason` (modes that chatter, an impulse that
+/// cannot be solved), as the failure the run reports with its partial result.
+fn stopped(prep: &Prepared, t: f64, y: &[f64], reason: String) -> RunFailure {
+    RunFailure {
+        t,
+        state: prep
+            .state_names
+            .iter()
+            .cloned()
+            .zip(y.iter().copied())
+            .collect(),
+        error: OdeError::InvalidInput { reason },
+        stiff_at: None,
+        non_finite: Vec::new(),
     }
 }
