@@ -182,6 +182,9 @@ pub struct Derivation {
     /// Whether `system` was assembled collected and contracted term by term (the projected
     /// form, derived for reading): its entries need only to be collected to print.
     pub assembled_collected: bool,
+    /// Whether a given `acceleration` entered as an equation `q'' = a` (a prescribed motion):
+    /// then what drives it does work, and no quantity is known to be conserved.
+    pub prescribed_acceleration: bool,
 }
 
 impl Derivation {
@@ -657,6 +660,7 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
         notes,
         recovered,
         assembled_collected: assembled && contract,
+        prescribed_acceleration: given_equations,
     })
 }
 

@@ -206,3 +206,24 @@ fn prescribed_acceleration_is_an_equation_and_the_reactions_are_solved() {
         "{vals:?}"
     );
 }
+
+/// The rotating bar is driven at a constant rate: no conservation law may be claimed for it
+/// (`pdyn run` warned that its "conserved" energy drifted).
+#[test]
+fn prescribed_acceleration_conserves_nothing() {
+    let src = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/rotating_bar_block.toml"
+    ))
+    .unwrap();
+    let mut model = load(&src, "rotating_bar_block.toml").unwrap();
+    let d = derive(&mut model, &DeriveOptions::default()).unwrap();
+    assert!(d.prescribed_acceleration);
+    let conserved = pdyn_mech::conservation::conserved_quantities(&mut model, &d);
+    assert!(conserved.is_empty(), "{conserved:?}");
+    // A model without a given acceleration keeps its conservation laws.
+    let (mut model, d, _) = derive_default(PENDULUM);
+    assert!(!d.prescribed_acceleration);
+    let conserved = pdyn_mech::conservation::conserved_quantities(&mut model, &d);
+    assert!(conserved.iter().any(|c| c.name == "energy"));
+}
