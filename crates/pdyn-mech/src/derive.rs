@@ -229,9 +229,9 @@ pub const CHEAP_SOLVE_BUDGET: u64 = 20_000;
 /// The budget is work actually done (polynomial term operations, about 0.25 µs each), not a
 /// predicted size: small classic systems are solved by default. Measured minimum budgets:
 /// the double pendulum in Newton form (4 unknowns: two angles, two rod tensions) 26,383
-/// units (7 ms of `pdyn derive`'s debug build), the 2-link chain in projected form 8,810.
-/// The 3-link chain needs 129,873: it gives up here after 40,000 units (8 ms) and is printed
-/// by reference (`--solve` solves it). It was 10,000, under which the double pendulum in
+/// units, the 2-link chain in projected form 8,810. The 3-link chain needs 129,873: it
+/// gives up here after 40,000 units and is printed by reference (`--solve` solves it); that
+/// attempt took its `pdyn derive` from 15.8 to 55.8 million instructions (callgrind). It was 10,000, under which the double pendulum in
 /// Newton form printed `(A⁻¹ b)_1` (issue 34).
 pub const PRINT_SOLVE_BUDGET: u64 = 40_000;
 /// Work budget of exact elimination for a run, which only evaluates the result: a closed
