@@ -4,6 +4,8 @@
 //! - **Energy** `E = Σ ½ mᵢ |vᵢ|² + Σ V`, when every force derives from a potential (or is a
 //!   workless reaction: the model is `conservative`), at least one potential exists, and nothing
 //!   depends explicitly on `t` (no prescribed motion, no time-varying potential).
+//! - Nothing when a given `acceleration` entered the equations as `q'' = a`
+//!   ([`Derivation::prescribed_acceleration`]): the motion is driven.
 //! - **Angular momentum** about the origin, component `c`, `H_c = Σ (rᵢ × mᵢ vᵢ)_c`, when the
 //!   resultant moment `Σ (rᵢ × Fᵢ)_c` is identically zero.
 //! - **Linear momentum**, component `c`, `Σ mᵢ vᵢ_c`, when the resultant force component is
@@ -43,6 +45,11 @@ pub fn depends_on_time(pool: &Pool, e: Id) -> bool {
 
 /// The conserved quantities of a derived model (see the module documentation for the rules).
 pub fn conserved_quantities(model: &mut Model, d: &Derivation) -> Vec<Conserved> {
+    // A motion prescribed by a given acceleration (`q'' = a` as an equation: a bar turned at
+    // a constant rate) is driven by whatever keeps it so: energy and momenta change.
+    if d.prescribed_acceleration {
+        return Vec::new();
+    }
     let p = &mut model.pool;
     let mut out = Vec::new();
     let explicit_time = model

@@ -182,6 +182,9 @@ pub struct Derivation {
     /// Whether `system` was assembled collected and contracted term by term (the projected
     /// form, derived for reading): its entries need only to be collected to print.
     pub assembled_collected: bool,
+    /// Whether a given `acceleration` entered as an equation `q'' = a` (a prescribed motion):
+    /// then what drives it does work, and no quantity is known to be conserved.
+    pub prescribed_acceleration: bool,
 }
 
 impl Derivation {
@@ -222,13 +225,15 @@ pub const FULL_SOLVE_BUDGET: u64 = 4_000_000;
 /// example needed more than 20,000.
 pub const CHEAP_SOLVE_BUDGET: u64 = 20_000;
 /// Work budget of exact elimination and of simplifying its result together
-/// ([`DeriveOptions::simplify_solution_within_budget`]) for `pdyn derive` without `--solve`:
-/// what the shipped examples' printed solutions need (the double pendulum's 8,361 units the
-/// most; the others under 5,000). Half of [`CHEAP_SOLVE_BUDGET`], so that the 3- to 6-link
-/// chains give up on elimination sooner: at 20,000 the 3-link chain, whose elimination
-/// fits, spent more than the 4- or 8-link chain on all of `pdyn derive` (28.7 against 24.3
-/// and 22.2 million instructions).
-pub const PRINT_SOLVE_BUDGET: u64 = 10_000;
+/// ([`DeriveOptions::simplify_solution_within_budget`]) for `pdyn derive` without `--solve`.
+/// The budget is work actually done (polynomial term operations, about 0.25 µs each), not a
+/// predicted size: small classic systems are solved by default. Measured minimum budgets:
+/// the double pendulum in Newton form (4 unknowns: two angles, two rod tensions) 26,383
+/// units, the 2-link chain in projected form 8,810. The 3-link chain needs 129,873: it
+/// gives up here after 40,000 units and is printed by reference (`--solve` solves it); that
+/// attempt took its `pdyn derive` from 15.8 to 55.8 million instructions (callgrind). It was 10,000, under which the double pendulum in
+/// Newton form printed `(A⁻¹ b)_1` (issue 34).
+pub const PRINT_SOLVE_BUDGET: u64 = 40_000;
 /// Work budget of exact elimination for a run, which only evaluates the result: a closed
 /// form pays off when it is found quickly (one or two unknowns, Newton's equations with a
 /// few reactions); past this, `A x = b` solved numerically at each evaluation is cheaper
@@ -366,9 +371,41 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
             .map(|&i| format!("{}'", model.coordinates[i].name)),
     );
 
-    let (mut parts, newton, constraint_eqs) = newton_equations(model);
+    let (mut parts, newton, mut constraint_eqs) = newton_equations(model);
     let newton_all = newton.clone();
     let p = &mut model.pool;
+    let mut notes = Vec::new();
+    // A free coordinate given an `acceleration` (a motion prescribed at an instant, as `pdyn
+    // forces` reads it: a bar turning at constant rate, a tablecloth pulled at `a`) whose
+    // Newton equations are too few for the reactions: the given acceleration is one more
+    // equation, `q'' = a`, so the reactions are solved as functions of the state. (When the
+    // equations are enough, they determine `q''` themselves, as on the banked curve.)
+    let n_before = newton.len() + constraint_eqs.len();
+    let n_unknowns_before = qdd.len() + model.reactions.len();
+    let mut given_equations = false;
+    if n_before < n_unknowns_before && !model.known_accelerations.is_empty() {
+        let mut given = Vec::new();
+        for &(ci, acc) in &model.known_accelerations {
+            let Some(k) = free.iter().position(|&f| f == ci) else {
+                continue;
+            };
+            let name = &model.coordinates[ci].name;
+            constraint_eqs.push(Equation {
+                label: format!("{name}'' given (the model's `acceleration`)"),
+                lhs: qdd[k],
+                rhs: acc,
+            });
+            given.push(format!("{name}''"));
+        }
+        if !given.is_empty() {
+            given_equations = true;
+            notes.push(format!(
+                "the motion is prescribed: {} given by the model (`acceleration = ...`) is an equation, \
+                 not a result; the reactions follow from it (`pdyn forces` evaluates them at the instant, with the model's checks)",
+                given.join(", ")
+            ));
+        }
+    }
 
     let reaction_unknowns: Vec<Unknown> = model
         .reactions
@@ -392,10 +429,12 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
 
     let n_newton = newton.len() + constraint_eqs.len();
     let n_unknowns = acc_unknowns.len() + reaction_unknowns.len();
-    let mut notes = Vec::new();
     let form = match opts.form {
         Form::Auto
-            if n_newton > n_unknowns && model.constraints.is_empty() && model.frames.is_empty() =>
+            if n_newton > n_unknowns
+                && model.constraints.is_empty()
+                && model.frames.is_empty()
+                && !given_equations =>
         {
             notes.push(format!(
                 "Newton's equations ({n_newton}) outnumber their unknowns ({n_unknowns}): the undeclared \
@@ -481,7 +520,7 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
         Some(
             (0..m)
                 .map(|i| p.div(system.b[i], system.a[i * m + i]))
-                .collect(),
+                .collect::<Vec<Id>>(),
         )
     } else if m <= opts.symbolic_limit || residual_count > m {
         // Exact elimination only when it is cheap (a few reactions, a double pendulum):
@@ -521,6 +560,30 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
         }
     } else {
         None
+    };
+
+    // For reading: an exact solution in two or more angles, written in their differences
+    // when that is shorter (the double pendulum's denominator `L1*(m1 + m2*sin(th1 - th2)^2)`
+    // rather than five expanded products). A run does not print it and skips this.
+    // Then what all terms of a numerator or denominator share is taken out, as a textbook
+    // writes it (one pass over the terms, no expansion).
+    let solution = match solution {
+        Some(sol) if opts.simplify && opts.simplify_printed && !diagonal => {
+            let mut left = DIFFERENCE_BUDGET;
+            Some(
+                sol.into_iter()
+                    .map(|s| {
+                        let s = if q.len() >= 2 {
+                            in_differences(p, s, &q, &mut left)
+                        } else {
+                            s
+                        };
+                        factor_quotient(p, s)
+                    })
+                    .collect(),
+            )
+        }
+        other => other,
     };
 
     for pk in parts.iter_mut() {
@@ -597,7 +660,104 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
         notes,
         recovered,
         assembled_collected: assembled && contract,
+        prescribed_acceleration: given_equations,
     })
+}
+
+/// Work budget (simplification work units, [`Pool::simplify_work`]) of rewriting one
+/// derivation's exact solution in differences of its coordinates ([`in_differences`]), all
+/// pairs and all unknowns together (the double pendulum in Newton form, four unknowns and
+/// both directions of its one pair, fits it).
+pub const DIFFERENCE_BUDGET: u64 = 20_000;
+
+/// `e` written in the difference `q_a - q_b` of two coordinates when that is shorter: `q_a`
+/// is replaced by `q_b + δ`, the result simplified (sines and cosines of `q_b + δ` expanded,
+/// so that `cos(q_a)^2 + cos(q_b)^2 - 2 cos(q_a)^2 cos(q_b)^2 - 2 sin(q_a) sin(q_b) cos(q_a)
+/// cos(q_b)` becomes `sin(δ)^2`), and `δ` replaced by `q_a - q_b` again. Each pair's
+/// simplification is paid from `budget`; when it runs out, `e` is kept (equal, longer).
+fn in_differences(p: &mut Pool, e: Id, q: &[Id], budget: &mut u64) -> Id {
+    let present: Vec<Id> = q.iter().copied().filter(|&c| p.contains(e, c)).collect();
+    if present.len() < 2 {
+        return e;
+    }
+    let delta = p.var("δ〈difference〉");
+    let mut best = e;
+    let mut best_size = p.tree_size(e, usize::MAX);
+    // Both directions: `q_a -> q_b + δ` keeps `q_b`'s sines and cosines whole, the other
+    // `q_a`'s; which is shorter depends on the expression (the double pendulum's `th1''` reads
+    // best with one, `th2''` with the other).
+    for &a in &present {
+        for &b in &present {
+            if a == b || *budget == 0 {
+                continue;
+            }
+            let shifted = p.add2(b, delta);
+            let there: FxHashMap<Id, Id> = [(a, shifted)].into_iter().collect();
+            let x = p.subs(e, &there);
+            let Some(x) = p.simplify_within(x, budget) else {
+                continue;
+            };
+            let diff = p.sub(a, b);
+            let back: FxHashMap<Id, Id> = [(delta, diff)].into_iter().collect();
+            let y = p.subs(x, &back);
+            // What the expansion left in `q_b` and `q_a - q_b` contracts back:
+            // `cos(q_b)*cos(q_a - q_b) - sin(q_b)*sin(q_a - q_b)` is `cos(q_a)`.
+            let y = p.contract_trig(y);
+            if p.contains(y, delta) {
+                continue;
+            }
+            let size = p.tree_size(y, best_size + 1);
+            if size < best_size {
+                best = y;
+                best_size = size;
+            }
+        }
+    }
+    best
+}
+
+/// `e` with what all terms of its numerator share taken out, and of its denominator too
+/// ([`Pool::factor_terms`] leaves a sum under a negative power as it is): `(L1*m1 +
+/// L1*m2*sin(d)^2)^-1` becomes `(L1*(m1 + m2*sin(d)^2))^-1`. Equal to `e`.
+fn factor_quotient(p: &mut Pool, e: Id) -> Id {
+    use pdyn_expr::Node;
+    // Only quotients by a sum: a polynomial such as `omega^2*r - 2*mu*omega*r'` reads
+    // better expanded than as `-omega*(2*mu*r' - omega*r)`.
+    let over_a_sum = |p: &Pool, f: Id| match p.node(f) {
+        Node::Pow(b, x) => {
+            matches!(p.node(*b), Node::Add(_)) && p.as_num(*x).is_some_and(|n| n.is_negative())
+        }
+        _ => false,
+    };
+    let quotient = match p.node(e) {
+        Node::Mul(fs) => fs.iter().any(|&f| over_a_sum(p, f)),
+        _ => over_a_sum(p, e),
+    };
+    if !quotient {
+        return e;
+    }
+    let e = p.factor_terms(e);
+    let factor_power = |p: &mut Pool, f: Id| -> Id {
+        match p.node(f).clone() {
+            Node::Pow(b, x) if matches!(p.node(b), Node::Add(_)) => {
+                let fb = p.factor_terms(b);
+                if fb == b {
+                    f
+                } else {
+                    p.pow(fb, x)
+                }
+            }
+            _ => f,
+        }
+    };
+    match p.node(e).clone() {
+        Node::Mul(fs) => {
+            let fs: Vec<Id> = fs.iter().map(|&f| factor_power(p, f)).collect();
+            p.mul(&fs)
+        }
+        Node::Pow(..) => factor_power(p, e),
+        _ => e,
+    }
 }
 
 /// Checks the equations (each involves an unknown, or holds identically; every unknown

@@ -39,8 +39,7 @@ fn chain_file(n: usize) -> PathBuf {
 }
 
 /// `pdyn derive FILE EXTRA...`: its stdout when it succeeds, `Err(stderr)` when it refuses
-/// the model (`rotating_bar_block` is a prescribed motion for `pdyn forces`: 2 equations for 3
-/// unknowns).
+/// the model (exit code 2).
 fn derive_output(file: &Path, extra: &[&str]) -> Result<String, String> {
     let file_arg = file.to_string_lossy();
     let mut args = vec!["derive", &file_arg];
