@@ -513,14 +513,17 @@ impl Hybrid {
         }
         let forces = Observer::new(p, &obs, vec![String::new(); fexprs.len()], &fexprs)
             .map_err(|e| compile_error("contact force", e))?;
-        let fused_forces = d.solution.as_ref().and_then(|sol| {
-            let solved: rustc_hash::FxHashMap<Id, Id> = d
-                .unknowns
+        // When the mode is solved in closed form: each unknown (acceleration or reaction) as
+        // its expression of the state, to compile what reads them over `[t, q, q', params]`.
+        let solved: Option<rustc_hash::FxHashMap<Id, Id>> = d.solution.as_ref().map(|sol| {
+            d.unknowns
                 .iter()
                 .zip(sol)
                 .map(|(u, &x)| (u.id, x))
-                .collect();
-            let outs: Vec<Id> = fexprs.iter().map(|&f| p.subs(f, &solved)).collect();
+                .collect()
+        });
+        let fused_forces = solved.as_ref().and_then(|solved| {
+            let outs: Vec<Id> = fexprs.iter().map(|&f| p.subs(f, solved)).collect();
             pdyn_expr::Program::compile(p, &self.base_inputs, &outs)
                 .ok()
                 .map(|prog| pdyn_jit::Evaluator::new(prog, self.jit))
@@ -540,28 +543,17 @@ impl Hybrid {
                     .map_err(|e| compile_error(&format!("event `{}`", ev.name), e))?,
             );
         }
-        let fused = match &d.solution {
-            Some(sol) => {
+        let fused = match &solved {
+            Some(solved) => {
                 let p = &mut m.pool;
-                let solved: rustc_hash::FxHashMap<Id, Id> = d
-                    .unknowns
-                    .iter()
-                    .zip(sol)
-                    .map(|(u, &x)| (u.id, x))
-                    .collect();
                 let mut outs: Vec<Id> = d
                     .free
                     .iter()
-                    .map(|&ci| {
-                        d.unknowns
-                            .iter()
-                            .zip(sol)
-                            .find(|(u, _)| u.kind == UnknownKind::Acceleration(ci))
-                            .map_or(Pool::ZERO, |(_, &x)| x)
-                    })
+                    .map(|&ci| p.coord(m.coordinates[ci].sym, 2))
+                    .map(|acc| solved.get(&acc).copied().unwrap_or(Pool::ZERO))
                     .collect();
-                outs.push(p.subs(power, &solved));
-                outs.push(p.subs(diss, &solved));
+                outs.push(p.subs(power, solved));
+                outs.push(p.subs(diss, solved));
                 pdyn_expr::Program::compile(p, &self.base_inputs, &outs)
                     .ok()
                     .map(|prog| pdyn_jit::Evaluator::new(prog, self.jit))
