@@ -12,22 +12,31 @@ use std::path::Path;
 
 /// Writes the trajectory table.
 pub fn write_csv(res: &RunResult, path: &Path) -> std::io::Result<()> {
-    let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let mut f = std::fs::File::create(path)?;
     writeln!(f, "{}", res.columns.join(","))?;
-    let mut line = String::new();
+    // Rows are formatted into one buffer, written every 256 KiB: a run of 1,000 stick-slip
+    // cycles writes 1.6 million numbers, and the formatting is half of its time.
+    let mut out: Vec<u8> = Vec::with_capacity(CSV_CHUNK + 4096);
+    let mut buf = ryu::Buffer::new();
     for row in &res.rows {
-        line.clear();
         for (i, x) in row.iter().enumerate() {
             if i > 0 {
-                line.push(',');
+                out.push(b',');
             }
-            push_number(&mut line, *x);
+            out.extend_from_slice(buf.format(*x).as_bytes());
         }
-        line.push('\n');
-        f.write_all(line.as_bytes())?;
+        out.push(b'\n');
+        if out.len() >= CSV_CHUNK {
+            f.write_all(&out)?;
+            out.clear();
+        }
     }
+    f.write_all(&out)?;
     f.flush()
 }
+
+/// Bytes of `trajectory.csv` formatted before each write.
+const CSV_CHUNK: usize = 1 << 18;
 
 /// Appends `x` in the shortest form that reads back as the same `f64` (`0.1`, `1e-7`,
 /// `-0.9700043600000001`: never more than 17 significant digits), by `ryu` (already
