@@ -89,6 +89,21 @@ impl Ast {
         }
     }
 
+    /// Whether `pred` holds for the name of some identifier in the tree (a variable, or a
+    /// function called by name).
+    pub fn any_name(&self, pred: &dyn Fn(&str) -> bool) -> bool {
+        match self {
+            Ast::Num { .. } | Ast::Quantity { .. } => false,
+            Ast::Ident { name, .. } => pred(name),
+            Ast::Neg { expr, .. } | Ast::Prime { expr, .. } | Ast::Component { expr, .. } => {
+                expr.any_name(pred)
+            }
+            Ast::Binary { lhs, rhs, .. } => lhs.any_name(pred) || rhs.any_name(pred),
+            Ast::Call { name, args, .. } => pred(name) || args.iter().any(|a| a.any_name(pred)),
+            Ast::Vector { items, .. } => items.iter().any(|a| a.any_name(pred)),
+        }
+    }
+
     /// Byte span covered by this node.
     pub fn span(&self) -> Range<usize> {
         match self {

@@ -260,3 +260,38 @@ fn absurd_sweep_steps_are_refused_before_allocating() {
     let fine = format!("{GOOD}\n[sweep]\nparameter = \"m\"\nfrom = 1\nto = 2\nsteps = 1000\n");
     assert!(load(&fine, "model.toml").is_ok());
 }
+
+/// A `[definitions]` name may give an initial value or rate (issue 34): definitions are
+/// read after the coordinates, so these initial conditions are read once they are declared,
+/// and recomputed when a parameter they use changes. A definition of the coordinates is not
+/// a number at t = 0: a located error.
+#[test]
+fn definitions_give_initial_values() {
+    let src = r#"
+[parameters]
+L = 2.0
+w = 3.0
+[definitions]
+x0 = "L/2"
+v0 = "w*x0"
+[coordinates]
+x = { initial = "x0", rate = "v0 + 1" }
+[particles.p]
+mass = 1
+position = "[x, 0, 0]"
+"#;
+    let mut m = load(src, "model.toml").unwrap_or_else(|e| panic!("{}", e.render(src)));
+    let free = |m: &pdyn_mech::Model| match m.coordinates[0].kind {
+        pdyn_mech::model::CoordinateKind::Free { initial, rate } => (initial, rate),
+        _ => panic!("free"),
+    };
+    assert_eq!(free(&m), (1.0, 4.0));
+    pdyn_mech::parameters::set_values(&mut m, &[("L".to_string(), 4.0)]).unwrap();
+    assert_eq!(free(&m), (2.0, 7.0));
+    let bad = src
+        .replace("x0 = \"L/2\"", "x0 = \"L/2\"\ny0 = \"2*x\"")
+        .replace("\"x0\"", "\"y0\"");
+    let e = load_err(&bad);
+    assert!(e.contains("model.toml:10:"), "{e}");
+    assert!(e.contains("`initial` of `x`"), "{e}");
+}

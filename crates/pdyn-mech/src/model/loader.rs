@@ -51,6 +51,12 @@ pub(crate) struct Loader<'a> {
     pub last_bare: bool,
     /// The coordinates read so far: name and whether it is free (not prescribed).
     pub coordinate_names: Vec<(String, bool)>,
+    /// The names `[definitions]` will declare (read after the coordinates, which they may
+    /// use): an initial value that names one is read once they are declared.
+    pub definition_names: Vec<String>,
+    /// `(coordinate index, name, its table's span and value, "initial" or "rate")` of the
+    /// initial conditions waiting for the definitions.
+    pub deferred_initials: Vec<(usize, String, Sv, toml::Table, &'static str)>,
 }
 
 impl<'a> Loader<'a> {
@@ -66,6 +72,8 @@ impl<'a> Loader<'a> {
             last: Form::default(),
             last_bare: false,
             coordinate_names: Vec::new(),
+            definition_names: Vec::new(),
+            deferred_initials: Vec::new(),
         }
     }
 

@@ -275,12 +275,19 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
     let mut ld = Loader::new(origin, source);
     ld.read_parameters(&raw)?;
     let unknowns = ld.read_unknowns(&raw)?;
+    ld.definition_names = raw
+        .definitions
+        .keys()
+        .map(|k| k.get_ref().clone())
+        .collect();
+    let mut coords = ld.read_coordinates(&raw)?;
+    let definitions = ld.read_definitions(&raw)?;
+    ld.resolve_deferred_initials(&mut coords)?;
     let tables::Coordinates {
         coordinates,
         initial_exprs,
         known_accelerations,
-    } = ld.read_coordinates(&raw)?;
-    let definitions = ld.read_definitions(&raw)?;
+    } = coords;
     let points = ld.read_points(&raw)?;
     let particles = ld.read_particles(&raw)?;
     let frames = ld.read_frames(&raw, &particles)?;

@@ -144,6 +144,50 @@ impl Loader<'_> {
         Ok(out)
     }
 
+    /// Whether the coordinate table's `key` names a definition not declared yet.
+    fn names_pending_definition(&self, t: &toml::Table, key: &str) -> bool {
+        let Some(v) = t.get(key) else { return false };
+        let Ok(text) = number_text(v) else {
+            return false;
+        };
+        if looks_like_quantity(&text) {
+            return false;
+        }
+        let Ok(ast) = pdyn_expr::syntax::parse(&text) else {
+            return false;
+        };
+        ast.any_name(&|name| {
+            self.definition_names.iter().any(|d| d == name) && !self.scope.names.contains_key(name)
+        })
+    }
+
+    /// The initial conditions that name definitions, read now that `[definitions]` is: a
+    /// definition of the parameters (`x0 = "L/2"`) is a number at t = 0; one of the
+    /// coordinates is refused as any non-constant initial value is.
+    pub(super) fn resolve_deferred_initials(
+        &mut self,
+        coords: &mut Coordinates,
+    ) -> Result<(), ModelError> {
+        for (index, n, sv, t, key) in std::mem::take(&mut self.deferred_initials) {
+            let (value, expr) = self.initial_condition(&n, &sv, &t, key)?;
+            if let CoordinateKind::Free { initial, rate } = &mut coords.coordinates[index].kind {
+                if key == "rate" {
+                    *rate = value;
+                } else {
+                    *initial = value;
+                }
+            }
+            if let Some(e) = coords.initial_exprs.iter_mut().find(|e| e.0 == index) {
+                if key == "rate" {
+                    e.2 = expr;
+                } else {
+                    e.1 = expr;
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// One coordinate written as a table: `{ initial, rate [, acceleration] }` or
     /// `{ prescribed = "f(t)" }`.
     fn coordinate_table(
@@ -192,8 +236,16 @@ impl Loader<'_> {
                 Value::Vector(_) => Err(self.err(sv.span(), "a coordinate is a scalar")),
             };
         }
-        let (initial, initial_expr) = self.initial_condition(n, sv, t, "initial")?;
-        let (rate, rate_expr) = self.initial_condition(n, sv, t, "rate")?;
+        let read = |ld: &mut Self, key: &'static str| {
+            if ld.names_pending_definition(t, key) {
+                ld.deferred_initials
+                    .push((index, n.to_string(), sv.clone(), t.clone(), key));
+                return Ok((f64::NAN, pdyn_expr::Pool::ZERO));
+            }
+            ld.initial_condition(n, sv, t, key)
+        };
+        let (initial, initial_expr) = read(self, "initial")?;
+        let (rate, rate_expr) = read(self, "rate")?;
         out.initial_exprs.push((index, initial_expr, rate_expr));
         if let Some(acc) = t.get("acceleration") {
             let text = number_text(acc).map_err(|found| {
