@@ -43,6 +43,39 @@ pub fn depends_on_time(pool: &Pool, e: Id) -> bool {
     pool.any_node(e, &|n| matches!(n, Node::Time))
 }
 
+/// The parts of a model's mechanical energy, as expressions of the state.
+#[derive(Clone, Copy, Debug)]
+pub struct Energy {
+    /// `Σ ½ m v²`.
+    pub kinetic: Id,
+    /// `Σ V` of the conservative forces.
+    pub potential: Id,
+    /// `Σ ½ m v² + Σ |V|`: the physical scale a drift of the energy is measured against.
+    pub scale: Id,
+}
+
+/// The kinetic and potential energy of `particles` under `potentials`, and their scale.
+pub fn energy(
+    p: &mut Pool,
+    particles: &[crate::derive::ParticleKinematics],
+    potentials: &[crate::model::PotentialTerm],
+) -> Energy {
+    let mut kinetic = Vec::new();
+    for pk in particles {
+        let v2 = vector::dot(p, pk.v, pk.v);
+        let half = p.num(Number::ratio(1, 2));
+        kinetic.push(p.mul(&[half, pk.mass, v2]));
+    }
+    let mut magnitudes = kinetic.clone();
+    magnitudes.extend(potentials.iter().map(|v| p.call(Func::Abs, &[v.energy])));
+    let potential: Vec<Id> = potentials.iter().map(|v| v.energy).collect();
+    Energy {
+        kinetic: p.add(&kinetic),
+        potential: p.add(&potential),
+        scale: p.add(&magnitudes),
+    }
+}
+
 /// The conserved quantities of a derived model (see the module documentation for the rules).
 pub fn conserved_quantities(model: &mut Model, d: &Derivation) -> Vec<Conserved> {
     // A motion prescribed by a given acceleration (`q'' = a` as an equation: a bar turned at
@@ -61,21 +94,12 @@ pub fn conserved_quantities(model: &mut Model, d: &Derivation) -> Vec<Conserved>
             .iter()
             .any(|v| depends_on_time(p, v.energy));
     if model.conservative && !explicit_time && !model.potentials.is_empty() {
-        let mut terms = Vec::new();
-        for pk in &d.particles {
-            let v2 = vector::dot(p, pk.v, pk.v);
-            let half = p.num(Number::ratio(1, 2));
-            terms.push(p.mul(&[half, pk.mass, v2]));
-        }
-        let mut magnitudes = terms.clone();
-        for v in &model.potentials {
-            magnitudes.push(p.call(Func::Abs, &[v.energy]));
-        }
-        terms.extend(model.potentials.iter().map(|v| v.energy));
+        let e = energy(p, &d.particles, &model.potentials);
+        let expr = p.add(&[e.kinetic, e.potential]);
         out.push(Conserved {
             name: "energy".into(),
-            expr: p.add(&terms),
-            scale: p.add(&magnitudes),
+            expr,
+            scale: e.scale,
         });
     }
     if d.form == Form::Projected {

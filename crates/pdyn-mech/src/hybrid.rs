@@ -199,8 +199,6 @@ pub struct ModeModel {
     /// The value of each contact force symbol that is not an unknown of this mode (`N` of an
     /// open contact is 0; the friction of a sliding one is `-s mu_k N`).
     pub known: FxHashMap<Id, Id>,
-    /// Per contact, the whole contact force on A, with `known` substituted.
-    pub force: Vec<[Id; 3]>,
     /// Per contact, the rate of work of the friction force on the slip (`-F_t·v_s`, the
     /// power dissipated: never negative), with `known` substituted.
     pub dissipation: Vec<Id>,
@@ -224,7 +222,6 @@ pub fn mode_model(base: &Model, layout: &Layout, modes: &[ContactMode]) -> ModeM
         }
     }
     let mut known = FxHashMap::default();
-    let mut forces = Vec::new();
     let mut dissipation = Vec::new();
     let mut power = Vec::new();
     let contacts = m.contacts.clone();
@@ -331,12 +328,10 @@ pub fn mode_model(base: &Model, layout: &Layout, modes: &[ContactMode]) -> ModeM
         let pw = vector::dot(p, force, g.relative_velocity);
         power.push(pw);
         dissipation.push(p.subs(diss, &known));
-        forces.push(force);
     }
     ModeModel {
         model: m,
         known,
-        force: forces,
         dissipation,
         power,
     }

@@ -505,6 +505,9 @@ fn bad_contacts_are_located_errors() {
             "cannot exceed static",
         ),
         ("surface = \"r.y\"", "needs `on` or `between`"),
+        // A surface with no inside: the particle would pass through it unseen.
+        ("on = \"b\"\nsurface = \"norm(r)\"", "never negative"),
+        ("on = \"b\"\nsurface = \"2*r.y^2\"", "never negative"),
     ] {
         let e = load_err(&base(contact));
         assert!(e.contains(says), "{contact}: {e}");
@@ -515,6 +518,12 @@ fn bad_contacts_are_located_errors() {
         + "[[events]]\nwhen = \"y - 0.5\"\nset = [\"g = 2\"]\n";
     let e = load_err(&src);
     assert!(e.contains("not a free coordinate or a parameter"), "{e}");
+    // An assignment that reads a contact force, which has no value at the jump.
+    let src = base("on = \"b\"\nsurface = \"r.y\"")
+        + "[[events]]\nwhen = \"y - 0.5\"\nset = [\"y' = N_contact1\"]\n";
+    let e = load_err(&src);
+    assert!(e.contains("cannot use a reaction or contact force"), "{e}");
+    assert!(e.contains("m.toml:12:14:"), "{e}");
 }
 
 /// A contact that starts penetrated is refused with its gap; a held contact that would have

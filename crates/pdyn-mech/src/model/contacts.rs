@@ -55,8 +55,6 @@ pub struct Contact {
     pub normal_in_model: bool,
     /// Loads of the model that the hybrid modes replace (a `friction` force's sliding load).
     pub replaces_loads: Vec<usize>,
-    /// Spans of `e`, `mu_s`, `mu_k` for value errors.
-    pub value_spans: [Range<usize>; 3],
 }
 
 impl Loader<'_> {
@@ -152,6 +150,12 @@ impl Loader<'_> {
                 .err(span, format!("the surface of contact `{name}` does not depend on the position `r`: it has no normal"))
                 .help("write the surface as a function of r that is zero on it and positive on the free side, e.g. \"r.y\" (the floor y = 0) or \"norm(r) - R\" (outside a sphere)"));
         }
+        if never_negative(&self.pool, phi) {
+            let span = raw.surface.as_ref().map_or(c.span(), |s| s.span());
+            return Err(self
+                .err(span, format!("the surface of contact `{name}` is never negative: nothing is ever on its other side, so the contact could never close (the particle would pass through)"))
+                .help("write phi(r) zero on the surface, positive on the free side and negative beyond it, e.g. \"norm(r) - R\" rather than \"norm(r)\""));
+        }
         let map: FxHashMap<Id, Id> = rho.iter().copied().zip(r_at).collect();
         let gap = self.pool.subs(phi, &map);
         let grad_at = grad.map(|g| self.pool.subs(g, &map));
@@ -235,17 +239,6 @@ impl Loader<'_> {
             friction_force: (f_name, [f1, f2]),
             normal_in_model: false,
             replaces_loads: Vec::new(),
-            value_spans: [
-                raw.e.as_ref().map_or(c.span(), |s| s.span()),
-                raw.mu_s
-                    .as_ref()
-                    .or(raw.mu.as_ref())
-                    .map_or(c.span(), |s| s.span()),
-                raw.mu_k
-                    .as_ref()
-                    .or(raw.mu.as_ref())
-                    .map_or(c.span(), |s| s.span()),
-            ],
         })
     }
 
@@ -344,5 +337,28 @@ impl Loader<'_> {
         self.declare(name, span, "reaction", Binding::Value(Value::Scalar(id)))?;
         self.dims.bind(name, Dimension::FORCE.into());
         Ok(id)
+    }
+}
+
+/// Whether `e` is non-negative whatever its symbols' values, by its form: an even power, a
+/// square root, an absolute value, or sums and positive multiples of those (`norm(r)`,
+/// `r.y^2`). Such a surface function has no inside.
+fn never_negative(p: &Pool, e: Id) -> bool {
+    use pdyn_expr::{Func, Node};
+    match p.node(e) {
+        Node::Num(n) => n.to_f64() >= 0.0,
+        Node::Pow(b, x) => match p.node(*x) {
+            Node::Num(n) => {
+                let v = n.to_f64();
+                // x^(1/2), x^(3/2)...: real only where the base is >= 0; x^2, x^4: even.
+                (v.fract() != 0.0 && v > 0.0)
+                    || (v.fract() == 0.0 && v % 2.0 == 0.0)
+                    || never_negative(p, *b)
+            }
+            _ => false,
+        },
+        Node::Call(Func::Abs, _) => true,
+        Node::Add(ts) | Node::Mul(ts) => ts.iter().all(|&t| never_negative(p, t)),
+        _ => false,
     }
 }

@@ -644,6 +644,20 @@ fn event_actions(ld: &mut Loader, list: &[Sv]) -> Result<Vec<EventAction>, Model
                 )
                 .help("each target may be set once per event"));
         }
+        // The assignments are evaluated at the state just before the event, where the
+        // forces are not solved for: a reaction or contact force has no value there.
+        let force_of = |name: &str| {
+            ld.scope
+                .names
+                .get(name)
+                .is_some_and(|(_, _, kind)| *kind == "reaction")
+        };
+        if rhs.any_name(&force_of) {
+            let rspan = rhs.span();
+            return Err(ld
+                .err(rspan.start + off..rspan.end + off, "an event's assignment cannot use a reaction or contact force")
+                .help("use t, coordinates, their rates and parameters (the forces are not solved for at the jump)"));
+        }
         let v = pdyn_expr::lower::lower(&mut ld.pool, &rhs, &mut ld.scope)
             .map_err(|e| ld.located(e, off))?;
         let Value::Scalar(value) = v else {

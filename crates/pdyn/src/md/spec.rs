@@ -501,8 +501,8 @@ pub fn parse(
         MAX_RDF_FRAMES,
     )?;
     if rdf_frames == 0 {
-        let sv = m.rdf_frames.as_ref().expect("0 is only read from the file");
-        return Err(r.err(sv.span(), "`rdf_frames` must be at least 1"));
+        let span = m.rdf_frames.as_ref().map_or(mspan.clone(), |sv| sv.span());
+        return Err(r.err(span, "`rdf_frames` must be at least 1"));
     }
     let rdf_frames = rdf_frames as usize;
     let equilibrate = r.count_or(&m.equilibrate, "equilibrate", &mspan, Some(0), MAX_STEPS)?;

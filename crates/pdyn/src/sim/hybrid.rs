@@ -35,7 +35,7 @@ use super::{
     compile_error, method_by_name, scale_of, EventFn, EventReport, MonitorReport, Prepared,
     RunFailure, RunResult, RunSettings, RunStatus, SimError, Solver,
 };
-use pdyn_expr::{vector, Func, Id, Number, Pool};
+use pdyn_expr::{Id, Pool};
 use pdyn_jit::JitMode;
 use pdyn_mech::derive::UnknownKind;
 use pdyn_mech::hybrid::{closed_modes, mode_model, ContactMode, Layout};
@@ -240,9 +240,10 @@ struct Impulse {
 }
 
 impl Hybrid {
-    /// Sets up the hybrid parts of `model`; `reference` is the mode the [`Prepared`] was
-    /// compiled in (its observation inputs start with the base inputs).
-    pub fn new(model: &Model, jit: JitMode) -> Result<(Hybrid, Vec<ContactMode>), SimError> {
+    /// Sets up the hybrid parts of `model`: the contacts' geometry, the programs every mode
+    /// shares (probes, coefficients, energy, event actions, sweep measures) over the inputs
+    /// `[t, q, q', parameters]`, found from the reference mode's derivation.
+    pub fn new(model: &Model, jit: JitMode) -> Result<Hybrid, SimError> {
         let mut model = model.clone();
         let layout = Layout::new(&mut model);
         let reference = pdyn_mech::hybrid::reference_modes(&model, &layout);
@@ -278,25 +279,12 @@ impl Hybrid {
             &coef_exprs,
         )
         .map_err(|e| compile_error("contact coefficient", e))?;
-        let mut t_terms = Vec::new();
-        for (part, pk) in model.particles.iter().zip(&d.particles) {
-            let v2 = vector::dot(p, pk.v, pk.v);
-            let half = p.num(Number::ratio(1, 2));
-            t_terms.push(p.mul(&[half, part.mass, v2]));
-        }
-        let kinetic_e = p.add(&t_terms);
-        let mut scale_terms = vec![kinetic_e];
-        for v in &model.potentials {
-            scale_terms.push(p.call(Func::Abs, &[v.energy]));
-        }
-        let scale_e = p.add(&scale_terms);
-        let potentials: Vec<Id> = model.potentials.iter().map(|v| v.energy).collect();
-        let potential_e = p.add(&potentials);
+        let e = pdyn_mech::conservation::energy(p, &d.particles, &model.potentials);
         let kinetic = Observer::new(
             p,
             &base_inputs,
             vec!["T".into(), "scale".into(), "V".into()],
-            &[kinetic_e, scale_e, potential_e],
+            &[e.kinetic, e.scale, e.potential],
         )
         .map_err(|e| compile_error("kinetic energy", e))?;
         let explicit_time = model.particles.iter().any(|pt| {
@@ -307,27 +295,9 @@ impl Hybrid {
             .potentials
             .iter()
             .any(|v| pdyn_mech::conservation::depends_on_time(p, v.energy));
-        // The friction kind's sliding load is replaced by the modes; any other load without a
-        // potential makes the balance meaningless.
-        let replaced = model
-            .contacts
-            .iter()
-            .flat_map(|c| c.replaces_loads.iter())
-            .count();
-        let others_conservative = model.conservative
-            || replaced > 0 && {
-                // `conservative` was cleared by the friction entries only if every other load has
-                // a potential: re-check by counting the loads that have none.
-                let with_potential: Vec<&str> =
-                    model.potentials.iter().map(|v| v.label.as_str()).collect();
-                model.loads.iter().enumerate().all(|(i, l)| {
-                    model.contacts.iter().any(|c| c.replaces_loads.contains(&i))
-                        || l.label.starts_with("normal force")
-                        || l.label.starts_with("reaction")
-                        || with_potential.iter().any(|w| l.label.starts_with(w))
-                })
-            };
-        let balance = others_conservative && !explicit_time;
+        // A Coulomb `friction` force does not clear `conservative` (the modes account for its
+        // work); any other force without a potential makes the balance meaningless.
+        let balance = model.conservative && !explicit_time;
         let mut actions = Vec::new();
         for ev in &model.run.events {
             if ev.actions.is_empty() {
@@ -397,25 +367,22 @@ impl Hybrid {
                 )
             }
         };
-        Ok((
-            Hybrid {
-                measures,
-                probe_exprs,
-                model,
-                layout,
-                jit,
-                base_inputs,
-                n,
-                probes,
-                coefficients,
-                kinetic,
-                actions,
-                balance,
-                column_names,
-                cache: RefCell::new(Vec::new()),
-            },
-            reference,
-        ))
+        Ok(Hybrid {
+            measures,
+            probe_exprs,
+            model,
+            layout,
+            jit,
+            base_inputs,
+            n,
+            probes,
+            coefficients,
+            kinetic,
+            actions,
+            balance,
+            column_names,
+            cache: RefCell::new(Vec::new()),
+        })
     }
 
     /// The `[sweep.measures]`, over `[t, q, q', parameters]`.
@@ -475,29 +442,14 @@ impl Hybrid {
             }
             cols.extend(g.slip.iter().copied());
         }
-        let mut energy = Vec::new();
-        for (part, pk) in m.particles.iter().zip(&d.particles) {
-            let v2 = vector::dot(p, pk.v, pk.v);
-            let half = p.num(Number::ratio(1, 2));
-            energy.push(p.mul(&[half, part.mass, v2]));
-        }
-        energy.extend(m.potentials.iter().map(|v| v.energy));
-        cols.push(p.add(&energy));
+        let energy = pdyn_mech::conservation::energy(p, &d.particles, &m.potentials);
+        cols.push(p.add(&[energy.kinetic, energy.potential]));
         for mon in &m.run.monitors {
             cols.push(p.subs(mon.expr, known));
         }
         let mut names = self.column_names[..cols.len()].to_vec();
         // After the columns, not one of them: the energy's scale, T + Σ|V|, of each row.
-        let mut scale = Vec::new();
-        for (part, pk) in m.particles.iter().zip(&d.particles) {
-            let v2 = vector::dot(p, pk.v, pk.v);
-            let half = p.num(Number::ratio(1, 2));
-            scale.push(p.mul(&[half, part.mass, v2]));
-        }
-        for v in &m.potentials {
-            scale.push(p.call(Func::Abs, &[v.energy]));
-        }
-        cols.push(p.add(&scale));
+        cols.push(energy.scale);
         names.push("energy scale".into());
         let columns =
             Observer::new(p, &obs, names, &cols).map_err(|e| compile_error("output column", e))?;
@@ -891,9 +843,6 @@ impl State<'_> {
             return;
         }
         self.modes[c] = to;
-        if to != ContactMode::Open {
-            // A new bounce sequence starts after the next opening.
-        }
         self.report.switches.push(Switch {
             t,
             contact: self.h.model.contacts[c].name.clone(),

@@ -470,7 +470,7 @@ pub fn prepare_with_jit(
     let mut hybrid = None;
     let mut reference_model;
     let model = if pdyn_mech::hybrid::is_hybrid(model) {
-        let (h, _) = hybrid::Hybrid::new(model, jit)?;
+        let h = hybrid::Hybrid::new(model, jit)?;
         reference_model = pdyn_mech::hybrid::reference_model(model).0;
         hybrid = Some(Box::new(h));
         &mut reference_model

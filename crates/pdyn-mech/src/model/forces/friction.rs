@@ -137,6 +137,7 @@ fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelEr
                 let vm = vector::norm(&mut ld.pool, slide);
                 let size = ld.pool.mul2(fm, vm);
                 b.friction_power.push((e.label.clone(), power, size));
+                b.conservative = false;
             }
             let slip_load = b.loads.len();
             b.loads.push(Load {
@@ -144,7 +145,6 @@ fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelEr
                 target: target.clone(),
                 force: tforce,
             });
-            b.conservative = false;
             if raw.opposes.is_none() {
                 let Target::Particle(a) = target else {
                     return Err(ld
@@ -174,7 +174,6 @@ fn build(b: &mut ForceBuilder, ld: &mut Loader, e: &Entry) -> Result<(), ModelEr
                     friction_force: (t_name.clone(), fs),
                     normal_in_model: true,
                     replaces_loads: vec![slip_load],
-                    value_spans: [e.f.span(), e.f.span(), e.f.span()],
                 });
             }
         }
