@@ -311,7 +311,10 @@ pub fn dsolve(a: &DsolveInput) -> Result<DsolveResult, Error> {
         .cloned()
         .collect();
     let times = eval_times(&mut pool, &a.at)?;
-    let table = evaluate(&mut pool, &cf, &times)?;
+    let table = match stable_table(&mut pool, &cf, (&eqs, &coords, &initial, t0), &times) {
+        Some(rows) => vec![rows],
+        None => evaluate(&mut pool, &cf, &times)?,
+    };
     let when = match &a.when {
         Some(w) => Some(when(&mut pool, &cf, w, &mut scope, &set)?),
         None => None,
@@ -371,6 +374,40 @@ fn eval_times(pool: &mut Pool, at: &[String]) -> Result<Vec<f64>, Error> {
             eval_const(pool, e, &format!("--at {s}"))
         })
         .collect()
+}
+
+/// The equations, their coordinates, initial conditions and initial time.
+type Problem<'a> = (&'a [Id], &'a [SymId], &'a [InitialCondition], Id);
+
+/// Per time, `[q1, q1', q2, q2', ...]` evaluated stably (`exp(𝒜 t) z(0)`, see
+/// [`pdyn_mech::dsolve::propagator`]) when everything is a number, there is one case and the
+/// initial conditions are at `t = 0`: the formula `(sin Ωt − (Ω/ω) sin ωt)/(ω² − Ω²)` loses
+/// its digits as `Ω → ω`. `None` otherwise (the formula is evaluated).
+fn stable_table(
+    pool: &mut Pool,
+    cf: &ClosedForm,
+    (eqs, coords, initial, t0): Problem,
+    times: &[f64],
+) -> Option<Vec<Vec<f64>>> {
+    if times.is_empty() || cf.cases.len() != 1 || t0 != Pool::ZERO {
+        return None;
+    }
+    let pairs: Vec<(Id, Id)> = initial
+        .iter()
+        .map(|ic| (pool.coord(ic.coord, ic.order), ic.value))
+        .collect();
+    let prop = pdyn_mech::dsolve::propagator(pool, eqs, coords, &pairs).ok()?;
+    // The propagator's coordinates are the equations' in the same order as the closed form's.
+    if cf.coords != coords {
+        return None;
+    }
+    let width = 2 * coords.len();
+    Some(
+        prop.sample(times)
+            .chunks_exact(width)
+            .map(<[f64]>::to_vec)
+            .collect(),
+    )
 }
 
 /// Per case, per time: `[q1, q1', q2, q2', ...]`.

@@ -101,6 +101,9 @@ fn assert_closed_form_matches_integration(mut m: Model, t_end: f64) {
     set.atol = Some(1e-11);
     let rep = sim::exact::check(&prep, &exact, &set).unwrap();
     assert!(!rep.errors.is_empty());
+    // The formula (modal, from dsolve) and its stable evaluation agree.
+    let gap = rep.formula_gap.expect("evaluated stably");
+    assert!(gap < 1e-9, "formula vs stable evaluation: {gap:e}");
     for (name, err, size) in &rep.errors {
         assert!(
             *err < 1e-7 * size.max(1e-3),

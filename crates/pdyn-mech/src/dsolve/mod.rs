@@ -41,6 +41,11 @@
 //!   the basis (the basis is closed under `d/dt`) together with the initial conditions, and the
 //!   residual is checked.
 //!
+//! The formulas are exact but not always evaluable: near a resonance (or two nearby roots)
+//! they subtract huge, nearly equal terms. [`propagator`] evaluates the same solution at
+//! numeric coefficients as `exp(𝒜 t) z(0)`, stable at every forcing frequency (see
+//! `propagator.rs`); `pdyn run --method exact` and `pdyn check` use it.
+//!
 //! # Use from derived equations of motion
 //!
 //! [`solve_system`] takes equations as expressions (each meaning `= 0`), the coordinates and the
@@ -72,6 +77,7 @@ mod exact;
 mod linear;
 mod modal;
 mod numeric;
+mod propagator;
 pub mod quad;
 mod roots;
 pub mod rules;
@@ -82,6 +88,7 @@ use std::fmt;
 
 pub(crate) use exact::nice_sqrt;
 pub use linear::{analyze, LinearOde};
+pub use propagator::{propagator, Propagator, MAX_STATE};
 pub use when::{when, StateAt, When};
 
 /// One initial condition: `coord^(order)(time) = value`.

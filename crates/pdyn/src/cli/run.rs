@@ -451,6 +451,7 @@ pub fn check(a: CheckArgs) -> Result<Outcome, Error> {
             "rows": rep.run.rows.len(),
             "errors": rep.errors.iter().zip(scales.iter().zip(&relative)).map(|((n, e, s), (scale, rel))| serde_json::json!({"name": n, "max_abs_error": e, "max_abs_value": s, "scale": scale, "relative_error": rel})).collect::<Vec<_>>(),
             "max_relative_error": worst,
+            "formula_relative_gap": rep.formula_gap,
         });
         let failure = rep.run.failure.clone().map(|failure| Error::Integration {
             origin: model.origin.clone(),
@@ -478,6 +479,17 @@ pub fn check(a: CheckArgs) -> Result<Outcome, Error> {
         "largest error relative to the size of the solution: {worst:.3e}\n\
          (each column against the largest max |value| of its order: coordinates together, rates together)\n"
     );
+    if let Some(gap) = rep.formula_gap {
+        out += &format!(
+            "the exact solution is evaluated stably (matrix exponential); the printed formula \
+             evaluated in floating point differs from it by {gap:.3e} relative{}\n",
+            if gap > sim::exact::EXACT_AGREEMENT {
+                " — near a resonance its terms cancel: do not evaluate it as printed"
+            } else {
+                ""
+            }
+        );
+    }
     let failure = rep.run.failure.clone().map(|failure| Error::Integration {
         origin: model.origin.clone(),
         failure: Box::new(failure),

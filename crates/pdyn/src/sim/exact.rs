@@ -7,7 +7,7 @@ use super::{tabulate, Prepared, RunResult, RunSettings};
 use pdyn_expr::number::Number;
 use pdyn_expr::{Id, Program};
 use pdyn_mech::derive::{Derivation, UnknownKind};
-use pdyn_mech::dsolve::{solve_system, ClosedForm, Relation};
+use pdyn_mech::dsolve::{propagator, solve_system, ClosedForm, Propagator, Relation};
 use pdyn_mech::model::CoordinateKind;
 use pdyn_mech::{derive, DeriveOptions, Model};
 use rustc_hash::FxHashMap;
@@ -20,6 +20,9 @@ pub struct ExactSolution {
     pub case: usize,
     /// Inputs `[t, parameters]`, outputs `[q1, q1', q2, q2', ...]` for that case.
     program: Program,
+    /// The same solution at the parameter values, evaluated stably (near a resonance the
+    /// formula cancels every digit); `None` when it cannot be built (then `program` serves).
+    propagator: Option<(Vec<f64>, Propagator)>,
     /// Number of free coordinates.
     n: usize,
     /// The parameter values the solution was found at, when it holds for those only (a system
@@ -70,7 +73,7 @@ fn closed_form_with(model: &mut Model, at_values: bool) -> Result<ExactSolution,
                     p.sub(qdd, a)
                 })
                 .collect();
-            match solve_equations(model, &d, equations, None) {
+            match solve_equations(model, &d, equations, None, at_values) {
                 // In symbols the numeric solvers do not apply either (a 50-mass chain with a
                 // mass and a stiffness symbol each): with the values they may.
                 Err(why @ (ClosedFormError::TooCostly { .. } | ClosedFormError::Dsolve(_)))
@@ -95,17 +98,19 @@ fn closed_form_with(model: &mut Model, at_values: bool) -> Result<ExactSolution,
 fn solve_at_values(model: &mut Model, d: &Derivation) -> Result<ExactSolution, ClosedFormError> {
     let map = parameter_numbers(model);
     let equations = equations_at_values(model, d, &map)?;
-    solve_equations(model, d, equations, Some(map))
+    solve_equations(model, d, equations, Some(map), true)
 }
 
 /// dsolve on `equations` (the model's, `= 0`) with the model's initial conditions; in symbols
 /// under [`CLOSED_FORM_WORK`] when `at_values` is `None`, else with the parameters' values
-/// substituted by that map.
+/// substituted by that map; with its stable evaluation at the parameter values when `stable`
+/// (what a run needs; `pdyn derive` only prints).
 fn solve_equations(
     model: &mut Model,
     d: &Derivation,
     equations: Vec<Id>,
     at_values: Option<FxHashMap<Id, Id>>,
+    stable: bool,
 ) -> Result<ExactSolution, ClosedFormError> {
     let n = d.free.len();
     let values: Vec<f64> = model.parameters.iter().map(|q| q.value).collect();
@@ -166,10 +171,28 @@ fn solve_equations(
     let program = closed
         .compile(p, case, &params)
         .map_err(ClosedFormError::Dsolve)?;
+    // The stable evaluation, with numbers for the parameters (already there at values).
+    let propagator = if stable {
+        let numbers = match &at_values {
+            Some(_) => FxHashMap::default(),
+            None => parameter_numbers_of(p, &model.parameters),
+        };
+        let numeric_equations: Vec<Id> = equations.iter().map(|&e| p.subs(e, &numbers)).collect();
+        let numeric_initial: Vec<(Id, Id)> = initial
+            .iter()
+            .map(|&(l, v)| (l, p.subs(v, &numbers)))
+            .collect();
+        propagator(p, &numeric_equations, &coords, &numeric_initial)
+            .ok()
+            .map(|prop| (values.clone(), prop))
+    } else {
+        None
+    };
     Ok(ExactSolution {
         closed,
         case,
         program,
+        propagator,
         n,
         fixed_parameters: at_values.map(|_| values),
     })
@@ -177,9 +200,14 @@ fn solve_equations(
 
 /// Each parameter's leaf mapped to its value as a number.
 fn parameter_numbers(model: &mut Model) -> FxHashMap<Id, Id> {
-    let p = &mut model.pool;
-    model
-        .parameters
+    parameter_numbers_of(&mut model.pool, &model.parameters)
+}
+
+fn parameter_numbers_of(
+    p: &mut pdyn_expr::Pool,
+    parameters: &[pdyn_mech::model::Parameter],
+) -> FxHashMap<Id, Id> {
+    parameters
         .iter()
         .map(|q| (q.id, p.num(Number::Float(q.value))))
         .collect()
@@ -219,21 +247,51 @@ fn equations_at_values(
 }
 
 impl ExactSolution {
-    /// The state `[q, q']` at time `t` (parameters in model order; those of
-    /// [`ExactSolution::fixed_parameters`] when it is set).
-    pub fn state(&self, t: f64, params: &[f64], ws: &mut Vec<f64>, y: &mut [f64]) {
-        if ws.is_empty() {
-            *ws = self.program.workspace();
+    /// The state `[q, q']` at each time of `times`, row after row (parameters in model order;
+    /// those of [`ExactSolution::fixed_parameters`] when it is set). At the parameter values
+    /// the solution was built with, the stable evaluation (`exp(𝒜 t) z(0)`, see
+    /// [`pdyn_mech::dsolve::propagator`]); else the formula.
+    pub fn states(&self, times: &[f64], params: &[f64]) -> Vec<f64> {
+        let n = self.n;
+        let mut rows = Vec::with_capacity(times.len() * 2 * n);
+        if let Some((values, prop)) = &self.propagator {
+            if values.as_slice() == params && prop.coordinates() == n {
+                let pairs = prop.sample(times);
+                for row in pairs.chunks_exact(2 * n) {
+                    rows.extend((0..n).map(|k| row[2 * k]));
+                    rows.extend((0..n).map(|k| row[2 * k + 1]));
+                }
+                return rows;
+            }
         }
+        self.formula_states(times, params)
+    }
+
+    /// As [`ExactSolution::states`], always from the formula (what `pdyn derive` prints),
+    /// however it cancels.
+    pub fn formula_states(&self, times: &[f64], params: &[f64]) -> Vec<f64> {
+        let n = self.n;
+        let mut rows = Vec::with_capacity(times.len() * 2 * n);
+        let mut ws = self.program.workspace();
         let mut input = Vec::with_capacity(1 + params.len());
-        input.push(t);
-        input.extend_from_slice(params);
-        let mut out = vec![0.0; 2 * self.n];
-        self.program.eval(&input, ws, &mut out);
-        for k in 0..self.n {
-            y[k] = out[2 * k];
-            y[self.n + k] = out[2 * k + 1];
+        let mut out = vec![0.0; 2 * n];
+        for &t in times {
+            input.clear();
+            input.push(t);
+            input.extend_from_slice(params);
+            self.program.eval(&input, &mut ws, &mut out);
+            rows.extend((0..n).map(|k| out[2 * k]));
+            rows.extend((0..n).map(|k| out[2 * k + 1]));
         }
+        rows
+    }
+
+    /// Whether [`ExactSolution::states`] evaluates stably at `params` (else it evaluates the
+    /// formula, which may cancel its digits near a resonance).
+    pub fn is_stable_at(&self, params: &[f64]) -> bool {
+        self.propagator
+            .as_ref()
+            .is_some_and(|(values, _)| values.as_slice() == params)
     }
 }
 
@@ -262,23 +320,16 @@ pub fn run_exact(
         .as_ref()
         .is_none_or(|fixed| *fixed == params));
     let n2 = 2 * exact.n;
-    let mut sol = pdyn_ode::Solution {
+    let sol = pdyn_ode::Solution {
         method: pdyn_ode::Method::Auto,
         n: n2,
-        t: Vec::with_capacity(ts.len()),
-        y: Vec::with_capacity(ts.len() * n2),
+        y: exact.states(&ts, &params),
+        t: ts,
         events: Vec::new(),
         possible_misses: Vec::new(),
         stats: Default::default(),
         status: pdyn_ode::Status::Finished,
     };
-    let mut ws = Vec::new();
-    let mut y = vec![0.0; n2];
-    for &t in &ts {
-        exact.state(t, &params, &mut ws, &mut y);
-        sol.t.push(t);
-        sol.y.extend_from_slice(&y);
-    }
     let mut res = tabulate(prep, &sol, set, None);
     res.method = super::Solver::Exact;
     if let Some(w) = verify_against_integration(prep, &sol, set) {
@@ -340,6 +391,10 @@ fn verify_against_integration(
 pub struct CheckReport {
     /// `(state name, max |numeric - exact|, max |exact|)`.
     pub errors: Vec<(String, f64, f64)>,
+    /// When the exact solution was evaluated stably: the largest difference between it and
+    /// the formula evaluated in floating point, relative to the [scale](CheckReport::scales)
+    /// of each column. Tiny unless the formula cancels its terms (near a resonance).
+    pub formula_gap: Option<f64>,
     /// The numerical run.
     pub run: RunResult,
 }
@@ -394,20 +449,35 @@ pub fn check(
         .as_ref()
         .is_none_or(|fixed| *fixed == params));
     let n2 = 2 * exact.n;
-    let mut ws = Vec::new();
-    let mut y = vec![0.0; n2];
+    let times: Vec<f64> = run.rows.iter().map(|r| r[0]).collect();
+    let states = exact.states(&times, &params);
     let mut errors: Vec<(String, f64, f64)> = prep
         .state_names
         .iter()
         .map(|s| (s.clone(), 0.0, 0.0))
         .collect();
-    for row in &run.rows {
-        exact.state(row[0], &params, &mut ws, &mut y);
+    for (row, y) in run.rows.iter().zip(states.chunks_exact(n2)) {
         for k in 0..n2 {
             let e = (row[1 + k] - y[k]).abs();
             errors[k].1 = errors[k].1.max(e);
             errors[k].2 = errors[k].2.max(y[k].abs());
         }
     }
-    Ok(CheckReport { errors, run })
+    let mut report = CheckReport {
+        errors,
+        run,
+        formula_gap: None,
+    };
+    if exact.is_stable_at(&params) {
+        let formula = exact.formula_states(&times, &params);
+        let scales = report.scales();
+        let gap = states
+            .chunks_exact(n2)
+            .zip(formula.chunks_exact(n2))
+            .flat_map(|(a, b)| (0..n2).map(move |k| (k, (a[k] - b[k]).abs())))
+            .map(|(k, d)| if scales[k] > 0.0 { d / scales[k] } else { d })
+            .fold(0.0, f64::max);
+        report.formula_gap = Some(gap);
+    }
+    Ok(report)
 }
