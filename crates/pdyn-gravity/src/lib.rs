@@ -45,7 +45,8 @@ pub mod kepler;
 mod kepler_lanes;
 pub mod orbit;
 pub mod plummer;
-pub mod rng;
+/// The seeded generators (shared with the MD engine).
+pub use pdyn_particles::rng;
 mod simulation;
 pub mod systems;
 pub mod units;

@@ -8,10 +8,13 @@
 //! system of particles — kinetic energy `T = ½ Σ mᵢ |vᵢ|²`, linear momentum `P = Σ mᵢ vᵢ`,
 //! angular momentum `L = Σ mᵢ rᵢ × vᵢ`, centre of mass.
 //!
+//! The seeded generators of their initial conditions live here too ([`rng`]).
+//!
 //! This crate knows nothing of symbols, integrators' step-size control, or forces.
 #![warn(missing_docs)]
 
 mod error;
+pub mod rng;
 mod store;
 mod vec3;
 

@@ -247,6 +247,42 @@ fn line_of(text: &str, needle: &str) -> u64 {
     text.lines().position(|l| l.starts_with(needle)).unwrap() as u64 + 1
 }
 
+/// The fields of `[md]` are read by the same reader as every model kind (pdyn-mech's
+/// `Constants`, issue 25): expressions of parameters, `pi`, a misspelt name located with a
+/// suggestion; and a unit literal, which that reader would convert to SI, is refused, since an
+/// MD model is in reduced or `real` units.
+#[test]
+fn md_fields_use_the_common_reader_and_refuse_units() {
+    let text = lj().replace("cutoff = \"2.5*sigma\"", "cutoff = \"2.5*sigmaa\"");
+    let line = line_of(&text, "cutoff = ");
+    assert_located(
+        "misspelt",
+        bad("misspelt", &text, &["--set", "n=5"]),
+        line,
+        "sigmaa",
+    );
+    let text = lj().replace("dt = 0.005", "dt = \"0.005 s\"");
+    let line = line_of(&text, "dt = ");
+    assert_located(
+        "unit",
+        bad("unit", &text, &["--set", "n=5"]),
+        line,
+        "carries a unit",
+    );
+    let text = lj().replace("sigma = 1.0", "sigma = \"1 angstrom\"");
+    let line = line_of(&text, "sigma = \"1");
+    assert_located(
+        "unitparam",
+        bad("unitparam", &text, &["--set", "n=5"]),
+        line,
+        "carries a unit",
+    );
+    // An expression with pi and a parameter runs (cutoff 2.5 written as 5*sigma*pi/(2*pi); 10 steps).
+    let text = lj().replace("cutoff = \"2.5*sigma\"", "cutoff = \"5*sigma*pi/(2*pi)\"");
+    let (code, _, err) = bad("pi", &text, &["--set", "n=5", "--t-end", "0.05"]);
+    assert_eq!(code, 0, "{err}");
+}
+
 #[test]
 fn bad_parameters_of_builtin_kernels_are_located() {
     for (value, needle) in [

@@ -192,6 +192,7 @@ impl ClosedForm {
 
 /// Why no closed form was produced.
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum DsolveError {
     /// Outside the method: non-linear, variable coefficients, unsupported forcing...
     NoClosedForm(String),

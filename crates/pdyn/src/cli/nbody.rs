@@ -210,7 +210,8 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
             .escape
             .map_or(nbody::spec::EscapeMode::Stop, |(_, m)| m),
     };
-    let res = nbody::run::run(built, &options).map_err(|m| Error::argument(option, m))?;
+    let res =
+        nbody::run::run(built, &options).map_err(|m| Error::argument(option, m.to_string()))?;
 
     let failure = res.failure.clone().map(|error| Error::Gravity {
         origin: origin.clone(),

@@ -7,7 +7,7 @@
 //! forces: [`super::build`] turns an [`MdSpec`] into a simulation.
 
 use indexmap::IndexMap;
-use pdyn_expr::{Binding, Id, Pool, Scope, Value};
+use pdyn_mech::model::constants::Constants;
 use pdyn_mech::ModelError;
 use serde::Deserialize;
 use std::ops::Range;
@@ -397,24 +397,6 @@ pub const MAX_ATOMS: u64 = 50_000_000;
 /// Most steps of one run.
 pub const MAX_STEPS: u64 = 1_000_000_000_000;
 
-/// Resolves parameters: names bound to their (exact, constant) expressions.
-struct ParamScope {
-    names: Vec<(String, Id)>,
-}
-
-impl Scope for ParamScope {
-    fn resolve(&mut self, _pool: &mut Pool, name: &str) -> Option<Binding> {
-        self.names
-            .iter()
-            .rev()
-            .find(|(n, _)| n == name)
-            .map(|(_, id)| Binding::Value(Value::Scalar(*id)))
-    }
-    fn names(&self) -> Vec<String> {
-        self.names.iter().map(|(n, _)| n.clone()).collect()
-    }
-}
-
 /// Reads the `[md]` table of `source`; `overrides` are `--set name=value` pairs for
 /// `[parameters]`, applied before anything is evaluated (names that are not parameters are
 /// ignored here: the caller compares them with [`MdSpec::parameters`]).
@@ -432,15 +414,12 @@ pub fn parse(
         .help("see docs/md.md for the keys of a molecular-dynamics model")
     })?;
     let mut r = Resolver {
-        origin,
-        source,
-        pool: Pool::new(),
-        scope: ParamScope { names: vec![] },
+        c: Constants::new(source, origin),
         values: vec![],
     };
     for (name, sv) in &raw.parameters {
         let n = name.get_ref();
-        if r.scope.names.iter().any(|(m, _)| m == n) {
+        if r.values.iter().any(|(m, _)| m == n) {
             return Err(r.err(name.span(), format!("duplicate parameter `{n}`")));
         }
         if n == "r" {
@@ -448,12 +427,9 @@ pub fn parse(
                 .err(name.span(), "`r` cannot be a parameter name")
                 .help("`r` is the pair distance in potential formulas"));
         }
-        // Exact values stay exact (`eps = 1` differentiates to integers in formulas).
-        let (id, value) = match overrides.iter().find(|(k, _)| k == n) {
-            Some((_, v)) => (r.pool.num(pdyn_expr::Number::Float(*v)), *v),
-            None => r.valued(sv, "a parameter")?,
-        };
-        r.scope.names.push((n.clone(), id));
+        r.refuse_units(sv, "a parameter")?;
+        let given = overrides.iter().find(|(k, _)| k == n).map(|(_, v)| *v);
+        let value = r.c.parameter(name, sv, given)?;
         r.values.push((n.clone(), value));
     }
     let md = &raw.md;
@@ -1010,68 +986,36 @@ fn quote_len(raw: &str) -> usize {
     }
 }
 
+/// Evaluates the numeric fields of `[md]` with pdyn-mech's [`Constants`] (the reader of every
+/// model kind: numbers, expressions of `[parameters]`, `pi`, located errors), refusing unit
+/// literals: an MD model's units are reduced (`lj`) or `real`, never SI.
 struct Resolver<'a> {
-    origin: &'a str,
-    source: &'a str,
-    pool: Pool,
-    scope: ParamScope,
+    c: Constants<'a>,
+    /// The parameters' names and values, in file order (after `--set`).
     values: Vec<(String, f64)>,
 }
 
 impl Resolver<'_> {
     fn err(&self, span: Range<usize>, msg: impl Into<String>) -> ModelError {
-        ModelError::new(self.origin, span, msg)
+        self.c.err(span, msg)
     }
 
-    /// The expression of a numeric field (a number, or a string of parameters).
-    fn expr(&mut self, sv: &Sv, what: &str) -> Result<Id, ModelError> {
-        let span = sv.span();
-        let (text, off) = match sv.get_ref() {
-            toml::Value::String(s) => (s.clone(), span.start + quote_len(&self.source[span.start..])),
-            toml::Value::Integer(_) | toml::Value::Float(_) => {
-                let t = self.source[span.clone()].replace('_', "");
-                if pdyn_expr::lower::literal(&t).is_some() {
-                    (t, span.start)
-                } else {
-                    (sv.get_ref().to_string(), span.start)
-                }
-            }
-            other => {
-                return Err(self
-                    .err(span, format!("{what} must be a number or an expression in quotes, found a {}", other.type_str()))
-                    .help("write numbers plainly (2.5) and expressions of [parameters] in quotes (\"2.5*sigma\")"))
-            }
-        };
-        let located = |e: pdyn_expr::ExprError| {
-            let e = e.offset(off);
-            let mut me = ModelError::new(self.origin, e.span, e.message);
-            me.help = e.help.or(Some(
-                "only numbers and [parameters] declared above may appear here".into(),
-            ));
-            me
-        };
-        let ast = pdyn_expr::syntax::parse(&text).map_err(located)?;
-        match pdyn_expr::lower::lower(&mut self.pool, &ast, &mut self.scope).map_err(located)? {
-            Value::Scalar(id) => Ok(id),
-            Value::Vector(_) => {
-                Err(self.err(span, format!("{what} must be a scalar, not a vector")))
-            }
+    /// A unit literal (`"3.4 angstrom"`) would be converted to SI, which an MD model is not in.
+    fn refuse_units(&self, sv: &Sv, what: &str) -> Result<(), ModelError> {
+        match self.c.unit_literal(sv) {
+            Some(text) => Err(self
+                .err(sv.span(), format!("{what}: `{text}` carries a unit"))
+                .help("an [md] model is in the units of `units` (\"lj\" reduced, or \"real\": Å, kcal/mol, g/mol, fs, K); write plain numbers")),
+            None => Ok(()),
         }
     }
 
+    /// A numeric field's finite value.
     fn number(&mut self, sv: &Sv, what: &str) -> Result<f64, ModelError> {
-        self.valued(sv, what).map(|(_, v)| v)
-    }
-
-    /// The expression of a numeric field and its finite value.
-    fn valued(&mut self, sv: &Sv, what: &str) -> Result<(Id, f64), ModelError> {
-        let id = self.expr(sv, what)?;
-        let v = self.pool.eval_const(id).map_err(|e| {
-            self.err(sv.span(), format!("{what} must be a number here: {e}"))
-                .help("only numbers and [parameters] may appear here")
-        })?;
+        self.refuse_units(sv, what)?;
+        let v = self.c.scalar(sv, what)?;
         if v.is_finite() {
-            Ok((id, v))
+            Ok(v)
         } else {
             Err(self.err(sv.span(), format!("{what} evaluates to {v}")))
         }

@@ -163,7 +163,7 @@ pub fn bodies(
         } else {
             let (a, e) = (get("a")?, get("e")?);
             check_elements(a, e).map_err(|msg| {
-                let c = if msg.starts_with('e') { "e" } else { "a" };
+                let c = if msg.blames_eccentricity() { "e" } else { "a" };
                 err(
                     cell(c).map_or(row_span.clone(), |(_, s)| s.clone()),
                     format!("body `{name}`: {msg}"),

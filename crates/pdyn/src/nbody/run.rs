@@ -60,14 +60,80 @@ pub struct RunOptions {
     pub escape: EscapeMode,
 }
 
-/// The output times of `options`, or a message saying what is wrong with them.
-pub fn output_times(t_end: f64, sampling: &Sampling) -> Result<Vec<f64>, String> {
+/// Why output times cannot be made (the front end names the option that gave them).
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum SamplingError {
+    /// A number of points outside `2..=max`.
+    Points {
+        /// The number asked for.
+        n: usize,
+        /// [`MAX_POINTS`].
+        max: usize,
+    },
+    /// An output interval that is not a positive number.
+    Interval(f64),
+    /// An interval that gives more than `max` outputs up to `t_end`.
+    TooMany {
+        /// The interval.
+        dt: f64,
+        /// The end time.
+        t_end: f64,
+        /// The outputs it would give.
+        n: f64,
+        /// [`MAX_POINTS`].
+        max: usize,
+    },
+    /// An output time outside `0..=t_end`.
+    Outside {
+        /// The time.
+        t: f64,
+        /// The end time.
+        t_end: f64,
+    },
+    /// Output times that do not increase.
+    NotIncreasing {
+        /// The time.
+        t: f64,
+        /// The time before it.
+        previous: Option<f64>,
+    },
+}
+
+impl std::fmt::Display for SamplingError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SamplingError::Points { n, max } => {
+                write!(f, "points must be between 2 and {max} (got {n})")
+            }
+            SamplingError::Interval(dt) => {
+                write!(f, "the output interval must be > 0 (got {dt})")
+            }
+            SamplingError::TooMany { dt, t_end, n, max } => write!(
+                f,
+                "output every {dt} up to {t_end} is {n} outputs, more than {max}"
+            ),
+            SamplingError::Outside { t, t_end } => {
+                write!(f, "output time {t} is outside 0..{t_end}")
+            }
+            SamplingError::NotIncreasing { t, previous } => {
+                write!(f, "output times must increase ({t} after {previous:?})")
+            }
+        }
+    }
+}
+
+impl std::error::Error for SamplingError {}
+
+/// The output times of `options`, or what is wrong with them.
+pub fn output_times(t_end: f64, sampling: &Sampling) -> Result<Vec<f64>, SamplingError> {
     match sampling {
         Sampling::Points(n) => {
             if *n < 2 || *n > MAX_POINTS {
-                return Err(format!(
-                    "points must be between 2 and {MAX_POINTS} (got {n})"
-                ));
+                return Err(SamplingError::Points {
+                    n: *n,
+                    max: MAX_POINTS,
+                });
             }
             Ok((0..*n)
                 .map(|k| t_end * k as f64 / (*n - 1) as f64)
@@ -75,13 +141,16 @@ pub fn output_times(t_end: f64, sampling: &Sampling) -> Result<Vec<f64>, String>
         }
         Sampling::Every(dt) => {
             if !(dt.is_finite() && *dt > 0.0) {
-                return Err(format!("the output interval must be > 0 (got {dt})"));
+                return Err(SamplingError::Interval(*dt));
             }
             let n = (t_end / dt).floor();
             if n > MAX_POINTS as f64 {
-                return Err(format!(
-                    "output every {dt} up to {t_end} is {n} outputs, more than {MAX_POINTS}"
-                ));
+                return Err(SamplingError::TooMany {
+                    dt: *dt,
+                    t_end,
+                    n,
+                    max: MAX_POINTS,
+                });
             }
             let mut v: Vec<f64> = (0..=n as usize).map(|k| k as f64 * dt).collect();
             // The last output is t_end itself (unless within round-off of the previous one).
@@ -97,13 +166,13 @@ pub fn output_times(t_end: f64, sampling: &Sampling) -> Result<Vec<f64>, String>
             }
             for &t in ts {
                 if !(t.is_finite() && (0.0..=t_end).contains(&t)) {
-                    return Err(format!("output time {t} is outside 0..{t_end}"));
+                    return Err(SamplingError::Outside { t, t_end });
                 }
                 if v.last().is_some_and(|&l| t <= l) && !(v.len() == 1 && t == 0.0) {
-                    return Err(format!(
-                        "output times must increase ({t} after {:?})",
-                        v.last()
-                    ));
+                    return Err(SamplingError::NotIncreasing {
+                        t,
+                        previous: v.last().copied(),
+                    });
                 }
                 if t > 0.0 || v.is_empty() {
                     v.push(t);
@@ -276,7 +345,7 @@ impl Segment {
 }
 
 /// Integrates `built` as `options` say.
-pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, String> {
+pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingError> {
     let Built {
         mut sim,
         config,

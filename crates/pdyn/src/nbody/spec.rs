@@ -428,6 +428,7 @@ pub fn parse(
 
 /// A problem with the model file or with a `--set` value.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub enum SetOrSpecError {
     /// A located problem in a file.
     Spec(SpecError),
@@ -878,7 +879,7 @@ impl Reader<'_> {
         };
         let e_span = raw.e.as_ref().map_or(span.clone(), |sv| sv.span());
         check_elements(a, e).map_err(|msg| {
-            let at = if msg.starts_with('e') {
+            let at = if msg.blames_eccentricity() {
                 e_span.clone()
             } else {
                 a_sv.span()
@@ -966,24 +967,76 @@ impl Reader<'_> {
     }
 }
 
-/// The conditions for `a` and `e` to describe a Kepler orbit, as a message naming the one
-/// that fails (`e` first when the eccentricity is at fault).
-pub fn check_elements(a: f64, e: f64) -> Result<(), String> {
+/// Why `a` and `e` do not describe a Kepler orbit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum ElementsError {
+    /// `e` negative or not finite.
+    Eccentricity(f64),
+    /// `e = 1`.
+    Parabola,
+    /// `e < 1` with `a ≤ 0`.
+    BoundNeedsPositiveAxis {
+        /// Semi-major axis.
+        a: f64,
+        /// Eccentricity.
+        e: f64,
+    },
+    /// `e > 1` with `a ≥ 0`.
+    HyperbolaNeedsNegativeAxis {
+        /// Semi-major axis.
+        a: f64,
+        /// Eccentricity.
+        e: f64,
+    },
+}
+
+impl ElementsError {
+    /// Whether the eccentricity is at fault (the error points at `e`; else at `a`).
+    pub fn blames_eccentricity(&self) -> bool {
+        matches!(
+            self,
+            ElementsError::Eccentricity(_) | ElementsError::Parabola
+        )
+    }
+}
+
+impl std::fmt::Display for ElementsError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            ElementsError::Eccentricity(e) => write!(f, "e = {e}: the eccentricity must be >= 0"),
+            ElementsError::Parabola => {
+                f.write_str("e = 1: a parabola has no semi-major axis; give a Cartesian state")
+            }
+            ElementsError::BoundNeedsPositiveAxis { a, e } => {
+                write!(
+                    f,
+                    "a = {a} <= 0 with e = {e} < 1: a bound orbit needs a > 0"
+                )
+            }
+            ElementsError::HyperbolaNeedsNegativeAxis { a, e } => write!(
+                f,
+                "a = {a} >= 0 with e = {e} > 1: a hyperbola has a < 0 (REBOUND's convention)"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for ElementsError {}
+
+/// The conditions for `a` and `e` to describe a Kepler orbit (`e` checked first).
+pub fn check_elements(a: f64, e: f64) -> Result<(), ElementsError> {
     if !(e.is_finite() && e >= 0.0) {
-        return Err(format!("e = {e}: the eccentricity must be >= 0"));
+        return Err(ElementsError::Eccentricity(e));
     }
     if e == 1.0 {
-        return Err("e = 1: a parabola has no semi-major axis; give a Cartesian state".into());
+        return Err(ElementsError::Parabola);
     }
     if e < 1.0 && !(a.is_finite() && a > 0.0) {
-        return Err(format!(
-            "a = {a} <= 0 with e = {e} < 1: a bound orbit needs a > 0"
-        ));
+        return Err(ElementsError::BoundNeedsPositiveAxis { a, e });
     }
     if e > 1.0 && !(a.is_finite() && a < 0.0) {
-        return Err(format!(
-            "a = {a} >= 0 with e = {e} > 1: a hyperbola has a < 0 (REBOUND's convention)"
-        ));
+        return Err(ElementsError::HyperbolaNeedsNegativeAxis { a, e });
     }
     Ok(())
 }
