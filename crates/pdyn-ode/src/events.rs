@@ -19,6 +19,7 @@
 //! finds no sign change, the interval is recorded in [`EventState::suspects`] so that callers
 //! can warn that a crossing may have been missed (limit `max_step` then).
 
+use crate::error::{invalid, OdeError};
 use crate::solution::{Direction, EventHit, PossibleMiss};
 
 /// Dense output of the last accepted step: the state at any `t` in `[t_old, t_new]`.
@@ -458,16 +459,18 @@ impl<'a> Output<'a> {
 }
 
 /// Checks `t_eval`: inside `[t0, tf]` and monotone in the direction of integration.
-pub(crate) fn check_t_eval(t_eval: &[f64], t0: f64, tf: f64) -> Result<(), String> {
+pub(crate) fn check_t_eval(t_eval: &[f64], t0: f64, tf: f64) -> Result<(), OdeError> {
     let dir = if tf >= t0 { 1.0 } else { -1.0 };
     for w in t_eval.windows(2) {
         if (w[1] - w[0]) * dir < 0.0 {
-            return Err("t_eval must be monotone in the direction of integration".into());
+            return Err(invalid(
+                "t_eval must be monotone in the direction of integration",
+            ));
         }
     }
     for &t in t_eval {
         if !t.is_finite() || (t - t0) * dir < 0.0 || (t - tf) * dir > 0.0 {
-            return Err(format!("t_eval point {t} outside [t0, tf]"));
+            return Err(invalid(format!("t_eval point {t} outside [t0, tf]")));
         }
     }
     Ok(())

@@ -103,13 +103,13 @@ pub(crate) fn setup<S: OdeSystem + ?Sized>(
     if y0.iter().any(|v| !v.is_finite()) {
         return Err(invalid("y0 must be finite"));
     }
-    let atol = opts.atol.check(n, "atol").map_err(invalid)?;
-    let rtol = opts.rtol.check(n, "rtol").map_err(invalid)?;
+    let atol = opts.atol.check(n, "atol")?;
+    let rtol = opts.rtol.check(n, "rtol")?;
     if atol.iter().zip(&rtol).any(|(a, r)| *a == 0.0 && *r == 0.0) {
         return Err(invalid("atol and rtol cannot both be zero for a component"));
     }
     if let Some(te) = &opts.t_eval {
-        check_t_eval(te, t0, tf).map_err(invalid)?;
+        check_t_eval(te, t0, tf)?;
     }
     if let Some(h) = opts.h0 {
         if !h.is_finite() || h == 0.0 {

@@ -5,6 +5,7 @@
 //! field and set in the single `impl Default for Options`.
 
 use crate::controller::Controller;
+use crate::error::{invalid, OdeError};
 
 /// Absolute or relative tolerance: one value for all components or one per component.
 #[derive(Debug, Clone, PartialEq)]
@@ -25,18 +26,21 @@ impl Tolerance {
         }
     }
 
-    pub(crate) fn check(&self, n: usize, name: &str) -> Result<Vec<f64>, String> {
+    pub(crate) fn check(&self, n: usize, name: &str) -> Result<Vec<f64>, OdeError> {
         let v: Vec<f64> = match self {
             Tolerance::Scalar(v) => vec![*v; n],
             Tolerance::PerComponent(v) => {
                 if v.len() != n {
-                    return Err(format!("{name} has {} components, the system {n}", v.len()));
+                    return Err(invalid(format!(
+                        "{name} has {} components, the system {n}",
+                        v.len()
+                    )));
                 }
                 v.clone()
             }
         };
         if v.iter().any(|x| !x.is_finite() || *x < 0.0) {
-            return Err(format!("{name} must be finite and non-negative"));
+            return Err(invalid(format!("{name} must be finite and non-negative")));
         }
         Ok(v)
     }
