@@ -277,6 +277,15 @@ fn md_fields_use_the_common_reader_and_refuse_units() {
         line,
         "carries a unit",
     );
+    // `--set` of a name that is not a parameter: refused by the library's `md::load`, as
+    // for N-body models.
+    let (code, e, _) = bad("setx", &lj(), &["--set", "n=5,epsilon=2"]);
+    assert_eq!(code, 2);
+    let msg = e["message"].as_str().unwrap();
+    assert!(
+        msg.contains("`epsilon` is not a parameter (parameters: n, eps, sigma)"),
+        "{msg}"
+    );
     // An expression with pi and a parameter runs (cutoff 2.5 written as 5*sigma*pi/(2*pi); 10 steps).
     let text = lj().replace("cutoff = \"2.5*sigma\"", "cutoff = \"5*sigma*pi/(2*pi)\"");
     let (code, _, err) = bad("pi", &text, &["--set", "n=5", "--t-end", "0.05"]);

@@ -71,19 +71,7 @@ pub fn run(a: RunArgs, source: String) -> Result<Outcome, Error> {
     }
     let origin = a.model.display().to_string();
     let sets = numeric_pairs(&a.set, "--set")?;
-    let mut spec = md::parse(&source, &origin, &sets).map_err(|e| model_err(e, &source))?;
-    for (k, _) in &sets {
-        if !spec.parameters.iter().any(|(n, _)| n == k) {
-            let names: Vec<&str> = spec.parameters.iter().map(|(n, _)| n.as_str()).collect();
-            return Err(Error::argument(
-                "--set",
-                format!(
-                    "--set: `{k}` is not a parameter (parameters: {})",
-                    names.join(", ")
-                ),
-            ));
-        }
-    }
+    let mut spec = md::load(&source, &origin, &sets)?;
     if let Some(dt) = a.dt {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(Error::argument(

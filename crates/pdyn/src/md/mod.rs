@@ -21,6 +21,32 @@ pub use build::{build, Prepared};
 pub use run::{run, MdResult, Progress, RunOptions};
 pub use spec::{parse, MdSpec};
 
+use crate::Error;
+
+/// Reads a molecular-dynamics model as [`crate::nbody::load`] reads an N-body one: `source` is
+/// the text of the file `origin`, `set` overrides parameters; a problem in the file is a
+/// located [`Error::Model`], a `set` name that is not a parameter an [`Error::Argument`].
+pub fn load(source: &str, origin: &str, set: &[(String, f64)]) -> Result<MdSpec, Error> {
+    let spec = parse(source, origin, set).map_err(|error| Error::Model {
+        error,
+        source: source.into(),
+    })?;
+    if let Some((k, _)) = set
+        .iter()
+        .find(|(k, _)| !spec.parameters.iter().any(|(n, _)| n == k))
+    {
+        let names: Vec<&str> = spec.parameters.iter().map(|(n, _)| n.as_str()).collect();
+        return Err(Error::argument(
+            "--set",
+            format!(
+                "--set: `{k}` is not a parameter (parameters: {})",
+                names.join(", ")
+            ),
+        ));
+    }
+    Ok(spec)
+}
+
 /// True when `source` is a TOML document with a top-level `[md]` table (a molecular-dynamics
 /// model). A document that does not parse is not one: the mechanics loader reports its error.
 pub fn is_md_source(source: &str) -> bool {
