@@ -938,3 +938,26 @@ fn plot_axes_carry_the_units_of_the_model() {
         std::fs::remove_dir_all(&dir).ok();
     }
 }
+
+/// The fixed-step limit is the one of every fixed-step run (`sim::MAX_FIXED_STEPS`, 1e10):
+/// the N-body command line had its own, 1e11 (issue 25). 2e10 WHFast steps are refused,
+/// naming `--dt`, before anything is built.
+#[test]
+fn the_fixed_step_limit_is_shared_with_mechanics() {
+    let (code, out, err) = pdyn(&[
+        "run",
+        "examples/nbody/outer_solar_system.toml",
+        "--t-end",
+        "10",
+        "--dt",
+        "5e-10",
+        "--json",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    let e = &json(&out)["error"];
+    let msg = e["message"].as_str().unwrap();
+    assert!(
+        msg.contains("--dt") && msg.contains("more than 1e10"),
+        "{msg}"
+    );
+}

@@ -7,6 +7,8 @@
 //!   literals), every problem a located `ModelError`;
 //! - [`build`]: the spec → a `pdyn_gravity::Simulation` (elements about their primary, the
 //!   Plummer sphere, centre-of-mass frame, integrator, forces, events);
+//! - [`request`]: a front end's options resolved against the table, with the limits, then
+//!   built ([`request::plan`]) and run ([`request::Planned::execute`]);
 //! - [`run`]: integration to the output times, conservation monitors (energy and angular
 //!   momentum drift against the existing tolerance), collisions, escapes, close encounters;
 //! - [`output`]: CSV files, `summary.json`, the text report; [`plots`]: the figures.
@@ -15,6 +17,7 @@ pub mod build;
 pub mod csv;
 pub mod output;
 pub mod plots;
+pub mod request;
 pub mod run;
 pub mod spec;
 

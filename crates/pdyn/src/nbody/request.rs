@@ -1,0 +1,257 @@
+//! One N-body run as a front end asks for it: the options (`pdyn run`'s flags, Python's
+//! keywords) resolved against the `[nbody]` table once, here, with the limits that keep a run
+//! within the machine — so the command line and Python refuse and accept the same things.
+
+use super::output::RunInfo;
+use super::run::{NbodyResult, RunOptions, Sampling};
+use super::spec::{EscapeMode, IntegratorKind, NbodySpec};
+use super::{build::Built, load};
+use crate::Error;
+
+/// Most per-body rows a run keeps for `trajectory.csv` (about 1 GB in memory).
+pub const MAX_TRAJECTORY_ROWS: usize = 10_000_000;
+
+/// Most steps a fixed-step run may ask for: the limit of every fixed-step run
+/// ([`crate::sim::MAX_FIXED_STEPS`], hours of computing at a microsecond a step).
+pub const MAX_FIXED_STEPS: f64 = crate::sim::MAX_FIXED_STEPS;
+
+/// The options of one run, each `None` (or empty) when the front end did not give it: the
+/// model's `[nbody]` table applies.
+#[derive(Clone, Debug, Default)]
+pub struct Request {
+    /// Integrator name (`whfast`, `ias15`, `leapfrog`).
+    pub method: Option<String>,
+    /// Fixed step (first trial step for IAS15).
+    pub dt: Option<f64>,
+    /// End time.
+    pub t_end: Option<f64>,
+    /// Relative drift of a conserved quantity that is reported.
+    pub drift_tolerance: Option<f64>,
+    /// Equally spaced output times.
+    pub points: Option<usize>,
+    /// Output interval.
+    pub output_dt: Option<f64>,
+    /// Output times.
+    pub t_eval: Vec<f64>,
+    /// Options of the ODE integrators, refused with what to use instead.
+    pub rtol: Option<f64>,
+    /// See [`Request::rtol`].
+    pub atol: Option<f64>,
+    /// See [`Request::rtol`].
+    pub max_step: Option<f64>,
+    /// See [`Request::rtol`].
+    pub max_steps: Option<usize>,
+}
+
+/// A run resolved and built, ready to [`Planned::execute`].
+pub struct Planned {
+    /// The model, with the request applied.
+    pub spec: NbodySpec,
+    /// What the report prints about the run.
+    pub info: RunInfo,
+    /// Integration options.
+    pub options: RunOptions,
+    /// Whether trajectories are kept (and written).
+    pub trajectory: bool,
+    /// The option the output times came from (named in errors about them).
+    pub sampling_option: &'static str,
+    built: Built,
+}
+
+/// Loads the model `source` (file `origin`) with parameters `set`, applies `req` and builds
+/// the simulation. Every problem is an [`Error`]: located in the file, or naming the option.
+pub fn plan(
+    source: &str,
+    origin: &str,
+    set: &[(String, f64)],
+    req: &Request,
+) -> Result<Planned, Error> {
+    for (given, option, instead) in [
+        (
+            req.rtol.is_some(),
+            "--rtol",
+            "IAS15's accuracy is `epsilon` in [nbody]",
+        ),
+        (
+            req.atol.is_some(),
+            "--atol",
+            "IAS15's accuracy is `epsilon` in [nbody]",
+        ),
+        (
+            req.max_step.is_some(),
+            "--max-step",
+            "the fixed-step integrators take --dt",
+        ),
+        (
+            req.max_steps.is_some(),
+            "--max-steps",
+            "shorten the run with --t-end",
+        ),
+    ] {
+        if given {
+            return Err(Error::argument(
+                option,
+                format!("{option} does not apply to N-body models ({instead})"),
+            ));
+        }
+    }
+    let mut spec = load(source, origin, set)?;
+    if let Some(m) = &req.method {
+        spec.integrator = IntegratorKind::from_name(m).ok_or_else(|| {
+            Error::argument(
+                "--method",
+                format!(
+                    "--method {m}: N-body models take whfast, ias15 or leapfrog (--method help)"
+                ),
+            )
+        })?;
+        if spec.integrator == IntegratorKind::WhFast && spec.tree.is_some() {
+            return Err(Error::argument(
+                "--method",
+                "--method whfast: WHFast with the tree (gravity = \"tree\") is not supported; use leapfrog",
+            ));
+        }
+    }
+    if let Some(dt) = req.dt {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(Error::argument(
+                "--dt",
+                format!("--dt must be > 0 (got {dt})"),
+            ));
+        }
+        spec.dt = Some((dt, 0..0));
+    }
+    if let Some(t) = req.t_end {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(Error::argument(
+                "--t-end",
+                format!("--t-end must be > 0 (got {t})"),
+            ));
+        }
+        spec.t_end = Some(t);
+    }
+    let drift_tolerance = match req.drift_tolerance {
+        Some(d) if !(d.is_finite() && d > 0.0) => {
+            return Err(Error::argument(
+                "--drift-tolerance",
+                format!("--drift-tolerance must be > 0 (got {d})"),
+            ))
+        }
+        Some(d) => d,
+        None => spec
+            .drift_tolerance
+            .unwrap_or(crate::sim::DEFAULT_DRIFT_TOLERANCE),
+    };
+    let Some(t_end) = spec.t_end else {
+        return Err(Error::Model {
+            error: pdyn_mech::ModelError::new(origin, spec.table_span.clone(), "no end time")
+                .help("t_end = ... in [nbody], or --t-end"),
+            source: source.into(),
+        });
+    };
+    let given = [
+        req.points.is_some(),
+        req.output_dt.is_some(),
+        !req.t_eval.is_empty(),
+    ];
+    if given.iter().filter(|g| **g).count() > 1 {
+        return Err(Error::argument(
+            "",
+            "give only one of --points, --output-dt and --t-eval",
+        ));
+    }
+    let (sampling, option) = if let Some(n) = req.points {
+        (Sampling::Points(n), "--points")
+    } else if let Some(dt) = req.output_dt {
+        (Sampling::Every(dt), "--output-dt")
+    } else if !req.t_eval.is_empty() {
+        (Sampling::Times(req.t_eval.clone()), "--t-eval")
+    } else if let Some(dt) = spec.output_dt {
+        (Sampling::Every(dt), "output_dt")
+    } else {
+        (Sampling::Points(spec.points.unwrap_or(201)), "points")
+    };
+    let n_outputs = super::run::output_times(t_end, &sampling)
+        .map_err(|m| Error::argument(option, format!("{option}: {m}")))?
+        .len();
+
+    // A fixed step absurdly small for the span would run for days: say so instead.
+    if let (Some((dt, span)), true) = (&spec.dt, spec.integrator != IntegratorKind::Ias15) {
+        let steps = t_end / dt;
+        if steps > MAX_FIXED_STEPS {
+            let message = format!(
+                "t_end/dt = {steps:.3e} steps, more than {MAX_FIXED_STEPS:.0e}: dt = {dt} is far too small for t_end = {t_end}"
+            );
+            return Err(if span.is_empty() {
+                Error::argument("--dt", format!("--dt: {message}"))
+            } else {
+                Error::Model {
+                    error: pdyn_mech::ModelError::new(origin, span.clone(), message),
+                    source: source.into(),
+                }
+            });
+        }
+    }
+    let built = super::build(&spec, source)?;
+    let n_bodies = built.sim.len();
+    let trajectory = spec
+        .trajectory
+        .unwrap_or(n_bodies <= super::run::TRAJECTORY_LIMIT);
+    // Trajectories are kept in memory until written: refuse what would not fit.
+    if trajectory && n_bodies.saturating_mul(n_outputs) > MAX_TRAJECTORY_ROWS {
+        return Err(Error::argument(
+            option,
+            format!(
+                "{option}: {n_outputs} outputs of {n_bodies} bodies are more than {MAX_TRAJECTORY_ROWS} trajectory rows; \
+                 ask for fewer outputs (or trajectory = false)"
+            ),
+        ));
+    }
+    let info = RunInfo {
+        integrator: spec.integrator.name(),
+        dt: built.config.dt,
+        t_end,
+        gravity: match spec.tree {
+            None => "direct".into(),
+            Some(t) => format!(
+                "tree (theta = {}, {})",
+                t.theta,
+                if t.quadrupole {
+                    "quadrupole"
+                } else {
+                    "monopole"
+                }
+            ),
+        },
+        n_bodies,
+        drift_tolerance,
+    };
+    let options = RunOptions {
+        t_end,
+        sampling,
+        drift_tolerance,
+        trajectory,
+        integrator: spec.integrator,
+        collisions: spec.collisions,
+        escape: spec.escape.map_or(EscapeMode::Stop, |(_, m)| m),
+    };
+    Ok(Planned {
+        spec,
+        info,
+        options,
+        trajectory,
+        sampling_option: option,
+        built,
+    })
+}
+
+impl Planned {
+    /// Integrates. A run that stops early (a collision, an escape, a failed step) is a result
+    /// with its `failure` set; an error here is about the output times only.
+    pub fn execute(self) -> Result<(NbodySpec, RunInfo, NbodyResult), Error> {
+        let option = self.sampling_option;
+        let res = super::run::run(self.built, &self.options)
+            .map_err(|m| Error::argument(option, m.to_string()))?;
+        Ok((self.spec, self.info, res))
+    }
+}
