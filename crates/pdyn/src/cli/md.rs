@@ -1,5 +1,6 @@
 //! `pdyn run FILE` for a molecular-dynamics model (a file with a top-level `[md]` table):
-//! options → `pdyn::md::{parse, build, run}` → live thermo table, files, summary.
+//! flags → `pdyn::md::request::plan` (resolved against the table) → `pdyn::md::{build, run}`
+//! → live thermo table, progress bar, files, summary.
 
 use super::run::{io_error, RunArgs};
 use super::{numeric_pairs, Outcome};
@@ -49,61 +50,22 @@ fn model_err(error: ModelError, source: &str) -> Error {
 
 /// `pdyn run` on an `[md]` model.
 pub fn run(a: RunArgs, source: String) -> Result<Outcome, Error> {
-    // Options of the ODE integrators have no meaning for fixed-step velocity Verlet.
-    let meaningless: [(&str, bool); 8] = [
-        ("--method", a.method.is_some()),
-        ("--rtol", a.rtol.is_some()),
-        ("--atol", a.atol.is_some()),
-        ("--max-step", a.max_step.is_some()),
-        ("--max-steps", a.max_steps.is_some()),
-        ("--points", a.points.is_some()),
-        ("--output-dt", a.output_dt.is_some()),
-        ("--t-eval", !a.t_eval.is_empty()),
-    ];
-    if let Some((opt, _)) = meaningless.iter().find(|(_, given)| *given) {
-        return Err(Error::argument(
-            *opt,
-            format!(
-                "{opt} has no meaning for a molecular-dynamics model (fixed-step velocity Verlet); \
-                 use --dt, --t-end (run length) and the [md] keys steps, thermo_every, dump_every"
-            ),
-        ));
-    }
     let origin = a.model.display().to_string();
     let sets = numeric_pairs(&a.set, "--set")?;
-    let mut spec = md::load(&source, &origin, &sets)?;
-    if let Some(dt) = a.dt {
-        if !(dt.is_finite() && dt > 0.0) {
-            return Err(Error::argument(
-                "--dt",
-                format!("--dt must be a positive number, got {dt}"),
-            ));
-        }
-        spec.dt.value = dt;
-    }
-    if let Some(t) = a.t_end {
-        let steps = t / spec.dt.value;
-        if !(steps.is_finite() && steps >= 0.0 && steps <= md::spec::MAX_STEPS as f64) {
-            return Err(Error::argument(
-                "--t-end",
-                format!(
-                    "--t-end {t} with dt = {} is not a valid number of steps",
-                    spec.dt.value
-                ),
-            ));
-        }
-        spec.steps = steps.round() as u64;
-    }
-    let drift_tolerance = match a.drift_tolerance {
-        Some(d) if d.is_finite() && d > 0.0 => d,
-        Some(d) => {
-            return Err(Error::argument(
-                "--drift-tolerance",
-                format!("--drift-tolerance must be a positive number, got {d}"),
-            ))
-        }
-        None => pdyn::sim::DEFAULT_DRIFT_TOLERANCE,
+    let request = md::request::Request {
+        dt: a.dt,
+        t_end: a.t_end,
+        drift_tolerance: a.drift_tolerance,
+        method: a.method.clone(),
+        rtol: a.rtol,
+        atol: a.atol,
+        max_step: a.max_step,
+        max_steps: a.max_steps,
+        points: a.points,
+        output_dt: a.output_dt,
+        t_eval: a.t_eval.clone(),
     };
+    let (spec, drift_tolerance) = md::request::plan(&source, &origin, &sets, &request)?;
     if a.plot && a.out.is_none() {
         return Err(Error::argument(
             "--plot",

@@ -1,7 +1,8 @@
 //! Molecular dynamics from a model file: the `[md]` table.
 //!
 //! The pipeline mirrors `sim` for the mechanics models: [`spec::parse`] reads the table with
-//! spans (numbers may be expressions of `[parameters]`, after `--set`), [`build::build`]
+//! spans (numbers may be expressions of `[parameters]`, after `--set`; [`load`] adds the check
+//! of the `--set` names, [`request::plan`] a front end's options), [`build::build`]
 //! compiles the pair potentials (built-in kernels, or a formula in `r` differentiated and
 //! compiled by pdyn-expr and pdyn-jit, [`formula`]) and sets up a `pdyn_md::Simulation`
 //! (lattice or file, bonds, Maxwell–Boltzmann velocities, minimisation, thermostat),
@@ -14,6 +15,7 @@ pub mod formula;
 pub mod memory;
 pub mod output;
 pub mod pair;
+pub mod request;
 pub mod run;
 pub mod spec;
 
