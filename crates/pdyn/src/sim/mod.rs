@@ -12,6 +12,7 @@
 //! linear momentum components when the resultant moment or force vanishes identically.
 
 pub mod compiled;
+pub mod ensemble;
 mod error;
 pub mod exact;
 pub mod hybrid;

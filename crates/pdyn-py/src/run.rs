@@ -1,0 +1,132 @@
+//! `Model.run`: one integration with the GIL released, returned as a dict of plain data (the
+//! Python layer builds `pdyn.OdeResult` from it).
+//!
+//! A run that finishes but tabulates NaN or infinity fails here as `pdyn run` fails: the
+//! scan ([`non_finite_columns`]) repeats the one in `crates/pdyn/src/cli/run.rs` (same message,
+//! same columns) until the library resolves runs once for both front ends (issue 25, item 2).
+
+use crate::convert::{f64_matrix, stats_dict};
+use crate::errors::to_py;
+use crate::model::{Overrides, PyModel};
+use pdyn::sim::ensemble::non_finite_error;
+use pdyn::sim::measured::NonFinite;
+use pdyn::sim::{self, RunResult};
+use pdyn::Error;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use std::path::PathBuf;
+
+/// The body of `Model.run`: parameters applied, settings resolved, the model derived,
+/// compiled and integrated with the GIL released; pdyn's plots written into `plots`.
+pub(crate) fn run(
+    py: Python<'_>,
+    model: &PyModel,
+    o: Overrides,
+    params: Option<Vec<(String, f64)>>,
+    plots: Option<PathBuf>,
+    jit: bool,
+) -> PyResult<PyObject> {
+    let outcome = py.allow_threads(|| -> Result<(RunResult, usize, Vec<String>, f64), Error> {
+        let mut m = model.with_params(params)?;
+        let set = PyModel::settings(&m, o)?;
+        let prep = PyModel::prepare(&mut m, jit)?;
+        let res = sim::run(&prep, &set).map_err(|error| Error::Sim {
+            origin: m.origin.clone(),
+            context: "",
+            error,
+        })?;
+        if let Some(dir) = &plots {
+            // pdyn's own PNG/SVG plots, as `pdyn run --out DIR`.
+            std::fs::create_dir_all(dir).map_err(|e| {
+                Error::argument("plots", format!("cannot create {}: {e}", dir.display()))
+            })?;
+            pdyn::plots::write_run_plots(&m, &prep, &res, dir)?;
+        }
+        let names = prep.events.iter().map(|e| e.name.clone()).collect();
+        Ok((res, prep.state_names.len(), names, set.drift_tolerance))
+    });
+    match outcome {
+        Ok((res, n, names, tol)) => run_dict(py, &model.model.origin, res, n, names, tol),
+        Err(e) => Err(to_py(py, &e)),
+    }
+}
+
+/// A run result as a dict of plain data (the Python layer builds `pdyn.OdeResult`).
+fn run_dict(
+    py: Python<'_>,
+    origin: &str,
+    res: RunResult,
+    n_states: usize,
+    event_names: Vec<String>,
+    drift_tolerance: f64,
+) -> PyResult<PyObject> {
+    let d = PyDict::new(py);
+    d.set_item("event_names", event_names)?;
+    // A run that finished but tabulated NaN or infinity fails, as `pdyn run` exits 1 with a
+    // `non_finite` error.
+    let non_finite = if res.failure.is_none() {
+        non_finite_columns(origin, &res)
+    } else {
+        None
+    };
+    let status = match &non_finite {
+        Some(_) => -1,
+        None => res.status.code(),
+    };
+    d.set_item("status", status)?;
+    match &non_finite {
+        Some((names, t, e)) => {
+            d.set_item("non_finite", names.clone())?;
+            d.set_item("non_finite_t", *t)?;
+            d.set_item("failure", e.to_string())?;
+        }
+        None => {
+            d.set_item("non_finite", PyList::empty(py))?;
+            d.set_item("non_finite_t", py.None())?;
+            d.set_item("failure", res.failure.as_ref().map(|f| f.to_string()))?;
+        }
+    }
+    d.set_item("drift_tolerance", drift_tolerance)?;
+    let rows = res.rows.len();
+    let cols = res.columns.len();
+    let flat: Vec<f64> = res.rows.into_iter().flatten().collect();
+    d.set_item("columns", res.columns)?;
+    d.set_item("table", f64_matrix(py, flat, rows, cols)?)?;
+    d.set_item("n_states", n_states)?;
+    let events = PyList::empty(py);
+    for e in res.events {
+        let k = e.state.len();
+        events.append((e.name, e.t, f64_matrix(py, e.state, 1, k)?, e.rising))?;
+    }
+    d.set_item("events", events)?;
+    let monitors = PyList::empty(py);
+    for m in res.monitors {
+        let md = PyDict::new(py);
+        md.set_item("name", m.name)?;
+        md.set_item("initial", m.initial)?;
+        md.set_item("drift", m.drift)?;
+        md.set_item("relative", m.relative)?;
+        md.set_item("scale", m.scale)?;
+        md.set_item("conserved", m.conserved)?;
+        monitors.append(md)?;
+    }
+    d.set_item("monitors", monitors)?;
+    d.set_item("warnings", res.warnings)?;
+    d.set_item("stats", stats_dict(py, &res.stats)?)?;
+    d.set_item("method", res.method.to_string())?;
+    // The mode timeline, switches, impacts and energy accounting of a hybrid run, as the
+    // `hybrid` object of `summary.json` (the Python layer reads it with `json`).
+    d.set_item(
+        "hybrid_json",
+        res.hybrid.as_ref().map(pdyn::output::hybrid_json),
+    )?;
+    Ok(d.into_any().unbind())
+}
+
+/// The output columns of a run that hold NaN or infinity, the first time one does, and the
+/// error `pdyn run` reports for them (`non_finite`, exit code 1); `None` when all are finite.
+fn non_finite_columns(origin: &str, res: &RunResult) -> Option<(Vec<String>, f64, Error)> {
+    let nf = NonFinite::of_rows(&res.rows)?;
+    let names: Vec<String> = nf.columns.iter().map(|&c| res.columns[c].clone()).collect();
+    Some((names, nf.t, non_finite_error(origin, &res.columns, &nf)))
+}
