@@ -9,13 +9,22 @@
 //! - when an unknown angle `α` enters only as `u sin α` and `u cos α` for one other unknown
 //!   `u` (a lift force and its bank angle), by solving for `S = u sin α`, `C = u cos α` and
 //!   returning `u = √(S² + C²)`, `α = atan2(S, C)` (and the mirror solution `-u`, `α + π`);
+//! - when some unknowns enter only through an even power (a conical pendulum's rate `ω` as
+//!   `ω²`), by solving the linear system in those powers (the `powers` submodule) and taking
+//!   the root: the positive one for a coordinate's rate or a declared non-negative range, the
+//!   negative one for a non-positive range, both (listed) otherwise, each choice said in a note;
 //! - otherwise numerically, by Newton's method from several starting points in the unknowns'
 //!   ranges, keeping every distinct real solution.
+//!
+//! An unknown may be a free coordinate's `rate` or `initial` value (`rate = "omega"`): the
+//! instant's substitution puts it into `F = m a` like any other unknown.
 //!
 //! `[[checks]]` turn a condition such as `abs(T) = mu*N` (slip) or `N_A = 0` (tip) into the
 //! critical value of a parameter: symbolically when the condition is polynomial in a power of
 //! the parameter, and numerically (root bracketing and bisection) over an optional range of a
 //! coordinate, reporting the smallest and largest critical values and where they occur.
+
+mod powers;
 
 use crate::derive::{newton_equations, Equation};
 use crate::model::{CoordinateKind, Model};
@@ -132,6 +141,18 @@ pub enum ForcesError {
     },
     /// A non-linear system without a real root in the unknowns' ranges.
     NoRealSolution,
+    /// An unknown found through an even power of it, which came out negative (`ω² < 0`): no
+    /// real value gives the prescribed motion.
+    NoRealRoot {
+        /// The unknown.
+        unknown: String,
+        /// The power it enters by.
+        degree: i64,
+        /// The power's exact value, as text.
+        power: String,
+        /// Its value.
+        value: f64,
+    },
     /// A `[[checks]]` entry needs the forces in closed form; they were found numerically.
     CheckNeedsClosedForm {
         /// The check's name.
@@ -186,6 +207,11 @@ impl std::fmt::Display for ForcesError {
             ForcesError::NoRealSolution => {
                 f.write_str("no real solution found in the unknowns' ranges")
             }
+            ForcesError::NoRealRoot { unknown, degree, power, value } => write!(
+                f,
+                "{unknown}^{degree} = {power} = {value} is negative: no real {unknown} gives this \
+                 motion with these parameters"
+            ),
             ForcesError::CheckNeedsClosedForm { check } => write!(
                 f,
                 "check `{check}` needs the forces in closed form, and they were only found numerically"
@@ -263,7 +289,27 @@ pub fn solve_forces(model: &mut Model, opts: &ForcesOptions) -> Result<ForcesRes
                 .find(|(k, _, _)| *k == ci)
                 .map_or((Pool::ZERO, Pool::ZERO), |&(_, a, b)| (a, b));
             let value = at.get(&c.name).copied();
-            instant.push((c.name.clone(), value.unwrap_or(initial)));
+            let in_unknowns = |key: &str| {
+                let found = model.unknown_initials.iter();
+                found
+                    .filter(|u| u.coordinate == ci && u.key == key)
+                    .map(|u| u.text.clone())
+                    .next()
+            };
+            match (value, in_unknowns("initial")) {
+                // The value is an unknown being solved for: no number to show.
+                (None, Some(u)) => notes.push(format!(
+                    "{} at the instant is `{u}`, solved for with the forces",
+                    c.name
+                )),
+                _ => instant.push((c.name.clone(), value.unwrap_or(initial))),
+            }
+            if let Some(u) = in_unknowns("rate") {
+                notes.push(format!(
+                    "the rate of {} is `{u}`, solved for with the forces",
+                    c.name
+                ));
+            }
             if !over_ids.contains(&q) {
                 let v = match value {
                     Some(x) => p.num(exact(x)),
@@ -426,25 +472,54 @@ pub fn solve_forces(model: &mut Model, opts: &ForcesOptions) -> Result<ForcesRes
                     }
                     (Some(sol), all)
                 }
-                None => {
-                    notes.push("nonlinear in the unknowns: solved numerically by Newton's method from several starts".into());
-                    let ranges: Vec<(f64, f64)> = unknown_ids
-                        .iter()
-                        .map(|&u| {
-                            model
-                                .unknowns
-                                .iter()
-                                .find(|q| q.id == u)
-                                .and_then(|q| q.range)
-                                .unwrap_or((-10.0, 10.0))
-                        })
-                        .collect();
-                    let sols = newton_multistart(p, &residuals, &unknown_ids, &ranges, &env)?;
-                    if sols.is_empty() {
-                        return Err(ForcesError::NoRealSolution);
+                None => match powers::solve(p, &residuals, &unknown_ids) {
+                    // Linear in a power of some unknowns (a rate squared): exact.
+                    Some((sol, powers)) => {
+                        let declared: Vec<Option<(f64, f64)>> = unknown_ids
+                            .iter()
+                            .map(|&u| {
+                                let q = model.unknowns.iter().find(|q| q.id == u);
+                                q.and_then(|q| q.range)
+                            })
+                            .collect();
+                        let rate_of: Vec<Option<String>> = unknown_names
+                            .iter()
+                            .map(|n| {
+                                let mut rates =
+                                    model.unknown_initials.iter().filter(|u| u.key == "rate");
+                                rates
+                                    .find(|u| u.unknowns.contains(n))
+                                    .map(|u| u.name.clone())
+                            })
+                            .collect();
+                        let ctx = RootContext {
+                            names: &unknown_names,
+                            declared: &declared,
+                            rate_of: &rate_of,
+                        };
+                        let (sol, all) = choose_roots(p, &env, &ctx, sol, &powers, &mut notes)?;
+                        (Some(sol), all)
                     }
-                    (None, sols)
-                }
+                    None => {
+                        notes.push("nonlinear in the unknowns: solved numerically by Newton's method from several starts".into());
+                        let ranges: Vec<(f64, f64)> = unknown_ids
+                            .iter()
+                            .map(|&u| {
+                                model
+                                    .unknowns
+                                    .iter()
+                                    .find(|q| q.id == u)
+                                    .and_then(|q| q.range)
+                                    .unwrap_or((-10.0, 10.0))
+                            })
+                            .collect();
+                        let sols = newton_multistart(p, &residuals, &unknown_ids, &ranges, &env)?;
+                        if sols.is_empty() {
+                            return Err(ForcesError::NoRealSolution);
+                        }
+                        (None, sols)
+                    }
+                },
             }
         }
         Err(e) => return Err(ForcesError::Linear(e.to_string())),
@@ -472,6 +547,116 @@ pub fn solve_forces(model: &mut Model, opts: &ForcesOptions) -> Result<ForcesRes
         notes,
         instant,
     })
+}
+
+/// What decides the sign of an unknown found through an even power.
+struct RootContext<'a> {
+    names: &'a [String],
+    /// Declared `range`s of the unknowns.
+    declared: &'a [Option<(f64, f64)>],
+    /// The coordinate whose `rate` each unknown is, if any.
+    rate_of: &'a [Option<String>],
+}
+
+/// Which root of `u^g = W` (g even) is kept.
+enum Root {
+    Positive,
+    Negative,
+    Both,
+}
+
+/// The signs of the roots of the unknowns found through even powers ([`powers`]): positive
+/// for a declared non-negative range or a coordinate's rate (the other sign is the same motion
+/// turning the other way), negative for a non-positive range, both otherwise (every
+/// combination listed); each choice is said in a note. Returns the exact solution with the
+/// chosen signs and the numeric solutions.
+fn choose_roots(
+    p: &mut Pool,
+    env: &Env,
+    ctx: &RootContext,
+    mut sol: Vec<Id>,
+    powers: &[powers::Power],
+    notes: &mut Vec<String>,
+) -> Result<(Vec<Id>, Vec<Vec<f64>>), ForcesError> {
+    let values: Vec<Id> = powers.iter().map(|w| w.value).collect();
+    let w_num = env.eval(p, &values)?;
+    let mut both = Vec::new();
+    for (w, &wv) in powers.iter().zip(&w_num) {
+        let name = &ctx.names[w.index];
+        let g = w.degree;
+        let (power_text, root_text) = (p.to_text(w.value), p.to_text(sol[w.index]));
+        notes.push(format!(
+            "`{name}` enters only as {name}^{g}: solved exactly for {name}^{g} = {power_text}"
+        ));
+        if wv < 0.0 {
+            return Err(ForcesError::NoRealRoot {
+                unknown: name.clone(),
+                degree: g,
+                power: power_text,
+                value: wv,
+            });
+        }
+        if wv == 0.0 {
+            continue;
+        }
+        let root = match (ctx.declared[w.index], &ctx.rate_of[w.index]) {
+            (Some((lo, _)), _) if lo >= 0.0 => Root::Positive,
+            (Some((_, hi)), _) if hi <= 0.0 => Root::Negative,
+            (None, Some(_)) => Root::Positive,
+            _ => Root::Both,
+        };
+        match root {
+            Root::Positive => notes.push(match &ctx.rate_of[w.index] {
+                Some(c) if ctx.declared[w.index].is_none() => format!(
+                    "{name} = +{root_text} taken: {name} is the rate of {c}, and -{root_text} is \
+                     the same motion turning the other way (with the same forces)"
+                ),
+                _ => format!("{name} = +{root_text} taken: its declared range is non-negative"),
+            }),
+            Root::Negative => {
+                sol[w.index] = p.neg(sol[w.index]);
+                notes.push(format!(
+                    "{name} = -{root_text} taken: its declared range is non-positive"
+                ));
+            }
+            Root::Both => {
+                both.push(w.index);
+                notes.push(format!(
+                    "{name} = ±{root_text}: both roots solve the equations (the solution shows \
+                     +; declare {name} = {{ range = [0, ...] }} to keep one)"
+                ));
+            }
+        }
+    }
+    let mut all = vec![env.eval(p, &sol)?];
+    for &i in &both {
+        let flipped: Vec<Vec<f64>> = all
+            .iter()
+            .map(|s| {
+                let mut m = s.clone();
+                m[i] = -m[i];
+                m
+            })
+            .collect();
+        // The negative root first, as the numeric solve lists ascending starts.
+        all = flipped.into_iter().chain(all).collect();
+    }
+    let before = all.len();
+    all.retain(|s| {
+        s.iter()
+            .zip(ctx.declared)
+            .all(|(v, r)| r.is_none_or(|(lo, hi)| (lo - 1e-12..=hi + 1e-12).contains(v)))
+    });
+    if all.is_empty() {
+        return Err(ForcesError::NoRealSolution);
+    }
+    if all.len() < before {
+        notes.push(format!(
+            "{} solution(s) outside the unknowns' declared ranges left out",
+            before - all.len()
+        ));
+    }
+    Ok((sol, all))
 }
 
 fn exact(x: f64) -> Number {

@@ -297,3 +297,40 @@ fn high_order_derivatives_finish() {
     assert!(err.contains("diff -n 100000: error:"), "{err}");
     assert!(err.contains("expression nodes"), "{err}");
 }
+
+/// A coordinate's rate written in [unknowns] (issue 34, item 5): `pdyn forces` solves for it in
+/// closed form; `run`, `check` and `derive` say where it is and what to do, with exit code 2.
+#[test]
+fn a_rate_in_unknowns_is_solved_by_forces_and_refused_by_run() {
+    let model = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/conical_pendulum.toml"
+    );
+    let (ok, out, err) = pdyn(&["forces", model]);
+    assert!(ok, "{err}");
+    assert!(out.contains("T = g*m/cos(alpha)"), "{out}");
+    assert!(out.contains("omega = sqrt("), "{out}");
+    assert!(!out.contains("numerically"), "{out}");
+    for command in ["run", "check"] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_pdyn"))
+            .args([command, model, "--t-end", "1"])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{command}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("conical_pendulum.toml:17:7: error:"),
+            "{command}: {err}"
+        );
+        assert!(err.contains("the rate of `phi`"), "{command}: {err}");
+        assert!(err.contains("rate = \"omega\""), "{command}: {err}");
+        assert!(err.contains("pdyn forces"), "{command}: {err}");
+    }
+    let (ok, out, err) = pdyn(&["derive", model]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("phi'(0) = omega (unknown, for pdyn forces)"),
+        "{out}"
+    );
+    assert!(!out.contains("NaN"), "{out}");
+}

@@ -12,8 +12,13 @@
 //!
 //! [`antiderivative`] integrates sums and constant multiples of powers, exponentials, sines,
 //! cosines and hyperbolic functions of linear arguments, `1/(p + q u^2)`, and anything of the
-//! form `c g'(u) h(g(u))` for those `h` (substitution). Every antiderivative is checked by
+//! form `c g'(u) h(g(u))` for those `h` (substitution); and, for the laws whose initial values
+//! are symbols (the `quadratic` submodule), `1/sqrt(p + r u + q u^2)` and `1/(p + r u + q u^2)`
+//! with a linear term or a constant of unknown sign, `u/(p + r u + q u^2)`, and
+//! `u^n (α u + β)^k`. Every antiderivative is checked by
 //! differentiating it back; an unchecked one is discarded and quadrature is used instead.
+
+mod quadratic;
 
 use super::exact::sign_of;
 use super::quad::integrate;
@@ -406,19 +411,29 @@ fn integrate_rec(pool: &mut Pool, e: Id, var: Id, steps: &mut usize, depth: usiz
                 return Some(pool.mul2(c, i));
             }
             substitution(pool, e, &rest, var)
+                .or_else(|| quadratic::power_times_linear(pool, &rest, var, steps, depth))
+                .or_else(|| quadratic::linear_over_quadratic(pool, &rest, var))
         }
         Node::Pow(b, x) if free_of(pool, x, var) => {
             if let Some((alpha, _)) = linear(pool, b, var) {
                 return Some(power_rule(pool, b, x, alpha));
             }
+            // The centred forms first (their output is the textbook's), then the general
+            // quadratic with a linear term or a constant of unknown sign (symbolic x0, v0).
             if x == Pool::MINUS_ONE {
                 if let Some(f) = inverse_quadratic(pool, b, var) {
+                    return Some(f);
+                }
+                if let Some(f) = quadratic::inverse(pool, b, var) {
                     return Some(f);
                 }
             }
             let minus_half = pool.num(Number::ratio(-1, 2));
             if x == minus_half {
                 if let Some(f) = inverse_sqrt_quadratic(pool, b, var) {
+                    return Some(f);
+                }
+                if let Some(f) = quadratic::inverse_sqrt(pool, b, var) {
                     return Some(f);
                 }
             }

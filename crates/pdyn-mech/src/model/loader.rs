@@ -57,6 +57,10 @@ pub(crate) struct Loader<'a> {
     /// `(coordinate index, name, its table's span and value, "initial" or "rate")` of the
     /// initial conditions waiting for the definitions.
     pub deferred_initials: Vec<(usize, String, Sv, toml::Table, &'static str)>,
+    /// The `[unknowns]`: name and symbol (an initial condition may name them).
+    pub unknown_ids: Vec<(String, Id)>,
+    /// The initial conditions read so far that name an unknown.
+    pub unknown_initials: Vec<super::UnknownInitial>,
 }
 
 impl<'a> Loader<'a> {
@@ -74,6 +78,8 @@ impl<'a> Loader<'a> {
             coordinate_names: Vec::new(),
             definition_names: Vec::new(),
             deferred_initials: Vec::new(),
+            unknown_ids: Vec::new(),
+            unknown_initials: Vec::new(),
         }
     }
 
@@ -261,6 +267,33 @@ impl<'a> Loader<'a> {
                 )
                 .help("write vectors as \"[x, y, z]\" (or \"[x, y]\" in the plane)")),
         }
+    }
+
+    /// The `[unknowns]` that `e` names, in declaration order.
+    pub fn unknowns_in(&self, e: Id) -> Vec<String> {
+        self.unknown_ids
+            .iter()
+            .filter(|(_, u)| self.pool.contains(e, *u))
+            .map(|(n, _)| n.clone())
+            .collect()
+    }
+
+    /// Checks that `e` involves only parameters and `[unknowns]` (what `pdyn forces` can
+    /// substitute at the instant), with the error [`Loader::constant`] gives otherwise.
+    pub fn constant_in_unknowns(
+        &mut self,
+        e: Id,
+        span: Range<usize>,
+        what: &str,
+    ) -> Result<(), ModelError> {
+        let mut inputs: Vec<Id> = self.params.iter().map(|p| p.id).collect();
+        inputs.extend(self.unknown_ids.iter().map(|u| u.1));
+        Program::compile(&mut self.pool, &inputs, &[e])
+            .map(|_| ())
+            .map_err(|err| {
+                self.err(span, format!("{what} must be a number here: {err}"))
+                    .help("only parameters, [unknowns] (for `pdyn forces`), numbers, pi and units may appear here")
+            })
     }
 
     /// Evaluates an expression that may only involve parameters.

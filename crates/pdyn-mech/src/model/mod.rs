@@ -14,6 +14,7 @@ mod loader;
 pub(crate) mod raw;
 pub mod spec;
 mod tables;
+mod unknown_initials;
 
 pub use contacts::Contact;
 pub(crate) use loader::Loader;
@@ -21,6 +22,7 @@ use pdyn_expr::error::render_diagnostic;
 use pdyn_expr::{Id, Pool, SymId, Value};
 use raw::RawModel;
 use std::ops::Range;
+pub use unknown_initials::UnknownInitial;
 
 /// A located problem in a model file.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -261,6 +263,9 @@ pub struct Model {
     /// `(coordinate index, initial value, initial rate)` as expressions of the parameters, so
     /// that a sweep over a parameter recomputes the initial conditions that depend on it.
     pub initial_exprs: Vec<(usize, Id, Id)>,
+    /// Initial values and rates written in `[unknowns]` (`rate = "omega"`): `pdyn forces`
+    /// solves for them; their numeric copies in [`CoordinateKind::Free`] are NaN.
+    pub unknown_initials: Vec<UnknownInitial>,
 }
 
 /// Reads a model from TOML text. `origin` names it in error messages.
@@ -275,6 +280,7 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
     let mut ld = Loader::new(origin, source);
     ld.read_parameters(&raw)?;
     let unknowns = ld.read_unknowns(&raw)?;
+    ld.unknown_ids = unknowns.iter().map(|u| (u.name.clone(), u.id)).collect();
     ld.definition_names = raw
         .definitions
         .keys()
@@ -314,6 +320,7 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
     Ok(Model {
         run,
         initial_exprs,
+        unknown_initials: std::mem::take(&mut ld.unknown_initials),
         unknowns,
         known_accelerations,
         checks,

@@ -319,10 +319,25 @@ impl Loader<'_> {
             return Err(self.err(sv.span(), format!("`{key}` must be a scalar")));
         };
         self.coordinate_dimension(n, sv, &ast, &text, order, key);
-        Ok((
-            self.constant(id, sv.span(), &format!("`{key}` of `{n}`"))?,
-            id,
-        ))
+        let what = format!("`{key}` of `{n}`");
+        let unknowns = self.unknowns_in(id);
+        if unknowns.is_empty() {
+            return Ok((self.constant(id, sv.span(), &what)?, id));
+        }
+        // `rate = "omega"` with `omega` in [unknowns]: `pdyn forces` solves for it, so the
+        // expression is kept and the number is NaN until then (a run refuses it, located).
+        self.constant_in_unknowns(id, sv.span(), &what)?;
+        let index = self.coordinate_names.len();
+        let key = if key == "rate" { "rate" } else { "initial" };
+        self.unknown_initials.push(super::UnknownInitial {
+            coordinate: self.coordinate_index(n).map_or(index, |(k, _)| k),
+            name: n.to_string(),
+            key,
+            text: text.trim().to_string(),
+            unknowns,
+            span: sv.span(),
+        });
+        Ok((f64::NAN, id))
     }
 
     /// The dimension of coordinate `n`'s `order`-th time derivative.

@@ -98,7 +98,21 @@ pub fn run(a: DeriveArgs) -> Result<String, Error> {
                 .is_ok()
         })
     });
-    let exact = if solution_printable {
+    // An initial condition left to `pdyn forces` (`rate = "omega"`, an unknown) has no
+    // number: a closed form from it is not attempted, and the reason is said below.
+    let left_to_forces = model.unknown_initials.first().map(|u| {
+        format!(
+            "the {} of `{}` is `{}`, an unknown that `pdyn forces` solves for",
+            if u.key == "rate" {
+                "rate"
+            } else {
+                "initial value"
+            },
+            u.name,
+            u.text
+        )
+    });
+    let exact = if solution_printable && left_to_forces.is_none() {
         Some(pdyn::sim::exact::symbolic_closed_form(&mut model))
     } else {
         None
@@ -120,12 +134,21 @@ pub fn run(a: DeriveArgs) -> Result<String, Error> {
     o.line(&model.name);
     o.line("");
     o.line("Coordinates:");
-    for c in &model.coordinates {
+    for (ci, c) in model.coordinates.iter().enumerate() {
         match &c.kind {
-            pdyn_mech::model::CoordinateKind::Free { initial, rate } => o.line(&format!(
-                "  {} (unknown): {0}(0) = {initial}, {0}'(0) = {rate}",
-                c.name
-            )),
+            pdyn_mech::model::CoordinateKind::Free { initial, rate } => {
+                // An initial condition in [unknowns] has no number: show what was written.
+                let shown = |key: &str, value: f64| match model.unknown_initial(ci, key) {
+                    Some(u) => format!("{} (unknown, for pdyn forces)", u.text),
+                    None => value.to_string(),
+                };
+                o.line(&format!(
+                    "  {} (unknown): {0}(0) = {}, {0}'(0) = {}",
+                    c.name,
+                    shown("initial", *initial),
+                    shown("rate", *rate)
+                ))
+            }
             pdyn_mech::model::CoordinateKind::Prescribed { expr } => {
                 o.expr_in(&format!("  {} = ", c.name), &c.name, *expr, " (prescribed)");
             }
@@ -307,6 +330,13 @@ pub fn run(a: DeriveArgs) -> Result<String, Error> {
                     chars(&why)
                 ));
             }
+        }
+        None if left_to_forces.is_some() && d.solution.is_some() => {
+            o.line("");
+            o.line(&format!(
+                "No closed form attempted: {}.",
+                left_to_forces.as_deref().unwrap_or_default()
+            ));
         }
         None if d.solution.is_some() => {
             o.line("");
@@ -528,7 +558,19 @@ fn to_json(
     json!({
         "model": model.name,
         "form": format!("{:?}", d.form).to_lowercase(),
-        "coordinates": model.coordinates.iter().map(|c| match &c.kind {
+        "coordinates": model.coordinates.iter().enumerate().map(|(ci, c)| match &c.kind {
+            // An initial value or rate in [unknowns] is null, with what was written beside it.
+            pdyn_mech::model::CoordinateKind::Free { initial, rate }
+                if model.unknown_initials.iter().any(|u| u.coordinate == ci) =>
+            {
+                let written = model
+                    .unknown_initials
+                    .iter()
+                    .filter(|u| u.coordinate == ci)
+                    .map(|u| (u.key.to_string(), json!(u.text)))
+                    .collect::<serde_json::Map<_, _>>();
+                json!({"name": c.name, "kind": "unknown", "initial": initial, "rate": rate, "in_unknowns": written})
+            }
             pdyn_mech::model::CoordinateKind::Free { initial, rate } =>
                 json!({"name": c.name, "kind": "unknown", "initial": initial, "rate": rate}),
             pdyn_mech::model::CoordinateKind::Prescribed { expr } =>

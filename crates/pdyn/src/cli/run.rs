@@ -91,6 +91,15 @@ pub(crate) fn prepare(model: &mut pdyn_mech::Model, a: &RunArgs) -> Result<sim::
 
 /// Merges `[simulate]` and the command line.
 pub fn settings(model: &pdyn_mech::Model, a: &RunArgs) -> Result<RunSettings, Error> {
+    // Every command that runs the motion reads its settings first: an initial condition left
+    // to `pdyn forces` is the first thing to report, at its place in the file.
+    if let Some(error) = model.unknown_initial_error() {
+        return Err(sim_error(
+            model,
+            "",
+            SimError::UnknownInitialCondition(Box::new(error)),
+        ));
+    }
     let s = &model.run.simulate;
     // A method named in the file is checked here, where its place in the file is known.
     if let (None, Some((m, span))) = (&a.method, &s.method) {
@@ -176,6 +185,13 @@ fn file_value_error(
 
 /// A simulation error located in the model file, with what was being attempted.
 pub(crate) fn sim_error(model: &pdyn_mech::Model, context: &'static str, error: SimError) -> Error {
+    // A problem with a place in the model file is shown at that place.
+    if let SimError::UnknownInitialCondition(error) = error {
+        return Error::Model {
+            error: *error,
+            source: model.source.as_str().into(),
+        };
+    }
     Error::Sim {
         origin: model.origin.clone(),
         context,

@@ -68,6 +68,9 @@ pub enum SimError {
         /// What is wrong, naming the contact and the time.
         message: String,
     },
+    /// An initial value or rate that names an `[unknowns]` quantity (`rate = "omega"`): only
+    /// `pdyn forces` can use it; the error points at it in the model file.
+    UnknownInitialCondition(Box<pdyn_mech::ModelError>),
     /// A run setting outside its valid range (named as on the command line).
     InvalidOption {
         /// The option, e.g. `--dt`.
@@ -172,6 +175,7 @@ impl fmt::Display for SimError {
                 requirement,
             } => write!(f, "{option} must be {requirement}, got {value}"),
             SimError::Contact { message } => f.write_str(message),
+            SimError::UnknownInitialCondition(e) => f.write_str(&e.message),
         }
     }
 }

@@ -466,6 +466,10 @@ pub fn prepare_with_jit(
     opts: &DeriveOptions,
     jit: JitMode,
 ) -> Result<Prepared, SimError> {
+    // A rate left to `pdyn forces` (`rate = "omega"`, an unknown) has no number to start from.
+    if let Some(e) = model.unknown_initial_error() {
+        return Err(SimError::UnknownInitialCondition(Box::new(e)));
+    }
     // A hybrid model is prepared in a reference mode (its held contacts touching, the others
     // open); the run derives the other modes as it meets them.
     let mut hybrid = None;
