@@ -15,5 +15,6 @@ pub mod output;
 pub mod params;
 pub mod plots;
 pub mod sim;
+pub mod summary;
 
 pub use error::{Error, Location};

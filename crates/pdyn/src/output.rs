@@ -48,8 +48,15 @@ pub fn push_number(line: &mut String, x: f64) {
     line.push_str(buf.format(x));
 }
 
-/// The JSON summary: final state, events, monitor drifts, solver statistics, warnings.
-pub fn summary(res: &RunResult, model_name: &str, state_names: &[String]) -> serde_json::Value {
+/// The JSON summary: the fields every kind shares ([`crate::summary::common`]: monitors with
+/// their verdict against `drift_tolerance`, solver statistics, warnings), then the final
+/// state, events, method and number of outputs.
+pub fn summary(
+    res: &RunResult,
+    model_name: &str,
+    state_names: &[String],
+    drift_tolerance: f64,
+) -> serde_json::Value {
     let last = res.rows.last();
     let final_state: serde_json::Map<String, serde_json::Value> = match last {
         Some(r) => res
@@ -60,30 +67,47 @@ pub fn summary(res: &RunResult, model_name: &str, state_names: &[String]) -> ser
             .collect(),
         None => Default::default(),
     };
-    json!({
-        "model": model_name,
-        "method": res.method.to_string(),
-        "ok": res.failure.is_none(),
-        "failure": res.failure.as_ref().map(|f| f.to_string()),
-        "final": final_state,
-        "events": res.events.iter().map(|e| json!({
-            "name": e.name,
-            "t": json_num(e.t),
-            "direction": if e.rising { "rising" } else { "falling" },
-            "state": state_names.iter().zip(&e.state).map(|(n, v)| (n.clone(), json_num(*v))).collect::<serde_json::Map<_, _>>(),
-        })).collect::<Vec<_>>(),
-        "monitors": res.monitors.iter().map(|m| json!({
-            "name": m.name, "initial": json_num(m.initial), "drift": json_num(m.drift),
-            "relative": m.relative, "scale": json_num(m.scale), "conserved": m.conserved,
-        })).collect::<Vec<_>>(),
-        "stats": {
+    let monitors: Vec<crate::summary::Conserved<'_>> = res
+        .monitors
+        .iter()
+        .map(|m| crate::summary::Conserved {
+            name: &m.name,
+            initial: m.initial,
+            final_value: res
+                .columns
+                .iter()
+                .position(|c| *c == m.name)
+                .and_then(|k| last.map(|r| r[k])),
+            drift: m.drift,
+            relative: m.relative,
+            scale: m.scale,
+            tolerance: drift_tolerance,
+            conserved: m.conserved,
+        })
+        .collect();
+    crate::summary::common(
+        "mechanics",
+        model_name,
+        res.failure.as_ref().map(|f| f.to_string()),
+        &res.warnings,
+        &monitors,
+        json!({
             "steps": res.stats.steps, "accepted": res.stats.accepted, "rejected": res.stats.rejected,
             "fevals": res.stats.fevals, "jacobians": res.stats.jacobians,
             "lu_decompositions": res.stats.lu_decompositions,
-        },
-        "outputs": res.rows.len(),
-        "warnings": res.warnings,
-    })
+        }),
+        json!({
+            "method": res.method.to_string(),
+            "final": final_state,
+            "events": res.events.iter().map(|e| json!({
+                "name": e.name,
+                "t": json_num(e.t),
+                "direction": if e.rising { "rising" } else { "falling" },
+                "state": state_names.iter().zip(&e.state).map(|(n, v)| (n.clone(), json_num(*v))).collect::<serde_json::Map<_, _>>(),
+            })).collect::<Vec<_>>(),
+            "outputs": res.rows.len(),
+        }),
+    )
 }
 
 /// The text of `summary.json` (and of `pdyn run --json`): the summary, then a hybrid run's

@@ -135,7 +135,7 @@ pub fn run(a: RunArgs, source: String) -> Result<Outcome, Error> {
         origin: origin.clone(),
         error,
     });
-    let mut sum = md::output::summary(&prep, &res);
+    let mut sum = md::output::summary(&prep, &res, drift_tolerance);
     if let Some(f) = &failure {
         sum["error"] = f.to_json()["error"].clone();
     }

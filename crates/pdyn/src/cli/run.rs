@@ -245,9 +245,14 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
             failure: Box::new(failure),
         })
         .or_else(|| non_finite_columns(&model, &res));
-    let mut sum = summary(&res, &model.name, &prep.state_names);
+    let mut sum = summary(&res, &model.name, &prep.state_names, set.drift_tolerance);
     if let Some(f) = &failure {
         sum["error"] = f.to_json()["error"].clone();
+        // A table with NaN is a failure too, though the integration finished.
+        sum["ok"] = false.into();
+        if sum["failure"].is_null() {
+            sum["failure"] = f.to_string().into();
+        }
     }
     if let Some(dir) = &a.out {
         std::fs::create_dir_all(dir).map_err(|e| io_error(dir, "create", e))?;

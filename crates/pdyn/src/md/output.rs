@@ -80,15 +80,39 @@ pub fn unit_names(units: Units) -> UnitNames {
 }
 
 /// The JSON summary of a run.
-pub fn summary(prep: &Prepared, res: &MdResult) -> serde_json::Value {
+pub fn summary(prep: &Prepared, res: &MdResult, drift_tolerance: f64) -> serde_json::Value {
     let spec = &prep.spec;
     let n = res.atoms.max(1) as f64;
     let last = res.records.last();
     let u = unit_names(spec.units);
     let units = json!({"name": u.name, "energy": u.energy, "length": u.length, "time": u.time, "temperature": u.temperature, "pressure": u.pressure});
-    json!({
-        "model": spec.name,
-        "engine": "md",
+    // The conserved energy (the extended one under Nosé–Hoover), when the dynamics has one.
+    let name = match spec.thermostat.ensemble {
+        Ensemble::NoseHoover { .. } => "energy_with_thermostat",
+        _ => "energy",
+    };
+    let monitors: Vec<crate::summary::Conserved<'_>> = res
+        .drift
+        .iter()
+        .map(|d| crate::summary::Conserved {
+            name,
+            initial: res.records.first().map_or(f64::NAN, |r| r.conserved),
+            final_value: last.map(|r| r.conserved),
+            drift: d.relative,
+            relative: d.scale > 0.0,
+            scale: d.scale,
+            tolerance: drift_tolerance,
+            conserved: true,
+        })
+        .collect();
+    crate::summary::common(
+        "md",
+        &spec.name,
+        res.failure.as_ref().map(|f| f.to_string()),
+        &res.warnings,
+        &monitors,
+        json!({"steps": res.steps, "neighbor_builds": res.builds}),
+        json!({
         "units": units,
         "atoms": res.atoms,
         "species": spec.species.iter().map(|s| json!({"name": s.name, "mass": s.mass.value})).collect::<Vec<_>>(),
@@ -125,8 +149,8 @@ pub fn summary(prep: &Prepared, res: &MdResult) -> serde_json::Value {
             "scale": json_num(d.scale),
             "slope_per_atom": json_num(d.slope_per_atom),
         })),
-        "warnings": res.warnings,
-    })
+        }),
+    )
 }
 
 /// `thermo.csv`, plus `rdf.csv` and `msd.csv` when computed, into `dir`.

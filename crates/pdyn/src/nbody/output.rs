@@ -135,41 +135,56 @@ pub fn summary(spec: &NbodySpec, info: &RunInfo, res: &NbodyResult) -> serde_jso
                 .collect()
         })
         .unwrap_or_default();
-    serde_json::json!({
-        "model": spec.name,
-        "kind": "nbody",
-        "ok": res.failure.is_none(),
-        "units": spec.units.label,
-        "G": spec.units.units.g(),
-        "integrator": info.integrator,
-        "gravity": info.gravity,
-        "dt": info.dt,
-        "t_end": info.t_end,
-        "t_reached": res.t_reached,
-        "bodies": {"initial": info.n_bodies, "final": last.map_or(0, |r| r.n)},
-        "stats": {"steps": res.steps, "final_dt": res.final_dt, "outputs": res.times.len()},
-        "energy": {
-            "initial": res.conservation.first().map(|r| r.energy),
-            "final": last.map(|r| r.energy),
-            "relative_error": finite(res.energy_error),
-        },
-        "virial_ratio": last.map(|r| finite(virial(r.kinetic, r.potential))),
-        "monitors": res.monitors.iter().map(|m| serde_json::json!({
-            "name": m.name,
-            "initial": m.initial,
-            "drift": finite(m.drift),
-            "scale": m.scale,
-            "relative": true,
-            "ok": m.ok,
-        })).collect::<Vec<_>>(),
-        "drift_tolerance": info.drift_tolerance,
-        "events": res.events.iter().map(|e| serde_json::json!({
-            "t": e.t, "kind": e.kind, "bodies": e.bodies, "message": e.message,
-        })).collect::<Vec<_>>(),
-        "warnings": res.warnings,
-        "final_state": final_bodies,
-        "parameters": spec.parameters.iter().map(|(n, v)| (n.clone(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
-    })
+    let monitors: Vec<crate::summary::Conserved<'_>> = res
+        .monitors
+        .iter()
+        .map(|m| crate::summary::Conserved {
+            name: m.name,
+            initial: m.initial,
+            final_value: last.map(|r| match m.name {
+                "energy" => r.energy,
+                _ => {
+                    let l = r.angular_momentum;
+                    (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt()
+                }
+            }),
+            drift: m.drift,
+            relative: true,
+            scale: m.scale,
+            tolerance: info.drift_tolerance,
+            conserved: true,
+        })
+        .collect();
+    crate::summary::common(
+        "nbody",
+        &spec.name,
+        res.failure.as_ref().map(|f| f.to_string()),
+        &res.warnings,
+        &monitors,
+        serde_json::json!({"steps": res.steps, "final_dt": res.final_dt, "outputs": res.times.len()}),
+        serde_json::json!({
+            "units": spec.units.label,
+            "G": spec.units.units.g(),
+            "integrator": info.integrator,
+            "gravity": info.gravity,
+            "dt": info.dt,
+            "t_end": info.t_end,
+            "t_reached": res.t_reached,
+            "bodies": {"initial": info.n_bodies, "final": last.map_or(0, |r| r.n)},
+            "energy": {
+                "initial": res.conservation.first().map(|r| r.energy),
+                "final": last.map(|r| r.energy),
+                "relative_error": finite(res.energy_error),
+            },
+            "virial_ratio": last.map(|r| finite(virial(r.kinetic, r.potential))),
+            "drift_tolerance": info.drift_tolerance,
+            "events": res.events.iter().map(|e| serde_json::json!({
+                "t": e.t, "kind": e.kind, "bodies": e.bodies, "message": e.message,
+            })).collect::<Vec<_>>(),
+            "final_state": final_bodies,
+            "parameters": spec.parameters.iter().map(|(n, v)| (n.clone(), serde_json::json!(v))).collect::<serde_json::Map<_, _>>(),
+        }),
+    )
 }
 
 /// The text report of `pdyn run`.
