@@ -7,7 +7,7 @@ SciPy's `RK45`) at rtol = 1e-6, atol = 1e-9, and write the trajectory as CSV. Ea
 timed as a whole process (interpreter start, imports, derivation, code generation,
 integration, output), as a user would see it:
 
-    cargo build --release -p pdyn
+    cargo build --release -p pdyn-cli
     python3 bench/chain_run_vs_sympy.py 2 4 8 16
 
 Prints one row per n: pdyn seconds, SymPy+SciPy seconds, their ratio, both f-evaluation counts
@@ -81,7 +81,7 @@ def timed(cmd):
 def main():
     sizes = [int(a) for a in sys.argv[1:]] or [2, 4, 8, 16]
     if not os.path.exists(PDYN):
-        sys.exit(f"{PDYN} not found: run `cargo build --release -p pdyn` first")
+        sys.exit(f"{PDYN} not found: run `cargo build --release -p pdyn-cli` first")
     with tempfile.TemporaryDirectory() as tmp:
         script = os.path.join(tmp, "sympy_user.py")
         with open(script, "w") as f:

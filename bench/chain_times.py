@@ -3,7 +3,7 @@
 and `pdyn run --t-end 10` on the n-link pendulum chain (bench/chain_model.py), best of
 REPEAT runs each, with the size of `pdyn derive`'s output and its longest line:
 
-    cargo build --release -p pdyn
+    cargo build --release -p pdyn-cli
     python3 bench/chain_times.py 2 3 4 8 16 32 64 100
 
 Prints one Markdown table row per n and the load average before and after.

@@ -2,7 +2,7 @@
 """Whole-process timing, in one run: `pdyn run` (parse, derive, compile, integrate, write CSV)
 vs a Python script solving the same equations with SciPy's solve_ivp (DOP853), both on the
 satellite for 100 periods at rtol = atol = 1e-10. Also: a 1000-run sweep of the 2-storey
-building on 1 and 2 threads. Build first: cargo build --release -p pdyn."""
+building on 1 and 2 threads. Build first: cargo build --release -p pdyn-cli."""
 import json
 import os
 import subprocess

@@ -4,7 +4,7 @@
 building, an n-mass spring chain, symbolic mass and stiffness per element), best of REPEAT
 runs each:
 
-    cargo build --release -p pdyn
+    cargo build --release -p pdyn-cli
     python3 bench/structure_times.py building:10 spring_chain:50
 
 Prints one Markdown table row per model and the load average before and after.

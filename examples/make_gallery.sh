@@ -2,7 +2,7 @@
 # Regenerates the plots of the README gallery into examples/gallery/ (PNG only).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo build -q -p pdyn
+cargo build -q -p pdyn-cli
 PDYN=target/debug/pdyn
 out=$(mktemp -d)
 run() { # name model [args...]

@@ -15,7 +15,7 @@ if [ -z "${SKIP_CARGO:-}" ]; then
     cargo test --workspace
 fi
 # The CLI-comparison tests run the binary.
-cargo build -p pdyn --bin pdyn
+cargo build -p pdyn-cli
 
 venv="$root/target/venv-test"
 if [ ! -x "$venv/bin/python" ]; then

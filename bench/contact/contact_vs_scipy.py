@@ -5,7 +5,7 @@ SciPy solve_ivp scripts with event restarts doing the same physics at the same t
 (rtol 1e-10, atol 1e-12):
   1. the bouncing ball of examples/contact/bouncing_ball.toml to rest (Zeno accumulation);
   2. 1,000 stick-slip cycles of examples/contact/belt.toml.
-Build first: cargo build --release -p pdyn. Usage: python3 bench/contact/contact_vs_scipy.py"""
+Build first: cargo build --release -p pdyn-cli. Usage: python3 bench/contact/contact_vs_scipy.py"""
 import json
 import os
 import subprocess

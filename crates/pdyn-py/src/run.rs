@@ -2,7 +2,7 @@
 //! Python layer builds `pdyn.OdeResult` from it).
 //!
 //! A run that finishes but tabulates NaN or infinity fails here as `pdyn run` fails: the
-//! scan ([`non_finite_columns`]) repeats the one in `crates/pdyn/src/cli/run.rs` (same message,
+//! scan ([`non_finite_columns`]) repeats the one in `crates/pdyn-cli/src/cli/run.rs` (same message,
 //! same columns) until the library resolves runs once for both front ends (issue 25, item 2).
 
 use crate::convert::{f64_matrix, stats_dict};

@@ -79,9 +79,9 @@ pub(crate) fn sweep(
         match threads {
             Some(n) => {
                 let pool = thread_pool(n)?;
-                pool.install(move || sweep::sweep(&prep, &set, &spec, &stats, false))
+                pool.install(move || sweep::sweep(&prep, &set, &spec, &stats, &sweep::quiet))
             }
-            None => sweep::sweep(&prep, &set, &spec, &stats, false),
+            None => sweep::sweep(&prep, &set, &spec, &stats, &sweep::quiet),
         }
         .map_err(sim_err)
     });

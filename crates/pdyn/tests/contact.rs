@@ -678,7 +678,7 @@ fn sweeps_run_hybrid_models_through_their_switches() {
     let spec = m.run.sweep.clone().unwrap();
     let stats: Vec<_> = spec.measures.iter().map(|x| x.stat).collect();
     let prep = sim::prepare(&mut m).unwrap();
-    let res = sim::sweep::sweep(&prep, &set, &spec, &stats, false).unwrap();
+    let res = sim::sweep::sweep(&prep, &set, &spec, &stats, &sim::sweep::quiet).unwrap();
     assert!(res.problems.is_empty(), "{:?}", res.problems);
     for (row, mu_k) in res.slices[0].table.iter().zip([0.1, 0.2, 0.3, 0.4]) {
         // mu_k = 0.1 slides 4.6 m and stops at 3.06 s: after t_end = 2, still sliding.

@@ -152,7 +152,7 @@ fn building_sweep_finds_the_natural_frequencies() {
     let spec = m.run.sweep.clone().unwrap();
     let stats: Vec<_> = spec.measures.iter().map(|x| x.stat).collect();
     let prep = sim::prepare(&mut m).unwrap();
-    let res = sim::sweep::sweep(&prep, &set, &spec, &stats, false).unwrap();
+    let res = sim::sweep::sweep(&prep, &set, &spec, &stats, &sim::sweep::quiet).unwrap();
     assert!(res.problems.is_empty(), "{:?}", res.problems);
     assert_eq!(res.slices.len(), 1);
     let y: Vec<f64> = res.slices[0].table.iter().map(|r| r[0]).collect();
@@ -344,7 +344,7 @@ fn two_parameter_sweep_covers_the_grid() {
     let spec = m.run.sweep.clone().unwrap();
     let stats: Vec<_> = spec.measures.iter().map(|x| x.stat).collect();
     let prep = sim::prepare(&mut m).unwrap();
-    let res = sim::sweep::sweep(&prep, &set, &spec, &stats, false).unwrap();
+    let res = sim::sweep::sweep(&prep, &set, &spec, &stats, &sim::sweep::quiet).unwrap();
     assert_eq!(res.runs, 6);
     assert_eq!(res.slices.len(), 2);
     assert_eq!(res.slices[0].fixed, vec![("d0".to_string(), 0.05)]);
@@ -687,7 +687,7 @@ fn sweep_measures_equal_the_full_path() {
                 if points.is_some() {
                     set.points = points;
                 }
-                let sw = sim::sweep::sweep(&prep, &set, &spec, &stats, false).unwrap();
+                let sw = sim::sweep::sweep(&prep, &set, &spec, &stats, &sim::sweep::quiet).unwrap();
                 for (k, &v) in spec.values.iter().enumerate() {
                     let p = prep.with_parameters(&[(spec.parameter, v)]);
                     let (full, res) = measures_from_rows(&p, &set, &stats);

@@ -291,7 +291,7 @@ pub fn member(p: &Prepared, set: &RunSettings, stats: &[Stat]) -> Member {
 /// The error `pdyn run` reports for output columns that hold NaN or infinity
 /// (`non_finite`, exit code 1): `origin: the output column(s) `x`, `y` (first at t = …)`.
 ///
-/// `crates/pdyn/src/cli/run.rs` builds the same message from the table itself; the Python
+/// `crates/pdyn-cli/src/cli/run.rs` builds the same message from the table itself; the Python
 /// bindings use this one for `Model.run` and every ensemble member.
 pub fn non_finite_error(origin: &str, columns: &[String], nf: &NonFinite) -> Error {
     let quoted: Vec<String> = nf

@@ -1,12 +1,12 @@
-//! Parameter sweeps: one run per value of a parameter, in parallel on all cores (rayon), with a
-//! progress bar (indicatif, on stderr when it is a terminal). A failed run is recorded with its
-//! message; it does not stop the others.
+//! Parameter sweeps: one run per value of a parameter, in parallel on all cores (rayon),
+//! reporting progress through a callback (the command line draws a bar with it). A failed run
+//! is recorded with its message; it does not stop the others.
 
 use super::measured::measure;
 use super::{Prepared, RunFailure, RunSettings, SimError};
-use indicatif::{ProgressBar, ProgressStyle};
 use pdyn_mech::model::spec::{Stat, SweepSpec};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Results of a sweep.
 #[derive(Clone, Debug)]
@@ -94,13 +94,19 @@ pub fn statistic(stat: Stat, t: &[f64], x: &[f64]) -> f64 {
     }
 }
 
+/// Told after each run, from the worker that did it: `(runs done, runs in all)`.
+pub type OnRun<'a> = &'a (dyn Fn(usize, usize) + Sync);
+
+/// No progress reporting.
+pub fn quiet(_: usize, _: usize) {}
+
 /// Runs the sweep: every value of the first parameter for every combination of the others.
 pub fn sweep(
     prep: &Prepared,
     set: &RunSettings,
     spec: &SweepSpec,
     stats: &[Stat],
-    progress: bool,
+    on_run: OnRun<'_>,
 ) -> Result<SweepResult, SimError> {
     set.validate()?;
     // Count the runs before building anything.
@@ -136,17 +142,7 @@ pub fn sweep(
     let jobs: Vec<(usize, f64)> = (0..combos.len())
         .flat_map(|ci| spec.values.iter().map(move |&v| (ci, v)))
         .collect();
-    let bar = if progress {
-        let b = ProgressBar::new(jobs.len() as u64);
-        if let Ok(style) = ProgressStyle::with_template(
-            "{spinner} sweep [{bar:40}] {pos}/{len} runs, {per_sec}, eta {eta}",
-        ) {
-            b.set_style(style.progress_chars("=> "));
-        }
-        b
-    } else {
-        ProgressBar::hidden()
-    };
+    let done = AtomicUsize::new(0);
     let n_meas = prep.measures.as_ref().map_or(0, |m| m.len());
     let results: Vec<(Vec<f64>, Option<RunProblem>)> = jobs
         .par_iter()
@@ -156,11 +152,10 @@ pub fn sweep(
             given.extend_from_slice(&combos[ci]);
             let p = base.with_parameters(&given);
             let out = measure_run(&p, set, stats, n_meas);
-            bar.inc(1);
+            on_run(done.fetch_add(1, Ordering::Relaxed) + 1, jobs.len());
             out
         })
         .collect();
-    bar.finish_and_clear();
     let name = |k: usize| prep.parameter_names.get(k).cloned().unwrap_or_default();
     let mut slices: Vec<Slice> = combos
         .iter()

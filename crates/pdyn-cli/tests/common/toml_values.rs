@@ -1,5 +1,5 @@
 //! Where the values are in a TOML file, for mutation testing and fuzzing: shared by
-//! `crates/pdyn/tests/mutations.rs` and the structure-aware fuzz targets (`fuzz/`).
+//! `crates/pdyn-cli/tests/mutations.rs` and the structure-aware fuzz targets (`fuzz/`).
 
 /// Byte ranges of the values in `key = value` lines (a quoted string or a bare token).
 pub fn value_spans(src: &str) -> Vec<(usize, usize)> {

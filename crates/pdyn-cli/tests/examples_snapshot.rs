@@ -162,7 +162,7 @@ fn slug(args: &[String]) -> String {
 
 #[test]
 fn every_example_prints_what_it_printed_before() {
-    let dir = root().join("crates/pdyn/tests/snapshots");
+    let dir = root().join("crates/pdyn-cli/tests/snapshots");
     let update = std::env::var_os("PDYN_UPDATE_SNAPSHOTS").is_some();
     let mut failures = Vec::new();
     let cases = cases();

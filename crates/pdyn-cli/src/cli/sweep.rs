@@ -38,7 +38,21 @@ pub fn run(a: SweepArgs) -> Result<Outcome, Error> {
         .sweep
         .as_ref()
         .map_or(Vec::new(), |s| s.measures.iter().map(|m| m.stat).collect());
-    let progress = std::io::stderr().is_terminal() && !a.run.json;
+    let bar = if std::io::stderr().is_terminal() && !a.run.json {
+        let b = indicatif::ProgressBar::new(0);
+        if let Ok(style) = indicatif::ProgressStyle::with_template(
+            "{spinner} sweep [{bar:40}] {pos}/{len} runs, {per_sec}, eta {eta}",
+        ) {
+            b.set_style(style.progress_chars("=> "));
+        }
+        b
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let progress = |done: usize, all: usize| {
+        bar.set_length(all as u64);
+        bar.set_position(done as u64);
+    };
     let res = match a.threads {
         Some(n) => {
             let pool = rayon::ThreadPoolBuilder::new()
@@ -48,11 +62,13 @@ pub fn run(a: SweepArgs) -> Result<Outcome, Error> {
                     Error::argument("--threads", format!("cannot start {n} threads: {e}"))
                 })?;
             let owned = prep.clone();
-            pool.install(move || sweep::sweep(&owned, &set, &spec, &stats, progress))
+            let on_run = &progress;
+            pool.install(move || sweep::sweep(&owned, &set, &spec, &stats, on_run))
         }
-        None => sweep::sweep(&prep, &set, &spec, &stats, progress),
+        None => sweep::sweep(&prep, &set, &spec, &stats, &progress),
     }
     .map_err(|e| sim_error(&model, "", e))?;
+    bar.finish_and_clear();
     let mut err = String::new();
     for (at, p) in &res.problems {
         let at: Vec<String> = at.iter().map(|(n, v)| format!("{n} = {v}")).collect();
