@@ -334,3 +334,16 @@ fn a_rate_in_unknowns_is_solved_by_forces_and_refused_by_run() {
     );
     assert!(!out.contains("NaN"), "{out}");
 }
+
+/// Output times given on the command line replace the file's spacing (issue 25: the run
+/// options are merged once, in `pdyn::sim::request`). The building's file says `points =
+/// 2001`; `--output-dt 1` used to lose to it silently (points come first), and now gives the
+/// 21 rows of t = 0, 1, …, 20, as Python's `t_eval=` always did.
+#[test]
+fn output_dt_on_the_command_line_replaces_the_files_points() {
+    let model = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/building.toml");
+    let (ok, out, err) = pdyn(&["run", model, "--output-dt", "1", "--json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["outputs"], 21, "{out}");
+}

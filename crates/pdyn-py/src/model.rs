@@ -13,7 +13,7 @@ use crate::sweep::SweepArgs;
 use numpy::{PyReadonlyArray1, PyReadonlyArray2};
 use pdyn::sim::{self, Prepared, RunSettings};
 use pdyn::Error;
-use pdyn_mech::model::spec::{SimulateSpec, Stat};
+use pdyn_mech::model::spec::Stat;
 use pyo3::prelude::*;
 use std::sync::Mutex;
 
@@ -101,32 +101,23 @@ impl PyModel {
         ))
     }
 
-    /// The model's `[simulate]` with the overrides given from Python applied.
+    /// The model's `[simulate]` with the overrides given from Python applied, by the same
+    /// library call as `pdyn run`'s flags (`pdyn::sim::request::settings`).
     pub(crate) fn settings(model: &pdyn_mech::Model, o: Overrides) -> Result<RunSettings, Error> {
-        let sim_err = |error| Error::Sim {
-            origin: model.origin.clone(),
-            context: "",
-            error,
-        };
-        let overrides = SimulateSpec {
-            t_end: o.t_end,
-            method: o.method.map(|m| (method_name(&m), 0..0)),
+        let req = sim::request::Request {
+            method: o.method.map(|m| method_name(&m)),
             rtol: o.rtol,
             atol: o.atol,
+            t_end: o.t_end,
             dt: o.dt,
             max_step: o.max_step,
             max_steps: o.max_steps,
             points: o.points,
             output_dt: None,
+            t_eval: o.t_eval,
             drift_tolerance: o.drift_tolerance,
         };
-        let mut file = model.run.simulate.clone();
-        if o.t_eval.is_some() || o.points.is_some() {
-            // Explicit output times replace the file's output spacing.
-            file.output_dt = None;
-            file.points = None;
-        }
-        RunSettings::resolve(&file, &overrides, o.t_eval).map_err(sim_err)
+        sim::request::settings(model, &req)
     }
 
     /// Derives and compiles `model`: the right-hand side as native code with `jit` (the
@@ -137,11 +128,7 @@ impl PyModel {
         } else {
             sim::JitMode::Off
         };
-        sim::prepare_with_jit(model, &sim::run_options(), mode).map_err(|error| Error::Sim {
-            origin: model.origin.clone(),
-            context: "",
-            error,
-        })
+        sim::request::prepare(model, mode)
     }
 }
 

@@ -1,15 +1,13 @@
 //! `Model.run`: one integration with the GIL released, returned as a dict of plain data (the
 //! Python layer builds `pdyn.OdeResult` from it).
 //!
-//! A run that finishes but tabulates NaN or infinity fails here as `pdyn run` fails: the
-//! scan ([`non_finite_columns`]) repeats the one in `crates/pdyn-cli/src/cli/run.rs` (same message,
-//! same columns) until the library resolves runs once for both front ends (issue 25, item 2).
+//! The run is `pdyn::sim::request::execute`, as for `pdyn run`: numerical, or the closed form
+//! with `method="exact"`; a run that finishes but tabulates NaN or infinity fails with the same
+//! error (`pdyn::sim::request::non_finite`).
 
 use crate::convert::{f64_matrix, stats_dict};
 use crate::errors::to_py;
 use crate::model::{Overrides, PyModel};
-use pdyn::sim::ensemble::non_finite_error;
-use pdyn::sim::measured::NonFinite;
 use pdyn::sim::{self, RunResult};
 use pdyn::Error;
 use pyo3::prelude::*;
@@ -30,11 +28,9 @@ pub(crate) fn run(
         let mut m = model.with_params(params)?;
         let set = PyModel::settings(&m, o)?;
         let prep = PyModel::prepare(&mut m, jit)?;
-        let res = sim::run(&prep, &set).map_err(|error| Error::Sim {
-            origin: m.origin.clone(),
-            context: "",
-            error,
-        })?;
+        // The failure is read back from the result by `run_dict` (with the non-finite columns'
+        // names for `OdeResult`).
+        let (res, _) = sim::request::execute(&mut m, &prep, &set)?;
         if let Some(dir) = &plots {
             // pdyn's own PNG/SVG plots, as `pdyn run --out DIR`.
             std::fs::create_dir_all(dir).map_err(|e| {
@@ -126,7 +122,7 @@ fn run_dict(
 /// The output columns of a run that hold NaN or infinity, the first time one does, and the
 /// error `pdyn run` reports for them (`non_finite`, exit code 1); `None` when all are finite.
 fn non_finite_columns(origin: &str, res: &RunResult) -> Option<(Vec<String>, f64, Error)> {
-    let nf = NonFinite::of_rows(&res.rows)?;
+    let (nf, error) = sim::request::non_finite(origin, res)?;
     let names: Vec<String> = nf.columns.iter().map(|&c| res.columns[c].clone()).collect();
-    Some((names, nf.t, non_finite_error(origin, &res.columns, &nf)))
+    Some((names, nf.t, error))
 }

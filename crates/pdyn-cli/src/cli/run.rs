@@ -5,7 +5,6 @@ use clap::Args;
 use pdyn::output::{summary, write_csv};
 use pdyn::sim::{self, RunSettings, SimError};
 use pdyn::Error;
-use pdyn_mech::model::spec::SimulateSpec;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -84,120 +83,34 @@ impl RunArgs {
     }
 }
 
-/// Derives and compiles the model as the options ask.
-pub(crate) fn prepare(model: &mut pdyn_mech::Model, a: &RunArgs) -> Result<sim::Prepared, Error> {
-    sim::prepare_with_jit(model, &sim::run_options(), a.jit()).map_err(|e| sim_error(model, "", e))
-}
-
-/// Merges `[simulate]` and the command line.
-pub fn settings(model: &pdyn_mech::Model, a: &RunArgs) -> Result<RunSettings, Error> {
-    // Every command that runs the motion reads its settings first: an initial condition left
-    // to `pdyn forces` is the first thing to report, at its place in the file.
-    if let Some(error) = model.unknown_initial_error() {
-        return Err(sim_error(
-            model,
-            "",
-            SimError::UnknownInitialCondition(Box::new(error)),
-        ));
-    }
-    let s = &model.run.simulate;
-    // A method named in the file is checked here, where its place in the file is known.
-    if let (None, Some((m, span))) = (&a.method, &s.method) {
-        if sim::method_by_name(m).is_none() {
-            let error = pdyn_mech::ModelError::new(
-                &model.origin,
-                span.clone(),
-                format!("unknown method `{m}`"),
-            )
-            .help("run `pdyn run --method help` for the list");
-            return Err(Error::Model {
-                error,
-                source: model.source.as_str().into(),
-            });
-        }
-    }
-    let overrides = SimulateSpec {
-        t_end: a.t_end,
-        method: a.method.clone().map(|m| (m, 0..0)),
+/// The run options the flags give (the library merges them with `[simulate]`).
+pub fn request(a: &RunArgs) -> sim::request::Request {
+    sim::request::Request {
+        method: a.method.clone(),
         rtol: a.rtol,
         atol: a.atol,
+        t_end: a.t_end,
         dt: a.dt,
         max_step: a.max_step,
         max_steps: a.max_steps,
         points: a.points,
         output_dt: a.output_dt,
+        t_eval: (!a.t_eval.is_empty()).then(|| a.t_eval.clone()),
         drift_tolerance: a.drift_tolerance,
-    };
-    let t_eval = (!a.t_eval.is_empty()).then(|| a.t_eval.clone());
-    let set = RunSettings::resolve(s, &overrides, t_eval).map_err(|e| sim_error(model, "", e))?;
-    file_value_error(model, a, set.validate())?;
-    Ok(set)
-}
-
-/// A setting the runner refuses that was written in the file, not on the command line, is
-/// shown at its key in `[simulate]` (it named `--output-dt`, with no place).
-fn file_value_error(
-    model: &pdyn_mech::Model,
-    a: &RunArgs,
-    checked: Result<(), SimError>,
-) -> Result<(), Error> {
-    let Err(error) = checked else { return Ok(()) };
-    let (option, message) = match &error {
-        SimError::InvalidOption {
-            option,
-            value,
-            requirement,
-        } => (*option, format!("must be {requirement}, got {value}")),
-        SimError::InvalidEndTime(t) => ("--t-end", format!("must be a positive time, got {t}")),
-        _ => return Err(sim_error(model, "", error)),
-    };
-    let from_file = match option {
-        "--t-end" => a.t_end.is_none(),
-        "--rtol" => a.rtol.is_none(),
-        "--atol" => a.atol.is_none(),
-        "--dt" => a.dt.is_none(),
-        "--max-step" => a.max_step.is_none(),
-        "--output-dt" => a.output_dt.is_none(),
-        "--points" => a.points.is_none(),
-        "--max-steps" => a.max_steps.is_none(),
-        _ => false,
-    };
-    let span = model.run.simulate_spans.iter().find(|(o, _)| *o == option);
-    match span {
-        Some((_, span)) if from_file => {
-            let key = option.trim_start_matches("--").replace('-', "_");
-            let error = pdyn_mech::ModelError::new(
-                &model.origin,
-                span.clone(),
-                format!("`{key}` in [simulate] {message}"),
-            )
-            .help(format!(
-                "change it in the file, or override it with {option}"
-            ));
-            Err(Error::Model {
-                error,
-                source: model.source.as_str().into(),
-            })
-        }
-        _ => Err(sim_error(model, "", error)),
     }
 }
 
-/// A simulation error located in the model file, with what was being attempted.
-pub(crate) fn sim_error(model: &pdyn_mech::Model, context: &'static str, error: SimError) -> Error {
-    // A problem with a place in the model file is shown at that place.
-    if let SimError::UnknownInitialCondition(error) = error {
-        return Error::Model {
-            error: *error,
-            source: model.source.as_str().into(),
-        };
-    }
-    Error::Sim {
-        origin: model.origin.clone(),
-        context,
-        error,
-    }
+/// Derives and compiles the model as the options ask.
+pub(crate) fn prepare(model: &mut pdyn_mech::Model, a: &RunArgs) -> Result<sim::Prepared, Error> {
+    sim::request::prepare(model, a.jit())
 }
+
+/// Merges `[simulate]` and the command line.
+pub fn settings(model: &pdyn_mech::Model, a: &RunArgs) -> Result<RunSettings, Error> {
+    sim::request::settings(model, &request(a))
+}
+
+pub(crate) use sim::request::located as sim_error;
 
 pub(crate) fn io_error(path: &Path, action: &'static str, e: std::io::Error) -> Error {
     Error::Io {
@@ -226,25 +139,11 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
         set.points = Some(2001);
     }
     let prep = prepare(&mut model, &a)?;
-    let res = if set.method == "exact" {
-        let exact = sim::exact::closed_form(&mut model)
-            .map_err(|e| sim_error(&model, "--method exact: ", SimError::NoClosedForm(e)))?;
-        sim::exact::run_exact(&prep, &exact, &set).map_err(|e| sim_error(&model, "", e))?
-    } else {
-        sim::run(&prep, &set).map_err(|e| sim_error(&model, "", e))?
-    };
+    let (res, failure) = sim::request::execute(&mut model, &prep, &set)?;
     let mut stderr = String::new();
     for w in &res.warnings {
         stderr += &format!("warning: {w}\n");
     }
-    let failure = res
-        .failure
-        .clone()
-        .map(|failure| Error::Integration {
-            origin: model.origin.clone(),
-            failure: Box::new(failure),
-        })
-        .or_else(|| non_finite_columns(&model, &res));
     let mut sum = summary(&res, &model.name, &prep.state_names, set.drift_tolerance);
     if let Some(f) = &failure {
         sum["error"] = f.to_json()["error"].clone();
@@ -283,32 +182,6 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
         stdout,
         stderr,
         failure,
-    })
-}
-
-/// A run that finished but tabulated NaN or infinity (a division by zero or a function outside
-/// its domain in a position, a monitor, the energy): a failure naming the columns and the
-/// first time, so that the exit code is not 0.
-fn non_finite_columns(model: &pdyn_mech::Model, res: &sim::RunResult) -> Option<Error> {
-    let bad: Vec<usize> = (0..res.columns.len())
-        .filter(|&c| res.rows.iter().any(|r| !r[c].is_finite()))
-        .collect();
-    let first_t = res
-        .rows
-        .iter()
-        .find(|r| r.iter().any(|x| !x.is_finite()))
-        .map(|r| r[0])?;
-    let names: Vec<String> = bad
-        .iter()
-        .map(|&c| format!("`{}`", res.columns[c]))
-        .collect();
-    Some(Error::NonFinite {
-        what: format!(
-            "{}: the output column(s) {} (first at t = {first_t:e})",
-            model.origin,
-            names.join(", ")
-        ),
-        components: bad,
     })
 }
 

@@ -7,7 +7,7 @@
 //! with the GIL released and turn the typed [`Ensemble`] into NumPy arrays. Nothing here knows
 //! about Python.
 
-use super::measured::{measure, NonFinite};
+use super::measured::measure;
 use super::{Prepared, RunSettings};
 use crate::Error;
 use pdyn_mech::model::spec::Stat;
@@ -269,7 +269,7 @@ pub fn member(p: &Prepared, set: &RunSettings, stats: &[Stat]) -> Member {
     out.message = res.failure.as_ref().map(|f| f.to_string());
     if let (None, Some(nf)) = (&res.failure, &res.non_finite) {
         out.status = -1;
-        out.message = Some(non_finite_error("this run", &p.columns(), nf).to_string());
+        out.message = Some(nf.error("this run", &p.columns()).to_string());
     }
     if let Some((t, y)) = res.last {
         out.t_final = t;
@@ -286,27 +286,6 @@ pub fn member(p: &Prepared, set: &RunSettings, stats: &[Stat]) -> Member {
         out.measures = res.measures;
     }
     out
-}
-
-/// The error `pdyn run` reports for output columns that hold NaN or infinity
-/// (`non_finite`, exit code 1): `origin: the output column(s) `x`, `y` (first at t = …)`.
-///
-/// `crates/pdyn-cli/src/cli/run.rs` builds the same message from the table itself; the Python
-/// bindings use this one for `Model.run` and every ensemble member.
-pub fn non_finite_error(origin: &str, columns: &[String], nf: &NonFinite) -> Error {
-    let quoted: Vec<String> = nf
-        .columns
-        .iter()
-        .map(|&c| format!("`{}`", columns[c]))
-        .collect();
-    Error::NonFinite {
-        what: format!(
-            "{origin}: the output column(s) {} (first at t = {:e})",
-            quoted.join(", "),
-            nf.t
-        ),
-        components: nf.columns.clone(),
-    }
 }
 
 /// A rayon pool with `n` threads (at least one): the `threads=` of a sweep or an ensemble.

@@ -231,6 +231,25 @@ pub struct NonFinite {
 }
 
 impl NonFinite {
+    /// The error every front end reports for these columns (`non_finite`, exit code 1):
+    /// `origin: the output column(s) `x`, `y` (first at t = …)`; `columns` names the table's
+    /// columns.
+    pub fn error(&self, origin: &str, columns: &[String]) -> crate::Error {
+        let quoted: Vec<String> = self
+            .columns
+            .iter()
+            .map(|&c| format!("`{}`", columns[c]))
+            .collect();
+        crate::Error::NonFinite {
+            what: format!(
+                "{origin}: the output column(s) {} (first at t = {:e})",
+                quoted.join(", "),
+                self.t
+            ),
+            components: self.columns.clone(),
+        }
+    }
+
     /// The non-finite values of a table ([`super::RunResult::rows`]), `None` if all are finite.
     pub fn of_rows(rows: &[Vec<f64>]) -> Option<NonFinite> {
         // The common case, every value finite, in one pass the compiler vectorizes: `0·x` is

@@ -17,6 +17,7 @@ mod error;
 pub mod exact;
 pub mod hybrid;
 pub mod measured;
+pub mod request;
 pub mod sweep;
 
 pub use error::{ClosedFormError, RunFailure, SimError};
