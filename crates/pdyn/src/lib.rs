@@ -10,6 +10,7 @@ pub mod dsolve;
 pub mod error;
 pub mod kin;
 pub mod md;
+pub mod model_file;
 pub mod nbody;
 pub mod output;
 pub mod params;

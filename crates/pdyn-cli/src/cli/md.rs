@@ -14,33 +14,6 @@ use std::sync::Arc;
 /// Steps × atoms above which a progress bar is shown (when stderr is a terminal).
 const PROGRESS_WORK: u64 = 20_000_000;
 
-/// The text of `path` when it is a molecular-dynamics model.
-pub fn md_source(path: &Path) -> Option<String> {
-    let source = std::fs::read_to_string(path).ok()?;
-    md::is_md_source(&source).then_some(source)
-}
-
-/// The error of a command other than `run` given a molecular-dynamics model (`source`), at
-/// its `[md]` table; `None` when `source` is not one.
-pub fn refusal(path: &Path, source: &str) -> Option<Error> {
-    if !md::is_md_source(source) {
-        return None;
-    }
-    let at = source.find("[md").unwrap_or(0);
-    // four characters, ending on a character boundary
-    let len: usize = source[at..].chars().take(4).map(char::len_utf8).sum();
-    let error = ModelError::new(
-        &path.display().to_string(),
-        at..at + len,
-        "molecular-dynamics model: use `pdyn run` (this command works on mechanics models)",
-    )
-    .help("an [md] model has pair potentials and thermostats, not equations of motion to derive");
-    Some(Error::Model {
-        error,
-        source: source.into(),
-    })
-}
-
 fn model_err(error: ModelError, source: &str) -> Error {
     Error::Model {
         error,

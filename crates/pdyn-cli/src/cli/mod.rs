@@ -100,24 +100,10 @@ pub fn both(pool: &Pool, id: Id) -> serde_json::Value {
     serde_json::json!({"text": pool.to_text(id), "latex": pool.to_latex(id)})
 }
 
-/// Loads a model file; errors keep the file's text so that they can show the offending line.
+/// Loads a mechanics model file (read once); errors keep the file's text so that they can
+/// show the offending line, and an `[nbody]` or `[md]` model says `pdyn run` runs it.
 pub fn load_model(path: &Path) -> Result<pdyn_mech::Model, Error> {
-    let source = Error::read_model_file(path)?;
-    if let Some(span) = pdyn::nbody::spec::nbody_table_span(&source) {
-        let error = pdyn_mech::ModelError::new(&path.display().to_string(), span, "N-body model: use `pdyn run`")
-            .help("an [nbody] table is integrated by pdyn run; it has no symbolic equations (docs/nbody.md)");
-        return Err(Error::Model {
-            error,
-            source: source.into(),
-        });
-    }
-    pdyn_mech::load(&source, &path.display().to_string()).map_err(|error| {
-        // an [md] model is not a mechanics model: say which command runs it
-        md::refusal(path, &source).unwrap_or_else(|| Error::Model {
-            error,
-            source: source.into(),
-        })
-    })
+    pdyn::model_file::ModelFile::read(path)?.mechanics()
 }
 
 /// `name=number` pairs of a comma-separated option such as `--at t=0,theta=0.5`.

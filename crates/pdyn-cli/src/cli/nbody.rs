@@ -8,12 +8,6 @@ use pdyn::nbody::{self, output};
 use pdyn::Error;
 use std::path::Path;
 
-/// Whether the file at `path` is an N-body model. A file that cannot be read or is not TOML
-/// is not (the mechanics loader then reports why, as for any model).
-pub fn is_nbody_file(path: &Path) -> bool {
-    std::fs::read_to_string(path).is_ok_and(|s| nbody::spec::is_nbody_source(&s))
-}
-
 const HELP: &str = "N-body integrators (integrator = \"...\" in [nbody], or --method):
   whfast    Wisdom-Holman map in Jacobi coordinates with symplectic correctors (Rein & Tamayo
             2015, MNRAS 452, 376); fixed step dt, corrector = 0, 3, 5, 7, 11 or 17. Planetary
@@ -26,12 +20,11 @@ const HELP: &str = "N-body integrators (integrator = \"...\" in [nbody], or --me
 ";
 
 /// `pdyn run` on an N-body model.
-pub fn run(a: RunArgs) -> Result<Outcome, Error> {
+pub fn run(a: RunArgs, file: pdyn::model_file::ModelFile) -> Result<Outcome, Error> {
     if a.method.as_deref() == Some("help") {
         return Ok(Outcome::text(HELP.into()));
     }
-    let source = Error::read_model_file(&a.model)?;
-    let origin = a.model.display().to_string();
+    let (source, origin) = (file.source, file.origin);
     let set = numeric_pairs(&a.set, "--set")?;
     let request = nbody::request::Request {
         method: a.method.clone(),

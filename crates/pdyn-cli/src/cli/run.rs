@@ -2,6 +2,7 @@
 
 use super::{load_model, set_parameters, Outcome};
 use clap::Args;
+use pdyn::model_file::Kind;
 use pdyn::output::{summary, write_csv};
 use pdyn::sim::{self, RunSettings, SimError};
 use pdyn::Error;
@@ -122,16 +123,15 @@ pub(crate) fn io_error(path: &Path, action: &'static str, e: std::io::Error) -> 
 
 /// `pdyn run MODEL`.
 pub fn run(a: RunArgs) -> Result<Outcome, Error> {
-    if super::nbody::is_nbody_file(&a.model) {
-        return super::nbody::run(a);
+    // Read once, told apart once; each kind has its own engine (and its own `--method help`).
+    let file = pdyn::model_file::ModelFile::read(&a.model)?;
+    match file.kind {
+        Kind::Nbody => return super::nbody::run(a, file),
+        _ if a.method.as_deref() == Some("help") => return Ok(Outcome::text(sim::methods_help())),
+        Kind::Md => return super::md::run(a, file.source),
+        Kind::Mechanics => {}
     }
-    if a.method.as_deref() == Some("help") {
-        return Ok(Outcome::text(sim::methods_help()));
-    }
-    if let Some(source) = super::md::md_source(&a.model) {
-        return super::md::run(a, source);
-    }
-    let mut model = load_model(&a.model)?;
+    let mut model = file.mechanics()?;
     set_parameters(&mut model, &a.set)?;
     let mut set = settings(&model, &a)?;
     if a.plot && set.points.is_none() && set.output_dt.is_none() && set.t_eval.is_none() {

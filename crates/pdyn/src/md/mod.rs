@@ -48,11 +48,3 @@ pub fn load(source: &str, origin: &str, set: &[(String, f64)]) -> Result<MdSpec,
     }
     Ok(spec)
 }
-
-/// True when `source` is a TOML document with a top-level `[md]` table (a molecular-dynamics
-/// model). A document that does not parse is not one: the mechanics loader reports its error.
-pub fn is_md_source(source: &str) -> bool {
-    source
-        .parse::<toml::Table>()
-        .is_ok_and(|t| t.contains_key("md"))
-}

@@ -293,12 +293,6 @@ pub struct SpecError {
     pub source: String,
 }
 
-/// Whether a TOML text has a top-level `[nbody]` table (what `pdyn run` dispatches on).
-/// Text that is not TOML is not an N-body model (the mechanics loader reports it).
-pub fn is_nbody_source(source: &str) -> bool {
-    nbody_table_span(source).is_some()
-}
-
 /// Where the top-level `[nbody]` table is, when there is one.
 pub fn nbody_table_span(source: &str) -> Option<Range<usize>> {
     #[derive(Deserialize)]
