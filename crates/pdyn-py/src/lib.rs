@@ -15,6 +15,7 @@
 //! | [`convert`] | arrays, statistics, dicts as TOML, `(text, latex)` |
 //! | [`model`] | `pdyn.Model` and its one `#[pymethods]` block |
 //! | [`run`] | `Model.run` |
+//! | [`particles`] | `[nbody]` and `[md]` model files: load, run |
 //! | [`derive`] | `Model.derive`, `Model.forces` |
 //! | [`sweep`] | `Model.sweep` |
 //! | [`ensemble`] | `Model.ensemble` (the engine is [`pdyn::sim::ensemble`]) |
@@ -27,6 +28,7 @@ mod derive;
 mod ensemble;
 mod errors;
 mod model;
+mod particles;
 mod run;
 mod solve_ivp;
 mod sweep;
@@ -55,6 +57,8 @@ fn methods(py: Python<'_>) -> PyResult<Vec<(String, String)>> {
 #[pymodule]
 fn _pdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<model::PyModel>()?;
+    m.add_class::<particles::PyParticleModel>()?;
+    m.add_function(wrap_pyfunction!(particles::load_model, m)?)?;
     m.add_function(wrap_pyfunction!(solve_ivp::_solve_ivp, m)?)?;
     m.add_function(wrap_pyfunction!(methods, m)?)?;
     m.add_function(wrap_pyfunction!(symbolic::_kin, m)?)?;

@@ -151,7 +151,7 @@ impl PyModel {
     /// Loads a model from TOML text; `origin` names it in error messages.
     #[staticmethod]
     #[pyo3(signature = (text, origin = "<string>"))]
-    fn from_toml(py: Python<'_>, text: &str, origin: &str) -> PyResult<PyModel> {
+    pub(crate) fn from_toml(py: Python<'_>, text: &str, origin: &str) -> PyResult<PyModel> {
         guarded(py, || {
             pdyn_mech::load(text, origin)
                 .map(PyModel::new)

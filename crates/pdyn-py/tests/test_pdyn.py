@@ -426,7 +426,7 @@ def test_method_exact_runs_the_closed_form_like_the_cli(examples, pdyn_bin):
     scale = np.max(np.abs(num.y[:2] - num.y[:2, :1]))
     assert np.max(np.abs(ex.y[:2] - num.y[:2])) < 1e-8 * max(scale, 1.0)
     code, summary = cli_json(pdyn_bin, "run", str(path), "--method", "exact",
-                             "--t-eval", ",".join(repr(x) for x in t),
+                             "--t-eval", ",".join(repr(float(x)) for x in t),
                              "--set", "omega=8.740320488976")
     assert code == 0
     for name in ["y1", "y2", "y1'", "y2'"]:

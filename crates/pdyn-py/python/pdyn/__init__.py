@@ -33,7 +33,7 @@ np = LazyModule("numpy")  # imported on first use
 from . import _pdyn
 from ._errors import DriftWarning, ModelError, ParameterError, PdynError
 from ._result import (DenseOutput, Derivation, EnsembleResult, Expr, ForcesResult,
-                      OdeResult, SweepResult,
+                      OdeResult, ParticleResult, SweepResult, Table,
                       _concat_raw, _from_ivp, _from_run)
 from ._symbolic import (DsolveCase, DsolveResult, KinInstant, KinResult, RuleResult, Vector,
                         dsolve, kin)
@@ -226,16 +226,33 @@ class Model:
 
     @classmethod
     def from_file(cls, path: Union[str, "os.PathLike[str]"]) -> "Model":
-        """Loads a model file (TOML, see docs/model-format.md)."""
+        """Loads a model file (TOML): a mechanics model (docs/model-format.md), an N-body
+        model (an ``[nbody]`` table, docs/nbody.md) or a molecular-dynamics model (``[md]``,
+        docs/md.md), as ``pdyn run`` reads them."""
         path = os.fspath(path)
         with open(path, encoding="utf-8") as f:
             text = f.read()
-        return cls(_pdyn.Model.from_toml(text, path))
+        return cls(_pdyn.load_model(text, path))
 
     @classmethod
     def from_toml(cls, text: str, origin: str = "<string>") -> "Model":
-        """Loads a model from TOML text; ``origin`` names it in error messages."""
-        return cls(_pdyn.Model.from_toml(text, origin))
+        """Loads a model from TOML text (any kind, as :meth:`from_file`); ``origin`` names it
+        in error messages."""
+        return cls(_pdyn.load_model(text, origin))
+
+    @property
+    def kind(self) -> str:
+        """``"mechanics"``, ``"nbody"`` or ``"md"``."""
+        m = self._m
+        return m.kind if isinstance(m, _pdyn.ParticleModel) else "mechanics"
+
+    def _mechanics(self) -> "_pdyn.Model":
+        # The commands for mechanics models only refuse an [nbody] or [md] model with the
+        # CLI's located error (ModelError) saying that `run` runs it.
+        m = self._m
+        if isinstance(m, _pdyn.ParticleModel):
+            m.refuse()
+        return m
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> "Model":
@@ -288,6 +305,11 @@ class Model:
         the right-hand side as native code (Cranelift), ``False`` for the interpreter (the
         same results bit for bit).
 
+        An ``[nbody]`` or ``[md]`` model runs on its own engine, as ``pdyn run`` runs it
+        (``method``: ``whfast``, ``ias15``, ``leapfrog`` for N-body; ``dt``, ``t_end``,
+        ``points``/``t_eval``, ``drift_tolerance``, ``params``; ``plots``: a directory for the
+        files ``pdyn run --out DIR`` writes) and returns a :class:`ParticleResult`.
+
         Returns an :class:`OdeResult` (``success=False`` with the partial solution when the
         integration fails, or when an output column becomes NaN or infinite: ``status``
         -1, ``message`` naming the columns and the first time, ``non_finite`` the columns,
@@ -296,6 +318,10 @@ class Model:
         more than ``drift_tolerance`` (relative, default 5e-3). The GIL is released while
         the integration runs.
         """
+        m = self._m
+        if isinstance(m, _pdyn.ParticleModel):
+            return self._run_particles(m, t_end, method, rtol, atol, t_eval, max_step, dt,
+                                       max_steps, points, drift_tolerance, params, plots, jit)
         te = None if t_eval is None else _array1(t_eval, "t_eval")
         raw = self._m.run(t_end=t_end, method=method, rtol=rtol, atol=atol, t_eval=te,
                           max_step=max_step, dt=dt, max_steps=max_steps, points=points,
@@ -303,10 +329,25 @@ class Model:
                           plots=None if plots is None else os.fspath(plots), jit=bool(jit))
         return _from_run(raw, list(raw["event_names"]))
 
+    def _run_particles(self, m: "_pdyn.ParticleModel", t_end, method, rtol, atol, t_eval,
+                       max_step, dt, max_steps, points, drift_tolerance, params, plots,
+                       jit) -> ParticleResult:
+        for name, given in (("rtol", rtol), ("atol", atol), ("max_step", max_step),
+                            ("max_steps", max_steps)):
+            if given is not None:
+                raise ParameterError(
+                    f"{name} does not apply to {m.kind} models (fixed-step or IAS15 "
+                    "integrators: give dt, t_end, points or t_eval)")
+        te = None if t_eval is None else [float(x) for x in _array1(t_eval, "t_eval")]
+        raw = m.run(t_end=t_end, method=method, dt=dt, points=points, t_eval=te,
+                    drift_tolerance=drift_tolerance, params=_params(params),
+                    out=None if plots is None else os.fspath(plots), jit=bool(jit))
+        return ParticleResult(raw)
+
     def derive(self) -> Derivation:
         """The equations of motion (F = ma or the projected form), the unknowns, their exact
         solution when the system is small, and the first-order system."""
-        return Derivation(self._m.derive())
+        return Derivation(self._mechanics().derive())
 
     def forces(self, at: Optional[Mapping[str, float]] = None,
                params: Optional[Mapping[str, float]] = None) -> ForcesResult:
@@ -316,7 +357,7 @@ class Model:
         the equations, the unknowns, their exact solution (``symbolic``) and values
         (``values``: one dict per real solution), and the ``[[checks]]`` (critical values
         of a parameter, e.g. the speeds at which a car skids)."""
-        raw = self._m.forces(at=_params(at), params=_params(params))
+        raw = self._mechanics().forces(at=_params(at), params=_params(params))
         return ForcesResult(raw)
 
     def sweep(self, param: str, values: Sequence[float],
@@ -337,7 +378,7 @@ class Model:
         interpreter; the same results).
         """
         ms = _measures(measures)
-        raw = self._m.sweep(str(param), _array1(values, "values"), measures=ms, t_end=t_end,
+        raw = self._mechanics().sweep(str(param), _array1(values, "values"), measures=ms, t_end=t_end,
                             method=method, rtol=rtol, atol=atol, max_step=max_step, dt=dt,
                             points=points, threads=threads, params=_params(params),
                             jit=bool(jit))
@@ -350,7 +391,7 @@ class Model:
 
     def _names(self) -> Tuple[List[str], List[str]]:
         """(parameter names, state names) in model order."""
-        raw = self._m.ensemble([], np.empty((0, 0)), [], dry_run=True)
+        raw = self._mechanics().ensemble([], np.empty((0, 0)), [], dry_run=True)
         return list(self.parameters), list(raw["state_names"])
 
     def check_ensemble(self, params: Any = None, initial: Any = None) -> List[Tuple[int, str]]:
@@ -358,7 +399,7 @@ class Model:
         :class:`ParameterError`; returns ``[(row, message)]`` for the rows whose parameter
         values the model refuses (a mass <= 0, a value that is not finite)."""
         pn, pm, sn, sm = self._ensemble_inputs(params, initial)
-        raw = self._m.ensemble(pn, pm, sn, sm, dry_run=True)
+        raw = self._mechanics().ensemble(pn, pm, sn, sm, dry_run=True)
         return [(int(r), m) for r, m in raw["problems"]]
 
     def _ensemble_inputs(self, params: Any, initial: Any):
@@ -437,13 +478,13 @@ class Model:
             except ImportError:
                 bar = None
         if bar is None:
-            raw = self._m.ensemble(pn, pm, sn, sm, **kw)
+            raw = self._mechanics().ensemble(pn, pm, sn, sm, **kw)
         else:
             parts = []
             step = max(1, -(-runs // 20))
             for a in range(0, runs, step):
                 b = min(runs, a + step)
-                parts.append(self._m.ensemble(pn, np.ascontiguousarray(pm[a:b]), sn,
+                parts.append(self._mechanics().ensemble(pn, np.ascontiguousarray(pm[a:b]), sn,
                                               None if sm is None else
                                               np.ascontiguousarray(sm[a:b]), **kw))
                 bar.update(b - a)

@@ -119,6 +119,28 @@ class ForcesResult:
 class _Parameters(Dict[str, float]):
     def __call__(self, **values: Any) -> None: ...
 
+class Table:
+    columns: List[str]
+    data: np.ndarray
+    def __getitem__(self, name: str) -> np.ndarray: ...
+    def __len__(self) -> int: ...
+    def to_pandas(self) -> Any: ...
+
+class ParticleResult:
+    kind: str
+    summary: Dict[str, Any]
+    success: bool
+    message: str
+    warnings: List[str]
+    t: np.ndarray
+    names: List[str]
+    trajectory: Table
+    elements: Table
+    conservation: Table
+    thermo: Table
+    rdf: Optional[Tuple[np.ndarray, np.ndarray]]
+    msd: Table
+
 class Model:
     def __init__(self, name: str = ...) -> None: ...
     def coordinate(self, name: str, initial: Any = ..., rate: Any = ...,
@@ -145,6 +167,8 @@ class Model:
     def source(self) -> str: ...
     @property
     def parameters(self) -> _Parameters: ...
+    @property
+    def kind(self) -> str: ...
     def run(self, t_end: Optional[float] = ..., method: Optional[str] = ...,
             rtol: Optional[float] = ..., atol: Optional[float] = ...,
             t_eval: Optional[Sequence[float]] = ..., max_step: Optional[float] = ...,
@@ -152,7 +176,7 @@ class Model:
             points: Optional[int] = ..., drift_tolerance: Optional[float] = ...,
             params: Optional[Mapping[str, float]] = ...,
             plots: Optional[Union[str, os.PathLike[str]]] = ...,
-            jit: bool = ...) -> OdeResult: ...
+            jit: bool = ...) -> Union[OdeResult, ParticleResult]: ...
     def derive(self) -> Derivation: ...
     def sweep(self, param: str, values: Sequence[float],
               measures: Optional[Mapping[str, Union[str, Tuple[str, str]]]] = ...,

@@ -526,3 +526,79 @@ class ForcesResult:
     def _repr_latex_(self) -> str:
         rows = " \\\\ ".join(f"{l.latex()} &= {r.latex()}" for _, l, r in self.equations)
         return "$\\begin{aligned}" + rows + "\\end{aligned}$"
+
+
+class Table:
+    """Named columns of equal length (float64 arrays): ``tab["energy"]``, ``tab.columns``,
+    ``tab.data`` (rows × columns), :meth:`to_pandas`."""
+
+    __slots__ = ("columns", "data")
+
+    def __init__(self, raw: Dict[str, Any]):
+        self.columns: List[str] = list(raw["columns"])
+        self.data = raw["data"]
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        try:
+            return self.data[:, self.columns.index(name)]
+        except ValueError:
+            raise KeyError(f"no column {name!r} (columns: {', '.join(self.columns)})") from None
+
+    def __len__(self) -> int:
+        return self.data.shape[0]
+
+    def to_pandas(self) -> Any:
+        """A ``pandas.DataFrame`` of the table."""
+        import pandas as pd
+        return pd.DataFrame(self.data, columns=self.columns)
+
+    def __repr__(self) -> str:
+        return f"Table({len(self)} rows: {', '.join(self.columns)})"
+
+
+class ParticleResult:
+    """What running an ``[nbody]`` or ``[md]`` model returns (:meth:`pdyn.Model.run`), with
+    the numbers ``pdyn run`` prints.
+
+    Every kind: ``kind`` (``"nbody"``, ``"md"``), ``summary`` (the dict of the CLI's
+    ``summary.json``, docs/summary.md), ``success``, ``message``, ``warnings``.
+    N-body: ``t`` (output times), ``names`` (bodies, in the order ``body`` indexes),
+    ``trajectory`` (:class:`Table` with ``t, body, mass, x, y, z, vx, vy, vz``, one row per body
+    and output; empty when trajectories are off), ``elements`` (``t, body, a, e, inc, Omega,
+    omega, f, M, period``), ``conservation`` (``t, n, energy, kinetic, potential, Lx, Ly,
+    Lz``). MD: ``thermo`` (``step, time, temperature, kinetic, potential, total, pressure,
+    conserved``), ``rdf`` (``(r, g)`` arrays or ``None``), ``msd`` (``step, time, msd``).
+    Drifting conserved quantities are warned as :class:`DriftWarning`, other warnings as
+    ``RuntimeWarning``.
+    """
+
+    def __init__(self, raw: Dict[str, Any]):
+        self.kind: str = raw["kind"]
+        self.summary: Dict[str, Any] = json.loads(raw["summary"])
+        self.success: bool = raw["failure"] is None
+        self.message: str = raw["failure"] or "The run finished."
+        self.warnings: List[str] = list(raw["warnings"])
+        if self.kind == "nbody":
+            self.t = raw["t"]
+            self.names: List[str] = list(raw["names"])
+            self.trajectory = Table(raw["trajectory"])
+            self.elements = Table(raw["elements"])
+            self.conservation = Table(raw["conservation"])
+        else:
+            self.thermo = Table(raw["thermo"])
+            self.rdf = None if raw["rdf_r"] is None else (raw["rdf_r"], raw["rdf_g"])
+            self.msd = Table(raw["msd"])
+        drifting = {m["name"]: m for m in self.summary["monitors"] if not m["ok"]}
+        for w in self.warnings:
+            mon = next((m for name, m in drifting.items()
+                        if name.replace("_", " ") in w or name in w), None)
+            if mon is not None and "conserved" in w:
+                drift = mon["drift"] if isinstance(mon["drift"], float) else float("nan")
+                warnings.warn(DriftWarning(w, mon["name"], drift, float(mon["tolerance"]),
+                                           bool(mon["relative"])), stacklevel=3)
+            else:
+                warnings.warn(w, RuntimeWarning, stacklevel=3)
+
+    def __repr__(self) -> str:
+        return (f"ParticleResult(kind={self.kind!r}, model={self.summary.get('model')!r}, "
+                f"success={self.success})")
