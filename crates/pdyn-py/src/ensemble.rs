@@ -4,7 +4,7 @@
 
 use crate::convert::{f64_array, f64_matrix};
 use crate::errors::{pdyn_error, to_py};
-use crate::model::{native_observers, Overrides, PyModel};
+use crate::model::{Overrides, PyModel};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pdyn::sim::ensemble::{self, Ensemble, Member, Rows};
 use pdyn::Error;
@@ -135,7 +135,7 @@ pub(crate) fn ensemble(
                 };
                 let mut p = PyModel::prepare(&mut m, jit)?;
                 if jit {
-                    native_observers(&mut p);
+                    p.make_observers_native();
                 }
                 let stats: Vec<Stat> = m
                     .run

@@ -132,20 +132,6 @@ impl PyModel {
     }
 }
 
-/// Output columns, conservation scales, measures and events as native code (the right-hand
-/// side already is, from [`sim::prepare`]): a sweep or an ensemble evaluates them at every
-/// output point of every run. The same results bit for bit.
-pub(crate) fn native_observers(p: &mut Prepared) {
-    p.observer.make_native();
-    p.scales.make_native();
-    if let Some(m) = p.measures.as_mut() {
-        m.make_native();
-    }
-    for e in &mut p.events {
-        e.function.make_native();
-    }
-}
-
 #[pymethods]
 impl PyModel {
     /// Loads a model from TOML text; `origin` names it in error messages.

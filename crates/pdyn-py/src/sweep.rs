@@ -3,7 +3,7 @@
 
 use crate::convert::f64_array;
 use crate::errors::to_py;
-use crate::model::{native_observers, Overrides, PyModel};
+use crate::model::{Overrides, PyModel};
 use pdyn::sim::ensemble::thread_pool;
 use pdyn::sim::sweep;
 use pdyn::Error;
@@ -73,7 +73,7 @@ pub(crate) fn sweep(
         let set = PyModel::settings(&model, o)?;
         let mut prep = PyModel::prepare(&mut model, jit)?;
         if jit {
-            native_observers(&mut prep);
+            prep.make_observers_native();
         }
         let stats: Vec<_> = spec.measures.iter().map(|m| m.stat).collect();
         match threads {

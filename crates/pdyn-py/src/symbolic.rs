@@ -236,7 +236,7 @@ pub(crate) fn _dsolve(
                     qd.set_item(
                         "messages",
                         vals.iter()
-                            .map(|v| v.as_ref().err().cloned())
+                            .map(|v| v.as_ref().err().map(ToString::to_string))
                             .collect::<Vec<_>>(),
                     )?;
                     qs.append(qd)?;

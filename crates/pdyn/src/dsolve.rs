@@ -6,7 +6,7 @@ use crate::args::{idents, positive_parameters, split_top, subs_all};
 use crate::Error;
 use pdyn_expr::{FreeScope, Id, Node, Pool, SymId, Value};
 use pdyn_mech::dsolve::rules::{self, Estimate, Given, RuleSolution};
-use pdyn_mech::dsolve::{solve_with, ClosedForm, InitialCondition, When};
+use pdyn_mech::dsolve::{solve_with, ClosedForm, DsolveError, InitialCondition, When};
 
 /// What to solve, as the text of the command's arguments.
 #[derive(Clone, Debug, Default)]
@@ -64,7 +64,7 @@ pub struct RuleResult {
     /// The points of `at`, evaluated.
     pub points: Vec<f64>,
     /// Per quantity, per point: the value, or why it has none.
-    pub values: Vec<Vec<Result<Estimate, String>>>,
+    pub values: Vec<Vec<Result<Estimate, DsolveError>>>,
     /// The parameters assumed positive.
     pub assumed_positive: Vec<String>,
 }
@@ -512,7 +512,7 @@ fn run_rule(a: &DsolveInput, rule: &str) -> Result<DsolveResult, Error> {
     for q in &sol.quantities {
         let mut vals = Vec::new();
         for &s in &points {
-            vals.push(rules::evaluate(&mut pool, q, s).map_err(|e| e.to_string()));
+            vals.push(rules::evaluate(&mut pool, q, s));
         }
         evaluated.push(vals);
     }

@@ -249,7 +249,7 @@ fn print_rule(pool: &Pool, s: &RuleResult, format: Format, json: bool) -> String
                     "closed_form": q.closed.map(|c| both(pool, c)),
                     "at": points.iter().zip(vals).map(|(s, v)| match v {
                         Ok(v) => json!({"at": s, "value": v.value, "error": v.error}),
-                        Err(e) => json!({"at": s, "value": null, "message": e}),
+                        Err(e) => json!({"at": s, "value": null, "message": e.to_string()}),
                     }).collect::<Vec<_>>(),
                 })
             })

@@ -2,8 +2,8 @@
 //! flags → `pdyn::md::request::plan` (resolved against the table) → `pdyn::md::{build, run}`
 //! → live thermo table, progress bar, files, summary.
 
-use super::run::{io_error, RunArgs};
-use super::{numeric_pairs, Outcome};
+use super::run::RunArgs;
+use super::{io_error, numeric_pairs, Outcome};
 use pdyn::md::{self, Progress, RunOptions};
 use pdyn::Error;
 use pdyn_mech::ModelError;

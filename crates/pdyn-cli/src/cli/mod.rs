@@ -106,6 +106,15 @@ pub fn load_model(path: &Path) -> Result<pdyn_mech::Model, Error> {
     pdyn::model_file::ModelFile::read(path)?.mechanics()
 }
 
+/// A file that could not be created or written (`action`: "create", "write").
+pub(crate) fn io_error(path: &Path, action: &'static str, e: std::io::Error) -> Error {
+    Error::Io {
+        path: path.to_path_buf(),
+        action,
+        error: std::sync::Arc::new(e),
+    }
+}
+
 /// `name=number` pairs of a comma-separated option such as `--at t=0,theta=0.5`.
 pub fn numeric_pairs(list: &[String], flag: &str) -> Result<Vec<(String, f64)>, Error> {
     list.iter()

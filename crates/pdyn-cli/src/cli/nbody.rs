@@ -2,8 +2,8 @@
 //! handed to `pdyn::nbody::request` (which resolves them against the table and builds), the
 //! run, then the files and the report.
 
-use super::run::{io_error, RunArgs};
-use super::{numeric_pairs, Outcome};
+use super::run::RunArgs;
+use super::{io_error, numeric_pairs, Outcome};
 use pdyn::nbody::{self, output};
 use pdyn::Error;
 use std::path::Path;

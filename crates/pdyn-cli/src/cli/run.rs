@@ -1,13 +1,12 @@
 //! `pdyn run MODEL`: simulate a model file.
 
-use super::{load_model, set_parameters, Outcome};
+use super::{io_error, load_model, set_parameters, Outcome};
 use clap::Args;
 use pdyn::model_file::Kind;
 use pdyn::output::{summary, write_csv};
 use pdyn::sim::{self, RunSettings, SimError};
 use pdyn::Error;
-use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::path::PathBuf;
 
 /// `pdyn run`.
 #[derive(Args, Debug, Clone)]
@@ -112,14 +111,6 @@ pub fn settings(model: &pdyn_mech::Model, a: &RunArgs) -> Result<RunSettings, Er
 }
 
 pub(crate) use sim::request::located as sim_error;
-
-pub(crate) fn io_error(path: &Path, action: &'static str, e: std::io::Error) -> Error {
-    Error::Io {
-        path: path.to_path_buf(),
-        action,
-        error: Arc::new(e),
-    }
-}
 
 /// `pdyn run MODEL`.
 pub fn run(a: RunArgs) -> Result<Outcome, Error> {

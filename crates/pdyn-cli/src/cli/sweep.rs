@@ -1,6 +1,7 @@
 //! `pdyn sweep MODEL`: the model's `[sweep]`, in parallel, with a progress bar.
 
-use super::run::{io_error, settings, sim_error, RunArgs};
+use super::io_error;
+use super::run::{settings, sim_error, RunArgs};
 use super::{load_model, set_parameters, Outcome};
 use clap::Args;
 use pdyn::sim::sweep;
@@ -32,7 +33,11 @@ pub fn run(a: SweepArgs) -> Result<Outcome, Error> {
         ));
     };
     let set = settings(&model, &a.run)?;
-    let prep = super::run::prepare(&mut model, &a.run)?;
+    let mut prep = super::run::prepare(&mut model, &a.run)?;
+    // Measures and monitors evaluated at every output of every run: native code, as in Python.
+    if !a.run.no_jit {
+        prep.make_observers_native();
+    }
     let stats: Vec<_> = model
         .run
         .sweep

@@ -274,6 +274,21 @@ pub struct Prepared {
 }
 
 impl Prepared {
+    /// Output columns, conservation scales, measures and events as native code (the
+    /// right-hand side already is, from [`prepare`]): a sweep or an ensemble evaluates them at
+    /// every output point of every run, and compiling them once pays there. The same results
+    /// bit for bit. Both front ends call it before a sweep or an ensemble.
+    pub fn make_observers_native(&mut self) {
+        self.observer.make_native();
+        self.scales.make_native();
+        if let Some(m) = self.measures.as_mut() {
+            m.make_native();
+        }
+        for e in &mut self.events {
+            e.function.make_native();
+        }
+    }
+
     /// The columns of a run's table ([`RunResult::columns`]): `t`, the state, the output
     /// columns.
     pub fn columns(&self) -> Vec<String> {
