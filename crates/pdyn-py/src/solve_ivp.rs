@@ -7,13 +7,12 @@
 use crate::convert::{f64_array, f64_matrix, method_name, stats_dict};
 use crate::errors::{guarded, pdyn_error};
 use numpy::{PyArray1, PyReadonlyArray1};
-use pdyn_expr::{Pool, Program};
 use pdyn_ode::{Direction, Event, FnSystem, Method, Options, Solution, Status};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::cell::RefCell;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 /// An event for `solve_ivp`: a Python callable or an expression, with SciPy's attributes.
 struct IvpEvent {
@@ -27,71 +26,6 @@ struct IvpEvent {
 enum Rhs {
     Compiled(Arc<pdyn_jit::Evaluator>),
     Callable(PyObject),
-}
-
-/// Compiled right-hand sides by their expressions, state size, parameter names and JIT mode:
-/// a loop calling `solve_ivp` with the same expressions (other values of `args`, `y0`)
-/// compiles them once. Bounded: cleared when it holds [`CACHE_SIZE`] programs.
-type CacheKey = (Vec<String>, usize, Vec<String>, bool);
-static COMPILED: Mutex<Vec<(CacheKey, Arc<pdyn_jit::Evaluator>)>> = Mutex::new(Vec::new());
-const CACHE_SIZE: usize = 64;
-
-/// [`compile_exprs`], then native code (`jit`) with the interpreter as fallback; cached.
-fn compile_rhs(
-    exprs: &[String],
-    n: usize,
-    params: &[(String, f64)],
-    jit: bool,
-) -> Result<Arc<pdyn_jit::Evaluator>, String> {
-    let key: CacheKey = (
-        exprs.to_vec(),
-        n,
-        params.iter().map(|p| p.0.clone()).collect(),
-        jit,
-    );
-    let mut cache = COMPILED.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some((_, ev)) = cache.iter().find(|(k, _)| *k == key) {
-        return Ok(ev.clone());
-    }
-    let program = compile_exprs(exprs, n, params)?;
-    let mode = if jit {
-        pdyn_jit::JitMode::Auto
-    } else {
-        pdyn_jit::JitMode::Off
-    };
-    let ev = Arc::new(pdyn_jit::Evaluator::new(program, mode));
-    if cache.len() >= CACHE_SIZE {
-        cache.clear();
-    }
-    cache.push((key, ev.clone()));
-    Ok(ev)
-}
-
-/// Compiles expressions in `t`, `y0..y{n-1}` and the names of `params` into one program
-/// over the inputs `[t, y0.., params..]`.
-fn compile_exprs(exprs: &[String], n: usize, params: &[(String, f64)]) -> Result<Program, String> {
-    let mut pool = Pool::new();
-    let mut outputs = Vec::new();
-    for (i, src) in exprs.iter().enumerate() {
-        let id = pool.parse_scalar(src).map_err(|e| {
-            let (_, col) = pdyn_expr::error::line_col(src, e.span.start);
-            format!("expression {i} (`{src}`), column {col}: {}", e.message)
-        })?;
-        outputs.push(id);
-    }
-    let mut inputs = vec![pool.var("t")];
-    for k in 0..n {
-        inputs.push(pool.var(&format!("y{k}")));
-    }
-    for (name, _) in params {
-        inputs.push(pool.var(name));
-    }
-    Program::compile(&mut pool, &inputs, &outputs).map_err(|e| {
-        format!(
-            "{e} (the expressions may use t, y0..y{}, and the names given in args)",
-            n.saturating_sub(1)
-        )
-    })
 }
 
 /// Evaluates one compiled program with its own registers.
@@ -288,7 +222,7 @@ pub(crate) fn _solve_ivp(
                         ));
                     }
                 }
-                compile_rhs(&exprs, n, &args, jit)
+                pdyn::ivp::compile_rhs(&exprs, n, &args, jit)
                     .map(Rhs::Compiled)
                     .map_err(|e| pdyn_error(py, "ParameterError", format!("{what}: {e}")))
             };

@@ -8,6 +8,7 @@
 pub mod args;
 pub mod dsolve;
 pub mod error;
+pub mod ivp;
 pub mod kin;
 pub mod md;
 pub mod model_file;
