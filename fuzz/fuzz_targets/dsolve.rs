@@ -1,5 +1,6 @@
 //! Fuzzing of the closed-form solver (`pdyn dsolve`): equations `lhs = rhs` separated by `;`,
-//! with initial conditions x(0) = 1, x'(0) = 0 for each coordinate, then `--when x = 0`.
+//! with initial conditions x(0) = 1, x'(0) = 0 for each coordinate: the stable evaluation
+//! (`dsolve::propagator`) at a few times, the closed form, then `--when x = 0`.
 //! Run: `RUSTC_BOOTSTRAP=1 cargo fuzz run dsolve -- -max_total_time=1800 -timeout=30`.
 #![no_main]
 
@@ -35,6 +36,11 @@ fuzz_target!(|data: &[u8]| {
     for &c in &coords {
         ics.push((p.coord(c, 0), Pool::ONE));
         ics.push((p.coord(c, 1), Pool::ZERO));
+    }
+    // The stable evaluation (`dsolve --at`, `run --method exact`) of the same equations:
+    // whatever they are, an error or finite-or-not numbers, never a panic or a hang.
+    if let Ok(prop) = pdyn_mech::dsolve::propagator(&mut p, &eqs, &coords, &ics) {
+        let _ = prop.sample(&[0.5, 1.0, 1.5, 10.0, 3.0]);
     }
     let Ok(cf) = pdyn_mech::dsolve::solve_system(&mut p, &eqs, &coords, &ics) else { return };
     let x = p.coord(coords[0], 0);

@@ -261,7 +261,7 @@ impl Propagator {
                         at += h0;
                     }
                     _ => {
-                        let e = (&self.generator * h).exp();
+                        let e = exponential(&self.generator, h);
                         z = &e * z;
                         at = t;
                         step = Some((h, e));
@@ -283,6 +283,25 @@ impl Propagator {
             }
         }
         out
+    }
+}
+
+/// Largest 1-norm of `𝒜 h` handed to the exponential. Past it the result overflows anyway
+/// (`e^{700}` is about the largest double), and nalgebra's scaling count, `⌈log₂ ‖𝒜h‖⌉`
+/// squarings, would saturate to 2⁶⁴ on an infinite norm: a hang, not an answer.
+const MAX_EXPONENT_NORM: f64 = 1e300;
+
+/// `exp(𝒜 h)`, or a matrix of NaN when `𝒜 h` is too large to exponentiate (the run then
+/// reports its values as not finite, with the time).
+fn exponential(generator: &DMatrix<f64>, h: f64) -> DMatrix<f64> {
+    let scaled = generator * h;
+    let norm = (0..scaled.ncols())
+        .map(|j| scaled.column(j).iter().map(|v| v.abs()).sum::<f64>())
+        .fold(0.0f64, f64::max);
+    if norm.is_finite() && norm <= MAX_EXPONENT_NORM {
+        scaled.exp()
+    } else {
+        DMatrix::from_element(scaled.nrows(), scaled.ncols(), f64::NAN)
     }
 }
 
@@ -356,6 +375,17 @@ mod tests {
             let dx = -t * (-t).exp();
             assert!((got[2 * k] - x).abs() < 1e-14 && (got[2 * k + 1] - dx).abs() < 1e-14);
         }
+    }
+
+    /// Rates of 1e200 over a time of 1e200: the exponent cannot be formed; the values are
+    /// NaN (a failure the run reports), not a hang in the squaring loop.
+    #[test]
+    fn an_exponent_too_large_gives_nan_not_a_hang() {
+        let (_, p) = build("x' - 1e200*x", &["x"], &[("x", "1")]);
+        let got = p.sample(&[1e200]);
+        assert!(got[0].is_nan(), "{got:?}");
+        let got = p.sample(&[1e-300]);
+        assert!((got[0] - 1.0).abs() < 1e-12, "{got:?}");
     }
 
     #[test]
