@@ -284,3 +284,29 @@ fn bare_numbers_beside_units_take_their_context_dimension() {
     ));
     assert!(e.contains("dimension mismatch"), "{e}");
 }
+
+/// The times of `[simulate]` are times (issue 34: `output_dt = "5 kg"` was accepted): a
+/// quantity of other units is a located error naming both dimensions; bare numbers and
+/// times in any unit pass.
+#[test]
+fn simulate_times_must_be_times() {
+    for (key, value) in [
+        ("output_dt", "\"5 kg\""),
+        ("t_end", "\"2 m\""),
+        ("max_step", "\"1 N\""),
+        ("dt", "\"3 kg*m\""),
+    ] {
+        let src = block("k = \"100 N/m\"\nm = \"1 kg\"", "[-k*x, 0, 0]")
+            + &format!("[simulate]\n{key} = {value}\n");
+        let e = load_err(&src);
+        assert!(
+            e.contains(&format!("`{key}` has the dimension")) && e.contains("s (time)"),
+            "{e}"
+        );
+    }
+    for value in ["0.5", "\"0.5 s\"", "\"2 min\"", "\"1 ms\""] {
+        let src = block("k = \"100 N/m\"\nm = \"1 kg\"", "[-k*x, 0, 0]")
+            + &format!("[simulate]\nt_end = 10\noutput_dt = {value}\n");
+        load(&src, "model.toml").unwrap_or_else(|e| panic!("{value}: {}", e.render(&src)));
+    }
+}

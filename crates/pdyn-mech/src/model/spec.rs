@@ -289,6 +289,16 @@ fn positive(ld: &mut Loader, sv: &Option<Sv>, what: &str) -> Result<Option<f64>,
     Ok(Some(x))
 }
 
+/// A positive time (`t_end`, `dt`, `output_dt`…): in a model that writes units, a value with
+/// other units (`output_dt = "5 kg"`) is a located dimension error.
+fn time(ld: &mut Loader, sv: &Option<Sv>, what: &str) -> Result<Option<f64>, ModelError> {
+    let x = positive(ld, sv, what)?;
+    if let Some(sv) = sv {
+        ld.want(sv, pdyn_expr::Dimension::TIME, what);
+    }
+    Ok(x)
+}
+
 pub(super) fn read(
     ld: &mut Loader,
     raw: &RawModel,
@@ -298,13 +308,13 @@ pub(super) fn read(
     if let Some(s) = &raw.simulate {
         let r = s.get_ref();
         let sim = &mut spec.simulate;
-        sim.t_end = positive(ld, &r.t_end, "`t_end`")?;
+        sim.t_end = time(ld, &r.t_end, "`t_end`")?;
         sim.method = r.method.as_ref().map(|m| (m.get_ref().clone(), m.span()));
         sim.rtol = positive(ld, &r.rtol, "`rtol`")?;
         sim.atol = positive(ld, &r.atol, "`atol`")?;
-        sim.dt = positive(ld, &r.dt, "`dt`")?.or(positive(ld, &r.h0, "`h0`")?);
-        sim.max_step = positive(ld, &r.max_step, "`max_step`")?;
-        sim.output_dt = positive(ld, &r.output_dt, "`output_dt`")?;
+        sim.dt = time(ld, &r.dt, "`dt`")?.or(time(ld, &r.h0, "`h0`")?);
+        sim.max_step = time(ld, &r.max_step, "`max_step`")?;
+        sim.output_dt = time(ld, &r.output_dt, "`output_dt`")?;
         sim.drift_tolerance = positive(ld, &r.drift_tolerance, "`drift_tolerance`")?;
         for (option, sv) in [
             ("--t-end", &r.t_end),
