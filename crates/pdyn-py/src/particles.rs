@@ -144,12 +144,14 @@ impl PyParticleModel {
                                 &req,
                             )?;
                             let (spec, info, res) = planned.execute()?;
-                            let failure = res.failure.clone().map(|error| Error::Gravity {
-                                origin: self.file.origin.clone(),
-                                error,
-                            });
+                            let (sum, failure) = pdyn::nbody::output::outcome(&spec, &info, &res);
                             if let Some(dir) = &out {
-                                write_nbody(dir, &spec, &info, &res, &failure)?;
+                                pdyn::nbody::output::write_files(
+                                    dir,
+                                    &res,
+                                    &sum,
+                                    !res.states.is_empty(),
+                                )?;
                             }
                             Ok(Ran::Nbody(Box::new(spec), info, Box::new(res), failure))
                         }
@@ -196,17 +198,14 @@ impl PyParticleModel {
                                 drift_tolerance: tolerance,
                             };
                             let res = pdyn::md::run(&mut prep, &opts, &mut |_| {})?;
-                            let failure = res.failure.clone().map(|error| Error::MdRun {
-                                origin: self.file.origin.clone(),
-                                error,
-                            });
+                            let (sum, failure) = pdyn::md::output::outcome(
+                                &prep,
+                                &res,
+                                tolerance,
+                                &self.file.origin,
+                            );
                             if let Some(dir) = &out {
-                                pdyn::md::output::write_files(&res, dir)?;
-                                let mut sum = pdyn::md::output::summary(&prep, &res, tolerance);
-                                if let Some(f) = &failure {
-                                    sum["error"] = f.to_json()["error"].clone();
-                                }
-                                write(dir, "summary.json", &format!("{sum:#}\n"))?;
+                                pdyn::md::output::write_all(&res, &sum, dir)?;
                             }
                             Ok(Ran::Md(Box::new(prep), res, tolerance, failure))
                         }
@@ -216,57 +215,6 @@ impl PyParticleModel {
             to_dict(py, ran)
         })
     }
-}
-
-fn write(dir: &std::path::Path, name: &str, text: &str) -> Result<(), Error> {
-    let path = dir.join(name);
-    std::fs::write(&path, text).map_err(|e| Error::Io {
-        path,
-        action: "write",
-        error: std::sync::Arc::new(e),
-    })
-}
-
-/// The files `pdyn run --out DIR` writes for an N-body model.
-fn write_nbody(
-    dir: &std::path::Path,
-    spec: &pdyn::nbody::spec::NbodySpec,
-    info: &pdyn::nbody::output::RunInfo,
-    res: &pdyn::nbody::run::NbodyResult,
-    failure: &Option<Error>,
-) -> Result<(), Error> {
-    use pdyn::nbody::output;
-    std::fs::create_dir_all(dir).map_err(|e| Error::Io {
-        path: dir.to_path_buf(),
-        action: "create",
-        error: std::sync::Arc::new(e),
-    })?;
-    let io = |name: &str, r: std::io::Result<()>| {
-        r.map_err(|e| Error::Io {
-            path: dir.join(name),
-            action: "write",
-            error: std::sync::Arc::new(e),
-        })
-    };
-    if !res.states.is_empty() {
-        io(
-            "trajectory.csv",
-            output::write_trajectory(res, &dir.join("trajectory.csv")),
-        )?;
-        io(
-            "elements.csv",
-            output::write_elements(res, &dir.join("elements.csv")),
-        )?;
-    }
-    io(
-        "conservation.csv",
-        output::write_conservation(res, &dir.join("conservation.csv")),
-    )?;
-    let mut sum = output::summary(spec, info, res);
-    if let Some(f) = failure {
-        sum["error"] = f.to_json()["error"].clone();
-    }
-    write(dir, "summary.json", &format!("{sum:#}\n"))
 }
 
 /// Columns of equal length as a `(rows, len(names))` array and the names.
@@ -283,10 +231,7 @@ fn to_dict(py: Python<'_>, ran: Ran) -> PyResult<PyObject> {
     let d = PyDict::new(py);
     match ran {
         Ran::Nbody(spec, info, res, failure) => {
-            let mut sum = pdyn::nbody::output::summary(&spec, &info, &res);
-            if let Some(f) = &failure {
-                sum["error"] = f.to_json()["error"].clone();
-            }
+            let (sum, _) = pdyn::nbody::output::outcome(&spec, &info, &res);
             d.set_item("kind", "nbody")?;
             d.set_item("summary", format!("{sum:#}"))?;
             d.set_item("failure", failure.map(|f| f.to_string()))?;
@@ -378,10 +323,7 @@ fn to_dict(py: Python<'_>, ran: Ran) -> PyResult<PyObject> {
             )?;
         }
         Ran::Md(prep, res, tolerance, failure) => {
-            let mut sum = pdyn::md::output::summary(&prep, &res, tolerance);
-            if let Some(f) = &failure {
-                sum["error"] = f.to_json()["error"].clone();
-            }
+            let (sum, _) = pdyn::md::output::outcome(&prep, &res, tolerance, &prep.spec.origin);
             d.set_item("kind", "md")?;
             d.set_item("summary", format!("{sum:#}"))?;
             d.set_item("failure", failure.map(|f| f.to_string()))?;

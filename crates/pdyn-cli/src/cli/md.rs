@@ -9,7 +9,6 @@ use pdyn::Error;
 use pdyn_mech::ModelError;
 use std::io::IsTerminal;
 use std::path::Path;
-use std::sync::Arc;
 
 /// Steps × atoms above which a progress bar is shown (when stderr is a terminal).
 const PROGRESS_WORK: u64 = 20_000_000;
@@ -104,22 +103,9 @@ pub fn run(a: RunArgs, source: String) -> Result<Outcome, Error> {
     };
     let res = md::run(&mut prep, &opts, &mut progress)?;
     bar.finish_and_clear();
-    let failure = res.failure.clone().map(|error| Error::MdRun {
-        origin: origin.clone(),
-        error,
-    });
-    let mut sum = md::output::summary(&prep, &res, drift_tolerance);
-    if let Some(f) = &failure {
-        sum["error"] = f.to_json()["error"].clone();
-    }
+    let (sum, failure) = md::output::outcome(&prep, &res, drift_tolerance, &origin);
     if let Some(dir) = &a.out {
-        md::output::write_files(&res, dir)?;
-        let js = dir.join("summary.json");
-        std::fs::write(&js, format!("{sum:#}\n")).map_err(|e| Error::Io {
-            path: js.clone(),
-            action: "write",
-            error: Arc::new(e),
-        })?;
+        md::output::write_all(&res, &sum, dir)?;
         if a.plot {
             md::output::write_plots(&prep, &res, dir)?;
         }

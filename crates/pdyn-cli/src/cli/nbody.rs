@@ -3,10 +3,9 @@
 //! run, then the files and the report.
 
 use super::run::RunArgs;
-use super::{io_error, numeric_pairs, Outcome};
+use super::{numeric_pairs, Outcome};
 use pdyn::nbody::{self, output};
 use pdyn::Error;
-use std::path::Path;
 
 const HELP: &str = "N-body integrators (integrator = \"...\" in [nbody], or --method):
   whfast    Wisdom-Holman map in Jacobi coordinates with symplectic correctors (Rein & Tamayo
@@ -43,26 +42,9 @@ pub fn run(a: RunArgs, file: pdyn::model_file::ModelFile) -> Result<Outcome, Err
     let trajectory = planned.trajectory;
     let (spec, info, res) = planned.execute()?;
 
-    let failure = res.failure.clone().map(|error| Error::Gravity {
-        origin: origin.clone(),
-        error,
-    });
-    let mut sum = output::summary(&spec, &info, &res);
-    if let Some(f) = &failure {
-        sum["error"] = f.to_json()["error"].clone();
-    }
+    let (sum, failure) = output::outcome(&spec, &info, &res);
     if let Some(dir) = &a.out {
-        std::fs::create_dir_all(dir).map_err(|e| io_error(dir, "create", e))?;
-        let write = |name: &str, f: &dyn Fn(&Path) -> std::io::Result<()>| {
-            let path = dir.join(name);
-            f(&path).map_err(|e| io_error(&path, "write", e))
-        };
-        if trajectory {
-            write("trajectory.csv", &|p| output::write_trajectory(&res, p))?;
-            write("elements.csv", &|p| output::write_elements(&res, p))?;
-        }
-        write("conservation.csv", &|p| output::write_conservation(&res, p))?;
-        write("summary.json", &|p| std::fs::write(p, format!("{sum:#}\n")))?;
+        output::write_files(dir, &res, &sum, trajectory)?;
         if a.plot {
             nbody::plots::write(&spec.name, &res, &spec.units, dir)?;
         }

@@ -153,6 +153,32 @@ pub fn summary(prep: &Prepared, res: &MdResult, drift_tolerance: f64) -> serde_j
     )
 }
 
+/// The run's failure as an [`Error`] (`origin` names the model file) and the summary with
+/// its `error` object, as `pdyn run --json` prints it and Python's `ParticleResult.summary`
+/// holds it.
+pub fn outcome(
+    prep: &Prepared,
+    res: &MdResult,
+    drift_tolerance: f64,
+    origin: &str,
+) -> (serde_json::Value, Option<Error>) {
+    let failure = res.failure.clone().map(|error| Error::MdRun {
+        origin: origin.to_string(),
+        error,
+    });
+    let mut sum = summary(prep, res, drift_tolerance);
+    if let Some(f) = &failure {
+        sum["error"] = f.to_json()["error"].clone();
+    }
+    (sum, failure)
+}
+
+/// [`write_files`] and `summary.json` (`sum`): what `pdyn run --out DIR` writes.
+pub fn write_all(res: &MdResult, sum: &serde_json::Value, dir: &Path) -> Result<(), Error> {
+    write_files(res, dir)?;
+    write(&dir.join("summary.json"), &format!("{sum:#}\n"))
+}
+
 /// `thermo.csv`, plus `rdf.csv` and `msd.csv` when computed, into `dir`.
 pub fn write_files(res: &MdResult, dir: &Path) -> Result<(), Error> {
     let mut s = format!("{THERMO_CSV_HEADER}\n");

@@ -187,6 +187,51 @@ pub fn summary(spec: &NbodySpec, info: &RunInfo, res: &NbodyResult) -> serde_jso
     )
 }
 
+/// The run's failure as an [`Error`] (a collision, an escape, a failed step) and the summary
+/// with its `error` object, as `pdyn run --json` prints it and Python's `ParticleResult.summary`
+/// holds it.
+pub fn outcome(
+    spec: &NbodySpec,
+    info: &RunInfo,
+    res: &NbodyResult,
+) -> (serde_json::Value, Option<crate::Error>) {
+    let failure = res.failure.clone().map(|error| crate::Error::Gravity {
+        origin: spec.origin.clone(),
+        error,
+    });
+    let mut sum = summary(spec, info, res);
+    if let Some(f) = &failure {
+        sum["error"] = f.to_json()["error"].clone();
+    }
+    (sum, failure)
+}
+
+/// The files of `pdyn run --out DIR`: `trajectory.csv` and `elements.csv` when trajectories
+/// were kept, `conservation.csv`, and `summary.json` (`sum`).
+pub fn write_files(
+    dir: &Path,
+    res: &NbodyResult,
+    sum: &serde_json::Value,
+    trajectory: bool,
+) -> Result<(), crate::Error> {
+    let io = |path: std::path::PathBuf, action: &'static str, e: std::io::Error| crate::Error::Io {
+        path,
+        action,
+        error: std::sync::Arc::new(e),
+    };
+    std::fs::create_dir_all(dir).map_err(|e| io(dir.to_path_buf(), "create", e))?;
+    let write = |name: &str, f: &dyn Fn(&Path) -> std::io::Result<()>| {
+        let path = dir.join(name);
+        f(&path).map_err(|e| io(path.clone(), "write", e))
+    };
+    if trajectory {
+        write("trajectory.csv", &|p| write_trajectory(res, p))?;
+        write("elements.csv", &|p| write_elements(res, p))?;
+    }
+    write("conservation.csv", &|p| write_conservation(res, p))?;
+    write("summary.json", &|p| std::fs::write(p, format!("{sum:#}\n")))
+}
+
 /// The text report of `pdyn run`.
 pub fn text_report(
     spec: &NbodySpec,
