@@ -141,6 +141,8 @@ fn install_panic_hook(json: bool) {
 }
 
 fn main() -> ExitCode {
+    // The library's messages name options as this front end does: `--t-end`, not `t_end`.
+    pdyn::options::name_options_as(pdyn::options::Naming::Flags);
     let json = wants_json();
     install_panic_hook(json);
     // For the test of the panic hook: a bug on demand.

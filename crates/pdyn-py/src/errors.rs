@@ -55,6 +55,7 @@ pub(crate) fn to_py(py: Python<'_>, e: &Error) -> PyErr {
         Error::Sim {
             error:
                 sim::SimError::InvalidOption { .. }
+                | sim::SimError::TooManySweepRuns { .. }
                 | sim::SimError::InvalidEndTime(_)
                 | sim::SimError::InvalidTEval { .. }
                 | sim::SimError::UnknownMethod { .. }

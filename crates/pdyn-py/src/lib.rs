@@ -56,6 +56,9 @@ fn methods(py: Python<'_>) -> PyResult<Vec<(String, String)>> {
 /// The Rust half of `pdyn`.
 #[pymodule]
 fn _pdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // The library's messages name options as Python's keywords (`t_end`, `rtol=1e-9`), never
+    // as the command line's flags.
+    pdyn::options::name_options_as(pdyn::options::Naming::Keywords);
     m.add_class::<model::PyModel>()?;
     m.add_class::<particles::PyParticleModel>()?;
     m.add_function(wrap_pyfunction!(particles::load_model, m)?)?;

@@ -104,7 +104,7 @@ impl PyModel {
     /// The model's `[simulate]` with the overrides given from Python applied, by the same
     /// library call as `pdyn run`'s flags (`pdyn::sim::request::settings`).
     pub(crate) fn settings(model: &pdyn_mech::Model, o: Overrides) -> Result<RunSettings, Error> {
-        let req = sim::request::Request {
+        let req = pdyn::Request {
             method: o.method.map(|m| method_name(&m)),
             rtol: o.rtol,
             atol: o.atol,
@@ -113,9 +113,9 @@ impl PyModel {
             max_step: o.max_step,
             max_steps: o.max_steps,
             points: o.points,
-            output_dt: None,
             t_eval: o.t_eval,
             drift_tolerance: o.drift_tolerance,
+            ..Default::default()
         };
         sim::request::settings(model, &req)
     }

@@ -1,13 +1,13 @@
-//! `[nbody]` and `[md]` model files from Python (issue 25, item 3): `pdyn.Model.from_file`
-//! on such a file holds a [`PyParticleModel`], whose `run` calls the same library requests as
-//! `pdyn run` (`pdyn::nbody::request`, `pdyn::md::request`) with the GIL released and returns
+//! `[nbody]` and `[md]` model files from Python: `pdyn.Model.from_file` on such a file holds a
+//! [`PyParticleModel`], whose `run` calls the library entry `pdyn run` calls (`pdyn::run`)
+//! with the GIL released and returns
 //! plain data: the summary (the text of the CLI's `summary.json`), warnings, the failure, and
 //! the tables as float64 arrays (the Python layer builds `pdyn.ParticleResult`).
 
 use crate::convert::{f64_array, f64_matrix};
 use crate::errors::{guarded, to_py};
 use pdyn::model_file::{Kind, ModelFile};
-use pdyn::Error;
+use pdyn::{Error, RunOutput};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
@@ -44,22 +44,6 @@ pub(crate) fn load(file: ModelFile) -> Result<PyParticleModel, Error> {
         name,
         parameters,
     })
-}
-
-/// What one run gives back, before it becomes Python data.
-enum Ran {
-    Nbody(
-        Box<pdyn::nbody::spec::NbodySpec>,
-        pdyn::nbody::output::RunInfo,
-        Box<pdyn::nbody::run::NbodyResult>,
-        Option<Error>,
-    ),
-    Md(
-        Box<pdyn::md::Prepared>,
-        pdyn::md::MdResult,
-        f64,
-        Option<Error>,
-    ),
 }
 
 #[pymethods]
@@ -106,8 +90,9 @@ impl PyParticleModel {
         })
     }
 
-    /// Runs the model as `pdyn run` does (see `pdyn.Model.run`); `out` writes the CLI's files.
-    #[pyo3(signature = (t_end=None, method=None, dt=None, points=None, t_eval=None, drift_tolerance=None, params=None, out=None, jit=true))]
+    /// Runs the model as `pdyn run` does (see `pdyn.Model.run`), through the same library
+    /// entry (`pdyn::run`); `out` writes the CLI's files there, and its plots with `plots`.
+    #[pyo3(signature = (t_end=None, method=None, dt=None, points=None, t_eval=None, drift_tolerance=None, params=None, out=None, plots=false, jit=true, rtol=None, atol=None, max_step=None, max_steps=None))]
     #[allow(clippy::too_many_arguments)]
     fn run(
         &self,
@@ -120,97 +105,37 @@ impl PyParticleModel {
         drift_tolerance: Option<f64>,
         params: Option<Vec<(String, f64)>>,
         out: Option<PathBuf>,
+        plots: bool,
         jit: bool,
+        rtol: Option<f64>,
+        atol: Option<f64>,
+        max_step: Option<f64>,
+        max_steps: Option<usize>,
     ) -> PyResult<PyObject> {
         guarded(py, || {
-            let set = params.unwrap_or_default();
+            let req = pdyn::Request {
+                method,
+                rtol,
+                atol,
+                t_end,
+                dt,
+                max_step,
+                max_steps,
+                points,
+                t_eval,
+                drift_tolerance,
+                params: params.unwrap_or_default(),
+                jit: if jit {
+                    pdyn::sim::JitMode::Auto
+                } else {
+                    pdyn::sim::JitMode::Off
+                },
+                out,
+                plots,
+                ..Default::default()
+            };
             let ran = py
-                .allow_threads(|| -> Result<Ran, Error> {
-                    match self.file.kind {
-                        Kind::Nbody => {
-                            let req = pdyn::nbody::request::Request {
-                                method,
-                                dt,
-                                t_end,
-                                drift_tolerance,
-                                points,
-                                t_eval: t_eval.unwrap_or_default(),
-                                ..Default::default()
-                            };
-                            let planned = pdyn::nbody::request::plan(
-                                &self.file.source,
-                                &self.file.origin,
-                                &set,
-                                &req,
-                            )?;
-                            let (spec, info, res) = planned.execute()?;
-                            let (sum, failure) = pdyn::nbody::output::outcome(&spec, &info, &res);
-                            if let Some(dir) = &out {
-                                pdyn::nbody::output::write_files(
-                                    dir,
-                                    &res,
-                                    &sum,
-                                    !res.states.is_empty(),
-                                )?;
-                            }
-                            Ok(Ran::Nbody(Box::new(spec), info, Box::new(res), failure))
-                        }
-                        _ => {
-                            let req = pdyn::md::request::Request {
-                                dt,
-                                t_end,
-                                drift_tolerance,
-                                method,
-                                points,
-                                t_eval: t_eval.unwrap_or_default(),
-                                ..Default::default()
-                            };
-                            let (spec, tolerance) = pdyn::md::request::plan(
-                                &self.file.source,
-                                &self.file.origin,
-                                &set,
-                                &req,
-                            )?;
-                            let base = std::path::Path::new(&self.file.origin)
-                                .parent()
-                                .map_or(PathBuf::from("."), |p| p.to_path_buf());
-                            let mode = if jit {
-                                pdyn::sim::JitMode::Auto
-                            } else {
-                                pdyn::sim::JitMode::Off
-                            };
-                            let mut prep =
-                                pdyn::md::build(&spec, &base, mode).map_err(|error| {
-                                    Error::Model {
-                                        error,
-                                        source: self.file.source.as_str().into(),
-                                    }
-                                })?;
-                            if let Some(dir) = &out {
-                                std::fs::create_dir_all(dir).map_err(|e| Error::Io {
-                                    path: dir.clone(),
-                                    action: "create",
-                                    error: std::sync::Arc::new(e),
-                                })?;
-                            }
-                            let opts = pdyn::md::RunOptions {
-                                out: out.clone(),
-                                drift_tolerance: tolerance,
-                            };
-                            let res = pdyn::md::run(&mut prep, &opts, &mut |_| {})?;
-                            let (sum, failure) = pdyn::md::output::outcome(
-                                &prep,
-                                &res,
-                                tolerance,
-                                &self.file.origin,
-                            );
-                            if let Some(dir) = &out {
-                                pdyn::md::output::write_all(&res, &sum, dir)?;
-                            }
-                            Ok(Ran::Md(Box::new(prep), res, tolerance, failure))
-                        }
-                    }
-                })
+                .allow_threads(|| pdyn::run(&self.file, &req, &mut |_| {}))
                 .map_err(|e| to_py(py, &e))?;
             to_dict(py, ran)
         })
@@ -227,14 +152,20 @@ fn table(py: Python<'_>, names: &[&str], rows: Vec<Vec<f64>>) -> PyResult<PyObje
     Ok(d.into_any().unbind())
 }
 
-fn to_dict(py: Python<'_>, ran: Ran) -> PyResult<PyObject> {
+fn to_dict(py: Python<'_>, ran: RunOutput) -> PyResult<PyObject> {
     let d = PyDict::new(py);
+    d.set_item("summary", format!("{:#}", ran.summary()))?;
+    d.set_item("failure", ran.failure().map(|f| f.to_string()))?;
     match ran {
-        Ran::Nbody(spec, info, res, failure) => {
-            let (sum, _) = pdyn::nbody::output::outcome(&spec, &info, &res);
+        RunOutput::Mechanics(_) => return Err(crate::errors::pdyn_error(
+            py,
+            "PdynError",
+            "internal error in pdyn (please report it): a mechanics model ran as a particle model"
+                .into(),
+        )),
+        RunOutput::Nbody(run) => {
+            let res = &run.result;
             d.set_item("kind", "nbody")?;
-            d.set_item("summary", format!("{sum:#}"))?;
-            d.set_item("failure", failure.map(|f| f.to_string()))?;
             d.set_item("warnings", res.warnings.clone())?;
             d.set_item("t", f64_array(py, res.times.clone()))?;
             d.set_item("names", res.names.clone())?;
@@ -322,11 +253,9 @@ fn to_dict(py: Python<'_>, ran: Ran) -> PyResult<PyObject> {
                 )?,
             )?;
         }
-        Ran::Md(prep, res, tolerance, failure) => {
-            let (sum, _) = pdyn::md::output::outcome(&prep, &res, tolerance, &prep.spec.origin);
+        RunOutput::Md(run) => {
+            let res = &run.result;
             d.set_item("kind", "md")?;
-            d.set_item("summary", format!("{sum:#}"))?;
-            d.set_item("failure", failure.map(|f| f.to_string()))?;
             d.set_item("warnings", res.warnings.clone())?;
             let thermo: Vec<Vec<f64>> = res
                 .records

@@ -107,3 +107,40 @@ def test_particle_models_refuse_the_mechanics_commands(examples):
     assert "use `pdyn run`" in str(e.value) and e.value.line is not None
     with pytest.raises(pdyn.ParameterError):
         m.run(rtol=1e-9)
+
+
+def test_errors_name_pythons_keywords_not_the_command_lines_flags(examples, pdyn_bin):
+    nbody = pdyn.Model.from_file(examples / "nbody" / "figure_eight.toml")
+    md = pdyn.Model.from_file(examples / "md" / "lj_liquid.toml")
+    mech = pdyn.Model.from_file(examples / "satellite.toml")
+    cases = [
+        (lambda: nbody.run(rtol=1e-9), "rtol does not apply to N-body models", "--rtol"),
+        (lambda: nbody.run(method="rk4"), "method=rk4: N-body models take", "--method"),
+        (lambda: md.run(points=10), "points has no meaning for a molecular-dynamics model",
+         "--points"),
+        (lambda: md.run(dt=-1.0), "dt must be a positive number", "--dt"),
+        (lambda: mech.run(dt=-1.0), "dt must be a finite time > 0", "--dt"),
+        (lambda: nbody.run(params={"nope": 1.0}), "params: `nope` is not a parameter", "--set"),
+    ]
+    for call, says, flag in cases:
+        with pytest.raises(pdyn.ParameterError) as e:
+            call()
+        assert says in str(e.value), (str(e.value), says)
+        assert "--" not in str(e.value), str(e.value)
+    # The command line keeps its flags for the same refusals.
+    out = subprocess.run([pdyn_bin, "run", str(examples / "nbody" / "figure_eight.toml"),
+                          "--rtol", "1e-9"], capture_output=True, text=True)
+    assert out.returncode == 2 and "--rtol does not apply to N-body models" in out.stderr
+
+
+def test_particle_plots_are_written_as_the_command_line_writes_them(examples, tmp_path):
+    res = pdyn.Model.from_file(examples / "nbody" / "figure_eight.toml").run(
+        t_end=1.0, plots=tmp_path / "nbody")
+    assert res.success
+    written = sorted(p.name for p in (tmp_path / "nbody").iterdir())
+    assert "summary.json" in written and any(n.endswith(".png") for n in written) \
+        and any(n.endswith(".svg") for n in written), written
+    pdyn.Model.from_file(examples / "md" / "lj_liquid.toml").run(
+        t_end=0.05, plots=tmp_path / "md")
+    written = sorted(p.name for p in (tmp_path / "md").iterdir())
+    assert "thermo.csv" in written and any(n.endswith(".png") for n in written), written

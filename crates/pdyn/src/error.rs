@@ -283,6 +283,16 @@ impl Error {
         }
     }
 
+    /// A file or directory that could not be created, written or read (`action`: "create",
+    /// "write").
+    pub fn io(path: &std::path::Path, action: &'static str, error: std::io::Error) -> Error {
+        Error::Io {
+            path: path.to_path_buf(),
+            action,
+            error: std::sync::Arc::new(error),
+        }
+    }
+
     /// An expression error in a command-line argument.
     pub fn expr(argument: &str, text: &str, error: ExprError) -> Error {
         Error::Expr {

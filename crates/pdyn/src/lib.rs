@@ -1,22 +1,29 @@
-//! The `pdyn` library behind the command: running models (integration, monitors, events),
-//! sweeps, output files and plots, the computations of `pdyn kin` and `pdyn dsolve` ([`kin`],
+//! The `pdyn` library behind the command line and Python: [`run`] runs a model file of any
+//! kind (mechanics, N-body, MD) from a kind-neutral [`Request`] and returns a typed
+//! [`RunOutput`]; below it, running models (integration, monitors, events), sweeps, output
+//! files and plots, the computations of `pdyn kin` and `pdyn dsolve` ([`kin`],
 //! [`dsolve`], shared with the Python package), and the typed [`Error`] every command
-//! returns. The binary (`main.rs`, `cli/`) parses arguments, calls this and the lower crates,
+//! returns. The binary (`crates/pdyn-cli`) parses arguments, calls this and the lower crates,
 //! and prints.
 #![warn(missing_docs)]
 
 pub mod args;
 pub mod dsolve;
+pub mod engine;
 pub mod error;
 pub mod ivp;
 pub mod kin;
 pub mod md;
 pub mod model_file;
 pub mod nbody;
+pub mod options;
 pub mod output;
 pub mod params;
 pub mod plots;
+pub mod request;
 pub mod sim;
 pub mod summary;
 
+pub use engine::{run, Progress, RunOutput};
 pub use error::{Error, Location};
+pub use request::Request;

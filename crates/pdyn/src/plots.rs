@@ -41,7 +41,10 @@ pub fn write_run_plots(
     dir: &Path,
 ) -> Result<(), Error> {
     if res.rows.len() < 2 {
-        return Err(Error::argument("--plot", "too few output points to plot"));
+        return Err(Error::argument(
+            crate::options::RunOption::Plot.name(),
+            "too few output points to plot",
+        ));
     }
     let t = column(res, "t").unwrap_or_default();
     let mut markers: Vec<Marker> = res
@@ -229,7 +232,7 @@ pub fn write_sweep_plot(
     }
     if series.is_empty() {
         return Err(Error::argument(
-            "--plot",
+            crate::options::RunOption::Plot.name(),
             "the sweep has no measures to plot: add [sweep.measures]",
         ));
     }

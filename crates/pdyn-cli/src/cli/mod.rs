@@ -11,8 +11,6 @@ pub mod dsolve;
 pub mod expr;
 pub mod forces;
 pub mod kin;
-pub mod md;
-pub mod nbody;
 pub mod run;
 pub mod sweep;
 
@@ -104,15 +102,6 @@ pub fn both(pool: &Pool, id: Id) -> serde_json::Value {
 /// show the offending line, and an `[nbody]` or `[md]` model says `pdyn run` runs it.
 pub fn load_model(path: &Path) -> Result<pdyn_mech::Model, Error> {
     pdyn::model_file::ModelFile::read(path)?.mechanics()
-}
-
-/// A file that could not be created or written (`action`: "create", "write").
-pub(crate) fn io_error(path: &Path, action: &'static str, e: std::io::Error) -> Error {
-    Error::Io {
-        path: path.to_path_buf(),
-        action,
-        error: std::sync::Arc::new(e),
-    }
 }
 
 /// `name=number` pairs of a comma-separated option such as `--at t=0,theta=0.5`.

@@ -1,11 +1,10 @@
 //! `pdyn run MODEL`: simulate a model file.
 
-use super::{io_error, load_model, set_parameters, Outcome};
+use super::{load_model, numeric_pairs, set_parameters, Outcome};
 use clap::Args;
-use pdyn::model_file::Kind;
-use pdyn::output::{summary, write_csv};
 use pdyn::sim::{self, RunSettings, SimError};
-use pdyn::Error;
+use pdyn::{Error, Progress};
+use std::io::IsTerminal;
 use std::path::PathBuf;
 
 /// `pdyn run`.
@@ -83,9 +82,9 @@ impl RunArgs {
     }
 }
 
-/// The run options the flags give (the library merges them with `[simulate]`).
-pub fn request(a: &RunArgs) -> sim::request::Request {
-    sim::request::Request {
+/// The run options the flags give (the library resolves them against the model file).
+pub fn request(a: &RunArgs) -> Result<pdyn::Request, Error> {
+    Ok(pdyn::Request {
         method: a.method.clone(),
         rtol: a.rtol,
         atol: a.atol,
@@ -97,7 +96,11 @@ pub fn request(a: &RunArgs) -> sim::request::Request {
         output_dt: a.output_dt,
         t_eval: (!a.t_eval.is_empty()).then(|| a.t_eval.clone()),
         drift_tolerance: a.drift_tolerance,
-    }
+        params: numeric_pairs(&a.set, "--set")?,
+        jit: a.jit(),
+        out: a.out.clone(),
+        plots: a.plot,
+    })
 }
 
 /// Derives and compiles the model as the options ask.
@@ -107,202 +110,69 @@ pub(crate) fn prepare(model: &mut pdyn_mech::Model, a: &RunArgs) -> Result<sim::
 
 /// Merges `[simulate]` and the command line.
 pub fn settings(model: &pdyn_mech::Model, a: &RunArgs) -> Result<RunSettings, Error> {
-    sim::request::settings(model, &request(a))
+    sim::request::settings(model, &request(a)?)
 }
 
 pub(crate) use sim::request::located as sim_error;
 
-/// `pdyn run MODEL`.
+/// Steps × particles above which a progress bar is drawn (when stderr is a terminal).
+const PROGRESS_WORK: u64 = 20_000_000;
+
+/// `pdyn run MODEL`: the file read once, the request run by `pdyn::run` on the file's kind,
+/// the output rendered.
 pub fn run(a: RunArgs) -> Result<Outcome, Error> {
-    // Read once, told apart once; each kind has its own engine (and its own `--method help`).
     let file = pdyn::model_file::ModelFile::read(&a.model)?;
-    match file.kind {
-        Kind::Nbody => return super::nbody::run(a, file),
-        _ if a.method.as_deref() == Some("help") => return Ok(Outcome::text(sim::methods_help())),
-        Kind::Md => return super::md::run(a, file.source),
-        Kind::Mechanics => {}
+    if a.method.as_deref() == Some("help") {
+        return Ok(Outcome::text(pdyn::engine::methods_help(file.kind)));
     }
-    let mut model = file.mechanics()?;
-    set_parameters(&mut model, &a.set)?;
-    let mut set = settings(&model, &a)?;
-    if a.plot && set.points.is_none() && set.output_dt.is_none() && set.t_eval.is_none() {
-        // Plots read better from evenly spaced dense output than from raw steps.
-        set.points = Some(2001);
-    }
-    let prep = prepare(&mut model, &a)?;
-    let (res, failure) = sim::request::execute(&mut model, &prep, &set)?;
-    let mut stderr = String::new();
-    for w in &res.warnings {
-        stderr += &format!("warning: {w}\n");
-    }
-    let mut sum = summary(&res, &model.name, &prep.state_names, set.drift_tolerance);
-    if let Some(f) = &failure {
-        sum["error"] = f.to_json()["error"].clone();
-        // A table with NaN is a failure too, though the integration finished.
-        sum["ok"] = false.into();
-        if sum["failure"].is_null() {
-            sum["failure"] = f.to_string().into();
+    let req = request(&a)?;
+    // The run's log (an MD run's thermo table) goes live to stderr unless --json.
+    let live = !a.json;
+    let mut bar = indicatif::ProgressBar::hidden();
+    let mut progress = |p: Progress| match p {
+        Progress::Started { steps, work }
+            if work >= PROGRESS_WORK && std::io::stderr().is_terminal() =>
+        {
+            bar = indicatif::ProgressBar::new(steps);
+            if let Ok(style) = indicatif::ProgressStyle::with_template(
+                "{spinner} [{bar:40}] {pos}/{len} steps, {per_sec}, eta {eta}",
+            ) {
+                bar.set_style(style.progress_chars("=> "));
+            }
         }
-    }
-    if let Some(dir) = &a.out {
-        std::fs::create_dir_all(dir).map_err(|e| io_error(dir, "create", e))?;
-        let csv = dir.join("trajectory.csv");
-        write_csv(&res, &csv).map_err(|e| io_error(&csv, "write", e))?;
-        let js = dir.join("summary.json");
-        let text = pdyn::output::summary_text(&sum, res.hybrid.as_ref());
-        std::fs::write(&js, text).map_err(|e| io_error(&js, "write", e))?;
-        if a.plot {
-            pdyn::plots::write_run_plots(&model, &prep, &res, dir)?;
-        }
-    } else if a.plot {
-        return Err(Error::argument(
-            "--plot",
-            "--plot needs --out DIR to write the images into",
-        ));
+        Progress::Step(s) => bar.set_position(s),
+        Progress::Log(line) if live => bar.suspend(|| eprintln!("{line}")),
+        _ => {}
+    };
+    let mut output = pdyn::run(&file, &req, &mut progress)?;
+    bar.finish_and_clear();
+    let mut stderr: String = output
+        .warnings()
+        .iter()
+        .map(|w| format!("warning: {w}\n"))
+        .collect();
+    let unwritten = output.files_needing_a_directory();
+    if a.out.is_none() && !unwritten.is_empty() {
+        stderr += &format!(
+            "warning: no --out DIR: {} not written\n",
+            unwritten.join(", ")
+        );
     }
     let stdout = if a.json {
-        pdyn::output::summary_text(&sum, res.hybrid.as_ref())
+        output.summary_text()
     } else {
-        text_report(&model, &res, &set, a.out.as_ref())
+        output.report(a.out.as_deref())
     };
+    let failure = output.take_failure();
     // The process ends after printing: the pool's nodes, the compiled programs and the table
     // are returned by the exit; freeing them one by one was measurable on large models (as
     // in `pdyn derive`).
-    std::mem::forget((model, prep, res));
+    std::mem::forget(output);
     Ok(Outcome {
         stdout,
         stderr,
         failure,
     })
-}
-
-fn text_report(
-    model: &pdyn_mech::Model,
-    res: &sim::RunResult,
-    set: &RunSettings,
-    out: Option<&PathBuf>,
-) -> String {
-    let mut s = format!("{}\n", model.name);
-    s += &format!(
-        "method {}, t = 0..{}, {} accepted / {} rejected steps, {} f-evaluations, {} output rows\n",
-        res.method,
-        set.t_end,
-        res.stats.accepted,
-        res.stats.rejected,
-        res.stats.fevals,
-        res.rows.len()
-    );
-    if let Some(last) = res.rows.last() {
-        s += "\nfinal values:\n";
-        for (c, v) in res.columns.iter().zip(last) {
-            s += &format!("  {c:<20} {v:.10e}\n");
-        }
-    }
-    if !res.events.is_empty() {
-        s += "\nevents:\n";
-        for e in &res.events {
-            s += &format!(
-                "  {:<16} t = {:.12e} ({})\n",
-                e.name,
-                e.t,
-                if e.rising { "rising" } else { "falling" }
-            );
-        }
-    }
-    if let Some(h) = &res.hybrid {
-        s += &hybrid_text(h);
-    }
-    if !res.monitors.is_empty() {
-        s += "\nconserved quantities:\n";
-        for m in &res.monitors {
-            let ok = m.drift <= set.drift_tolerance;
-            s += &format!(
-                "  {:<20} initial {:.10e}, drift {:.3e} ({}) {}\n",
-                m.name,
-                m.initial,
-                m.drift,
-                if m.relative { "relative" } else { "absolute" },
-                if ok { "ok" } else { "DRIFTING" }
-            );
-        }
-    }
-    if let Some(dir) = out {
-        s += &format!(
-            "\nwrote {}/trajectory.csv and summary.json\n",
-            dir.display()
-        );
-    }
-    s
-}
-
-/// Most lines of each list (mode intervals, switches, impacts) in the text report; the whole
-/// lists are in `summary.json`.
-const HYBRID_LINES: usize = 12;
-
-/// The mode timeline, impacts, Zeno accumulations, event actions and energy accounting of a
-/// hybrid run.
-fn hybrid_text(h: &sim::hybrid::HybridReport) -> String {
-    let mut s = String::new();
-    let more = |s: &mut String, total: usize| {
-        if total > HYBRID_LINES {
-            *s += &format!("  ... {} more in summary.json\n", total - HYBRID_LINES);
-        }
-    };
-    if !h.timeline.is_empty() {
-        s += "\ncontact modes:\n";
-        for iv in h.timeline.iter().take(HYBRID_LINES) {
-            let modes: Vec<String> = iv.modes.iter().map(|(c, m)| format!("{c} {m}")).collect();
-            s += &format!(
-                "  t = {:.9e} .. {:.9e}  {}\n",
-                iv.t_from,
-                iv.t_to,
-                modes.join(", ")
-            );
-        }
-        more(&mut s, h.timeline.len());
-    }
-    if !h.switches.is_empty() {
-        s += "\nswitches:\n";
-        for sw in h.switches.iter().take(HYBRID_LINES) {
-            s += &format!(
-                "  t = {:.12e}  {}: {} -> {} ({})\n",
-                sw.t, sw.contact, sw.from, sw.to, sw.reason
-            );
-        }
-        more(&mut s, h.switches.len());
-    }
-    if !h.impacts.is_empty() {
-        s += &format!("\nimpacts ({}):\n", h.impacts.len());
-        for im in h.impacts.iter().take(HYBRID_LINES) {
-            s += &format!(
-                "  t = {:.12e}  {}: normal speed {:.6e} -> {:.6e}, impulse {:.6e}, energy lost {:.6e}\n",
-                im.t, im.contact, im.normal_speed_before, im.normal_speed_after, im.impulse, im.energy_lost
-            );
-        }
-        more(&mut s, h.impacts.len());
-    }
-    for z in &h.zeno {
-        s += &format!(
-            "\nZeno: the bounces at `{}` accumulate at t = {:.12e} (ratio {:.9}, {} bounces integrated): resting contact from there\n",
-            z.contact, z.t_accumulation, z.ratio, z.bounces
-        );
-    }
-    if !h.actions.is_empty() {
-        s += "\nevent actions:\n";
-        for a in h.actions.iter().take(HYBRID_LINES) {
-            s += &format!("  t = {:.12e}  {}: {}\n", a.t, a.event, a.set.join("; "));
-        }
-        more(&mut s, h.actions.len());
-    }
-    s += &format!(
-        "\nenergy: work of the contact forces {:.9e}, dissipated by friction {:.9e}, lost in impacts {:.9e}",
-        h.work_contacts, h.dissipated_friction, h.dissipated_impacts
-    );
-    if h.energy_actions != 0.0 {
-        s += &format!(", added by event actions {:.9e}", h.energy_actions);
-    }
-    s += "\n";
-    s
 }
 
 /// `pdyn check`.

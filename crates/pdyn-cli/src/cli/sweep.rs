@@ -1,6 +1,5 @@
 //! `pdyn sweep MODEL`: the model's `[sweep]`, in parallel, with a progress bar.
 
-use super::io_error;
 use super::run::{settings, sim_error, RunArgs};
 use super::{load_model, set_parameters, Outcome};
 use clap::Args;
@@ -95,7 +94,7 @@ pub fn run(a: SweepArgs) -> Result<Outcome, Error> {
         })
         .collect();
     if let Some(dir) = &a.run.out {
-        std::fs::create_dir_all(dir).map_err(|e| io_error(dir, "create", e))?;
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "create", e))?;
         let mut csv = res.parameter.clone();
         if let Some(sl) = res.slices.first() {
             for (n, _) in &sl.fixed {
@@ -121,7 +120,7 @@ pub fn run(a: SweepArgs) -> Result<Outcome, Error> {
             }
         }
         let path = dir.join("sweep.csv");
-        std::fs::write(&path, csv).map_err(|e| io_error(&path, "write", e))?;
+        std::fs::write(&path, csv).map_err(|e| Error::io(&path, "write", e))?;
         if a.run.plot {
             pdyn::plots::write_sweep_plot(&model, &res, &peaks, dir)?;
         }

@@ -171,8 +171,8 @@ pub struct RunSpec {
     pub monitors: Vec<Monitor>,
     /// `[sweep]`.
     pub sweep: Option<SweepSpec>,
-    /// Where each key of `[simulate]` is written, by the command-line option that overrides
-    /// it (`--t-end`, `--output-dt`, ...): a value the runner refuses is shown at its key.
+    /// Where each key of `[simulate]` is written, by its key (`t_end`, `output_dt`, ...; `dt`
+    /// for `h0` too): a value the runner refuses is shown at its key.
     pub simulate_spans: Vec<(&'static str, Range<usize>)>,
 }
 
@@ -317,18 +317,18 @@ pub(super) fn read(
         sim.output_dt = time(ld, &r.output_dt, "`output_dt`")?;
         sim.drift_tolerance = positive(ld, &r.drift_tolerance, "`drift_tolerance`")?;
         for (option, sv) in [
-            ("--t-end", &r.t_end),
-            ("--rtol", &r.rtol),
-            ("--atol", &r.atol),
-            ("--dt", if r.dt.is_some() { &r.dt } else { &r.h0 }),
-            ("--max-step", &r.max_step),
-            ("--output-dt", &r.output_dt),
+            ("t_end", &r.t_end),
+            ("rtol", &r.rtol),
+            ("atol", &r.atol),
+            ("dt", if r.dt.is_some() { &r.dt } else { &r.h0 }),
+            ("max_step", &r.max_step),
+            ("output_dt", &r.output_dt),
         ] {
             if let Some(sv) = sv {
                 spec.simulate_spans.push((option, sv.span()));
             }
         }
-        for (option, v) in [("--points", &r.points), ("--max-steps", &r.max_steps)] {
+        for (option, v) in [("points", &r.points), ("max_steps", &r.max_steps)] {
             if let Some(v) = v {
                 spec.simulate_spans.push((option, v.span()));
             }

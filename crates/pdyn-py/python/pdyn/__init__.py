@@ -308,7 +308,8 @@ class Model:
         An ``[nbody]`` or ``[md]`` model runs on its own engine, as ``pdyn run`` runs it
         (``method``: ``whfast``, ``ias15``, ``leapfrog`` for N-body; ``dt``, ``t_end``,
         ``points``/``t_eval``, ``drift_tolerance``, ``params``; ``plots``: a directory for the
-        files ``pdyn run --out DIR`` writes) and returns a :class:`ParticleResult`.
+        files and plots ``pdyn run --out DIR --plot`` writes) and returns a
+        :class:`ParticleResult`.
 
         Returns an :class:`OdeResult` (``success=False`` with the partial solution when the
         integration fails, or when an output column becomes NaN or infinite: ``status``
@@ -332,16 +333,14 @@ class Model:
     def _run_particles(self, m: "_pdyn.ParticleModel", t_end, method, rtol, atol, t_eval,
                        max_step, dt, max_steps, points, drift_tolerance, params, plots,
                        jit) -> ParticleResult:
-        for name, given in (("rtol", rtol), ("atol", atol), ("max_step", max_step),
-                            ("max_steps", max_steps)):
-            if given is not None:
-                raise ParameterError(
-                    f"{name} does not apply to {m.kind} models (fixed-step or IAS15 "
-                    "integrators: give dt, t_end, points or t_eval)")
+        # Options with no meaning for the kind (rtol for WHFast, method for MD) are refused by
+        # the library, by name, as `pdyn run` refuses them.
         te = None if t_eval is None else [float(x) for x in _array1(t_eval, "t_eval")]
         raw = m.run(t_end=t_end, method=method, dt=dt, points=points, t_eval=te,
                     drift_tolerance=drift_tolerance, params=_params(params),
-                    out=None if plots is None else os.fspath(plots), jit=bool(jit))
+                    out=None if plots is None else os.fspath(plots), plots=plots is not None,
+                    jit=bool(jit), rtol=rtol, atol=atol, max_step=max_step,
+                    max_steps=max_steps)
         return ParticleResult(raw)
 
     def derive(self) -> Derivation:

@@ -7,7 +7,7 @@
 //! compiled by pdyn-expr and pdyn-jit, [`formula`]) and sets up a `pdyn_md::Simulation`
 //! (lattice or file, bonds, Maxwell–Boltzmann velocities, minimisation, thermostat),
 //! [`run::run`] steps it and gathers thermodynamics, trajectory frames, RDF and MSD, and
-//! [`output`] writes the files and the summary. pdyn-md knows nothing of files or symbols:
+//! [`output`] writes the files and the summary, [`report`] the lines printed. pdyn-md knows nothing of files or symbols:
 //! everything about the model file lives here. See `docs/md.md` for the format.
 
 pub mod build;
@@ -15,6 +15,7 @@ pub mod formula;
 pub mod memory;
 pub mod output;
 pub mod pair;
+pub mod report;
 pub mod request;
 pub mod run;
 pub mod spec;
@@ -23,7 +24,16 @@ pub use build::{build, Prepared};
 pub use run::{run, MdResult, Progress, RunOptions};
 pub use spec::{parse, MdSpec};
 
+use crate::options::RunOption;
 use crate::Error;
+
+/// What `method` means for an `[md]` model (`pdyn run --method help`): nothing to choose.
+pub const METHODS_HELP: &str =
+    "Molecular-dynamics models ([md]) step with velocity Verlet at the fixed step dt
+(with the thermostat's splitting: BAOAB for Langevin, Trotter for Nose-Hoover chains); there is
+no method to choose. Give dt and the run length (steps, or t_end), thermo_every and dump_every
+in [md] (docs/md.md).
+";
 
 /// Reads a molecular-dynamics model as [`crate::nbody::load`] reads an N-body one: `source` is
 /// the text of the file `origin`, `set` overrides parameters; a problem in the file is a
@@ -39,9 +49,10 @@ pub fn load(source: &str, origin: &str, set: &[(String, f64)]) -> Result<MdSpec,
     {
         let names: Vec<&str> = spec.parameters.iter().map(|(n, _)| n.as_str()).collect();
         return Err(Error::argument(
-            "--set",
+            RunOption::Set.name(),
             format!(
-                "--set: `{k}` is not a parameter (parameters: {})",
+                "{}: `{k}` is not a parameter (parameters: {})",
+                RunOption::Set,
                 names.join(", ")
             ),
         ));

@@ -208,7 +208,7 @@ pub fn write_plots(prep: &Prepared, res: &MdResult, dir: &Path) -> Result<(), Er
     use pdyn_plot::{save_grid, Figure, Series};
     if res.records.len() < 2 {
         return Err(Error::argument(
-            "--plot",
+            crate::options::RunOption::Plot.name(),
             "too few thermo records to plot (lower thermo_every)",
         ));
     }

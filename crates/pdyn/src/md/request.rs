@@ -3,70 +3,43 @@
 //! Python refuse and accept the same things.
 
 use super::{load, MdSpec};
-use crate::Error;
+use crate::options::RunOption;
+use crate::{Error, Request};
 
-/// The options of one run, each `None` (or empty) when not given: the `[md]` table applies.
-/// The options of the ODE integrators are carried only to be refused by name: they have no
-/// meaning for fixed-step velocity Verlet.
-#[derive(Clone, Debug, Default)]
-pub struct Request {
-    /// Time step.
-    pub dt: Option<f64>,
-    /// Run length (`steps = t_end / dt`).
-    pub t_end: Option<f64>,
-    /// Relative energy drift that is reported.
-    pub drift_tolerance: Option<f64>,
-    /// Refused (see above).
-    pub method: Option<String>,
-    /// Refused.
-    pub rtol: Option<f64>,
-    /// Refused.
-    pub atol: Option<f64>,
-    /// Refused.
-    pub max_step: Option<f64>,
-    /// Refused.
-    pub max_steps: Option<usize>,
-    /// Refused.
-    pub points: Option<usize>,
-    /// Refused.
-    pub output_dt: Option<f64>,
-    /// Refused.
-    pub t_eval: Vec<f64>,
-}
-
-/// Loads the model `source` (file `origin`) with parameters `set` and applies `req`: the spec
-/// to build and the drift tolerance of the run.
-pub fn plan(
-    source: &str,
-    origin: &str,
-    set: &[(String, f64)],
-    req: &Request,
-) -> Result<(MdSpec, f64), Error> {
+/// Loads the model `source` (file `origin`) with the request's parameters and applies the
+/// request: the spec to build and the drift tolerance of the run. The options of the ODE
+/// integrators are refused by name: they have no meaning for fixed-step velocity Verlet.
+pub fn plan(source: &str, origin: &str, req: &Request) -> Result<(MdSpec, f64), Error> {
     let meaningless = [
-        ("--method", req.method.is_some()),
-        ("--rtol", req.rtol.is_some()),
-        ("--atol", req.atol.is_some()),
-        ("--max-step", req.max_step.is_some()),
-        ("--max-steps", req.max_steps.is_some()),
-        ("--points", req.points.is_some()),
-        ("--output-dt", req.output_dt.is_some()),
-        ("--t-eval", !req.t_eval.is_empty()),
+        (RunOption::Method, req.method.is_some()),
+        (RunOption::Rtol, req.rtol.is_some()),
+        (RunOption::Atol, req.atol.is_some()),
+        (RunOption::MaxStep, req.max_step.is_some()),
+        (RunOption::MaxSteps, req.max_steps.is_some()),
+        (RunOption::Points, req.points.is_some()),
+        (RunOption::OutputDt, req.output_dt.is_some()),
+        (
+            RunOption::TEval,
+            req.t_eval.as_ref().is_some_and(|t| !t.is_empty()),
+        ),
     ];
     if let Some((opt, _)) = meaningless.iter().find(|(_, given)| *given) {
         return Err(Error::argument(
-            *opt,
+            opt.name(),
             format!(
                 "{opt} has no meaning for a molecular-dynamics model (fixed-step velocity Verlet); \
-                 use --dt, --t-end (run length) and the [md] keys steps, thermo_every, dump_every"
+                 use {}, {} (run length) and the [md] keys steps, thermo_every, dump_every",
+                RunOption::Dt,
+                RunOption::TEnd
             ),
         ));
     }
-    let mut spec = load(source, origin, set)?;
+    let mut spec = load(source, origin, &req.params)?;
     if let Some(dt) = req.dt {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(Error::argument(
-                "--dt",
-                format!("--dt must be a positive number, got {dt}"),
+                RunOption::Dt.name(),
+                format!("{} must be a positive number, got {dt}", RunOption::Dt),
             ));
         }
         spec.dt.value = dt;
@@ -75,9 +48,10 @@ pub fn plan(
         let steps = t / spec.dt.value;
         if !(steps.is_finite() && steps >= 0.0 && steps <= super::spec::MAX_STEPS as f64) {
             return Err(Error::argument(
-                "--t-end",
+                RunOption::TEnd.name(),
                 format!(
-                    "--t-end {t} with dt = {} is not a valid number of steps",
+                    "{} with dt = {} is not a valid number of steps",
+                    RunOption::TEnd.with(t),
                     spec.dt.value
                 ),
             ));
@@ -88,8 +62,11 @@ pub fn plan(
         Some(d) if d.is_finite() && d > 0.0 => d,
         Some(d) => {
             return Err(Error::argument(
-                "--drift-tolerance",
-                format!("--drift-tolerance must be a positive number, got {d}"),
+                RunOption::DriftTolerance.name(),
+                format!(
+                    "{} must be a positive number, got {d}",
+                    RunOption::DriftTolerance
+                ),
             ))
         }
         None => crate::sim::DEFAULT_DRIFT_TOLERANCE,

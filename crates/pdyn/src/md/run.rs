@@ -400,7 +400,7 @@ fn run_sim<P: PairPotential>(
                      mode = \"shifted-energy\" removes that; if the drift remains, reduce the time step."
                         .to_string()
                 } else {
-                    format!("Reduce the time step (--dt {}).", dt / 2.0)
+                    format!("Reduce the time step ({}).", crate::options::RunOption::Dt.with(dt / 2.0))
                 }
             ));
         }

@@ -56,7 +56,10 @@ impl Config {
                     spec.integrator_span.clone(),
                     format!("integrator `{}` has a fixed step: give dt", kind.name()),
                 )
-                .help("for WHFast a twentieth of the shortest orbital period is usual; or --dt"))
+                .help(format!(
+                    "for WHFast a twentieth of the shortest orbital period is usual; or {}",
+                    crate::options::RunOption::Dt
+                )))
             }
         };
         Ok(Config {

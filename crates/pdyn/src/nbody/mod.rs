@@ -21,7 +21,20 @@ pub mod request;
 pub mod run;
 pub mod spec;
 
+use crate::options::RunOption;
 use crate::Error;
+
+/// The integrators `method` takes, with their papers (`pdyn run --method help`).
+pub const METHODS_HELP: &str = "N-body integrators (integrator = \"...\" in [nbody], or --method):
+  whfast    Wisdom-Holman map in Jacobi coordinates with symplectic correctors (Rein & Tamayo
+            2015, MNRAS 452, 376); fixed step dt, corrector = 0, 3, 5, 7, 11 or 17. Planetary
+            systems dominated by one mass; stops at close encounters (use ias15).
+  ias15     Adaptive 15th-order Gauss-Radau (Rein & Spiegel 2015, MNRAS 446, 1424); dt is the
+            first trial step, epsilon the accuracy (default 1e-9). Close encounters, high
+            eccentricities, machine-precision energy.
+  leapfrog  Drift-kick-drift, second order, symplectic, fixed step dt; with gravity = \"tree\"
+            (Barnes-Hut, theta) for large N.
+";
 
 /// Reads an N-body model: `source` is the text of the file `origin`; `set` overrides
 /// parameters (`--set`). Problems are located [`Error::Model`]s (in the model file, or in
@@ -33,8 +46,11 @@ pub fn load(source: &str, origin: &str, set: &[(String, f64)]) -> Result<spec::N
             source: s.source.into(),
         },
         spec::SetOrSpecError::UnknownParameter { name, parameters } => Error::argument(
-            "--set",
-            format!("--set: `{name}` is not a parameter (parameters: {parameters})"),
+            RunOption::Set.name(),
+            format!(
+                "{}: `{name}` is not a parameter (parameters: {parameters})",
+                RunOption::Set
+            ),
         ),
     })
 }

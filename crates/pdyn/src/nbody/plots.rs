@@ -25,7 +25,10 @@ pub fn write(title: &str, res: &NbodyResult, units: &UnitsSpec, dir: &Path) -> R
         format!("t [{time}]"),
     );
     if res.times.len() < 2 {
-        return Err(Error::argument("--plot", "too few output points to plot"));
+        return Err(Error::argument(
+            crate::options::RunOption::Plot.name(),
+            "too few output points to plot",
+        ));
     }
     let markers: Vec<Marker> = res
         .events

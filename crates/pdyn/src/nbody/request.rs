@@ -6,7 +6,8 @@ use super::output::RunInfo;
 use super::run::{NbodyResult, RunOptions, Sampling};
 use super::spec::{EscapeMode, IntegratorKind, NbodySpec};
 use super::{build::Built, load};
-use crate::Error;
+use crate::options::{naming, Naming, RunOption};
+use crate::{Error, Request};
 
 /// Most per-body rows a run keeps for `trajectory.csv` (about 1 GB in memory).
 pub const MAX_TRAJECTORY_ROWS: usize = 10_000_000;
@@ -14,34 +15,6 @@ pub const MAX_TRAJECTORY_ROWS: usize = 10_000_000;
 /// Most steps a fixed-step run may ask for: the limit of every fixed-step run
 /// ([`crate::sim::MAX_FIXED_STEPS`], hours of computing at a microsecond a step).
 pub const MAX_FIXED_STEPS: f64 = crate::sim::MAX_FIXED_STEPS;
-
-/// The options of one run, each `None` (or empty) when the front end did not give it: the
-/// model's `[nbody]` table applies.
-#[derive(Clone, Debug, Default)]
-pub struct Request {
-    /// Integrator name (`whfast`, `ias15`, `leapfrog`).
-    pub method: Option<String>,
-    /// Fixed step (first trial step for IAS15).
-    pub dt: Option<f64>,
-    /// End time.
-    pub t_end: Option<f64>,
-    /// Relative drift of a conserved quantity that is reported.
-    pub drift_tolerance: Option<f64>,
-    /// Equally spaced output times.
-    pub points: Option<usize>,
-    /// Output interval.
-    pub output_dt: Option<f64>,
-    /// Output times.
-    pub t_eval: Vec<f64>,
-    /// Options of the ODE integrators, refused with what to use instead.
-    pub rtol: Option<f64>,
-    /// See [`Request::rtol`].
-    pub atol: Option<f64>,
-    /// See [`Request::rtol`].
-    pub max_step: Option<f64>,
-    /// See [`Request::rtol`].
-    pub max_steps: Option<usize>,
-}
 
 /// A run resolved and built, ready to [`Planned::execute`].
 pub struct Planned {
@@ -58,65 +31,70 @@ pub struct Planned {
     built: Built,
 }
 
-/// Loads the model `source` (file `origin`) with parameters `set`, applies `req` and builds
-/// the simulation. Every problem is an [`Error`]: located in the file, or naming the option.
-pub fn plan(
-    source: &str,
-    origin: &str,
-    set: &[(String, f64)],
-    req: &Request,
-) -> Result<Planned, Error> {
+/// Loads the model `source` (file `origin`) with the request's parameters, applies the
+/// request and builds the simulation. Every problem is an [`Error`]: located in the file, or
+/// naming the option.
+pub fn plan(source: &str, origin: &str, req: &Request) -> Result<Planned, Error> {
+    let ias15_accuracy = "IAS15's accuracy is `epsilon` in [nbody]";
     for (given, option, instead) in [
         (
             req.rtol.is_some(),
-            "--rtol",
-            "IAS15's accuracy is `epsilon` in [nbody]",
+            RunOption::Rtol,
+            ias15_accuracy.to_string(),
         ),
         (
             req.atol.is_some(),
-            "--atol",
-            "IAS15's accuracy is `epsilon` in [nbody]",
+            RunOption::Atol,
+            ias15_accuracy.to_string(),
         ),
         (
             req.max_step.is_some(),
-            "--max-step",
-            "the fixed-step integrators take --dt",
+            RunOption::MaxStep,
+            format!("the fixed-step integrators take {}", RunOption::Dt),
         ),
         (
             req.max_steps.is_some(),
-            "--max-steps",
-            "shorten the run with --t-end",
+            RunOption::MaxSteps,
+            format!("shorten the run with {}", RunOption::TEnd),
         ),
     ] {
         if given {
             return Err(Error::argument(
-                option,
+                option.name(),
                 format!("{option} does not apply to N-body models ({instead})"),
             ));
         }
     }
-    let mut spec = load(source, origin, set)?;
+    let mut spec = load(source, origin, &req.params)?;
     if let Some(m) = &req.method {
         spec.integrator = IntegratorKind::from_name(m).ok_or_else(|| {
+            let list = match naming() {
+                Naming::Flags => " (--method help)",
+                Naming::Keywords => "",
+            };
             Error::argument(
-                "--method",
+                RunOption::Method.name(),
                 format!(
-                    "--method {m}: N-body models take whfast, ias15 or leapfrog (--method help)"
+                    "{}: N-body models take whfast, ias15 or leapfrog{list}",
+                    RunOption::Method.with(m)
                 ),
             )
         })?;
         if spec.integrator == IntegratorKind::WhFast && spec.tree.is_some() {
             return Err(Error::argument(
-                "--method",
-                "--method whfast: WHFast with the tree (gravity = \"tree\") is not supported; use leapfrog",
+                RunOption::Method.name(),
+                format!(
+                    "{}: WHFast with the tree (gravity = \"tree\") is not supported; use leapfrog",
+                    RunOption::Method.with("whfast")
+                ),
             ));
         }
     }
     if let Some(dt) = req.dt {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(Error::argument(
-                "--dt",
-                format!("--dt must be > 0 (got {dt})"),
+                RunOption::Dt.name(),
+                format!("{} must be > 0 (got {dt})", RunOption::Dt),
             ));
         }
         spec.dt = Some((dt, 0..0));
@@ -124,8 +102,8 @@ pub fn plan(
     if let Some(t) = req.t_end {
         if !(t.is_finite() && t > 0.0) {
             return Err(Error::argument(
-                "--t-end",
-                format!("--t-end must be > 0 (got {t})"),
+                RunOption::TEnd.name(),
+                format!("{} must be > 0 (got {t})", RunOption::TEnd),
             ));
         }
         spec.t_end = Some(t);
@@ -133,8 +111,8 @@ pub fn plan(
     let drift_tolerance = match req.drift_tolerance {
         Some(d) if !(d.is_finite() && d > 0.0) => {
             return Err(Error::argument(
-                "--drift-tolerance",
-                format!("--drift-tolerance must be > 0 (got {d})"),
+                RunOption::DriftTolerance.name(),
+                format!("{} must be > 0 (got {d})", RunOption::DriftTolerance),
             ))
         }
         Some(d) => d,
@@ -145,27 +123,34 @@ pub fn plan(
     let Some(t_end) = spec.t_end else {
         return Err(Error::Model {
             error: pdyn_mech::ModelError::new(origin, spec.table_span.clone(), "no end time")
-                .help("t_end = ... in [nbody], or --t-end"),
+                .help(format!("t_end = ... in [nbody], or {}", RunOption::TEnd)),
             source: source.into(),
         });
     };
+    let t_eval = req.t_eval.as_deref().unwrap_or_default();
     let given = [
         req.points.is_some(),
         req.output_dt.is_some(),
-        !req.t_eval.is_empty(),
+        !t_eval.is_empty(),
     ];
     if given.iter().filter(|g| **g).count() > 1 {
         return Err(Error::argument(
             "",
-            "give only one of --points, --output-dt and --t-eval",
+            format!(
+                "give only one of {}, {} and {}",
+                RunOption::Points,
+                RunOption::OutputDt,
+                RunOption::TEval
+            ),
         ));
     }
+    // The option the output times came from, as errors about them name it.
     let (sampling, option) = if let Some(n) = req.points {
-        (Sampling::Points(n), "--points")
+        (Sampling::Points(n), RunOption::Points.name())
     } else if let Some(dt) = req.output_dt {
-        (Sampling::Every(dt), "--output-dt")
-    } else if !req.t_eval.is_empty() {
-        (Sampling::Times(req.t_eval.clone()), "--t-eval")
+        (Sampling::Every(dt), RunOption::OutputDt.name())
+    } else if !t_eval.is_empty() {
+        (Sampling::Times(t_eval.to_vec()), RunOption::TEval.name())
     } else if let Some(dt) = spec.output_dt {
         (Sampling::Every(dt), "output_dt")
     } else {
@@ -183,7 +168,10 @@ pub fn plan(
                 "t_end/dt = {steps:.3e} steps, more than {MAX_FIXED_STEPS:.0e}: dt = {dt} is far too small for t_end = {t_end}"
             );
             return Err(if span.is_empty() {
-                Error::argument("--dt", format!("--dt: {message}"))
+                Error::argument(
+                    RunOption::Dt.name(),
+                    format!("{}: {message}", RunOption::Dt),
+                )
             } else {
                 Error::Model {
                     error: pdyn_mech::ModelError::new(origin, span.clone(), message),

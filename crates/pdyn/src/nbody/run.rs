@@ -524,7 +524,8 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingEr
                             bodies: vec![who.clone()],
                             message: format!(
                                 "close encounter of `{who}` (perturbation/Kepler acceleration = {ratio:.3}): WHFast cannot resolve it; \
-                                 switch to IAS15 (integrator = \"ias15\" or --method ias15)"
+                                 switch to IAS15 (integrator = \"ias15\" or {})",
+                                crate::options::RunOption::Method.with("ias15")
                             ),
                         });
                     }

@@ -1,6 +1,7 @@
 //! [`SimError`]: why a model could not be prepared or run, and [`RunFailure`]: where an
 //! integration that started stopped early (the partial result is kept).
 
+use crate::options::RunOption;
 use pdyn_expr::compile::CompileError;
 use pdyn_mech::dsolve::DsolveError;
 use pdyn_mech::DeriveError;
@@ -71,14 +72,19 @@ pub enum SimError {
     /// An initial value or rate that names an `[unknowns]` quantity (`rate = "omega"`): only
     /// `pdyn forces` can use it; the error points at it in the model file.
     UnknownInitialCondition(Box<pdyn_mech::ModelError>),
-    /// A run setting outside its valid range (named as on the command line).
+    /// A run setting outside its valid range.
     InvalidOption {
-        /// The option, e.g. `--dt`.
-        option: &'static str,
+        /// The option (named as the front end names it when shown).
+        option: crate::options::RunOption,
         /// The value given.
         value: String,
         /// What would be valid.
         requirement: String,
+    },
+    /// A `[sweep]` whose combinations of values are more runs than `limit`.
+    TooManySweepRuns {
+        /// The most runs a sweep may have.
+        limit: usize,
     },
 }
 
@@ -137,14 +143,16 @@ impl fmt::Display for SimError {
             SimError::Compile { what, error } => write!(f, "{what}: {error}"),
             SimError::UnknownMethod { name } => write!(
                 f,
-                "unknown method `{name}`; run `pdyn run --method help` for the list"
+                "unknown method `{name}`; {} lists them",
+                crate::options::methods_list()
             ),
             SimError::NeedsStep { method } => write!(
                 f,
-                "method `{method}` takes fixed steps: give the step with --dt (or dt = ... in [simulate])"
+                "method `{method}` takes fixed steps: give the step with {} (or dt = ... in [simulate])",
+                RunOption::Dt
             ),
             SimError::NoEndTime => {
-                f.write_str("no end time: add t_end = ... under [simulate] or pass --t-end")
+                write!(f, "no end time: add t_end = ... under [simulate] or give {}", RunOption::TEnd)
             }
             SimError::InvalidEndTime(t) => write!(f, "t_end must be a positive time, got {t}"),
             SimError::InvalidTEval { t_end } => {
@@ -174,6 +182,10 @@ impl fmt::Display for SimError {
                 value,
                 requirement,
             } => write!(f, "{option} must be {requirement}, got {value}"),
+            SimError::TooManySweepRuns { limit } => write!(
+                f,
+                "[sweep] must be at most {limit} runs (every combination of the swept values), got more runs"
+            ),
             SimError::Contact { message } => f.write_str(message),
             SimError::UnknownInitialCondition(e) => f.write_str(&e.message),
         }
@@ -226,7 +238,9 @@ impl fmt::Display for RunFailure {
             write!(
                 f,
                 "\n  the problem seems to have become stiff at t = {at:.6e} (the explicit method's \
-                 stiffness test fired): use --method radau5, or --method auto to switch when it does"
+                 stiffness test fired): use {}, or {} to switch when it does",
+                RunOption::Method.with("radau5"),
+                RunOption::Method.with("auto")
             )?;
         }
         Ok(())

@@ -381,7 +381,8 @@ fn verify_against_integration(
             "the closed form differs from a DOP853 integration (rtol 1e-11) by {worst:.3e} relative \
              to the solution's size: evaluated in floating point it cannot be trusted here (near a \
              resonance or a repeated root the formula cancels large terms). Use a numerical method \
-             (drop --method exact)."
+             (drop {}).",
+            crate::options::RunOption::Method.with("exact")
         )
     })
 }

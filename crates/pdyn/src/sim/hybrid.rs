@@ -1413,9 +1413,10 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
                 }
                 Some(i) => {
                     st.warnings.push(format!(
-                        "a contact was found penetrated by {:.3e} at t = {:.9e}, and shorter steps did not find where it closed: the motion after this time is wrong; limit the step with --max-step",
+                        "a contact was found penetrated by {:.3e} at t = {:.9e}, and shorter steps did not find where it closed: the motion after this time is wrong; limit the step with {}",
                         -st.probe(sol.t[i], sol.y_at(i)).iter().map(|p| p[0]).fold(0.0, f64::min),
-                        sol.t[i]
+                        sol.t[i],
+                        crate::options::RunOption::MaxStep
                     ));
                     break (sol, fail);
                 }
@@ -1493,8 +1494,8 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
                 _ => "a contact switch".to_string(),
             };
             st.warnings.push(format!(
-                "{what} may have crossed zero twice unseen between t = {:.9e} and {:.9e}: limit the step with --max-step",
-                miss.t_from, miss.t_to
+                "{what} may have crossed zero twice unseen between t = {:.9e} and {:.9e}: limit the step with {}",
+                miss.t_from, miss.t_to, crate::options::RunOption::MaxStep
             ));
         }
         for hit in &sol.events {
@@ -1768,8 +1769,9 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
         });
         if drift.is_nan() || drift > set.drift_tolerance {
             warnings.push(format!(
-                "energy_balance should be conserved but drifted by {drift:.3e} (relative) over t = 0..{:.6e}: the energy minus the work of the contact forces and the energy changed at impacts and event actions must stay constant, so this result cannot be trusted (the First Law of Scientific Computing). Tighten the tolerance (e.g. --rtol 1e-9)",
-                rows.last().map_or(0.0, |r| r[0])
+                "energy_balance should be conserved but drifted by {drift:.3e} (relative) over t = 0..{:.6e}: the energy minus the work of the contact forces and the energy changed at impacts and event actions must stay constant, so this result cannot be trusted (the First Law of Scientific Computing). Tighten the tolerance (e.g. {})",
+                rows.last().map_or(0.0, |r| r[0]),
+                crate::options::RunOption::Rtol.with("1e-9")
             ));
         }
     }

@@ -18,6 +18,7 @@ use super::{
     integrate, scale_of, EventReport, MonitorReport, Prepared, RunFailure, RunSettings, RunStatus,
     SimError,
 };
+use crate::options::RunOption;
 use pdyn_mech::model::spec::Stat;
 use pdyn_ode::{Direction, Solution};
 
@@ -349,9 +350,14 @@ pub(crate) fn report(
             warnings.push(format!(
                 "{name} should be conserved but drifted by {drift:.3e} ({}) over t = 0..{t_last}: \
                  this result cannot be trusted (the First Law of Scientific Computing). Tighten \
-                 the tolerance (e.g. --rtol {:.0e}) or use a symplectic method (--method symplectic --dt ...).",
+                 the tolerance (e.g. {}) or use a symplectic method ({} {}).",
                 if relative { "relative" } else { "absolute" },
-                (set.rtol.unwrap_or(1e-6) * 1e-3).max(1e-13),
+                RunOption::Rtol.with(format!(
+                    "{:.0e}",
+                    (set.rtol.unwrap_or(1e-6) * 1e-3).max(1e-13)
+                )),
+                RunOption::Method.with("symplectic"),
+                RunOption::Dt.with("..."),
             ));
         }
         monitors.push(MonitorReport {
@@ -374,8 +380,10 @@ pub(crate) fn report(
         warnings.push(format!(
             "event `{name}` may have crossed zero twice between t = {:.6e} and t = {:.6e} \
              unseen (its function came back towards zero and away within one step): limit the \
-             step (--max-step) to be sure",
-            miss.t_from, miss.t_to
+             step ({}) to be sure",
+            miss.t_from,
+            miss.t_to,
+            RunOption::MaxStep
         ));
     }
     let status = match (failure, sol.status) {

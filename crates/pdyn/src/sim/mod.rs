@@ -17,11 +17,13 @@ mod error;
 pub mod exact;
 pub mod hybrid;
 pub mod measured;
+pub mod report;
 pub mod request;
 pub mod sweep;
 
 pub use error::{ClosedFormError, RunFailure, SimError};
 
+use crate::options::RunOption;
 use compiled::{CompiledModel, Observer};
 use measured::report;
 use pdyn_expr::{Id, Pool};
@@ -133,10 +135,10 @@ impl RunSettings {
         }
     }
 
-    /// Checks every setting against its valid range, naming the option as the command line
-    /// does. Sizes are checked here, before anything is allocated.
+    /// Checks every setting against its valid range, naming the option. Sizes are checked
+    /// here, before anything is allocated.
     pub fn validate(&self) -> Result<(), SimError> {
-        let bad = |option: &'static str, value: f64, requirement: &str| {
+        let bad = |option: RunOption, value: f64, requirement: &str| {
             let value = if value != 0.0 && !(1e-4..1e7).contains(&value.abs()) {
                 format!("{value:e}")
             } else {
@@ -151,7 +153,7 @@ impl RunSettings {
         if !(self.t_end.is_finite() && self.t_end > 0.0) {
             return Err(SimError::InvalidEndTime(self.t_end));
         }
-        for (option, v) in [("--rtol", self.rtol), ("--atol", self.atol)] {
+        for (option, v) in [(RunOption::Rtol, self.rtol), (RunOption::Atol, self.atol)] {
             if let Some(v) = v {
                 if !(v.is_finite() && v >= 0.0) {
                     return bad(option, v, "a finite number >= 0");
@@ -159,9 +161,16 @@ impl RunSettings {
             }
         }
         if self.rtol == Some(0.0) && self.atol == Some(0.0) {
-            return bad("--atol", 0.0, "> 0 when --rtol is 0");
+            return bad(
+                RunOption::Atol,
+                0.0,
+                &format!("> 0 when {} is 0", RunOption::Rtol),
+            );
         }
-        for (option, v) in [("--dt", self.dt), ("--max-step", self.max_step)] {
+        for (option, v) in [
+            (RunOption::Dt, self.dt),
+            (RunOption::MaxStep, self.max_step),
+        ] {
             if let Some(v) = v {
                 if !(v.is_finite() && v > 0.0) {
                     return bad(option, v, "a finite time > 0");
@@ -171,7 +180,7 @@ impl RunSettings {
         if let Some(dt) = self.dt {
             if self.t_end / dt > MAX_FIXED_STEPS {
                 return bad(
-                    "--dt",
+                    RunOption::Dt,
                     dt,
                     &format!(
                         "at least t_end/{MAX_FIXED_STEPS:e} = {:e}",
@@ -183,7 +192,7 @@ impl RunSettings {
         if let Some(n) = self.points {
             if !(2..=MAX_OUTPUT_ROWS).contains(&n) {
                 return bad(
-                    "--points",
+                    RunOption::Points,
                     n as f64,
                     &format!("between 2 and {MAX_OUTPUT_ROWS}"),
                 );
@@ -191,11 +200,11 @@ impl RunSettings {
         }
         if let Some(h) = self.output_dt {
             if !(h.is_finite() && h > 0.0) {
-                return bad("--output-dt", h, "a finite time > 0");
+                return bad(RunOption::OutputDt, h, "a finite time > 0");
             }
             if self.t_end / h > MAX_OUTPUT_ROWS as f64 {
                 return bad(
-                    "--output-dt",
+                    RunOption::OutputDt,
                     h,
                     &format!(
                         "at least t_end/{MAX_OUTPUT_ROWS} = {:e} (at most {MAX_OUTPUT_ROWS} output rows)",
@@ -207,7 +216,7 @@ impl RunSettings {
         if let Some(ts) = &self.t_eval {
             if ts.len() > MAX_OUTPUT_ROWS {
                 return bad(
-                    "--t-eval",
+                    RunOption::TEval,
                     ts.len() as f64,
                     &format!("at most {MAX_OUTPUT_ROWS} times"),
                 );
@@ -220,7 +229,7 @@ impl RunSettings {
         }
         if !(self.drift_tolerance.is_finite() && self.drift_tolerance > 0.0) {
             return bad(
-                "--drift-tolerance",
+                RunOption::DriftTolerance,
                 self.drift_tolerance,
                 "a finite number > 0",
             );

@@ -5,37 +5,10 @@
 
 use super::measured::NonFinite;
 use super::{JitMode, Prepared, RunResult, RunSettings, SimError};
-use crate::Error;
+use crate::options::RunOption;
+use crate::{Error, Request};
 use pdyn_mech::model::spec::SimulateSpec;
 use pdyn_mech::Model;
-
-/// The options of one run, each `None` (or empty) when not given: the model's `[simulate]`
-/// applies.
-#[derive(Clone, Debug, Default)]
-pub struct Request {
-    /// Method name (`auto`, `dop853`, `radau5`, …, or `exact`).
-    pub method: Option<String>,
-    /// Relative tolerance.
-    pub rtol: Option<f64>,
-    /// Absolute tolerance.
-    pub atol: Option<f64>,
-    /// End time.
-    pub t_end: Option<f64>,
-    /// Fixed step, or first step.
-    pub dt: Option<f64>,
-    /// Largest step.
-    pub max_step: Option<f64>,
-    /// Step limit.
-    pub max_steps: Option<usize>,
-    /// Equally spaced output times.
-    pub points: Option<usize>,
-    /// Output interval.
-    pub output_dt: Option<f64>,
-    /// Output times (SciPy's `t_eval`).
-    pub t_eval: Option<Vec<f64>>,
-    /// Relative drift of a conserved quantity that is reported.
-    pub drift_tolerance: Option<f64>,
-}
 
 /// A simulation error located in the model file where it has a place there, else with the
 /// file's name and what was being attempted (`context`).
@@ -74,7 +47,7 @@ pub fn settings(model: &Model, req: &Request) -> Result<RunSettings, Error> {
                 span.clone(),
                 format!("unknown method `{m}`"),
             )
-            .help("run `pdyn run --method help` for the list");
+            .help(format!("{} lists them", crate::options::methods_list()));
             return Err(Error::Model {
                 error,
                 source: model.source.as_str().into(),
@@ -107,7 +80,7 @@ pub fn settings(model: &Model, req: &Request) -> Result<RunSettings, Error> {
 }
 
 /// A setting the runner refuses that was written in the file, not given by the front end, is
-/// shown at its key in `[simulate]` (it named `--output-dt`, with no place).
+/// shown at its key in `[simulate]` (the runner names the option, with no place).
 fn file_value_error(
     model: &Model,
     req: &Request,
@@ -120,24 +93,26 @@ fn file_value_error(
             value,
             requirement,
         } => (*option, format!("must be {requirement}, got {value}")),
-        SimError::InvalidEndTime(t) => ("--t-end", format!("must be a positive time, got {t}")),
+        SimError::InvalidEndTime(t) => {
+            (RunOption::TEnd, format!("must be a positive time, got {t}"))
+        }
         _ => return Err(located(model, "", error)),
     };
     let from_file = match option {
-        "--t-end" => req.t_end.is_none(),
-        "--rtol" => req.rtol.is_none(),
-        "--atol" => req.atol.is_none(),
-        "--dt" => req.dt.is_none(),
-        "--max-step" => req.max_step.is_none(),
-        "--output-dt" => req.output_dt.is_none(),
-        "--points" => req.points.is_none(),
-        "--max-steps" => req.max_steps.is_none(),
+        RunOption::TEnd => req.t_end.is_none(),
+        RunOption::Rtol => req.rtol.is_none(),
+        RunOption::Atol => req.atol.is_none(),
+        RunOption::Dt => req.dt.is_none(),
+        RunOption::MaxStep => req.max_step.is_none(),
+        RunOption::OutputDt => req.output_dt.is_none(),
+        RunOption::Points => req.points.is_none(),
+        RunOption::MaxSteps => req.max_steps.is_none(),
         _ => false,
     };
-    let span = model.run.simulate_spans.iter().find(|(o, _)| *o == option);
+    let key = option.keyword();
+    let span = model.run.simulate_spans.iter().find(|(k, _)| *k == key);
     match span {
         Some((_, span)) if from_file => {
-            let key = option.trim_start_matches("--").replace('-', "_");
             let error = pdyn_mech::ModelError::new(
                 &model.origin,
                 span.clone(),
@@ -169,8 +144,13 @@ pub fn execute(
     set: &RunSettings,
 ) -> Result<(RunResult, Option<Error>), Error> {
     let res = if set.method == "exact" {
-        let exact = super::exact::closed_form(model)
-            .map_err(|e| located(model, "--method exact: ", SimError::NoClosedForm(e)))?;
+        let exact = super::exact::closed_form(model).map_err(|e| {
+            let context = match crate::options::naming() {
+                crate::options::Naming::Flags => "--method exact: ",
+                crate::options::Naming::Keywords => "method=\"exact\": ",
+            };
+            located(model, context, SimError::NoClosedForm(e))
+        })?;
         super::exact::run_exact(prep, &exact, set).map_err(|e| located(model, "", e))?
     } else {
         super::run(prep, set).map_err(|e| located(model, "", e))?

@@ -116,12 +116,8 @@ pub fn sweep(
         .try_fold(spec.values.len(), |n, (_, v)| n.checked_mul(v.len()))
         .filter(|&n| n <= MAX_SWEEP_RUNS);
     if runs.is_none() {
-        return Err(SimError::InvalidOption {
-            option: "[sweep]",
-            value: "more runs".into(),
-            requirement: format!(
-                "at most {MAX_SWEEP_RUNS} runs (every combination of the swept values)"
-            ),
+        return Err(SimError::TooManySweepRuns {
+            limit: MAX_SWEEP_RUNS,
         });
     }
     let start = std::time::Instant::now();
