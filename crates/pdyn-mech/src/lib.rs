@@ -21,6 +21,7 @@ pub mod hybrid;
 pub mod kinematics;
 pub mod matrix_form;
 pub mod model;
+pub mod options;
 pub mod parameters;
 pub mod prescribed;
 mod projection;

@@ -16,7 +16,6 @@ pub mod kin;
 pub mod md;
 pub mod model_file;
 pub mod nbody;
-pub mod options;
 pub mod output;
 pub mod params;
 pub mod plots;
@@ -26,4 +25,6 @@ pub mod summary;
 
 pub use engine::{run, Progress, RunOutput};
 pub use error::{Error, Location};
+/// How options are named in messages (they live in pdyn-mech, whose messages name some).
+pub use pdyn_mech::options;
 pub use request::Request;

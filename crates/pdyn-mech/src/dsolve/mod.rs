@@ -214,7 +214,11 @@ impl fmt::Display for DsolveError {
             DsolveError::NoClosedForm(why) => write!(f, "{why}: {USE_RUN}"),
             DsolveError::Invalid(why) => write!(f, "{why}"),
             DsolveError::SeveralCases => {
-                f.write_str("the solution has several cases; give the parameters with --set")
+                write!(
+                    f,
+                    "the solution has several cases; give the parameters with {}",
+                    crate::options::RunOption::Set
+                )
             }
             DsolveError::Instant(e) => write!(f, "{e}"),
         }

@@ -36,7 +36,8 @@ fn value(pool: &mut Pool, e: Id, what: &dyn Fn(&Pool) -> String) -> Result<f64, 
             Err(size) => format!("{} ({size}) is", what(pool)),
         };
         no_closed_form(format!(
-            "{what} not a number; systems and equations whose characteristic polynomial has degree ≥ 3 are solved with numeric coefficients only (give values with --set)"
+            "{what} not a number; systems and equations whose characteristic polynomial has degree ≥ 3 are solved with numeric coefficients only (give values with {})",
+            crate::options::RunOption::Set
         ))
     })
 }

@@ -660,8 +660,9 @@ pub fn evaluate(pool: &mut Pool, q: &Quantity, s: f64) -> Result<Estimate, Dsolv
 fn evaluate_raw(pool: &mut Pool, q: &Quantity, s: f64) -> Result<Estimate, DsolveError> {
     let need = |e: String| {
         DsolveError::Invalid(format!(
-            "{}: {e}; give the parameters values with --set",
-            q.name
+            "{}: {e}; give the parameters values with {}",
+            q.name,
+            crate::options::RunOption::Set
         ))
     };
     if let Some(c) = q.closed {

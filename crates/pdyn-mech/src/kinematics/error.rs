@@ -81,11 +81,13 @@ impl fmt::Display for KinError {
             KinError::ConstantInTime { expr } => write!(f, "`{expr}` does not change with t"),
             KinError::NotEvaluable { expr, reason } if expr.is_empty() => write!(
                 f,
-                "cannot locate the instant: {reason}; give the parameters values with --set"
+                "cannot locate the instant: {reason}; give the parameters values with {}",
+                crate::options::RunOption::Set
             ),
             KinError::NotEvaluable { expr, reason } => write!(
                 f,
-                "cannot evaluate `{expr}`: {reason}; give the parameters values with --set"
+                "cannot evaluate `{expr}`: {reason}; give the parameters values with {}",
+                crate::options::RunOption::Set
             ),
             KinError::NeverReaches { expr, target, t_max } => write!(
                 f,
@@ -97,12 +99,14 @@ impl fmt::Display for KinError {
             }
             KinError::DependsOnTime { expr } => write!(
                 f,
-                "`{expr}` also depends on t; give t a value (--set is for parameters) or maximise over t"
+                "`{expr}` also depends on t; give t a value ({} is for parameters) or maximise over t",
+                crate::options::RunOption::Set
             ),
             KinError::LocationDependsOn { parameters } => write!(
                 f,
-                "the location of the maximum depends on {}; give values with --set",
-                parameters.join(", ")
+                "the location of the maximum depends on {}; give values with {}",
+                parameters.join(", "),
+                crate::options::RunOption::Set
             ),
         }
     }

@@ -1,6 +1,6 @@
-//! The options of a run, named neutrally in the library and by each front end in its own way:
+//! The options of a run, named neutrally in the libraries and by each front end in its own way:
 //! `--t-end` on the command line, `t_end=` in Python. Library messages that name an option
-//! format a [`RunOption`]; the front end says once, at start-up, which names it uses
+//! (here, in `pdyn`, and the parameter values of `kin`/`dsolve`) format a [`RunOption`]; the front end says once, at start-up, which names it uses
 //! ([`name_options_as`]), so a Python user never reads a command-line flag and the command
 //! line keeps its own.
 
