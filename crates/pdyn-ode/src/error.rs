@@ -80,6 +80,11 @@ pub enum OdeError {
         /// Time, state, partial solution.
         at: FailurePoint,
     },
+    /// [`crate::Options::interrupt`] was set: stopped at the last accepted step.
+    Interrupted {
+        /// Time, state, partial solution.
+        at: FailurePoint,
+    },
 }
 
 impl OdeError {
@@ -92,7 +97,8 @@ impl OdeError {
             | OdeError::MaxSteps { at, .. }
             | OdeError::Stiff { at }
             | OdeError::SingularMatrix { at }
-            | OdeError::NoConvergence { at } => Some(at),
+            | OdeError::NoConvergence { at }
+            | OdeError::Interrupted { at } => Some(at),
         }
     }
 }
@@ -121,6 +127,7 @@ impl fmt::Display for OdeError {
             OdeError::NoConvergence { at } => {
                 write!(f, "nonlinear iteration did not converge at t = {}", at.t)
             }
+            OdeError::Interrupted { at } => write!(f, "interrupted at t = {}", at.t),
         }
     }
 }

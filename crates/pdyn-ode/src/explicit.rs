@@ -193,6 +193,11 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
     let mut stiff_countdown = nstiff;
     let mut nonfinite_in_row = 0usize;
     loop {
+        if opts.interrupted() {
+            return Err(OdeError::Interrupted {
+                at: point(t, &y, &sol),
+            });
+        }
         if nstep >= opts.max_steps {
             return Err(OdeError::MaxSteps {
                 max_steps: opts.max_steps,

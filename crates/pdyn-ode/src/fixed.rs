@@ -142,6 +142,11 @@ pub(crate) fn integrate_fixed<P: ?Sized, F: OdeSystem + ?Sized, M: FixedStepper<
     let mut ev = EventState::new(events, n, t0, y0);
     let mut t = t0;
     for k in 1..=nsteps {
+        if opts.interrupted() {
+            return Err(OdeError::Interrupted {
+                at: point(t, &y, &sol),
+            });
+        }
         let t_new = if k == nsteps { tf } else { t0 + k as f64 * h };
         if stepper
             .step(problem, t, &y, t_new - t, &mut y_new, &mut sol.stats)

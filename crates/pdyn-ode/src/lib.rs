@@ -78,7 +78,7 @@ pub mod tableau;
 pub use controller::Controller;
 pub use error::{FailurePoint, OdeError};
 pub use events::{DenseOutput, Event};
-pub use options::{Options, StiffnessAction, Tolerance};
+pub use options::{Interrupt, Options, StiffnessAction, Tolerance};
 pub use problem::{
     FirstOrderForm, FnSecondOrder, FnSystem, FnSystemWithJacobian, MassInverse, MassKind,
     OdeSystem, SecondOrderSystem,
@@ -484,7 +484,8 @@ fn auto<S: OdeSystem + ?Sized>(
                 OdeError::StepSizeUnderflow { at, .. }
                 | OdeError::NonFinite { at }
                 | OdeError::MaxSteps { at, .. }
-                | OdeError::SingularMatrix { at } => Some(at),
+                | OdeError::SingularMatrix { at }
+                | OdeError::Interrupted { at } => Some(at),
                 _ => None,
             } {
                 let mut full = sol.clone();

@@ -104,6 +104,22 @@ pub struct Options {
     /// What to do when stiffness is detected. Default [`StiffnessAction::Ignore`]
     /// (`Method::Auto` switches to Radau5 regardless).
     pub on_stiffness: StiffnessAction,
+    /// A flag another thread may set to stop the integration (Ctrl-C in Python): checked
+    /// before every step attempt; the solve then ends with [`OdeError::Interrupted`] and the
+    /// partial solution. Default `None`.
+    pub interrupt: Option<Interrupt>,
+}
+
+/// A stop request shared with the thread that may set it.
+pub type Interrupt = std::sync::Arc<std::sync::atomic::AtomicBool>;
+
+impl Options {
+    /// Whether [`Options::interrupt`] has been set.
+    pub(crate) fn interrupted(&self) -> bool {
+        self.interrupt
+            .as_ref()
+            .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
+    }
 }
 
 impl Default for Options {
@@ -118,6 +134,7 @@ impl Default for Options {
             controller: None,
             stiffness_check_interval: 1000,
             on_stiffness: StiffnessAction::Ignore,
+            interrupt: None,
         }
     }
 }

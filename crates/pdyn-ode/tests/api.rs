@@ -210,3 +210,44 @@ fn empty_system_is_invalid() {
     let r = solve(Method::Dopri5, &sys, (0.0, 1.0), &[], &Options::default());
     assert!(is_invalid(r));
 }
+
+#[test]
+fn an_interrupt_stops_every_kind_of_method_at_its_next_step_with_the_partial_solution() {
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    use std::sync::Arc;
+    // The flag is raised by the right-hand side itself after 200 evaluations, as another
+    // thread would raise it: the solve must stop at the next step attempt, not at t = 1e6.
+    for m in [
+        Method::Dopri5,
+        Method::Dop853,
+        Method::Tsit5,
+        Method::Radau5,
+        Method::Rk4,
+    ] {
+        let flag = Arc::new(AtomicBool::new(false));
+        let calls = AtomicUsize::new(0);
+        let sys = FnSystem::new(2, |_t, y: &[f64], f: &mut [f64]| {
+            if calls.fetch_add(1, Ordering::Relaxed) == 200 {
+                flag.store(true, Ordering::Relaxed);
+            }
+            f[0] = y[1];
+            f[1] = -y[0];
+        });
+        let opts = Options {
+            interrupt: Some(flag.clone()),
+            h0: Some(1e-2),
+            max_steps: usize::MAX,
+            ..Options::default()
+        };
+        let r = solve(m, &sys, (0.0, 1e6), &[1.0, 0.0], &opts);
+        let Err(OdeError::Interrupted { at }) = &r else {
+            panic!("{m}: expected Interrupted, got {:?}", r.map(|s| s.t.len()));
+        };
+        assert!(at.t > 0.0 && at.t < 1e3, "{m}: stopped at t = {}", at.t);
+        assert!(!at.partial.is_empty(), "{m}");
+        // Few evaluations after the flag: one step's worth (Radau's Newton iterations).
+        let after = calls.load(Ordering::Relaxed) - 201;
+        assert!(after < 40, "{m}: {after} evaluations after the interrupt");
+        assert!(r.unwrap_err().to_string().contains("interrupted at t ="));
+    }
+}

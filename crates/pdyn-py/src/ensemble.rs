@@ -119,8 +119,9 @@ pub(crate) fn ensemble(
         initial_names: &initial_names,
         initial: &ivals,
     };
-    let outcome = py.allow_threads(|| -> Result<Ensemble, Error> {
-        let set = PyModel::settings(&model.model, o)?;
+    let finished = crate::interrupt::interruptible(py, |stop| -> Result<Ensemble, Error> {
+        let mut set = PyModel::settings(&model.model, o)?;
+        set.interrupt = Some(stop);
         set.validate().map_err(|error| Error::Sim {
             origin: model.model.origin.clone(),
             context: "",
@@ -149,9 +150,11 @@ pub(crate) fn ensemble(
             }
         };
         ensemble::run(prep, &set, &stats, &rows, threads, dry_run)
-    });
-    let out = outcome.map_err(|e| to_py(py, &e))?;
-    ensemble_dict(py, out, runs)
+    })?;
+    let out = finished.value.map_err(|e| to_py(py, &e))?;
+    let d = ensemble_dict(py, out, runs)?;
+    d.bind(py).set_item("interrupted", finished.interrupted)?;
+    Ok(d)
 }
 
 /// An ensemble's results as a dict of arrays with one row per run (only the names and the

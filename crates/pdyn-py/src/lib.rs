@@ -27,6 +27,7 @@ mod convert;
 mod derive;
 mod ensemble;
 mod errors;
+mod interrupt;
 mod model;
 mod particles;
 mod run;
@@ -59,6 +60,10 @@ fn _pdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // The library's messages name options as Python's keywords (`t_end`, `rtol=1e-9`), never
     // as the command line's flags.
     pdyn::options::name_options_as(pdyn::options::Naming::Keywords);
+    // NumPy's C API is imported now, not by the first array a call returns: a Ctrl-C pending
+    // at that moment would make the import fail inside Rust (a PanicException, not a
+    // KeyboardInterrupt).
+    let _ = numpy::PyArray1::<f64>::zeros(m.py(), 0, false);
     m.add_class::<model::PyModel>()?;
     m.add_class::<particles::PyParticleModel>()?;
     m.add_function(wrap_pyfunction!(particles::load_model, m)?)?;

@@ -134,10 +134,17 @@ impl PyParticleModel {
                 plots,
                 ..Default::default()
             };
-            let ran = py
-                .allow_threads(|| pdyn::run(&self.file, &req, &mut |_| {}))
-                .map_err(|e| to_py(py, &e))?;
-            to_dict(py, ran)
+            let finished = crate::interrupt::interruptible(py, |stop| {
+                let req = pdyn::Request {
+                    interrupt: Some(stop),
+                    ..req
+                };
+                pdyn::run(&self.file, &req, &mut |_| {})
+            })?;
+            let ran = finished.value.map_err(|e| to_py(py, &e))?;
+            let d = to_dict(py, ran)?;
+            d.bind(py).set_item("interrupted", finished.interrupted)?;
+            Ok(d)
         })
     }
 }

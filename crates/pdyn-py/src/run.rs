@@ -24,9 +24,10 @@ pub(crate) fn run(
     plots: Option<PathBuf>,
     jit: bool,
 ) -> PyResult<PyObject> {
-    let outcome = py.allow_threads(|| -> Result<(RunResult, usize, Vec<String>, f64), Error> {
+    let finished = crate::interrupt::interruptible(py, |stop| -> Result<_, Error> {
         let mut m = model.with_params(params)?;
-        let set = PyModel::settings(&m, o)?;
+        let mut set = PyModel::settings(&m, o)?;
+        set.interrupt = Some(stop);
         let prep = PyModel::prepare(&mut m, jit)?;
         // The failure is read back from the result by `run_dict` (with the non-finite columns'
         // names for `OdeResult`).
@@ -40,9 +41,13 @@ pub(crate) fn run(
         }
         let names = prep.events.iter().map(|e| e.name.clone()).collect();
         Ok((res, prep.state_names.len(), names, set.drift_tolerance))
-    });
-    match outcome {
-        Ok((res, n, names, tol)) => run_dict(py, &model.model.origin, res, n, names, tol),
+    })?;
+    match finished.value {
+        Ok((res, n, names, tol)) => {
+            let d = run_dict(py, &model.model.origin, res, n, names, tol)?;
+            d.bind(py).set_item("interrupted", finished.interrupted)?;
+            Ok(d)
+        }
         Err(e) => Err(to_py(py, &e)),
     }
 }

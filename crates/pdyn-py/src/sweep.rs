@@ -43,7 +43,7 @@ pub(crate) fn sweep(
         jit,
     } = a;
     let base = model.with_measures(py, measures.as_deref(), &parameter, &values)?;
-    let outcome = py.allow_threads(|| -> Result<sweep::SweepResult, Error> {
+    let finished = crate::interrupt::interruptible(py, |stop| -> Result<_, Error> {
         let mut model = base.with_params(params)?;
         let origin = model.origin.clone();
         let sim_err = |error| Error::Sim {
@@ -70,7 +70,8 @@ pub(crate) fn sweep(
         spec.parameter = index;
         spec.values = values;
         spec.others.clear();
-        let set = PyModel::settings(&model, o)?;
+        let mut set = PyModel::settings(&model, o)?;
+        set.interrupt = Some(stop);
         let mut prep = PyModel::prepare(&mut model, jit)?;
         if jit {
             prep.make_observers_native();
@@ -84,9 +85,10 @@ pub(crate) fn sweep(
             None => sweep::sweep(&prep, &set, &spec, &stats, &sweep::quiet),
         }
         .map_err(sim_err)
-    });
-    let res = outcome.map_err(|e| to_py(py, &e))?;
+    })?;
+    let res = finished.value.map_err(|e| to_py(py, &e))?;
     let d = PyDict::new(py);
+    d.set_item("interrupted", finished.interrupted)?;
     d.set_item("parameter", res.parameter.clone())?;
     let nv = res.values.len();
     d.set_item("values", f64_array(py, res.values.clone()))?;

@@ -301,6 +301,7 @@ fn run_md(
     let opts = md::RunOptions {
         out: req.out.clone(),
         drift_tolerance,
+        interrupt: req.interrupt.clone(),
     };
     let result = md::run(&mut prepared, &opts, &mut |p| match p {
         md::Progress::Record(r) => progress(Progress::Log(&md::report::thermo_line(r))),

@@ -39,4 +39,7 @@ pub struct Request {
     pub out: Option<PathBuf>,
     /// Also draw the run's plots into `out`.
     pub plots: bool,
+    /// Set by another thread to stop the run early, keeping what was computed (Ctrl-C in
+    /// Python; the front end knows it set it).
+    pub interrupt: Option<pdyn_ode::Interrupt>,
 }

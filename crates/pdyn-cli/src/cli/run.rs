@@ -100,6 +100,8 @@ pub fn request(a: &RunArgs) -> Result<pdyn::Request, Error> {
         jit: a.jit(),
         out: a.out.clone(),
         plots: a.plot,
+        // Ctrl-C ends the process (a clean stop with files kept is issue 29's).
+        interrupt: None,
     })
 }
 

@@ -342,6 +342,11 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
             // ---- one step attempt (label 30)
             nstep += 1;
             sol.stats.steps += 1;
+            if opts.interrupted() {
+                return Err(OdeError::Interrupted {
+                    at: point(x, &y, &sol),
+                });
+            }
             if nstep > opts.max_steps {
                 return Err(OdeError::MaxSteps {
                     max_steps: opts.max_steps,

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 from ._lazy import LazyModule
@@ -31,7 +32,7 @@ from ._lazy import LazyModule
 np = LazyModule("numpy")  # imported on first use
 
 from . import _pdyn
-from ._errors import DriftWarning, ModelError, ParameterError, PdynError
+from ._errors import DriftWarning, Interrupted, ModelError, ParameterError, PdynError
 from ._result import (DenseOutput, Derivation, EnsembleResult, Expr, ForcesResult,
                       OdeResult, ParticleResult, SweepResult, Table,
                       _concat_raw, _from_ivp, _from_run)
@@ -53,7 +54,7 @@ __all__ = [
     "EnsembleResult", "DenseOutput", "ForcesResult",
     "kin", "dsolve", "KinResult", "KinInstant", "DsolveResult", "DsolveCase", "RuleResult",
     "Vector",
-    "PdynError", "ModelError", "ParameterError", "DriftWarning", "__version__",
+    "PdynError", "ModelError", "ParameterError", "DriftWarning", "Interrupted", "__version__",
 ]
 
 
@@ -328,6 +329,11 @@ class Model:
                           max_step=max_step, dt=dt, max_steps=max_steps, points=points,
                           drift_tolerance=drift_tolerance, params=_params(params),
                           plots=None if plots is None else os.fspath(plots), jit=bool(jit))
+        if raw.get("interrupted"):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                partial = _from_run(raw, list(raw["event_names"]))
+            _interrupted("Model.run", partial)
         return _from_run(raw, list(raw["event_names"]))
 
     def _run_particles(self, m: "_pdyn.ParticleModel", t_end, method, rtol, atol, t_eval,
@@ -341,6 +347,8 @@ class Model:
                     out=None if plots is None else os.fspath(plots), plots=plots is not None,
                     jit=bool(jit), rtol=rtol, atol=atol, max_step=max_step,
                     max_steps=max_steps)
+        if raw.get("interrupted"):
+            _interrupted("Model.run", ParticleResult(raw))
         return ParticleResult(raw)
 
     def derive(self) -> Derivation:
@@ -381,11 +389,14 @@ class Model:
                             method=method, rtol=rtol, atol=atol, max_step=max_step, dt=dt,
                             points=points, threads=threads, params=_params(params),
                             jit=bool(jit))
-        return SweepResult(
+        res = SweepResult(
             parameter=raw["parameter"], values=raw["values"], measures=dict(raw["measures"]),
             problems=list(raw["problems"]), runs=raw["runs"], seconds=raw["seconds"],
             threads=raw["threads"],
         )
+        if raw.get("interrupted"):
+            _interrupted("Model.sweep", res)
+        return res
 
 
     def _names(self) -> Tuple[List[str], List[str]]:
@@ -487,13 +498,27 @@ class Model:
                                               None if sm is None else
                                               np.ascontiguousarray(sm[a:b]), **kw))
                 bar.update(b - a)
+                if parts[-1].get("interrupted"):
+                    break
             bar.close()
             raw = _concat_raw(parts)
-        return EnsembleResult(
+            raw["interrupted"] = any(p.get("interrupted") for p in parts)
+            # Slices after an interrupted one never ran: the result holds the runs that did.
+            done = len(raw["status"])
+            pm = pm[:done]
+            sm = None if sm is None else sm[:done]
+        res = EnsembleResult(
             raw,
             {n: np.ascontiguousarray(pm[:, j]) for j, n in enumerate(pn)},
             {} if sm is None else {n: np.ascontiguousarray(sm[:, j]) for j, n in enumerate(sn)},
         )
+        if raw.get("interrupted"):
+            _interrupted("Model.ensemble", res)
+        return res
+
+def _interrupted(call: str, partial: Any) -> None:
+    raise Interrupted(f"{call} interrupted (Ctrl-C); what was computed is in .result", partial)
+
 
 def methods() -> Dict[str, str]:
     """pdyn's integration methods: name -> description (order, adaptivity, paper)."""

@@ -25,6 +25,10 @@ class DriftWarning(UserWarning):
     def __init__(self, message: str, quantity: str = ..., drift: float = ...,
                  tolerance: float = ..., relative: bool = ...) -> None: ...
 
+class Interrupted(KeyboardInterrupt):
+    result: Any
+    def __init__(self, message: str, result: Any = ...) -> None: ...
+
 class DenseOutput:
     ts: npt.NDArray[np.float64]
     t_min: float

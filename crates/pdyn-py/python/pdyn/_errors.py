@@ -49,3 +49,17 @@ class DriftWarning(UserWarning):
         self.drift = drift
         self.tolerance = tolerance
         self.relative = relative
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C (SIGINT) stopped a long call: ``Model.run``, ``sweep`` or ``ensemble``.
+
+    A subclass of ``KeyboardInterrupt`` (``except KeyboardInterrupt`` catches it): the call
+    stopped at its next step, within tens of milliseconds, and ``result`` holds what was
+    computed until then (the partial :class:`OdeResult`, ``ParticleResult``, ``SweepResult`` or
+    ``EnsembleResult``; runs that had not finished carry their failure, measures NaN).
+    """
+
+    def __init__(self, message: str, result=None):
+        super().__init__(message)
+        self.result = result

@@ -28,6 +28,8 @@ pub struct RunOptions {
     pub out: Option<PathBuf>,
     /// Relative drift of the conserved energy that triggers a warning.
     pub drift_tolerance: f64,
+    /// Set by another thread to stop after the current stretch of steps (Ctrl-C in Python).
+    pub interrupt: Option<pdyn_ode::Interrupt>,
 }
 
 /// What happens during a run, for a live display.
@@ -289,6 +291,10 @@ fn run_sim<P: PairPotential>(
     let mut builds = 0;
     let mut done = 0u64;
     while done < spec.steps || (done == 0 && records.is_empty()) {
+        let stop = opts.interrupt.as_ref();
+        if done > 0 && stop.is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed)) {
+            break;
+        }
         let k = chunk.min(spec.steps - done);
         if let Some((a, b)) = ramp {
             let frac = (done as f64 + 0.5 * k as f64) / spec.steps.max(1) as f64;

@@ -222,6 +222,7 @@ pub fn plan(source: &str, origin: &str, req: &Request) -> Result<Planned, Error>
         integrator: spec.integrator,
         collisions: spec.collisions,
         escape: spec.escape.map_or(EscapeMode::Stop, |(_, m)| m),
+        interrupt: req.interrupt.clone(),
     };
     Ok(Planned {
         spec,

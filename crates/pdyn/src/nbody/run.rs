@@ -58,6 +58,8 @@ pub struct RunOptions {
     pub collisions: CollisionMode,
     /// What an escape does.
     pub escape: EscapeMode,
+    /// Set by another thread to stop at the next output time (Ctrl-C in Python).
+    pub interrupt: Option<pdyn_ode::Interrupt>,
 }
 
 /// Why output times cannot be made (the front end names the option that gave them).
@@ -391,6 +393,13 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingEr
         &mut seg,
     );
     'outer: for &tk in &times[1..] {
+        if options
+            .interrupt
+            .as_ref()
+            .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
+        {
+            break;
+        }
         loop {
             match sim.integrate((tk - t_offset).max(sim.t())) {
                 Ok(Outcome::Reached) => break,

@@ -1157,6 +1157,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
     if let Some(m) = set.max_steps {
         opts.max_steps = m;
     }
+    opts.interrupt = set.interrupt.clone();
     let t_end = set.t_end;
     let step_budget = opts.max_steps;
     let mut steps_used = 0usize;

@@ -62,6 +62,9 @@ pub struct RunSettings {
     /// Relative drift of a conserved quantity that triggers a warning. Default 5e-3 (0.5 %):
     /// DOPRI5 at rtol 1e-3 on the chapter's satellite drifts by 7 (warns), at rtol 1e-5 by 1e-3.
     pub drift_tolerance: f64,
+    /// Set by another thread to stop the run at its next step (Ctrl-C in Python): the result
+    /// keeps the rows computed, with an `Interrupted` failure.
+    pub interrupt: Option<pdyn_ode::Interrupt>,
 }
 
 impl RunSettings {
@@ -97,6 +100,7 @@ impl RunSettings {
                 .drift_tolerance
                 .or(s.drift_tolerance)
                 .unwrap_or(DEFAULT_DRIFT_TOLERANCE),
+            interrupt: None,
         })
     }
 
@@ -956,6 +960,7 @@ pub(crate) fn integrate(
     }
     let t_end = set.t_end;
     opts.t_eval = set.output_times();
+    opts.interrupt = set.interrupt.clone();
 
     let sys = &prep.system;
     let n = sys.n;

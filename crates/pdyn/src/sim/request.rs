@@ -73,8 +73,9 @@ pub fn settings(model: &Model, req: &Request) -> Result<RunSettings, Error> {
         file.output_dt = None;
         file.points = None;
     }
-    let set = RunSettings::resolve(&file, &overrides, req.t_eval.clone())
+    let mut set = RunSettings::resolve(&file, &overrides, req.t_eval.clone())
         .map_err(|e| located(model, "", e))?;
+    set.interrupt = req.interrupt.clone();
     file_value_error(model, req, set.validate())?;
     Ok(set)
 }

@@ -1,0 +1,92 @@
+//! Ctrl-C during a long call. Python runs its signal handlers only on the main thread and only
+//! when that thread runs Python code; a call that releases the GIL for seconds of Rust work
+//! would otherwise ignore Ctrl-C until it ends. [`interruptible`] runs the work on a worker
+//! thread and keeps the calling thread checking Python's signals every 20 ms: a handler that
+//! raises (the default SIGINT handler raises `KeyboardInterrupt`) sets the stop flag the work
+//! was given, the work stops at its next step and returns what it computed, and the exception
+//! is handed back with it.
+
+use pdyn_ode::Interrupt;
+use pyo3::exceptions::PyKeyboardInterrupt;
+use pyo3::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Condvar, Mutex};
+use std::time::Duration;
+
+/// How often the calling thread looks for a signal.
+const POLL: Duration = Duration::from_millis(20);
+
+/// What [`interruptible`] gives back: the work's result, and whether Ctrl-C stopped it.
+pub(crate) struct Finished<T> {
+    /// The work's result (partial when interrupted).
+    pub value: T,
+    /// Ctrl-C (`KeyboardInterrupt`) arrived while the work ran; it was told to stop.
+    pub interrupted: bool,
+}
+
+/// Runs `work` with the GIL released on a worker thread, handing it a stop flag that Ctrl-C
+/// sets. An exception other than `KeyboardInterrupt` raised by a signal handler (a custom
+/// SIGINT handler, `SystemExit`) also stops the work and is returned as the error; a panic in
+/// the work unwinds into the caller (`errors::guarded` turns it into `PdynError`).
+pub(crate) fn interruptible<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce(Interrupt) -> T + Send,
+) -> PyResult<Finished<T>> {
+    let flag: Interrupt = Arc::new(AtomicBool::new(false));
+    // The worker says it is done through this (also when it panics: the guard's drop), so a
+    // short call returns at once rather than at the next poll.
+    let done = (Mutex::new(false), Condvar::new());
+    std::thread::scope(|scope| {
+        let worker_flag = flag.clone();
+        let done = &done;
+        let worker = scope.spawn(move || {
+            let _tell = Done(done);
+            work(worker_flag)
+        });
+        let mut raised: Option<PyErr> = None;
+        loop {
+            let finished = py.allow_threads(|| {
+                let guard = done.0.lock().unwrap_or_else(|e| e.into_inner());
+                let (guard, _) = done
+                    .1
+                    .wait_timeout_while(guard, POLL, |finished| !*finished)
+                    .unwrap_or_else(|e| e.into_inner());
+                *guard
+            });
+            if finished {
+                break;
+            }
+            if raised.is_none() {
+                if let Err(e) = py.check_signals() {
+                    flag.store(true, Ordering::Relaxed);
+                    raised = Some(e);
+                }
+            }
+        }
+        let value = match worker.join() {
+            Ok(v) => v,
+            Err(panic) => std::panic::resume_unwind(panic),
+        };
+        match raised {
+            Some(e) if !e.is_instance_of::<PyKeyboardInterrupt>(py) => Err(e),
+            Some(_) => Ok(Finished {
+                value,
+                interrupted: true,
+            }),
+            None => Ok(Finished {
+                value,
+                interrupted: false,
+            }),
+        }
+    })
+}
+
+/// Marks the work done when dropped: at its end, or while a panic unwinds out of it.
+struct Done<'a>(&'a (Mutex<bool>, Condvar));
+
+impl Drop for Done<'_> {
+    fn drop(&mut self) {
+        *self.0 .0.lock().unwrap_or_else(|e| e.into_inner()) = true;
+        self.0 .1.notify_all();
+    }
+}
