@@ -320,10 +320,7 @@ mod tests {
             "c - g*l1*(m1 + m2)*sin(q1) - l1*l2*(m2 + m3)*q2'^2*sin(q1 - q2)"
         );
         let latex = c.to_latex(&mut p);
-        assert!(
-            latex.contains("\\left(\\mathrm{m2} + \\mathrm{m3}\\right)"),
-            "{latex}"
-        );
+        assert!(latex.contains("\\left(m_{2} + m_{3}\\right)"), "{latex}");
         // The text parses back to an equal expression, and collecting is idempotent.
         let f = c.sum(&mut p);
         let mut scope = crate::FreeScope::with_coordinates(["q1", "q2"]);

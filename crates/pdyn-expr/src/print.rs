@@ -389,7 +389,17 @@ pub fn latex_name(name: &str) -> String {
         Some((base, sub)) if !base.is_empty() && !sub.is_empty() => {
             format!("{}_{{{}}}", one(base), one(sub))
         }
-        _ => one(name),
+        _ => {
+            // Trailing digits are a subscript, as SymPy prints them: `l1` is `l_{1}`,
+            // `theta12` is `\theta_{12}` (not `\mathrm{l1}`).
+            let digits = name.len() - name.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+            let (base, sub) = name.split_at(name.len() - digits);
+            if digits > 0 && !base.is_empty() {
+                format!("{}_{{{sub}}}", one(base))
+            } else {
+                one(name)
+            }
+        }
     }
 }
 
@@ -683,6 +693,25 @@ mod tests {
         // Not for symbols of unknown sign: sqrt(a)*sqrt(b) is not sqrt(a*b) for a, b < 0.
         let e = p.parse_scalar("sqrt(a)*sqrt(b)").unwrap();
         assert_eq!(p.to_text(e), "sqrt(a)*sqrt(b)");
+    }
+
+    #[test]
+    fn latex_names_follow_sympys_subscripts() {
+        // SymPy's `latex(Symbol(name))` for these names (split_super_sub: trailing digits and
+        // what follows `_` are subscripts; Greek names are letters).
+        for (name, sympy) in [
+            ("l1", "l_{1}"),
+            ("m23", "m_{23}"),
+            ("theta1", "\\theta_{1}"),
+            ("omega_n", "\\omega_{n}"),
+            ("F_T", "F_{T}"),
+            ("x", "x"),
+            ("alpha", "\\alpha"),
+        ] {
+            assert_eq!(super::latex_name(name), sympy, "{name}");
+        }
+        // Multi-letter bases stay upright (SymPy prints them italic, letter by letter).
+        assert_eq!(super::latex_name("th2"), "\\mathrm{th}_{2}");
     }
 
     #[test]

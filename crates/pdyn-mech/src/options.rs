@@ -70,6 +70,8 @@ pub enum RunOption {
     Out,
     /// Plots.
     Plot,
+    /// Initial values of state components.
+    Initial,
 }
 
 impl RunOption {
@@ -90,6 +92,7 @@ impl RunOption {
             RunOption::Set => "--set",
             RunOption::Out => "--out",
             RunOption::Plot => "--plot",
+            RunOption::Initial => "--initial",
         }
     }
 
@@ -110,6 +113,7 @@ impl RunOption {
             RunOption::Set => "params",
             RunOption::Out => "out",
             RunOption::Plot => "plots",
+            RunOption::Initial => "initial",
         }
     }
 

@@ -186,7 +186,7 @@ impl PyModel {
     }
 
     /// Integrates the model; returns a dict of plain data (see `pdyn.Model.run`).
-    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, t_eval=None, max_step=None, dt=None, max_steps=None, points=None, drift_tolerance=None, params=None, plots=None, jit=true))]
+    #[pyo3(signature = (t_end=None, method=None, rtol=None, atol=None, t_eval=None, max_step=None, dt=None, max_steps=None, points=None, drift_tolerance=None, params=None, plots=None, jit=true, initial=None))]
     #[allow(clippy::too_many_arguments)]
     fn run(
         &self,
@@ -204,6 +204,7 @@ impl PyModel {
         params: Option<Vec<(String, f64)>>,
         plots: Option<std::path::PathBuf>,
         jit: bool,
+        initial: Option<Vec<(String, f64)>>,
     ) -> PyResult<PyObject> {
         guarded(py, || {
             let t_eval = match t_eval {
@@ -222,7 +223,7 @@ impl PyModel {
                 points,
                 drift_tolerance,
             };
-            crate::run::run(py, self, o, params, plots, jit)
+            crate::run::run(py, self, o, params, initial.unwrap_or_default(), plots, jit)
         })
     }
 

@@ -21,6 +21,7 @@ pub(crate) fn run(
     model: &PyModel,
     o: Overrides,
     params: Option<Vec<(String, f64)>>,
+    initial: Vec<(String, f64)>,
     plots: Option<PathBuf>,
     jit: bool,
 ) -> PyResult<PyObject> {
@@ -28,7 +29,8 @@ pub(crate) fn run(
         let mut m = model.with_params(params)?;
         let mut set = PyModel::settings(&m, o)?;
         set.interrupt = Some(stop);
-        let prep = PyModel::prepare(&mut m, jit)?;
+        let mut prep = PyModel::prepare(&mut m, jit)?;
+        sim::request::set_initial(&mut m, &mut prep, &initial)?;
         // The failure is read back from the result by `run_dict` (with the non-finite columns'
         // names for `OdeResult`).
         let (res, _) = sim::request::execute(&mut m, &prep, &set)?;

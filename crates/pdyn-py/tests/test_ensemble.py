@@ -122,3 +122,75 @@ def test_derived_parameters_follow_in_run_sweep_and_ensemble(examples):
                        measures={"top": ("z", "max")})
     np.testing.assert_allclose(given.measures["top"], 1.3806503e-23 * 293.0 / (1e-19 * 9.81),
                                rtol=1e-6)
+
+
+BLOW_UP = """
+name = "x' = c x^2 in disguise: x'' = 2 c^2 x^3 blows up at t = 1/(c x0) for c > 0"
+[parameters]
+c = 0.0
+m = 1.0
+[coordinates]
+x = { initial = 1.0, rate = "c" }
+[particles.p]
+mass = "m"
+position = "[x, 0, 0]"
+[[forces]]
+kind = "applied"
+on = "p"
+force = "[2*m*c^2*x^3, 0, 0]"
+[simulate]
+t_end = 2.0
+[sweep]
+parameter = "c"
+values = [0.1, 1.0, 2.0]
+[sweep.measures]
+xmax = { of = "x", stat = "max" }
+"""
+
+
+def test_failed_runs_give_nan_measures_never_a_number_in_sweeps_and_ensembles():
+    # c = 0.1 is smooth to t = 2 (blow-up at t = 10); c = 1 and c = 2 blow up at t = 1 and
+    # 0.5: the integrations stop there, and their measures must be NaN with a problem each
+    # (the statistics over the rows before the failure are not the run's).
+    m = pdyn.Model.from_toml(BLOW_UP)
+    exact = 1.0 / (1.0 - 0.1 * 2.0)  # x(t) = x0/(1 - c x0 t), the maximum at t_end
+    for res in (m.sweep("c", [0.1, 1.0, 2.0]),
+                m.ensemble(params={"c": [0.1, 1.0, 2.0]})):
+        xmax = np.asarray(res.measures["xmax"])
+        assert abs(xmax[0] - exact) < 1e-4 * exact, xmax
+        assert np.isnan(xmax[1]) and np.isnan(xmax[2]), xmax
+        assert sorted(int(r) if not isinstance(r, float) else r
+                      for r, _ in res.problems)[-2:] in ([1, 2], [1.0, 2.0]), res.problems
+
+
+def test_parameters_cannot_be_assigned_silently(examples):
+    m = pdyn.Model.from_file(examples / "satellite.toml")
+    for change in (lambda p: p.__setitem__("GM", 2.0), lambda p: p.update(GM=2.0),
+                   lambda p: p.pop("GM"), lambda p: p.clear()):
+        with pytest.raises(TypeError, match="params="):
+            change(m.parameters)
+    assert m.parameters["GM"] == 1.0
+
+
+def test_run_from_another_initial_state(examples):
+    # The satellite from (x, y) = (2, 0) with speed 1/sqrt(2): a circular orbit of radius 2
+    # (GM = 1), period 2*pi*2^1.5. Independent of the file's own circle of radius 1.
+    m = pdyn.Model.from_file(examples / "satellite.toml")
+    v = 2 ** -0.5
+    period = 2 * np.pi * 2 ** 1.5
+    sol = m.run(initial={"x": 2.0, "x'": 0.0, "y": 0.0, "y'": v}, t_end=period, rtol=1e-10,
+                atol=1e-12, t_eval=[0.0, period / 4, period])
+    assert sol.success
+    assert abs(sol.column("x")[0] - 2.0) < 1e-15
+    assert abs(sol.column("y")[1] - 2.0) < 1e-6 and abs(sol.column("x")[1]) < 1e-6
+    assert abs(sol.column("x")[2] - 2.0) < 1e-6
+    # The same as an ensemble member with that initial state, bit for bit.
+    ens = m.ensemble(initial={"x": [2.0], "x'": [0.0], "y": [0.0], "y'": [v]}, t_end=period,
+                     rtol=1e-10, atol=1e-12)
+    assert ens.final[0][0] == sol.y[0][-1]
+    with pytest.raises(pdyn.ParameterError, match="initial: `z` is not a state component"):
+        m.run(initial={"z": 1.0})
+    with pytest.raises(pdyn.ParameterError, match="closed form"):
+        m.run(initial={"x": 2.0}, method="exact", t_end=1.0)
+    with pytest.raises(pdyn.ParameterError, match="mechanics models"):
+        pdyn.Model.from_file(examples / "nbody" / "figure_eight.toml").run(initial={"x": 1.0})

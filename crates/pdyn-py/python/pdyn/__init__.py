@@ -76,6 +76,14 @@ class _Parameters(dict):
         self._model._edit().setdefault("parameters", {}).update(
             {k: _value(v) for k, v in values.items()})
 
+    def _read_only(self, *args: Any, **kwargs: Any) -> None:
+        # Assigning into a copy would change nothing and say nothing: refuse it.
+        raise TypeError(
+            "Model.parameters is a read-only view: pass params={'name': value} to run, sweep "
+            "or ensemble (or call m.parameters(name=value) on a model built in code)")
+
+    __setitem__ = __delitem__ = update = pop = popitem = clear = setdefault = _read_only
+
 
 def _text(x: Any) -> str:
     """An expression as pdyn text: a string as is, a SymPy expression through its text
@@ -273,12 +281,24 @@ class Model:
 
     @property
     def parameters(self) -> "_Parameters":
-        """Parameter values in SI units, in file order (a copy: pass ``params=`` to
-        :meth:`run` to change them). On a model built in code, calling it sets values:
+        """Parameter values in SI units, in file order (read-only: assigning raises
+        ``TypeError``; pass ``params=`` to :meth:`run` to change them). On a model built in code, calling it sets values:
         ``m.parameters(g=9.81, L=1, m=1)`` (numbers, or quantities with units as text)."""
         if self._spec is not None and self._inner is None and "parameters" not in self._spec:
             return _Parameters(self, {})
         return _Parameters(self, dict(self._m.parameters))
+
+    def _repr_html_(self) -> str:
+        import html
+        if self._spec is not None and self._inner is None:
+            return f"<b>pdyn.Model</b> {html.escape(repr(self._spec.get('name')))} (built in code)"
+        params = ", ".join(f"{html.escape(k)} = {v:.6g}" for k, v in self.parameters.items())
+        rows = [("kind", self.kind), ("file", html.escape(str(self._m.origin))),
+                ("parameters", params or "none")]
+        body = "".join(f"<tr><th style='text-align:left'>{k}</th><td style='text-align:left'>"
+                       f"{v}</td></tr>" for k, v in rows)
+        return (f"<table><caption style='text-align:left'><b>pdyn.Model</b> "
+                f"{html.escape(self.name)}</caption>{body}</table>")
 
     def __repr__(self) -> str:
         if self._spec is not None and self._inner is None:
@@ -292,7 +312,7 @@ class Model:
             points: Optional[int] = None, drift_tolerance: Optional[float] = None,
             params: Optional[Mapping[str, float]] = None,
             plots: Optional[Union[str, "os.PathLike[str]"]] = None,
-            jit: bool = True) -> OdeResult:
+            jit: bool = True, initial: Optional[Mapping[str, float]] = None) -> OdeResult:
         """Integrates the equations of motion, like ``pdyn run``.
 
         Every argument left ``None`` takes the model's ``[simulate]`` value, then pdyn's
@@ -302,7 +322,9 @@ class Model:
         ``dt``: the fixed step (symplectic methods, RK4) or the first step; ``params``:
         parameter values (checked like ``pdyn run --set``); ``plots``: a directory where
         pdyn's own PNG/SVG plots are written, as ``pdyn run --out DIR`` (no matplotlib
-        needed; ``sol.plot()`` and ``sol.plot_trajectory()`` use matplotlib); ``jit``:
+        needed; ``sol.plot()`` and ``sol.plot_trajectory()`` use matplotlib); ``initial``:
+        initial values of state components by name (``{"x": 2.0, "x'": 0.5}``; the
+        model's own for the others; checked against its constraints); ``jit``:
         the right-hand side as native code (Cranelift), ``False`` for the interpreter (the
         same results bit for bit).
 
@@ -322,13 +344,18 @@ class Model:
         """
         m = self._m
         if isinstance(m, _pdyn.ParticleModel):
+            if initial is not None:
+                raise ParameterError(
+                    f"initial= applies to mechanics models; a {m.kind} model's initial state is "
+                    "its bodies or atoms in the file")
             return self._run_particles(m, t_end, method, rtol, atol, t_eval, max_step, dt,
                                        max_steps, points, drift_tolerance, params, plots, jit)
         te = None if t_eval is None else _array1(t_eval, "t_eval")
         raw = self._m.run(t_end=t_end, method=method, rtol=rtol, atol=atol, t_eval=te,
                           max_step=max_step, dt=dt, max_steps=max_steps, points=points,
                           drift_tolerance=drift_tolerance, params=_params(params),
-                          plots=None if plots is None else os.fspath(plots), jit=bool(jit))
+                          plots=None if plots is None else os.fspath(plots), jit=bool(jit),
+                          initial=_params(initial))
         if raw.get("interrupted"):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")

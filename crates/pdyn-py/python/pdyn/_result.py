@@ -26,9 +26,11 @@ class OdeResult(dict):
     * ``status`` (0 end reached, 1 terminal event, -1 integration failed), ``message``,
       ``success``;
     * ``nfev``, ``njev``, ``nlu`` -- the Rust solver's counts; ``stats`` has all of them;
-    * pdyn's: ``columns`` (every tabulated column of a model run), ``sol["x"]`` (a column by
-      name; a model's columns take precedence over SciPy's keys, so ``sol["y"]`` is a
-      coordinate ``y`` when there is one, ``sol.y`` always the states), :meth:`column`,
+    * pdyn's: ``columns`` (every tabulated column of a model run), ``sol.coords`` (every
+      column by name: ``sol.coords.x``, ``sol.coords["y"]``; never shadowed), ``sol["x"]``
+      (a column by name; a model's columns take precedence over SciPy's keys, so
+      ``sol["y"]`` is a coordinate ``y`` when there is one, ``sol.y`` always the states),
+      :meth:`column`,
       ``monitors`` (conserved quantities with their drift), ``warnings``,
       ``method``, :meth:`to_pandas`;
     * for a model with contacts or event actions, ``hybrid``: a dict with ``timeline`` (intervals
@@ -62,15 +64,50 @@ class OdeResult(dict):
             raise KeyError(f"no column {name!r} (columns: {cols})")
         return np.ascontiguousarray(dict.__getitem__(self, "_table")[:, cols.index(name)])
 
+    @property
+    def coords(self) -> "_Columns":
+        """Every tabulated column by name, as attributes or items (``sol.coords.y``,
+        ``sol.coords["x'"]``): a coordinate named like one of SciPy's fields (``y``, ``t``)
+        is reached here without ambiguity."""
+        return _Columns(self)
+
     def __dir__(self):
         return list(self.keys()) + list(super().__dir__())
 
+    def _field(self, name: str) -> Any:
+        # SciPy's field, never a column of the same name.
+        return dict.__getitem__(self, name)
+
     def __repr__(self) -> str:
         shown = ["message", "success", "status", "nfev", "njev", "nlu", "method"]
-        parts = [f"{k}: {self.get(k)!r}" for k in shown if k in self]
-        parts.append(f"t: array of {len(self['t'])} times")
-        parts.append(f"y: array of shape {self['y'].shape}")
+        parts = [f"{k}: {dict.get(self, k)!r}" for k in shown if k in self]
+        parts.append(f"t: array of {len(self._field('t'))} times")
+        parts.append(f"y: array of shape {self._field('y').shape}")
         return "OdeResult(" + ", ".join(parts) + ")"
+
+    def _repr_html_(self) -> str:
+        import html
+        t, y = self._field("t"), self._field("y")
+        ok = dict.get(self, "success")
+        rows = [("status", f"{'✓' if ok else '✗'} {html.escape(str(dict.get(self, 'message')))}"),
+                ("method", html.escape(str(dict.get(self, "method")))),
+                ("t", f"{len(t)} times, {t[0]:.6g} … {t[-1]:.6g}" if len(t) else "no times"),
+                ("y", f"{y.shape[0]} states × {y.shape[1]} times"),
+                ("evaluations", f"nfev {dict.get(self, 'nfev')}, njev {dict.get(self, 'njev')}, "
+                                f"nlu {dict.get(self, 'nlu')}")]
+        cols = dict.get(self, "columns")
+        if cols and len(t):
+            last = dict.__getitem__(self, "_table")[-1]
+            final = ", ".join(f"{html.escape(c)} = {v:.6g}" for c, v in zip(cols[1:9], last[1:9]))
+            rows.append(("final", final + (" …" if len(cols) > 9 else "")))
+        for m in dict.get(self, "monitors") or []:
+            if m["conserved"]:
+                rows.append((html.escape(m["name"]), f"drift {m['drift']:.3e}"))
+        for w in dict.get(self, "warnings") or []:
+            rows.append(("warning", f"<span style='color:#b00'>{html.escape(w)}</span>"))
+        body = "".join(f"<tr><th style='text-align:left'>{k}</th><td style='text-align:left'>"
+                       f"{v}</td></tr>" for k, v in rows)
+        return f"<table><caption style='text-align:left'><b>OdeResult</b></caption>{body}</table>"
 
     def to_pandas(self):
         """Every column (``t``, the states, positions, monitors...) as a pandas DataFrame;
@@ -81,8 +118,9 @@ class OdeResult(dict):
             raise ImportError("OdeResult.to_pandas() needs pandas: pip install pandas") from e
         cols = self.get("columns")
         if cols is None:
-            cols = ["t"] + [f"y{k}" for k in range(self["y"].shape[0])]
-            data = np.column_stack([self["t"], self["y"].T])
+            y = self._field("y")
+            cols = ["t"] + [f"y{k}" for k in range(y.shape[0])]
+            data = np.column_stack([self._field("t"), y.T])
         else:
             data = self["_table"]
         return pd.DataFrame(data, columns=list(cols))
@@ -103,15 +141,16 @@ def _plot(self, *names: str, ax=None):
     """Plots columns against ``t`` (default: the states) with matplotlib; returns the axes."""
     ax = _plot_axes(ax)
     cols = self.get("columns")
+    y = self._field("y")
     if not names:
-        names = tuple(cols[1:1 + self["y"].shape[0]]) if cols else tuple(
-            f"y{k}" for k in range(self["y"].shape[0]))
+        names = tuple(cols[1:1 + y.shape[0]]) if cols else tuple(
+            f"y{k}" for k in range(y.shape[0]))
     for name in names:
         if cols and name in cols:
             data = self.column(name)
         else:
-            data = self["y"][int(name[1:])]
-        ax.plot(self["t"], data, label=name)
+            data = y[int(name[1:])]
+        ax.plot(self._field("t"), data, label=name)
     ax.set_xlabel("t")
     ax.legend()
     return ax
@@ -124,7 +163,7 @@ def _plot_trajectory(self, x: str = None, y: str = None, ax=None):
     cols = self.get("columns")
     if x is None or y is None:
         x, y = (cols[1], cols[2]) if cols and len(cols) > 2 else ("y0", "y1")
-    get = (lambda n: self.column(n)) if cols else (lambda n: self["y"][int(n[1:])])
+    get = (lambda n: self.column(n)) if cols else (lambda n: self._field("y")[int(n[1:])])
     ax.plot(get(x), get(y))
     ax.set_xlabel(x)
     ax.set_ylabel(y)
@@ -134,6 +173,36 @@ def _plot_trajectory(self, x: str = None, y: str = None, ax=None):
 
 OdeResult.plot = _plot
 OdeResult.plot_trajectory = _plot_trajectory
+
+
+class _Columns:
+    """``OdeResult.coords``: the tabulated columns by name (attributes and items)."""
+
+    __slots__ = ("_res",)
+
+    def __init__(self, res: OdeResult):
+        self._res = res
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self._res.column(name)
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        try:
+            return self._res.column(name)
+        except KeyError as e:
+            raise AttributeError(str(e)) from e
+
+    def __contains__(self, name: str) -> bool:
+        return name in (dict.get(self._res, "columns") or [])
+
+    def __iter__(self):
+        return iter(dict.get(self._res, "columns") or [])
+
+    def __dir__(self):
+        return [c for c in (dict.get(self._res, "columns") or []) if c.isidentifier()]
+
+    def __repr__(self) -> str:
+        return f"coords({dict.get(self._res, 'columns')})"
 
 
 def _stats_counts(stats: Dict[str, Any]) -> Dict[str, int]:

@@ -282,7 +282,9 @@ pub fn member(p: &Prepared, set: &RunSettings, stats: &[Stat]) -> Member {
             out.drifted = true;
         }
     }
-    if p.measures.is_some() {
+    // A failed run's measures are NaN (statistics over the rows before the failure are not
+    // the run's); its final state is where it stopped.
+    if p.measures.is_some() && out.status >= 0 {
         out.measures = res.measures;
     }
     out

@@ -263,6 +263,9 @@ pub struct Prepared {
     pub value_checks: Option<ValueChecks>,
     /// Initial state.
     pub y0: Vec<f64>,
+    /// `y0` was set from outside the model file ([`request::set_initial`]): the closed form,
+    /// which solves for the file's initial conditions, does not apply.
+    pub initial_overridden: bool,
     /// The model's `[[events]]`, compiled.
     pub events: Vec<PreparedEvent>,
     /// Sweep measures: observer over the same inputs.
@@ -548,6 +551,7 @@ pub fn prepare_with_jit(
         state_names: d.state_names.clone(),
         value_checks: ValueChecks::compile(model).ok(),
         y0,
+        initial_overridden: false,
         events,
         measures,
         notes: d.notes.clone(),
@@ -567,7 +571,7 @@ pub const CONSTRAINT_TOLERANCE: f64 = 1e-8;
 /// Every constraint `f(q, t) = 0` and its rate `df/dt = 0` must hold at t = 0: an initial
 /// state off the constraint makes the integrator follow a different motion, and the only
 /// symptom would be a drift warning that blames the tolerance.
-fn check_constraints_at_start(
+pub(crate) fn check_constraints_at_start(
     model: &mut Model,
     system: &CompiledModel,
     y0: &[f64],

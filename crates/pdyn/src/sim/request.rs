@@ -145,6 +145,16 @@ pub fn execute(
     set: &RunSettings,
 ) -> Result<(RunResult, Option<Error>), Error> {
     let res = if set.method == "exact" {
+        if prep.initial_overridden {
+            return Err(Error::argument(
+                RunOption::Initial.name(),
+                format!(
+                    "{}: the closed form solves for the model's own initial conditions; \
+                     change them in the file, or use a numerical method",
+                    RunOption::Initial
+                ),
+            ));
+        }
         let exact = super::exact::closed_form(model).map_err(|e| {
             let context = match crate::options::naming() {
                 crate::options::Naming::Flags => "--method exact: ",
@@ -173,4 +183,39 @@ pub fn non_finite(origin: &str, res: &RunResult) -> Option<(NonFinite, Error)> {
     let nf = NonFinite::of_rows(&res.rows)?;
     let error = nf.error(origin, &res.columns);
     Some((nf, error))
+}
+
+/// Starts the run of `prep` (compiled from `model`) from other initial values: `values` names
+/// state components (`x`, `x'`, as [`Prepared::state_names`]). An unknown name or a value that
+/// is not finite names the option; a state off the model's constraints is refused as the
+/// file's own initial values are. The closed form (`method = "exact"`) solves for the file's
+/// initial conditions and refuses them (see [`execute`]).
+pub fn set_initial(
+    model: &mut Model,
+    prep: &mut Prepared,
+    values: &[(String, f64)],
+) -> Result<(), Error> {
+    let option = RunOption::Initial;
+    for (name, value) in values {
+        let Some(i) = prep.state_names.iter().position(|s| s == name) else {
+            return Err(Error::argument(
+                option.name(),
+                format!(
+                    "{option}: `{name}` is not a state component (state: {})",
+                    prep.state_names.join(", ")
+                ),
+            ));
+        };
+        if !value.is_finite() {
+            return Err(Error::argument(
+                option.name(),
+                format!("{option}: `{name}` = {value} is not a finite number"),
+            ));
+        }
+        prep.y0[i] = *value;
+    }
+    super::check_constraints_at_start(model, &prep.system, &prep.y0)
+        .map_err(|e| located(model, "", e))?;
+    prep.initial_overridden = !values.is_empty();
+    Ok(())
 }

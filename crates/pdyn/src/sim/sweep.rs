@@ -196,10 +196,12 @@ fn measure_run(
         Err(e) => return (vec![f64::NAN; n_meas], Some(RunProblem::NotRun(e))),
         Ok(r) => r,
     };
-    let mut problem = res.failure.map(RunProblem::Stopped);
-    if problem.is_none() && !res.warnings.is_empty() {
-        problem = Some(RunProblem::Warnings(res.warnings));
+    if let Some(failure) = res.failure {
+        // A statistic over the rows before a failure is not the run's: NaN, never a number
+        // that looks like a result (the problem says where it stopped).
+        return (vec![f64::NAN; n_meas], Some(RunProblem::Stopped(failure)));
     }
+    let problem = (!res.warnings.is_empty()).then_some(RunProblem::Warnings(res.warnings));
     (res.measures, problem)
 }
 
