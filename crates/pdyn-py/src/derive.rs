@@ -78,6 +78,18 @@ pub(crate) fn derive(py: Python<'_>, model: &pdyn_mech::Model) -> PyResult<PyObj
     out.set_item("first_order", first_order)?;
     out.set_item("notes", d.notes.clone())?;
     out.set_item("form", format!("{:?}", d.form).to_lowercase())?;
+    // The names declared positive (masses, lengths, g): `to_sympy` gives their SymPy symbols
+    // `positive=True`, so that expressions simplify against PyDy's as they do here.
+    let positive: Vec<&str> = model
+        .parameters
+        .iter()
+        .map(|q| q.name.as_str())
+        .filter(|name| {
+            p.find_symbol(name)
+                .is_some_and(|s| p.symbol_info(s).positive)
+        })
+        .collect();
+    out.set_item("positive", positive)?;
     Ok(out.into_any().unbind())
 }
 

@@ -47,3 +47,62 @@ def test_latex_names_are_sympys(examples):
     sympy = pytest.importorskip("sympy")
     assert sympy.latex(sympy.Symbol("l1")) == "l_{1}"
     assert sympy.latex(sympy.Symbol("theta1")) == "\\theta_{1}"
+
+
+SHADOWED = """
+name = "parameters named like SymPy's constants and keywords"
+[parameters]
+E = 2.0
+I = 3.0
+S = 5.0
+N = 7.0
+Q = 11.0
+beta = 13.0
+gamma = 17.0
+zeta = 19.0
+lambda = 23.0
+m = 1.0
+[coordinates]
+x = { initial = 0.0, rate = 1.0 }
+[particles.p]
+mass = "m"
+position = "[x, 0, 0]"
+[[forces]]
+kind = "applied"
+on = "p"
+force = "[-(E*I + S*N - Q*beta + gamma*zeta*lambda)*x, 0, 0]"
+"""
+
+
+def test_to_sympy_keeps_names_and_assumptions():
+    sympy = pytest.importorskip("sympy")
+    d = pdyn.Model.from_toml(SHADOWED).derive()
+    acc = dict(d.solution)["x''"].to_sympy()
+    names = {"E", "I", "S", "N", "Q", "beta", "gamma", "zeta", "lambda", "m", "x"}
+    assert {s.name for s in acc.free_symbols} == names, acc.free_symbols
+    # Symbols, never Euler's number, the imaginary unit, or SymPy's S/N/Q objects; the masses
+    # declared positive by the model stay positive.
+    sym = {s.name: s for s in acc.free_symbols}
+    assert sym["m"].is_positive and sym["x"].is_positive is None
+    values = {sym[k]: float(v) for k, v in
+              dict(E=2, I=3, S=5, N=7, Q=11, beta=13, gamma=17, zeta=19, m=1, x=1).items()}
+    values[sym["lambda"]] = 23.0
+    # x'' = -(E I + S N - Q beta + gamma zeta lambda) x / m, evaluated independently.
+    expected = -(2 * 3 + 5 * 7 - 11 * 13 + 17 * 19 * 23) * 1.0
+    assert float(acc.subs(values)) == pytest.approx(expected, rel=1e-15)
+
+
+def test_exprs_take_part_in_sympy_arithmetic(examples):
+    sympy = pytest.importorskip("sympy")
+    d = pdyn.Model.from_file(examples / "pendulum_chain_2.toml").derive()
+    M = sympy.Matrix(d.mass_matrix)  # sympify through Expr._sympy_
+    l1, l2, m1, m2 = sympy.symbols("l1 l2 m1 m2", positive=True)
+    q1, q2 = sympy.symbols("q1 q2")
+    expected = sympy.Matrix([[l1**2 * (m1 + m2), l1 * l2 * m2 * sympy.cos(q1 - q2)],
+                             [l1 * l2 * m2 * sympy.cos(q1 - q2), l2**2 * m2]])
+    assert sympy.simplify(M - expected) == sympy.zeros(2, 2)
+    # Arithmetic and subs go through SymPy.
+    e = d.mass_matrix[1][1]
+    assert sympy.simplify((e + e) - 2 * l2**2 * m2) == 0
+    assert e.subs({l2: 2, m2: 3}) == 12
+    assert sympy.sympify(e) == l2**2 * m2

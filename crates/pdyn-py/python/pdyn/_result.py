@@ -300,13 +300,16 @@ def _from_ivp(raw: Dict[str, Any], n_events: int, n: int) -> OdeResult:
 
 class Expr:
     """A symbolic expression of pdyn: ``str(e)`` is re-parsable text, :meth:`latex` LaTeX;
-    Jupyter renders it through :meth:`_repr_latex_`."""
+    Jupyter renders it through :meth:`_repr_latex_`. With SymPy installed it converts
+    (:meth:`to_sympy`, ``sympy.sympify(e)``, ``sympy.Matrix(rows_of_exprs)``) and takes part
+    in arithmetic and :meth:`subs` as its SymPy expression."""
 
-    __slots__ = ("_text", "_latex")
+    __slots__ = ("_text", "_latex", "_positive")
 
-    def __init__(self, text: str, latex: str):
+    def __init__(self, text: str, latex: str, positive: frozenset = frozenset()):
         self._text = text
         self._latex = latex
+        self._positive = positive
 
     def __str__(self) -> str:
         return self._text
@@ -329,20 +332,97 @@ class Expr:
 
     def to_sympy(self):
         """The expression as a SymPy expression (``^`` read as ``**``; primes ``x'`` become
-        ``x_d``, ``x''`` ``x_dd``). Raises ImportError when SymPy is not installed."""
+        symbols ``x_d``, ``x''`` ``x_dd``). Every name is a SymPy ``Symbol`` of that name,
+        never a SymPy constant or keyword (``E``, ``I``, ``S``, ``N``, ``Q``, ``beta``,
+        ``lambda``...), ``positive=True`` where the model declares it (masses, lengths), without
+        assumptions otherwise; ``pi`` is ``sympy.pi``. Raises ImportError when SymPy is not installed."""
         try:
             import sympy
         except ImportError as e:
             raise ImportError("Expr.to_sympy() needs sympy: pip install sympy") from e
-        import re
-        text = self._text.replace("^", "**")
-        text = re.sub(r"([A-Za-z_][A-Za-z_0-9]*)''", r"\1_dd", text)
-        text = re.sub(r"([A-Za-z_][A-Za-z_0-9]*)'", r"\1_d", text)
-        return sympy.sympify(text)
+        return _to_sympy(sympy, self._text, self._positive)
+
+    def _sympy_(self):
+        # sympy.sympify(e), sympy.Matrix([[e, ...]]) and arithmetic with SymPy objects.
+        return self.to_sympy()
+
+    def subs(self, *args, **kwargs):
+        """``self.to_sympy().subs(...)``: SymPy's ``subs``."""
+        return self.to_sympy().subs(*args, **kwargs)
+
+    def __add__(self, other):
+        return self.to_sympy() + _as_sympy(other)
+
+    def __radd__(self, other):
+        return _as_sympy(other) + self.to_sympy()
+
+    def __sub__(self, other):
+        return self.to_sympy() - _as_sympy(other)
+
+    def __rsub__(self, other):
+        return _as_sympy(other) - self.to_sympy()
+
+    def __mul__(self, other):
+        return self.to_sympy() * _as_sympy(other)
+
+    def __rmul__(self, other):
+        return _as_sympy(other) * self.to_sympy()
+
+    def __truediv__(self, other):
+        return self.to_sympy() / _as_sympy(other)
+
+    def __rtruediv__(self, other):
+        return _as_sympy(other) / self.to_sympy()
+
+    def __pow__(self, other):
+        return self.to_sympy() ** _as_sympy(other)
+
+    def __neg__(self):
+        return -self.to_sympy()
 
 
-def _expr(pair) -> Expr:
-    return Expr(pair[0], pair[1])
+# Function names pdyn prints, as SymPy's.
+_SYMPY_FUNCTIONS = ("sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh",
+                    "tanh", "exp", "log", "sqrt", "abs", "sign", "min", "max")
+
+
+def _as_sympy(x):
+    return x.to_sympy() if isinstance(x, Expr) else x
+
+
+def _to_sympy(sympy, text: str, positive: frozenset):
+    import re
+    text = text.replace("^", "**")
+    text = re.sub(r"([A-Za-z_][A-Za-z_0-9]*)''", r"\1_dd", text)
+    text = re.sub(r"([A-Za-z_][A-Za-z_0-9]*)'", r"\1_d", text)
+    functions = {"sin": sympy.sin, "cos": sympy.cos, "tan": sympy.tan, "asin": sympy.asin,
+                 "acos": sympy.acos, "atan": sympy.atan, "atan2": sympy.atan2,
+                 "sinh": sympy.sinh, "cosh": sympy.cosh, "tanh": sympy.tanh, "exp": sympy.exp,
+                 "log": sympy.log, "sqrt": sympy.sqrt, "abs": sympy.Abs, "sign": sympy.sign,
+                 "min": sympy.Min, "max": sympy.Max}
+    # Every identifier becomes a placeholder bound to a Symbol of its own name: `E`, `I`,
+    # `lambda` never reach SymPy's parser (constants, a keyword).
+    names: Dict[str, Any] = {}
+
+    def bind(m):
+        name = m.group(0)
+        if m.end() < len(text) and text[m.end()] == "(" and name in functions:
+            key = f"__f_{name}"
+            names[key] = functions[name]
+            return key
+        if name == "pi":
+            names["__pi"] = sympy.pi
+            return "__pi"
+        key = f"__s{len(names)}"
+        assumptions = {"positive": True} if name in positive else {}
+        names[key] = sympy.Symbol(name, **assumptions)
+        return key
+    safe = re.sub(r"[A-Za-z_][A-Za-z_0-9]*", bind, text)
+    return sympy.sympify(safe, locals=names)
+
+
+def _expr(pair, positive: frozenset = frozenset()) -> Expr:
+    return Expr(pair[0], pair[1], positive)
 
 
 class Derivation:
@@ -359,19 +439,21 @@ class Derivation:
     """
 
     def __init__(self, raw: Dict[str, Any]):
-        self.equations = [(lab, _expr(l), _expr(r)) for lab, l, r in raw["equations"]]
+        pos = frozenset(raw.get("positive", ()))
+        _e = lambda pair: _expr(pair, pos)  # noqa: E731
+        self.equations = [(lab, _e(l), _e(r)) for lab, l, r in raw["equations"]]
         self.unknowns: List[str] = list(raw["unknowns"])
         sol = raw["solution"]
-        self.solution = None if sol is None else [(u, _expr(e)) for u, e in sol]
+        self.solution = None if sol is None else [(u, _e(e)) for u, e in sol]
         fo = raw["first_order"]
-        self.first_order = None if fo is None else [(s, _expr(e)) for s, e in fo]
+        self.first_order = None if fo is None else [(s, _e(e)) for s, e in fo]
         self.state: List[str] = list(raw["state"])
         self.form: str = raw["form"]
         self.notes: List[str] = list(raw["notes"])
         mm = raw.get("mass_matrix")
-        self.mass_matrix = None if mm is None else [[_expr(e) for e in row] for row in mm]
+        self.mass_matrix = None if mm is None else [[_e(e) for e in row] for row in mm]
         fo = raw.get("forcing")
-        self.forcing = None if fo is None else [_expr(e) for e in fo]
+        self.forcing = None if fo is None else [_e(e) for e in fo]
 
     def __repr__(self) -> str:
         lines = [f"{lab}: {l} = {r}" for lab, l, r in self.equations]
