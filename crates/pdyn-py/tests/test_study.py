@@ -154,11 +154,26 @@ def test_resume_runs_only_the_missing_chunks(examples, tmp_path):
     meta = pdyn.study.read_metadata(os.path.join(out, files[0]))
     assert meta["model"] == kremlin(examples).source and meta["seed"] == 2026
     assert meta["pdyn_version"] == pdyn.__version__ and meta["design"]["kind"] == "samples"
-    # A different design never reuses these chunks.
+    # A different design never reuses these chunks, nor shares their folder: reading the
+    # folder as one dataset must never mix two studies.
     other = Study(kremlin(examples), Samples(2000, seed=7, v0=normal(V0, SD_V0)),
-                  measures=MEASURES, chunk_size=200, out=out).run()
-    assert other.chunks_run == 10
+                  measures=MEASURES, chunk_size=200, out=out)
+    with pytest.raises(pdyn.study.OutputFolderError, match="another study"):
+        other.run()
     assert pq.read_table(os.path.join(out, files[0])).num_rows == 200
+    folder = pd.read_parquet(out)
+    assert len(folder) == 2000 and folder["sample"].is_unique
+    pd.testing.assert_frame_equal(folder.sort_values("sample", ignore_index=True),
+                                  clean.table.sort_values("sample", ignore_index=True),
+                                  check_exact=True, check_like=True)
+    other.out = str(tmp_path / "other")
+    assert other.run().chunks_run == 10
+    # A folder with result files of another study and no manifest (older pdyn) is refused
+    # too.
+    os.remove(os.path.join(out, pdyn.study.MANIFEST))
+    with pytest.raises(pdyn.study.OutputFolderError, match="result files of another study"):
+        Study(kremlin(examples), Samples(2000, seed=7, v0=normal(V0, SD_V0)),
+              measures=MEASURES, chunk_size=200, out=out).run()
 
 
 def test_dask_cluster_equals_local_bit_for_bit_for_any_chunk_size(examples, cluster):

@@ -23,7 +23,9 @@ With ``out=DIR`` every finished chunk is written to ``DIR/chunk-NNNNN-KEY.parque
 hashes the model text, the design, the measures and settings, and the chunk's rows) with
 the model text, pdyn's version, the seed and the design in the file's metadata. Running the
 same study again skips the chunks already written: an interrupted study resumes, and no
-chunk is ever counted twice. The files are written by the client, so a worker lost in the
+chunk is ever counted twice. A folder holds one study (``_pdyn_study.json`` names it): another
+study's ``out=`` there raises :class:`OutputFolderError`, so that ``pandas.read_parquet(DIR)``
+never mixes two. The files are written by the client, so a worker lost in the
 middle of a chunk loses nothing written (Dask runs its chunk again elsewhere).
 
 Command line: ``python -m pdyn.study MODEL --design study.toml --out DIR
@@ -45,7 +47,7 @@ from ._errors import ParameterError
 
 __all__ = [
     "Study", "StudyResult", "Grid", "Sets", "Samples", "normal", "uniform", "lognormal",
-    "DesignError", "Probability", "load_design", "main",
+    "DesignError", "OutputFolderError", "Probability", "load_design", "main",
 ]
 
 #: Runs per task when ``chunk_size`` is not given: the smallest chunk at which the measured
@@ -57,6 +59,17 @@ DEFAULT_CHUNK_SIZE = 1000
 class DesignError(ParameterError):
     """A design the model cannot run: an unknown name, a negative spread, an empty grid, a
     sample that gives an invalid value (a mass <= 0). Raised before any run starts."""
+
+
+class OutputFolderError(ParameterError):
+    """``out=`` names a folder that holds another study (another model, design, measures or
+    settings): its chunks and this study's would be read back mixed (``pandas.read_parquet``
+    of the folder). Raised before any run starts; choose another folder or empty it."""
+
+
+# The study a folder holds; underscore-prefixed, so that pyarrow and pandas reading the folder
+# as a dataset skip it (as they skip the hidden temporary files of chunks being written).
+MANIFEST = "_pdyn_study.json"
 
 
 # ---------------------------------------------------------------------------------------
@@ -546,9 +559,38 @@ class Study:
         table = pa.table(cols)
         table = table.replace_schema_metadata({b"pdyn": json.dumps(meta).encode()})
         path = self._path(index, key)
-        tmp = path + f".tmp{os.getpid()}"
+        # Hidden while written (a dot: dataset readers skip it), then renamed: a chunk is on
+        # disk whole or not at all.
+        tmp = os.path.join(self.out, f".{os.path.basename(path)}.tmp{os.getpid()}")
         pq.write_table(table, tmp)
-        os.replace(tmp, path)  # atomic: a chunk is on disk whole or not at all
+        os.replace(tmp, path)
+
+    def _claim_folder(self, keys: Dict[int, str]) -> None:
+        """Makes ``out`` this study's folder, or refuses a folder that holds another study."""
+        os.makedirs(self.out, exist_ok=True)
+        manifest = os.path.join(self.out, MANIFEST)
+        mine = self._study_key()
+        if os.path.exists(manifest):
+            with open(manifest) as f:
+                theirs = json.load(f).get("study_key")
+            if theirs != mine:
+                raise OutputFolderError(
+                    f"{self.out} holds another study (key {str(theirs)[:12]}…, this one "
+                    f"{mine[:12]}…: a different model, design, measures or settings); "
+                    "its results and these would be read back mixed: use another out= "
+                    "folder, or empty this one")
+        else:
+            ours = {f"chunk-{i:05d}-{k}.parquet" for i, k in keys.items()}
+            foreign = sorted(n for n in os.listdir(self.out)
+                             if n.endswith(".parquet") and n not in ours)
+            if foreign:
+                raise OutputFolderError(
+                    f"{self.out} holds {len(foreign)} result files of another study "
+                    f"({foreign[0]}, ...): use another out= folder, or empty this one")
+            tmp = manifest + f".tmp{os.getpid()}"
+            with open(tmp, "w") as f:
+                json.dump({"study_key": mine, "metadata": self.metadata()}, f, default=str)
+            os.replace(tmp, manifest)
 
     def run(self, client: Any = None, threads: Optional[int] = None,
             progress: bool = False, on_chunk: Optional[Callable[[int, int], None]] = None,
@@ -569,7 +611,7 @@ class Study:
         keys = {i: self.chunk_key(i, a, b) for i, a, b in chunks}
         done: Dict[int, Any] = {}
         if self.out is not None:
-            os.makedirs(self.out, exist_ok=True)
+            self._claim_folder(keys)
             for i, a, b in chunks:
                 if os.path.exists(self._path(i, keys[i])):
                     done[i] = None
