@@ -106,3 +106,40 @@ def test_exprs_take_part_in_sympy_arithmetic(examples):
     assert sympy.simplify((e + e) - 2 * l2**2 * m2) == 0
     assert e.subs({l2: 2, m2: 3}) == 12
     assert sympy.sympify(e) == l2**2 * m2
+
+
+def test_the_builder_takes_what_sympy_writes():
+    sympy = pytest.importorskip("sympy")
+    from pdyn._sympy_text import to_pdyn_text
+    x, y, c = sympy.symbols("x y c")
+    q = sympy.Function("q")
+    t = sympy.Symbol("t")
+    # Each translation evaluated by pdyn must equal SymPy's value of the original.
+    cases = [sympy.Abs(x - 3) * sympy.exp(1), sympy.E ** x, sympy.sqrt(y) / (x**2 + 1),
+             sympy.Max(x, y, 2), sympy.Heaviside(x - 1),
+             sympy.Piecewise((x**2, x > 1), (-y, x < -1), (c, True))]
+    for e in cases:
+        text = to_pdyn_text(e)
+        for xv, yv, cv in [(2.5, 0.5, 7.0), (-2.0, 3.0, 1.5), (0.3, 1.0, -4.0)]:
+            want = float(e.subs({x: xv, y: yv, c: cv}))
+            m = pdyn.Model.from_toml(f"""
+name = "probe"
+[parameters]
+x = {xv}
+y = {yv}
+c = {cv}
+p = "{text}"
+[coordinates]
+z = {{ initial = 0.0, rate = 0.0 }}
+[particles.a]
+mass = 1.0
+position = "[z, 0, 0]"
+""")
+            assert m.parameters["p"] == pytest.approx(want, rel=1e-14, abs=1e-14), (e, text)
+    # Rates of dynamicsymbols-style coordinates and 3-vectors.
+    assert to_pdyn_text(sympy.Derivative(q(t), t, 2)) == "q''"
+    assert to_pdyn_text(sympy.Matrix([sympy.cos(q(t)), sympy.sin(q(t)), 0])) == \
+        "[cos(q), sin(q), 0]"
+    for bad in (sympy.I * x, sympy.oo, sympy.Piecewise((x, (x > 0) & (y > 0)), (y, True))):
+        with pytest.raises(TypeError):
+            to_pdyn_text(bad)

@@ -86,8 +86,9 @@ class _Parameters(dict):
 
 
 def _text(x: Any) -> str:
-    """An expression as pdyn text: a string as is, a SymPy expression through its text
-    form (``**`` written ``^``), a list of three as a vector."""
+    """An expression as pdyn text: a string as is, a SymPy expression translated
+    (:func:`pdyn._sympy_text.to_pdyn_text`: ``Abs``, ``E``, ``Derivative``, ``Piecewise``,
+    3-vector matrices), a list of three as a vector."""
     if isinstance(x, str):
         return x
     if isinstance(x, (list, tuple)):
@@ -95,7 +96,8 @@ def _text(x: Any) -> str:
     if isinstance(x, (int, float)) and not isinstance(x, bool):
         return repr(float(x))
     if hasattr(x, "free_symbols"):  # SymPy
-        return str(x).replace("**", "^")
+        from ._sympy_text import to_pdyn_text
+        return to_pdyn_text(x)
     raise TypeError(f"cannot use {x!r} as an expression (give a string or a SymPy expression)")
 
 

@@ -69,12 +69,15 @@ def _q(x) -> Union[Expr, Vector]:
 
 
 def _text(x: Any) -> str:
-    """An expression argument: a string, a number, or a SymPy expression (its text, ``**``
-    written ``^``)."""
+    """An expression argument: a string, a number, or a SymPy expression (translated by
+    :func:`pdyn._sympy_text.to_pdyn_text`)."""
     if isinstance(x, str):
         return x
     if isinstance(x, (list, tuple)):
         return "[" + ", ".join(_text(c) for c in x) + "]"
+    if hasattr(x, "free_symbols"):
+        from ._sympy_text import to_pdyn_text
+        return to_pdyn_text(x)
     return str(x).replace("**", "^")
 
 
