@@ -33,6 +33,7 @@ np = LazyModule("numpy")  # imported on first use
 
 from . import _pdyn
 from ._errors import DriftWarning, Interrupted, ModelError, ParameterError, PdynError
+from ._nbody import NBody, Particle
 from ._result import (DenseOutput, Derivation, EnsembleResult, Expr, ForcesResult,
                       OdeResult, ParticleResult, SweepResult, Table,
                       _concat_raw, _from_ivp, _from_run)
@@ -50,7 +51,7 @@ def __getattr__(name: str):
     raise AttributeError(f"module 'pdyn' has no attribute {name!r}")
 
 __all__ = [
-    "Model", "solve_ivp", "methods", "OdeResult", "Derivation", "Expr", "SweepResult",
+    "Model", "NBody", "Particle", "solve_ivp", "methods", "OdeResult", "Derivation", "Expr", "SweepResult",
     "EnsembleResult", "DenseOutput", "ForcesResult",
     "kin", "dsolve", "KinResult", "KinInstant", "DsolveResult", "DsolveCase", "RuleResult",
     "Vector",

@@ -29,6 +29,37 @@ class Interrupted(KeyboardInterrupt):
     result: Any
     def __init__(self, message: str, result: Any = ...) -> None: ...
 
+class Particle:
+    name: str
+    m: float
+    r: float
+    x: float
+    y: float
+    z: float
+    vx: float
+    vy: float
+    vz: float
+
+class NBody:
+    name: str
+    t: float
+    last: Optional[ParticleResult]
+    def __init__(self, name: str = ..., **options: Any) -> None: ...
+    def add(self, m: float, name: Optional[str] = ..., r: float = ...,
+            primary: Optional[str] = ..., **coords: float) -> None: ...
+    def integrate(self, t: float, points: Optional[int] = ...,
+                  output_dt: Optional[float] = ...) -> ParticleResult: ...
+    def to_toml(self, t_end: float, output: Dict[str, Any]) -> str: ...
+    @property
+    def particles(self) -> List[Particle]: ...
+    @property
+    def positions(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def velocities(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def masses(self) -> npt.NDArray[np.float64]: ...
+    def energy(self) -> float: ...
+
 class DenseOutput:
     ts: npt.NDArray[np.float64]
     t_min: float
