@@ -227,6 +227,43 @@ impl PyModel {
         })
     }
 
+    /// The equations linearized about a state (see `pdyn.Model.linearize`).
+    #[pyo3(signature = (at=None, params=None, t=0.0))]
+    fn linearize(
+        &self,
+        py: Python<'_>,
+        at: Option<Vec<(String, f64)>>,
+        params: Option<Vec<(String, f64)>>,
+        t: f64,
+    ) -> PyResult<PyObject> {
+        guarded(py, || {
+            let lin = py
+                .allow_threads(|| -> Result<_, Error> {
+                    let mut m = self.with_params(params)?;
+                    let mut prep = PyModel::prepare(&mut m, false)?;
+                    pdyn::sim::request::set_initial(&mut m, &mut prep, &at.unwrap_or_default())?;
+                    let lin = pdyn::sim::linearize::linearize(&prep, t, &prep.y0);
+                    Ok((lin, prep.state_names.clone(), prep.y0.clone()))
+                })
+                .map_err(|e| to_py(py, &e))?;
+            let (lin, names, y0) = lin;
+            let n = lin.dim / 2;
+            let (k, c) = lin.stiffness_and_damping();
+            let d = pyo3::types::PyDict::new(py);
+            d.set_item(
+                "A",
+                crate::convert::f64_matrix(py, lin.a, lin.dim, lin.dim)?,
+            )?;
+            d.set_item("K", crate::convert::f64_matrix(py, k, n, n)?)?;
+            d.set_item("C", crate::convert::f64_matrix(py, c, n, n)?)?;
+            d.set_item("f0", crate::convert::f64_array(py, lin.f0))?;
+            d.set_item("y0", crate::convert::f64_array(py, y0))?;
+            d.set_item("state", names)?;
+            d.set_item("analytic", lin.analytic)?;
+            Ok(d.into_any().unbind())
+        })
+    }
+
     /// The equations of motion, as text and LaTeX (see `pdyn.Model.derive`).
     fn derive(&self, py: Python<'_>) -> PyResult<PyObject> {
         guarded(py, || crate::derive::derive(py, &self.model))

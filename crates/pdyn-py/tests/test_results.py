@@ -143,3 +143,42 @@ position = "[z, 0, 0]"
     for bad in (sympy.I * x, sympy.oo, sympy.Piecewise((x, (x > 0) & (y > 0)), (y, True))):
         with pytest.raises(TypeError):
             to_pdyn_text(bad)
+
+
+DUFFING = """
+name = "damped Duffing oscillator: m x'' = -k x - c x' - eps x^3"
+[parameters]
+m = 2.0
+k = 3.0
+c = 0.5
+eps = 0.7
+[coordinates]
+x = { initial = 0.4, rate = 0.0 }
+[particles.p]
+mass = "m"
+position = "[x, 0, 0]"
+[[forces]]
+kind = "applied"
+on = "p"
+force = "[-k*x - c*x' - eps*x^3, 0, 0]"
+"""
+
+
+def test_linearize_matches_the_hand_derivation():
+    m = pdyn.Model.from_toml(DUFFING)
+    for x0 in (0.0, 0.4, -1.3):
+        lin = m.linearize(op_point={"x": x0, "x'": 0.0})
+        # d/dx of -(k x + eps x^3)/m is -(k + 3 eps x0^2)/m; d/dx' of -c x'/m is -c/m.
+        K = (3.0 + 3 * 0.7 * x0**2) / 2.0
+        C = 0.5 / 2.0
+        np.testing.assert_allclose(lin.A, [[0.0, 1.0], [-K, -C]], rtol=1e-13, atol=1e-13)
+        np.testing.assert_allclose(lin.K, [[K]], rtol=1e-13)
+        np.testing.assert_allclose(lin.C, [[C]], rtol=1e-13)
+        # f0: zero only at the equilibrium x0 = 0.
+        assert abs(lin.f0[1] + (3.0 * x0 + 0.7 * x0**3) / 2.0) < 1e-14
+    assert lin.state == ["x", "x'"]
+    ev = m.linearize(op_point={"x": 0.0}).eigenvalues()
+    # Damped oscillator roots: -C/2 ± i sqrt(K - C^2/4).
+    assert np.allclose(sorted(ev.imag), [-np.sqrt(1.5 - 0.25**2 / 4), np.sqrt(1.5 - 0.25**2 / 4)])
+    with pytest.raises(pdyn.ParameterError, match="not a state component"):
+        m.linearize(op_point={"y": 1.0})

@@ -34,6 +34,7 @@ np = LazyModule("numpy")  # imported on first use
 from . import _pdyn
 from ._errors import DriftWarning, Interrupted, ModelError, ParameterError, PdynError
 from ._nbody import NBody, Particle
+from ._linearize import Linearization
 from ._result import (DenseOutput, Derivation, EnsembleResult, Expr, ForcesResult,
                       OdeResult, ParticleResult, SweepResult, Table,
                       _concat_raw, _from_ivp, _from_run)
@@ -51,7 +52,7 @@ def __getattr__(name: str):
     raise AttributeError(f"module 'pdyn' has no attribute {name!r}")
 
 __all__ = [
-    "Model", "NBody", "Particle", "solve_ivp", "methods", "OdeResult", "Derivation", "Expr", "SweepResult",
+    "Model", "NBody", "Particle", "Linearization", "solve_ivp", "methods", "OdeResult", "Derivation", "Expr", "SweepResult",
     "EnsembleResult", "DenseOutput", "ForcesResult",
     "kin", "dsolve", "KinResult", "KinInstant", "DsolveResult", "DsolveCase", "RuleResult",
     "Vector",
@@ -380,6 +381,18 @@ class Model:
         if raw.get("interrupted"):
             _interrupted("Model.run", ParticleResult(raw))
         return ParticleResult(raw)
+
+    def linearize(self, op_point: Optional[Mapping[str, float]] = None,
+                  params: Optional[Mapping[str, float]] = None, t: float = 0.0) -> "Linearization":
+        """The equations of motion linearized about a state, as PyDy's ``linearize`` (without
+        inputs): ``δy' = A δy`` with ``A = ∂f/∂y`` at ``(t, y0)``; ``y0`` is the model's initial
+        state with ``op_point`` (``{"x": 0.1, "x'": 0.0}``) on top. Returns a
+        :class:`Linearization`: ``A``, and for the state ``(q, q')`` the second-order form
+        ``δq'' + C δq' + K δq = 0`` (``K``, ``C``: the mass matrix divided out), ``f0`` (zero
+        at an equilibrium), ``state``, ``analytic`` (``A`` from the compiled analytic
+        Jacobian, else central differences)."""
+        return Linearization(self._mechanics().linearize(at=_params(op_point),
+                                                          params=_params(params), t=float(t)))
 
     def derive(self) -> Derivation:
         """The equations of motion (F = ma or the projected form), the unknowns, their exact

@@ -60,6 +60,16 @@ class NBody:
     def masses(self) -> npt.NDArray[np.float64]: ...
     def energy(self) -> float: ...
 
+class Linearization:
+    A: npt.NDArray[np.float64]
+    K: npt.NDArray[np.float64]
+    C: npt.NDArray[np.float64]
+    f0: npt.NDArray[np.float64]
+    y0: npt.NDArray[np.float64]
+    state: List[str]
+    analytic: bool
+    def eigenvalues(self) -> npt.NDArray[np.complex128]: ...
+
 class DenseOutput:
     ts: npt.NDArray[np.float64]
     t_min: float
@@ -213,6 +223,8 @@ class Model:
             plots: Optional[Union[str, os.PathLike[str]]] = ...,
             jit: bool = ..., initial: Optional[Mapping[str, float]] = ...
             ) -> Union[OdeResult, ParticleResult]: ...
+    def linearize(self, op_point: Optional[Mapping[str, float]] = ...,
+                  params: Optional[Mapping[str, float]] = ..., t: float = ...) -> Linearization: ...
     def derive(self) -> Derivation: ...
     def sweep(self, param: str, values: Sequence[float],
               measures: Optional[Mapping[str, Union[str, Tuple[str, str]]]] = ...,

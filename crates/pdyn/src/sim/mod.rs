@@ -16,6 +16,7 @@ pub mod ensemble;
 mod error;
 pub mod exact;
 pub mod hybrid;
+pub mod linearize;
 pub mod measured;
 pub mod report;
 pub mod request;
