@@ -95,7 +95,7 @@ Velocities
     let bad = text.replace("3 1 2.0", "7 1 2.0");
     assert!(matches!(
         read_lammps_data(bad.as_bytes(), 100),
-        Err(MdError::IndexOutOfRange { index: 7, .. })
+        Err(MdError::InvalidInput { line: 23, .. })
     ));
 }
 
