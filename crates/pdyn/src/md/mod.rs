@@ -11,6 +11,7 @@
 //! everything about the model file lives here. See `docs/md.md` for the format.
 
 pub mod build;
+pub mod data_file;
 pub mod formula;
 pub mod memory;
 pub mod output;
