@@ -350,6 +350,20 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
         )
         .help("bond types apply to the Bonds section of a LAMMPS data file ([md.read])"));
     }
+    if let (Some(r), true) = (&spec.rdf_range, spec.rdf) {
+        let half = 0.5 * system.sim_box.min_edge();
+        if r.value > half {
+            return Err(err(
+                &r.span,
+                format!(
+                    "rdf_range = {} is more than half the shortest box edge ({}): the minimum image cannot count pairs that far",
+                    short(r.value),
+                    short(half)
+                ),
+            )
+            .help("leave rdf_range out for the largest range the box allows"));
+        }
+    }
     system.special_lj = spec.special_lj.0;
     let params = SimParams {
         neighbor_every: spec.neighbor_every,

@@ -16,6 +16,7 @@ pub mod formula;
 pub mod memory;
 pub mod output;
 pub mod pair;
+pub mod rdf_blocks;
 pub mod request;
 pub mod run;
 pub mod spec;

@@ -196,9 +196,18 @@ pub fn write_files(res: &MdResult, dir: &Path) -> Result<(), Error> {
     }
     write(&dir.join("thermo.csv"), &s)?;
     if let Some((r, g)) = &res.rdf {
-        let mut s = String::from("r,g\n");
-        for (a, b) in r.iter().zip(g) {
-            let _ = writeln!(s, "{a},{b}");
+        // `error`: the standard error of g from 5 blocks of frames, when there are two or more
+        let mut s = String::from(if res.rdf_error.is_some() {
+            "r,g,error\n"
+        } else {
+            "r,g\n"
+        });
+        for (k, (a, b)) in r.iter().zip(g).enumerate() {
+            match &res.rdf_error {
+                Some(e) => writeln!(s, "{a},{b},{}", e[k]),
+                None => writeln!(s, "{a},{b}"),
+            }
+            .ok();
         }
         write(&dir.join("rdf.csv"), &s)?;
     }

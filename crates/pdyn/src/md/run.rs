@@ -8,9 +8,10 @@
 //! the trajectory written so far ends with the failing configuration.
 
 use super::build::{Engine, Prepared, UnitSystem};
+use super::rdf_blocks::RdfBlocks;
 use super::spec::{Ensemble, MdSpec, Mode, Units};
 use crate::Error;
-use pdyn_md::analysis::{Msd, Rdf};
+use pdyn_md::analysis::Msd;
 use pdyn_md::potential::PairPotential;
 use pdyn_md::thermostat::Thermostat;
 use pdyn_md::{MdError, Simulation, System, ThermoRecord};
@@ -81,7 +82,10 @@ pub struct MdResult {
     pub rdf: Option<(Vec<f64>, Vec<f64>)>,
     /// Frames the RDF averaged.
     pub rdf_frames: u64,
-    /// `(step, time, msd)` at every record when asked for.
+    /// Standard error of `g(r)` per bin from 5 blocks of frames (None with fewer than two
+    /// blocks with frames).
+    pub rdf_error: Option<Vec<f64>>,
+    /// `(step, time, msd)` every `msd_every` steps (and the last step) when asked for.
     pub msd: Vec<[f64; 3]>,
     /// Energy conservation (NVE, Nosé–Hoover).
     pub drift: Option<Drift>,
@@ -289,11 +293,33 @@ fn run_sim<P: PairPotential>(
         frames += 1;
     }
     let msd0 = spec.msd.then(|| Msd::new(&sim.system));
+    let half = spec.steps / 2;
+    // At most `rdf_frames` frames, equally spaced over the records of the second half.
+    let second_half_records = {
+        let te = spec.thermo_every.max(1);
+        let (first, last) = ((spec.steps / 2).div_ceil(te).max(1), spec.steps / te);
+        (last + 1).saturating_sub(first)
+    };
+    let planned_rdf_frames = match spec.rdf_every {
+        // the multiples of rdf_every in [max(half, 1), steps]
+        Some(e) => spec.steps / e - (half.max(1) - 1) / e,
+        None => (spec.rdf_frames as u64).min(second_half_records),
+    };
     let mut rdf = if spec.rdf && n <= RDF_MAX_ATOMS {
-        let r_max = 0.5 * sim.system.sim_box.min_edge() * (1.0 - 1e-9);
-        Some(Rdf::new(r_max, spec.rdf_bins).map_err(|e| Error::Internal {
-            message: format!("RDF: {e}"),
-        })?)
+        // the range was checked against the box when the model was built
+        let r_max = spec
+            .rdf_range
+            .as_ref()
+            .map_or(0.5 * sim.system.sim_box.min_edge() * (1.0 - 1e-9), |r| {
+                r.value
+            });
+        Some(
+            RdfBlocks::new(r_max, spec.rdf_bins, planned_rdf_frames).map_err(|e| {
+                Error::Internal {
+                    message: format!("RDF: {e}"),
+                }
+            })?,
+        )
     } else {
         None
     };
@@ -303,12 +329,6 @@ fn run_sim<P: PairPotential>(
             "rdf = true ignored: {n} atoms is more than {RDF_MAX_ATOMS} for the all-pairs histogram"
         ));
     }
-    // At most `rdf_frames` frames, equally spaced over the records of the second half.
-    let second_half_records = {
-        let te = spec.thermo_every.max(1);
-        let (first, last) = ((spec.steps / 2).div_ceil(te).max(1), spec.steps / te);
-        (last + 1).saturating_sub(first)
-    };
     // Record j of the R is taken when (j·F mod R) < F: exactly min(F, R) of them, spread
     // evenly (Bresenham), the first included.
     let rdf_take = |j: u64| {
@@ -317,14 +337,16 @@ fn run_sim<P: PairPotential>(
     };
     let mut records: Vec<ThermoRecord> = vec![];
     let mut msd = vec![];
+    if let (Some(m), true) = (&msd0, sim.step == 0) {
+        msd.push([0.0, 0.0, m.value(&sim.system)]);
+    }
     let mut rdf_seen = 0u64;
-    let mut rdf_frames = 0u64;
     let every = spec.thermo_every.max(1);
-    let chunk = if spec.dump_every > 0 {
-        gcd(every, spec.dump_every)
-    } else {
-        every
-    };
+    // the run stops at every step where something is due: thermo, a frame, an MSD or RDF sample
+    let chunk = [spec.dump_every, spec.msd_every, spec.rdf_every.unwrap_or(0)]
+        .into_iter()
+        .filter(|&k| k > 0)
+        .fold(every, gcd);
     let ramp = match (
         &spec.thermostat.temperature,
         &spec.thermostat.final_temperature,
@@ -332,7 +354,6 @@ fn run_sim<P: PairPotential>(
         (Some(a), Some(b)) if spec.thermostat.ensemble != Ensemble::Nve => Some((a.value, b.value)),
         _ => None,
     };
-    let half = spec.steps / 2;
     let start = std::time::Instant::now();
     let mut failure = None;
     let mut builds = 0;
@@ -347,15 +368,11 @@ fn run_sim<P: PairPotential>(
             let c = convert(r, u, dt);
             progress(Progress::Record(&c));
             records.push(c);
-            if let Some(m) = &msd0 {
-                msd.push([r.step as f64, c.time, m.value(s)]);
-            }
-            if let Some(h) = &mut rdf {
+            if let (Some(h), None) = (&mut rdf, spec.rdf_every) {
                 if r.step >= half && r.step > 0 {
                     if rdf_take(rdf_seen) {
                         // the box is fixed, so `add` cannot refuse r_max here
                         let _ = h.add(s);
-                        rdf_frames += 1;
                     }
                     rdf_seen += 1;
                 }
@@ -374,6 +391,17 @@ fn run_sim<P: PairPotential>(
             }
         }
         progress(Progress::Step(done));
+        let step = sim.step;
+        if let Some(m) = &msd0 {
+            if step % spec.msd_every.max(1) == 0 && step > 0 {
+                msd.push([step as f64, step as f64 * dt, m.value(&sim.system)]);
+            }
+        }
+        if let (Some(h), Some(e)) = (&mut rdf, spec.rdf_every) {
+            if step >= half && step > 0 && step % e == 0 {
+                let _ = h.add(&sim.system);
+            }
+        }
         if let Some((w, path)) = &mut traj {
             let dump = spec.dump_every > 0 && sim.step % spec.dump_every == 0;
             if dump || failure.is_some() {
@@ -392,22 +420,25 @@ fn run_sim<P: PairPotential>(
         let c = convert(&sim.thermo(), u, dt);
         progress(Progress::Record(&c));
         records.push(c);
-        if let Some(m) = &msd0 {
-            msd.push([c.step as f64, c.time, m.value(&sim.system)]);
-        }
         if let Some(h) = &mut rdf {
-            if c.step > 0 && (rdf_frames as usize) < spec.rdf_frames {
+            if spec.rdf_every.is_none() && c.step > 0 && (h.frames() as usize) < spec.rdf_frames {
                 let _ = h.add(&sim.system);
-                rdf_frames += 1;
             }
         }
     }
+    if let Some(m) = &msd0 {
+        // the last step, when it is not a multiple of msd_every
+        if failure.is_none() && msd.last().map(|x| x[0]) != Some(sim.step as f64) {
+            msd.push([sim.step as f64, sim.step as f64 * dt, m.value(&sim.system)]);
+        }
+    }
+    let rdf_frames = rdf.as_ref().map_or(0, |h| h.frames());
     if spec.rdf && rdf.is_some() && rdf_frames == 0 {
         warnings.push("rdf = true: no frame to average (the run has no steps)".into());
         rdf = None;
     }
     // Said when the file asked for a count (the default is "up to 20").
-    let asked = spec.rdf_frames != super::spec::RDF_FRAMES;
+    let asked = spec.rdf_frames != super::spec::RDF_FRAMES && spec.rdf_every.is_none();
     if asked && rdf.is_some() && failure.is_none() && (rdf_frames as usize) < spec.rdf_frames {
         warnings.push(format!(
             "the RDF averages {rdf_frames} frames, fewer than rdf_frames = {}: the second half \
@@ -454,6 +485,12 @@ fn run_sim<P: PairPotential>(
             ));
         }
     }
+    let rdf_result = match &rdf {
+        Some(h) => Some(h.result().map_err(|e| Error::Internal {
+            message: format!("RDF: {e}"),
+        })?),
+        None => None,
+    };
     let temperature_convention = TemperatureConvention {
         degrees_of_freedom: sim.dof(),
         momentum_conserved: sim.conserves_momentum(),
@@ -467,7 +504,8 @@ fn run_sim<P: PairPotential>(
         atoms: n,
         frames,
         rdf_frames: if rdf.is_some() { rdf_frames } else { 0 },
-        rdf: rdf.map(|h| h.result()),
+        rdf_error: rdf_result.as_ref().and_then(|b| b.error.clone()),
+        rdf: rdf_result.map(|b| (b.r, b.g)),
         msd,
         drift,
         warnings,

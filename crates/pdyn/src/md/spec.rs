@@ -49,7 +49,10 @@ struct RawMd {
     rdf: Option<Spanned<bool>>,
     rdf_bins: Option<Sv>,
     rdf_frames: Option<Sv>,
+    rdf_every: Option<Sv>,
+    rdf_range: Option<Sv>,
     msd: Option<Spanned<bool>>,
+    msd_every: Option<Sv>,
     equilibrate: Option<Sv>,
     #[serde(default)]
     species: IndexMap<Name, Spanned<RawSpecies>>,
@@ -398,8 +401,16 @@ pub struct MdSpec {
     /// Frames the RDF averages, equally spaced over the thermo records of the second half of
     /// the run (`rdf_frames`, default [`RDF_FRAMES`]; fewer when there are fewer records).
     pub rdf_frames: usize,
+    /// A frame every this many steps of the second half of the run (`rdf_every`), instead of
+    /// the `rdf_frames` thermo records.
+    pub rdf_every: Option<u64>,
+    /// Largest distance of the RDF (`rdf_range`, default half the shortest box edge, which is
+    /// also its upper limit).
+    pub rdf_range: Option<Num>,
     /// Mean-squared displacement post-processing.
     pub msd: bool,
+    /// Steps between MSD samples (`msd_every`, default `thermo_every`).
+    pub msd_every: u64,
     /// Records before this step are left out of the averages (equilibration).
     pub equilibrate: u64,
     /// Species in declaration order.
@@ -521,6 +532,25 @@ pub fn parse(
         return Err(r.err(span, "`rdf_frames` must be at least 1"));
     }
     let rdf_frames = rdf_frames as usize;
+    let rdf_every = m
+        .rdf_every
+        .as_ref()
+        .map(|sv| r.count(sv, "rdf_every", 1, MAX_STEPS))
+        .transpose()?;
+    if let (Some(_), Some(sv)) = (rdf_every, &m.rdf_frames) {
+        return Err(r
+            .err(sv.span(), "both `rdf_every` and `rdf_frames`: they are two ways to choose the RDF's frames")
+            .help("keep `rdf_every` (a frame every so many steps) or `rdf_frames` (that many thermo records)"));
+    }
+    let rdf_range = m
+        .rdf_range
+        .as_ref()
+        .map(|sv| r.positive(sv, "rdf_range"))
+        .transpose()?;
+    let msd_every = match &m.msd_every {
+        Some(sv) => r.count(sv, "msd_every", 1, MAX_STEPS)?,
+        None => thermo_every,
+    };
     let equilibrate = r.count_or(&m.equilibrate, "equilibrate", &mspan, Some(0), MAX_STEPS)?;
 
     if m.species.is_empty() {
@@ -1070,7 +1100,10 @@ pub fn parse(
         rdf: m.rdf.as_ref().is_some_and(|b| *b.get_ref()),
         rdf_bins,
         rdf_frames,
+        rdf_every,
+        rdf_range,
         msd: m.msd.as_ref().is_some_and(|b| *b.get_ref()),
+        msd_every,
         equilibrate,
         species,
         pairs,
