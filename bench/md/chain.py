@@ -12,7 +12,7 @@ bench/md/run/chain/data.chain (`write_data`: `Atoms # bond`, velocities); then
 1. reads it in LAMMPS with in.chain's settings (special_bonds 0 1 1, bond fene 30 1.5 1 1,
    lj/cut 1.12 shifted, neighbor 0.4 every 1 delay 1, Langevin 1 1 10 904297, dt 0.012) and
    in pdyn (bench/md/in_chain.toml) and compares the initial PE/N (`run 0`);
-2. runs STEPS steps (default 100) in each, whole process timed, and prints T, PE/N, P at the
+2. runs STEPS steps (default 100; of DT, default in.chain's 0.012) in each, whole process timed, and prints T, PE/N, P at the
    end and their averages over the second half (thermo every 10 steps; block errors).
 """
 import json
@@ -31,6 +31,7 @@ os.makedirs(run, exist_ok=True)
 steps = int(sys.argv[1]) if len(sys.argv) > 1 else 100
 chains = int(sys.argv[2]) if len(sys.argv) > 2 else 320
 beads, rho, bond, rmin = 100, 0.85, 0.97, 0.6
+dt = float(os.environ.get("DT", "0.012"))  # in.chain's 0.012 unless DT is set
 
 
 def generate(path, seed=12345):
@@ -123,7 +124,7 @@ fix		2 all langevin 1.0 1.0 10.0 904297
 thermo_style    custom step temp pe press
 thermo_modify   format float %.15g
 thermo          10
-timestep	0.012
+timestep	{dt}
 run		{steps}
 """)
     lmp.close()
@@ -137,6 +138,7 @@ def pdyn_run(steps, outdir):
     exe = os.environ.get("PDYN_EXE") or os.path.join(root, "target", "release", "pdyn")
     t0 = time.perf_counter()
     subprocess.run([exe, "run", os.path.join(here, "in_chain.toml"), "--set", f"steps={steps}",
+                    "--dt", str(dt),
                     "--out", outdir, "--json"], check=True, stdout=subprocess.DEVNULL,
                    stderr=subprocess.DEVNULL)
     wall = time.perf_counter() - t0
@@ -192,11 +194,11 @@ if not os.path.exists(data) or os.environ.get("REGENERATE"):
     relax(walk, data)
 if os.environ.get("GENERATE_ONLY"):
     sys.exit(0)
-lmp_rows, lmp_wall = lammps_run(data, steps, os.path.join(run, "log.lammps"))
-pd_rows, pd_wall = pdyn_run(steps, os.path.join(run, "pdyn"))
+lmp_rows, lmp_wall = lammps_run(data, steps, os.path.join(run, f"log.lammps.dt{dt}"))
+pd_rows, pd_wall = pdyn_run(steps, os.path.join(run, f"pdyn.dt{dt}"))
 print(f"initial PE/N: LAMMPS {lmp_rows[0][2]:.15g}  pdyn {pd_rows[0][2]:.15g}  "
       f"difference {abs(lmp_rows[0][2] - pd_rows[0][2]):.2e}")
-print(f"whole process: LAMMPS {lmp_wall:.2f} s, pdyn {pd_wall:.2f} s ({steps} steps)")
+print(f"whole process: LAMMPS {lmp_wall:.2f} s, pdyn {pd_wall:.2f} s ({steps} steps of dt = {dt})")
 for name, rows in [("LAMMPS", lmp_rows), ("pdyn", pd_rows)]:
     half = [r for r in rows if r[0] > steps / 2]
     cols = [block([r[k] for r in half]) for k in (1, 2, 3)]
