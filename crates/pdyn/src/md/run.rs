@@ -84,11 +84,11 @@ pub struct MdResult {
     pub rdf_frames: u64,
     /// Standard error of `g(r)` per bin from 5 blocks of frames (None with fewer than two
     /// blocks with frames).
-    pub rdf_error: Option<Vec<f64>>,
+    pub rdf_error: Option<Box<[f64]>>,
     /// `(step, time, msd)` every `msd_every` steps (and the last step) when asked for.
     pub msd: Vec<[f64; 3]>,
     /// Energy conservation (NVE, Nosé–Hoover).
-    pub drift: Option<Drift>,
+    pub drift: Option<Box<Drift>>,
     /// Warnings for the user.
     pub warnings: Vec<String>,
     /// Wall-clock seconds spent stepping.
@@ -96,7 +96,7 @@ pub struct MdResult {
     /// First step that counts in the averages.
     pub average_from: u64,
     /// How the temperature was measured.
-    pub temperature_convention: TemperatureConvention,
+    pub temperature_convention: Box<TemperatureConvention>,
 }
 
 /// How a run's temperature `T = 2K/(N_f k_B)` is measured (stated in `summary.json`).
@@ -459,11 +459,12 @@ fn run_sim<P: PairPotential>(
             let scale = records.iter().map(|r| r.kinetic).sum::<f64>() / records.len() as f64;
             let relative = if scale > 0.0 { dev / scale } else { dev };
             let slope = fit_slope(&records, n);
-            Some(Drift {
+            // boxed: MdResult stays small beside the N-body result in the callers' enums
+            Some(Box::new(Drift {
                 relative,
                 slope_per_atom: slope,
                 scale,
-            })
+            }))
         }
         _ => None,
     };
@@ -504,14 +505,17 @@ fn run_sim<P: PairPotential>(
         atoms: n,
         frames,
         rdf_frames: if rdf.is_some() { rdf_frames } else { 0 },
-        rdf_error: rdf_result.as_ref().and_then(|b| b.error.clone()),
+        rdf_error: rdf_result
+            .as_ref()
+            .and_then(|b| b.error.clone())
+            .map(Vec::into_boxed_slice),
         rdf: rdf_result.map(|b| (b.r, b.g)),
         msd,
         drift,
         warnings,
         seconds,
         average_from: spec.equilibrate,
-        temperature_convention,
+        temperature_convention: Box::new(temperature_convention),
     };
     if res.failure.is_none() {
         if let Some(w) = time_step_bias_warning(&res, dt) {
