@@ -26,6 +26,19 @@ pub enum BondKind {
         /// Maximum extension R₀.
         r_max: f64,
     },
+    /// LAMMPS's `bond_style fene` (`bond_coeff K R₀ ε σ`): FENE plus the purely repulsive
+    /// Weeks–Chandler–Andersen term `4ε[(σ/r)¹² − (σ/r)⁶] + ε` for `r < 2^{1/6} σ`, meant for
+    /// bonded pairs excluded from the pair potential (`special_bonds lj 0 1 1`).
+    FeneWca {
+        /// Stiffness K.
+        k: f64,
+        /// Maximum extension R₀.
+        r_max: f64,
+        /// WCA energy ε.
+        epsilon: f64,
+        /// WCA length σ.
+        sigma: f64,
+    },
 }
 
 /// A bond between particles `i` and `j`.
@@ -56,6 +69,24 @@ impl BondKind {
                 }
                 Some((-0.5 * k * r_max * r_max * (1.0 - x).ln(), -k / (1.0 - x)))
             }
+            BondKind::FeneWca {
+                k,
+                r_max,
+                epsilon,
+                sigma,
+            } => {
+                let (u, fr) = BondKind::Fene { k, r_max }.energy_force(r2)?;
+                // (r/σ)² at the WCA cutoff r = 2^{1/6} σ is 2^{1/3} (LAMMPS's MY_CUBEROOT2)
+                const CUBE_ROOT_2: f64 = 1.259_921_049_894_873_2;
+                if r2 >= CUBE_ROOT_2 * sigma * sigma {
+                    return Some((u, fr));
+                }
+                let s2 = sigma * sigma / r2;
+                let s6 = s2 * s2 * s2;
+                let wca = 4.0 * epsilon * (s6 * s6 - s6) + epsilon;
+                let wca_fr = 24.0 * epsilon * (2.0 * s6 * s6 - s6) / r2;
+                Some((u + wca, fr + wca_fr))
+            }
         }
     }
 }
@@ -72,6 +103,12 @@ mod tests {
                 k: 30.0,
                 r_max: 1.5,
             },
+            BondKind::FeneWca {
+                k: 30.0,
+                r_max: 1.5,
+                epsilon: 1.0,
+                sigma: 1.0,
+            },
         ] {
             for r in [0.8f64, 1.0, 1.3] {
                 let h = 1e-6;
@@ -87,5 +124,27 @@ mod tests {
         }
         .energy_force(2.25)
         .is_none());
+    }
+}
+
+#[cfg(test)]
+mod fene_wca_tests {
+    use super::*;
+
+    #[test]
+    fn fene_wca_is_fene_plus_shifted_lj_inside_its_cutoff_only() {
+        let (k, r_max) = (30.0, 1.5);
+        let b = BondKind::FeneWca {
+            k,
+            r_max,
+            epsilon: 1.0,
+            sigma: 1.0,
+        };
+        let fene = |r: f64| -0.5 * k * r_max * r_max * (1.0 - (r / r_max).powi(2)).ln();
+        let r: f64 = 0.97;
+        let lj = 4.0 * (r.powi(-12) - r.powi(-6)) + 1.0;
+        assert!((b.energy_force(r * r).unwrap().0 - (fene(r) + lj)).abs() < 1e-12);
+        let r = 1.2; // beyond 2^(1/6)
+        assert!((b.energy_force(r * r).unwrap().0 - fene(r)).abs() < 1e-12);
     }
 }

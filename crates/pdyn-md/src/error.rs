@@ -93,6 +93,15 @@ pub enum MdError {
         /// What was expected there.
         expected: &'static str,
     },
+    /// Invalid content of an input file, with what would be valid there.
+    InvalidInput {
+        /// Format (`"lammps-data"`).
+        format: &'static str,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong and what would be valid.
+        message: String,
+    },
     /// An I/O failure (message of the underlying error).
     Io {
         /// Kind of the underlying error.
@@ -182,6 +191,11 @@ impl fmt::Display for MdError {
             } => {
                 write!(f, "{format} line {line}: expected {expected}")
             }
+            InvalidInput {
+                format,
+                line,
+                message,
+            } => write!(f, "{format} line {line}: {message}"),
             Io { kind } => write!(f, "I/O error: {kind}"),
         }
     }

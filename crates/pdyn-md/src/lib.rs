@@ -9,6 +9,8 @@
 //! Equations of motion `ẋ = v`, `m v̇ = F = −∇U` are integrated by velocity Verlet (Swope et
 //! al., J. Chem. Phys. 76, 637 (1982)), optionally coupled to a thermostat (Langevin BAOAB,
 //! Nosé–Hoover chain, Berendsen).
+//! Pair interactions between bonded neighbours can be scaled or excluded (`special`, LAMMPS's
+//! `special_bonds lj`).
 //!
 //! Determinism: each pair is computed once (Newton's third law) by one of a fixed number of
 //! segments of particles, into the segment's own force buffer; the buffers, energies and
@@ -30,6 +32,7 @@ mod neighbor;
 pub mod potential;
 mod sim_box;
 mod simulation;
+pub mod special;
 mod thermo;
 pub mod thermostat;
 mod velocities;
@@ -44,5 +47,5 @@ pub use pdyn_particles::rng::Rng;
 pub use pdyn_particles::{Particle, Particles, Vec3};
 pub use sim_box::SimBox;
 pub use simulation::{Observer, RunReport, SimParams, Simulation, System};
-pub use thermo::{ThermoRecord, THERMO_CSV_HEADER};
+pub use thermo::{KineticEstimator, ThermoRecord, THERMO_CSV_HEADER};
 pub use velocities::maxwell_boltzmann;

@@ -80,6 +80,7 @@ pub fn minimize_fire<P: PairPotential>(
     let n = system.particles.len();
     let mut out = vec![[0.0; 3]; n];
     let mut scratch = crate::forces::ForceScratch::default();
+    let special = crate::special::SpecialPairs::from_bonds(n, &system.bonds, system.special_lj)?;
     let mut eval = |s: &mut System, nl: &mut NeighborList| -> Result<(f64, f64), MdError> {
         if nl.needs_rebuild(&s.particles) {
             nl.build(&mut s.particles, &mut s.images, &s.sim_box);
@@ -87,8 +88,9 @@ pub fn minimize_fire<P: PairPotential>(
             nl.update_ghosts(&s.particles);
         }
         let (u_p, _) = ff.compute(nl, &s.types, &mut scratch, &mut out);
+        let (u_s, _) = special.correct(s, ff, &mut out);
         let (u_b, _) = bond_forces(s, &mut out)?;
-        let u = u_p + u_b;
+        let u = u_p + u_s + u_b;
         let mut fmax2: f64 = 0.0;
         let p = &mut s.particles;
         for (i, f) in out.iter().enumerate() {

@@ -14,8 +14,11 @@
 use crate::bonds::Bond;
 use crate::forces::ForceScratch;
 use crate::potential::PairPotential;
+use crate::special::SpecialPairs;
 use crate::thermostat::Thermostat;
-use crate::{ForceField, MdError, NeighborList, RunFailure, SimBox, ThermoRecord};
+use crate::{
+    ForceField, KineticEstimator, MdError, NeighborList, RunFailure, SimBox, ThermoRecord,
+};
 use pdyn_particles::{Particles, Vec3};
 
 /// Particles in a periodic box, with types and bonds.
@@ -31,6 +34,9 @@ pub struct System {
     pub images: Vec<[i32; 3]>,
     /// Bonds.
     pub bonds: Vec<Bond>,
+    /// Factors of the pair interaction between 1-2, 1-3 and 1-4 bonded neighbours (LAMMPS
+    /// `special_bonds lj`; default [`crate::special::NO_SCALING`], every pair in full).
+    pub special_lj: [f64; 3],
 }
 
 impl System {
@@ -43,6 +49,7 @@ impl System {
             sim_box,
             images: vec![[0; 3]; n],
             bonds: vec![],
+            special_lj: crate::special::NO_SCALING,
         }
     }
 
@@ -182,6 +189,8 @@ pub struct Simulation<P> {
     /// Parameters.
     pub params: SimParams,
     nl: NeighborList,
+    /// Pairs scaled by `system.special_lj`, from the bonds at construction.
+    special: SpecialPairs,
     scratch: ForceScratch,
     /// Total force on every particle (pair + bond), particle order.
     out: Vec<[f64; 3]>,
@@ -190,6 +199,10 @@ pub struct Simulation<P> {
     potential: f64,
     virial: f64,
     e0: Option<f64>,
+    /// Kinetic energy of the half-step velocities of the last step: after the first half-kick
+    /// (velocity Verlet), after the O step (Langevin BAOAB, [`KineticEstimator::HalfStep`]);
+    /// `None` before the first step.
+    half_step_kinetic: Option<f64>,
 }
 
 impl<P: PairPotential> Simulation<P> {
@@ -226,18 +239,21 @@ impl<P: PairPotential> Simulation<P> {
             });
         }
         let n = system.particles.len();
+        let special = SpecialPairs::from_bonds(n, &system.bonds, system.special_lj)?;
         let mut sim = Simulation {
             system,
             force_field,
             thermostat,
             params,
             nl,
+            special,
             scratch: ForceScratch::default(),
             out: vec![[0.0; 3]; n],
             step: 0,
             potential: 0.0,
             virial: 0.0,
             e0: None,
+            half_step_kinetic: None,
         };
         sim.rebuild();
         sim.check_overlap()?;
@@ -287,6 +303,7 @@ impl<P: PairPotential> Simulation<P> {
         let (u_p, w_p) =
             self.force_field
                 .compute(&self.nl, &s.types, &mut self.scratch, &mut self.out);
+        let (u_s, w_s) = self.special.correct(s, &self.force_field, &mut self.out);
         let (u_b, w_b) = bond_forces(s, &mut self.out)?;
         let p = &mut s.particles;
         for (i, f) in self.out.iter().enumerate() {
@@ -295,17 +312,34 @@ impl<P: PairPotential> Simulation<P> {
             p.ay[i] = f[1] * inv_m;
             p.az[i] = f[2] * inv_m;
         }
-        self.potential = u_p + u_b;
-        self.virial = w_p + w_b;
+        self.potential = u_p + u_s + u_b;
+        self.virial = w_p + w_s + w_b;
         Ok(())
     }
 
-    /// Degrees of freedom: `3N − 3` (momentum conserved), `3N` under Langevin.
+    /// Degrees of freedom `N_f` of the temperature `T = 2K/(N_f k_B)`: `3N − 3` when the
+    /// dynamics conserves the total momentum (NVE, Nosé–Hoover, Berendsen: LAMMPS's
+    /// `compute temp`), `3N` under Langevin, whose random forces do not conserve it. There
+    /// are no constraints in pdyn-md, so nothing else is subtracted.
     pub fn dof(&self) -> f64 {
         let n = self.system.particles.len();
+        if self.conserves_momentum() {
+            (3 * n).saturating_sub(3) as f64
+        } else {
+            (3 * n) as f64
+        }
+    }
+
+    /// Whether the dynamics conserves the total momentum (every thermostat but Langevin).
+    pub fn conserves_momentum(&self) -> bool {
+        !matches!(self.thermostat, Thermostat::Langevin(_))
+    }
+
+    /// Which velocities the reported kinetic energy and temperature come from.
+    pub fn kinetic_estimator(&self) -> KineticEstimator {
         match self.thermostat {
-            Thermostat::Langevin(_) => (3 * n) as f64,
-            _ => (3 * n).saturating_sub(3) as f64,
+            Thermostat::Langevin(_) => KineticEstimator::HalfStep,
+            _ => KineticEstimator::FullStep,
         }
     }
 
@@ -340,9 +374,14 @@ impl<P: PairPotential> Simulation<P> {
     /// Thermodynamic state now.
     pub fn thermo(&self) -> ThermoRecord {
         let p = &self.system.particles;
-        let k = p.kinetic_energy();
+        let k_full = p.kinetic_energy();
+        let k = match self.kinetic_estimator() {
+            KineticEstimator::HalfStep => self.half_step_kinetic.unwrap_or(k_full),
+            KineticEstimator::FullStep => k_full,
+        };
         let nf = self.dof();
         let kb = self.params.boltzmann;
+        let temperature = |k: f64| if nf > 0.0 { 2.0 * k / (nf * kb) } else { 0.0 };
         let total = k + self.potential;
         let extra = match &self.thermostat {
             Thermostat::NoseHooverChain(c) => c.energy(nf, kb),
@@ -351,7 +390,9 @@ impl<P: PairPotential> Simulation<P> {
         ThermoRecord {
             step: self.step,
             time: self.step as f64 * self.params.dt,
-            temperature: if nf > 0.0 { 2.0 * k / (nf * kb) } else { 0.0 },
+            temperature: temperature(k),
+            full_step_temperature: temperature(k_full),
+            half_step_temperature: temperature(self.half_step_kinetic.unwrap_or(k_full)),
             kinetic: k,
             potential: self.potential,
             total,
@@ -419,14 +460,17 @@ impl<P: PairPotential> Simulation<P> {
         let p = &mut self.system.particles;
         p.kick(0.5 * h);
         // largest displacement of this step, |v| h
-        let (mut vmax2, mut imax) = (0.0, 0);
+        // and the kinetic energy of the half-step velocities
+        let (mut vmax2, mut imax, mut mv2) = (0.0, 0, 0.0);
         for i in 0..p.len() {
             let v2 = p.vx[i] * p.vx[i] + p.vy[i] * p.vy[i] + p.vz[i] * p.vz[i];
+            mv2 += p.m[i] * v2;
             if v2 > vmax2 || v2.is_nan() {
                 vmax2 = v2;
                 imax = i;
             }
         }
+        self.half_step_kinetic = Some(0.5 * mv2);
         let disp = vmax2.sqrt() * h;
         if !within(disp, self.params.max_displacement) {
             return Err(self.unstable(step, imax, disp));
@@ -434,6 +478,7 @@ impl<P: PairPotential> Simulation<P> {
         if let Thermostat::Langevin(l) = &mut self.thermostat {
             p.drift(0.5 * h);
             l.ou_step(p, h, kb);
+            self.half_step_kinetic = Some(p.kinetic_energy());
             p.drift(0.5 * h);
         } else {
             p.drift(h);
@@ -522,7 +567,9 @@ pub(crate) fn bond_forces(s: &System, out: &mut [[f64; 3]]) -> Result<(f64, f64)
         let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         let Some((e, fr)) = bond.kind.energy_force(r2) else {
             let max = match bond.kind {
-                crate::BondKind::Fene { r_max, .. } => r_max,
+                crate::BondKind::Fene { r_max, .. } | crate::BondKind::FeneWca { r_max, .. } => {
+                    r_max
+                }
                 _ => f64::INFINITY,
             };
             return Err(MdError::BondBroken {

@@ -95,7 +95,7 @@ Velocities
     let bad = text.replace("3 1 2.0", "7 1 2.0");
     assert!(matches!(
         read_lammps_data(bad.as_bytes(), 100),
-        Err(MdError::IndexOutOfRange { index: 7, .. })
+        Err(MdError::InvalidInput { line: 23, .. })
     ));
 }
 
@@ -153,4 +153,26 @@ fn msd_follows_particles_across_boundaries() {
     assert!((m - direct).abs() < 1e-9 * direct, "{m} vs {direct}");
     assert!(sim.system.images.iter().any(|im| *im != [0, 0, 0]));
     assert!(m > 0.1, "{m}");
+}
+
+#[test]
+fn rdf_block_error_of_two_blocks_is_half_their_difference() {
+    use pdyn_md::analysis::Rdf;
+    let a = lj_liquid(4, 2, 0.005);
+    let mut b = lj_liquid(4, 2, 0.005);
+    b.run(50, &mut |_: &ThermoRecord, _: &System| {}).unwrap();
+    let r_max = 0.5 * a.system.sim_box.min_edge() * 0.999;
+    let (mut ha, mut hb) = (Rdf::new(r_max, 30).unwrap(), Rdf::new(r_max, 30).unwrap());
+    ha.add(&a.system).unwrap();
+    hb.add(&b.system).unwrap();
+    let (ga, gb) = (ha.result().1, hb.result().1);
+    let res = Rdf::block_result(&[ha, hb, Rdf::new(r_max, 30).unwrap()]).unwrap();
+    assert_eq!((res.blocks, res.frames), (2, 2));
+    let e = res.error.unwrap();
+    for k in 0..30 {
+        // two blocks: √(((g₁ − m)² + (g₂ − m)²)/2) = |g₁ − g₂|/2; the mean of equal frames
+        assert!((e[k] - 0.5 * (ga[k] - gb[k]).abs()).abs() < 1e-12);
+        assert!((res.g[k] - 0.5 * (ga[k] + gb[k])).abs() < 1e-12);
+    }
+    assert!(e.iter().any(|&x| x > 0.0));
 }

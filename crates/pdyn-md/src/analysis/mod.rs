@@ -4,4 +4,4 @@ mod msd;
 mod rdf;
 
 pub use msd::Msd;
-pub use rdf::Rdf;
+pub use rdf::{BlockRdf, Rdf};

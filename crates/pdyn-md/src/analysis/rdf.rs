@@ -65,6 +65,66 @@ impl Rdf {
         Ok(())
     }
 
+    /// Frames added so far.
+    pub fn frames(&self) -> u64 {
+        self.frames
+    }
+
+    /// Adds the frames of `other` (same range and bins, else an error).
+    pub fn merge(&mut self, other: &Rdf) -> Result<(), MdError> {
+        if other.r_max != self.r_max || other.counts.len() != self.counts.len() {
+            return Err(MdError::InvalidParameter {
+                name: "rdf to merge (other range or bins)",
+                value: other.r_max,
+            });
+        }
+        for (a, b) in self.counts.iter_mut().zip(&other.counts) {
+            *a += b;
+        }
+        self.frames += other.frames;
+        self.norm += other.norm;
+        Ok(())
+    }
+
+    /// `g(r)` of the frames of all `blocks` together, and its standard error per bin from the
+    /// spread of the blocks' own `g(r)` (`√(Σ (g_b − ḡ)²/(B(B − 1)))` over the `B` blocks with
+    /// frames; Flyvbjerg & Petersen 1989: blocks of consecutive frames longer than the
+    /// correlation time are nearly independent). `None` for the error with fewer than two
+    /// blocks with frames.
+    pub fn block_result(blocks: &[Rdf]) -> Result<BlockRdf, MdError> {
+        let first = blocks.first().ok_or(MdError::InvalidParameter {
+            name: "rdf blocks",
+            value: 0.0,
+        })?;
+        let mut all = Rdf::new(first.r_max, first.counts.len())?;
+        for b in blocks {
+            all.merge(b)?;
+        }
+        let (r, g) = all.result();
+        let used: Vec<Vec<f64>> = blocks
+            .iter()
+            .filter(|b| b.frames > 0)
+            .map(|b| b.result().1)
+            .collect();
+        let nb = used.len();
+        let error = (nb >= 2).then(|| {
+            (0..g.len())
+                .map(|k| {
+                    let m = used.iter().map(|gb| gb[k]).sum::<f64>() / nb as f64;
+                    let var = used.iter().map(|gb| (gb[k] - m).powi(2)).sum::<f64>();
+                    (var / (nb * (nb - 1)) as f64).sqrt()
+                })
+                .collect()
+        });
+        Ok(BlockRdf {
+            r,
+            g,
+            error,
+            blocks: nb,
+            frames: all.frames,
+        })
+    }
+
     /// Bin centres and `g(r)`.
     pub fn result(&self) -> (Vec<f64>, Vec<f64>) {
         let nb = self.counts.len();
@@ -83,4 +143,19 @@ impl Rdf {
         }
         (r, g)
     }
+}
+
+/// `g(r)` with block error bars ([`Rdf::block_result`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BlockRdf {
+    /// Bin centres.
+    pub r: Vec<f64>,
+    /// `g(r)` over all frames.
+    pub g: Vec<f64>,
+    /// Standard error of `g` per bin (None with fewer than two blocks).
+    pub error: Option<Vec<f64>>,
+    /// Blocks with frames.
+    pub blocks: usize,
+    /// Frames in all.
+    pub frames: u64,
 }

@@ -1,10 +1,13 @@
 //! Reading and writing configurations: extended XYZ (ASE, OVITO) and LAMMPS data files
-//! (`atom_style atomic`).
+//! (read: `atom_style` atomic, bond, angle, molecular, full; written: atomic).
 
 mod lammps_data;
 mod xyz;
 
-pub use lammps_data::{read_lammps_data, write_lammps_data};
+pub use lammps_data::{
+    read_lammps_data, read_lammps_data_file, write_lammps_data, AtomStyle, DataAngle, DataBond,
+    LammpsData,
+};
 pub use xyz::{read_xyz, write_xyz, XyzFrame};
 
 use crate::MdError;

@@ -7,8 +7,7 @@
 use super::formula::{FormulaError, FormulaPair};
 use super::pair::Pair;
 use super::spec::{
-    BondSpecKind, Ensemble, FileFormat, LatticeKind, MdSpec, Mode, Num, PairKind, Start, Units,
-    MAX_ATOMS,
+    Ensemble, FileFormat, LatticeKind, MdSpec, Mode, Num, PairKind, Start, Units, MAX_ATOMS,
 };
 use pdyn_jit::JitMode;
 use pdyn_md::potential::{CutoffMode, LennardJones, Morse, Truncated};
@@ -17,7 +16,7 @@ use pdyn_md::thermostat::{
     Thermostat,
 };
 use pdyn_md::{
-    Bond, BondKind, FireParams, ForceField, MdError, MinimizeReport, SimParams, Simulation, System,
+    Bond, FireParams, ForceField, MdError, MinimizeReport, SimParams, Simulation, System,
 };
 use pdyn_mech::ModelError;
 use std::ops::Range;
@@ -201,7 +200,7 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
     let cutoff = ff.max_cutoff();
 
     // Configuration.
-    let (mut system, start_span) = match &spec.start {
+    let (mut system, start_span, data_bond_lines) = match &spec.start {
         Start::Lattice {
             kind,
             density,
@@ -234,7 +233,7 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
             .map_err(|e| md_err(span, e))?;
             let mut s = System::new(p, bx);
             s.types = vec![*species as u32; s.particles.len()];
-            (s, span.clone())
+            (s, span.clone(), vec![])
         }
         Start::File { path, format, span } => {
             let full = base.join(path);
@@ -244,6 +243,7 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
             })?;
             let r = std::io::BufReader::new(file);
             let located = |e: MdError| err(span, format!("{}: {e}", full.display()));
+            let mut data_bond_lines = vec![];
             let mut s = match format {
                 FileFormat::Xyz => {
                     let frame =
@@ -265,8 +265,16 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
                     s
                 }
                 FileFormat::LammpsData => {
-                    let s =
-                        pdyn_md::io::read_lammps_data(r, MAX_ATOMS as usize).map_err(located)?;
+                    let data = pdyn_md::io::read_lammps_data_file(r, MAX_ATOMS as usize)
+                        .map_err(located)?;
+                    let at = |line: usize, msg: String| {
+                        err(
+                            span,
+                            format!("{}: lammps-data line {line}: {msg}", full.display()),
+                        )
+                    };
+                    let (s, lines) = super::data_file::with_topology(data, spec, &at)?;
+                    data_bond_lines = lines;
                     if let Some(&t) = s.types.iter().find(|&&t| t as usize >= nt) {
                         return Err(err(span, format!(
                             "{} has atom type {}, but the model declares {nt} species (types 1..{nt} in declaration order)",
@@ -285,7 +293,7 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
                 s.particles.vy[i] *= u.time;
                 s.particles.vz[i] *= u.time;
             }
-            (s, span.clone())
+            (s, span.clone(), data_bond_lines)
         }
     };
     let n = system.particles.len();
@@ -301,6 +309,13 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
     }
 
     // Bonds: consecutive atoms in chains of `chain_length`.
+    if let (Some(b), false) = (&spec.bonds, system.bonds.is_empty()) {
+        return Err(err(
+            &b.span,
+            "[md.bonds] makes chains, but the data file has its own bonds".into(),
+        )
+        .help("give the data file's bond coefficients as [[md.bond_types]] instead"));
+    }
     if let Some(b) = &spec.bonds {
         let l = b.chain_length as usize;
         if n % l != 0 {
@@ -310,10 +325,7 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
             )
             .help("choose a chain_length that divides the number of atoms"));
         }
-        let kind = match b.kind {
-            BondSpecKind::Harmonic { k, r0 } => BondKind::Harmonic { k, r0 },
-            BondSpecKind::Fene { k, r_max } => BondKind::Fene { k, r_max },
-        };
+        let kind = super::data_file::bond_kind(b.kind);
         system.bonds.reserve(n / l * (l - 1));
         for c in 0..n / l {
             for k in 0..l - 1 {
@@ -331,7 +343,31 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
             .map_err(|e| md_err(&t.span, e))?;
     }
 
+    if let (Some(t), true) = (spec.bond_types.first(), data_bond_lines.is_empty()) {
+        return Err(err(
+            &t.span,
+            "[[md.bond_types]] gives bond coefficients, but the configuration has no bonds".into(),
+        )
+        .help("bond types apply to the Bonds section of a LAMMPS data file ([md.read])"));
+    }
+    if let (Some(r), true) = (&spec.rdf_range, spec.rdf) {
+        let half = 0.5 * system.sim_box.min_edge();
+        if r.value > half {
+            return Err(err(
+                &r.span,
+                format!(
+                    "rdf_range = {} is more than half the shortest box edge ({}): the minimum image cannot count pairs that far",
+                    short(r.value),
+                    short(half)
+                ),
+            )
+            .help("leave rdf_range out for the largest range the box allows"));
+        }
+    }
+    system.special_lj = spec.special_lj.0;
     let params = SimParams {
+        neighbor_every: spec.neighbor_every,
+        neighbor_check: spec.neighbor_check,
         dt: spec.dt.value / u.time,
         skin: spec.skin.value,
         thermo_every: spec.thermo_every,
@@ -422,6 +458,14 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
         } else {
             "add `minimize = true` to [md] to relax the configuration (FIRE) before the run, or fix the file"
         }),
+        MdError::BondBroken { bond, atoms, length, max, .. } if bond < data_bond_lines.len() => err(
+            &start_span,
+            format!(
+                "lammps-data line {}: the FENE bond between atoms {} and {} starts at length {length:.6} ≥ r_max = {max}",
+                data_bond_lines[bond], atoms[0] + 1, atoms[1] + 1
+            ),
+        )
+        .help("check the bond list and the box of the data file, or r_max in [[md.bond_types]]"),
         MdError::BondBroken { atoms, length, max, .. } => err(
             spec.bonds.as_ref().map_or(&spec.span, |b| &b.span),
             format!(

@@ -11,10 +11,12 @@
 //! everything about the model file lives here. See `docs/md.md` for the format.
 
 pub mod build;
+pub mod data_file;
 pub mod formula;
 pub mod memory;
 pub mod output;
 pub mod pair;
+pub mod rdf_blocks;
 pub mod report;
 pub mod request;
 pub mod run;

@@ -137,6 +137,15 @@ pub fn summary(prep: &Prepared, res: &MdResult, drift_tolerance: f64) -> serde_j
             "total": json_num(r.total), "pressure": json_num(r.pressure),
             "total_per_atom": json_num(r.total / n),
         })),
+        "temperature": {
+            "degrees_of_freedom": res.temperature_convention.degrees_of_freedom,
+            "rule": if res.temperature_convention.momentum_conserved {
+                "3N - 3: the total momentum is conserved (as LAMMPS's compute temp)"
+            } else {
+                "3N: Langevin forces do not conserve the total momentum (LAMMPS counts 3N - 3)"
+            },
+            "velocities": res.temperature_convention.estimator.name(),
+        },
         "averages_from_step": res.average_from.max(1),
         "averages": {
             "temperature": avg_json(res.average(|r| r.temperature)),
@@ -187,9 +196,18 @@ pub fn write_files(res: &MdResult, dir: &Path) -> Result<(), Error> {
     }
     write(&dir.join("thermo.csv"), &s)?;
     if let Some((r, g)) = &res.rdf {
-        let mut s = String::from("r,g\n");
-        for (a, b) in r.iter().zip(g) {
-            let _ = writeln!(s, "{a},{b}");
+        // `error`: the standard error of g from 5 blocks of frames, when there are two or more
+        let mut s = String::from(if res.rdf_error.is_some() {
+            "r,g,error\n"
+        } else {
+            "r,g\n"
+        });
+        for (k, (a, b)) in r.iter().zip(g).enumerate() {
+            match &res.rdf_error {
+                Some(e) => writeln!(s, "{a},{b},{}", e[k]),
+                None => writeln!(s, "{a},{b}"),
+            }
+            .ok();
         }
         write(&dir.join("rdf.csv"), &s)?;
     }

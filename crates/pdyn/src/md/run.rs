@@ -8,9 +8,10 @@
 //! the trajectory written so far ends with the failing configuration.
 
 use super::build::{Engine, Prepared, UnitSystem};
+use super::rdf_blocks::RdfBlocks;
 use super::spec::{Ensemble, MdSpec, Mode, Units};
 use crate::Error;
-use pdyn_md::analysis::{Msd, Rdf};
+use pdyn_md::analysis::Msd;
 use pdyn_md::potential::PairPotential;
 use pdyn_md::thermostat::Thermostat;
 use pdyn_md::{MdError, Simulation, System, ThermoRecord};
@@ -83,16 +84,68 @@ pub struct MdResult {
     pub rdf: Option<(Vec<f64>, Vec<f64>)>,
     /// Frames the RDF averaged.
     pub rdf_frames: u64,
-    /// `(step, time, msd)` at every record when asked for.
+    /// Standard error of `g(r)` per bin from 5 blocks of frames (None with fewer than two
+    /// blocks with frames).
+    pub rdf_error: Option<Box<[f64]>>,
+    /// `(step, time, msd)` every `msd_every` steps (and the last step) when asked for.
     pub msd: Vec<[f64; 3]>,
     /// Energy conservation (NVE, Nosé–Hoover).
-    pub drift: Option<Drift>,
+    pub drift: Option<Box<Drift>>,
     /// Warnings for the user.
     pub warnings: Vec<String>,
     /// Wall-clock seconds spent stepping.
     pub seconds: f64,
     /// First step that counts in the averages.
     pub average_from: u64,
+    /// How the temperature was measured.
+    pub temperature_convention: Box<TemperatureConvention>,
+}
+
+/// How a run's temperature `T = 2K/(N_f k_B)` is measured (stated in `summary.json`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TemperatureConvention {
+    /// `N_f`.
+    pub degrees_of_freedom: f64,
+    /// Whether the dynamics conserves the total momentum (then `N_f = 3N − 3`, else `3N`).
+    pub momentum_conserved: bool,
+    /// Which velocities `K` comes from.
+    pub estimator: pdyn_md::KineticEstimator,
+}
+
+/// The time step's bias of the thermodynamics, estimated from the difference between the
+/// full-step and half-step temperatures (both `O(h²)` away from each other and from the
+/// `h → 0` limit), when it exceeds twice the reported temperature's standard error. `None`
+/// when it does not, or when there are too few records for an error bar.
+pub fn time_step_bias_warning(res: &MdResult, dt: f64) -> Option<String> {
+    let t = res.average(|r| r.temperature)?;
+    let diff = res.average(|r| r.full_step_temperature - r.half_step_temperature)?;
+    let err = t.error?;
+    // NaN compares false: no warning without a meaningful difference
+    let beyond = diff.mean.abs() > 2.0 * err;
+    if !beyond || t.mean == 0.0 {
+        return None;
+    }
+    let rel = diff.mean / t.mean;
+    let reported = match res.temperature_convention.estimator {
+        pdyn_md::KineticEstimator::HalfStep => {
+            "The reported temperature and pressure use the half-step velocities, which are \
+             free of this bias in BAOAB; the potential energy and the virial carry an O(dt²) \
+             bias of their own, usually smaller but not measured here"
+        }
+        pdyn_md::KineticEstimator::FullStep => {
+            "The reported temperature, kinetic energy and pressure use the full-step velocities \
+             and carry a bias of about this size"
+        }
+    };
+    Some(format!(
+        "dt = {dt} is large for these thermodynamics: the full-step velocities' temperature \
+         differs from the half-step one by {:+.2} % ({:.1} times the standard error of T, {:.2e}), \
+         an O(dt²) time-step error. {reported}. Compare with a run at dt = {}.",
+        100.0 * rel,
+        diff.mean.abs() / err,
+        err,
+        dt / 2.0
+    ))
 }
 
 impl MdResult {
@@ -242,11 +295,33 @@ fn run_sim<P: PairPotential>(
         frames += 1;
     }
     let msd0 = spec.msd.then(|| Msd::new(&sim.system));
+    let half = spec.steps / 2;
+    // At most `rdf_frames` frames, equally spaced over the records of the second half.
+    let second_half_records = {
+        let te = spec.thermo_every.max(1);
+        let (first, last) = ((spec.steps / 2).div_ceil(te).max(1), spec.steps / te);
+        (last + 1).saturating_sub(first)
+    };
+    let planned_rdf_frames = match spec.rdf_every {
+        // the multiples of rdf_every in [max(half, 1), steps]
+        Some(e) => spec.steps / e - (half.max(1) - 1) / e,
+        None => (spec.rdf_frames as u64).min(second_half_records),
+    };
     let mut rdf = if spec.rdf && n <= RDF_MAX_ATOMS {
-        let r_max = 0.5 * sim.system.sim_box.min_edge() * (1.0 - 1e-9);
-        Some(Rdf::new(r_max, spec.rdf_bins).map_err(|e| Error::Internal {
-            message: format!("RDF: {e}"),
-        })?)
+        // the range was checked against the box when the model was built
+        let r_max = spec
+            .rdf_range
+            .as_ref()
+            .map_or(0.5 * sim.system.sim_box.min_edge() * (1.0 - 1e-9), |r| {
+                r.value
+            });
+        Some(
+            RdfBlocks::new(r_max, spec.rdf_bins, planned_rdf_frames).map_err(|e| {
+                Error::Internal {
+                    message: format!("RDF: {e}"),
+                }
+            })?,
+        )
     } else {
         None
     };
@@ -256,12 +331,6 @@ fn run_sim<P: PairPotential>(
             "rdf = true ignored: {n} atoms is more than {RDF_MAX_ATOMS} for the all-pairs histogram"
         ));
     }
-    // At most `rdf_frames` frames, equally spaced over the records of the second half.
-    let second_half_records = {
-        let te = spec.thermo_every.max(1);
-        let (first, last) = ((spec.steps / 2).div_ceil(te).max(1), spec.steps / te);
-        (last + 1).saturating_sub(first)
-    };
     // Record j of the R is taken when (j·F mod R) < F: exactly min(F, R) of them, spread
     // evenly (Bresenham), the first included.
     let rdf_take = |j: u64| {
@@ -270,14 +339,16 @@ fn run_sim<P: PairPotential>(
     };
     let mut records: Vec<ThermoRecord> = vec![];
     let mut msd = vec![];
+    if let (Some(m), true) = (&msd0, sim.step == 0) {
+        msd.push([0.0, 0.0, m.value(&sim.system)]);
+    }
     let mut rdf_seen = 0u64;
-    let mut rdf_frames = 0u64;
     let every = spec.thermo_every.max(1);
-    let chunk = if spec.dump_every > 0 {
-        gcd(every, spec.dump_every)
-    } else {
-        every
-    };
+    // the run stops at every step where something is due: thermo, a frame, an MSD or RDF sample
+    let chunk = [spec.dump_every, spec.msd_every, spec.rdf_every.unwrap_or(0)]
+        .into_iter()
+        .filter(|&k| k > 0)
+        .fold(every, gcd);
     let ramp = match (
         &spec.thermostat.temperature,
         &spec.thermostat.final_temperature,
@@ -285,7 +356,6 @@ fn run_sim<P: PairPotential>(
         (Some(a), Some(b)) if spec.thermostat.ensemble != Ensemble::Nve => Some((a.value, b.value)),
         _ => None,
     };
-    let half = spec.steps / 2;
     let start = std::time::Instant::now();
     let mut failure = None;
     let mut builds = 0;
@@ -304,15 +374,11 @@ fn run_sim<P: PairPotential>(
             let c = convert(r, u, dt);
             progress(Progress::Record(&c));
             records.push(c);
-            if let Some(m) = &msd0 {
-                msd.push([r.step as f64, c.time, m.value(s)]);
-            }
-            if let Some(h) = &mut rdf {
+            if let (Some(h), None) = (&mut rdf, spec.rdf_every) {
                 if r.step >= half && r.step > 0 {
                     if rdf_take(rdf_seen) {
                         // the box is fixed, so `add` cannot refuse r_max here
                         let _ = h.add(s);
-                        rdf_frames += 1;
                     }
                     rdf_seen += 1;
                 }
@@ -331,6 +397,17 @@ fn run_sim<P: PairPotential>(
             }
         }
         progress(Progress::Step(done));
+        let step = sim.step;
+        if let Some(m) = &msd0 {
+            if step % spec.msd_every.max(1) == 0 && step > 0 {
+                msd.push([step as f64, step as f64 * dt, m.value(&sim.system)]);
+            }
+        }
+        if let (Some(h), Some(e)) = (&mut rdf, spec.rdf_every) {
+            if step >= half && step > 0 && step % e == 0 {
+                let _ = h.add(&sim.system);
+            }
+        }
         if let Some((w, path)) = &mut traj {
             let dump = spec.dump_every > 0 && sim.step % spec.dump_every == 0;
             if dump || failure.is_some() {
@@ -349,22 +426,25 @@ fn run_sim<P: PairPotential>(
         let c = convert(&sim.thermo(), u, dt);
         progress(Progress::Record(&c));
         records.push(c);
-        if let Some(m) = &msd0 {
-            msd.push([c.step as f64, c.time, m.value(&sim.system)]);
-        }
         if let Some(h) = &mut rdf {
-            if c.step > 0 && (rdf_frames as usize) < spec.rdf_frames {
+            if spec.rdf_every.is_none() && c.step > 0 && (h.frames() as usize) < spec.rdf_frames {
                 let _ = h.add(&sim.system);
-                rdf_frames += 1;
             }
         }
     }
+    if let Some(m) = &msd0 {
+        // the last step, when it is not a multiple of msd_every
+        if failure.is_none() && msd.last().map(|x| x[0]) != Some(sim.step as f64) {
+            msd.push([sim.step as f64, sim.step as f64 * dt, m.value(&sim.system)]);
+        }
+    }
+    let rdf_frames = rdf.as_ref().map_or(0, |h| h.frames());
     if spec.rdf && rdf.is_some() && rdf_frames == 0 {
         warnings.push("rdf = true: no frame to average (the run has no steps)".into());
         rdf = None;
     }
     // Said when the file asked for a count (the default is "up to 20").
-    let asked = spec.rdf_frames != super::spec::RDF_FRAMES;
+    let asked = spec.rdf_frames != super::spec::RDF_FRAMES && spec.rdf_every.is_none();
     if asked && rdf.is_some() && failure.is_none() && (rdf_frames as usize) < spec.rdf_frames {
         warnings.push(format!(
             "the RDF averages {rdf_frames} frames, fewer than rdf_frames = {}: the second half \
@@ -385,11 +465,12 @@ fn run_sim<P: PairPotential>(
             let scale = records.iter().map(|r| r.kinetic).sum::<f64>() / records.len() as f64;
             let relative = if scale > 0.0 { dev / scale } else { dev };
             let slope = fit_slope(&records, n);
-            Some(Drift {
+            // boxed: MdResult stays small beside the N-body result in the callers' enums
+            Some(Box::new(Drift {
                 relative,
                 slope_per_atom: slope,
                 scale,
-            })
+            }))
         }
         _ => None,
     };
@@ -411,7 +492,18 @@ fn run_sim<P: PairPotential>(
             ));
         }
     }
-    Ok(MdResult {
+    let rdf_result = match &rdf {
+        Some(h) => Some(h.result().map_err(|e| Error::Internal {
+            message: format!("RDF: {e}"),
+        })?),
+        None => None,
+    };
+    let temperature_convention = TemperatureConvention {
+        degrees_of_freedom: sim.dof(),
+        momentum_conserved: sim.conserves_momentum(),
+        estimator: sim.kinetic_estimator(),
+    };
+    let mut res = MdResult {
         records,
         failure,
         steps: done,
@@ -419,13 +511,24 @@ fn run_sim<P: PairPotential>(
         atoms: n,
         frames,
         rdf_frames: if rdf.is_some() { rdf_frames } else { 0 },
-        rdf: rdf.map(|h| h.result()),
+        rdf_error: rdf_result
+            .as_ref()
+            .and_then(|b| b.error.clone())
+            .map(Vec::into_boxed_slice),
+        rdf: rdf_result.map(|b| (b.r, b.g)),
         msd,
         drift,
         warnings,
         seconds,
         average_from: spec.equilibrate,
-    })
+        temperature_convention: Box::new(temperature_convention),
+    };
+    if res.failure.is_none() {
+        if let Some(w) = time_step_bias_warning(&res, dt) {
+            res.warnings.push(w);
+        }
+    }
+    Ok(res)
 }
 
 /// Least-squares slope of the conserved energy per atom against time.

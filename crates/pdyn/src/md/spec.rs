@@ -49,7 +49,10 @@ struct RawMd {
     rdf: Option<Spanned<bool>>,
     rdf_bins: Option<Sv>,
     rdf_frames: Option<Sv>,
+    rdf_every: Option<Sv>,
+    rdf_range: Option<Sv>,
     msd: Option<Spanned<bool>>,
+    msd_every: Option<Sv>,
     equilibrate: Option<Sv>,
     #[serde(default)]
     species: IndexMap<Name, Spanned<RawSpecies>>,
@@ -60,6 +63,11 @@ struct RawMd {
     velocities: Option<Spanned<RawVelocities>>,
     thermostat: Option<Spanned<RawThermostat>>,
     bonds: Option<Spanned<RawBonds>>,
+    #[serde(default)]
+    bond_types: Vec<Spanned<RawBonds>>,
+    special_lj: Option<Spanned<Vec<Sv>>>,
+    neighbor_every: Option<Sv>,
+    neighbor_check: Option<Spanned<bool>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -126,7 +134,11 @@ struct RawBonds {
     k: Option<Sv>,
     r0: Option<Sv>,
     r_max: Option<Sv>,
+    epsilon: Option<Sv>,
+    sigma: Option<Sv>,
     chain_length: Option<Sv>,
+    #[serde(rename = "type")]
+    bond_type: Option<Sv>,
 }
 
 /// A number read from the file, with the span of its text (for later, located, checks).
@@ -265,7 +277,7 @@ pub enum Start {
 pub enum FileFormat {
     /// Extended XYZ (first frame).
     Xyz,
-    /// LAMMPS data file, atomic style.
+    /// LAMMPS data file (atom_style atomic, bond, angle, molecular, full).
     LammpsData,
 }
 
@@ -325,6 +337,27 @@ pub enum BondSpecKind {
         /// Maximum extension R₀.
         r_max: f64,
     },
+    /// FENE plus the WCA repulsion `4ε[(σ/r)¹² − (σ/r)⁶] + ε` below `2^{1/6} σ` (LAMMPS's
+    /// `bond_style fene`, `kind = "fene"` with `epsilon` and `sigma`).
+    FeneWca {
+        /// Stiffness.
+        k: f64,
+        /// Maximum extension R₀.
+        r_max: f64,
+        /// WCA energy.
+        epsilon: f64,
+        /// WCA length.
+        sigma: f64,
+    },
+}
+
+/// `[[md.bond_types]]`: the coefficients of one bond type of a LAMMPS data file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BondTypeSpec {
+    /// The bond potential.
+    pub kind: BondSpecKind,
+    /// Span of the entry.
+    pub span: Range<usize>,
 }
 
 /// `[md.bonds]`: atoms `0..L`, `L..2L`, … form linear chains of `chain_length` beads.
@@ -368,8 +401,16 @@ pub struct MdSpec {
     /// Frames the RDF averages, equally spaced over the thermo records of the second half of
     /// the run (`rdf_frames`, default [`RDF_FRAMES`]; fewer when there are fewer records).
     pub rdf_frames: usize,
+    /// A frame every this many steps of the second half of the run (`rdf_every`), instead of
+    /// the `rdf_frames` thermo records.
+    pub rdf_every: Option<u64>,
+    /// Largest distance of the RDF (`rdf_range`, default half the shortest box edge, which is
+    /// also its upper limit).
+    pub rdf_range: Option<Num>,
     /// Mean-squared displacement post-processing.
     pub msd: bool,
+    /// Steps between MSD samples (`msd_every`, default `thermo_every`).
+    pub msd_every: u64,
     /// Records before this step are left out of the averages (equilibration).
     pub equilibrate: u64,
     /// Species in declaration order.
@@ -384,6 +425,16 @@ pub struct MdSpec {
     pub thermostat: ThermostatSpec,
     /// Bonds.
     pub bonds: Option<BondsSpec>,
+    /// Coefficients of the bond types of a data file, by type (`[[md.bond_types]]`).
+    pub bond_types: Vec<BondTypeSpec>,
+    /// Pair-interaction factors of 1-2, 1-3, 1-4 bonded neighbours (`special_lj`, LAMMPS
+    /// `special_bonds lj`; default `[1, 1, 1]`), and where they were written.
+    pub special_lj: ([f64; 3], Range<usize>),
+    /// The neighbour list is considered every this many steps (`neighbor_every`, default 1).
+    pub neighbor_every: u64,
+    /// Rebuild only when the exact displacement check asks (`neighbor_check`, default true);
+    /// false rebuilds at every considered step without checking (LAMMPS `check no`).
+    pub neighbor_check: bool,
     /// Parameters (name, value) after `--set`, for formulas.
     pub parameters: Vec<(String, f64)>,
     /// Span of `[md]` (for errors about the whole table).
@@ -481,6 +532,25 @@ pub fn parse(
         return Err(r.err(span, "`rdf_frames` must be at least 1"));
     }
     let rdf_frames = rdf_frames as usize;
+    let rdf_every = m
+        .rdf_every
+        .as_ref()
+        .map(|sv| r.count(sv, "rdf_every", 1, MAX_STEPS))
+        .transpose()?;
+    if let (Some(_), Some(sv)) = (rdf_every, &m.rdf_frames) {
+        return Err(r
+            .err(sv.span(), "both `rdf_every` and `rdf_frames`: they are two ways to choose the RDF's frames")
+            .help("keep `rdf_every` (a frame every so many steps) or `rdf_frames` (that many thermo records)"));
+    }
+    let rdf_range = m
+        .rdf_range
+        .as_ref()
+        .map(|sv| r.positive(sv, "rdf_range"))
+        .transpose()?;
+    let msd_every = match &m.msd_every {
+        Some(sv) => r.count(sv, "msd_every", 1, MAX_STEPS)?,
+        None => thermo_every,
+    };
     let equilibrate = r.count_or(&m.equilibrate, "equilibrate", &mspan, Some(0), MAX_STEPS)?;
 
     if m.species.is_empty() {
@@ -918,28 +988,18 @@ pub fn parse(
         Some(b) => {
             let q = b.get_ref();
             let span = b.span();
-            let kind = match q.kind.as_ref().map(|k| (k.get_ref().as_str(), k.span())) {
-                Some(("harmonic", _)) => BondSpecKind::Harmonic {
-                    k: r.required_positive(&q.k, "k", &span, "harmonic")?.value,
-                    r0: r.required_positive(&q.r0, "r0", &span, "harmonic")?.value,
-                },
-                Some(("fene", _)) => BondSpecKind::Fene {
-                    k: r.required_positive(&q.k, "k", &span, "fene")?.value,
-                    r_max: r.required_positive(&q.r_max, "r_max", &span, "fene")?.value,
-                },
-                Some((other, ks)) => {
-                    return Err(r
-                        .err(ks, format!("unknown bond kind `{other}`"))
-                        .help("bond kinds: \"harmonic\" (k, r0), \"fene\" (k, r_max)"))
-                }
-                None => {
-                    return Err(r.err(span, "[md.bonds] needs `kind` (\"harmonic\" or \"fene\")"))
-                }
-            };
+            if let Some(t) = &q.bond_type {
+                return Err(r
+                    .err(t.span(), "`type` belongs to [[md.bond_types]], not [md.bonds]")
+                    .help("[md.bonds] makes chains of consecutive atoms; the bond types of a data file are [[md.bond_types]]"));
+            }
+            let kind = bond_kind(&mut r, q, &span, "[md.bonds]")?;
             let chain_length = match &q.chain_length {
                 Some(sv) => r.count(sv, "chain_length", 2, MAX_ATOMS)?,
                 None => {
-                    return Err(r.err(span, "[md.bonds] needs `chain_length` (beads per chain)"))
+                    return Err(r
+                        .err(span, "[md.bonds] needs `chain_length` (beads per chain)")
+                        .help("bonds listed in a LAMMPS data file take their coefficients from [[md.bond_types]] instead"))
                 }
             };
             Some(BondsSpec {
@@ -949,6 +1009,82 @@ pub fn parse(
             })
         }
     };
+    let mut bond_types = vec![];
+    for (k, b) in m.bond_types.iter().enumerate() {
+        let q = b.get_ref();
+        let span = b.span();
+        if let Some(sv) = &q.chain_length {
+            return Err(r
+                .err(sv.span(), "`chain_length` belongs to [md.bonds]: [[md.bond_types]] gives the coefficients of a data file's bonds")
+                .help("remove it"));
+        }
+        if let Some(sv) = &q.bond_type {
+            let t = r.count(sv, "type", 1, MAX_ATOMS)?;
+            if t != k as u64 + 1 {
+                return Err(r
+                    .err(
+                        sv.span(),
+                        format!(
+                            "this is entry {} of [[md.bond_types]], so its type is {}",
+                            k + 1,
+                            k + 1
+                        ),
+                    )
+                    .help("list the bond types in order 1, 2, …"));
+            }
+        }
+        let kind = bond_kind(&mut r, q, &span, "[[md.bond_types]]")?;
+        bond_types.push(BondTypeSpec { kind, span });
+    }
+    if bonds.is_some() && !bond_types.is_empty() {
+        return Err(r
+            .err(
+                m.bond_types[0].span(),
+                "both [md.bonds] (generated chains) and [[md.bond_types]] (a data file's bonds)",
+            )
+            .help("keep one: chains of consecutive atoms, or the bonds of the data file"));
+    }
+    let special_lj = match &m.special_lj {
+        None => ([1.0; 3], mspan.clone()),
+        Some(v) => {
+            let span = v.span();
+            if v.get_ref().len() != 3 {
+                return Err(r
+                    .err(
+                        span,
+                        "`special_lj` has three factors: 1-2, 1-3 and 1-4 neighbours",
+                    )
+                    .help("e.g. special_lj = [0, 1, 1] (LAMMPS `special_bonds lj 0 1 1`)"));
+            }
+            let mut f = [1.0; 3];
+            for (k, sv) in v.get_ref().iter().enumerate() {
+                let x = r.nonneg(sv, "special_lj")?;
+                if x.value > 1.0 {
+                    return Err(r.err(
+                        sv.span(),
+                        format!("a factor of {} (factors are 0 to 1)", x.value),
+                    ));
+                }
+                f[k] = x.value;
+            }
+            (f, span)
+        }
+    };
+    let neighbor_every = r.count_or(
+        &m.neighbor_every,
+        "neighbor_every",
+        &mspan,
+        Some(1),
+        MAX_STEPS,
+    )?;
+    if neighbor_every == 0 {
+        let span = m
+            .neighbor_every
+            .as_ref()
+            .map_or(mspan.clone(), |sv| sv.span());
+        return Err(r.err(span, "`neighbor_every` must be at least 1"));
+    }
+    let neighbor_check = m.neighbor_check.as_ref().is_none_or(|b| *b.get_ref());
 
     Ok(MdSpec {
         name: raw.name.clone().unwrap_or_else(|| origin.to_string()),
@@ -964,7 +1100,10 @@ pub fn parse(
         rdf: m.rdf.as_ref().is_some_and(|b| *b.get_ref()),
         rdf_bins,
         rdf_frames,
+        rdf_every,
+        rdf_range,
         msd: m.msd.as_ref().is_some_and(|b| *b.get_ref()),
+        msd_every,
         equilibrate,
         species,
         pairs,
@@ -972,9 +1111,75 @@ pub fn parse(
         velocities,
         thermostat,
         bonds,
+        bond_types,
+        special_lj,
+        neighbor_every,
+        neighbor_check,
         parameters: r.values,
         span: mspan,
     })
+}
+
+/// The potential of a `[md.bonds]` or `[[md.bond_types]]` entry (`table` names it in errors).
+fn bond_kind(
+    r: &mut Resolver,
+    q: &RawBonds,
+    span: &Range<usize>,
+    table: &str,
+) -> Result<BondSpecKind, ModelError> {
+    let wca = |r: &mut Resolver, which: &str| -> Result<(), ModelError> {
+        for (key, v) in [("epsilon", &q.epsilon), ("sigma", &q.sigma)] {
+            if let Some(sv) = v {
+                return Err(r
+                    .err(
+                        sv.span(),
+                        format!("`{key}` has no meaning for a {which} bond"),
+                    )
+                    .help("epsilon and sigma add LAMMPS's WCA term to a \"fene\" bond"));
+            }
+        }
+        Ok(())
+    };
+    Ok(
+        match q.kind.as_ref().map(|k| (k.get_ref().as_str(), k.span())) {
+            Some(("harmonic", _)) => {
+                wca(r, "harmonic")?;
+                BondSpecKind::Harmonic {
+                    k: r.required_positive(&q.k, "k", span, "harmonic")?.value,
+                    r0: r.required_positive(&q.r0, "r0", span, "harmonic")?.value,
+                }
+            }
+            Some(("fene", _)) => {
+                let k = r.required_positive(&q.k, "k", span, "fene")?.value;
+                let r_max = r.required_positive(&q.r_max, "r_max", span, "fene")?.value;
+                match (&q.epsilon, &q.sigma) {
+                (None, None) => BondSpecKind::Fene { k, r_max },
+                (Some(e), Some(sg)) => BondSpecKind::FeneWca {
+                    k,
+                    r_max,
+                    epsilon: r.positive(e, "epsilon")?.value,
+                    sigma: r.positive(sg, "sigma")?.value,
+                },
+                (Some(sv), None) | (None, Some(sv)) => {
+                    return Err(r
+                        .err(sv.span(), "a FENE bond's WCA term needs both `epsilon` and `sigma`")
+                        .help("LAMMPS `bond_coeff 1 30.0 1.5 1.0 1.0` is k = 30, r_max = 1.5, epsilon = 1, sigma = 1"))
+                }
+            }
+            }
+            Some((other, ks)) => return Err(r
+                .err(ks, format!("unknown bond kind `{other}`"))
+                .help(
+                "bond kinds: \"harmonic\" (k, r0), \"fene\" (k, r_max, optional epsilon and sigma)",
+            )),
+            None => {
+                return Err(r.err(
+                    span.clone(),
+                    format!("{table} needs `kind` (\"harmonic\" or \"fene\")"),
+                ))
+            }
+        },
+    )
 }
 
 /// Length of the opening quote of a TOML string at the start of `raw`.

@@ -1,0 +1,81 @@
+//! MSD and RDF on their own schedules (`msd_every`, `rdf_every`, `rdf_range`, `rdf_bins`), the
+//! RDF's block error bars, and located errors for schedules that cannot be honoured.
+
+use pdyn::md::{self, RunOptions};
+use pdyn_jit::JitMode;
+use std::path::Path;
+
+fn model(extra: &str) -> String {
+    format!(
+        "name = \"lj\"\n[md]\ndt = 0.005\nsteps = 60\nthermo_every = 20\nmsd = true\nrdf = true\n{extra}\n\
+         [md.species.Ar]\nmass = 1.0\n\n\
+         [[md.pairs]]\nkind = \"lj\"\nepsilon = 1.0\nsigma = 1.0\ncutoff = 2.5\n\n\
+         [md.lattice]\nkind = \"fcc\"\ndensity = 0.8442\ncells = 4\n\n\
+         [md.velocities]\ntemperature = 1.44\nseed = 3\n"
+    )
+}
+
+fn run(text: &str) -> Result<md::MdResult, String> {
+    let spec = md::load(text, "m.toml", &[]).map_err(|e| e.to_string())?;
+    let mut prep = md::build(&spec, Path::new("."), JitMode::Auto).map_err(|e| e.message)?;
+    md::run(&mut prep, &RunOptions::default(), &mut |_| {}).map_err(|e| e.to_string())
+}
+
+#[test]
+fn msd_follows_msd_every_not_thermo_every() {
+    let res = run(&model("msd_every = 7")).unwrap();
+    let steps: Vec<u64> = res.msd.iter().map(|m| m[0] as u64).collect();
+    // every 7 steps from 0, and the last step
+    assert_eq!(steps, vec![0, 7, 14, 21, 28, 35, 42, 49, 56, 60]);
+    assert_eq!(res.msd[0][2], 0.0);
+    assert!(res.msd.windows(2).all(|w| w[1][1] > w[0][1]));
+    // thermo records are unchanged by the MSD's schedule
+    let rec: Vec<u64> = res.records.iter().map(|r| r.step).collect();
+    assert_eq!(rec, vec![0, 20, 40, 60]);
+    // by default, at the thermo steps, as before
+    let res = run(&model("")).unwrap();
+    let steps: Vec<u64> = res.msd.iter().map(|m| m[0] as u64).collect();
+    assert_eq!(steps, vec![0, 20, 40, 60]);
+}
+
+#[test]
+fn rdf_every_range_and_bins_set_the_histogram_with_block_errors() {
+    let res = run(&model("rdf_every = 3\nrdf_range = 2.0\nrdf_bins = 40")).unwrap();
+    // multiples of 3 in [30, 60]: 30, 33, …, 60
+    assert_eq!(res.rdf_frames, 11);
+    let (r, g) = res.rdf.as_ref().unwrap();
+    assert_eq!(r.len(), 40);
+    assert!(
+        (r[39] - (2.0 - 0.025)).abs() < 1e-12,
+        "last bin centre {}",
+        r[39]
+    );
+    let e = res
+        .rdf_error
+        .as_ref()
+        .expect("block errors with 11 frames in 5 blocks");
+    assert_eq!(e.len(), 40);
+    // no pairs inside the core: g = 0 exactly with zero spread; the first peak has a spread
+    assert_eq!((g[5], e[5]), (0.0, 0.0));
+    let peak = (0..40).max_by(|&a, &b| g[a].total_cmp(&g[b])).unwrap();
+    assert!(
+        g[peak] > 2.0 && e[peak] > 0.0 && e[peak] < 0.5 * g[peak],
+        "{} ± {}",
+        g[peak],
+        e[peak]
+    );
+}
+
+#[test]
+fn impossible_schedules_are_located_errors() {
+    let text = model("rdf_range = 9.0");
+    let e = run(&text).unwrap_err();
+    assert!(e.contains("more than half the shortest box edge"), "{e}");
+    let e = run(&model("rdf_every = 3\nrdf_frames = 4")).unwrap_err();
+    assert!(e.contains("both `rdf_every` and `rdf_frames`"), "{e}");
+    for bad in ["msd_every = 0", "rdf_every = -2", "rdf_range = 0"] {
+        let e = run(&model(bad)).unwrap_err();
+        let key = bad.split(' ').next().unwrap();
+        assert!(e.contains(key), "{bad}: {e}");
+    }
+}
