@@ -283,6 +283,14 @@ impl<'a> ForceBuilder<'a> {
                     format!("`between` lists {} names; it needs two", b.get_ref().len()),
                 ));
             }
+            if b.get_ref()[0].get_ref() == b.get_ref()[1].get_ref() {
+                return Err(ld
+                    .err(
+                        b.span(),
+                        format!("`between` joins `{}` to itself", b.get_ref()[0].get_ref()),
+                    )
+                    .help("a two-body force joins two different bodies (in a family, check the index arithmetic)"));
+            }
             let (e0, r0) = self.endpoint(ld, &b.get_ref()[0])?;
             let (e1, r1) = self.endpoint(ld, &b.get_ref()[1])?;
             if matches!((e0, e1), (Endpoint::Point, Endpoint::Point)) {
@@ -297,6 +305,14 @@ impl<'a> ForceBuilder<'a> {
             ]);
         }
         if let (Some(on), Some(to)) = (&raw.on, &raw.to) {
+            if on.get_ref() == to.get_ref() {
+                return Err(ld
+                    .err(
+                        to.span(),
+                        format!("`to` names `{}`, the body the force is on", on.get_ref()),
+                    )
+                    .help("a two-body force joins two different bodies"));
+            }
             let (e0, r0) = self.endpoint(ld, on)?;
             let (e1, r1) = self.endpoint(ld, to)?;
             return Ok([
