@@ -7,7 +7,8 @@ Two spellings of the same model:
 - `explicit`: every coordinate, particle and spring written out (what users generated before
   families), with the member names a family gives (`x[1,2]`, `P[1,2]`), so the two load the
   same model entry for entry;
-- `family`: the same model as `examples/hanging_net.toml` writes it, with its size `n`.
+- `family`: the same model as `examples/hanging_net.toml` writes it, with its size `n`;
+- `legacy`: `explicit` with plain names (`x_1_2`, `P_1_2`), for a pdyn from before families.
 
     python3 bench/net/net_model.py explicit 10 > /tmp/net10.toml   # 98 particles
     python3 bench/net/net_model.py family 10 > /tmp/net10f.toml
@@ -76,6 +77,10 @@ def family(n: int) -> str:
     return re.sub(r"^n = \d+", f"n = {n}", text, count=1, flags=re.M)
 
 
+def legacy(n: int) -> str:
+    return re.sub(r"\b([A-Za-z]\w*)\[(\d+),(\d+)\]", r"\1_\2_\3", explicit(n))
+
+
 if __name__ == "__main__":
     kind, n = sys.argv[1], int(sys.argv[2])
-    print({"explicit": explicit, "family": family}[kind](n), end="")
+    print({"explicit": explicit, "family": family, "legacy": legacy}[kind](n), end="")

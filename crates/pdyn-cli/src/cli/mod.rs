@@ -8,10 +8,12 @@
 pub mod bounded;
 pub mod derive;
 pub mod dsolve;
+pub mod equilibrium;
 pub mod expr;
 pub mod forces;
 pub mod kin;
 pub mod md;
+pub mod modes;
 pub mod nbody;
 pub mod run;
 pub mod sweep;

@@ -163,6 +163,18 @@ pub struct Load {
     pub force: [Id; 3],
 }
 
+/// A two-body force's pull on a fixed or moving point (a spring anchored at a pin): what the
+/// support holding the point must react.
+#[derive(Clone, Debug)]
+pub struct PointLoad {
+    /// Human-readable origin, e.g. `horizontal[i=0, j=0] (P[0,0], P[1,0]) on P[0,0]`.
+    pub label: String,
+    /// The point's name.
+    pub point: String,
+    /// The force on the point.
+    pub force: [Id; 3],
+}
+
 /// An unknown reaction magnitude (or vector component).
 #[derive(Clone, Debug)]
 pub struct Reaction {
@@ -233,6 +245,9 @@ pub struct Model {
     pub frames: Vec<Frame>,
     /// Every force, split into loads.
     pub loads: Vec<Load>,
+    /// The two-body forces' pulls on points (the reactions of their supports are minus
+    /// their sum).
+    pub point_loads: Vec<PointLoad>,
     /// Unknown reaction magnitudes.
     pub reactions: Vec<Reaction>,
     /// Constraint equations.
@@ -312,6 +327,7 @@ fn read(ld: &mut Loader, raw: &RawModel) -> Result<Model, ModelError> {
         friction_power,
         one_sided,
         loads,
+        point_loads,
         reactions,
         potentials,
         conservative,
@@ -347,6 +363,7 @@ fn read(ld: &mut Loader, raw: &RawModel) -> Result<Model, ModelError> {
         particles,
         frames,
         loads,
+        point_loads,
         reactions,
         constraints,
         contacts,
