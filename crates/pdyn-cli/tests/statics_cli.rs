@@ -106,3 +106,27 @@ fn both_commands_have_help() {
         );
     }
 }
+
+/// The equilibrium is where damped motion comes to rest: the net with heavier drag run for
+/// 60 s ends within 1e-9 m of it, coordinate by coordinate.
+#[test]
+fn the_equilibrium_is_where_a_long_damped_run_ends() {
+    let net = example("hanging_net.toml");
+    let (ok, out, err) = pdyn(&["equilibrium", &net, "--set", "c=0.5", "--json"]);
+    assert!(ok, "{err}");
+    let eq: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let (ok, out, err) = pdyn(&[
+        "run", &net, "--set", "c=0.5", "--t-end", "60", "--rtol", "1e-12", "--atol", "1e-14",
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let run: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let coordinates = eq["coordinates"].as_array().unwrap();
+    assert_eq!(coordinates.len(), 69);
+    for c in coordinates {
+        let name = c["name"].as_str().unwrap();
+        let at_rest = run["final"][name].as_f64().unwrap();
+        let q = c["value"].as_f64().unwrap();
+        assert!((at_rest - q).abs() < 1e-9, "{name}: {at_rest} vs {q}");
+    }
+}

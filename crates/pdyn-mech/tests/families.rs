@@ -166,7 +166,13 @@ fn a_member_outside_its_family_in_an_expression_is_located() {
 
 #[test]
 fn bad_families_are_clear_errors() {
-    let cases: [(&str, &str, &str); 9] = [
+    let cases: [(&str, &str, &str); 10] = [
+        // The widest range there is: refused, not overflowed.
+        (
+            "i = \"0..n-1\"",
+            "i = \"-9223372036854775807-1..9223372036854775807\"",
+            "which would make the model's families more than",
+        ),
         // An empty range.
         (
             "i = \"0..n-1\"",

@@ -204,7 +204,8 @@ impl Domain {
     fn count(&self) -> u64 {
         self.ranges
             .iter()
-            .map(|(lo, hi)| (hi - lo + 1) as u64)
+            // In i128: a range from i64::MIN to i64::MAX must not overflow while it is refused.
+            .map(|(lo, hi)| u64::try_from(*hi as i128 - *lo as i128 + 1).unwrap_or(u64::MAX))
             .fold(1u64, |a, b| a.saturating_mul(b))
     }
 }
