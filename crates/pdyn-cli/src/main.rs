@@ -39,6 +39,10 @@ enum Command {
     Derive(cli::derive::DeriveArgs),
     /// Forces required by a prescribed motion (reactions, thrust, bank angle) and design checks (slip, tip).
     Forces(cli::forces::ForcesArgs),
+    /// Static equilibrium of a model: Newton's method, reactions at the points, mechanisms named.
+    Equilibrium(cli::equilibrium::EquilibriumArgs),
+    /// Natural frequencies and mode shapes of a model linearized about its equilibrium.
+    Modes(cli::modes::ModesArgs),
     /// Simulate a model file: integrate, check conservation laws, write CSV/JSON/plots.
     Run(cli::run::RunArgs),
     /// Integrate numerically and compare with the closed-form solution (linear models).
@@ -63,6 +67,8 @@ fn dispatch(command: Command) -> Result<Outcome, Error> {
         Command::Eval(a) => cli::expr::eval(a),
         Command::Derive(a) => text(cli::derive::run(a)),
         Command::Forces(a) => text(cli::forces::run(a)),
+        Command::Equilibrium(a) => text(cli::equilibrium::run(a)),
+        Command::Modes(a) => text(cli::modes::run(a)),
         Command::Run(a) => cli::run::run(a),
         Command::Check(a) => cli::run::check(a),
         Command::Sweep(a) => cli::sweep::run(a),

@@ -705,10 +705,16 @@ impl Program {
 impl Pool {
     /// `∂f_i/∂v_j`, row-major (`fs.len() × vars.len()`).
     pub fn jacobian(&mut self, fs: &[Id], vars: &[Id]) -> Vec<Id> {
-        let mut out = Vec::with_capacity(fs.len() * vars.len());
-        for &f in fs {
-            for &v in vars {
-                out.push(self.diff(f, v));
+        let wanted: rustc_hash::FxHashSet<Id> = vars.iter().copied().collect();
+        let column: rustc_hash::FxHashMap<Id, usize> =
+            vars.iter().enumerate().map(|(j, &v)| (v, j)).collect();
+        let mut out = vec![Pool::ZERO; fs.len() * vars.len()];
+        for (i, &f) in fs.iter().enumerate() {
+            // Only the variables `f` contains have a derivative other than zero (a net's
+            // particle depends on its few neighbours of the N).
+            for v in self.occurring(f, &wanted) {
+                let j = column[&v];
+                out[i * vars.len() + j] = self.diff(f, v);
             }
         }
         out

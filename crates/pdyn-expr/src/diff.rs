@@ -141,6 +141,12 @@ impl Pool {
         self.derive(e, var, false)
     }
 
+    /// Derivatives of nodes formed on this pool so far (each remembered): a deterministic
+    /// measure of differentiation work, for regression tests.
+    pub fn derivative_work(&self) -> usize {
+        self.memo.diff.len()
+    }
+
     fn derive(&mut self, e: Id, var: Id, total: bool) -> Id {
         if let Some(&d) = self.memo.diff.get(&(e, var, total)) {
             return d;

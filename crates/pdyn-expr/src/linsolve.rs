@@ -103,18 +103,31 @@ impl Pool {
         unknowns: &[Id],
     ) -> Result<LinearSystem, LinearError> {
         let zero: FxHashMap<Id, Id> = unknowns.iter().map(|&u| (u, Pool::ZERO)).collect();
-        let mut a = Vec::with_capacity(eqs.len() * unknowns.len());
+        let wanted: rustc_hash::FxHashSet<Id> = unknowns.iter().copied().collect();
+        let column: FxHashMap<Id, usize> =
+            unknowns.iter().enumerate().map(|(j, &u)| (u, j)).collect();
+        let mut a = vec![Pool::ZERO; eqs.len() * unknowns.len()];
         let mut b = Vec::with_capacity(eqs.len());
         for (i, &eq) in eqs.iter().enumerate() {
-            for &u in unknowns {
+            // Only the unknowns the equation contains have a coefficient other than zero: an
+            // equation of a net's particle holds its own three accelerations of the 3N
+            // (differentiating by all of them made assembly quadratic).
+            let mut present: Vec<usize> = self
+                .occurring(eq, &wanted)
+                .iter()
+                .map(|u| column[u])
+                .collect();
+            present.sort_unstable();
+            for j in present {
+                let u = unknowns[j];
                 let c = self.diff(eq, u);
-                if unknowns.iter().any(|&v| self.contains(c, v)) {
+                if !self.occurring(c, &wanted).is_empty() {
                     return Err(LinearError::NotLinear {
                         equation: i,
                         unknown: u,
                     });
                 }
-                a.push(c);
+                a[i * unknowns.len() + j] = c;
             }
             let rest = self.subs(eq, &zero);
             b.push(self.neg(rest));

@@ -68,6 +68,12 @@ pub trait Scope {
     fn resolve(&mut self, pool: &mut Pool, name: &str) -> Option<Binding>;
     /// Names in scope, for "did you mean" suggestions.
     fn names(&self) -> Vec<String>;
+    /// Why `name` (which [`Scope::resolve`] did not know) is undefined, when the scope can say
+    /// better than "undefined name": `(message, help)`. A model file explains a member of an
+    /// indexed family outside its range (`P[4,20] is outside P[0..19, 0..19]`).
+    fn undefined(&self, _name: &str) -> Option<(String, Option<String>)> {
+        None
+    }
 }
 
 /// A permissive scope: every unknown name becomes a symbol; names listed in `coordinates`, or
@@ -382,6 +388,13 @@ impl Lowerer<'_> {
             "pi" => return Ok(Value::Scalar(self.pool.constant(Constant::Pi))),
             "e" => return Ok(Value::Scalar(self.pool.constant(Constant::E))),
             _ => {}
+        }
+        if let Some((message, help)) = self.scope.undefined(name) {
+            let err = ExprError::new(span.clone(), message);
+            return Err(match help {
+                Some(h) => err.with_help(h),
+                None => err,
+            });
         }
         let mut names = self.scope.names();
         names.extend(["t", "pi", "e"].map(String::from));

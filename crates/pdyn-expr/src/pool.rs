@@ -487,6 +487,29 @@ impl Pool {
         false
     }
 
+    /// The members of `needles` that occur in `hay`, in one traversal of its DAG (asking
+    /// [`Pool::contains`] for each needle costs one traversal per needle: the equations of a
+    /// net of N particles against its 3N accelerations made that quadratic).
+    pub fn occurring(&self, hay: Id, needles: &rustc_hash::FxHashSet<Id>) -> Vec<Id> {
+        let Some(oldest) = needles.iter().min().copied() else {
+            return Vec::new();
+        };
+        let mut found = Vec::new();
+        let mut seen = rustc_hash::FxHashSet::default();
+        let mut stack = vec![hay];
+        while let Some(x) = stack.pop() {
+            if x.0 < oldest.0 || !seen.insert(x) {
+                // Children are always older than parents: nothing below `x` is a needle.
+                continue;
+            }
+            if needles.contains(&x) {
+                found.push(x);
+            }
+            self.for_each_child(x, |c| stack.push(c));
+        }
+        found
+    }
+
     /// True if any node in `hay` satisfies `pred`.
     pub fn any_node(&self, hay: Id, pred: &dyn Fn(&Node) -> bool) -> bool {
         let mut seen = rustc_hash::FxHashSet::default();

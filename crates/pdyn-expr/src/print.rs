@@ -196,9 +196,9 @@ impl Pool {
     /// Default Rust identifier for a leaf node.
     pub fn rust_leaf_name(&self, node: &Node) -> String {
         match node {
-            Node::Sym(s) => self.name(*s).to_string(),
-            Node::Coord(s, 0) => self.name(*s).to_string(),
-            Node::Coord(s, k) => format!("{}_d{k}", self.name(*s)),
+            Node::Sym(s) => rust_identifier(self.name(*s)),
+            Node::Coord(s, 0) => rust_identifier(self.name(*s)),
+            Node::Coord(s, k) => format!("{}_d{k}", rust_identifier(self.name(*s))),
             Node::Time => "t".to_string(),
             _ => String::new(),
         }
@@ -338,7 +338,19 @@ impl TextPrinter<'_> {
     }
 }
 
-/// LaTeX name of a symbol: Greek letters, subscripts after `_`, multi-letter names upright.
+/// `name` as a Rust identifier: a family member `x[3,-1]` is `x_3_m1`.
+fn rust_identifier(name: &str) -> String {
+    match name.strip_suffix(']').and_then(|n| n.split_once('[')) {
+        Some((base, sub)) => {
+            let sub = sub.replace('-', "m").replace([',', ' '], "_");
+            format!("{base}_{sub}")
+        }
+        None => name.to_string(),
+    }
+}
+
+/// LaTeX name of a symbol: Greek letters, subscripts after `_` (or in brackets, `x[3,4]`),
+/// multi-letter names upright.
 pub fn latex_name(name: &str) -> String {
     const GREEK: [&str; 34] = [
         "alpha",
@@ -385,6 +397,10 @@ pub fn latex_name(name: &str) -> String {
             s.to_string()
         }
     };
+    // A member of a family, `x[3,4]`, is the chapter's x_{3,4}.
+    if let Some((base, sub)) = name.strip_suffix(']').and_then(|n| n.split_once('[')) {
+        return format!("{}_{{{sub}}}", latex_name(base));
+    }
     match name.split_once('_') {
         Some((base, sub)) if !base.is_empty() && !sub.is_empty() => {
             format!("{}_{{{}}}", one(base), one(sub))
@@ -677,6 +693,14 @@ mod tests {
         assert_eq!(text("x''*R"), "R*x''");
         assert_eq!(text("(a+b)^2"), "(a + b)^2");
         assert_eq!(text("2^(-x)"), "2^(-x)");
+    }
+
+    #[test]
+    fn family_members_print_as_subscripts() {
+        assert_eq!(super::latex_name("x[3,4]"), "x_{3,4}");
+        assert_eq!(super::latex_name("theta[2]"), "\\theta_{2}");
+        assert_eq!(super::rust_identifier("x[3,-1]"), "x_3_m1");
+        assert_eq!(super::rust_identifier("x"), "x");
     }
 
     #[test]

@@ -12,7 +12,9 @@
 //! Numbers: `12`, `1.5`, `.5`, `1.5e-3`, optionally followed by a unit (`120 s`, `9.81 m/s^2`,
 //! `45 deg`: see [`crate::units`]); a name after a number that is not a unit is an error
 //! (multiplication is written with `*`). Identifiers: letters (Unicode allowed, e.g. `θ`),
-//! digits and `_`, not starting with a digit.
+//! digits and `_`, not starting with a digit. A name followed at once by a subscript,
+//! `x[i+1, j]`, is one identifier (a member of an indexed family in a model file): the
+//! subscript is kept as written for the scope to resolve.
 
 use crate::error::ExprError;
 use std::ops::Range;
@@ -160,6 +162,11 @@ impl<'a> Lexer<'a> {
                 } else {
                     break;
                 }
+            }
+            // `x[i+1, j]`, written without a space: one member of an indexed family, whose
+            // name the scope resolves (the indices are its business, not the parser's).
+            if let Some(close) = member_subscript_end(&self.src[end..]) {
+                end += close;
             }
             self.pos = end;
             return Ok((Tok::Ident(self.src[start..end].to_string()), start..end));
@@ -610,6 +617,16 @@ pub fn parse_equation(src: &str) -> Result<(Ast, Option<Ast>), ExprError> {
     Ok((lhs, None))
 }
 
+/// The length of the subscript `[...]` that `rest` starts with, when it is one: a bracket
+/// right after a name, holding no bracket, closed on the same line. Before families this was
+/// always a syntax error (a name followed by a vector), so no valid expression changes
+/// meaning.
+fn member_subscript_end(rest: &str) -> Option<usize> {
+    let inner = rest.strip_prefix('[')?;
+    let close = inner.find([']', '[', '\n'])?;
+    (inner.as_bytes()[close] == b']' && !inner[..close].trim().is_empty()).then_some(close + 2)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -649,5 +666,29 @@ mod tests {
         assert_eq!(e.span, 2..3);
         let deep = "(".repeat(10_000) + "x" + &")".repeat(10_000);
         assert!(parse(&deep).unwrap_err().message.contains("nested"));
+    }
+
+    #[test]
+    fn a_subscript_right_after_a_name_is_part_of_it() {
+        let Ast::Binary { lhs, rhs, .. } = parse("x[i+1, j]'' + r_P[3,4].z").unwrap() else {
+            panic!()
+        };
+        let Ast::Prime { expr, .. } = *lhs else {
+            panic!()
+        };
+        assert!(
+            matches!(*expr, Ast::Ident { ref name, span: ref s } if name == "x[i+1, j]" && *s == (0..9))
+        );
+        let Ast::Component { expr, .. } = *rhs else {
+            panic!()
+        };
+        assert!(matches!(*expr, Ast::Ident { ref name, .. } if name == "r_P[3,4]"));
+        // With a space it is a name followed by a vector, still an error; so is an empty or
+        // unclosed subscript.
+        assert!(parse("x [1, 2]").is_err());
+        assert!(parse("x[]").is_err());
+        assert!(parse("x[1").is_err());
+        // A vector literal is not a subscript.
+        assert!(matches!(parse("2*[1, 0, 0]").unwrap(), Ast::Binary { .. }));
     }
 }

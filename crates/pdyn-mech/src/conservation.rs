@@ -114,19 +114,20 @@ pub fn conserved_quantities(model: &mut Model, d: &Derivation) -> Vec<Conserved>
     }
     let linear_scale = p.add(&linear_scale);
     let angular_scale = p.add(&angular_scale);
-    let mut h = [Pool::ZERO; 3];
-    let mut moment = [Pool::ZERO; 3];
-    let mut momentum = [Pool::ZERO; 3];
-    let mut total_force = [Pool::ZERO; 3];
+    // The terms are gathered and each sum formed once: adding particle by particle re-sorted
+    // the growing sum at every step, quadratic in the particles of a net.
+    let mut terms: [[Vec<Id>; 3]; 4] = Default::default();
     for pk in &d.particles {
         let mv = vector::scale(p, pk.mass, pk.v);
         let hr = vector::cross(p, pk.r, mv);
-        h = vector::add(p, h, hr);
         let mr = vector::cross(p, pk.r, pk.force);
-        moment = vector::add(p, moment, mr);
-        momentum = vector::add(p, momentum, mv);
-        total_force = vector::add(p, total_force, pk.force);
+        for (k, v) in [hr, mr, mv, pk.force].into_iter().enumerate() {
+            for c in 0..3 {
+                terms[k][c].push(v[c]);
+            }
+        }
     }
+    let [h, moment, momentum, total_force] = terms.map(|t| t.map(|c| p.add(&c)));
     let vanishes = |p: &mut Pool, e: Id| {
         p.tree_size(e, PROOF_SIZE_LIMIT + 1) < PROOF_SIZE_LIMIT && p.provably_equal(e, Pool::ZERO)
     };

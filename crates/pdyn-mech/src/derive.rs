@@ -506,22 +506,27 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
     // A diagonal A (each equation has one unknown: a building's floors, a chain of masses on
     // springs) is solved exactly whatever its size: x_i = b_i / a_ii, as short as b. (Small
     // systems go through the general elimination, as before, for the same printed forms.)
+    // So is a diagonal A whose rows come in another order than the unknowns (particles in
+    // Cartesian coordinates declared coordinate family by family, `x[i,j]` then `y[i,j]`:
+    // row `P[0,1]: x` holds `x[0,1]''` alone, row `P[0,1]: y` holds `y[0,1]''`): equation i
+    // gives unknown `column[i]`. Solving that A by LU at every step made a 400-particle net's
+    // set-up compile a dense 1,200 x 1,200 matrix.
     let m = unknowns.len();
-    let diagonal = m > opts.symbolic_limit
-        && residual_count == m
-        && (0..m).all(|i| {
-            system.a[i * m + i] != Pool::ZERO
-                && (0..m).all(|j| i == j || system.a[i * m + j] == Pool::ZERO)
-        });
+    let diagonal_columns = if m > opts.symbolic_limit && residual_count == m {
+        permuted_diagonal(&system.a, m)
+    } else {
+        None
+    };
+    let diagonal = diagonal_columns.is_some();
 
-    let solution = if diagonal {
+    let solution = if let Some(column) = &diagonal_columns {
         // Not simplified: a rational normal form would put an N-body force sum over one
         // common denominator, whose powers of masses and distances overflow in SI units.
-        Some(
-            (0..m)
-                .map(|i| p.div(system.b[i], system.a[i * m + i]))
-                .collect::<Vec<Id>>(),
-        )
+        let mut x = vec![Pool::ZERO; m];
+        for (i, &j) in column.iter().enumerate() {
+            x[j] = p.div(system.b[i], system.a[i * m + j]);
+        }
+        Some(x)
     } else if m <= opts.symbolic_limit || residual_count > m {
         // Exact elimination only when it is cheap (a few reactions, a double pendulum):
         // otherwise A x = b is solved numerically at each evaluation. On the 4-link chain the
@@ -762,17 +767,39 @@ fn factor_quotient(p: &mut Pool, e: Id) -> Id {
 
 /// Checks the equations (each involves an unknown, or holds identically; every unknown
 /// appears; enough equations) and writes them as `A x = b`.
+/// For a square `a` (row-major, `m` x `m`) with exactly one entry other than zero in each row
+/// and each column, the column of each row's entry; `None` otherwise.
+fn permuted_diagonal(a: &[Id], m: usize) -> Option<Vec<usize>> {
+    let mut column = Vec::with_capacity(m);
+    let mut taken = vec![false; m];
+    for row in a.chunks(m) {
+        let mut nonzero = row.iter().enumerate().filter(|(_, &e)| e != Pool::ZERO);
+        let (j, _) = nonzero.next()?;
+        if nonzero.next().is_some() || std::mem::replace(&mut taken[j], true) {
+            return None;
+        }
+        column.push(j);
+    }
+    Some(column)
+}
+
 fn linear_form(
     p: &mut Pool,
     equations: Vec<Equation>,
     unknowns: &[Unknown],
 ) -> Result<(Vec<Equation>, LinearSystem), DeriveError> {
     let unknown_ids: Vec<Id> = unknowns.iter().map(|u| u.id).collect();
+    let wanted: rustc_hash::FxHashSet<Id> = unknown_ids.iter().copied().collect();
+    // Which unknowns some equation holds, found in one traversal per equation (asking each
+    // equation about each unknown was quadratic in a net of many particles).
+    let mut involved = rustc_hash::FxHashSet::default();
     let mut kept = Vec::new();
     let mut residuals = Vec::new();
     for e in equations {
         let r = p.sub(e.lhs, e.rhs);
-        if unknown_ids.iter().any(|&u| p.contains(r, u)) {
+        let present = p.occurring(r, &wanted);
+        if !present.is_empty() {
+            involved.extend(present);
             residuals.push(r);
             kept.push(e);
         } else if !p.provably_equal(r, Pool::ZERO) {
@@ -795,7 +822,7 @@ fn linear_form(
     }
     let equations = kept;
     for u in unknowns {
-        if !residuals.iter().any(|&r| p.contains(r, u.id)) {
+        if !involved.contains(&u.id) {
             return Err(derr(
                 format!("no equation involves `{}`", u.name),
                 match u.kind {

@@ -140,7 +140,7 @@ impl Inference {
 
     /// Gives `name` a dimension.
     pub fn bind(&mut self, name: &str, form: Form) {
-        self.names.insert(name.to_string(), form);
+        self.names.insert(family_key(name).into_owned(), form);
     }
 
     /// Forgets `name` (a local such as `dist` in a potential).
@@ -156,7 +156,9 @@ impl Inference {
 
     /// The dimension of `name`, if declared.
     pub fn of(&self, name: &str) -> Option<Form> {
-        self.names.get(name).map(|f| self.normalize(f))
+        self.names
+            .get(family_key(name).as_ref())
+            .map(|f| self.normalize(f))
     }
 
     /// `form` with every solved unknown replaced by its solution.
@@ -355,7 +357,7 @@ impl Inference {
             }
             Ast::Ident { name, .. } => match name.as_str() {
                 "t" => Form::from(Dimension::TIME),
-                _ => match self.names.get(name) {
+                _ => match self.names.get(family_key(name).as_ref()) {
                     Some(f) => f.clone(),
                     None if name == "pi" || name == "e" => Form::from(Dimension::NONE),
                     None => self.fresh(name),
@@ -462,6 +464,15 @@ fn constant_exponent(ast: &Ast) -> Option<Exponent> {
             }
         }
         _ => None,
+    }
+}
+
+/// The key under which a name's dimension is kept: the members of a family (`x[3,4]`, and
+/// `x[i+1, j]` as written in a member's expression) share their family's, `x[]`.
+fn family_key(name: &str) -> std::borrow::Cow<'_, str> {
+    match name.find('[') {
+        Some(open) if name.ends_with(']') => format!("{}[]", &name[..open]).into(),
+        _ => name.into(),
     }
 }
 

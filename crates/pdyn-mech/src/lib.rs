@@ -8,7 +8,9 @@
 //!   eliminated to `q'' = f(q, q', t)` with the reactions as functions of state;
 //! - [`matrix_form`]: `M(q) q'' = f` with collected, factored entries, for reading;
 //! - [`dsolve`]: closed-form solutions of linear constant-coefficient equations of motion, and
-//!   the 1-D integration rules of section 3.1.3.
+//!   the 1-D integration rules of section 3.1.3;
+//! - [`linearization`], [`equilibrium`], [`modes`]: `M`, `K`, `C` at a state at rest, static
+//!   equilibrium by Newton's method, natural frequencies and mode shapes.
 #![warn(missing_docs)]
 
 pub mod algebra;
@@ -17,14 +19,18 @@ mod constraint_rank;
 pub mod derive;
 pub mod dimensions;
 pub mod dsolve;
+pub mod equilibrium;
 pub mod hybrid;
 pub mod kinematics;
+pub mod linearization;
 pub mod matrix_form;
 pub mod model;
+pub mod modes;
 pub mod options;
 pub mod parameters;
 pub mod prescribed;
 mod projection;
+pub mod statics;
 pub mod units;
 pub mod validity;
 

@@ -92,6 +92,13 @@ pub enum Error {
         /// Why.
         error: ForcesError,
     },
+    /// No equilibrium, or no modes, for a model (`pdyn equilibrium`, `pdyn modes`).
+    Statics {
+        /// The model file.
+        origin: String,
+        /// Why.
+        error: pdyn_mech::statics::StaticsError,
+    },
     /// A model could not be prepared or run.
     Sim {
         /// The model file.
@@ -180,6 +187,7 @@ impl Error {
             Error::Value { .. } => "value",
             Error::Derive { .. } => "derivation",
             Error::Forces { .. } => "forces",
+            Error::Statics { .. } => "statics",
             Error::Sim { .. } => "simulation",
             Error::Kin { .. } => "kinematics",
             Error::Dsolve { .. } => "dsolve",
@@ -238,6 +246,7 @@ impl Error {
             }),
             Error::Value { origin, .. }
             | Error::Forces { origin, .. }
+            | Error::Statics { origin, .. }
             | Error::Sim { origin, .. }
             | Error::Integration { origin, .. }
             | Error::Gravity { origin, .. }
@@ -336,6 +345,7 @@ impl fmt::Display for Error {
                 error,
             } => write!(f, "{origin}: error: {option}: {error}"),
             Error::Forces { origin, error } => write!(f, "{origin}: error: {error}"),
+            Error::Statics { origin, error } => write!(f, "{origin}: error: {error}"),
             Error::Sim {
                 origin,
                 context,

@@ -8,9 +8,11 @@
 pub mod bounded;
 pub mod derive;
 pub mod dsolve;
+pub mod equilibrium;
 pub mod expr;
 pub mod forces;
 pub mod kin;
+pub mod modes;
 pub mod run;
 pub mod sweep;
 

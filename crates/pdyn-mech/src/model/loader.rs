@@ -2,6 +2,7 @@
 //! the parameters' values, with the helpers every table uses to turn a TOML value into an
 //! expression (located errors, unit literals, shape checks, constant evaluation).
 
+use super::families::{in_member, Indices, Member, Members, Table};
 use super::raw::Sv;
 use super::{ModelError, Parameter};
 use crate::dimensions::{Form, Inference, Source};
@@ -18,19 +19,60 @@ pub(crate) struct ModelScope {
     pub(super) names: FxHashMap<String, (Binding, Range<usize>, &'static str)>,
     pub(super) order: Vec<String>,
     pub(super) local: FxHashMap<String, Binding>,
+    /// Sizes, index ranges and family shapes ([`super::families`]).
+    pub(super) indices: Indices,
+    /// The indices of the family member being read (`i = 3, j = 4`), empty elsewhere.
+    pub(super) bindings: Vec<(String, i64)>,
+    /// The names `[indices]` declares as indices: no other entry may take them.
+    pub(super) index_names: Vec<String>,
 }
 
-impl Scope for ModelScope {
-    fn resolve(&mut self, _pool: &mut Pool, name: &str) -> Option<Binding> {
+impl ModelScope {
+    fn lookup(&self, name: &str) -> Option<Binding> {
         if let Some((b, _, _)) = self.names.get(name) {
             return Some(*b);
         }
         self.local.get(name).copied()
     }
+}
+
+impl Scope for ModelScope {
+    fn resolve(&mut self, pool: &mut Pool, name: &str) -> Option<Binding> {
+        if let Some((_, v)) = self.bindings.iter().find(|(n, _)| n == name) {
+            return Some(Binding::Value(Value::Scalar(pool.int(*v))));
+        }
+        if name.ends_with(']') {
+            // `x[i+1, j]`: the member the subscript names with the current indices.
+            let member = self.indices.member_name(name, &self.bindings).ok()??;
+            return self.lookup(&member);
+        }
+        self.lookup(name)
+    }
     fn names(&self) -> Vec<String> {
         let mut v = self.order.clone();
         v.extend(self.local.keys().cloned());
         v
+    }
+    fn undefined(&self, name: &str) -> Option<(String, Option<String>)> {
+        if !name.ends_with(']') {
+            return None;
+        }
+        let help = "a member is written NAME[i] or NAME[i,j] with indices in its family's ranges";
+        match self.indices.member_name(name, &self.bindings) {
+            Err(e) => Some((e.message, Some(help.to_string()))),
+            Ok(Some(member)) => {
+                let base = member.split('[').next().unwrap_or_default();
+                let message = match self.indices.shapes.get(base) {
+                    Some(shape) => format!(
+                        "{member} is not declared: it is inside {} but its `where` leaves it out",
+                        super::families::shape_text(base, shape)
+                    ),
+                    None => format!("undefined name `{member}`"),
+                };
+                Some((message, Some(help.to_string())))
+            }
+            Ok(None) => None,
+        }
     }
 }
 
@@ -61,6 +103,10 @@ pub(crate) struct Loader<'a> {
     pub unknown_ids: Vec<(String, Id)>,
     /// The initial conditions read so far that name an unknown.
     pub unknown_initials: Vec<super::UnknownInitial>,
+    /// Which family member each expanded entry is ([`super::families`]).
+    pub members: Members,
+    /// The label of the member being read (`spring[i=3, j=19]`), prefixed to its errors.
+    pub member: Option<String>,
 }
 
 impl<'a> Loader<'a> {
@@ -80,7 +126,59 @@ impl<'a> Loader<'a> {
             deferred_initials: Vec::new(),
             unknown_ids: Vec::new(),
             unknown_initials: Vec::new(),
+            members: Members::default(),
+            member: None,
         }
+    }
+
+    /// Starts reading entry `k` of `table`: binds its indices if it is a family member.
+    pub(super) fn enter(&mut self, table: Table, k: usize) {
+        let list = match table {
+            Table::Coordinates => &self.members.coordinates,
+            Table::Definitions => &self.members.definitions,
+            Table::Points => &self.members.points,
+            Table::Particles => &self.members.particles,
+            Table::Forces => &self.members.forces,
+        };
+        match list.get(k).cloned().flatten() {
+            Some(Member { label, bindings }) => {
+                self.scope.bindings = bindings;
+                self.member = Some(label);
+            }
+            None => self.leave(),
+        }
+    }
+
+    /// Done with the entries of families.
+    pub(super) fn leave(&mut self) {
+        self.scope.bindings.clear();
+        self.member = None;
+    }
+
+    /// `err` with the label of the member being read, if any.
+    pub(super) fn in_member(&self, err: ModelError) -> ModelError {
+        match &self.member {
+            Some(label) => in_member(err, label),
+            None => err,
+        }
+    }
+
+    /// Keeps `name` for an index of `[indices]`.
+    pub(super) fn reserve_index_name(
+        &mut self,
+        name: &str,
+        span: Range<usize>,
+    ) -> Result<(), ModelError> {
+        if !is_identifier(name) || RESERVED.contains(&name) {
+            return Err(self
+                .err(span, format!("`{name}` cannot be used as an index name"))
+                .help("index names are letters, digits and `_`, not starting with a digit, and not t or pi"));
+        }
+        if self.scope.names.contains_key(name) {
+            return Err(self.err(span, format!("`{name}` is already declared")));
+        }
+        self.scope.index_names.push(name.to_string());
+        Ok(())
     }
 
     /// The index of coordinate `name` in the model and whether it is free.
@@ -117,10 +215,15 @@ impl<'a> Loader<'a> {
                 .err(span, format!("duplicate name `{name}`: already a {kind} (line {line})"))
                 .help("every parameter, coordinate, definition, point, particle and reaction needs its own name"));
         }
+        if self.scope.index_names.iter().any(|n| n == name) {
+            return Err(self
+                .err(span, format!("`{name}` is an index (declared under [indices]): it cannot also be a {what}"))
+                .help("rename the index or this entry"));
+        }
         let reserved = (RESERVED.contains(&name) && what != "reaction")
             || pdyn_expr::Func::from_name(name).is_some()
             || ["sqrt", "dot", "cross", "norm", "unit"].contains(&name);
-        if reserved || !is_identifier(name) {
+        if reserved || !(is_identifier(name) || is_member_name(name)) {
             return Err(self
                 .err(span, format!("`{name}` cannot be used as a {what} name"))
                 .help("names are letters, digits and `_`, not starting with a digit, and not t, pi or a function name"));
@@ -327,4 +430,20 @@ fn is_identifier(name: &str) -> bool {
     let mut chars = name.chars();
     matches!(chars.next(), Some(c) if c.is_alphabetic() || c == '_')
         && chars.all(|c| c.is_alphanumeric() || c == '_')
+}
+
+/// `P[3,4]`: a member of a family, as the expansion names it.
+fn is_member_name(name: &str) -> bool {
+    match super::index_expr::split_subscript(name) {
+        Some((base, parts)) => {
+            is_identifier(base)
+                && parts.iter().all(|(p, _)| {
+                    !p.is_empty()
+                        && p.trim_start_matches('-')
+                            .bytes()
+                            .all(|b| b.is_ascii_digit())
+                })
+        }
+        None => false,
+    }
 }

@@ -9,7 +9,9 @@
 
 pub mod constants;
 mod contacts;
+pub mod families;
 mod forces;
+pub mod index_expr;
 mod loader;
 pub(crate) mod raw;
 pub mod spec;
@@ -161,6 +163,18 @@ pub struct Load {
     pub force: [Id; 3],
 }
 
+/// A two-body force's pull on a fixed or moving point (a spring anchored at a pin): what the
+/// support holding the point must react.
+#[derive(Clone, Debug)]
+pub struct PointLoad {
+    /// Human-readable origin, e.g. `horizontal[i=0, j=0] (P[0,0], P[1,0]) on P[0,0]`.
+    pub label: String,
+    /// The point's name.
+    pub point: String,
+    /// The force on the point.
+    pub force: [Id; 3],
+}
+
 /// An unknown reaction magnitude (or vector component).
 #[derive(Clone, Debug)]
 pub struct Reaction {
@@ -231,6 +245,9 @@ pub struct Model {
     pub frames: Vec<Frame>,
     /// Every force, split into loads.
     pub loads: Vec<Load>,
+    /// The two-body forces' pulls on points (the reactions of their supports are minus
+    /// their sum).
+    pub point_loads: Vec<PointLoad>,
     /// Unknown reaction magnitudes.
     pub reactions: Vec<Reaction>,
     /// Constraint equations.
@@ -278,41 +295,49 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
             .help("see docs/model-format.md for the tables a model file may contain")
     })?;
     let mut ld = Loader::new(origin, source);
-    ld.read_parameters(&raw)?;
-    let unknowns = ld.read_unknowns(&raw)?;
+    let (raw, members) = families::expand(&mut ld, raw)?;
+    ld.members = members;
+    // An error met inside a family member names the member (`spring[i=3, j=19]: ...`).
+    read(&mut ld, &raw).map_err(|e| ld.in_member(e))
+}
+
+fn read(ld: &mut Loader, raw: &RawModel) -> Result<Model, ModelError> {
+    ld.read_parameters(raw)?;
+    let unknowns = ld.read_unknowns(raw)?;
     ld.unknown_ids = unknowns.iter().map(|u| (u.name.clone(), u.id)).collect();
     ld.definition_names = raw
         .definitions
         .keys()
         .map(|k| k.get_ref().clone())
         .collect();
-    let mut coords = ld.read_coordinates(&raw)?;
-    let definitions = ld.read_definitions(&raw)?;
+    let mut coords = ld.read_coordinates(raw)?;
+    let definitions = ld.read_definitions(raw)?;
     ld.resolve_deferred_initials(&mut coords)?;
     let tables::Coordinates {
         coordinates,
         initial_exprs,
         known_accelerations,
     } = coords;
-    let points = ld.read_points(&raw)?;
-    let particles = ld.read_particles(&raw)?;
-    let frames = ld.read_frames(&raw, &particles)?;
+    let points = ld.read_points(raw)?;
+    let particles = ld.read_particles(raw)?;
+    let frames = ld.read_frames(raw, &particles)?;
     let forces::Built {
         friction_forces,
         contacts: mut friction_contacts,
         friction_power,
         one_sided,
         loads,
+        point_loads,
         reactions,
         potentials,
         conservative,
-    } = ld.read_forces(&raw, &particles, &frames, &points)?;
-    let constraints = ld.read_constraints(&raw)?;
-    friction_contacts.extend(ld.read_contacts(&raw, &particles, &reactions)?);
+    } = ld.read_forces(raw, &particles, &frames, &points)?;
+    let constraints = ld.read_constraints(raw)?;
+    friction_contacts.extend(ld.read_contacts(raw, &particles, &reactions)?);
     let contacts = friction_contacts;
     let params = ld.params.clone();
-    let run = spec::read(&mut ld, &raw, &params)?;
-    let checks = spec::read_checks(&mut ld, &raw)?;
+    let run = spec::read(ld, raw, &params)?;
+    let checks = spec::read_checks(ld, raw)?;
     if let Some(e) = ld.dimension_error() {
         return Err(e);
     }
@@ -327,17 +352,18 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
         friction_forces,
         friction_power,
         one_sided,
-        name: raw.name.clone().unwrap_or_else(|| origin.to_string()),
-        origin: origin.to_string(),
-        source: source.to_string(),
-        pool: ld.pool,
-        parameters: ld.params,
+        name: raw.name.clone().unwrap_or_else(|| ld.origin.to_string()),
+        origin: ld.origin.to_string(),
+        source: ld.source.to_string(),
+        pool: std::mem::take(&mut ld.pool),
+        parameters: std::mem::take(&mut ld.params),
         coordinates,
         definitions,
         points,
         particles,
         frames,
         loads,
+        point_loads,
         reactions,
         constraints,
         contacts,

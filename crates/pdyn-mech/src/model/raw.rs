@@ -19,6 +19,9 @@ pub struct RawModel {
     pub description: Option<String>,
     /// Uniform gravitational acceleration vector, applied to every particle.
     pub gravity: Option<Sv>,
+    /// Sizes and index ranges of the families ([`super::families`]).
+    #[serde(default)]
+    pub indices: IndexMap<Name, Sv>,
     #[serde(default)]
     pub parameters: IndexMap<Name, Sv>,
     #[serde(default)]
@@ -123,11 +126,17 @@ pub struct RawMeasure {
     pub stat: Option<Name>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawParticle {
     pub mass: Option<Sv>,
     pub position: Option<Sv>,
+    /// A family's ranges, when not those of `[indices]`.
+    #[serde(rename = "for")]
+    pub for_list: Option<Sv>,
+    /// A family's condition: which members exist.
+    #[serde(rename = "where")]
+    pub condition: Option<Sv>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -145,10 +154,16 @@ pub struct RawConstraint {
 }
 
 /// One `[[forces]]` entry; which fields apply depends on `kind`.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawForce {
     pub kind: Option<Name>,
+    /// A family of forces: `"i in 0..n-2, j"`.
+    #[serde(rename = "for")]
+    pub for_list: Option<Sv>,
+    /// Which members of the family exist: `"j > 0 or i != 0"`.
+    #[serde(rename = "where")]
+    pub condition: Option<Sv>,
     pub name: Option<Name>,
     pub on: Option<Name>,
     pub at: Option<Sv>,

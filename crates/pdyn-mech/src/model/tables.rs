@@ -1,6 +1,7 @@
 //! One method per table of a model file, in the order [`super::load`] reads them: each
 //! declares the names it introduces (so later tables can use them) and returns what it built.
 
+use super::families::Table;
 use super::forces;
 use super::loader::Loader;
 use super::raw::{RawModel, Sv};
@@ -107,7 +108,8 @@ impl Loader<'_> {
             initial_exprs: Vec::new(),
             known_accelerations: Vec::new(),
         };
-        for (name, sv) in &raw.coordinates {
+        for (k, (name, sv)) in raw.coordinates.iter().enumerate() {
+            self.enter(Table::Coordinates, k);
             let n = name.get_ref();
             let index = out.coordinates.len();
             let kind = match sv.get_ref() {
@@ -141,6 +143,7 @@ impl Loader<'_> {
                 kind,
             });
         }
+        self.leave();
         Ok(out)
     }
 
@@ -169,6 +172,7 @@ impl Loader<'_> {
         coords: &mut Coordinates,
     ) -> Result<(), ModelError> {
         for (index, n, sv, t, key) in std::mem::take(&mut self.deferred_initials) {
+            self.enter(Table::Coordinates, index);
             let (value, expr) = self.initial_condition(&n, &sv, &t, key)?;
             if let CoordinateKind::Free { initial, rate } = &mut coords.coordinates[index].kind {
                 if key == "rate" {
@@ -185,6 +189,7 @@ impl Loader<'_> {
                 }
             }
         }
+        self.leave();
         Ok(())
     }
 
@@ -386,13 +391,15 @@ impl Loader<'_> {
         raw: &RawModel,
     ) -> Result<Vec<(String, Value)>, ModelError> {
         let mut definitions = Vec::new();
-        for (name, sv) in &raw.definitions {
+        for (k, (name, sv)) in raw.definitions.iter().enumerate() {
+            self.enter(Table::Definitions, k);
             let v = self.value(sv)?;
             let form = self.last_for(name.get_ref());
             self.dims.bind(name.get_ref(), form);
             self.declare(name.get_ref(), name.span(), "definition", Binding::Value(v))?;
             definitions.push((name.get_ref().clone(), v));
         }
+        self.leave();
         Ok(definitions)
     }
 
@@ -402,7 +409,8 @@ impl Loader<'_> {
         raw: &RawModel,
     ) -> Result<Vec<(String, [Id; 3])>, ModelError> {
         let mut points = Vec::new();
-        for (name, sv) in &raw.points {
+        for (k, (name, sv)) in raw.points.iter().enumerate() {
+            self.enter(Table::Points, k);
             let v = self.vector(sv, &format!("point `{}`", name.get_ref()))?;
             self.want(
                 sv,
@@ -418,6 +426,7 @@ impl Loader<'_> {
             )?;
             points.push((name.get_ref().clone(), v));
         }
+        self.leave();
         Ok(points)
     }
 
@@ -425,7 +434,8 @@ impl Loader<'_> {
     /// `v_NAME`. A model needs at least one.
     pub(super) fn read_particles(&mut self, raw: &RawModel) -> Result<Vec<Particle>, ModelError> {
         let mut particles = Vec::new();
-        for (name, sp) in &raw.particles {
+        for (k, (name, sp)) in raw.particles.iter().enumerate() {
+            self.enter(Table::Particles, k);
             let n = name.get_ref();
             let p = sp.get_ref();
             let Some(msv) = &p.mass else {
@@ -479,6 +489,7 @@ impl Loader<'_> {
                 position,
             });
         }
+        self.leave();
         if particles.is_empty() {
             return Err(self
                 .err(0..0, "the model has no particles")
@@ -540,9 +551,11 @@ impl Loader<'_> {
         if let Some(g) = gravity {
             fb.gravity(self, g);
         }
-        for f in &raw.forces {
+        for (k, f) in raw.forces.iter().enumerate() {
+            self.enter(Table::Forces, k);
             fb.force(self, f)?;
         }
+        self.leave();
         let built = fb.finish();
         let friction_names = built.contacts.iter().flat_map(|c| {
             let (n, ids) = &c.friction_force;

@@ -50,7 +50,12 @@ pub struct CompiledModel {
     /// reaction `r`).
     slots: Vec<Result<usize, usize>>,
     engine: Engine,
+    /// The entries of `∂q''/∂w` that are not identically zero, as one program...
     jacobian: Option<Evaluator>,
+    /// ...and where each of its outputs goes: `i * 2n + j` for `∂q''_i/∂w_j`. A net's
+    /// particle depends on a few neighbours: compiling the dense matrix (mostly zeros) made
+    /// set-up quadratic in the particles.
+    jacobian_entries: Vec<usize>,
     /// Whether the right-hand side runs as native code.
     native: bool,
     /// True when no acceleration depends on a rate (needed by Verlet and its compositions).
@@ -121,6 +126,7 @@ impl CompiledModel {
             .collect();
         let p = &mut model.pool;
         let rates: Vec<Id> = d.state[n..].to_vec();
+        let mut jacobian_entries = Vec::new();
         let (engine, jacobian, numeric, separable) = match &d.solution {
             Some(sol) => {
                 let prog = Program::compile(p, &inputs, sol)?;
@@ -132,7 +138,14 @@ impl CompiledModel {
                     .collect();
                 let separable = !p.contains_any(&accs, &rates);
                 let jac = p.jacobian(&accs, &d.state);
-                let jprog = Program::compile(p, &inputs, &jac)?;
+                let mut nonzero = Vec::new();
+                for (k, &e) in jac.iter().enumerate() {
+                    if e != Pool::ZERO {
+                        jacobian_entries.push(k);
+                        nonzero.push(e);
+                    }
+                }
+                let jprog = Program::compile(p, &inputs, &nonzero)?;
                 let engine = Engine::Exact(Evaluator::new(prog, jit));
                 (engine, Some(Evaluator::new(jprog, jit)), None, separable)
             }
@@ -165,6 +178,7 @@ impl CompiledModel {
             slots: slots.clone(),
             engine,
             jacobian,
+            jacobian_entries,
             native,
             separable,
             scratch: RefCell::new(Scratch {
@@ -304,9 +318,10 @@ impl OdeSystem for CompiledModel {
         jac[..m * m].iter_mut().for_each(|x| *x = 0.0);
         for i in 0..n {
             jac[i * m + n + i] = 1.0;
-            for j in 0..m {
-                jac[(n + i) * m + j] = s.jac_out[i * m + j];
-            }
+        }
+        // Row i of ∂q''/∂w is row n + i of the state's Jacobian.
+        for (&k, &value) in self.jacobian_entries.iter().zip(&s.jac_out) {
+            jac[n * m + k] = value;
         }
     }
 }

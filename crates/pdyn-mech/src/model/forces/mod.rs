@@ -31,7 +31,9 @@ mod reaction;
 mod spring;
 
 use super::raw::{Name, RawForce, Sv};
-use super::{Frame, Load, Loader, ModelError, Particle, PotentialTerm, Reaction, Target};
+use super::{
+    Frame, Load, Loader, ModelError, Particle, PointLoad, PotentialTerm, Reaction, Target,
+};
 use pdyn_expr::error::suggest;
 use pdyn_expr::lower::{Binding, Scope};
 use pdyn_expr::vector;
@@ -140,6 +142,7 @@ pub(super) struct Built {
     /// Reactions declared `one_sided`.
     pub one_sided: Vec<String>,
     pub loads: Vec<Load>,
+    pub point_loads: Vec<PointLoad>,
     pub reactions: Vec<Reaction>,
     pub potentials: Vec<PotentialTerm>,
     pub conservative: bool,
@@ -149,7 +152,12 @@ pub(super) struct ForceBuilder<'a> {
     particles: &'a [Particle],
     frames: &'a [Frame],
     points: &'a [(String, [Id; 3])],
+    /// Particle and point indices by name: a net's tens of thousands of springs each find
+    /// their two ends (searching the lists was quadratic in the number of particles).
+    particle_index: rustc_hash::FxHashMap<&'a str, usize>,
+    point_index: rustc_hash::FxHashMap<&'a str, usize>,
     loads: Vec<Load>,
+    point_loads: Vec<PointLoad>,
     reactions: Vec<Reaction>,
     potentials: Vec<PotentialTerm>,
     conservative: bool,
@@ -177,11 +185,23 @@ impl<'a> ForceBuilder<'a> {
         frames: &'a [Frame],
         points: &'a [(String, [Id; 3])],
     ) -> Self {
+        // The first of two equal names wins, as the searches it replaces found it.
+        let mut particle_index = rustc_hash::FxHashMap::default();
+        for (i, p) in particles.iter().enumerate() {
+            particle_index.entry(p.name.as_str()).or_insert(i);
+        }
+        let mut point_index = rustc_hash::FxHashMap::default();
+        for (i, p) in points.iter().enumerate() {
+            point_index.entry(p.0.as_str()).or_insert(i);
+        }
         ForceBuilder {
             particles,
             frames,
             points,
+            particle_index,
+            point_index,
             loads: Vec::new(),
+            point_loads: Vec::new(),
             reactions: Vec::new(),
             potentials: Vec::new(),
             conservative: true,
@@ -200,6 +220,7 @@ impl<'a> ForceBuilder<'a> {
             friction_power: self.friction_power,
             one_sided: self.one_sided,
             loads: self.loads,
+            point_loads: self.point_loads,
             reactions: self.reactions,
             potentials: self.potentials,
             conservative: self.conservative,
@@ -227,7 +248,7 @@ impl<'a> ForceBuilder<'a> {
     /// The body a one-body force acts on: a particle, or a frame (then `at` is required).
     fn target(&self, ld: &mut Loader, e: &Entry) -> Result<(Target, [Id; 3]), ModelError> {
         let on = e.need_name(ld, &e.raw.on, "on")?;
-        if let Some(i) = self.particles.iter().position(|p| &p.name == on.get_ref()) {
+        if let Some(&i) = self.particle_index.get(on.get_ref().as_str()) {
             return Ok((Target::Particle(i), self.particles[i].position));
         }
         if let Some(j) = self.frames.iter().position(|fr| &fr.name == on.get_ref()) {
@@ -259,15 +280,11 @@ impl<'a> ForceBuilder<'a> {
     }
 
     fn endpoint(&self, ld: &mut Loader, name: &Name) -> Result<(Endpoint, [Id; 3]), ModelError> {
-        if let Some(i) = self
-            .particles
-            .iter()
-            .position(|p| &p.name == name.get_ref())
-        {
+        if let Some(&i) = self.particle_index.get(name.get_ref().as_str()) {
             return Ok((Endpoint::Particle(i), self.particles[i].position));
         }
-        if let Some((_, r)) = self.points.iter().find(|(n, _)| n == name.get_ref()) {
-            return Ok((Endpoint::Point, *r));
+        if let Some(&k) = self.point_index.get(name.get_ref().as_str()) {
+            return Ok((Endpoint::Point, self.points[k].1));
         }
         Err(self
             .unknown_body(ld, name, false)
@@ -283,6 +300,14 @@ impl<'a> ForceBuilder<'a> {
                     format!("`between` lists {} names; it needs two", b.get_ref().len()),
                 ));
             }
+            if b.get_ref()[0].get_ref() == b.get_ref()[1].get_ref() {
+                return Err(ld
+                    .err(
+                        b.span(),
+                        format!("`between` joins `{}` to itself", b.get_ref()[0].get_ref()),
+                    )
+                    .help("a two-body force joins two different bodies (in a family, check the index arithmetic)"));
+            }
             let (e0, r0) = self.endpoint(ld, &b.get_ref()[0])?;
             let (e1, r1) = self.endpoint(ld, &b.get_ref()[1])?;
             if matches!((e0, e1), (Endpoint::Point, Endpoint::Point)) {
@@ -297,6 +322,14 @@ impl<'a> ForceBuilder<'a> {
             ]);
         }
         if let (Some(on), Some(to)) = (&raw.on, &raw.to) {
+            if on.get_ref() == to.get_ref() {
+                return Err(ld
+                    .err(
+                        to.span(),
+                        format!("`to` names `{}`, the body the force is on", on.get_ref()),
+                    )
+                    .help("a two-body force joins two different bodies"));
+            }
             let (e0, r0) = self.endpoint(ld, on)?;
             let (e1, r1) = self.endpoint(ld, to)?;
             return Ok([
@@ -324,13 +357,24 @@ impl<'a> ForceBuilder<'a> {
                 force,
             });
         }
+        let neg = force.map(|c| ld.pool.neg(c));
         if let Endpoint::Particle(j) = ends[1].0 {
-            let neg = force.map(|c| ld.pool.neg(c));
             self.loads.push(Load {
                 label: format!("{label} on {}", ends[1].2),
                 target: Target::Particle(j),
                 force: neg,
             });
+        }
+        // What the force does to a point: the pin holding it must take it (`pdyn
+        // equilibrium` reports the reactions at the points).
+        for (end, on_it) in [(&ends[0], force), (&ends[1], neg)] {
+            if let Endpoint::Point = end.0 {
+                self.point_loads.push(PointLoad {
+                    label: format!("{label} on {}", end.2),
+                    point: end.2.clone(),
+                    force: on_it,
+                });
+            }
         }
     }
 

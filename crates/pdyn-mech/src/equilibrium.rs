@@ -1,0 +1,296 @@
+//! Static equilibrium: the state at rest where every force balances, `f(q, 0) = 0`, found by
+//! Newton's method with the exact Jacobian `-K` ([`crate::linearization`]), damped where the
+//! structure is slack.
+//!
+//! A net released flat has no stiffness across its plane (its springs are at their natural
+//! length), so the plain Newton step is undefined there. Each step solves
+//! `(K + μ D) δq = f` with `D` the mass matrix's diagonal (Levenberg–Marquardt: for large `μ`
+//! a short step along the forces, as damped dynamics would take; for `μ → 0` Newton's step),
+//! `μ` shrinking tenfold after a step that lowers `|f|` and growing tenfold after one that
+//! does not. Where `μ` must grow past any bound, no state balances the forces: the stiffness is
+//! singular along the directions the forces push (a mechanism), which are named.
+
+use crate::linearization::{Linearization, Linearizer};
+use nalgebra::{DMatrix, DVector};
+
+/// Knobs of [`solve`].
+#[derive(Clone, Debug)]
+pub struct EquilibriumOptions {
+    /// Converged when `|f| <= tolerance * force scale` (Euclidean norm; the scale is the
+    /// largest of `|f|` at the start and `max |K_ii| * max(|q0|, 1)`). Default 1e-12.
+    pub tolerance: f64,
+    /// Most steps. Default 200.
+    pub max_steps: usize,
+}
+
+impl Default for EquilibriumOptions {
+    fn default() -> Self {
+        EquilibriumOptions {
+            tolerance: 1e-12,
+            max_steps: 200,
+        }
+    }
+}
+
+/// A direction of free motion: the coordinates it moves, largest first, with their share.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FreeDirection {
+    /// `(coordinate name, component)` of the unit vector, components below a tenth of the
+    /// largest left out.
+    pub components: Vec<(String, f64)>,
+    /// How many coordinates the direction moves in all.
+    pub moved: usize,
+}
+
+impl std::fmt::Display for FreeDirection {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        const SHOWN: usize = 6;
+        let parts: Vec<String> = self
+            .components
+            .iter()
+            .take(SHOWN)
+            .map(|(n, c)| format!("{c:+.3} {n}"))
+            .collect();
+        write!(f, "{}", parts.join(" "))?;
+        if self.moved > SHOWN {
+            write!(f, " (and {} more coordinates)", self.moved - SHOWN)?;
+        }
+        Ok(())
+    }
+}
+
+/// Why no equilibrium was found.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum EquilibriumError {
+    /// The stiffness is singular along directions the forces push: no state at rest
+    /// balances them (a free structure under load, a pin missing).
+    Mechanism {
+        /// The out-of-balance force left, `|f|`.
+        residual: f64,
+        /// The directions of free motion.
+        directions: Vec<FreeDirection>,
+    },
+    /// Newton's method did not converge within the step limit.
+    NotConverged {
+        /// Steps taken.
+        steps: usize,
+        /// `|f|` at the end.
+        residual: f64,
+    },
+}
+
+impl std::fmt::Display for EquilibriumError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            EquilibriumError::Mechanism {
+                residual,
+                directions,
+            } => {
+                write!(
+                    f,
+                    "no equilibrium: the structure is a mechanism (its stiffness is singular) \
+                     and the forces push along its free motion (out-of-balance force {residual:.3e}); free direction"
+                )?;
+                if directions.len() > 1 {
+                    write!(f, "s")?;
+                }
+                for (k, d) in directions.iter().enumerate() {
+                    write!(f, "{} {d}", if k == 0 { ":" } else { ";" })?;
+                }
+                Ok(())
+            }
+            EquilibriumError::NotConverged { steps, residual } => write!(
+                f,
+                "Newton's method did not converge in {steps} steps (out-of-balance force \
+                 {residual:.3e})"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for EquilibriumError {}
+
+/// An equilibrium found.
+#[derive(Clone, Debug)]
+pub struct Equilibrium {
+    /// The free coordinates at equilibrium.
+    pub q: Vec<f64>,
+    /// `|f|` there (Euclidean norm of the out-of-balance generalized forces).
+    pub residual: f64,
+    /// The force scale the tolerance is relative to.
+    pub scale: f64,
+    /// Newton steps taken.
+    pub steps: usize,
+    /// The linearization there.
+    pub linearization: Linearization,
+    /// Directions along which the equilibrium is neutral (the stiffness is singular there,
+    /// but no force pushes along them): the equilibrium is not unique.
+    pub neutral: Vec<FreeDirection>,
+}
+
+fn max_abs(v: &DVector<f64>) -> f64 {
+    v.iter().fold(0.0, |m, x| m.max(x.abs()))
+}
+
+/// The equilibrium nearest `start` (default: the initial values).
+pub fn solve(
+    lin: &Linearizer,
+    start: Option<&[f64]>,
+    opts: &EquilibriumOptions,
+) -> Result<Equilibrium, EquilibriumError> {
+    let n = lin.len();
+    let mut q = DVector::from_column_slice(start.unwrap_or(&lin.initial));
+    let mut at = lin.at(q.as_slice());
+    let stiff = (0..n).fold(0.0f64, |m, i| m.max(at.stiffness[(i, i)].abs()));
+    let length = max_abs(&q).max(1.0);
+    let scale = at.force.norm().max(stiff * length).max(f64::MIN_POSITIVE);
+    let target = opts.tolerance * scale;
+    let diag: DVector<f64> = DVector::from_iterator(
+        n,
+        (0..n).map(|i| at.mass[(i, i)].abs().max(f64::MIN_POSITIVE)),
+    );
+    // μ is relative to K's scale over D's: μ = 1 makes the two comparable.
+    let ratio = stiff.max(f64::MIN_POSITIVE) / diag.max();
+    let mut mu = 0.0f64;
+    let mut steps = 0;
+    let mut residual = at.force.norm();
+    while residual > target {
+        if steps >= opts.max_steps {
+            return Err(EquilibriumError::NotConverged { steps, residual });
+        }
+        steps += 1;
+        let mut improved = false;
+        // Try the step with the current μ, raising it until |f| decreases.
+        for _ in 0..40 {
+            let mut a = at.stiffness.clone();
+            for i in 0..n {
+                a[(i, i)] += mu * ratio * diag[i];
+            }
+            if let Some(dq) = a.lu().solve(&at.force) {
+                let trial = &q + &dq;
+                let next = lin.at(trial.as_slice());
+                let r = next.force.norm();
+                if r.is_finite() && r < residual {
+                    q = trial;
+                    at = next;
+                    residual = r;
+                    improved = true;
+                    break;
+                }
+            }
+            mu = if mu == 0.0 { 1e-6 } else { mu * 10.0 };
+            if mu > 1e12 {
+                break;
+            }
+        }
+        if !improved {
+            let directions = free_directions(&lin.names, &at.stiffness);
+            return Err(if directions.is_empty() {
+                EquilibriumError::NotConverged { steps, residual }
+            } else {
+                EquilibriumError::Mechanism {
+                    residual,
+                    directions,
+                }
+            });
+        }
+        mu /= 10.0;
+        if mu < 1e-12 {
+            mu = 0.0;
+        }
+    }
+    let neutral = free_directions(&lin.names, &at.stiffness);
+    Ok(Equilibrium {
+        q: q.iter().copied().collect(),
+        residual,
+        scale,
+        steps,
+        linearization: at,
+        neutral,
+    })
+}
+
+/// The null space of the stiffness's symmetric part: eigenvectors whose eigenvalue is below
+/// 1e-9 of the largest in magnitude.
+pub fn free_directions(names: &[String], stiffness: &DMatrix<f64>) -> Vec<FreeDirection> {
+    let sym = (stiffness + stiffness.transpose()) * 0.5;
+    let eig = sym.symmetric_eigen();
+    let largest = eig.eigenvalues.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut out = Vec::new();
+    for (k, &lambda) in eig.eigenvalues.iter().enumerate() {
+        if lambda.abs() > 1e-9 * largest && largest > 0.0 {
+            continue;
+        }
+        let v = eig.eigenvectors.column(k);
+        let big = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        // The sign that makes the largest component positive, for a stable report.
+        let sign = v
+            .iter()
+            .find(|x| x.abs() == big)
+            .map_or(1.0, |x| x.signum());
+        let mut comps: Vec<(String, f64)> = v
+            .iter()
+            .enumerate()
+            .filter(|(_, x)| x.abs() >= 0.1 * big)
+            .map(|(i, &x)| (names[i].clone(), sign * x))
+            .collect();
+        comps.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()).then(a.0.cmp(&b.0)));
+        out.push(FreeDirection {
+            moved: comps.len(),
+            components: comps,
+        });
+    }
+    out
+}
+
+/// The reactions of the supports holding the model's points (pins): minus the sum of the
+/// forces the two-body forces put on each point, at rest at `q` (t = 0). Points no force
+/// touches are left out.
+pub fn support_reactions(
+    model: &mut crate::Model,
+    d: &crate::Derivation,
+    q: &[f64],
+) -> Result<Vec<(String, [f64; 3])>, crate::linearization::LinearizationError> {
+    let mut names: Vec<String> = Vec::new();
+    let mut sums: Vec<[pdyn_expr::Id; 3]> = Vec::new();
+    for (name, _) in &model.points {
+        let on: Vec<&crate::model::PointLoad> = model
+            .point_loads
+            .iter()
+            .filter(|l| &l.point == name)
+            .collect();
+        if on.is_empty() {
+            continue;
+        }
+        let mut total = [pdyn_expr::Pool::ZERO; 3];
+        for l in on {
+            for (c, t) in total.iter_mut().enumerate() {
+                *t = model.pool.add(&[*t, l.force[c]]);
+            }
+        }
+        names.push(name.clone());
+        sums.push(total.map(|c| model.pool.neg(c)));
+    }
+    let p = &mut model.pool;
+    let mut inputs = vec![p.time()];
+    inputs.extend(&d.state);
+    inputs.extend(model.parameters.iter().map(|par| par.id));
+    let outputs: Vec<pdyn_expr::Id> = sums.iter().flatten().copied().collect();
+    let prog = pdyn_expr::Program::compile(p, &inputs, &outputs)
+        .map_err(|e| crate::linearization::LinearizationError::Compile(e.to_string()))?;
+    let n = d.free.len();
+    let mut input = vec![0.0; inputs.len()];
+    input[1..1 + n].copy_from_slice(q);
+    for (k, par) in model.parameters.iter().enumerate() {
+        input[1 + 2 * n + k] = par.value;
+    }
+    let mut ws = prog.workspace();
+    let mut out = vec![0.0; outputs.len()];
+    prog.eval(&input, &mut ws, &mut out);
+    Ok(names
+        .into_iter()
+        .enumerate()
+        .map(|(k, name)| (name, [out[3 * k], out[3 * k + 1], out[3 * k + 2]]))
+        .collect())
+}

@@ -1,0 +1,249 @@
+//! The equations of motion `M(q) q'' = f(q, q', t)` linearized about a state at rest: the
+//! numbers behind `pdyn equilibrium` and `pdyn modes`.
+//!
+//! At rest (`q' = 0`) and in equilibrium (`f = 0`), a small motion `q = q0 + δq` obeys
+//! `M δq'' + C δq' + K δq = 0` with `M = M(q0)`, `K = -∂f/∂q`, `C = -∂f/∂q'`: the term
+//! `(∂M/∂q) q''` vanishes with `q''`. The derivatives are exact (symbolic, taken only where the
+//! expressions hold the variable: a net's particle depends on its neighbours), compiled once
+//! into one program, and evaluated at any `q0`; the matrices are dense (`nalgebra`), which
+//! suits systems of up to a few thousand coordinates.
+
+use crate::derive::{Derivation, UnknownKind};
+use crate::model::Model;
+use nalgebra::{DMatrix, DVector};
+use pdyn_expr::{Id, Pool, Program};
+
+/// Why a model cannot be linearized.
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum LinearizationError {
+    /// The equations keep unknown reactions (constraints, massless frames, declared reaction
+    /// forces): statics of such models is `pdyn forces`' business.
+    Reactions(Vec<String>),
+    /// No free coordinate.
+    NoCoordinates,
+    /// The expressions could not be compiled (a function without a numeric form).
+    Compile(String),
+    /// More equations than coordinates.
+    NotSquare {
+        /// Equations.
+        equations: usize,
+        /// Free coordinates.
+        coordinates: usize,
+    },
+}
+
+impl std::fmt::Display for LinearizationError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LinearizationError::Reactions(names) => write!(
+                f,
+                "the equations keep unknown reactions ({}): linearization needs a model whose \
+                 equations hold the accelerations only (use `pdyn forces` for its statics)",
+                names.join(", ")
+            ),
+            LinearizationError::NoCoordinates => write!(f, "the model has no free coordinate"),
+            LinearizationError::Compile(e) => write!(f, "cannot compile the equations: {e}"),
+            LinearizationError::NotSquare {
+                equations,
+                coordinates,
+            } => write!(
+                f,
+                "{equations} equations for {coordinates} coordinates: linearization needs as \
+                 many equations as coordinates"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for LinearizationError {}
+
+/// The linearized equations at one state.
+#[derive(Clone, Debug)]
+pub struct Linearization {
+    /// `M(q0)`.
+    pub mass: DMatrix<f64>,
+    /// `K = -∂f/∂q` at `(q0, 0)`.
+    pub stiffness: DMatrix<f64>,
+    /// `C = -∂f/∂q'` at `(q0, 0)`.
+    pub damping: DMatrix<f64>,
+    /// `f(q0, 0)`: zero in equilibrium (the out-of-balance force otherwise).
+    pub force: DVector<f64>,
+}
+
+/// Where each compiled output goes.
+#[derive(Clone, Debug)]
+enum Slot {
+    Force(usize),
+    Mass(usize, usize),
+    Stiffness(usize, usize),
+    Damping(usize, usize),
+}
+
+/// The model's `M`, `f`, `K`, `C` compiled once, to be evaluated at any state at rest.
+#[derive(Clone, Debug)]
+pub struct Linearizer {
+    /// Names of the free coordinates, in state order.
+    pub names: Vec<String>,
+    /// Initial values of the free coordinates.
+    pub initial: Vec<f64>,
+    program: Program,
+    slots: Vec<Slot>,
+    /// `[t, q, q', parameters]`, with the parameters' values set.
+    input: Vec<f64>,
+}
+
+impl Linearizer {
+    /// Compiles the linearization of `d`, derived from `model`.
+    pub fn new(model: &mut Model, d: &Derivation) -> Result<Linearizer, LinearizationError> {
+        let reactions: Vec<String> = d
+            .unknowns
+            .iter()
+            .filter(|u| matches!(u.kind, UnknownKind::Reaction(_)))
+            .map(|u| u.name.clone())
+            .collect();
+        if !reactions.is_empty() {
+            return Err(LinearizationError::Reactions(reactions));
+        }
+        let n = d.free.len();
+        if n == 0 {
+            return Err(LinearizationError::NoCoordinates);
+        }
+        let sys = &d.system;
+        if sys.rows() != n || sys.cols() != n {
+            return Err(LinearizationError::NotSquare {
+                equations: sys.rows(),
+                coordinates: n,
+            });
+        }
+        // Row i of A x = b may be any equation; column j is unknown j, the acceleration of
+        // free coordinate `column[j]`.
+        let column: Vec<usize> = d
+            .unknowns
+            .iter()
+            .map(|u| match u.kind {
+                UnknownKind::Acceleration(ci) => d.free.iter().position(|&f| f == ci).unwrap_or(0),
+                UnknownKind::Reaction(_) => 0,
+            })
+            .collect();
+        // Newton's equations come particle by particle (`m x'' = F_x` of P, then its y...),
+        // not coordinate by coordinate: when each row holds one acceleration, row i is put
+        // where its coordinate is, so that M and K come out symmetric (as the projected
+        // form writes them) and the eigenproblem is a symmetric one.
+        let mut row_to = (0..sys.rows()).collect::<Vec<usize>>();
+        let single: Vec<Option<usize>> = (0..sys.rows())
+            .map(|i| {
+                let nz: Vec<usize> = (0..sys.cols())
+                    .filter(|&j| sys.a[i * sys.cols() + j] != Pool::ZERO)
+                    .collect();
+                (nz.len() == 1).then(|| column[nz[0]])
+            })
+            .collect();
+        if single.iter().all(Option::is_some) {
+            let targets: Vec<usize> = single.iter().map(|t| t.unwrap_or(0)).collect();
+            let mut seen = vec![false; n];
+            if targets
+                .iter()
+                .all(|&t| !std::mem::replace(&mut seen[t], true))
+            {
+                row_to = targets;
+            }
+        }
+        let p = &mut model.pool;
+        let (q, qd) = d.state.split_at(n);
+        let mut outputs: Vec<Id> = Vec::new();
+        let mut slots = Vec::new();
+        // The equations' rows are combined into M and f as written: M δq'' = f holds row by
+        // row, and K, C are taken row by row too (a square system of independent rows).
+        for (i, &b) in sys.b.iter().enumerate() {
+            outputs.push(b);
+            slots.push(Slot::Force(row_to[i]));
+            for (j, &c) in column.iter().enumerate() {
+                let a = sys.a[i * sys.cols() + j];
+                if a != Pool::ZERO {
+                    outputs.push(a);
+                    slots.push(Slot::Mass(row_to[i], c));
+                }
+            }
+        }
+        let dq = p.jacobian(&sys.b, q);
+        let dqd = p.jacobian(&sys.b, qd);
+        for (i, &row) in row_to.iter().enumerate() {
+            for j in 0..n {
+                if dq[i * n + j] != Pool::ZERO {
+                    let k = p.neg(dq[i * n + j]);
+                    outputs.push(k);
+                    slots.push(Slot::Stiffness(row, j));
+                }
+                if dqd[i * n + j] != Pool::ZERO {
+                    let c = p.neg(dqd[i * n + j]);
+                    outputs.push(c);
+                    slots.push(Slot::Damping(row, j));
+                }
+            }
+        }
+        let mut inputs = vec![p.time()];
+        inputs.extend(&d.state);
+        inputs.extend(model.parameters.iter().map(|par| par.id));
+        let program = Program::compile(p, &inputs, &outputs)
+            .map_err(|e| LinearizationError::Compile(e.to_string()))?;
+        let mut input = vec![0.0; inputs.len()];
+        for (k, par) in model.parameters.iter().enumerate() {
+            input[1 + 2 * n + k] = par.value;
+        }
+        let initial = d
+            .free
+            .iter()
+            .map(|&ci| match model.coordinates[ci].kind {
+                crate::model::CoordinateKind::Free { initial, .. } => initial,
+                crate::model::CoordinateKind::Prescribed { .. } => 0.0,
+            })
+            .collect();
+        Ok(Linearizer {
+            names: d
+                .free
+                .iter()
+                .map(|&ci| model.coordinates[ci].name.clone())
+                .collect(),
+            initial,
+            program,
+            slots,
+            input,
+        })
+    }
+
+    /// Number of free coordinates.
+    pub fn len(&self) -> usize {
+        self.names.len()
+    }
+
+    /// True when there is no coordinate (never, for a built linearizer).
+    pub fn is_empty(&self) -> bool {
+        self.names.is_empty()
+    }
+
+    /// The linearization at rest at `q` (at t = 0).
+    pub fn at(&self, q: &[f64]) -> Linearization {
+        let n = self.len();
+        let mut input = self.input.clone();
+        input[1..1 + n].copy_from_slice(q);
+        let mut ws = self.program.workspace();
+        let mut out = vec![0.0; self.slots.len()];
+        self.program.eval(&input, &mut ws, &mut out);
+        let mut lin = Linearization {
+            mass: DMatrix::zeros(n, n),
+            stiffness: DMatrix::zeros(n, n),
+            damping: DMatrix::zeros(n, n),
+            force: DVector::zeros(n),
+        };
+        for (slot, &v) in self.slots.iter().zip(&out) {
+            match *slot {
+                Slot::Force(i) => lin.force[i] = v,
+                Slot::Mass(i, j) => lin.mass[(i, j)] = v,
+                Slot::Stiffness(i, j) => lin.stiffness[(i, j)] = v,
+                Slot::Damping(i, j) => lin.damping[(i, j)] = v,
+            }
+        }
+        lin
+    }
+}

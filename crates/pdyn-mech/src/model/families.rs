@@ -1,0 +1,839 @@
+//! Indexed families: one declaration standing for many coordinates, points, particles,
+//! definitions or forces, the way the chapter writes "P_ij, i = 0, …, n−1".
+//!
+//! ```toml
+//! [indices]
+//! n = 5                    # a size (an integer that ranges and conditions may use)
+//! i = "0..n-1"             # an index and its range, both ends included
+//! j = "0..n-1"
+//!
+//! [particles."P[i,j]"]     # P[0,0] ... P[4,4], except where `where` is false
+//! where = "not (j == 0 and (i == 0 or i == n-1))"
+//! position = "[x[i,j], y[i,j], z[i,j]]"
+//!
+//! [[forces]]
+//! kind = "spring"
+//! for = "i in 0..n-2, j"   # a range of its own for i, the [indices] range for j
+//! between = ["P[i,j]", "P[i+1,j]"]
+//! ```
+//!
+//! Expansion happens before anything is resolved: each family becomes its members, ordinary
+//! entries named `P[3,4]` whose values are the family's own (same text, same place in the
+//! file), read with the member's indices bound. Name fields (`on`, `between`...) are resolved
+//! here to the members they name. A reference outside a family's declared ranges is a located
+//! error naming the family and the member being read (`spring[i=3, j=19]: P[4,20] is outside
+//! P[0..19, 0..19]`). Sizes are checked before anything is allocated.
+
+use super::index_expr::{self, ForClause, IndexError, IndexExpr};
+use super::loader::Loader;
+use super::raw::{Name, RawForce, RawModel, RawParticle, Sv};
+use super::ModelError;
+use indexmap::IndexMap;
+use rustc_hash::FxHashMap;
+use std::ops::Range;
+use toml::Spanned;
+
+/// Most members all families of one model may have together: expansion allocates an entry per
+/// member (and loading a symbolic expression per field), so a family of 10^12 is refused
+/// before anything is made.
+pub const MAX_MEMBERS: u64 = 2_000_000;
+
+/// A family's declared shape, for messages about references outside it: `P[0..19, 0..19]`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct Shape {
+    /// Inclusive range of each index.
+    pub ranges: Vec<(i64, i64)>,
+}
+
+/// Which member of which family an expanded entry is.
+#[derive(Clone, Debug)]
+pub(crate) struct Member {
+    /// `P[i=3, j=4]`, `spring[i=3, j=19]`: prefixed to errors while it is read.
+    pub label: String,
+    /// The values of its indices.
+    pub bindings: Vec<(String, i64)>,
+}
+
+/// For each entry of each expanded table, the member it is (`None` for an ordinary entry).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Members {
+    pub coordinates: Vec<Option<Member>>,
+    pub definitions: Vec<Option<Member>>,
+    pub points: Vec<Option<Member>>,
+    pub particles: Vec<Option<Member>>,
+    pub forces: Vec<Option<Member>>,
+}
+
+/// An expanded table and, entry by entry, the member each is.
+type Expanded<T> = (T, Vec<Option<Member>>);
+
+/// Which table an entry is in.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Table {
+    Coordinates,
+    Definitions,
+    Points,
+    Particles,
+    Forces,
+}
+
+/// `[indices]` read: sizes and index ranges, and the shapes of the families declared so far.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Indices {
+    /// Named integers.
+    pub sizes: FxHashMap<String, i64>,
+    /// Each index's default range.
+    pub ranges: IndexMap<String, (i64, i64)>,
+    /// The shape of each family, by its base name.
+    pub shapes: FxHashMap<String, Shape>,
+}
+
+impl Indices {
+    /// The value of a size or a bound index.
+    fn lookup<'a>(&'a self, bindings: &'a [(String, i64)]) -> impl Fn(&str) -> Option<i64> + 'a {
+        move |name| {
+            bindings
+                .iter()
+                .find(|(n, _)| n == name)
+                .map(|b| b.1)
+                .or_else(|| self.sizes.get(name).copied())
+        }
+    }
+
+    /// The member that `name` (`P[i+1, j]`, `P[3,4]`, `P`) names with `bindings`: its canonical
+    /// name `P[4,3]`. `Ok(None)` when `name` has no subscript. An error when an index cannot
+    /// be evaluated, or the member is outside its family's shape; spans are in `name`.
+    pub fn member_name(
+        &self,
+        name: &str,
+        bindings: &[(String, i64)],
+    ) -> Result<Option<String>, IndexError> {
+        let Some((base, parts)) = index_expr::split_subscript(name) else {
+            return Ok(None);
+        };
+        let lookup = self.lookup(bindings);
+        let mut values = Vec::with_capacity(parts.len());
+        for (text, offset) in &parts {
+            let shift = |e: IndexError| IndexError {
+                span: e.span.start + offset..e.span.end + offset,
+                message: e.message,
+            };
+            let e = index_expr::parse(text).map_err(shift)?;
+            values.push(e.int(&lookup).map_err(|e| {
+                let e = if e.span == (0..0) {
+                    IndexError {
+                        span: 0..text.len(),
+                        message: e.message,
+                    }
+                } else {
+                    e
+                };
+                shift(e)
+            })?);
+        }
+        let canonical = member(base, &values);
+        if let Some(shape) = self.shapes.get(base) {
+            let inside = shape.ranges.len() == values.len()
+                && shape
+                    .ranges
+                    .iter()
+                    .zip(&values)
+                    .all(|((lo, hi), v)| lo <= v && v <= hi);
+            if !inside {
+                return Err(IndexError {
+                    span: 0..name.len(),
+                    message: format!("{canonical} is outside {}", shape_text(base, shape)),
+                });
+            }
+        }
+        Ok(Some(canonical))
+    }
+}
+
+/// `P[3,4]`.
+pub(crate) fn member(base: &str, values: &[i64]) -> String {
+    let v: Vec<String> = values.iter().map(i64::to_string).collect();
+    format!("{base}[{}]", v.join(","))
+}
+
+/// `P[0..19, 0..19]`.
+pub(crate) fn shape_text(base: &str, shape: &Shape) -> String {
+    let r: Vec<String> = shape
+        .ranges
+        .iter()
+        .map(|(lo, hi)| format!("{lo}..{hi}"))
+        .collect();
+    format!("{base}[{}]", r.join(", "))
+}
+
+/// `spring[i=3, j=19]`.
+fn label(base: &str, bindings: &[(String, i64)]) -> String {
+    let b: Vec<String> = bindings.iter().map(|(n, v)| format!("{n}={v}")).collect();
+    format!("{base}[{}]", b.join(", "))
+}
+
+/// A family declaration's head: `P[i,j]` is `P` over `i`, `j`; `P[3,4]` (all numbers) is an
+/// ordinary name, `P` too.
+enum Head<'a> {
+    Plain,
+    Family(&'a str, Vec<String>),
+}
+
+/// The byte offset at which the text of a string value or key starts (after its quote).
+fn text_start(ld: &Loader, span: &Range<usize>) -> usize {
+    match ld.source.as_bytes().get(span.start) {
+        Some(b'"') | Some(b'\'') => span.start + 1,
+        _ => span.start,
+    }
+}
+
+fn located(ld: &Loader, span: &Range<usize>, e: IndexError) -> ModelError {
+    let start = text_start(ld, span);
+    let end = (start + e.span.end).min(span.end.max(start));
+    ld.err(start + e.span.start.min(end - start)..end, e.message)
+}
+
+/// What one family iterates over: its index names and their ranges, and its condition.
+struct Domain {
+    names: Vec<String>,
+    ranges: Vec<(i64, i64)>,
+    condition: Option<(IndexExpr, Sv)>,
+}
+
+impl Domain {
+    fn count(&self) -> u64 {
+        self.ranges
+            .iter()
+            // In i128: a range from i64::MIN to i64::MAX must not overflow while it is refused.
+            .map(|(lo, hi)| u64::try_from(*hi as i128 - *lo as i128 + 1).unwrap_or(u64::MAX))
+            .fold(1u64, |a, b| a.saturating_mul(b))
+    }
+}
+
+struct Expander<'l, 'a> {
+    ld: &'l mut Loader<'a>,
+    indices: Indices,
+    members: u64,
+}
+
+impl<'l, 'a> Expander<'l, 'a> {
+    fn head<'n>(&self, name: &'n Name) -> Result<Head<'n>, ModelError> {
+        let text = name.get_ref();
+        let Some((base, parts)) = index_expr::split_subscript(text) else {
+            if text.contains('[') || text.contains(']') {
+                return Err(self.ld.err(
+                    name.span(),
+                    format!("`{text}` is not a name: a family is written NAME[i] or NAME[i,j]"),
+                ));
+            }
+            return Ok(Head::Plain);
+        };
+        let trimmed: Vec<&str> = parts.iter().map(|(p, _)| p.trim()).collect();
+        if trimmed.iter().all(|p| p.parse::<i64>().is_ok()) {
+            return Ok(Head::Plain);
+        }
+        let mut names = Vec::new();
+        for (p, (_, off)) in trimmed.iter().zip(&parts) {
+            let is_name = p
+                .chars()
+                .next()
+                .is_some_and(|c| c.is_alphabetic() || c == '_')
+                && p.chars().all(|c| c.is_alphanumeric() || c == '_');
+            if !is_name {
+                let e = IndexError {
+                    span: *off..off + p.len().max(1),
+                    message: format!("a family is declared over index names (`{base}[i,j]`), not `{p}`: index arithmetic belongs where members are used"),
+                };
+                return Err(located(self.ld, &name.span(), e));
+            }
+            if names.contains(&p.to_string()) {
+                return Err(self.ld.err(
+                    name.span(),
+                    format!("index `{p}` appears twice in `{text}`"),
+                ));
+            }
+            names.push(p.to_string());
+        }
+        if names.len() > 2 {
+            return Err(self.ld.err(
+                name.span(),
+                format!(
+                    "`{text}` has {} indices: families have one or two",
+                    names.len()
+                ),
+            ));
+        }
+        Ok(Head::Family(base, names))
+    }
+
+    /// The ranges of `names` (from `for` when given, else from `[indices]`) and the `where`.
+    fn domain(
+        &self,
+        at: &Range<usize>,
+        names: &[String],
+        for_list: Option<&Sv>,
+        condition: Option<&Sv>,
+    ) -> Result<Domain, ModelError> {
+        let clauses: Vec<ForClause> = match for_list {
+            Some(sv) => {
+                let toml::Value::String(text) = sv.get_ref() else {
+                    return Err(self
+                        .ld
+                        .err(sv.span(), "`for` is a string: \"i in 0..n-2, j\""));
+                };
+                index_expr::parse_for(text).map_err(|e| located(self.ld, &sv.span(), e))?
+            }
+            None => names
+                .iter()
+                .map(|n| ForClause {
+                    name: n.clone(),
+                    span: 0..0,
+                    range: None,
+                })
+                .collect(),
+        };
+        let mut out = Domain {
+            names: Vec::new(),
+            ranges: Vec::new(),
+            condition: None,
+        };
+        let lookup = self.indices.lookup(&[]);
+        for c in &clauses {
+            let range = match &c.range {
+                Some(r) => {
+                    let sv = for_list.expect("a range is written in a `for` list");
+                    let lo =
+                        r.lo.int(&lookup)
+                            .map_err(|e| located(self.ld, &sv.span(), e))?;
+                    let hi =
+                        r.hi.int(&lookup)
+                            .map_err(|e| located(self.ld, &sv.span(), e))?;
+                    (lo, hi)
+                }
+                None => match self.indices.ranges.get(&c.name) {
+                    Some(r) => *r,
+                    None => {
+                        let span = match for_list {
+                            Some(sv) => {
+                                let s = text_start(self.ld, &sv.span());
+                                s + c.span.start..s + c.span.end
+                            }
+                            None => at.clone(),
+                        };
+                        return Err(self
+                            .ld
+                            .err(span, format!("index `{}` has no range", c.name))
+                            .help(format!("declare it under [indices] (`{} = \"0..n-1\"`) or give it one here: for = \"{} in 0..n-1\"", c.name, c.name)));
+                    }
+                },
+            };
+            if range.1 < range.0 {
+                let span = for_list.map_or(at.clone(), |sv| sv.span());
+                return Err(self
+                    .ld
+                    .err(
+                        span,
+                        format!(
+                            "index `{}` has an empty range {}..{}",
+                            c.name, range.0, range.1
+                        ),
+                    )
+                    .help("a range first..last includes both ends and needs first <= last"));
+            }
+            out.names.push(c.name.clone());
+            out.ranges.push(range);
+        }
+        for n in names {
+            if !out.names.contains(n) {
+                let span = for_list.map_or(at.clone(), |sv| sv.span());
+                return Err(self
+                    .ld
+                    .err(span, format!("`for` gives no range to index `{n}`")));
+            }
+        }
+        if let Some(sv) = condition {
+            let toml::Value::String(text) = sv.get_ref() else {
+                return Err(self.ld.err(
+                    sv.span(),
+                    "`where` is a condition in quotes: \"j > 0 or i != 0\"",
+                ));
+            };
+            let e = index_expr::parse(text).map_err(|e| located(self.ld, &sv.span(), e))?;
+            out.condition = Some((e, sv.clone()));
+        }
+        Ok(out)
+    }
+
+    /// Every member of `domain` (row-major: the last index fastest), with `make` building each
+    /// entry.
+    fn each(
+        &mut self,
+        at: &Range<usize>,
+        base: &str,
+        domain: &Domain,
+        mut make: impl FnMut(&mut Self, &[(String, i64)]) -> Result<(), ModelError>,
+    ) -> Result<(), ModelError> {
+        let count = domain.count();
+        self.members = self.members.saturating_add(count);
+        if self.members > MAX_MEMBERS {
+            return Err(self
+                .ld
+                .err(
+                    at.clone(),
+                    format!(
+                        "the family `{base}` has {count} members, which would make the model's families more than {MAX_MEMBERS} entries"
+                    ),
+                )
+                .help("a model of this size cannot be loaded; use smaller ranges"));
+        }
+        let mut any = false;
+        let mut values: Vec<i64> = domain.ranges.iter().map(|r| r.0).collect();
+        'all: loop {
+            let bindings: Vec<(String, i64)> = domain
+                .names
+                .iter()
+                .cloned()
+                .zip(values.iter().copied())
+                .collect();
+            let keep = match &domain.condition {
+                None => true,
+                Some((e, sv)) => e.condition(&self.indices.lookup(&bindings)).map_err(|e| {
+                    let e = if e.span == (0..0) {
+                        IndexError {
+                            span: 0..self.ld.source[sv.span()].len().saturating_sub(2),
+                            message: e.message,
+                        }
+                    } else {
+                        e
+                    };
+                    let err = located(self.ld, &sv.span(), e);
+                    in_member(err, &label(base, &bindings))
+                })?,
+            };
+            if keep {
+                any = true;
+                make(self, &bindings)?;
+            }
+            for k in (0..values.len()).rev() {
+                if values[k] < domain.ranges[k].1 {
+                    values[k] += 1;
+                    continue 'all;
+                }
+                values[k] = domain.ranges[k].0;
+            }
+            break;
+        }
+        if !any {
+            return Err(self
+                .ld
+                .err(
+                    at.clone(),
+                    format!("the family `{base}` has no members: its `where` excludes every index"),
+                )
+                .help("check the condition, or remove the family"));
+        }
+        Ok(())
+    }
+
+    /// Records a declared family's shape (the union of its declarations' ranges: `P` may be
+    /// points where pinned and particles elsewhere).
+    fn record_shape(
+        &mut self,
+        name: &Name,
+        base: &str,
+        ranges: &[(i64, i64)],
+    ) -> Result<(), ModelError> {
+        match self.indices.shapes.get_mut(base) {
+            None => {
+                self.indices.shapes.insert(
+                    base.to_string(),
+                    Shape {
+                        ranges: ranges.to_vec(),
+                    },
+                );
+            }
+            Some(shape) if shape.ranges.len() == ranges.len() => {
+                for (s, r) in shape.ranges.iter_mut().zip(ranges) {
+                    *s = (s.0.min(r.0), s.1.max(r.1));
+                }
+            }
+            Some(shape) => {
+                return Err(self.ld.err(
+                    name.span(),
+                    format!(
+                        "`{}` has {} indices but `{base}` was declared with {}",
+                        name.get_ref(),
+                        ranges.len(),
+                        shape.ranges.len()
+                    ),
+                ))
+            }
+        }
+        Ok(())
+    }
+
+    /// Expands one keyed table (`[coordinates]`, `[points]`, `[definitions]`, `[particles]`).
+    /// `split` takes the `for` and `where` out of an entry's value and returns the value left.
+    fn keyed<V: Clone>(
+        &mut self,
+        table: IndexMap<Name, V>,
+        span_of: impl Fn(&V) -> Range<usize>,
+        split: impl Fn(&Self, &V) -> Result<(V, Option<Sv>, Option<Sv>), ModelError>,
+    ) -> Result<Expanded<IndexMap<Name, V>>, ModelError> {
+        let mut out = IndexMap::with_capacity(table.len());
+        let mut members = Vec::with_capacity(table.len());
+        for (name, value) in table {
+            match self.head(&name)? {
+                Head::Plain => {
+                    let (value, for_list, condition) = split(self, &value)?;
+                    if let Some(sv) = for_list.or(condition) {
+                        return Err(self
+                            .ld
+                            .err(
+                                sv.span(),
+                                format!(
+                                    "`for` and `where` belong to families; `{}` is one entry",
+                                    name.get_ref()
+                                ),
+                            )
+                            .help(format!(
+                                "declare a family with its indices: `{}[i]`",
+                                name.get_ref()
+                            )));
+                    }
+                    let key = match index_expr::split_subscript(name.get_ref()) {
+                        Some(_) => Spanned::new(
+                            name.span(),
+                            self.indices
+                                .member_name(name.get_ref(), &[])
+                                .map_err(|e| located(self.ld, &name.span(), e))?
+                                .unwrap_or_else(|| name.get_ref().clone()),
+                        ),
+                        None => name,
+                    };
+                    self.insert(&mut out, key, value)?;
+                    members.push(None);
+                }
+                Head::Family(base, names) => {
+                    let base = base.to_string();
+                    let (value, for_list, condition) = split(self, &value)?;
+                    let domain = self.domain(
+                        &span_of(&value),
+                        &names,
+                        for_list.as_ref(),
+                        condition.as_ref(),
+                    )?;
+                    // The shape is the ranges declared, whatever `where` leaves out.
+                    let ranges: Vec<(i64, i64)> = names
+                        .iter()
+                        .map(|n| {
+                            domain.ranges[domain.names.iter().position(|d| d == n).unwrap_or(0)]
+                        })
+                        .collect();
+                    self.record_shape(&name, &base, &ranges)?;
+                    self.each(&name.span(), &base, &domain, |ex, bindings| {
+                        let values: Vec<i64> = names
+                            .iter()
+                            .map(|n| bindings.iter().find(|b| &b.0 == n).map_or(0, |b| b.1))
+                            .collect();
+                        let key = Spanned::new(name.span(), member(&base, &values));
+                        ex.insert(&mut out, key, value.clone())?;
+                        members.push(Some(Member {
+                            label: label(&base, bindings),
+                            bindings: bindings.to_vec(),
+                        }));
+                        Ok(())
+                    })?;
+                }
+            }
+        }
+        Ok((out, members))
+    }
+
+    fn insert<V>(
+        &self,
+        out: &mut IndexMap<Name, V>,
+        key: Name,
+        value: V,
+    ) -> Result<(), ModelError> {
+        if out.contains_key(&key) {
+            return Err(self
+                .ld
+                .err(
+                    key.span(),
+                    format!("`{}` is declared twice in this table", key.get_ref()),
+                )
+                .help("a family's members and the table's other entries need distinct names"));
+        }
+        out.insert(key, value);
+        Ok(())
+    }
+
+    /// A name field of a force member: `P[i+1, j]` → `P[4,3]`.
+    fn resolve_name(&self, name: &Name, bindings: &[(String, i64)]) -> Result<Name, ModelError> {
+        match self
+            .indices
+            .member_name(name.get_ref(), bindings)
+            .map_err(|e| located(self.ld, &name.span(), e))?
+        {
+            Some(n) => Ok(Spanned::new(name.span(), n)),
+            None => Ok(name.clone()),
+        }
+    }
+
+    /// A force's name fields resolved to members: `P[i+1, j]` → `P[4,3]` with `bindings`
+    /// (`P[0, 9]` → `P[0,9]`, checked against its family, in an ordinary force).
+    fn resolve_names(
+        &self,
+        raw: &RawForce,
+        bindings: &[(String, i64)],
+    ) -> Result<RawForce, ModelError> {
+        let mut m = raw.clone();
+        m.for_list = None;
+        m.condition = None;
+        let names = |field: &Option<Name>| -> Result<Option<Name>, ModelError> {
+            field
+                .as_ref()
+                .map(|n| self.resolve_name(n, bindings))
+                .transpose()
+        };
+        m.on = names(&raw.on)?;
+        m.to = names(&raw.to)?;
+        m.normal_force = names(&raw.normal_force)?;
+        m.friction_force = names(&raw.friction_force)?;
+        if let Some(b) = &raw.between {
+            let ends = b
+                .get_ref()
+                .iter()
+                .map(|n| self.resolve_name(n, bindings))
+                .collect::<Result<Vec<_>, _>>()?;
+            m.between = Some(Spanned::new(b.span(), ends));
+        }
+        Ok(m)
+    }
+
+    fn force_member(
+        &self,
+        f: &Spanned<RawForce>,
+        base: &str,
+        bindings: &[(String, i64)],
+    ) -> Result<Spanned<RawForce>, ModelError> {
+        let raw = f.get_ref();
+        let mut m = self.resolve_names(raw, bindings)?;
+        m.name = Some(match &raw.name {
+            Some(n) if n.get_ref().contains('[') => self.resolve_name(n, bindings)?,
+            Some(n) => Spanned::new(n.span(), label(n.get_ref(), bindings)),
+            None => Spanned::new(f.span(), label(base, bindings)),
+        });
+        Ok(Spanned::new(f.span(), m))
+    }
+
+    fn forces(
+        &mut self,
+        forces: Vec<Spanned<RawForce>>,
+    ) -> Result<Expanded<Vec<Spanned<RawForce>>>, ModelError> {
+        let mut out = Vec::with_capacity(forces.len());
+        let mut members = Vec::with_capacity(forces.len());
+        for f in forces {
+            let raw = f.get_ref();
+            let Some(for_list) = raw.for_list.clone() else {
+                if let Some(c) = &raw.condition {
+                    return Err(self
+                        .ld
+                        .err(
+                            c.span(),
+                            "`where` needs `for`: it selects members of a family",
+                        )
+                        .help(
+                            "add for = \"i in 0..n-2\" (or the indices declared under [indices])",
+                        ));
+                }
+                let plain = self.resolve_names(raw, &[])?;
+                out.push(Spanned::new(f.span(), plain));
+                members.push(None);
+                continue;
+            };
+            let base = match (&raw.name, &raw.kind) {
+                (Some(n), _) => n.get_ref().split('[').next().unwrap_or("").to_string(),
+                (None, Some(k)) => k.get_ref().clone(),
+                (None, None) => "force".to_string(),
+            };
+            let domain = self.domain(&f.span(), &[], Some(&for_list), raw.condition.as_ref())?;
+            self.each(&for_list.span(), &base, &domain, |ex, bindings| {
+                let m = ex
+                    .force_member(&f, &base, bindings)
+                    .map_err(|e| in_member(e, &label(&base, bindings)))?;
+                out.push(m);
+                members.push(Some(Member {
+                    label: label(&base, bindings),
+                    bindings: bindings.to_vec(),
+                }));
+                Ok(())
+            })?;
+        }
+        Ok((out, members))
+    }
+}
+
+/// `err` as met while reading member `label`.
+pub(crate) fn in_member(mut err: ModelError, label: &str) -> ModelError {
+    if !err.message.starts_with(label) {
+        err.message = format!("{label}: {}", err.message);
+    }
+    err
+}
+
+/// Splits `for` and `where` out of a table value (`{ initial = ..., where = ... }`), with
+/// `main` naming the field that holds a point's or definition's value in table form.
+fn split_table(
+    ld: &Loader,
+    v: &Sv,
+    main: Option<&str>,
+) -> Result<(Sv, Option<Sv>, Option<Sv>), ModelError> {
+    let toml::Value::Table(t) = v.get_ref() else {
+        return Ok((v.clone(), None, None));
+    };
+    let mut t = t.clone();
+    // The values inside an inline table carry no spans: errors point at the whole table.
+    let take = |t: &mut toml::Table, key: &str| t.remove(key).map(|x| Spanned::new(v.span(), x));
+    let for_list = take(&mut t, "for");
+    let condition = take(&mut t, "where");
+    let value = match main {
+        Some(key) if t.len() == 1 && t.contains_key(key) => Spanned::new(
+            v.span(),
+            t.remove(key).unwrap_or(toml::Value::Boolean(false)),
+        ),
+        Some(key) => {
+            return Err(ld
+                .err(
+                    v.span(),
+                    format!("a table here holds `{key}` and optionally `for` and `where`"),
+                )
+                .help(format!("{{ {key} = \"...\", where = \"i > 0\" }}")))
+        }
+        None => Spanned::new(v.span(), toml::Value::Table(t)),
+    };
+    Ok((value, for_list, condition))
+}
+
+/// Reads `[indices]` into the loader's scope and replaces every family in `raw` by its
+/// members.
+pub(crate) fn expand(
+    ld: &mut Loader,
+    mut raw: RawModel,
+) -> Result<(RawModel, Members), ModelError> {
+    let indices = read_indices(ld, &raw)?;
+    if indices.ranges.is_empty() && indices.sizes.is_empty() && !mentions_families(&raw) {
+        let members = Members {
+            coordinates: vec![None; raw.coordinates.len()],
+            definitions: vec![None; raw.definitions.len()],
+            points: vec![None; raw.points.len()],
+            particles: vec![None; raw.particles.len()],
+            forces: vec![None; raw.forces.len()],
+        };
+        return Ok((raw, members));
+    }
+    let mut ex = Expander {
+        ld,
+        indices,
+        members: 0,
+    };
+    let sv_span = |v: &Sv| v.span();
+    let (coordinates, mc) = ex.keyed(std::mem::take(&mut raw.coordinates), sv_span, |ex, v| {
+        split_table(ex.ld, v, None)
+    })?;
+    let (points, mp) = ex.keyed(std::mem::take(&mut raw.points), sv_span, |ex, v| {
+        split_table(ex.ld, v, Some("position"))
+    })?;
+    let (definitions, md) = ex.keyed(std::mem::take(&mut raw.definitions), sv_span, |ex, v| {
+        split_table(ex.ld, v, Some("value"))
+    })?;
+    let (particles, mq) = ex.keyed(
+        std::mem::take(&mut raw.particles),
+        |p: &Spanned<RawParticle>| p.span(),
+        |_, p| {
+            let mut q = p.get_ref().clone();
+            let for_list = q.for_list.take();
+            let condition = q.condition.take();
+            Ok((Spanned::new(p.span(), q), for_list, condition))
+        },
+    )?;
+    let (forces, mf) = ex.forces(std::mem::take(&mut raw.forces))?;
+    raw.coordinates = coordinates;
+    raw.points = points;
+    raw.definitions = definitions;
+    raw.particles = particles;
+    raw.forces = forces;
+    let indices = ex.indices;
+    ld.scope.indices = indices;
+    Ok((
+        raw,
+        Members {
+            coordinates: mc,
+            definitions: md,
+            points: mp,
+            particles: mq,
+            forces: mf,
+        },
+    ))
+}
+
+/// Whether any entry is written with a subscript or `for`/`where` (a file without
+/// `[indices]` is then still expanded, to report what is missing).
+fn mentions_families(raw: &RawModel) -> bool {
+    let keyed = |k: &Name| k.get_ref().contains('[');
+    raw.coordinates.keys().any(keyed)
+        || raw.points.keys().any(keyed)
+        || raw.definitions.keys().any(keyed)
+        || raw.particles.keys().any(keyed)
+        || raw
+            .forces
+            .iter()
+            .any(|f| f.get_ref().for_list.is_some() || f.get_ref().condition.is_some())
+        || raw
+            .particles
+            .values()
+            .any(|p| p.get_ref().for_list.is_some() || p.get_ref().condition.is_some())
+}
+
+/// `[indices]`: sizes (integers) and index ranges (`"0..n-1"`), in order, each range using
+/// the sizes above it.
+fn read_indices(ld: &mut Loader, raw: &RawModel) -> Result<Indices, ModelError> {
+    let mut indices = Indices::default();
+    for (name, sv) in &raw.indices {
+        let n = name.get_ref();
+        match sv.get_ref() {
+            toml::Value::Integer(v) => {
+                let value = pdyn_expr::Value::Scalar(ld.pool.int(*v));
+                ld.declare(n, name.span(), "size", pdyn_expr::lower::Binding::Value(value))?;
+                ld.dims.bind(n, pdyn_expr::Dimension::NONE.into());
+                indices.sizes.insert(n.clone(), *v);
+            }
+            toml::Value::String(text) => {
+                let r = index_expr::parse_range(text).map_err(|e| located(ld, &sv.span(), e))?;
+                let (lo, hi) = {
+                    let lookup = indices.lookup(&[]);
+                    let lo = r.lo.int(&lookup).map_err(|e| located(ld, &sv.span(), e))?;
+                    let hi = r.hi.int(&lookup).map_err(|e| located(ld, &sv.span(), e))?;
+                    (lo, hi)
+                };
+                if hi < lo {
+                    return Err(ld
+                        .err(sv.span(), format!("index `{n}` has an empty range {lo}..{hi}"))
+                        .help("a range first..last includes both ends and needs first <= last"));
+                }
+                if indices.sizes.contains_key(n) || indices.ranges.contains_key(n) {
+                    return Err(ld.err(name.span(), format!("`{n}` is declared twice in [indices]")));
+                }
+                ld.reserve_index_name(n, name.span())?;
+                indices.ranges.insert(n.clone(), (lo, hi));
+            }
+            other => {
+                return Err(ld
+                    .err(sv.span(), format!("an entry of [indices] is a size (an integer) or a range (\"0..n-1\"), not a {}", other.type_str()))
+                    .help("n = 20 declares a size; i = \"0..n-1\" an index running from 0 to n-1"))
+            }
+        }
+    }
+    Ok(indices)
+}
