@@ -75,6 +75,14 @@ pub enum OdeError {
         /// Time, state, partial solution.
         at: FailurePoint,
     },
+    /// A step of the smallest size allowed ([`crate::Options::min_step`]) failed its error
+    /// test.
+    MinStep {
+        /// The limit.
+        min_step: f64,
+        /// Time, state, partial solution.
+        at: FailurePoint,
+    },
     /// The nonlinear solve of a fixed-step implicit method did not converge.
     NoConvergence {
         /// Time, state, partial solution.
@@ -95,6 +103,7 @@ impl OdeError {
             OdeError::StepSizeUnderflow { at, .. }
             | OdeError::NonFinite { at }
             | OdeError::MaxSteps { at, .. }
+            | OdeError::MinStep { at, .. }
             | OdeError::Stiff { at }
             | OdeError::SingularMatrix { at }
             | OdeError::NoConvergence { at }
@@ -118,6 +127,11 @@ impl fmt::Display for OdeError {
                     at.t
                 )
             }
+            OdeError::MinStep { min_step, at } => write!(
+                f,
+                "the step size needed is below min_step = {min_step:e} at t = {}",
+                at.t
+            ),
             OdeError::Stiff { at } => {
                 write!(f, "the problem seems to become stiff at t = {}", at.t)
             }

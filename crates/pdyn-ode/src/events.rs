@@ -26,6 +26,8 @@ use crate::solution::{Direction, EventHit, PossibleMiss};
 pub trait DenseOutput {
     /// Writes the interpolated state at `t` into `out`.
     fn interpolate(&self, t: f64, out: &mut [f64]);
+    /// Appends this step's interpolant, valid on `[t_from, t_to]`, to `into`.
+    fn record(&self, t_from: f64, t_to: f64, into: &mut crate::dense::DenseSolution);
 }
 
 /// An event function `g(t, y)`, its direction filter and whether it stops the integration.
@@ -381,14 +383,18 @@ pub(crate) struct Output<'a> {
     t_eval: Option<&'a [f64]>,
     next: usize,
     dir: f64,
+    /// With `t_eval`: whether a terminal event's point is output too.
+    event_point: bool,
 }
 
 impl<'a> Output<'a> {
-    pub(crate) fn new(t_eval: Option<&'a [f64]>, dir: f64) -> Self {
+    /// Outputs at `opts.t_eval` (or after every step) in the direction `dir`.
+    pub(crate) fn new(opts: &'a crate::Options, dir: f64) -> Self {
         Output {
-            t_eval,
+            t_eval: opts.t_eval.as_deref(),
             next: 0,
             dir,
+            event_point: opts.output_terminal_event,
         }
     }
 
@@ -444,7 +450,7 @@ impl<'a> Output<'a> {
         }
         match stop {
             Some(ts) => {
-                if sol.t.last() != Some(&ts) {
+                if (self.t_eval.is_none() || self.event_point) && sol.t.last() != Some(&ts) {
                     interp.interpolate(ts, ytmp);
                     sol.push(ts, ytmp);
                 }

@@ -78,6 +78,8 @@ pub(crate) struct Setup {
     pub atol: Vec<f64>,
     pub rtol: Vec<f64>,
     pub hmax: f64,
+    /// [`Options::min_step`] (0 when unset).
+    pub hmin: f64,
 }
 
 pub(crate) fn setup<S: OdeSystem + ?Sized>(
@@ -121,12 +123,21 @@ pub(crate) fn setup<S: OdeSystem + ?Sized>(
         Some(m) => m.abs(),
         None => (tf - t0).abs(),
     };
+    let hmin = match opts.min_step {
+        Some(m) if !(m >= 0.0 && m.is_finite()) => {
+            return Err(invalid("min_step must be finite and non-negative"))
+        }
+        Some(m) if m > hmax => return Err(invalid("min_step exceeds max_step")),
+        Some(m) => m,
+        None => 0.0,
+    };
     Ok(Setup {
         n,
         dir: if tf >= t0 { 1.0 } else { -1.0 },
         atol,
         rtol,
         hmax,
+        hmin,
     })
 }
 
@@ -146,8 +157,12 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
         atol,
         rtol,
         hmax,
+        hmin,
     } = setup(sys, t0, tf, y0, opts)?;
     let mut sol = Solution::new(M::METHOD, n);
+    if opts.dense_output {
+        sol.dense = Some(crate::DenseSolution::new(n));
+    }
     let mut y = y0.to_vec();
     let mut y_new = vec![0.0; n];
     let mut ytmp = vec![0.0; n];
@@ -156,7 +171,7 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
     let ctrl = opts.controller.unwrap_or_else(M::default_controller);
     let mut pi = PiState::new(&ctrl, M::alpha(&ctrl));
 
-    let mut out = Output::new(opts.t_eval.as_deref(), dir);
+    let mut out = Output::new(opts, dir);
     out.start(&mut sol, t0, y0);
     if t0 == tf {
         return Ok(sol);
@@ -183,6 +198,9 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
             )
         }
     };
+    if h.abs() < hmin {
+        h = hmin * dir;
+    }
     let mut ev = EventState::new(events, n, t0, y0);
     let mut t = t0;
     let mut reject = false;
@@ -259,7 +277,7 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
                 }
             }
             let crossed = !events.is_empty() && ev.check(t_new, &y_new);
-            if crossed || out.needs_dense(t_new) {
+            if crossed || out.needs_dense(t_new) || sol.dense.is_some() {
                 rk.prepare_dense(sys, t, &y, h, &y_new, &mut sol.stats);
             }
             let stop = if crossed {
@@ -267,6 +285,9 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
             } else {
                 None
             };
+            if let Some(d) = sol.dense.as_mut() {
+                rk.record(t, stop.map_or(t_new, |s| s.0), d);
+            }
             ev.drain_suspects(&mut sol.possible_misses);
             out.emit(&mut sol, &rk, t_new, &y_new, stop.map(|s| s.0), &mut ytmp);
             if let Some((_, idx)) = stop {
@@ -287,13 +308,19 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
             }
             reject = false;
         } else {
+            if hmin > 0.0 && h.abs() <= hmin {
+                return Err(OdeError::MinStep {
+                    min_step: hmin,
+                    at: point(t, &y, &sol),
+                });
+            }
             reject = true;
             last = false;
             if sol.stats.accepted >= 1 {
                 sol.stats.rejected += 1;
             }
         }
-        h = hnew;
+        h = if hnew.abs() < hmin { hmin * dir } else { hnew };
     }
 }
 

@@ -77,18 +77,19 @@ impl Hermite {
 
 impl DenseOutput for Hermite {
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let n = self.n;
         let s = (t - self.t0) / self.h;
-        let s2 = s * s;
-        let s3 = s2 * s;
-        let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
-        let h10 = (s3 - 2.0 * s2 + s) * self.h;
-        let h01 = -2.0 * s3 + 3.0 * s2;
-        let h11 = (s3 - s2) * self.h;
-        let b = &self.buf;
-        for i in 0..n {
-            out[i] = h00 * b[i] + h10 * b[n + i] + h01 * b[2 * n + i] + h11 * b[3 * n + i];
-        }
+        crate::dense::hermite(&self.buf, self.n, s, self.h, out);
+    }
+    fn record(&self, t_from: f64, t_to: f64, into: &mut crate::dense::DenseSolution) {
+        use crate::dense::Interpolant;
+        into.push(
+            t_from,
+            t_to,
+            Interpolant::Hermite,
+            self.t0,
+            self.h,
+            &[&self.buf[..4 * self.n]],
+        );
     }
 }
 
@@ -109,6 +110,9 @@ pub(crate) fn integrate_fixed<P: ?Sized, F: OdeSystem + ?Sized, M: FixedStepper<
     let su = setup(deriv, t0, tf, y0, opts)?;
     let n = su.n;
     let mut sol = Solution::new(method, n);
+    if opts.dense_output {
+        sol.dense = Some(crate::DenseSolution::new(n));
+    }
     let Some(h0) = opts.h0 else {
         return Err(invalid(format!(
             "{method} is a fixed-step method: set h0 (the step size)"
@@ -122,7 +126,7 @@ pub(crate) fn integrate_fixed<P: ?Sized, F: OdeSystem + ?Sized, M: FixedStepper<
             .ceil()
             .max(1.0) as usize
     };
-    let mut out = Output::new(opts.t_eval.as_deref(), su.dir);
+    let mut out = Output::new(opts, su.dir);
     out.start(&mut sol, t0, y0);
     if nsteps > opts.max_steps {
         return Err(OdeError::MaxSteps {
@@ -163,7 +167,7 @@ pub(crate) fn integrate_fixed<P: ?Sized, F: OdeSystem + ?Sized, M: FixedStepper<
         }
         sol.stats.accepted += 1;
         let crossed = !events.is_empty() && ev.check(t_new, &y_new);
-        if crossed || out.needs_dense(t_new) {
+        if crossed || out.needs_dense(t_new) || sol.dense.is_some() {
             herm.prepare(deriv, t, &y, t_new, &y_new, &mut sol.stats);
         }
         let stop = if crossed {
@@ -171,6 +175,9 @@ pub(crate) fn integrate_fixed<P: ?Sized, F: OdeSystem + ?Sized, M: FixedStepper<
         } else {
             None
         };
+        if let Some(d) = sol.dense.as_mut() {
+            herm.record(t, stop.map_or(t_new, |s| s.0), d);
+        }
         ev.drain_suspects(&mut sol.possible_misses);
         out.emit(&mut sol, &herm, t_new, &y_new, stop.map(|s| s.0), &mut ytmp);
         if let Some((_, idx)) = stop {

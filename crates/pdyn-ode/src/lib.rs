@@ -25,6 +25,7 @@
 //! | `problem.rs` | [`OdeSystem`] (`M y' = f(t, y)` in place, optional Jacobian and mass matrix), [`SecondOrderSystem`] (`q'' = a(t, q, q')`, `separable` flag), closure wrappers, [`MassInverse`] |
 //! | `options.rs` | [`Options`] (`rtol`, `atol`, `h0`, `max_step`, `max_steps`, `t_eval`, …) with documented defaults |
 //! | `solution.rs` | [`Solution`] (output times and states, [`Stats`], [`EventHit`]s) |
+//! | `dense.rs` | [`DenseSolution`]: every step's own interpolant, when [`Options::dense_output`] is set |
 //! | `error.rs` | [`OdeError`]: typed failures carrying `t`, the state and the partial solution |
 //! | `controller.rs` | the shared PI step-size controller and initial-step estimate (Hairer) |
 //! | `events.rs` | [`Event`]s and the shared locator (Brent's method on the dense output), output at `t_eval` |
@@ -32,6 +33,7 @@
 //! | `tableau.rs` | Butcher tableaus as data; order-condition checker over rooted trees |
 //! | `linalg.rs` | dense real/complex LU with partial pivoting (decsol.f), allocation-free |
 //! | `methods/dopri5.rs` | **DOPRI5**, Dormand & Prince 1980: 5(4), FSAL, 4th-order dense output, stiffness detection (MATLAB `ode45`) |
+//! | `methods/rk23.rs` | **RK23**, Bogacki & Shampine 1989: 3(2), FSAL, cubic Hermite dense output (MATLAB `ode23`) |
 //! | `methods/tsit5.rs` | **Tsit5**, Tsitouras 2011: 5(4), FSAL, 4th-order dense output |
 //! | `methods/dop853.rs` | **DOP853**, Prince & Dormand 1981 / Hairer: 8(5,3), 7th-order dense output |
 //! | `methods/vern9.rs` | **Vern9**, Verner 2010: 9(8), for very tight tolerances (cubic Hermite dense output) |
@@ -63,6 +65,7 @@
 #![allow(clippy::excessive_precision)]
 
 pub mod controller;
+pub mod dense;
 mod error;
 pub mod events;
 mod explicit;
@@ -76,6 +79,7 @@ mod solution;
 pub mod tableau;
 
 pub use controller::Controller;
+pub use dense::{DenseSolution, Interpolant};
 pub use error::{FailurePoint, OdeError};
 pub use events::{DenseOutput, Event};
 pub use options::{Interrupt, Options, StiffnessAction, Tolerance};
@@ -94,6 +98,8 @@ pub enum Method {
     Dopri5,
     /// Tsitouras 5(4) ([`methods::tsit5`]), adaptive.
     Tsit5,
+    /// Bogacki–Shampine 3(2) ([`methods::rk23`]), adaptive; MATLAB's `ode23`, SciPy's `RK23`.
+    Rk23,
     /// Dormand–Prince 8(5,3) ([`methods::dop853`]), adaptive.
     Dop853,
     /// Verner 9(8) ([`methods::vern9`]), adaptive.
@@ -172,7 +178,7 @@ impl MethodInfo {
 
 /// Every method, in the order `--method help` lists them. Adding a method: a variant of
 /// [`Method`], a row here, an arm in `dispatch` (which calls the method's generic code).
-pub const METHODS: [MethodInfo; 13] = {
+pub const METHODS: [MethodInfo; 14] = {
     use methods::*;
     const fn row(
         method: Method,
@@ -198,6 +204,10 @@ pub const METHODS: [MethodInfo; 13] = {
             ..row(Method::Dopri5, "dopri5", 5, Adaptive, dopri5::DOC)
         },
         row(Method::Tsit5, "tsit5", 5, Adaptive, tsit5::DOC),
+        MethodInfo {
+            aliases: &["ode23"],
+            ..row(Method::Rk23, "rk23", 3, Adaptive, rk23::DOC)
+        },
         row(Method::Dop853, "dop853", 8, Adaptive, dop853::DOC),
         row(Method::Vern9, "vern9", 9, Adaptive, vern9::DOC),
         row(Method::Rk4, "rk4", 4, FixedStep, rk4::DOC),
@@ -380,6 +390,9 @@ fn dispatch<S: OdeSystem + ?Sized>(
         Method::Dop853 => {
             explicit::integrate::<methods::dop853::Dop853, S>(sys, t0, tf, y0, opts, events, act)
         }
+        Method::Rk23 => {
+            explicit::integrate::<methods::rk23::Rk23, S>(sys, t0, tf, y0, opts, events, act)
+        }
         Method::Vern9 => {
             explicit::integrate::<methods::vern9::Vern9, S>(sys, t0, tf, y0, opts, events, act)
         }
@@ -469,6 +482,9 @@ fn auto<S: OdeSystem + ?Sized>(
         sol.y.extend_from_slice(&r.y[skip * r.n..]);
         sol.events.append(&mut r.events);
         sol.possible_misses.append(&mut r.possible_misses);
+        if let (Some(d), Some(rd)) = (sol.dense.as_mut(), r.dense.as_ref()) {
+            d.append(rd);
+        }
         // The stiffness detection that caused the switch stays the first one recorded.
         sol.stats.add(&r.stats);
         sol.status = r.status;
@@ -484,6 +500,7 @@ fn auto<S: OdeSystem + ?Sized>(
                 OdeError::StepSizeUnderflow { at, .. }
                 | OdeError::NonFinite { at }
                 | OdeError::MaxSteps { at, .. }
+                | OdeError::MinStep { at, .. }
                 | OdeError::SingularMatrix { at }
                 | OdeError::Interrupted { at } => Some(at),
                 _ => None,

@@ -104,6 +104,18 @@ pub struct Options {
     /// What to do when stiffness is detected. Default [`StiffnessAction::Ignore`]
     /// (`Method::Auto` switches to Radau5 regardless).
     pub on_stiffness: StiffnessAction,
+    /// Record every accepted step's interpolant in [`crate::Solution::dense`] (the method's
+    /// own continuous extension; DOP853 then spends its three extra stages on every step).
+    /// Default `false`.
+    pub dense_output: bool,
+    /// Smallest step size allowed (magnitude) for the adaptive methods: steps are not made
+    /// smaller (except the last one, which lands on `tf`), and a step of this size that fails
+    /// its error test ends the solve with [`crate::OdeError::MinStep`]. Default `None`.
+    pub min_step: Option<f64>,
+    /// With `t_eval`, whether a terminal event's time and state are also output (after the
+    /// requested times before it). Default `true`; SciPy's `solve_ivp` outputs exactly
+    /// `t_eval` (`false`), the event being in [`crate::Solution::events`] either way.
+    pub output_terminal_event: bool,
     /// A flag another thread may set to stop the integration (Ctrl-C in Python): checked
     /// before every step attempt; the solve then ends with [`OdeError::Interrupted`] and the
     /// partial solution. Default `None`.
@@ -134,6 +146,9 @@ impl Default for Options {
             controller: None,
             stiffness_check_interval: 1000,
             on_stiffness: StiffnessAction::Ignore,
+            dense_output: false,
+            min_step: None,
+            output_terminal_event: true,
             interrupt: None,
         }
     }

@@ -34,6 +34,18 @@ pub trait OdeSystem {
     /// matters: integrators call it once per stage.
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]);
 
+    /// Writes `f(t, y)` for several states at once: `ys` holds `k` states one after the other
+    /// (`k · n` values), `out` receives the `k` derivatives likewise. The finite-difference
+    /// Jacobians call it with the `n` perturbed states. The default calls
+    /// [`rhs`](OdeSystem::rhs) once per state; a system that evaluates many states in one call
+    /// (SciPy's `vectorized=True`) overrides it.
+    fn rhs_batch(&self, t: f64, ys: &[f64], out: &mut [f64]) {
+        let n = self.dim();
+        for (y, o) in ys.chunks_exact(n).zip(out.chunks_exact_mut(n)) {
+            self.rhs(t, y, o);
+        }
+    }
+
     /// Whether [`jacobian`](OdeSystem::jacobian) is implemented. When `false` the implicit
     /// methods approximate the Jacobian by forward finite differences.
     fn has_jacobian(&self) -> bool {
@@ -64,6 +76,9 @@ impl<S: OdeSystem + ?Sized> OdeSystem for &S {
     }
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
         (**self).rhs(t, y, dydt)
+    }
+    fn rhs_batch(&self, t: f64, ys: &[f64], out: &mut [f64]) {
+        (**self).rhs_batch(t, ys, out)
     }
     fn has_jacobian(&self) -> bool {
         (**self).has_jacobian()

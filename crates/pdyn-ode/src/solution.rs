@@ -110,6 +110,8 @@ pub struct Solution {
     pub stats: Stats,
     /// How the integration ended.
     pub status: Status,
+    /// Every accepted step's interpolant, when [`crate::Options::dense_output`] is set.
+    pub dense: Option<crate::DenseSolution>,
 }
 
 impl Solution {
@@ -123,6 +125,7 @@ impl Solution {
             possible_misses: Vec::new(),
             stats: Stats::default(),
             status: Status::Finished,
+            dense: None,
         }
     }
 

@@ -7,11 +7,11 @@
 use crate::convert::{f64_array, f64_matrix, method_name, stats_dict};
 use crate::errors::{guarded, pdyn_error};
 use numpy::{PyArray1, PyReadonlyArray1};
-use pdyn_ode::{Direction, Event, FnSystem, Method, Options, Solution, Status};
-use pyo3::exceptions::PyTypeError;
+use pdyn_ode::{Direction, Event, Method, OdeSystem, Options, Solution, Status};
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::sync::Arc;
 
 /// An event for `solve_ivp`: a Python callable or an expression, with SciPy's attributes.
@@ -56,16 +56,91 @@ impl<'a> Evaluator<'a> {
 /// An event function `g(t, y)`.
 type EventFn<'a> = dyn Fn(f64, &[f64]) -> f64 + 'a;
 
+/// The Jacobian given to `solve_ivp`: a constant matrix or a callable `jac(t, y)`.
+enum Jac {
+    Constant(Vec<f64>),
+    Callable(PyObject),
+}
+
 /// The options of one `solve_ivp` call.
 struct IvpOptions {
     method: Method,
     t_span: (f64, f64),
     y0: Vec<f64>,
     opts: Options,
+    /// SciPy's `vectorized`: `fun` takes a `(n, k)` array and returns one.
+    vectorized: bool,
+    jac: Option<Jac>,
+}
+
+/// What the callables were asked to do (SciPy's `nfev`, `njev`), counted at the calls.
+#[derive(Default)]
+struct Calls {
+    fun: Cell<usize>,
+    jac: Cell<usize>,
+}
+
+/// The system `solve_ivp` integrates: `f`, its batch form (the finite-difference Jacobian's
+/// perturbed states in one call when `vectorized`), and the Jacobian when one was given.
+struct IvpSystem<'a> {
+    n: usize,
+    f: &'a VecFn<'a>,
+    batch: Option<&'a VecFn<'a>>,
+    jac: Option<&'a VecFn<'a>>,
+}
+
+/// `f(t, y, out)`: a right-hand side, its batch form, or a Jacobian.
+type VecFn<'a> = dyn Fn(f64, &[f64], &mut [f64]) + 'a;
+
+impl OdeSystem for IvpSystem<'_> {
+    fn dim(&self) -> usize {
+        self.n
+    }
+    fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
+        (self.f)(t, y, dydt)
+    }
+    fn rhs_batch(&self, t: f64, ys: &[f64], out: &mut [f64]) {
+        match self.batch {
+            Some(b) => b(t, ys, out),
+            None => {
+                for (y, o) in ys.chunks_exact(self.n).zip(out.chunks_exact_mut(self.n)) {
+                    (self.f)(t, y, o);
+                }
+            }
+        }
+    }
+    fn has_jacobian(&self) -> bool {
+        self.jac.is_some()
+    }
+    fn jacobian(&self, t: f64, y: &[f64], jac: &mut [f64]) {
+        if let Some(j) = self.jac {
+            j(t, y, jac)
+        }
+    }
+}
+
+/// Keeps the first Python error raised in a callback.
+fn keep(err: &RefCell<Option<PyErr>>, e: PyErr) {
+    if err.borrow().is_none() {
+        *err.borrow_mut() = Some(e);
+    }
+}
+
+/// `v` as a flat float64 vector (row-major for a matrix; a SciPy sparse matrix is made dense).
+fn to_vec(py: Python<'_>, v: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    let np = py.import("numpy")?;
+    let v = if v.hasattr("toarray")? && !v.is_instance(&np.getattr("ndarray")?)? {
+        v.call_method0("toarray")?
+    } else {
+        v.clone()
+    };
+    let a = np.call_method1("asarray", (v, "float64"))?;
+    a.call_method0("ravel")?.extract::<Vec<f64>>()
 }
 
 /// Integrates with the given right-hand side and events; Python errors raised inside
 /// callbacks are kept in `err` (the solver then sees NaN and stops).
+#[allow(clippy::too_many_arguments)]
 fn integrate(
     py: Option<Python<'_>>,
     rhs: &Rhs,
@@ -73,26 +148,46 @@ fn integrate(
     params: &[(String, f64)],
     o: &IvpOptions,
     err: &RefCell<Option<PyErr>>,
+    calls: &Calls,
 ) -> Result<Solution, pdyn_ode::OdeError> {
     let n = o.y0.len();
-    let call_py = |f: &PyObject, t: f64, y: &[f64]| -> Option<Vec<f64>> {
+    // Calls a Python function of (t, y) with y of shape (n,), or (n, k) for `k` states given
+    // one after the other (`cols`).
+    let call_py = |f: &PyObject, t: f64, y: &[f64], cols: Option<usize>| -> Option<Vec<f64>> {
         let py = py?;
         if err.borrow().is_some() {
             return None;
         }
-        let arr = PyArray1::from_slice(py, y);
-        let r = f.call1(py, (t, arr)).and_then(|v| {
+        let r = (|| -> PyResult<Vec<f64>> {
+            let arr = PyArray1::from_slice(py, y);
+            let arg: Bound<'_, PyAny> = match cols {
+                // k states of n one after the other = the (k, n) array, transposed.
+                Some(k) => arr.call_method1("reshape", (k, n))?.getattr("T")?,
+                None => arr.into_any(),
+            };
+            let v = f.call1(py, (t, arg))?;
             let v = v.bind(py);
-            // Arrays, lists and scalars (for an event) alike.
-            let np = py.import("numpy")?;
-            let a = np.call_method1("asarray", (v, "float64"))?;
-            let a = a.call_method0("ravel")?;
-            a.extract::<Vec<f64>>()
-        });
+            match cols {
+                Some(k) => {
+                    // The (n, k) result, read state by state.
+                    let np = py.import("numpy")?;
+                    let a = np.call_method1("asarray", (v, "float64"))?;
+                    let shape: Vec<usize> = a.getattr("shape")?.extract()?;
+                    if shape != [n, k] {
+                        return Err(PyValueError::new_err(format!(
+                            "fun (vectorized) returned an array of shape {shape:?} for y of \
+                             shape ({n}, {k}); expected ({n}, {k})"
+                        )));
+                    }
+                    a.getattr("T")?.call_method0("ravel")?.extract()
+                }
+                None => to_vec(py, v),
+            }
+        })();
         match r {
             Ok(v) => Some(v),
             Err(e) => {
-                *err.borrow_mut() = Some(e);
+                keep(err, e);
                 None
             }
         }
@@ -101,23 +196,69 @@ fn integrate(
         Rhs::Compiled(p) => Some(Evaluator::new(p, n, params)),
         Rhs::Callable(_) => None,
     };
+    let fill = |dy: &mut [f64], v: Option<Vec<f64>>| match v {
+        Some(v) if v.len() == dy.len() => dy.copy_from_slice(&v),
+        Some(v) => {
+            keep(
+                err,
+                PyValueError::new_err(format!(
+                    "fun returned {} values; expected {} (y0 has {n} components)",
+                    v.len(),
+                    dy.len()
+                )),
+            );
+            dy.fill(f64::NAN);
+        }
+        None => dy.fill(f64::NAN),
+    };
     let f = |t: f64, y: &[f64], dy: &mut [f64]| match (rhs, &evaluator) {
         (Rhs::Compiled(_), Some(ev)) => ev.eval(t, y, dy),
-        (Rhs::Callable(func), _) => match call_py(func, t, y) {
-            Some(v) if v.len() == dy.len() => dy.copy_from_slice(&v),
-            Some(v) => {
-                if err.borrow().is_none() {
-                    *err.borrow_mut() = Some(PyErr::new::<pyo3::exceptions::PyValueError, _>(
-                        format!("fun returned {} values for {} states", v.len(), dy.len()),
-                    ));
-                }
-                dy.fill(f64::NAN);
-            }
-            None => dy.fill(f64::NAN),
-        },
+        (Rhs::Callable(func), _) => {
+            calls.fun.set(calls.fun.get() + 1);
+            let v = call_py(func, t, y, o.vectorized.then_some(1));
+            fill(dy, v)
+        }
         _ => dy.fill(f64::NAN),
     };
-    let system = FnSystem::new(n, f);
+    let batch = |t: f64, ys: &[f64], out: &mut [f64]| match rhs {
+        Rhs::Callable(func) => {
+            calls.fun.set(calls.fun.get() + 1);
+            let v = call_py(func, t, ys, Some(ys.len() / n));
+            fill(out, v)
+        }
+        Rhs::Compiled(_) => {
+            for (y, o) in ys.chunks_exact(n).zip(out.chunks_exact_mut(n)) {
+                f(t, y, o);
+            }
+        }
+    };
+    let jac = |t: f64, y: &[f64], out: &mut [f64]| {
+        calls.jac.set(calls.jac.get() + 1);
+        match &o.jac {
+            Some(Jac::Constant(m)) => out.copy_from_slice(m),
+            Some(Jac::Callable(j)) => match call_py(j, t, y, None) {
+                Some(v) if v.len() == out.len() => out.copy_from_slice(&v),
+                Some(v) => {
+                    keep(
+                        err,
+                        PyValueError::new_err(format!(
+                            "jac returned {} values; expected an array of shape ({n}, {n})",
+                            v.len()
+                        )),
+                    );
+                    out.fill(f64::NAN);
+                }
+                None => out.fill(f64::NAN),
+            },
+            None => out.fill(f64::NAN),
+        }
+    };
+    let system = IvpSystem {
+        n,
+        f: &f,
+        batch: (o.vectorized && matches!(rhs, Rhs::Callable(_))).then_some(&batch as _),
+        jac: o.jac.as_ref().map(|_| &jac as _),
+    };
     let event_evals: Vec<Option<Evaluator<'_>>> = events
         .iter()
         .map(|e| match &e.function {
@@ -136,7 +277,7 @@ fn integrate(
                     out[0]
                 }),
                 (Rhs::Callable(func), _) => Box::new(move |t, y| {
-                    call_py(func, t, y)
+                    call_py(func, t, y, None)
                         .and_then(|v| v.first().copied())
                         .unwrap_or(f64::NAN)
                 }),
@@ -159,10 +300,108 @@ fn integrate(
     pdyn_ode::solve_with_events(o.method, &system, o.t_span, &o.y0, &o.opts, &evs)
 }
 
+/// `sol.sol` of `pdyn.solve_ivp(..., dense_output=True)`: every step's own interpolant (the
+/// method's continuous extension: order 7 for DOP853, 4 for RK45 and Tsit5, 3 for RK23 and
+/// Radau), called like SciPy's `OdeSolution`: `sol(t)` is the state at `t`, shape `(n,)` for
+/// a scalar and `(n, len(t))` for an array.
+#[pyclass(module = "pdyn", name = "OdeSolution", frozen)]
+pub(crate) struct IvpDense {
+    inner: pdyn_ode::DenseSolution,
+    n: usize,
+}
+
+#[pymethods]
+impl IvpDense {
+    fn __call__<'py>(&self, py: Python<'py>, t: &Bound<'py, PyAny>) -> PyResult<PyObject> {
+        let np = py.import("numpy")?;
+        let a = np.call_method1("asarray", (t, "float64"))?;
+        let ndim: usize = a.getattr("ndim")?.extract()?;
+        if ndim > 1 {
+            return Err(PyValueError::new_err("`t` must be a float or a 1-D array."));
+        }
+        let ts: Vec<f64> = a.call_method0("ravel")?.extract()?;
+        let n = self.n;
+        let mut out = vec![0.0; n * ts.len()];
+        if !self.inner.is_empty() {
+            for (k, &t) in ts.iter().enumerate() {
+                self.inner.eval(t, &mut out[k * n..(k + 1) * n]);
+            }
+        }
+        if ndim == 0 {
+            return Ok(f64_array(py, out).into_any().unbind());
+        }
+        let m = f64_matrix(py, out, ts.len(), n)?;
+        Ok(m.bind(py).getattr("T")?.call_method0("copy")?.unbind())
+    }
+
+    /// The step boundaries (SciPy's `OdeSolution.ts`).
+    #[getter]
+    fn ts<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, self.inner.steps())
+    }
+
+    /// The start of the interval covered.
+    #[getter]
+    fn t_min(&self) -> f64 {
+        let s = self.inner.steps();
+        s.first()
+            .copied()
+            .unwrap_or(f64::NAN)
+            .min(s.last().copied().unwrap_or(f64::NAN))
+    }
+
+    /// The end of the interval covered.
+    #[getter]
+    fn t_max(&self) -> f64 {
+        let s = self.inner.steps();
+        s.first()
+            .copied()
+            .unwrap_or(f64::NAN)
+            .max(s.last().copied().unwrap_or(f64::NAN))
+    }
+
+    /// Number of steps (SciPy's `n_segments`).
+    #[getter]
+    fn n_segments(&self) -> usize {
+        self.inner.len()
+    }
+
+    /// The interpolant's name and order.
+    #[getter]
+    fn interpolant(&self) -> &'static str {
+        if self.inner.is_empty() {
+            return "none";
+        }
+        match self.inner.interpolant(self.inner.len() - 1) {
+            pdyn_ode::Interpolant::Dopri5 => "dopri5 (order 4)",
+            pdyn_ode::Interpolant::Tsit5 => "tsit5 (order 4)",
+            pdyn_ode::Interpolant::Dop853 => "dop853 (order 7)",
+            pdyn_ode::Interpolant::Radau5 { .. } => "radau5 collocation (order 3)",
+            pdyn_ode::Interpolant::Hermite => "cubic Hermite (order 3)",
+        }
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "OdeSolution({} steps on [{}, {}], {})",
+            self.inner.len(),
+            self.t_min(),
+            self.t_max(),
+            self.interpolant()
+        )
+    }
+}
+
+/// Doubles a solve may store before pdyn's memory guard stops it (2^28 = 2 GiB) when no
+/// `max_steps` is given: the outputs after every step (without `t_eval`) and the dense output
+/// grow with the number of steps.
+const MEMORY_GUARD_DOUBLES: usize = 1 << 28;
+
 /// `solve_ivp`'s Rust part: returns a dict of plain data (`pdyn.solve_ivp` builds the
-/// `OdeResult`). `fun` is a callable `fun(t, y)` or a list of expression strings.
+/// `OdeResult`). `fun` is a callable `fun(t, y)` (arguments already bound) or a list of
+/// expression strings; `jac` a callable, a matrix (row-major, flat) or `None`.
 #[pyfunction]
-#[pyo3(signature = (fun, t0, tf, y0, method, t_eval, rtol, atol, max_step, first_step, max_steps, events, args, dense=false, jit=true))]
+#[pyo3(signature = (fun, t0, tf, y0, method, t_eval, rtol, atol, max_step, first_step, min_step, max_steps, events, args, dense=false, jit=true, jac=None, vectorized=false))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn _solve_ivp(
     py: Python<'_>,
@@ -176,11 +415,14 @@ pub(crate) fn _solve_ivp(
     atol: Vec<f64>,
     max_step: Option<f64>,
     first_step: Option<f64>,
+    min_step: Option<f64>,
     max_steps: Option<usize>,
     events: Vec<(Bound<'_, PyAny>, Option<usize>, i32)>,
     args: Vec<(String, f64)>,
     dense: bool,
     jit: bool,
+    jac: Option<Bound<'_, PyAny>>,
+    vectorized: bool,
 ) -> PyResult<PyObject> {
     guarded(py, || {
         let y0 = y0.as_slice()?.to_vec();
@@ -190,7 +432,8 @@ pub(crate) fn _solve_ivp(
                 py,
                 "ParameterError",
                 format!(
-                    "unknown method `{method}`: use RK45, DOP853, Radau or one of pdyn's ({})",
+                    "unknown method `{method}`: use RK45, RK23, DOP853, Radau, BDF, LSODA or \
+                     one of pdyn's ({})",
                     Method::all()
                         .iter()
                         .map(|m| m.name())
@@ -239,6 +482,21 @@ pub(crate) fn _solve_ivp(
                 },
             });
         }
+        let jac = match jac {
+            None => None,
+            Some(j) if j.is_callable() => Some(Jac::Callable(j.unbind())),
+            Some(j) => {
+                let v = to_vec(py, &j)?;
+                if v.len() != n * n {
+                    return Err(PyValueError::new_err(format!(
+                        "`jac` is expected to have shape ({n}, {n}), but actually has {} \
+                         elements.",
+                        v.len()
+                    )));
+                }
+                Some(Jac::Constant(v))
+            }
+        };
         let tol = |v: Vec<f64>| -> pdyn_ode::Tolerance {
             if v.len() == 1 {
                 v[0].into()
@@ -251,25 +509,58 @@ pub(crate) fn _solve_ivp(
             atol: tol(atol),
             h0: first_step,
             max_step,
+            min_step,
+            dense_output: dense,
+            // SciPy: t is exactly t_eval; a terminal event is in t_events/y_events.
+            output_terminal_event: false,
             ..Options::default()
         };
-        if let Some(ms) = max_steps {
-            opts.max_steps = ms;
-        }
+        // No step cap unless asked (SciPy has none), but a memory guard when what is stored
+        // grows with the steps: the outputs of every step (no t_eval) and the dense output.
+        let per_step = if t_eval.is_none() { n + 1 } else { 0 }
+            + if dense {
+                pdyn_ode::DenseSolution::doubles_per_step(pdyn_ode::Interpolant::Dop853, n) + 1
+            } else {
+                0
+            };
+        let guard = match max_steps {
+            Some(ms) => {
+                opts.max_steps = ms;
+                None
+            }
+            None if per_step == 0 => {
+                opts.max_steps = usize::MAX;
+                None
+            }
+            None => {
+                let g = MEMORY_GUARD_DOUBLES / per_step;
+                opts.max_steps = g;
+                Some(g)
+            }
+        };
         if let Some(te) = t_eval {
             opts.t_eval = Some(te.as_slice()?.to_vec());
+        }
+        if m == Method::Auto {
+            // LSODA: the stiffness test at every step (as LSODA weighs a switch at every
+            // step), not every 1000 steps as dopri5.f.
+            opts.stiffness_check_interval = 1;
         }
         let o = IvpOptions {
             method: m,
             t_span: (t0, tf),
             y0,
             opts,
+            vectorized,
+            jac,
         };
         let all_compiled = matches!(rhs, Rhs::Compiled(_))
+            && !matches!(o.jac, Some(Jac::Callable(_)))
             && ivp_events
                 .iter()
                 .all(|e| matches!(e.function, Rhs::Compiled(_)));
         let err = RefCell::new(None);
+        let calls = Calls::default();
         let result = if all_compiled {
             // No Python in the loop: the GIL is released for the whole integration.
             let rhs_ref = &rhs;
@@ -278,10 +569,10 @@ pub(crate) fn _solve_ivp(
             let o_ref = &o;
             py.allow_threads(move || {
                 let err = RefCell::new(None);
-                integrate(None, rhs_ref, evs, args_ref, o_ref, &err)
+                integrate(None, rhs_ref, evs, args_ref, o_ref, &err, &Calls::default())
             })
         } else {
-            integrate(Some(py), &rhs, &ivp_events, &args, &o, &err)
+            integrate(Some(py), &rhs, &ivp_events, &args, &o, &err, &calls)
         };
         if let Some(e) = err.into_inner() {
             return Err(e);
@@ -299,7 +590,22 @@ pub(crate) fn _solve_ivp(
                 (sol, msg, status)
             }
             Err(e) => match e.failure_point() {
-                Some(fp) => ((*fp.partial).clone(), e.to_string(), -1),
+                Some(fp) => {
+                    let msg = match (&e, guard) {
+                        (pdyn_ode::OdeError::MaxSteps { at, .. }, Some(g)) => format!(
+                            "pdyn's memory guard: more than {g} steps would store over 2 GiB \
+                             (outputs{} of {n} states); stopped at t = {}. Pass t_eval= (without \
+                             dense_output) for no limit, or max_steps= to set one.",
+                            if dense { " and dense output" } else { "" },
+                            at.t
+                        ),
+                        (pdyn_ode::OdeError::StepSizeUnderflow { .. }, _) => format!(
+                            "Required step size is less than spacing between numbers. ({e})"
+                        ),
+                        _ => e.to_string(),
+                    };
+                    ((*fp.partial).clone(), msg, -1)
+                }
                 None => return Err(pdyn_error(py, "ParameterError", e.to_string())),
             },
         };
@@ -311,6 +617,27 @@ pub(crate) fn _solve_ivp(
         }
         d.set_item("events", hits)?;
         d.set_item("stats", stats_dict(py, &sol.stats)?)?;
+        // What was done: the callable's calls when fun is Python, the solver's count of
+        // evaluations of the compiled right-hand side otherwise; LU factorizations counted
+        // one per matrix (Radau5 factors a real and a complex one per decomposition).
+        let nfev = match rhs {
+            Rhs::Callable(_) => calls.fun.get(),
+            Rhs::Compiled(_) => sol.stats.fevals,
+        };
+        let njev = if o.jac.is_some() {
+            calls.jac.get()
+        } else {
+            sol.stats.jacobians
+        };
+        let nlu = sol.stats.lu_decompositions
+            * if matches!(sol.method, Method::Radau5) {
+                2
+            } else {
+                1
+            };
+        d.set_item("nfev", nfev)?;
+        d.set_item("njev", njev)?;
+        d.set_item("nlu", nlu)?;
         d.set_item("message", message)?;
         d.set_item("status", status)?;
         d.set_item("method", sol.method.name())?;
@@ -319,35 +646,8 @@ pub(crate) fn _solve_ivp(
             "native",
             matches!(&rhs, Rhs::Compiled(ev) if ev.is_native()),
         )?;
-        if dense {
-            // f(t, y) at every output point, for the Hermite interpolant of `sol.sol` (extra
-            // evaluations, not counted in nfev).
-            let mut f_rows = vec![0.0; len * n];
-            match &rhs {
-                Rhs::Compiled(p) => {
-                    let ev = Evaluator::new(p, n, &args);
-                    for k in 0..len {
-                        ev.eval(sol.t[k], sol.y_at(k), &mut f_rows[k * n..(k + 1) * n]);
-                    }
-                }
-                Rhs::Callable(func) => {
-                    let np = py.import("numpy")?;
-                    for k in 0..len {
-                        let arr = PyArray1::from_slice(py, sol.y_at(k));
-                        let v = func.call1(py, (sol.t[k], arr))?;
-                        let v = np.call_method1("asarray", (v, "float64"))?;
-                        let v: Vec<f64> = v.call_method0("ravel")?.extract()?;
-                        if v.len() != n {
-                            return Err(PyErr::new::<pyo3::exceptions::PyValueError, _>(format!(
-                                "fun returned {} values for {n} states",
-                                v.len()
-                            )));
-                        }
-                        f_rows[k * n..(k + 1) * n].copy_from_slice(&v);
-                    }
-                }
-            }
-            d.set_item("f_rows", f64_matrix(py, f_rows, len, n)?)?;
+        if let Some(inner) = sol.dense {
+            d.set_item("sol", Py::new(py, IvpDense { inner, n })?)?;
         }
         // The solution's own buffers become the arrays: no copy.
         d.set_item("t", f64_array(py, sol.t))?;

@@ -453,27 +453,37 @@ pub(crate) struct Dop853 {
 
 impl DenseOutput for Dop853 {
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        match self.n {
-            2 => self.interpolate_n::<2>(t, out),
-            4 => self.interpolate_n::<4>(t, out),
-            6 => self.interpolate_n::<6>(t, out),
-            _ => self.interpolate_n::<0>(t, out),
+        let s = (t - self.t_old) / self.h;
+        let (c, n) = (&self.cont, self.n);
+        match n {
+            2 => eval_cont::<2>(c, n, s, out),
+            4 => eval_cont::<4>(c, n, s, out),
+            6 => eval_cont::<6>(c, n, s, out),
+            _ => eval_cont::<0>(c, n, s, out),
         }
+    }
+    fn record(&self, t_from: f64, t_to: f64, into: &mut crate::dense::DenseSolution) {
+        use crate::dense::Interpolant;
+        into.push(
+            t_from,
+            t_to,
+            Interpolant::Dop853,
+            self.t_old,
+            self.h,
+            &[&self.cont[..8 * self.n]],
+        );
     }
 }
 
-impl Dop853 {
-    /// [`DenseOutput::interpolate`]; `N > 0` fixes the dimension at compile time.
-    #[inline(always)]
-    fn interpolate_n<const N: usize>(&self, t: f64, out: &mut [f64]) {
-        let n = if N > 0 { N } else { self.n };
-        let s = (t - self.t_old) / self.h;
-        let s1 = 1.0 - s;
-        let c = &self.cont;
-        for i in 0..n {
-            let conpar = c[4 * n + i] + s * (c[5 * n + i] + s1 * (c[6 * n + i] + s * c[7 * n + i]));
-            out[i] = c[i] + s * (c[n + i] + s1 * (c[2 * n + i] + s * (c[3 * n + i] + s1 * conpar)));
-        }
+/// DOP853's 7th-order continuous extension (dop853.f `CONTD8`) at `s = (t − t_old)/h` from its
+/// coefficients `c` (`8n`); `N > 0` fixes the dimension at compile time.
+#[inline(always)]
+pub(crate) fn eval_cont<const N: usize>(c: &[f64], n: usize, s: f64, out: &mut [f64]) {
+    let n = if N > 0 { N } else { n };
+    let s1 = 1.0 - s;
+    for i in 0..n {
+        let conpar = c[4 * n + i] + s * (c[5 * n + i] + s1 * (c[6 * n + i] + s * c[7 * n + i]));
+        out[i] = c[i] + s * (c[n + i] + s1 * (c[2 * n + i] + s * (c[3 * n + i] + s1 * conpar)));
     }
 }
 
@@ -882,8 +892,8 @@ mod tests {
         assert!(a.cont.iter().all(|x| x.is_finite()) && a.cont[4 * n..].iter().any(|&x| x != 0.0));
         let (mut oa, mut ob) = ([0.0; 4], [0.0; 4]);
         for s in [0.0, 0.3, 0.77, 1.0] {
-            a.interpolate_n::<4>(t + s * h, &mut oa);
-            b.interpolate_n::<0>(t + s * h, &mut ob);
+            eval_cont::<4>(&a.cont, 4, s, &mut oa);
+            eval_cont::<0>(&b.cont, 4, s, &mut ob);
             assert_eq!(bits(&oa), bits(&ob));
         }
     }

@@ -121,17 +121,31 @@ pub(crate) struct Dopri5 {
     h: f64,
 }
 
+/// DOPRI5's continuous extension at `s = (t − t_old)/h` from its coefficients `c` (`5n`).
+#[inline]
+pub(crate) fn eval_cont(c: &[f64], n: usize, s: f64, out: &mut [f64]) {
+    let s1 = 1.0 - s;
+    for i in 0..n {
+        out[i] =
+            c[i] + s * (c[n + i] + s1 * (c[2 * n + i] + s * (c[3 * n + i] + s1 * c[4 * n + i])));
+    }
+}
+
 impl DenseOutput for Dopri5 {
     #[inline]
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let n = self.n;
-        let s = (t - self.t_old) / self.h;
-        let s1 = 1.0 - s;
-        let c = &self.cont;
-        for i in 0..n {
-            out[i] = c[i]
-                + s * (c[n + i] + s1 * (c[2 * n + i] + s * (c[3 * n + i] + s1 * c[4 * n + i])));
-        }
+        eval_cont(&self.cont, self.n, (t - self.t_old) / self.h, out);
+    }
+    fn record(&self, t_from: f64, t_to: f64, into: &mut crate::dense::DenseSolution) {
+        use crate::dense::Interpolant;
+        into.push(
+            t_from,
+            t_to,
+            Interpolant::Dopri5,
+            self.t_old,
+            self.h,
+            &[&self.cont],
+        );
     }
 }
 

@@ -4,6 +4,7 @@ pub mod dop853;
 pub mod dopri5;
 pub mod gauss;
 pub mod radau5;
+pub mod rk23;
 pub mod rk4;
 pub mod symplectic;
 pub mod tsit5;

@@ -156,14 +156,24 @@ struct Radau5Dense {
 
 impl DenseOutput for Radau5Dense {
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let n = self.n;
         let s = (t - self.xsol) / self.hsol;
-        let c = &self.cont;
-        for i in 0..n {
-            out[i] = c[i]
-                + s * (c[i + n]
-                    + (s - self.c2m1) * (c[i + 2 * n] + (s - self.c1m1) * c[i + 3 * n]));
-        }
+        eval_cont(&self.cont, self.n, s, self.c1m1, self.c2m1, out);
+    }
+    fn record(&self, t_from: f64, t_to: f64, into: &mut crate::dense::DenseSolution) {
+        let kind = crate::dense::Interpolant::Radau5 {
+            c1m1: self.c1m1,
+            c2m1: self.c2m1,
+        };
+        into.push(t_from, t_to, kind, self.xsol, self.hsol, &[&self.cont]);
+    }
+}
+
+/// The collocation polynomial (radau5.f `CONTR5`) at `s = (t − x_end)/h` from its
+/// coefficients `c` (`4n`).
+#[inline]
+pub(crate) fn eval_cont(c: &[f64], n: usize, s: f64, c1m1: f64, c2m1: f64, out: &mut [f64]) {
+    for i in 0..n {
+        out[i] = c[i] + s * (c[i + n] + (s - c2m1) * (c[i + 2 * n] + (s - c1m1) * c[i + 3 * n]));
     }
 }
 
@@ -216,7 +226,10 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
     let hmaxn = su.hmax.min((tf - t0).abs());
 
     let mut sol = Solution::new(Method::Radau5, n);
-    let mut out = Output::new(opts.t_eval.as_deref(), posneg);
+    if opts.dense_output {
+        sol.dense = Some(crate::DenseSolution::new(n));
+    }
+    let mut out = Output::new(opts, posneg);
     out.start(&mut sol, t0, y_init);
     if t0 == tf {
         return Ok(sol);
@@ -251,6 +264,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
     let mut tmp = vec![0.0; n];
     let mut ytmp = vec![0.0; n];
     let mut fjac = vec![0.0; n * n]; // row-major ∂f_i/∂y_j
+    let (mut fd_states, mut fd_out) = (Vec::new(), Vec::new());
     let mut e1 = Lu::new(n);
     let mut e2 = LuComplex::new(n);
     let mut dense = Radau5Dense {
@@ -270,6 +284,8 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
     let mut alphn = 0.0;
     let mut betan = 0.0;
     let mut next = Next::Jacobian;
+    // A step of size min_step was tried since the last accepted step.
+    let mut tried_min = false;
 
     'outer: loop {
         // Set by an "unexpected rejection" (radau5.f label 78): `Some(singular)`.
@@ -280,15 +296,23 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                 if sys.has_jacobian() {
                     sys.jacobian(x, &y, &mut fjac);
                 } else {
+                    // The n perturbed states, evaluated in one batch (one call of a
+                    // vectorized right-hand side).
+                    if fd_states.is_empty() {
+                        fd_states = vec![0.0; n * n];
+                        fd_out = vec![0.0; n * n];
+                    }
                     for i in 0..n {
-                        let ysafe = y[i];
-                        let delt = (UROUND * 1e-5f64.max(ysafe.abs())).sqrt();
-                        y[i] = ysafe + delt;
-                        sys.rhs(x, &y, &mut tmp);
+                        let row = &mut fd_states[i * n..(i + 1) * n];
+                        row.copy_from_slice(&y);
+                        row[i] = y[i] + (UROUND * 1e-5f64.max(y[i].abs())).sqrt();
+                    }
+                    sys.rhs_batch(x, &fd_states, &mut fd_out);
+                    for i in 0..n {
+                        let delt = (UROUND * 1e-5f64.max(y[i].abs())).sqrt();
                         for j in 0..n {
-                            fjac[j * n + i] = (tmp[j] - y0f[j]) / delt;
+                            fjac[j * n + i] = (fd_out[i * n + j] - y0f[j]) / delt;
                         }
-                        y[i] = ysafe;
                     }
                     sol.stats.fevals += n;
                     sol.stats.jac_fevals += n;
@@ -298,6 +322,16 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                 continue;
             }
             Next::Decompose => {
+                if su.hmin > 0.0 && h.abs() < su.hmin && !last {
+                    if tried_min {
+                        return Err(OdeError::MinStep {
+                            min_step: su.hmin,
+                            at: point(x, &y, &sol),
+                        });
+                    }
+                    h = su.hmin * posneg;
+                    tried_min = true;
+                }
                 fac1 = k.u1 / h;
                 alphn = k.alph / h;
                 betan = k.beta / h;
@@ -540,6 +574,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                 let mut hnew = h / quot;
                 if err < 1.0 {
                     first = false;
+                    tried_min = false;
                     sol.stats.accepted += 1;
                     if sol.stats.accepted > 1 {
                         let facgus = (hacc / h) * (err * err / erracc).powf(0.25) / safe;
@@ -583,6 +618,9 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                     } else {
                         None
                     };
+                    if let Some(d) = sol.dense.as_mut() {
+                        dense.record(x_old, stop.map_or(x, |s| s.0), d);
+                    }
                     ev.drain_suspects(&mut sol.possible_misses);
                     out.emit(&mut sol, &dense, x, &y, stop.map(|s| s.0), &mut ytmp);
                     if let Some((_, idx)) = stop {

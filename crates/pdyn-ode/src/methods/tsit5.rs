@@ -144,21 +144,36 @@ pub(crate) struct Tsit5 {
     h: f64,
 }
 
+/// Tsit5's interpolant at `θ = (t − t_old)/h` from `y0` and the 7 stages `k` (stage-major).
+#[inline]
+fn eval_parts(y0: &[f64], k: &[f64], n: usize, th: f64, h: f64, out: &mut [f64]) {
+    let mut bt = [0.0; 7];
+    for (i, r) in R.iter().enumerate() {
+        bt[i] = th * (r[0] + th * (r[1] + th * (r[2] + th * r[3])));
+    }
+    for j in 0..n {
+        let mut acc = 0.0;
+        for m in 0..7 {
+            acc += bt[m] * k[m * n + j];
+        }
+        out[j] = y0[j] + h * acc;
+    }
+}
+
+/// Tsit5's interpolant from a recorded block `c = [y0, k1..k7]` (`8n`).
+pub(crate) fn eval_cont(c: &[f64], n: usize, th: f64, h: f64, out: &mut [f64]) {
+    eval_parts(&c[..n], &c[n..8 * n], n, th, h, out);
+}
+
 impl DenseOutput for Tsit5 {
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let n = self.n;
         let th = (t - self.t_old) / self.h;
-        let mut bt = [0.0; 7];
-        for (i, r) in R.iter().enumerate() {
-            bt[i] = th * (r[0] + th * (r[1] + th * (r[2] + th * r[3])));
-        }
-        for j in 0..n {
-            let mut acc = 0.0;
-            for m in 0..7 {
-                acc += bt[m] * self.k[m * n + j];
-            }
-            out[j] = self.y0[j] + self.h * acc;
-        }
+        eval_parts(&self.y0, &self.k, self.n, th, self.h, out);
+    }
+    fn record(&self, t_from: f64, t_to: f64, into: &mut crate::dense::DenseSolution) {
+        use crate::dense::Interpolant;
+        let parts: [&[f64]; 2] = [&self.y0, &self.k[..7 * self.n]];
+        into.push(t_from, t_to, Interpolant::Tsit5, self.t_old, self.h, &parts);
     }
 }
 

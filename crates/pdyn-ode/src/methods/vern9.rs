@@ -376,18 +376,19 @@ pub(crate) struct Vern9 {
 
 impl DenseOutput for Vern9 {
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let n = self.n;
         let s = (t - self.t_old) / self.h;
-        let s2 = s * s;
-        let s3 = s2 * s;
-        let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
-        let h10 = (s3 - 2.0 * s2 + s) * self.h;
-        let h01 = -2.0 * s3 + 3.0 * s2;
-        let h11 = (s3 - s2) * self.h;
-        let b = &self.herm;
-        for i in 0..n {
-            out[i] = h00 * b[i] + h10 * b[n + i] + h01 * b[2 * n + i] + h11 * b[3 * n + i];
-        }
+        crate::dense::hermite(&self.herm, self.n, s, self.h, out);
+    }
+    fn record(&self, t_from: f64, t_to: f64, into: &mut crate::dense::DenseSolution) {
+        use crate::dense::Interpolant;
+        into.push(
+            t_from,
+            t_to,
+            Interpolant::Hermite,
+            self.t_old,
+            self.h,
+            &[&self.herm[..4 * self.n]],
+        );
     }
 }
 

@@ -248,12 +248,24 @@ class Model:
 def methods() -> Dict[str, str]: ...
 
 def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float, float],
-              y0: Sequence[float], method: str = ..., t_eval: Optional[Sequence[float]] = ...,
+              y0: Sequence[float], method: Union[str, type] = ...,
+              t_eval: Optional[Sequence[float]] = ...,
               dense_output: bool = ..., events: Optional[Any] = ..., vectorized: bool = ...,
               args: Optional[Any] = ..., rtol: Union[float, Sequence[float]] = ...,
               atol: Union[float, Sequence[float]] = ..., max_step: float = ...,
-              first_step: Optional[float] = ..., max_steps: Optional[int] = ...,
+              first_step: Optional[float] = ..., min_step: float = ...,
+              jac: Optional[Any] = ..., max_steps: Optional[int] = ...,
               jit: bool = ..., **options: Any) -> OdeResult: ...
+
+class OdeSolution:
+    """``sol.sol`` of :func:`solve_ivp` with ``dense_output=True`` (every step's own
+    interpolant)."""
+    ts: Any
+    t_min: float
+    t_max: float
+    n_segments: int
+    interpolant: str
+    def __call__(self, t: Any) -> Any: ...
 
 class Vector(Tuple[Expr, Expr, Expr]):
     def latex(self) -> str: ...

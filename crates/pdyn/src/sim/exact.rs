@@ -329,6 +329,7 @@ pub fn run_exact(
         possible_misses: Vec::new(),
         stats: Default::default(),
         status: pdyn_ode::Status::Finished,
+        dense: None,
     };
     let mut res = tabulate(prep, &sol, set, None);
     res.method = super::Solver::Exact;

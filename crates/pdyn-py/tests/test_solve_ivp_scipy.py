@@ -1,0 +1,384 @@
+"""pdyn.solve_ivp as a drop-in for scipy.integrate.solve_ivp (issue 30, item 3).
+
+Written after reading SciPy's own tests (scipy/integrate/_ivp/tests/test_ivp.py) for what
+they check; the problems and expected values here are derived independently: closed forms
+(exponential, harmonic oscillator, SciPy's "rational" problem y = (t/(t+10), 10t/(t+10)^2)),
+event times from those closed forms by a root finder, published reference values (Robertson,
+Hairer & Wanner's test set), and SciPy run side by side.
+"""
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+import pdyn
+
+scipy_integrate = pytest.importorskip("scipy.integrate")
+scipy_optimize = pytest.importorskip("scipy.optimize")
+
+
+# --- problems with closed forms ---------------------------------------------------------------
+
+def fun_rational(t, y):
+    return np.array([y[1] / t, y[1] * (y[0] + 2 * y[1] - 1) / (t * (y[0] - 1))])
+
+
+def jac_rational(t, y):
+    return np.array([
+        [0, 1 / t],
+        [-2 * y[1] ** 2 / (t * (y[0] - 1) ** 2),
+         (y[0] + 4 * y[1] - 1) / (t * (y[0] - 1))],
+    ])
+
+
+def sol_rational(t):
+    t = np.asarray(t)
+    return np.vstack([t / (t + 10), 10 * t / (t + 10) ** 2])
+
+
+def scaled_error(y, y_true, rtol, atol):
+    """RMS over components of the error in units of the tolerance, per time."""
+    e = (y - y_true) / (atol + rtol * np.abs(y_true))
+    return np.sqrt(np.mean(e ** 2, axis=0))
+
+
+def osc(t, y):
+    return [y[1], -y[0]]
+
+
+OSC_T = np.linspace(0.0, 20.0, 4001)
+OSC_EXACT = np.vstack([np.cos(OSC_T), -np.sin(OSC_T)])
+
+METHODS = ["RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA"]
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_rational_problem_is_solved_within_tolerance(method):
+    rtol, atol = 1e-3, 1e-6
+    res = pdyn.solve_ivp(fun_rational, [5, 9], [1 / 3, 2 / 9], method=method, rtol=rtol,
+                         atol=atol, dense_output=True)
+    assert res.success and res.status == 0
+    assert res.t[0] == 5 and res.t[-1] == 9
+    assert res.t_events is None and res.y_events is None
+    assert np.all(scaled_error(res.y, sol_rational(res.t), rtol, atol) < 5)
+    tc = np.linspace(5, 9, 101)
+    assert np.all(scaled_error(res.sol(tc), sol_rational(tc), rtol, atol) < 5)
+    # The interpolant passes through the steps.
+    np.testing.assert_allclose(res.sol(res.t), res.y, rtol=1e-15, atol=1e-15)
+    if method in ("RK45", "RK23", "DOP853"):
+        assert res.njev == 0 and res.nlu == 0
+
+
+def test_backward_integration():
+    res = pdyn.solve_ivp(fun_rational, [9, 5], sol_rational(9.0).ravel(), rtol=1e-6,
+                         atol=1e-9, dense_output=True)
+    assert res.success and res.t[-1] == 5
+    np.testing.assert_allclose(res.y[:, -1], [1 / 3, 2 / 9], rtol=1e-5)
+    np.testing.assert_allclose(res.sol(6.0), sol_rational(6.0).ravel(), rtol=1e-5)
+
+
+def test_exponential_with_args_and_default_method_rk45():
+    def decay(t, y, k):
+        return -k * y
+
+    res = pdyn.solve_ivp(decay, (0, 2), [1.0, 2.0], args=(1.5,), rtol=1e-8, atol=1e-10)
+    assert res.method == "dopri5"  # SciPy's default, RK45
+    np.testing.assert_allclose(res.y[:, -1], np.array([1.0, 2.0]) * math.exp(-3.0),
+                               rtol=1e-7)
+
+
+# --- dense output at the method's own order ----------------------------------------------------
+
+@pytest.mark.parametrize("method", ["RK45", "RK23", "DOP853", "Radau"])
+@pytest.mark.parametrize("rtol", [1e-3, 1e-6, 1e-9])
+def test_dense_output_error_within_twice_scipys(method, rtol):
+    atol = rtol * 1e-3
+    kw = dict(method=method, rtol=rtol, atol=atol, dense_output=True)
+    if method == "RK23" and rtol < 1e-8:
+        pytest.skip("25,000 calls of a Python function: slow in a debug build")
+    s = scipy_integrate.solve_ivp(osc, (0, 20), [1, 0], **kw)
+    p = pdyn.solve_ivp(osc, (0, 20), [1, 0], **kw)
+    err_scipy = np.abs(s.sol(OSC_T) - OSC_EXACT).max()
+    err_pdyn = np.abs(p.sol(OSC_T) - OSC_EXACT).max()
+    assert err_pdyn <= 2 * err_scipy, (err_pdyn, err_scipy)
+
+
+def test_dop853_dense_output_is_seventh_order_not_hermite():
+    # DOP853 at rtol 1e-6 takes ~25 steps over [0, 20]: a cubic Hermite interpolant between
+    # steps of h ~ 0.8 errs by ~h^4/384 ~ 1e-3; the 7th-order extension by ~1e-6.
+    p = pdyn.solve_ivp(osc, (0, 20), [1, 0], method="DOP853", rtol=1e-6, atol=1e-9,
+                       dense_output=True)
+    assert p.sol.n_segments == len(p.t) - 1
+    assert "order 7" in p.sol.interpolant
+    assert np.abs(p.sol(OSC_T) - OSC_EXACT).max() < 1e-5
+
+
+def test_dense_output_with_t_eval_is_one_solve():
+    te = np.linspace(0, 10, 7)
+    p = pdyn.solve_ivp(osc, (0, 10), [1, 0], method="DOP853", t_eval=te, rtol=1e-9,
+                       atol=1e-12, dense_output=True)
+    np.testing.assert_array_equal(p.t, te)
+    np.testing.assert_allclose(p.sol(te), p.y, rtol=0, atol=1e-15)
+    assert p.sol(3.3).shape == (2,) and p.sol([1.0, 2.0]).shape == (2, 2)
+    assert p.sol.t_min == 0 and p.sol.t_max == 10
+
+
+# --- events ------------------------------------------------------------------------------------
+
+def event_1(t, y):
+    return y[0] - y[1] ** 0.7
+
+
+def event_2(t, y):
+    return y[1] ** 0.6 - y[0]
+
+
+def exact_root(g, a, b):
+    return scipy_optimize.brentq(lambda t: g(t, sol_rational(t).ravel()), a, b, xtol=1e-14)
+
+
+T1 = None
+
+
+def roots():
+    return exact_root(event_1, 5, 6.5), exact_root(event_2, 6.5, 8)
+
+
+@pytest.mark.parametrize("method", ["RK45", "RK23", "DOP853", "Radau", "LSODA"])
+def test_events_directions_and_terminal(method):
+    r1, r2 = roots()
+    kw = dict(method=method, rtol=1e-6, atol=1e-9)
+
+    res = pdyn.solve_ivp(fun_rational, [5, 8], [1 / 3, 2 / 9], events=(event_1, event_2), **kw)
+    assert res.status == 0 and len(res.t_events) == 2
+    assert len(res.t_events[0]) == 1 and len(res.t_events[1]) == 1
+    np.testing.assert_allclose(res.t_events[0][0], r1, rtol=1e-5)
+    np.testing.assert_allclose(res.t_events[1][0], r2, rtol=1e-5)
+    assert res.y_events[0].shape == (1, 2)
+    np.testing.assert_allclose(res.y_events[0][0], sol_rational(r1).ravel(), rtol=1e-5)
+    # The events' own directions: event_1 goes up, event_2 down.
+    event_1.direction, event_2.direction = -1, 1
+    try:
+        res = pdyn.solve_ivp(fun_rational, [5, 8], [1 / 3, 2 / 9],
+                             events=(event_1, event_2), **kw)
+        assert len(res.t_events[0]) == 0 and len(res.t_events[1]) == 0
+        assert res.y_events[0].shape[0] == 0
+    finally:
+        event_1.direction = event_2.direction = 0
+    # Terminal: stops at the first one; t ends there (no t_eval).
+    event_1.terminal = True
+    try:
+        res = pdyn.solve_ivp(fun_rational, [5, 8], [1 / 3, 2 / 9],
+                             events=(event_1, event_2), **kw)
+        assert res.status == 1 and res.success
+        assert res.message.startswith("A termination event occurred.")
+        assert res.t[-1] == res.t_events[0][0]
+        assert len(res.t_events[1]) == 0
+    finally:
+        del event_1.terminal
+
+
+def test_terminal_event_count():
+    # sin crosses zero at pi, 2pi, 3pi: terminal=2 stops at the second crossing.
+    def zero(t, y):
+        return y[0]
+    zero.terminal = 2
+    res = pdyn.solve_ivp(osc, (0.5 * math.pi, 20), [0.0, -1.0], events=zero, rtol=1e-9,
+                         atol=1e-12)
+    assert res.status == 1
+    np.testing.assert_allclose(res.t_events[0], [1.5 * math.pi, 2.5 * math.pi], rtol=1e-8)
+
+
+def test_t_is_exactly_t_eval_with_a_terminal_event():
+    def ground(t, y):
+        return y[0]
+    ground.terminal = True
+    ground.direction = -1
+
+    def fall(t, y):
+        return [y[1], -9.81]
+    te = np.linspace(0, 3, 31)
+    kw = dict(t_eval=te, events=ground, rtol=1e-9, atol=1e-12)
+    p = pdyn.solve_ivp(fall, (0, 3), [10.0, 0.0], **kw)
+    s = scipy_integrate.solve_ivp(fall, (0, 3), [10.0, 0.0], **kw)
+    t_hit = math.sqrt(2 * 10 / 9.81)
+    assert p.status == 1 == s.status
+    np.testing.assert_array_equal(p.t, s.t)
+    assert set(p.t) <= set(te) and p.t[-1] < t_hit
+    np.testing.assert_allclose(p.t_events[0], [t_hit], rtol=1e-9)
+    np.testing.assert_allclose(p.y_events[0][0], [0.0, -9.81 * t_hit], atol=1e-8)
+    np.testing.assert_allclose(p.y, s.y, rtol=1e-8, atol=1e-8)
+
+
+def test_args_reach_fun_jac_and_events():
+    seen = {"fun": 0, "jac": 0, "event": 0}
+
+    def f(t, y, a, b):
+        seen["fun"] += 1
+        return [-a * y[0] + b]
+
+    def jac(t, y, a, b):
+        seen["jac"] += 1
+        return [[-a]]
+
+    def level(t, y, a, b):
+        seen["event"] += 1
+        return y[0] - (b / a + 0.25)  # y = b/a + (1 - b/a) e^{-a t} = 0.75 at t = ln 2 / 2
+    level.terminal = True
+
+    a, b = 2.0, 1.0
+    for method in ("Radau", "RK45"):
+        res = pdyn.solve_ivp(f, (0, 10), [1.0], method=method,
+                             jac=jac if method == "Radau" else None, events=level,
+                             args=(a, b), rtol=1e-8, atol=1e-10)
+        assert res.status == 1
+        np.testing.assert_allclose(res.t_events[0], [math.log(2) / 2], rtol=1e-7)
+    assert all(v > 0 for v in seen.values()), seen
+    with pytest.raises(TypeError):
+        pdyn.solve_ivp(f, (0, 1), [1.0], args=2.0)
+
+
+# --- counts --------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("method,dense,t_eval", [
+    ("RK45", False, None), ("DOP853", True, None), ("DOP853", True, np.linspace(0, 5, 11)),
+    ("RK23", False, None), ("Radau", True, None), ("LSODA", False, None)])
+def test_nfev_counts_the_calls_made(method, dense, t_eval):
+    calls = [0]
+
+    def vdp(t, y):
+        calls[0] += 1
+        return [y[1], 2.0 * (1 - y[0] ** 2) * y[1] - y[0]]
+    res = pdyn.solve_ivp(vdp, (0, 5), [2.0, 0.0], method=method, dense_output=dense,
+                         t_eval=t_eval, rtol=1e-6, atol=1e-9)
+    assert res.success
+    assert res.nfev == calls[0]
+
+
+def test_njev_nlu_with_a_jacobian_callable():
+    jcalls = [0]
+
+    def jac(t, y):
+        jcalls[0] += 1
+        return jac_rational(t, y)
+    res = pdyn.solve_ivp(fun_rational, [5, 9], [1 / 3, 2 / 9], method="Radau", jac=jac,
+                         rtol=1e-6, atol=1e-9)
+    assert res.success and res.njev == jcalls[0] > 0
+    # Radau factors a real and a complex matrix each time it decomposes.
+    assert res.nlu > 0 and res.nlu % 2 == 0
+    # A constant Jacobian array is accepted too (a linear system).
+    a = np.array([[-1.0, 0.0], [0.0, -100.0]])
+    res = pdyn.solve_ivp(lambda t, y: a @ y, (0, 1), [1.0, 1.0], method="BDF", jac=a,
+                         rtol=1e-8, atol=1e-10)
+    np.testing.assert_allclose(res.y[:, -1], [math.exp(-1), math.exp(-100)], rtol=1e-5,
+                               atol=1e-10)
+    assert "Radau" in res.message  # BDF runs as Radau, and says so
+
+
+def test_vectorized_calls_fun_with_2d_states():
+    shapes = set()
+
+    def f(t, y):
+        shapes.add(y.shape)
+        return np.vstack([y[1], 1000.0 * (1 - y[0] ** 2) * y[1] - y[0]])
+    res = pdyn.solve_ivp(f, (0, 1), [2.0, 0.0], method="Radau", vectorized=True, rtol=1e-6,
+                         atol=1e-9)
+    assert res.success
+    assert shapes == {(2, 1), (2, 2)}  # single states, and the Jacobian's in one call
+    ref = scipy_integrate.solve_ivp(f, (0, 1), [2.0, 0.0], method="Radau", rtol=1e-10,
+                                    atol=1e-12, vectorized=True)
+    np.testing.assert_allclose(res.y[:, -1], ref.y[:, -1], rtol=1e-4)
+
+
+# --- stiff problems ------------------------------------------------------------------------------
+
+def robertson(t, y):
+    return [-0.04 * y[0] + 1e4 * y[1] * y[2],
+            0.04 * y[0] - 1e4 * y[1] * y[2] - 3e7 * y[1] ** 2,
+            3e7 * y[1] ** 2]
+
+
+@pytest.mark.parametrize("method", ["Radau", "BDF", "LSODA"])
+def test_robertson(method):
+    # Reference at t = 40 (Hairer & Wanner, Solving ODEs II, and the IVP test set).
+    ref = np.array([0.7158270687193941, 9.185534764529195e-06, 0.2841637457458413])
+    res = pdyn.solve_ivp(robertson, (0, 40), [1.0, 0.0, 0.0], method=method, rtol=1e-6,
+                         atol=[1e-8, 1e-12, 1e-8])
+    assert res.success
+    np.testing.assert_allclose(res.y[:, -1], ref, rtol=1e-4)
+    assert len(res.t) < 1000  # a stiff method, not an explicit one crawling
+
+
+# --- options ------------------------------------------------------------------------------------
+
+def test_first_min_max_step():
+    res = pdyn.solve_ivp(osc, (0, 10), [1, 0], max_step=0.1)
+    assert np.all(np.diff(res.t) <= 0.1 + 1e-12)
+    res = pdyn.solve_ivp(osc, (0, 10), [1, 0], first_step=1e-3)
+    assert res.t[1] == pytest.approx(1e-3)
+    res = pdyn.solve_ivp(osc, (0, 10), [1, 0], min_step=0.5)
+    assert res.success and np.all(np.diff(res.t)[:-1] >= 0.5 - 1e-12)
+    # A problem that needs smaller steps than min_step fails, with a message saying so.
+    res = pdyn.solve_ivp(lambda t, y: [-1e4 * (y[0] - math.cos(t))], (0, 1), [0.0],
+                         min_step=0.01, rtol=1e-8, atol=1e-10)
+    assert res.status == -1 and not res.success and "min_step" in res.message
+
+
+def test_no_step_cap_unless_asked():
+    # 1.2 million steps (SciPy has no cap; pdyn's former default stopped at 10^6).
+    res = pdyn.solve_ivp(["y1", "-y0"], (0, 1.2), [1.0, 0.0], method="RK23",
+                         max_step=1e-6, t_eval=[1.2], rtol=1e-3, atol=1e-6)
+    assert res.success, res.message
+    assert res.stats["accepted"] > 1_000_000
+    res = pdyn.solve_ivp(osc, (0, 10), [1, 0], max_steps=10)
+    assert res.status == -1 and "max_steps" in res.message
+
+
+def test_unused_options_warn_like_scipy():
+    with pytest.warns(UserWarning, match="no effect"):
+        pdyn.solve_ivp(osc, (0, 1), [1, 0], method="RK45", jac=[[0, 1], [-1, 0]])
+    with pytest.warns(UserWarning, match="no effect"):
+        pdyn.solve_ivp(osc, (0, 1), [1, 0], bogus_option=3)
+
+
+def test_mapped_methods_say_so():
+    r = pdyn.solve_ivp(osc, (0, 1), [1, 0], method="LSODA")
+    assert r.success and "LSODA ran as pdyn's auto" in r.message
+    r = pdyn.solve_ivp(osc, (0, 1), [1, 0], method="RK23")
+    assert r.method == "rk23" and "ran as" not in r.message
+
+
+# --- invalid input: SciPy's exception kinds ----------------------------------------------------
+
+@pytest.mark.parametrize("kw,exc", [
+    (dict(t_eval=[0, 2]), ValueError),                 # outside t_span
+    (dict(t_eval=[0.5, 0.2]), ValueError),             # not sorted
+    (dict(t_eval=[[0.1, 0.2]]), ValueError),           # not 1-D
+    (dict(first_step=-1.0), ValueError),
+    (dict(first_step=5.0), ValueError),                # exceeds bounds
+    (dict(max_step=0.0), ValueError),
+    (dict(atol=-1.0), ValueError),
+    (dict(atol=[1e-6, 1e-6, 1e-6]), ValueError),       # wrong shape
+    (dict(method="Euler"), ValueError),
+    (dict(args=1.0), TypeError),
+])
+def test_invalid_input_raises_scipys_kind(kw, exc):
+    for solver in (pdyn.solve_ivp, scipy_integrate.solve_ivp):
+        with pytest.raises(exc):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                solver(lambda t, y, *a: [y[1], -y[0]], (0, 1), [1.0, 0.0], **kw)
+
+
+def test_y0_must_be_one_dimensional():
+    with pytest.raises(ValueError):
+        pdyn.solve_ivp(osc, (0, 1), [[1.0, 0.0]])
+
+
+def test_exception_in_fun_propagates():
+    def bad(t, y):
+        raise ZeroDivisionError("boom")
+    with pytest.raises(ZeroDivisionError, match="boom"):
+        pdyn.solve_ivp(bad, (0, 1), [1.0])
