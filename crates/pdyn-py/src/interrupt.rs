@@ -33,15 +33,25 @@ pub(crate) fn interruptible<T: Send>(
     work: impl FnOnce(Interrupt) -> T + Send,
 ) -> PyResult<Finished<T>> {
     let flag: Interrupt = Arc::new(AtomicBool::new(false));
+    let worker_flag = flag.clone();
+    with_flag(py, flag, move || work(worker_flag))
+}
+
+/// [`interruptible`] with the stop flag made by the caller (who has already handed it to the
+/// work, e.g. in solver options).
+pub(crate) fn with_flag<T: Send>(
+    py: Python<'_>,
+    flag: Interrupt,
+    work: impl FnOnce() -> T + Send,
+) -> PyResult<Finished<T>> {
     // The worker says it is done through this (also when it panics: the guard's drop), so a
     // short call returns at once rather than at the next poll.
     let done = (Mutex::new(false), Condvar::new());
     std::thread::scope(|scope| {
-        let worker_flag = flag.clone();
         let done = &done;
         let worker = scope.spawn(move || {
             let _tell = Done(done);
-            work(worker_flag)
+            work()
         });
         let mut raised: Option<PyErr> = None;
         loop {

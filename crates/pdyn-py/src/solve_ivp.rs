@@ -546,7 +546,7 @@ pub(crate) fn _solve_ivp(
             // step), not every 1000 steps as dopri5.f.
             opts.stiffness_check_interval = 1;
         }
-        let o = IvpOptions {
+        let mut o = IvpOptions {
             method: m,
             t_span: (t0, tf),
             y0,
@@ -563,14 +563,27 @@ pub(crate) fn _solve_ivp(
         let calls = Calls::default();
         let result = if all_compiled {
             // No Python in the loop: the GIL is released for the whole integration.
+            // Ctrl-C stops it at the next step (the calling thread watches for signals).
+            let stop: pdyn_ode::Interrupt = Default::default();
+            o.opts.interrupt = Some(stop.clone());
             let rhs_ref = &rhs;
             let evs = &ivp_events;
             let args_ref = &args;
             let o_ref = &o;
-            py.allow_threads(move || {
+            let finished = crate::interrupt::with_flag(py, stop, move || {
                 let err = RefCell::new(None);
                 integrate(None, rhs_ref, evs, args_ref, o_ref, &err, &Calls::default())
-            })
+            })?;
+            if finished.interrupted {
+                let at = match &finished.value {
+                    Err(e) => e.failure_point().map_or(f64::NAN, |f| f.t),
+                    Ok(_) => o.t_span.1,
+                };
+                return Err(crate::errors::py_error(py, "Interrupted", |c| {
+                    c.call1((format!("solve_ivp interrupted (Ctrl-C) at t = {at}"),))
+                }));
+            }
+            finished.value
         } else {
             integrate(Some(py), &rhs, &ivp_events, &args, &o, &err, &calls)
         };

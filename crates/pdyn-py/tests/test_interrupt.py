@@ -24,6 +24,8 @@ CHILD = textwrap.dedent("""
                                    measures={"r": ("x", "max")}, t_end=1e8, rtol=1e-12),
         "ensemble": lambda: sat.ensemble(params={"GM": [1.0 + 0.01 * i for i in range(4)]},
                                          t_end=1e8, rtol=1e-12),
+        "solve_ivp": lambda: pdyn.solve_ivp(["y1", "-y0"], (0.0, 1e10), [1.0, 0.0],
+                                            rtol=1e-12, atol=1e-12, t_eval=[1e10]),
     }
     if warm:
         sat.run(t_end=1.0)
@@ -46,15 +48,16 @@ CHILD = textwrap.dedent("""
             "md": lambda: len(r.thermo) >= 1,
             "sweep": lambda: len(r.values) == 4,
             "ensemble": lambda: len(r) == 4,
+            "solve_ivp": lambda: r is None and "interrupted (Ctrl-C) at t = " in str(e),
         }[which]()
         print("interrupted", type(r).__name__, partial, f"{latency:.3f}")
 """)
 
 
-@pytest.mark.parametrize("which", ["run", "nbody", "md", "sweep", "ensemble"])
+@pytest.mark.parametrize("which", ["run", "nbody", "md", "sweep", "ensemble", "solve_ivp"])
 @pytest.mark.parametrize("state", ["fresh", "warm"])
 def test_ctrl_c_stops_a_long_call_with_what_it_computed(examples, which, state):
-    if state == "warm" and which in ("nbody", "md", "ensemble"):
+    if state == "warm" and which in ("nbody", "md", "ensemble", "solve_ivp"):
         pytest.skip("warm covered by run and sweep; keeps the suite short")
     out = subprocess.run([sys.executable, "-c", CHILD, str(examples), which, state],
                          capture_output=True, text=True, timeout=120)
