@@ -190,6 +190,8 @@ def test_run_from_another_initial_state(examples):
     assert ens.final[0][0] == sol.y[0][-1]
     with pytest.raises(pdyn.ParameterError, match="initial: `z` is not a state component"):
         m.run(initial={"z": 1.0})
+    with pytest.raises(pdyn.ParameterError, match="not a finite number"):
+        m.run(initial={"x": float("nan")})
     with pytest.raises(pdyn.ParameterError, match="closed form"):
         m.run(initial={"x": 2.0}, method="exact", t_end=1.0)
     with pytest.raises(pdyn.ParameterError, match="mechanics models"):

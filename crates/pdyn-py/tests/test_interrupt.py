@@ -68,3 +68,5 @@ def test_ctrl_c_stops_a_long_call_with_what_it_computed(examples, which, state):
     # The call stopped at its next step (or stretch of MD steps), not at its end minutes
     # later. A generous bound: the measured latency is in docs/benchmarks-python.md.
     assert float(words[3]) < 5.0, out.stdout
+    # `pytest -s` shows the measured latency (docs/benchmarks-python.md).
+    print(f"\nCtrl-C latency {which} ({state}): {words[3]} s")

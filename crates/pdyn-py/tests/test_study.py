@@ -166,6 +166,13 @@ def test_resume_runs_only_the_missing_chunks(examples, tmp_path):
     pd.testing.assert_frame_equal(folder.sort_values("sample", ignore_index=True),
                                   clean.table.sort_values("sample", ignore_index=True),
                                   check_exact=True, check_like=True)
+    # A manifest that is not JSON is a clear error, not a JSONDecodeError.
+    bad = tmp_path / "bad"
+    bad.mkdir()
+    (bad / pdyn.study.MANIFEST).write_text("{not json")
+    with pytest.raises(pdyn.study.OutputFolderError, match="cannot be read"):
+        Study(kremlin(examples), Samples(20, seed=7, v0=normal(V0, SD_V0)),
+              measures=MEASURES, chunk_size=200, out=str(bad)).run()
     other.out = str(tmp_path / "other")
     assert other.run().chunks_run == 10
     # A folder with result files of another study and no manifest (older pdyn) is refused

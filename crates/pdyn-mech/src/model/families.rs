@@ -301,13 +301,10 @@ impl<'l, 'a> Expander<'l, 'a> {
         for c in &clauses {
             let range = match &c.range {
                 Some(r) => {
-                    let sv = for_list.expect("a range is written in a `for` list");
-                    let lo =
-                        r.lo.int(&lookup)
-                            .map_err(|e| located(self.ld, &sv.span(), e))?;
-                    let hi =
-                        r.hi.int(&lookup)
-                            .map_err(|e| located(self.ld, &sv.span(), e))?;
+                    // A range is written in a `for` list; its clause's own span otherwise.
+                    let span = for_list.map_or(c.span.clone(), |sv| sv.span());
+                    let lo = r.lo.int(&lookup).map_err(|e| located(self.ld, &span, e))?;
+                    let hi = r.hi.int(&lookup).map_err(|e| located(self.ld, &span, e))?;
                     (lo, hi)
                 }
                 None => match self.indices.ranges.get(&c.name) {

@@ -571,8 +571,13 @@ class Study:
         manifest = os.path.join(self.out, MANIFEST)
         mine = self._study_key()
         if os.path.exists(manifest):
-            with open(manifest) as f:
-                theirs = json.load(f).get("study_key")
+            try:
+                with open(manifest) as f:
+                    theirs = json.load(f).get("study_key")
+            except (OSError, ValueError, AttributeError) as e:
+                raise OutputFolderError(
+                    f"{manifest} cannot be read ({e}): it should name the study the folder "
+                    "holds; use another out= folder, or empty this one") from e
             if theirs != mine:
                 raise OutputFolderError(
                     f"{self.out} holds another study (key {str(theirs)[:12]}…, this one "
