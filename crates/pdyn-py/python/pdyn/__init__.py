@@ -35,9 +35,9 @@ from . import _pdyn
 from ._errors import DriftWarning, Interrupted, ModelError, ParameterError, PdynError
 from ._nbody import NBody, Particle
 from ._linearize import Linearization
-from ._result import (DenseOutput, Derivation, EnsembleResult, Expr, ForcesResult,
+from ._result import (Derivation, EnsembleResult, Expr, ForcesResult,
                       OdeResult, ParticleResult, SweepResult, Table,
-                      _concat_raw, _from_ivp, _from_run)
+                      _concat_raw, _from_run)
 from ._symbolic import (DsolveCase, DsolveResult, KinInstant, KinResult, RuleResult, Vector,
                         dsolve, kin)
 from ._ivp import solve_ivp  # SciPy's solve_ivp on pdyn's integrators
@@ -54,7 +54,7 @@ def __getattr__(name: str):
 
 __all__ = [
     "Model", "NBody", "Particle", "Linearization", "solve_ivp", "methods", "OdeResult", "Derivation", "Expr", "SweepResult",
-    "EnsembleResult", "DenseOutput", "ForcesResult",
+    "EnsembleResult", "ForcesResult",
     "kin", "dsolve", "KinResult", "KinInstant", "DsolveResult", "DsolveCase", "RuleResult",
     "Vector",
     "PdynError", "ModelError", "ParameterError", "DriftWarning", "Interrupted", "__version__",

@@ -70,12 +70,6 @@ class Linearization:
     analytic: bool
     def eigenvalues(self) -> npt.NDArray[np.complex128]: ...
 
-class DenseOutput:
-    ts: npt.NDArray[np.float64]
-    t_min: float
-    t_max: float
-    def __call__(self, t: Any) -> npt.NDArray[np.float64]: ...
-
 class OdeResult(dict):
     t: npt.NDArray[np.float64]
     y: npt.NDArray[np.float64]
@@ -87,7 +81,7 @@ class OdeResult(dict):
     nfev: int
     njev: int
     nlu: int
-    sol: Optional[DenseOutput]
+    sol: Optional[Callable[[Any], npt.NDArray[np.float64]]]
     stats: Dict[str, Any]
     method: str
     columns: List[str]

@@ -601,45 +601,6 @@ def _concat_raw(parts: List[Dict[str, Any]]) -> Dict[str, Any]:
     return out
 
 
-class DenseOutput:
-    """``sol.sol`` of :func:`pdyn.solve_ivp` with ``dense_output=True``: ``sol.sol(t)`` is the
-    state at ``t`` (shape ``(n,)`` for a scalar, ``(n, len(t))`` for an array), like SciPy's
-    ``OdeSolution``. A cubic Hermite interpolant through every step and its slope ``f(t, y)``
-    there: exact at the steps, O(h^4) between them. ``ts`` are the steps; ``t_min``,
-    ``t_max`` the interval."""
-
-    def __init__(self, ts: np.ndarray, ys: np.ndarray, fs: np.ndarray):
-        self.ts, self._y, self._f = ts, ys, fs
-        self.t_min, self.t_max = float(min(ts[0], ts[-1])), float(max(ts[0], ts[-1]))
-
-    def __call__(self, t: Any) -> np.ndarray:
-        ta = np.asarray(t, dtype=np.float64)
-        scalar = ta.ndim == 0
-        ta = np.atleast_1d(ta)
-        ts = self.ts
-        forward = ts[-1] >= ts[0]
-        key = ts if forward else -ts
-        tk = ta if forward else -ta
-        i = np.clip(np.searchsorted(key, tk, side="right") - 1, 0, max(len(ts) - 2, 0))
-        if len(ts) == 1:
-            out = np.repeat(self._y[:, :1], len(ta), axis=1)
-            return out[:, 0] if scalar else out
-        t0, t1 = ts[i], ts[i + 1]
-        h = t1 - t0
-        s = (ta - t0) / h
-        y0, y1 = self._y[:, i], self._y[:, i + 1]
-        f0, f1 = self._f[:, i], self._f[:, i + 1]
-        h00 = 2 * s**3 - 3 * s**2 + 1
-        h10 = s**3 - 2 * s**2 + s
-        h01 = -2 * s**3 + 3 * s**2
-        h11 = s**3 - s**2
-        out = h00 * y0 + h10 * h * f0 + h01 * y1 + h11 * h * f1
-        return out[:, 0] if scalar else out
-
-    def __repr__(self) -> str:
-        return f"DenseOutput({len(self.ts)} steps on [{self.t_min}, {self.t_max}])"
-
-
 class ForcesResult:
     """The result of :meth:`pdyn.Model.forces`.
 
