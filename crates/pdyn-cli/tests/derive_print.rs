@@ -56,7 +56,7 @@ fn assert_lines_within_budget(file: &Path, extra: &[&str]) {
     let text = derive_output(file, extra).unwrap_or_else(|e| e);
     for (i, line) in text.lines().enumerate() {
         let n = line.chars().count();
-        // The last-resort clipping of `cli/bounded.rs` would hide an expression printed
+        // The last-resort clipping of `pdyn::derivation::bounded` would hide an expression printed
         // whole: it must never be needed.
         assert!(
             !line.contains("⟨line clipped"),

@@ -35,6 +35,18 @@ pub enum Progress<'a> {
     /// A line of the run's log (what is simulated, a live thermo row), for a front end that
     /// shows the run as it goes.
     Log(&'a str),
+    /// The particles' positions at `time` (an MD run's `dump_every` frames), for a front end
+    /// that animates them; coordinates in the model's units.
+    Frame {
+        /// The time of the frame.
+        time: f64,
+        /// x of each particle.
+        x: &'a [f64],
+        /// y of each particle.
+        y: &'a [f64],
+        /// z of each particle.
+        z: &'a [f64],
+    },
 }
 
 /// A finished mechanics run (or one that stopped early: `failure`).
@@ -306,6 +318,15 @@ fn run_md(
     let result = md::run(&mut prepared, &opts, &mut |p| match p {
         md::Progress::Record(r) => progress(Progress::Log(&md::report::thermo_line(r))),
         md::Progress::Step(s) => progress(Progress::Step(s)),
+        md::Progress::Frame { step, system } => {
+            let p = &system.particles;
+            progress(Progress::Frame {
+                time: step as f64 * spec.dt.value,
+                x: &p.x,
+                y: &p.y,
+                z: &p.z,
+            })
+        }
     })?;
     let (summary, failure) = md::output::outcome(&prepared, &result, drift_tolerance, &file.origin);
     if let Some(dir) = &req.out {

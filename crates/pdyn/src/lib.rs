@@ -8,6 +8,7 @@
 #![warn(missing_docs)]
 
 pub mod args;
+pub mod clock;
 pub mod dsolve;
 pub mod engine;
 pub mod error;
@@ -19,6 +20,7 @@ pub mod nbody;
 pub mod output;
 pub mod params;
 pub mod plots;
+pub mod report;
 pub mod request;
 pub mod sim;
 pub mod summary;

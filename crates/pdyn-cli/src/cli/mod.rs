@@ -5,7 +5,6 @@
 //! Every command returns an [`Outcome`] (what to print, and a failure that still produced
 //! output) or a [`pdyn::Error`]; `main` prints and exits.
 
-pub mod bounded;
 pub mod derive;
 pub mod dsolve;
 pub mod equilibrium;

@@ -2,7 +2,7 @@
 
 use super::{load_model, numeric_pairs, set_parameters, Outcome};
 use clap::Args;
-use pdyn::sim::{self, RunSettings, SimError};
+use pdyn::sim;
 use pdyn::{Error, Progress};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -105,18 +105,6 @@ pub fn request(a: &RunArgs) -> Result<pdyn::Request, Error> {
     })
 }
 
-/// Derives and compiles the model as the options ask.
-pub(crate) fn prepare(model: &mut pdyn_mech::Model, a: &RunArgs) -> Result<sim::Prepared, Error> {
-    sim::request::prepare(model, a.jit())
-}
-
-/// Merges `[simulate]` and the command line.
-pub fn settings(model: &pdyn_mech::Model, a: &RunArgs) -> Result<RunSettings, Error> {
-    sim::request::settings(model, &request(a)?)
-}
-
-pub(crate) use sim::request::located as sim_error;
-
 /// Steps × particles above which a progress bar is drawn (when stderr is a terminal).
 const PROGRESS_WORK: u64 = 20_000_000;
 
@@ -189,71 +177,10 @@ pub fn check(a: CheckArgs) -> Result<Outcome, Error> {
     let a = a.run;
     let mut model = load_model(&a.model)?;
     set_parameters(&mut model, &a.set)?;
-    let set = settings(&model, &a)?;
-    let exact = sim::exact::closed_form(&mut model).map_err(|e| {
-        sim_error(
-            &model,
-            "no exact solution to check against: ",
-            SimError::NoClosedForm(e),
-        )
-    })?;
-    let prep = prepare(&mut model, &a)?;
-    let rep = sim::exact::check(&prep, &exact, &set).map_err(|e| sim_error(&model, "", e))?;
-    let (scales, relative) = (rep.scales(), rep.relative_errors());
-    let worst = relative.iter().copied().fold(0.0, f64::max);
-    if a.json {
-        let v = serde_json::json!({
-            "model": model.name,
-            "method": rep.run.method.to_string(),
-            "rows": rep.run.rows.len(),
-            "errors": rep.errors.iter().zip(scales.iter().zip(&relative)).map(|((n, e, s), (scale, rel))| serde_json::json!({"name": n, "max_abs_error": e, "max_abs_value": s, "scale": scale, "relative_error": rel})).collect::<Vec<_>>(),
-            "max_relative_error": worst,
-            "formula_relative_gap": rep.formula_gap,
-        });
-        let failure = rep.run.failure.clone().map(|failure| Error::Integration {
-            origin: model.origin.clone(),
-            failure: Box::new(failure),
-        });
-        return Ok(Outcome {
-            stdout: format!("{v:#}\n"),
-            stderr: String::new(),
-            failure,
-        });
-    }
-    let mut out = format!(
-        "{}\n{} vs the closed form at {} times (t = 0..{}):\n",
-        model.name,
-        rep.run.method,
-        rep.run.rows.len(),
-        set.t_end
-    );
-    for ((n, e, s), rel) in rep.errors.iter().zip(&relative) {
-        out += &format!(
-            "  {n:<12} max |error| {e:.3e}   (max |value| {s:.3e})   relative {rel:.3e}\n"
-        );
-    }
-    out += &format!(
-        "largest error relative to the size of the solution: {worst:.3e}\n\
-         (each column against the largest max |value| of its order: coordinates together, rates together)\n"
-    );
-    if let Some(gap) = rep.formula_gap {
-        out += &format!(
-            "the exact solution is evaluated stably (matrix exponential); the printed formula \
-             evaluated in floating point differs from it by {gap:.3e} relative{}\n",
-            if gap > sim::exact::EXACT_AGREEMENT {
-                " — near a resonance its terms cancel: do not evaluate it as printed"
-            } else {
-                ""
-            }
-        );
-    }
-    let failure = rep.run.failure.clone().map(|failure| Error::Integration {
-        origin: model.origin.clone(),
-        failure: Box::new(failure),
-    });
+    let rep = pdyn::report::check::report(model, &request(&a)?, a.json)?;
     Ok(Outcome {
-        stdout: out,
-        stderr: String::new(),
-        failure,
+        stdout: rep.stdout,
+        stderr: rep.stderr,
+        failure: rep.failure,
     })
 }

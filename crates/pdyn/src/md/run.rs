@@ -40,6 +40,14 @@ pub enum Progress<'a> {
     Record(&'a ThermoRecord),
     /// Steps completed so far.
     Step(u64),
+    /// The system at a step of `dump_every` (and the first), for a front end that shows the
+    /// atoms moving: what `traj.xyz` gets, whether or not a directory was given.
+    Frame {
+        /// The step.
+        step: u64,
+        /// The atoms (positions in file units).
+        system: &'a System,
+    },
 }
 
 /// Energy conservation of a run whose dynamics conserve an energy (NVE, Nosé–Hoover).
@@ -289,6 +297,12 @@ fn run_sim<P: PairPotential>(
         },
     };
     let mut frames = 0u64;
+    if spec.dump_every > 0 {
+        progress(Progress::Frame {
+            step: sim.step,
+            system: &sim.system,
+        });
+    }
     if let Some((w, path)) = &mut traj {
         write_frame(w, &sim.system, &names, u, sim.step, sim.step as f64 * dt)
             .map_err(|e| traj_err(path, e))?;
@@ -356,7 +370,7 @@ fn run_sim<P: PairPotential>(
         (Some(a), Some(b)) if spec.thermostat.ensemble != Ensemble::Nve => Some((a.value, b.value)),
         _ => None,
     };
-    let start = std::time::Instant::now();
+    let start = crate::clock::Stopwatch::start();
     let mut failure = None;
     let mut builds = 0;
     let mut done = 0u64;
@@ -408,8 +422,14 @@ fn run_sim<P: PairPotential>(
                 let _ = h.add(&sim.system);
             }
         }
+        let dump = spec.dump_every > 0 && sim.step % spec.dump_every == 0;
+        if dump {
+            progress(Progress::Frame {
+                step: sim.step,
+                system: &sim.system,
+            });
+        }
         if let Some((w, path)) = &mut traj {
-            let dump = spec.dump_every > 0 && sim.step % spec.dump_every == 0;
             if dump || failure.is_some() {
                 write_frame(w, &sim.system, &names, u, sim.step, sim.step as f64 * dt)
                     .map_err(|e| traj_err(path, e))?;
@@ -420,7 +440,7 @@ fn run_sim<P: PairPotential>(
             break;
         }
     }
-    let seconds = start.elapsed().as_secs_f64();
+    let seconds = start.seconds();
     if failure.is_none() && records.last().map(|r| r.step) != Some(sim.step) {
         // the last step, when it is not a multiple of thermo_every
         let c = convert(&sim.thermo(), u, dt);

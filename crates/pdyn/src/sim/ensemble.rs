@@ -226,7 +226,7 @@ pub fn run(
             })
             .collect()
     };
-    let start = std::time::Instant::now();
+    let start = crate::clock::Stopwatch::start();
     let (members, threads) = match threads {
         Some(n) => {
             let pool = thread_pool(n)?;
@@ -234,12 +234,7 @@ pub fn run(
         }
         None => (work(), rayon::current_num_threads()),
     };
-    Ok(Ensemble::new(
-        members,
-        names,
-        start.elapsed().as_secs_f64(),
-        threads,
-    ))
+    Ok(Ensemble::new(members, names, start.seconds(), threads))
 }
 
 /// Runs one member of an ensemble, without its table ([`measure`]: the same bits as

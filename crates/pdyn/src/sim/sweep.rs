@@ -120,7 +120,7 @@ pub fn sweep(
             limit: MAX_SWEEP_RUNS,
         });
     }
-    let start = std::time::Instant::now();
+    let start = crate::clock::Stopwatch::start();
     // Combinations of the other parameters (cartesian product).
     let mut combos: Vec<Vec<(usize, f64)>> = vec![Vec::new()];
     for (k, vals) in &spec.others {
@@ -180,7 +180,7 @@ pub fn sweep(
         slices,
         problems,
         runs: jobs.len(),
-        seconds: start.elapsed().as_secs_f64(),
+        seconds: start.seconds(),
         threads: rayon::current_num_threads(),
     })
 }
