@@ -196,6 +196,7 @@ pub fn run(
     req: &Request,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<RunOutput, Error> {
+    plots_available(req)?;
     if req.plots && req.out.is_none() {
         return Err(Error::argument(
             RunOption::Plot.name(),
@@ -253,6 +254,7 @@ pub fn run_mechanics(mut model: Model, req: &Request) -> Result<MechanicsRun, Er
         let text = output::summary_text(&summary, result.hybrid.as_ref());
         std::fs::write(&js, text).map_err(|e| Error::io(&js, "write", e))?;
         if req.plots {
+            #[cfg(feature = "plots")]
             crate::plots::write_run_plots(&model, &prepared, &result, dir)?;
         }
     }
@@ -274,6 +276,7 @@ fn run_nbody(file: &ModelFile, req: &Request) -> Result<NbodyRun, Error> {
     if let Some(dir) = &req.out {
         nbody::output::write_files(dir, &result, &summary, trajectory)?;
         if req.plots {
+            #[cfg(feature = "plots")]
             nbody::plots::write(&spec.name, &result, &spec.units, dir)?;
         }
     }
@@ -332,6 +335,7 @@ fn run_md(
     if let Some(dir) = &req.out {
         md::output::write_all(&result, &summary, dir)?;
         if req.plots {
+            #[cfg(feature = "plots")]
             md::output::write_plots(&prepared, &result, dir)?;
         }
     }
@@ -342,6 +346,17 @@ fn run_md(
         summary,
         failure,
     })
+}
+
+/// A request for plot files is refused by a build without them (WebAssembly), never ignored.
+pub(crate) fn plots_available(req: &Request) -> Result<(), Error> {
+    if req.plots && !cfg!(feature = "plots") {
+        return Err(Error::argument(
+            RunOption::Plot.name(),
+            "this build of pdyn draws no plot files (built without the `plots` feature)",
+        ));
+    }
+    Ok(())
 }
 
 fn create_dir(dir: &Path) -> Result<(), Error> {

@@ -19,6 +19,7 @@ pub mod model_file;
 pub mod nbody;
 pub mod output;
 pub mod params;
+#[cfg(feature = "plots")]
 pub mod plots;
 pub mod report;
 pub mod request;

@@ -537,6 +537,14 @@ fn param_err(origin: &str, e: MdError, fields: &[(&str, &Num)]) -> ModelError {
     )
 }
 
+/// The periodic box's edge lengths (file units).
+pub fn box_edges(p: &Prepared) -> [f64; 3] {
+    match &p.engine {
+        Engine::Lj(s) => s.system.sim_box.l,
+        Engine::General(s) => s.system.sim_box.l,
+    }
+}
+
 /// Number of atoms of the prepared system.
 pub fn atoms(p: &Prepared) -> usize {
     match &p.engine {

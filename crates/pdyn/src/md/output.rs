@@ -222,6 +222,7 @@ pub fn write_files(res: &MdResult, dir: &Path) -> Result<(), Error> {
 }
 
 /// `thermo.svg`/`.png`: energies and temperature against the step.
+#[cfg(feature = "plots")]
 pub fn write_plots(prep: &Prepared, res: &MdResult, dir: &Path) -> Result<(), Error> {
     use pdyn_plot::{save_grid, Figure, Series};
     if res.records.len() < 2 {

@@ -16,6 +16,7 @@
 pub mod build;
 pub mod csv;
 pub mod output;
+#[cfg(feature = "plots")]
 pub mod plots;
 pub mod request;
 pub mod run;

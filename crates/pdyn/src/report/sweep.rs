@@ -25,6 +25,7 @@ pub fn report(
             ),
         ));
     };
+    crate::engine::plots_available(req)?;
     let set = sim::request::settings(&model, req)?;
     let mut prep = sim::request::prepare(&mut model, req.jit)?;
     // Measures and monitors evaluated at every output of every run: native code, as in Python.
@@ -101,6 +102,7 @@ pub fn report(
         let path = dir.join("sweep.csv");
         std::fs::write(&path, csv).map_err(|e| Error::io(&path, "write", e))?;
         if req.plots {
+            #[cfg(feature = "plots")]
             crate::plots::write_sweep_plot(&model, &res, &peaks, dir)?;
         }
     }
