@@ -10,7 +10,7 @@
 #   sources): the standard library is built for wasm32-unknown-unknown with -Z build-std
 #   (RUSTC_BOOTSTRAP=1), linked by rust-lld (lld-22);
 # - wasm-bindgen-cli from crates.io, the same version as the wasm-bindgen crate of
-#   crates/pdyn-web/Cargo.toml, installed into target/tools;
+#   crates/pdyn-web/Cargo.toml (installed with cargo install when missing);
 # - Node.js and npm (front-end packages from the npm registry, pinned in web/package-lock.json);
 # - for the browser tests (web/tests, scripts/test-web.sh): Debian's chromium.
 set -euo pipefail
@@ -43,11 +43,19 @@ if [ -z "${SKIP_INSTALL:-}" ]; then
     fi
 fi
 
-tools="$root/target/tools"
-bindgen="$tools/bin/wasm-bindgen"
-if ! { [ -x "$bindgen" ] && "$bindgen" --version | grep -q " $WASM_BINDGEN_VERSION\$"; }; then
-    echo "installing wasm-bindgen-cli $WASM_BINDGEN_VERSION into target/tools (cargo)" >&2
-    cargo install --quiet --root "$tools" wasm-bindgen-cli --version "$WASM_BINDGEN_VERSION"
+# wasm-bindgen-cli at the crate's version: on PATH, else in cargo's bin directory, else
+# installed there from crates.io (once per machine: a few minutes).
+bindgen=""
+for candidate in "$(command -v wasm-bindgen || true)" "${CARGO_HOME:-$HOME/.cargo}/bin/wasm-bindgen"; do
+    if [ -n "$candidate" ] && [ -x "$candidate" ] && "$candidate" --version | grep -q " $WASM_BINDGEN_VERSION\$"; then
+        bindgen="$candidate"
+        break
+    fi
+done
+if [ -z "$bindgen" ]; then
+    echo "installing wasm-bindgen-cli $WASM_BINDGEN_VERSION (cargo install)" >&2
+    cargo install --quiet --root "${CARGO_HOME:-$HOME/.cargo}" wasm-bindgen-cli --version "$WASM_BINDGEN_VERSION"
+    bindgen="${CARGO_HOME:-$HOME/.cargo}/bin/wasm-bindgen"
 fi
 
 # The library for the browser: Debian's Rust 1.96 builds std for the target from its sources.

@@ -16,6 +16,9 @@ const EXAMPLES = Object.fromEntries(
     .sort(([a], [b]) => a.localeCompare(b)),
 );
 const DEFAULT_EXAMPLE = "examples/satellite.toml";
+// Small sizes by default in the browser, where the CLI's defaults are benchmark sizes
+// (32,000 and 6,912 atoms): 500 LJ atoms. The option box shows it and can be cleared.
+const BROWSER_SET = { "examples/md/lj_liquid.toml": "n=5", "examples/md/lj_formula.toml": "n=5" };
 
 const $ = (id) => document.getElementById(id);
 const state = { origin: DEFAULT_EXAMPLE, lastRun: null };
@@ -59,6 +62,7 @@ function loadExample(path, updateUrl) {
   if (!(path in EXAMPLES)) return false;
   editor.text = EXAMPLES[path];
   state.origin = path;
+  $("opt-set").value = BROWSER_SET[path] ?? "";
   $("example").value = path;
   if (updateUrl) history.replaceState(null, "", `#example=${encodeURIComponent(path)}`);
   return true;
@@ -107,13 +111,15 @@ function options(cmd) {
   }
   if (cmd === "derive") return { json: true, ...(o.set ? { set: o.set } : {}) };
   if (cmd === "check" || cmd === "sweep") o.json = false;
+  // An MD run's atoms drawn every 20 steps (at most 200 frames kept).
+  if (cmd === "run" && /^\[md\]/m.test(editor.text)) Object.assign(o, { frame_every: 20, max_frames: 200 });
   return o;
 }
 
 function cliEquivalent(cmd, o) {
   const parts = [`pdyn ${cmd}`, state.origin.replace(" (edited)", "")];
   for (const [k, v] of Object.entries(o)) {
-    if (k === "json" || k === "max_frames") continue;
+    if (k === "json" || k === "max_frames" || k === "frame_every") continue;
     const flag = `--${k.replace(/_/g, "-")}`;
     if (k === "set" || k === "at") parts.push(`${flag} ${Object.entries(v).map(([a, b]) => `${a}=${b}`).join(",")}`);
     else parts.push(`${flag} ${v}`);

@@ -111,7 +111,9 @@ for (const ex of examples) {
       const r = await command(page, "run");
       assert.ok(r?.value?.ok, `${ex}: run failed: ${await page.textContent("#error")}`);
       const mine = JSON.parse(r.value.summary_text);
-      const want = cli(["run", ex, "--no-jit", "--json"]);
+      // The browser's default sizes (the "set" box) go to the CLI too.
+      const set = (await page.inputValue("#opt-set")).replace(/\s+/g, "");
+      const want = cli(["run", ex, "--no-jit", "--json", ...(set ? ["--set", set] : [])]);
       const s = compare(mine, want);
       if (IDENTICAL.has(ex)) {
         assert.deepEqual(s.mismatches, []);

@@ -31,6 +31,7 @@ const KEYS: &[&str] = &[
     "symbolic_limit",
     "solve",
     "max_frames",
+    "frame_every",
 ];
 
 /// Frames of an animation kept when the page does not say (evenly thinned beyond).
@@ -166,6 +167,7 @@ impl Options {
             out: None,
             plots: false,
             interrupt: None,
+            frame_every: self.count("frame_every")?.map(|k| k as u64),
         })
     }
 

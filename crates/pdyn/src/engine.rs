@@ -35,8 +35,8 @@ pub enum Progress<'a> {
     /// A line of the run's log (what is simulated, a live thermo row), for a front end that
     /// shows the run as it goes.
     Log(&'a str),
-    /// The particles' positions at `time` (an MD run's `dump_every` frames), for a front end
-    /// that animates them; coordinates in the model's units.
+    /// The particles' positions at `time` (an MD run's frames: `Request::frame_every`, else
+    /// `dump_every`), for a front end that animates them; coordinates in the model's units.
     Frame {
         /// The time of the frame.
         time: f64,
@@ -317,6 +317,7 @@ fn run_md(
         out: req.out.clone(),
         drift_tolerance,
         interrupt: req.interrupt.clone(),
+        frame_every: req.frame_every.unwrap_or(0),
     };
     let result = md::run(&mut prepared, &opts, &mut |p| match p {
         md::Progress::Record(r) => progress(Progress::Log(&md::report::thermo_line(r))),

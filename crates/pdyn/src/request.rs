@@ -42,4 +42,7 @@ pub struct Request {
     /// Set by another thread to stop the run early, keeping what was computed (Ctrl-C in
     /// Python; the front end knows it set it).
     pub interrupt: Option<pdyn_ode::Interrupt>,
+    /// An MD run's frames for a front end that animates them (`Progress::Frame`), one every
+    /// this many steps (default: the model's `dump_every`); no file is written for them.
+    pub frame_every: Option<u64>,
 }

@@ -102,6 +102,7 @@ pub fn request(a: &RunArgs) -> Result<pdyn::Request, Error> {
         plots: a.plot,
         // Ctrl-C ends the process (a clean stop with files kept is issue 29's).
         interrupt: None,
+        frame_every: None,
     })
 }
 

@@ -31,6 +31,9 @@ pub struct RunOptions {
     pub drift_tolerance: f64,
     /// Set by another thread to stop after the current stretch of steps (Ctrl-C in Python).
     pub interrupt: Option<pdyn_ode::Interrupt>,
+    /// Frames for a live display (`Progress::Frame`) every this many steps; 0: at the model's
+    /// `dump_every` (none without).
+    pub frame_every: u64,
 }
 
 /// What happens during a run, for a live display.
@@ -40,8 +43,8 @@ pub enum Progress<'a> {
     Record(&'a ThermoRecord),
     /// Steps completed so far.
     Step(u64),
-    /// The system at a step of `dump_every` (and the first), for a front end that shows the
-    /// atoms moving: what `traj.xyz` gets, whether or not a directory was given.
+    /// The system at a frame step (`RunOptions::frame_every`, else `dump_every`; and the
+    /// first), for a front end that shows the atoms moving.
     Frame {
         /// The step.
         step: u64,
@@ -297,7 +300,13 @@ fn run_sim<P: PairPotential>(
         },
     };
     let mut frames = 0u64;
-    if spec.dump_every > 0 {
+    // Frames shown live: as the front end asks, else at dump_every.
+    let frame_every = if opts.frame_every > 0 {
+        opts.frame_every
+    } else {
+        spec.dump_every
+    };
+    if frame_every > 0 {
         progress(Progress::Frame {
             step: sim.step,
             system: &sim.system,
@@ -359,7 +368,12 @@ fn run_sim<P: PairPotential>(
     let mut rdf_seen = 0u64;
     let every = spec.thermo_every.max(1);
     // the run stops at every step where something is due: thermo, a frame, an MSD or RDF sample
-    let chunk = [spec.dump_every, spec.msd_every, spec.rdf_every.unwrap_or(0)]
+    let chunk = [
+        spec.dump_every,
+        frame_every,
+        spec.msd_every,
+        spec.rdf_every.unwrap_or(0),
+    ]
         .into_iter()
         .filter(|&k| k > 0)
         .fold(every, gcd);
@@ -423,7 +437,7 @@ fn run_sim<P: PairPotential>(
             }
         }
         let dump = spec.dump_every > 0 && sim.step % spec.dump_every == 0;
-        if dump {
+        if frame_every > 0 && sim.step % frame_every == 0 {
             progress(Progress::Frame {
                 step: sim.step,
                 system: &sim.system,
