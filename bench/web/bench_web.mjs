@@ -49,22 +49,34 @@ try {
     out.satellite_first_click_ms = clicks[0];
     out.satellite_click_to_plot_ms_median = median(clicks.slice(1));
 
-    // Interpreter: wasm engine time vs native --no-jit whole process.
+    // Interpreter: wasm engine time vs native --no-jit whole process, on runs long enough
+    // that the process's start (a few ms) does not decide the ratio; the same options in both.
     out.interpreter = [];
-    for (const ex of ["examples/satellite.toml", "examples/pendulum_chain_3.toml", "examples/hanging_net.toml", "examples/md/lj_liquid.toml"]) {
+    const cases = [
+      ["examples/satellite.toml", { t_end: "10000" }],
+      ["examples/pendulum_chain_3.toml", { t_end: "100" }],
+      ["examples/hanging_net.toml", {}],
+      ["examples/md/lj_liquid.toml", { set: "n=5", t_end: "5" }],
+    ];
+    for (const [ex, opts] of cases) {
       const p = (await open(browser, server.url, `#example=${ex}`)).page;
+      await p.fill("#opt-t_end", opts.t_end ?? "");
+      await p.fill("#opt-set", opts.set ?? "");
       const engine = [];
       for (let i = 0; i < 3; i++) {
         await command(p, "run");
-        engine.push(await p.evaluate(() => window.pdynLast && Number(document.getElementById("status").textContent.match(/engine (\d+) ms/)[1])));
+        engine.push(await p.evaluate(() => Number(document.getElementById("status").textContent.match(/engine (\d+) ms/)[1])));
       }
+      const args = ["run", ex, "--no-jit", "--json"];
+      if (opts.t_end) args.push("--t-end", opts.t_end);
+      if (opts.set) args.push("--set", opts.set);
       const native = [];
       for (let i = 0; i < 3; i++) {
         const t0 = performance.now();
-        execFileSync(bin, ["run", ex, "--no-jit", "--json"], { cwd: root, stdio: ["ignore", "ignore", "ignore"] });
+        execFileSync(bin, args, { cwd: root, stdio: ["ignore", "ignore", "ignore"] });
         native.push(performance.now() - t0);
       }
-      out.interpreter.push({ model: ex, wasm_ms: median(engine), native_no_jit_ms: median(native), ratio: median(engine) / median(native) });
+      out.interpreter.push({ model: ex, options: opts, wasm_ms: median(engine), native_no_jit_ms: median(native), ratio: median(engine) / median(native) });
       await p.close();
     }
   } finally {

@@ -52,4 +52,32 @@ self.onmessage = async (event) => {
   }
 };
 
-ready.then(() => self.postMessage({ type: "ready", version: pdyn.version() }));
+// A first call pays for V8 compiling the functions it reaches (parser, derivation,
+// integrator, JSON): a small run right after loading does that while the reader looks at the
+// page, so the first click is as fast as the next ones. Its result is discarded.
+const WARM_UP = `name = "warm-up"
+[parameters]
+GM = 1.0
+[coordinates]
+x = { initial = 1.0, rate = 0.0 }
+y = { initial = 0.0, rate = 1.0 }
+[particles.p]
+mass = "1"
+position = "[x, y, 0]"
+[points]
+O = "[0, 0, 0]"
+[[forces]]
+kind = "inverse_square"
+on = "p"
+to = "O"
+strength = "GM"
+[simulate]
+t_end = 1.0
+`;
+
+ready.then(() => {
+  self.postMessage({ type: "ready", version: pdyn.version() });
+  const answers = [pdyn.derive(WARM_UP, "warm-up", '{"json": true}'), pdyn.run(WARM_UP, "warm-up", "{}", null)];
+  // A warm-up that fails means the engine is broken: say so in the console.
+  for (const a of answers) if (!JSON.parse(a).ok) console.error("pdyn warm-up failed:", a);
+});

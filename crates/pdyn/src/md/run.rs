@@ -374,9 +374,9 @@ fn run_sim<P: PairPotential>(
         spec.msd_every,
         spec.rdf_every.unwrap_or(0),
     ]
-        .into_iter()
-        .filter(|&k| k > 0)
-        .fold(every, gcd);
+    .into_iter()
+    .filter(|&k| k > 0)
+    .fold(every, gcd);
     let ramp = match (
         &spec.thermostat.temperature,
         &spec.thermostat.final_temperature,
