@@ -83,17 +83,10 @@ pub fn run(
         let req = opts.request()?;
         let mut frames = tables::Frames::new(opts.max_frames);
         let mut total = 0u64;
+        let report = ProgressFn(on_progress);
         let mut progress = |p: Progress| match p {
             Progress::Started { steps, .. } => total = steps,
-            Progress::Step(done) => {
-                if let Some(f) = &on_progress {
-                    let _ = f.call2(
-                        &JsValue::NULL,
-                        &(done as f64).into(),
-                        &(total as f64).into(),
-                    );
-                }
-            }
+            Progress::Step(done) => report.call(done as f64, total as f64),
             Progress::Frame { time, x, y, z } => frames.push(time, x, y, z),
             _ => {}
         };
@@ -168,7 +161,7 @@ pub fn sweep(
         let opts = Options::parse(options)?;
         let model = opts.mechanics(source, origin)?;
         let progress = ProgressFn(on_progress);
-        let on_run = |done: usize, all: usize| progress.call(done, all);
+        let on_run = |done: usize, all: usize| progress.call(done as f64, all as f64);
         let rep = pdyn::report::sweep::report(model, &opts.request()?, None, opts.json, &on_run)?;
         let mut v = opts.text_or_json(rep.stdout)?;
         v["warnings"] = rep
@@ -188,7 +181,7 @@ pub fn methods_help(source: &str, origin: &str) -> String {
     ok(json!({"text": pdyn::engine::methods_help(file.kind)}))
 }
 
-/// A JS callback that a sweep may call: the sweep's callback must be `Sync` (rayon), and a
+/// The page's progress callback. A sweep's callback must be `Sync` (rayon), and a
 /// WebAssembly build without threads runs it on the one thread there is.
 struct ProgressFn(Option<js_sys::Function>);
 
@@ -197,9 +190,10 @@ struct ProgressFn(Option<js_sys::Function>);
 unsafe impl Sync for ProgressFn {}
 
 impl ProgressFn {
-    fn call(&self, done: usize, all: usize) {
+    /// `on_progress(done, all)`; an exception thrown by the page's callback is its own.
+    fn call(&self, done: f64, all: f64) {
         if let Some(f) = &self.0 {
-            let _ = f.call2(&JsValue::NULL, &(done as f64).into(), &(all as f64).into());
+            let _ = f.call2(&JsValue::NULL, &done.into(), &all.into());
         }
     }
 }
