@@ -18,12 +18,14 @@
 //! unknown); velocity 0 with σ = [`Noise::v0`] (default 10³); bias 0 with σ =
 //! [`Noise::bias0`] (default 1 m/s²).
 //!
-//! **Noise levels** given, or estimated by maximising the log-likelihood of the innovations
-//! (the prediction errors at the fixes, Gaussian with variance `S = HPHᵀ + σ_p²` under the
-//! model; Harvey 1989) summed over the axes, over `(log σ_a, log σ_p)`: a grid of ½ decade
-//! over 4 decades each around the data's own scales (σ_a: the second differences of the
-//! accelerometer; σ_p: of the fixes), then alternating golden-section refinement of each to
-//! 0.01 decade. A parameter given is held fixed; σ_b is never estimated (give it).
+//! **Noise levels** given, or estimated: σ_a from the accelerometer record itself by second
+//! differences (`Var Δ²a = 6 σ_a²` for a signal smooth at the sampling scale; Gasser, Sroka &
+//! Jennen-Steinmetz 1986) — the fixes cannot tell σ_a, whose effect between two fixes is far
+//! below σ_p in any useful set-up, so the likelihood is flat in it; σ_p by maximising the
+//! log-likelihood of the innovations (the prediction errors at the fixes, Gaussian with
+//! variance `S = HPHᵀ + σ_p²` under the model; Harvey 1989) summed over the axes: a grid of
+//! ½ decade over 6 decades, then golden section on log σ_p to 0.01 decade. σ_b is never
+//! estimated (give it; 0 means a constant bias, which the filter estimates).
 
 use crate::error::DataError;
 
@@ -436,16 +438,6 @@ pub fn fuse(
         .collect();
     let fs = (ta.len() - 1) as f64 / (t1 - t0);
     let qb = noise.sigma_b * noise.sigma_b;
-    let total = |sa: f64, sp: f64| -> (f64, f64, usize) {
-        let mut out = (0.0, 0.0, 0);
-        for ax in &axes {
-            let (l, e, c, _) = filter(ax, sa * sa / fs, qb, sp, noise, false);
-            out.0 += l;
-            out.1 += e;
-            out.2 += c;
-        }
-        out
-    };
     let second_diff_sd = |xs: &[f64]| {
         if xs.len() < 3 {
             return 1.0;
@@ -461,70 +453,61 @@ pub fn fuse(
             1.0
         }
     };
-    let guess_a = a.iter().map(|c| second_diff_sd(c)).fold(0.0, f64::max);
-    let guess_p = z.iter().map(|c| second_diff_sd(c)).fold(0.0, f64::max);
-    let (mut la, mut lp) = (
-        noise
-            .sigma_a
-            .map_or(guess_a.log10(), |s| s.max(1e-300).log10()),
-        noise.sigma_p.map_or(guess_p.log10(), |s| s.log10()),
-    );
-    let est = [noise.sigma_a.is_none(), noise.sigma_p.is_none()];
-    let objective = |la: f64, lp: f64| {
-        let l = total(10f64.powf(la), 10f64.powf(lp)).0;
+    // σ_a: from the accelerometer itself, by second differences (Var Δ²a = 6 σ_a² for a
+    // signal smooth at the sampling scale). The fixes cannot tell it: between fixes its
+    // effect on the position is far below σ_p in any useful set-up, so the innovations'
+    // likelihood is flat in σ_a.
+    let sa = match noise.sigma_a {
+        Some(s) => s,
+        None => a.iter().map(|c| second_diff_sd(c)).fold(0.0, f64::max),
+    };
+    let qa = sa * sa / fs;
+    // σ_p: maximum likelihood of the innovations, a grid of ½ decade over 6 decades around
+    // the fixes' own second differences (which include the motion, hence an upper scale),
+    // then golden section to 0.01 decade.
+    let objective = |lp: f64| {
+        let sp = 10f64.powf(lp);
+        let l: f64 = axes
+            .iter()
+            .map(|ax| filter(ax, qa, qb, sp, noise, false).0)
+            .sum();
         if l.is_finite() {
             -l
         } else {
             f64::INFINITY
         }
     };
-    if est[0] || est[1] {
-        // Grid: ½ decade over [guess − 3, guess + 1] decades (the second differences include
-        // the signal, so they overestimate the noise).
-        let ga: Vec<f64> = if est[0] {
-            (0..9).map(|k| la - 3.0 + 0.5 * k as f64).collect()
-        } else {
-            vec![la]
-        };
-        let gp: Vec<f64> = if est[1] {
-            (0..9).map(|k| lp - 3.0 + 0.5 * k as f64).collect()
-        } else {
-            vec![lp]
-        };
-        let mut best = (f64::INFINITY, la, lp);
-        for &x in &ga {
-            for &y in &gp {
-                let v = objective(x, y);
+    let sp = match noise.sigma_p {
+        Some(s) => s,
+        None => {
+            let guess = z
+                .iter()
+                .map(|c| second_diff_sd(c))
+                .fold(0.0, f64::max)
+                .log10();
+            let mut best = (f64::INFINITY, guess);
+            for k in 0..13 {
+                let lp = guess - 5.0 + 0.5 * k as f64;
+                let v = objective(lp);
                 if v < best.0 {
-                    best = (v, x, y);
+                    best = (v, lp);
                 }
             }
-        }
-        if !best.0.is_finite() {
-            return Err(DataError::new(
-                "",
-                "the noise levels could not be estimated (no finite likelihood)",
-            )
-            .help("give σ_a and σ_p"));
-        }
-        la = best.1;
-        lp = best.2;
-        for _round in 0..4 {
-            if est[0] {
-                la = golden(|x| objective(x, lp), la - 0.5, la + 0.5);
+            if !best.0.is_finite() {
+                return Err(DataError::new(
+                    "",
+                    "σ_p could not be estimated (no finite likelihood of the fixes)",
+                )
+                .help("give σ_p"));
             }
-            if est[1] {
-                lp = golden(|y| objective(la, y), lp - 0.5, lp + 0.5);
-            }
+            10f64.powf(golden(objective, best.1 - 0.5, best.1 + 0.5))
         }
-    }
-    let (sa, sp) = (10f64.powf(la), 10f64.powf(lp));
-    let sa = noise.sigma_a.unwrap_or(sa);
-    let sp = noise.sigma_p.unwrap_or(sp);
+    };
+    let est = [noise.sigma_a.is_none(), noise.sigma_p.is_none()];
     let mut out_axes = Vec::with_capacity(axes.len());
     let (mut ll, mut nis, mut count) = (0.0, 0.0, 0usize);
     for ax in &axes {
-        let (l, e, c, nodes) = filter(ax, sa * sa / fs, qb, sp, noise, true);
+        let (l, e, c, nodes) = filter(ax, qa, qb, sp, noise, true);
         ll += l;
         nis += e;
         count += c;

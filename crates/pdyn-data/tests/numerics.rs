@@ -1,9 +1,9 @@
 //! Known truth for the numerics: interpolation orders, the smoothing spline against a dense
-#![allow(clippy::needless_range_loop)]
 //! solve of its defining equations, the equivalent-kernel standard errors against Monte Carlo,
 //! kinematics of a noisy circle within the stated band at the stated rate, and integration of
 //! a clean accelerometer at the quadrature's order.
 
+#![allow(clippy::needless_range_loop)]
 mod common;
 use common::Rng;
 use pdyn_data::csv::Series;
