@@ -8,6 +8,7 @@
 #![warn(missing_docs)]
 
 pub mod args;
+pub mod data;
 pub mod dsolve;
 pub mod engine;
 pub mod error;
