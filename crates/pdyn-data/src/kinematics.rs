@@ -36,6 +36,11 @@ pub struct ComponentFit {
     pub edf: f64,
     /// Standard errors of the position, velocity and acceleration component (interior).
     pub se: [f64; 3],
+    /// Within this time of either end this coordinate's end bias may exceed its standard
+    /// errors: four decay lengths `√2 (λ h)^{1/4}` of the smoothing kernel. A coordinate
+    /// fitted as (nearly) a straight line has a huge λ and a boundary spanning the record;
+    /// its errors are then a line fit's, small beside a curved coordinate's.
+    pub boundary: f64,
 }
 
 /// Kinematics at every sample time.
@@ -139,6 +144,7 @@ pub fn kinematics(series: &Series, smoothing: Smoothing) -> Result<KinData, Data
             sigma: f.sigma2.sqrt(),
             edf: f.edf,
             se: f.se,
+            boundary: 4.0 * std::f64::consts::SQRT_2 * (f.lambda * f.h).powf(0.25),
         })
         .collect();
     let se_v: Vec<f64> = fits.iter().map(|f| f.se[1]).collect();

@@ -445,3 +445,49 @@ fn error_growth_matches_the_statement() {
     assert_eq!(r.sigma_a_source, "second differences");
     assert!((r.sigma_a / sa - 1.0).abs() < 0.1);
 }
+
+/// Three coordinates: the helix x = R cos ωt, y = R sin ωt, z = c t has speed √(R²ω² + c²),
+/// a_n = R ω², curvature R ω²/(R²ω² + c²), a_t = 0, and its normal points to the axis.
+#[test]
+fn helix_in_three_dimensions() {
+    let (r, w, c, sigma) = (3.0, 0.9, 0.5, 0.005);
+    let mut rng = Rng::new(77);
+    let t: Vec<f64> = (0..=600).map(|i| i as f64 * 0.05).collect();
+    let x = t
+        .iter()
+        .map(|s| r * (w * s).cos() + sigma * rng.normal())
+        .collect();
+    let y = t
+        .iter()
+        .map(|s| r * (w * s).sin() + sigma * rng.normal())
+        .collect();
+    let z = t.iter().map(|s| c * s + sigma * rng.normal()).collect();
+    let names = vec!["x".into(), "y".into(), "z".into()];
+    let s = Series::from_arrays(t, names, vec![x, y, z], 5, "k").unwrap();
+    let k = kinematics(&s, Smoothing::Gcv).unwrap();
+    let speed = (r * r * w * w + c * c).sqrt();
+    let kappa = r * w * w / (speed * speed);
+    // z is a straight line: GCV smooths it as one (λ huge, boundary over the whole record);
+    // the interior is that of the curved coordinates.
+    assert!(k.fits[2].boundary > 30.0, "{}", k.fits[2].boundary);
+    let b = k.fits[0].boundary.max(k.fits[1].boundary);
+    let interior: Vec<usize> = (0..k.t.len())
+        .filter(|&i| k.t[i] > b && k.t[i] < k.t[k.t.len() - 1] - b)
+        .collect();
+    assert!(interior.len() > 300);
+    let cover = |est: &[f64], se: &[f64], truth: f64| {
+        interior
+            .iter()
+            .filter(|&&i| (est[i] - truth).abs() <= 2.0 * se[i])
+            .count() as f64
+            / interior.len() as f64
+    };
+    assert!(cover(&k.speed, &k.se_speed, speed) >= 0.9);
+    assert!(cover(&k.a_n, &k.se_a_n, r * w * w) >= 0.9);
+    assert!(cover(&k.a_t, &k.se_a_t, 0.0) >= 0.9);
+    assert!(cover(&k.curvature, &k.se_curvature, kappa) >= 0.9);
+    let i = interior[interior.len() / 2];
+    let toward_axis = [-(w * k.t[i]).cos(), -(w * k.t[i]).sin(), 0.0];
+    let dot: f64 = (0..3).map(|c| k.normal[c][i] * toward_axis[c]).sum();
+    assert!(dot > 0.99, "normal · (toward the axis) = {dot}");
+}

@@ -342,6 +342,7 @@ pub fn kin_summary(k: &KinData) -> serde_json::Value {
                 "se_position": f.se[0],
                 "se_velocity": f.se[1],
                 "se_acceleration": f.se[2],
+                "boundary": f.boundary,
             })
         })
         .collect();
@@ -366,7 +367,7 @@ pub fn kin_summary_text(k: &KinData) -> String {
     out += "smoothing spline per coordinate (standard errors in the interior):\n";
     for f in &k.fits {
         out += &format!(
-            "  {}: λ = {:.4e} ({}), noise σ = {:.4e}, edf = {:.1}, se(position) = {:.3e}, se(velocity) = {:.3e}, se(acceleration) = {:.3e}\n",
+            "  {}: λ = {:.4e} ({}), noise σ = {:.4e}, edf = {:.1}, se(position) = {:.3e}, se(velocity) = {:.3e}, se(acceleration) = {:.3e}, boundary {:.4}\n",
             f.name,
             f.lambda,
             if f.from_gcv { "GCV" } else { "given" },
@@ -374,7 +375,8 @@ pub fn kin_summary_text(k: &KinData) -> String {
             f.edf,
             f.se[0],
             f.se[1],
-            f.se[2]
+            f.se[2],
+            f.boundary
         );
     }
     let span = k.t[k.t.len() - 1] - k.t[0];
@@ -383,7 +385,7 @@ pub fn kin_summary_text(k: &KinData) -> String {
         k.boundary
     );
     if 2.0 * k.boundary >= span {
-        out += "warning: the smoothing spans the whole record: the standard errors do not hold anywhere (too few samples, or λ too large)\n";
+        out += "warning: a coordinate's smoothing spans the whole record (a straight line, too few samples, or λ too large): its standard errors are those of the interior formula, not of a line fit; the others hold beyond their own boundary\n";
     }
     out
 }
