@@ -197,14 +197,37 @@ pub fn read_columns(file: &str, text: &str, wanted: &[&str]) -> Result<Columns, 
     let mut values: Vec<Vec<f64>> = vec![Vec::new(); wanted.len()];
     let mut starts: Vec<Vec<u32>> = vec![Vec::new(); wanted.len()];
     let mut row_lines = Vec::new();
+    // The hot loop: fields split without allocating; only the wanted ones are parsed. The
+    // column (in characters) of a field is counted only for a line that is not ASCII.
+    let mut fs: Vec<(usize, &str)> = Vec::with_capacity(names.len());
     for (line_no, line) in lines {
-        let fs = fields(line, delim);
+        fs.clear();
+        let ascii = line.is_ascii();
+        let mut start = 0;
+        for (k, f) in line.split(delim).enumerate() {
+            if k >= needed {
+                break;
+            }
+            let lead = f.len() - f.trim_start().len();
+            let col = if ascii {
+                start + lead + 1
+            } else {
+                line[..start + lead].chars().count() + 1
+            };
+            let t = f.trim();
+            let t = t
+                .strip_prefix('"')
+                .and_then(|x| x.strip_suffix('"'))
+                .unwrap_or(t);
+            fs.push((col, t));
+            start += f.len() + delim.len_utf8();
+        }
         if fs.len() < needed {
             return Err(DataError::new(
                 file,
                 format!(
                     "the row has {} field(s) but column `{}` is field {} of the header",
-                    fs.len(),
+                    fields(line, delim).len(),
                     names[needed - 1],
                     needed
                 ),

@@ -177,21 +177,22 @@ pub fn kinematics(series: &Series, smoothing: Smoothing) -> Result<KinData, Data
     }
     let mut prev_theta = f64::NAN;
     for i in 0..n {
-        let v: Vec<f64> = (0..dim).map(|c| k.velocity[c][i]).collect();
-        let a: Vec<f64> = (0..dim).map(|c| k.acceleration[c][i]).collect();
-        let s = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let tan: Vec<f64> = if s > 0.0 {
-            v.iter().map(|x| x / s).collect()
+        // Fixed-size vectors (a third component of 0 in the plane): no allocation per sample.
+        let mut v = [0.0; 3];
+        let mut a = [0.0; 3];
+        for c in 0..dim {
+            v[c] = k.velocity[c][i];
+            a[c] = k.acceleration[c][i];
+        }
+        let s = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let tan = if s > 0.0 { v.map(|x| x / s) } else { [0.0; 3] };
+        let at = a[0] * tan[0] + a[1] * tan[1] + a[2] * tan[2];
+        let perp = [a[0] - at * tan[0], a[1] - at * tan[1], a[2] - at * tan[2]];
+        let an = (perp[0] * perp[0] + perp[1] * perp[1] + perp[2] * perp[2]).sqrt();
+        let nor = if an > 0.0 {
+            perp.map(|x| x / an)
         } else {
-            vec![0.0; dim]
-        };
-        let at: f64 = a.iter().zip(&tan).map(|(a, t)| a * t).sum();
-        let perp: Vec<f64> = a.iter().zip(&tan).map(|(a, t)| a - at * t).collect();
-        let an = perp.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let nor: Vec<f64> = if an > 0.0 {
-            perp.iter().map(|x| x / an).collect()
-        } else {
-            vec![0.0; dim]
+            [0.0; 3]
         };
         let kappa = if s > 0.0 { an / (s * s) } else { f64::INFINITY };
         let (mut vs, mut vat, mut van, mut vk) = (0.0, 0.0, 0.0, 0.0);

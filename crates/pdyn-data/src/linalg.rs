@@ -2,13 +2,17 @@
 //! spline's tridiagonal one, both O(n).
 
 /// A symmetric positive definite pentadiagonal matrix `M` factored as `L D Lᵀ` (`L` unit lower
-/// triangular with two sub-diagonals), with the band of `M⁻¹` on demand.
+/// triangular with two sub-diagonals), with the band of `M⁻¹` on demand. The reference
+/// implementation that the smoothing spline's fused one-pass version
+/// (`spline::Setup::score`) is tested against.
+#[cfg(test)]
 pub(crate) struct Penta {
     d: Vec<f64>,
     l1: Vec<f64>,
     l2: Vec<f64>,
 }
 
+#[cfg(test)]
 impl Penta {
     /// Factors `M` given by its diagonal `m0`, first super-diagonal `m1` (`m1[j] = M[j][j+1]`)
     /// and second `m2`. `None` when a pivot is not positive (the matrix is singular to

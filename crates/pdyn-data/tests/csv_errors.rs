@@ -82,6 +82,15 @@ fn extra_text_columns_and_other_delimiters_are_fine() {
     );
 }
 
+/// Columns count characters, not bytes, on a line that is not ASCII.
+#[test]
+fn columns_count_characters() {
+    let e = series("t,label,x,y\n0,é,0,0\n1,ñandú,bad,1\n", &["t", "x", "y"]).unwrap_err();
+    assert_eq!((e.line, e.column), (Some(3), Some(9)), "{e}");
+    let e = series("t,x,y\n0, 0,0\n1,  bad,1\n", &["t", "x", "y"]).unwrap_err();
+    assert_eq!((e.line, e.column), (Some(3), Some(5)), "{e}");
+}
+
 #[test]
 fn arrays_are_checked_like_files() {
     let e = Series::from_arrays(
