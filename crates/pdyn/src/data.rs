@@ -35,33 +35,47 @@ impl Table {
         self.columns.first().map_or(0, Vec::len)
     }
 
-    /// The table as CSV text (shortest round-trip numbers; `inf` where a quantity is
+    /// Writes the table as CSV (shortest round-trip numbers; `inf` where a quantity is
     /// undefined, such as the curvature at rest).
-    pub fn to_csv(&self) -> String {
-        let mut out = String::with_capacity(self.rows() * self.names.len() * 20 + 64);
-        out += &self.names.join(",");
-        out.push('\n');
+    pub fn write_csv(&self, out: &mut impl std::io::Write) -> std::io::Result<()> {
+        out.write_all(self.names.join(",").as_bytes())?;
+        out.write_all(b"\n")?;
         let mut buf = ryu::Buffer::new();
+        let mut line = String::with_capacity(self.names.len() * 24);
         for i in 0..self.rows() {
+            line.clear();
             for (k, c) in self.columns.iter().enumerate() {
                 if k > 0 {
-                    out.push(',');
+                    line.push(',');
                 }
                 let x = c[i];
                 if x.is_finite() {
-                    out += buf.format_finite(x);
+                    line += buf.format_finite(x);
                 } else {
-                    out += &x.to_string();
+                    line += &x.to_string();
                 }
             }
-            out.push('\n');
+            line.push('\n');
+            out.write_all(line.as_bytes())?;
         }
-        out
+        Ok(())
     }
 
-    /// Writes the CSV to `path`.
+    /// The table as CSV text.
+    pub fn to_csv(&self) -> String {
+        let mut out = Vec::with_capacity(self.rows() * self.names.len() * 20 + 64);
+        // Writing into a Vec cannot fail.
+        let _ = self.write_csv(&mut out);
+        String::from_utf8_lossy(&out).into_owned()
+    }
+
+    /// Writes the CSV to `path` (streamed: a table of 10⁶ rows is not built as one string).
     pub fn write(&self, path: &Path) -> Result<(), Error> {
-        std::fs::write(path, self.to_csv()).map_err(|e| Error::io(path, "write", e))
+        let file = std::fs::File::create(path).map_err(|e| Error::io(path, "create", e))?;
+        let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
+        self.write_csv(&mut w)
+            .and_then(|()| std::io::Write::flush(&mut w))
+            .map_err(|e| Error::io(path, "write", e))
     }
 
     /// The columns as a JSON object `{name: [values]}`.
