@@ -210,3 +210,39 @@ pub(crate) fn _fuse<'py>(
         ))
     })
 }
+
+/// Interpolation of samples at the times `at` (`kind`: linear, cubic, pchip).
+#[pyfunction]
+#[pyo3(signature = (t, y, at, kind="linear".to_string()))]
+pub(crate) fn _interp<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArray1<'py, f64>,
+    y: PyReadonlyArray1<'py, f64>,
+    at: PyReadonlyArray1<'py, f64>,
+    kind: String,
+) -> PyResult<Array<'py>> {
+    let (t, y, at) = (
+        t.as_array().to_vec(),
+        y.as_array().to_vec(),
+        at.as_array().to_vec(),
+    );
+    guarded(py, || {
+        let values = py
+            .allow_threads(|| {
+                let k = lib::interp::Kind::parse(&kind).ok_or_else(|| {
+                    Error::argument(
+                        "kind",
+                        format!("kind={kind:?} is not 'linear', 'cubic' or 'pchip'"),
+                    )
+                })?;
+                let s = series(t, vec!["y".into()], vec![y], 2, "interpolation")?;
+                let f = lib::interp::Interpolant::new(k, &s.t, &s.values[0], "y")
+                    .map_err(data::data_error)?;
+                at.iter()
+                    .map(|&x| f.eval(x).map_err(data::data_error))
+                    .collect::<Result<Vec<f64>, Error>>()
+            })
+            .map_err(|e| data_py(py, &e))?;
+        Ok(f64_array(py, values))
+    })
+}

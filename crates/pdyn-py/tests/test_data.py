@@ -155,3 +155,19 @@ def test_bad_data_raise_located_errors(tmp_path):
         pdyn.kin_data(tmp_path / "bad.csv", columns=["t", "x", "q"])
     with pytest.raises(pdyn.ParameterError):
         pdyn.integrate_accel(t, x, rule="euler")
+
+
+def test_interp_matches_numpy_and_scipy():
+    interpolate = pytest.importorskip("scipy.interpolate")
+    rng = np.random.default_rng(8)
+    t = np.sort(rng.uniform(0, 5, 40))
+    y = np.sin(t) + 0.3 * rng.standard_normal(40)
+    at = np.linspace(t[0], t[-1], 777)
+    np.testing.assert_allclose(pdyn.interp(t, y, at), np.interp(at, t, y), rtol=0, atol=1e-13)
+    np.testing.assert_allclose(pdyn.interp(t, y, at, kind="cubic"),
+                               interpolate.CubicSpline(t, y, bc_type="natural")(at), rtol=0, atol=1e-11)
+    np.testing.assert_allclose(pdyn.interp(t, y, at, kind="pchip"),
+                               interpolate.PchipInterpolator(t, y)(at), rtol=0, atol=1e-12)
+    assert pdyn.interp(t, y, t[3]) == pytest.approx(y[3])
+    with pytest.raises(pdyn.ModelError, match="outside the data's time range"):
+        pdyn.interp(t, y, [t[-1] + 1])

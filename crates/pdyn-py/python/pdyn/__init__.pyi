@@ -325,6 +325,7 @@ def dsolve(*equations: Any, ic: Any = ..., rule: Any = ...,
 # Measured motion (pdyn._data; docs/data.md).
 def read_csv(path: Union[str, os.PathLike], columns: Optional[Sequence[str]] = ...,
              kind: str = ...) -> Tuple[List[str], npt.NDArray[np.float64], List[npt.NDArray[np.float64]]]: ...
+def interp(t: Any, y: Any, at: Any, kind: str = ...) -> Any: ...
 class KinDataResult:
     columns: Dict[str, npt.NDArray[np.float64]]
     summary: Dict[str, Any]

@@ -39,6 +39,17 @@ def read_csv(path: _PathLike, columns: Optional[Sequence[str]] = None,
     return _pdyn._read_csv(os.fspath(path), list(columns or []), kind)
 
 
+def interp(t: Any, y: Any, at: Any, kind: str = "linear"):
+    """Interpolates samples ``(t, y)`` at the times ``at``: ``kind="linear"``, ``"cubic"``
+    (natural cubic spline, as SciPy's ``CubicSpline(bc_type="natural")``) or ``"pchip"``
+    (monotone, as SciPy's ``PchipInterpolator``). Times must increase strictly; a time in
+    ``at`` outside ``[t[0], t[-1]]`` raises :class:`~pdyn.ModelError` (data say nothing
+    there)."""
+    at_arr = np.atleast_1d(np.asarray(at, dtype=np.float64))
+    out = _pdyn._interp(_array1(t, "t"), _array1(y, "y"), np.ascontiguousarray(at_arr.ravel()), kind)
+    return out.reshape(at_arr.shape) if np.ndim(at) else out[0]
+
+
 class _Table:
     """A result's columns as attributes and by name."""
 
