@@ -284,3 +284,35 @@ fn help_describes_the_data_modes() {
         "{stdout}"
     );
 }
+
+/// An option of the other mode is refused (nothing silently ignored), and the data options
+/// need --data.
+#[test]
+fn options_of_the_other_mode_are_errors() {
+    let track = example("track.csv");
+    let (code, _, stderr) = pdyn(&["kin", "--data", &track, "--rule", "trapezoid"]);
+    assert_eq!(code, 2);
+    assert!(
+        stderr.contains("--rule applies only to accelerations"),
+        "{stderr}"
+    );
+    let (code, _, stderr) = pdyn(&[
+        "kin",
+        "--data",
+        &example("lift.csv"),
+        "--from",
+        "accel",
+        "--smooth",
+        "1",
+    ]);
+    assert_eq!(code, 2);
+    assert!(
+        stderr.contains("--smooth applies only to positions"),
+        "{stderr}"
+    );
+    let (code, _, _) = pdyn(&["kin", "[t, t, 0]", "--smooth", "gcv"]);
+    assert_eq!(code, 2);
+    let (code, _, stderr) = pdyn(&["kin", "--data", &track, "--from", "speed"]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("is not `position` or `accel`"), "{stderr}");
+}

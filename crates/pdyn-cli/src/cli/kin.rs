@@ -79,39 +79,31 @@ pub struct KinArgs {
 #[derive(Args, Debug)]
 pub struct DataArgs {
     /// With --data: what the columns hold: `position` (t,x,y[,z]: smoothed and differentiated)
-    /// or `accel` (t,ax[,ay[,az]]: integrated to velocity and position).
-    #[arg(
-        long,
-        value_name = "position|accel",
-        default_value = "position",
-        requires = "data"
-    )]
-    from: String,
+    /// or `accel` (t,ax[,ay[,az]]: integrated to velocity and position). [default: position]
+    #[arg(long, value_name = "position|accel", requires = "data")]
+    from: Option<String>,
     /// With --data: the columns to read, time first (default `t,x,y[,z]`, or `t,ax[,ay[,az]]`
     /// with --from accel).
     #[arg(long, value_delimiter = ',', requires = "data")]
     columns: Vec<String>,
     /// With --data (positions): the smoothing: `gcv` (generalized cross-validation) or a
-    /// smoothing parameter λ ≥ 0 (value² · time³; 0 interpolates).
-    #[arg(long, default_value = "gcv", requires = "data")]
-    smooth: String,
+    /// smoothing parameter λ ≥ 0 (value² · time³; 0 interpolates). [default: gcv]
+    #[arg(long, requires = "data")]
+    smooth: Option<String>,
     /// With --data (positions): the quantities to write, comma-separated, from: position,
     /// velocity, acceleration, speed, tangent, normal, curvature, a_t, a_n, polar, se
     /// (default all).
     #[arg(long, value_delimiter = ',', requires = "data")]
     quantities: Vec<String>,
     /// With --from accel: the quadrature: `simpson` (4th order) or `trapezoid` (2nd order).
-    #[arg(long, default_value = "simpson", requires = "data")]
-    rule: String,
+    /// [default: simpson]
+    #[arg(long, requires = "data")]
+    rule: Option<String>,
     /// With --from accel: the accelerometer bias to remove: `none`, `mean` (the record starts
     /// and ends at the same velocity), `T0..T1` (the mean over an interval at rest) or a value.
-    #[arg(
-        long,
-        default_value = "none",
-        allow_hyphen_values = true,
-        requires = "data"
-    )]
-    bias: String,
+    /// [default: none]
+    #[arg(long, allow_hyphen_values = true, requires = "data")]
+    bias: Option<String>,
     /// With --from accel: initial velocity per axis, e.g. `--v0 0,1.5`.
     #[arg(
         long,
@@ -151,9 +143,40 @@ const PRINT_ROWS: usize = 1000;
 /// `pdyn kin --data ...`.
 fn run_data(a: KinArgs, path: &std::path::Path) -> Result<String, Error> {
     use pdyn::data::{self, DataKind};
-    let (summary_text, summary_json, table) = match a.d.from.as_str() {
+    let d = &a.d;
+    let from = d.from.as_deref().unwrap_or("position");
+    // An option of the other mode is an error, not silently ignored.
+    let accel_only = [
+        ("--rule", d.rule.is_some()),
+        ("--bias", d.bias.is_some()),
+        ("--v0", !d.v0.is_empty()),
+        ("--x0", !d.x0.is_empty()),
+        ("--sigma-a", d.sigma_a.is_some()),
+    ];
+    let position_only = [
+        ("--smooth", d.smooth.is_some()),
+        ("--quantities", !d.quantities.is_empty()),
+    ];
+    let (wrong, mode) = if from == "accel" {
+        (
+            position_only.iter().find(|o| o.1),
+            "positions (the default --from position)",
+        )
+    } else {
+        (
+            accel_only.iter().find(|o| o.1),
+            "accelerations (--from accel)",
+        )
+    };
+    if let Some((flag, _)) = wrong {
+        return Err(Error::argument(
+            *flag,
+            format!("{flag} applies only to {mode}"),
+        ));
+    }
+    let (summary_text, summary_json, table) = match from {
         "position" => {
-            let smoothing = data::parse_smoothing(&a.d.smooth)?;
+            let smoothing = data::parse_smoothing(d.smooth.as_deref().unwrap_or("gcv"))?;
             let series = data::read_series(
                 path,
                 &a.d.columns,
@@ -172,15 +195,16 @@ fn run_data(a: KinArgs, path: &std::path::Path) -> Result<String, Error> {
             (data::kin_summary_text(&k), data::kin_summary(&k), table)
         }
         "accel" => {
-            let rule = data::lib::integrate::Rule::parse(&a.d.rule).ok_or_else(|| {
+            let rule_text = d.rule.as_deref().unwrap_or("simpson");
+            let rule = data::lib::integrate::Rule::parse(rule_text).ok_or_else(|| {
                 Error::argument(
                     "--rule",
-                    format!("`{}` is not `simpson` or `trapezoid`", a.d.rule),
+                    format!("`{rule_text}` is not `simpson` or `trapezoid`"),
                 )
             })?;
             let options = data::lib::integrate::AccelOptions {
                 rule,
-                bias: data::parse_bias(&a.d.bias)?,
+                bias: data::parse_bias(d.bias.as_deref().unwrap_or("none"))?,
                 sigma_a: a.d.sigma_a,
                 ..Default::default()
             };
@@ -260,6 +284,26 @@ pub(crate) fn finish(
 pub fn run(a: KinArgs) -> Result<String, Error> {
     if let Some(path) = a.data.clone() {
         return run_data(a, &path);
+    }
+    // The options of --data mean nothing without it: refuse them rather than ignore them.
+    let d = &a.d;
+    let given = [
+        ("--from", d.from.is_some()),
+        ("--columns", !d.columns.is_empty()),
+        ("--smooth", d.smooth.is_some()),
+        ("--quantities", !d.quantities.is_empty()),
+        ("--rule", d.rule.is_some()),
+        ("--bias", d.bias.is_some()),
+        ("--v0", !d.v0.is_empty()),
+        ("--x0", !d.x0.is_empty()),
+        ("--sigma-a", d.sigma_a.is_some()),
+        ("--output", d.output.is_some()),
+    ];
+    if let Some((flag, _)) = given.iter().find(|g| g.1) {
+        return Err(Error::argument(
+            *flag,
+            format!("{flag} applies to measured data: give the file with --data FILE"),
+        ));
     }
     let input = KinInput {
         position: a.position,
