@@ -53,6 +53,8 @@ enum Command {
     Dsolve(cli::dsolve::DsolveArgs),
     /// Kinematics of a particle: velocity, acceleration, normal-tangential and polar components.
     Kin(cli::kin::KinArgs),
+    /// Fuse an accelerometer record with position fixes (Kalman filter + RTS smoother).
+    Fuse(cli::fuse::FuseArgs),
 }
 
 /// Stack of the thread that runs a command: 1 GiB of address space.
@@ -74,6 +76,7 @@ fn dispatch(command: Command) -> Result<Outcome, Error> {
         Command::Sweep(a) => cli::sweep::run(a),
         Command::Dsolve(a) => text(cli::dsolve::run(a)),
         Command::Kin(a) => text(cli::kin::run(a)),
+        Command::Fuse(a) => text(cli::fuse::run(a)),
     }
 }
 

@@ -21,9 +21,11 @@
 //! | [`ensemble`] | `Model.ensemble` (the engine is [`pdyn::sim::ensemble`]) |
 //! | [`solve_ivp`] | `pdyn.solve_ivp` and its cache of compiled right-hand sides |
 //! | [`symbolic`] | `pdyn.kin`, `pdyn.dsolve` |
+//! | [`data`] | `pdyn.kin_data`, `pdyn.integrate_accel`, `pdyn.fuse`, `pdyn.read_csv`, `pdyn.interp` |
 #![warn(missing_docs)]
 
 mod convert;
+mod data;
 mod derive;
 mod ensemble;
 mod errors;
@@ -71,6 +73,11 @@ fn _pdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(methods, m)?)?;
     m.add_function(wrap_pyfunction!(symbolic::_kin, m)?)?;
     m.add_function(wrap_pyfunction!(symbolic::_dsolve, m)?)?;
+    m.add_function(wrap_pyfunction!(data::_read_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(data::_kin_data, m)?)?;
+    m.add_function(wrap_pyfunction!(data::_integrate_accel, m)?)?;
+    m.add_function(wrap_pyfunction!(data::_fuse, m)?)?;
+    m.add_function(wrap_pyfunction!(data::_interp, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -165,6 +165,12 @@ pub enum Error {
         /// Why.
         error: pdyn_gravity::GravityError,
     },
+    /// Measured data that cannot be used: the file, line and column, the offending text, what
+    /// would be valid (exit code 2).
+    Data {
+        /// The located problem (boxed: it carries its whole location and help text).
+        error: Box<pdyn_data::DataError>,
+    },
     /// A molecular-dynamics run that stopped before its last step (exit code 1): unstable (the
     /// step, the offending atoms) or a bond stretched past its limit. What was computed up to
     /// there has been written.
@@ -198,6 +204,7 @@ impl Error {
             Error::Internal { .. } => "internal",
             Error::Gravity { .. } => "gravity",
             Error::MdRun { .. } => "md_run",
+            Error::Data { .. } => "data",
         }
     }
 
@@ -251,6 +258,11 @@ impl Error {
             | Error::Integration { origin, .. }
             | Error::Gravity { origin, .. }
             | Error::MdRun { origin, .. } => Some(file(origin)),
+            Error::Data { error } if !error.file.is_empty() => Some(Location {
+                file: error.file.clone(),
+                line: error.line,
+                column: error.column,
+            }),
             _ => None,
         }
     }
@@ -367,6 +379,7 @@ impl fmt::Display for Error {
                 "internal error — please report it with the command that caused it: {message}"
             ),
             Error::Gravity { origin, error } => write!(f, "{origin}: error: {error}"),
+            Error::Data { error } => write!(f, "{error}"),
             Error::MdRun { origin, error } => {
                 write!(
                     f,

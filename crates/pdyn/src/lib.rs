@@ -9,6 +9,7 @@
 
 pub mod args;
 pub mod clock;
+pub mod data;
 pub mod dsolve;
 pub mod engine;
 pub mod error;

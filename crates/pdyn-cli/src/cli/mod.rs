@@ -10,6 +10,7 @@ pub mod dsolve;
 pub mod equilibrium;
 pub mod expr;
 pub mod forces;
+pub mod fuse;
 pub mod kin;
 pub mod modes;
 pub mod run;

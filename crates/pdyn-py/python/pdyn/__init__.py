@@ -41,6 +41,8 @@ from ._result import (Derivation, EnsembleResult, Expr, ForcesResult,
 from ._symbolic import (DsolveCase, DsolveResult, KinInstant, KinResult, RuleResult, Vector,
                         dsolve, kin)
 from ._ivp import solve_ivp  # SciPy's solve_ivp on pdyn's integrators
+from ._data import (FuseResult, IntegratedAccel, KinDataResult, fuse, integrate_accel, interp,
+                    kin_data, read_csv)
 
 __version__ = _pdyn.__version__
 
@@ -57,6 +59,8 @@ __all__ = [
     "EnsembleResult", "ForcesResult",
     "kin", "dsolve", "KinResult", "KinInstant", "DsolveResult", "DsolveCase", "RuleResult",
     "Vector",
+    "kin_data", "integrate_accel", "fuse", "read_csv", "interp", "KinDataResult", "IntegratedAccel",
+    "FuseResult",
     "PdynError", "ModelError", "ParameterError", "DriftWarning", "Interrupted", "__version__",
 ]
 

@@ -1,0 +1,390 @@
+//! Time series from CSV text.
+//!
+//! The format: an optional UTF-8 byte-order mark; lines that are blank or start with `#` are
+//! skipped anywhere; the first other line is a header naming the columns; then one row per
+//! sample. The delimiter is the header's: `,` (default), `;` or a tab. Fields may be quoted
+//! with `"` (no embedded delimiters in numeric fields, which is all this reader needs).
+//!
+//! Only the columns asked for are parsed, so a file may carry text columns (labels, flags)
+//! beside its numbers. Every value must be a finite number: an empty field, `NaN`, `inf` or
+//! any other text is an error naming the file, line, column and text. A [`Series`] then
+//! requires strictly increasing times and a minimum number of samples.
+
+use crate::error::DataError;
+
+/// Columns of numbers read from a CSV file, with where each value came from.
+#[derive(Clone, Debug)]
+pub struct Columns {
+    /// The file name (used in messages).
+    pub file: String,
+    /// The names of the columns read, in the order asked for.
+    pub names: Vec<String>,
+    /// The values, one vector per column in `names`.
+    pub values: Vec<Vec<f64>>,
+    /// The 1-based line of each row.
+    pub lines: Vec<usize>,
+    /// For each column, the 1-based character column where its field starts, per row.
+    starts: Vec<Vec<u32>>,
+    /// The 1-based line of the header.
+    pub header_line: usize,
+}
+
+impl Columns {
+    /// The number of rows.
+    pub fn len(&self) -> usize {
+        self.lines.len()
+    }
+
+    /// Whether there are no rows.
+    pub fn is_empty(&self) -> bool {
+        self.lines.is_empty()
+    }
+
+    /// An error located at row `row` (0-based) of column `col` (index into `names`).
+    pub fn error_at(&self, row: usize, col: usize, message: impl Into<String>) -> DataError {
+        let line = self.lines.get(row).copied().unwrap_or(self.header_line);
+        let column = self
+            .starts
+            .get(col)
+            .and_then(|s| s.get(row))
+            .map(|&c| c as usize);
+        let mut e = DataError::new(&self.file, message).at(line, column);
+        if let Some(name) = self.names.get(col) {
+            e = e.column_name(name);
+        }
+        if let Some(v) = self.values.get(col).and_then(|v| v.get(row)) {
+            e = e.text(&v.to_string());
+        }
+        e
+    }
+}
+
+/// The delimiter of a header line.
+fn delimiter(header: &str) -> char {
+    for d in [',', ';', '\t'] {
+        if header.contains(d) {
+            return d;
+        }
+    }
+    ','
+}
+
+/// The fields of a line with their 1-based character columns, quotes removed, spaces trimmed.
+fn fields(line: &str, delim: char) -> Vec<(usize, &str)> {
+    let mut out = Vec::new();
+    let mut start_byte = 0;
+    let mut start_char = 1;
+    for (chars, (i, c)) in line.char_indices().enumerate() {
+        if c == delim {
+            out.push((start_char, &line[start_byte..i]));
+            start_byte = i + c.len_utf8();
+            start_char = chars + 2;
+        }
+    }
+    out.push((start_char, &line[start_byte..]));
+    out.into_iter()
+        .map(|(col, f)| {
+            // The column reported is that of the first non-blank character of the field.
+            let lead = f.chars().take_while(|c| c.is_whitespace()).count();
+            let t = f.trim();
+            let t = t
+                .strip_prefix('"')
+                .and_then(|s| s.strip_suffix('"'))
+                .unwrap_or(t);
+            (col + lead, t)
+        })
+        .collect()
+}
+
+/// Parses one field as a finite number, or says why not and what would be valid.
+fn number(text: &str) -> Result<f64, (String, String)> {
+    if text.is_empty() {
+        return Err((
+            "missing value (empty field)".into(),
+            "every row needs a number in every column used; remove the row or fill the value"
+                .into(),
+        ));
+    }
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(v) if v.is_nan() => Err((
+            "the value is NaN (not a number)".into(),
+            "a measurement that is missing must be removed, not written as NaN (pdyn does not \
+             guess values)"
+                .into(),
+        )),
+        Ok(_) => Err((
+            "the value is infinite".into(),
+            "values must be finite numbers".into(),
+        )),
+        Err(_) => Err((
+            "not a number".into(),
+            "write a decimal number such as 1.5, -2e-3 or 42 (a decimal point, not a comma)".into(),
+        )),
+    }
+}
+
+/// Reads the columns `wanted` (by header name) from CSV `text` of the file named `file`. When
+/// `wanted` is empty, every column is read.
+pub fn read_columns(file: &str, text: &str, wanted: &[&str]) -> Result<Columns, DataError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut lines = text
+        .split('\n')
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.strip_suffix('\r').unwrap_or(l)))
+        .filter(|(_, l)| {
+            let t = l.trim();
+            !t.is_empty() && !t.starts_with('#')
+        });
+    let Some((header_line, header)) = lines.next() else {
+        return Err(
+            DataError::new(file, "the file has no header line and no data").help(
+                "the first line names the columns (e.g. `t,x,y`); one row per sample follows",
+            ),
+        );
+    };
+    let delim = delimiter(header);
+    let head = fields(header, delim);
+    let names: Vec<String> = head.iter().map(|(_, n)| n.to_string()).collect();
+    if let Some((col, n)) = head.iter().find(|(_, n)| n.parse::<f64>().is_ok()) {
+        return Err(
+            DataError::new(file, "the first line must be a header naming the columns")
+                .at(header_line, Some(*col))
+                .text(n)
+                .help(format!(
+                    "add a line such as `{}` before the data",
+                    default_names(head.len()).join(&delim.to_string())
+                )),
+        );
+    }
+    for (i, (col, n)) in head.iter().enumerate() {
+        if n.is_empty() {
+            return Err(DataError::new(file, "a column of the header has no name")
+                .at(header_line, Some(*col))
+                .help("name every column in the header line"));
+        }
+        if names[..i].iter().any(|m| m == n) {
+            return Err(DataError::new(file, "two columns have the same name")
+                .at(header_line, Some(*col))
+                .text(n)
+                .help("give every column a different name"));
+        }
+    }
+    let wanted: Vec<String> = if wanted.is_empty() {
+        names.clone()
+    } else {
+        wanted.iter().map(|s| s.to_string()).collect()
+    };
+    let mut index = Vec::with_capacity(wanted.len());
+    for w in &wanted {
+        match names.iter().position(|n| n == w) {
+            Some(i) => index.push(i),
+            None => {
+                return Err(DataError::new(file, format!("no column named `{w}`"))
+                    .at(header_line, None)
+                    .help(format!(
+                        "the header has {}; choose the columns with --columns (Python: columns=)",
+                        names
+                            .iter()
+                            .map(|n| format!("`{n}`"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )))
+            }
+        }
+    }
+    let needed = index.iter().copied().max().map_or(0, |m| m + 1);
+    let mut values: Vec<Vec<f64>> = vec![Vec::new(); wanted.len()];
+    let mut starts: Vec<Vec<u32>> = vec![Vec::new(); wanted.len()];
+    let mut row_lines = Vec::new();
+    // The hot loop: fields split without allocating; only the wanted ones are parsed. The
+    // column (in characters) of a field is counted only for a line that is not ASCII.
+    let mut fs: Vec<(usize, &str)> = Vec::with_capacity(names.len());
+    for (line_no, line) in lines {
+        fs.clear();
+        let ascii = line.is_ascii();
+        let mut start = 0;
+        for (k, f) in line.split(delim).enumerate() {
+            if k >= needed {
+                break;
+            }
+            let lead = f.len() - f.trim_start().len();
+            let col = if ascii {
+                start + lead + 1
+            } else {
+                line[..start + lead].chars().count() + 1
+            };
+            let t = f.trim();
+            let t = t
+                .strip_prefix('"')
+                .and_then(|x| x.strip_suffix('"'))
+                .unwrap_or(t);
+            fs.push((col, t));
+            start += f.len() + delim.len_utf8();
+        }
+        if fs.len() < needed {
+            return Err(DataError::new(
+                file,
+                format!(
+                    "the row has {} field(s) but column `{}` is field {} of the header",
+                    fields(line, delim).len(),
+                    names[needed - 1],
+                    needed
+                ),
+            )
+            .at(line_no, None)
+            .text(line)
+            .help(format!(
+                "every row needs a value for each of the {} header columns, separated by `{}`",
+                names.len(),
+                if delim == '\t' {
+                    "\\t".to_string()
+                } else {
+                    delim.to_string()
+                }
+            )));
+        }
+        for (k, &i) in index.iter().enumerate() {
+            let (col, f) = fs[i];
+            match number(f) {
+                Ok(v) => {
+                    values[k].push(v);
+                    starts[k].push(u32::try_from(col).unwrap_or(u32::MAX));
+                }
+                Err((message, help)) => {
+                    return Err(DataError::new(file, message)
+                        .at(line_no, Some(col))
+                        .column_name(&wanted[k])
+                        .text(f)
+                        .help(help))
+                }
+            }
+        }
+        row_lines.push(line_no);
+    }
+    if row_lines.is_empty() {
+        return Err(
+            DataError::new(file, "the file has a header but no data rows")
+                .at(header_line, None)
+                .help("add one row per sample below the header"),
+        );
+    }
+    Ok(Columns {
+        file: file.to_string(),
+        names: wanted,
+        values,
+        lines: row_lines,
+        starts,
+        header_line,
+    })
+}
+
+fn default_names(n: usize) -> Vec<String> {
+    ["t", "x", "y", "z"]
+        .iter()
+        .map(|s| s.to_string())
+        .chain((4..).map(|i| format!("c{i}")))
+        .take(n.max(1))
+        .collect()
+}
+
+/// A time series: strictly increasing times and one or more columns of values.
+#[derive(Clone, Debug)]
+pub struct Series {
+    /// The times.
+    pub t: Vec<f64>,
+    /// The names of the value columns.
+    pub names: Vec<String>,
+    /// The value columns, each as long as `t`.
+    pub values: Vec<Vec<f64>>,
+}
+
+impl Series {
+    /// The series of a CSV file's columns: the first of `columns.names` is the time. At least
+    /// `min_len` rows are required (`what` names the use, for the message).
+    pub fn from_columns(columns: Columns, min_len: usize, what: &str) -> Result<Series, DataError> {
+        if columns.values.is_empty() {
+            return Err(DataError::new(&columns.file, "no time column"));
+        }
+        check_times(&columns.values[0], |row, msg| columns.error_at(row, 0, msg))?;
+        if columns.len() < min_len {
+            return Err(DataError::new(
+                &columns.file,
+                format!(
+                    "{} data row(s), but {what} needs at least {min_len}",
+                    columns.len()
+                ),
+            )
+            .at(columns.header_line, None));
+        }
+        let mut values = columns.values;
+        let t = values.remove(0);
+        let mut names = columns.names;
+        names.remove(0);
+        Ok(Series { t, names, values })
+    }
+
+    /// A series from arrays (Python's), checked as a file is: equal lengths, finite values,
+    /// strictly increasing times, at least `min_len` samples. Problems are located by index.
+    pub fn from_arrays(
+        t: Vec<f64>,
+        names: Vec<String>,
+        values: Vec<Vec<f64>>,
+        min_len: usize,
+        what: &str,
+    ) -> Result<Series, DataError> {
+        let at_index = |name: &str, i: usize, v: f64, msg: String| {
+            DataError::new(name, format!("at index {i}: {msg}")).text(&v.to_string())
+        };
+        for (name, col) in
+            std::iter::once(("t", &t)).chain(names.iter().map(|n| n.as_str()).zip(&values))
+        {
+            if col.len() != t.len() {
+                return Err(DataError::new(
+                    name,
+                    format!("{} values, but t has {}", col.len(), t.len()),
+                )
+                .help("every array must have one value per time"));
+            }
+            if let Some(i) = col.iter().position(|v| !v.is_finite()) {
+                return Err(at_index(name, i, col[i], "the value is not finite".into())
+                    .help("remove missing samples instead of writing NaN (pdyn does not guess values)"));
+            }
+        }
+        check_times(&t, |i, msg| at_index("t", i, t[i], msg))?;
+        if t.len() < min_len {
+            return Err(DataError::new(
+                "t",
+                format!("{} sample(s), but {what} needs at least {min_len}", t.len()),
+            ));
+        }
+        Ok(Series { t, names, values })
+    }
+}
+
+/// Strictly increasing times, or the first place where they are not.
+fn check_times(t: &[f64], error_at: impl Fn(usize, String) -> DataError) -> Result<(), DataError> {
+    for i in 1..t.len() {
+        if t[i] > t[i - 1] {
+            continue;
+        }
+        let (msg, help) =
+            if t[i] == t[i - 1] {
+                (
+                format!("duplicate time {} (the previous row has the same time)", t[i]),
+                "remove the duplicate sample (or average the two): times must increase strictly",
+            )
+            } else {
+                (
+                    format!(
+                        "time {} comes after the larger time {}: the times are not sorted",
+                        t[i],
+                        t[i - 1]
+                    ),
+                    "sort the rows by time (e.g. `sort -t, -g -k1`): times must increase strictly",
+                )
+            };
+        return Err(error_at(i, msg).help(help));
+    }
+    Ok(())
+}

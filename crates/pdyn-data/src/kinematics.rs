@@ -1,0 +1,242 @@
+//! Kinematics from sampled positions: each coordinate is smoothed by a cubic smoothing spline
+//! ([`crate::spline`], λ by GCV unless given), whose first and second derivatives at the
+//! sample times are the velocity and acceleration. From them, as in the chapter's section 3.1:
+//! speed `|v|`, unit tangent `T = v/|v|`, tangential acceleration `a_t = a·T`, normal
+//! acceleration `a_n = |a − a_t T|` (≥ 0) and principal normal `N = (a − a_t T)/a_n`,
+//! curvature `κ = a_n/|v|²`, and polar (cylindrical) components in the x–y plane: `r`, `θ`
+//! (continuous, unwrapped), `v_r`, `v_θ`, `a_r`, `a_θ`.
+//!
+//! **Uncertainty.** Every coordinate gets interior standard errors of its value, velocity and
+//! acceleration ([`crate::spline::standard_errors`]); the errors of the coordinates are
+//! independent, and at one instant the spline's velocity and acceleration errors are
+//! uncorrelated (the equivalent kernel's first and second derivatives are odd and even), so
+//! the standard errors of speed, a_t, a_n and curvature follow by first-order propagation:
+//! `se(|v|)² = Σ T_i² se(v_i)²`, `se(a_t)² = Σ T_i² se(a_i)² + Σ (a_n N_i/|v|)² se(v_i)²`,
+//! `se(a_n)² = Σ N_i² se(a_i)² + Σ (a_t N_i/|v|)² se(v_i)²`,
+//! `se(κ)² = Σ (N_i/|v|²)² se(a_i)² + Σ ((a_t N_i + 2 a_n T_i)/|v|³)² se(v_i)²`.
+//! They hold away from the ends: within [`KinData::boundary`] of the first or last sample the
+//! natural end condition (`f'' = 0`) biases the fit.
+
+use crate::csv::Series;
+use crate::error::DataError;
+use crate::spline::{fit, Smoothing, SmoothingSpline};
+
+/// The smoothing of one coordinate.
+#[derive(Clone, Debug)]
+pub struct ComponentFit {
+    /// The column's name.
+    pub name: String,
+    /// The smoothing parameter λ.
+    pub lambda: f64,
+    /// Whether λ came from GCV.
+    pub from_gcv: bool,
+    /// The residual standard deviation (the estimated measurement noise).
+    pub sigma: f64,
+    /// Effective degrees of freedom of the fit.
+    pub edf: f64,
+    /// Standard errors of the position, velocity and acceleration component (interior).
+    pub se: [f64; 3],
+    /// Within this time of either end this coordinate's end bias may exceed its standard
+    /// errors: four decay lengths `√2 (λ h)^{1/4}` of the smoothing kernel. A coordinate
+    /// fitted as (nearly) a straight line has a huge λ and a boundary spanning the record;
+    /// its errors are then a line fit's, small beside a curved coordinate's.
+    pub boundary: f64,
+}
+
+/// Kinematics at every sample time.
+#[derive(Clone, Debug, Default)]
+pub struct KinData {
+    /// Sample times.
+    pub t: Vec<f64>,
+    /// Smoothed position, one vector per coordinate (2 or 3).
+    pub position: Vec<Vec<f64>>,
+    /// Velocity components.
+    pub velocity: Vec<Vec<f64>>,
+    /// Acceleration components.
+    pub acceleration: Vec<Vec<f64>>,
+    /// Speed |v|.
+    pub speed: Vec<f64>,
+    /// Unit tangent components (zero where the speed is zero).
+    pub tangent: Vec<Vec<f64>>,
+    /// Principal normal components (zero where a_n is zero).
+    pub normal: Vec<Vec<f64>>,
+    /// Curvature a_n/|v|².
+    pub curvature: Vec<f64>,
+    /// Tangential acceleration.
+    pub a_t: Vec<f64>,
+    /// Normal acceleration (≥ 0).
+    pub a_n: Vec<f64>,
+    /// Polar radius in the x–y plane.
+    pub r: Vec<f64>,
+    /// Polar angle, unwrapped to be continuous.
+    pub theta: Vec<f64>,
+    /// Radial velocity.
+    pub v_r: Vec<f64>,
+    /// Transverse velocity r θ'.
+    pub v_theta: Vec<f64>,
+    /// Radial acceleration r'' − r θ'².
+    pub a_r: Vec<f64>,
+    /// Transverse acceleration r θ'' + 2 r' θ'.
+    pub a_theta: Vec<f64>,
+    /// Standard error of the speed.
+    pub se_speed: Vec<f64>,
+    /// Standard error of a_t.
+    pub se_a_t: Vec<f64>,
+    /// Standard error of a_n.
+    pub se_a_n: Vec<f64>,
+    /// Standard error of the curvature.
+    pub se_curvature: Vec<f64>,
+    /// The fit of each coordinate.
+    pub fits: Vec<ComponentFit>,
+    /// Within this time of either end the standard errors do not hold (end bias): four decay
+    /// lengths `√2 (λ h)^{1/4}` of the smoothing kernel, the largest over the coordinates.
+    pub boundary: f64,
+}
+
+/// Kinematics of the positions in `series` (2 or 3 value columns: x, y[, z]).
+pub fn kinematics(series: &Series, smoothing: Smoothing) -> Result<KinData, DataError> {
+    let dim = series.values.len();
+    if !(2..=3).contains(&dim) {
+        return Err(DataError::new(
+            "",
+            format!("kinematics needs 2 or 3 position columns (x, y[, z]); {dim} given"),
+        )
+        .help("choose the columns with --columns t,x,y[,z]"));
+    }
+    let t = &series.t;
+    let n = t.len();
+    // The coordinates are independent fits: one thread each.
+    let fits: Vec<Result<SmoothingSpline, DataError>> = std::thread::scope(|s| {
+        let handles: Vec<_> = series
+            .values
+            .iter()
+            .zip(&series.names)
+            .map(|(y, name)| s.spawn(move || fit(t, y, smoothing, name)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| {
+                h.join().unwrap_or_else(|_| {
+                    Err(DataError::new(
+                        "",
+                        "internal error: a smoothing thread panicked",
+                    ))
+                })
+            })
+            .collect()
+    });
+    let fits: Vec<SmoothingSpline> = fits.into_iter().collect::<Result<_, _>>()?;
+    let mut k = KinData {
+        t: t.clone(),
+        ..KinData::default()
+    };
+    k.boundary = fits
+        .iter()
+        .map(|f| 4.0 * std::f64::consts::SQRT_2 * (f.lambda * f.h).powf(0.25))
+        .fold(0.0, f64::max);
+    k.fits = fits
+        .iter()
+        .zip(&series.names)
+        .map(|(f, name)| ComponentFit {
+            name: name.clone(),
+            lambda: f.lambda,
+            from_gcv: f.from_gcv,
+            sigma: f.sigma2.sqrt(),
+            edf: f.edf,
+            se: f.se,
+            boundary: 4.0 * std::f64::consts::SQRT_2 * (f.lambda * f.h).powf(0.25),
+        })
+        .collect();
+    let se_v: Vec<f64> = fits.iter().map(|f| f.se[1]).collect();
+    let se_a: Vec<f64> = fits.iter().map(|f| f.se[2]).collect();
+    let mut fits = fits;
+    for f in fits.iter_mut() {
+        k.position.push(std::mem::take(&mut f.value));
+        k.velocity.push(std::mem::take(&mut f.d1));
+        k.acceleration.push(std::mem::take(&mut f.d2));
+    }
+    k.tangent = vec![vec![0.0; n]; dim];
+    k.normal = vec![vec![0.0; n]; dim];
+    for v in [
+        &mut k.speed,
+        &mut k.curvature,
+        &mut k.a_t,
+        &mut k.a_n,
+        &mut k.r,
+        &mut k.theta,
+        &mut k.v_r,
+        &mut k.v_theta,
+        &mut k.a_r,
+        &mut k.a_theta,
+        &mut k.se_speed,
+        &mut k.se_a_t,
+        &mut k.se_a_n,
+        &mut k.se_curvature,
+    ] {
+        *v = vec![0.0; n];
+    }
+    let mut prev_theta = f64::NAN;
+    for i in 0..n {
+        // Fixed-size vectors (a third component of 0 in the plane): no allocation per sample.
+        let mut v = [0.0; 3];
+        let mut a = [0.0; 3];
+        for c in 0..dim {
+            v[c] = k.velocity[c][i];
+            a[c] = k.acceleration[c][i];
+        }
+        let s = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let tan = if s > 0.0 { v.map(|x| x / s) } else { [0.0; 3] };
+        let at = a[0] * tan[0] + a[1] * tan[1] + a[2] * tan[2];
+        let perp = [a[0] - at * tan[0], a[1] - at * tan[1], a[2] - at * tan[2]];
+        let an = (perp[0] * perp[0] + perp[1] * perp[1] + perp[2] * perp[2]).sqrt();
+        let nor = if an > 0.0 {
+            perp.map(|x| x / an)
+        } else {
+            [0.0; 3]
+        };
+        let kappa = if s > 0.0 { an / (s * s) } else { f64::INFINITY };
+        let (mut vs, mut vat, mut van, mut vk) = (0.0, 0.0, 0.0, 0.0);
+        for c in 0..dim {
+            let (sv, sa) = (se_v[c] * se_v[c], se_a[c] * se_a[c]);
+            vs += tan[c] * tan[c] * sv;
+            if s > 0.0 {
+                vat += tan[c] * tan[c] * sa + (an * nor[c] / s).powi(2) * sv;
+                van += nor[c] * nor[c] * sa + (at * nor[c] / s).powi(2) * sv;
+                vk += (nor[c] / (s * s)).powi(2) * sa
+                    + ((at * nor[c] + 2.0 * an * tan[c]) / (s * s * s)).powi(2) * sv;
+            }
+        }
+        k.speed[i] = s;
+        k.a_t[i] = at;
+        k.a_n[i] = an;
+        k.curvature[i] = kappa;
+        for c in 0..dim {
+            k.tangent[c][i] = tan[c];
+            k.normal[c][i] = nor[c];
+        }
+        k.se_speed[i] = vs.sqrt();
+        k.se_a_t[i] = if s > 0.0 { vat.sqrt() } else { f64::INFINITY };
+        k.se_a_n[i] = if s > 0.0 { van.sqrt() } else { f64::INFINITY };
+        k.se_curvature[i] = if s > 0.0 { vk.sqrt() } else { f64::INFINITY };
+        // Polar components in the x–y plane.
+        let (x, y) = (k.position[0][i], k.position[1][i]);
+        let r = x.hypot(y);
+        let mut th = y.atan2(x);
+        if prev_theta.is_finite() {
+            // Unwrap: the branch nearest the previous sample's angle.
+            let tau = std::f64::consts::TAU;
+            th += tau * ((prev_theta - th) / tau).round();
+        }
+        prev_theta = th;
+        k.r[i] = r;
+        k.theta[i] = th;
+        if r > 0.0 {
+            let (c, sn) = (x / r, y / r);
+            k.v_r[i] = c * v[0] + sn * v[1];
+            k.v_theta[i] = c * v[1] - sn * v[0];
+            k.a_r[i] = c * a[0] + sn * a[1];
+            k.a_theta[i] = c * a[1] - sn * a[0];
+        }
+    }
+    Ok(k)
+}

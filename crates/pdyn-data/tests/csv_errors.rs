@@ -1,0 +1,126 @@
+//! Bad data: every problem a located error (file, line, column, text, help).
+#![allow(clippy::result_large_err)]
+
+use pdyn_data::csv::{read_columns, Series};
+
+fn series(text: &str, cols: &[&str]) -> Result<Series, pdyn_data::DataError> {
+    Series::from_columns(read_columns("track.csv", text, cols)?, 3, "the test")
+}
+
+#[test]
+fn unsorted_time_is_located() {
+    let e = series("t,x,y\n0,0,0\n2,1,1\n1,2,2\n3,3,3\n", &["t", "x", "y"]).unwrap_err();
+    assert_eq!((e.line, e.column), (Some(4), Some(1)));
+    assert!(e.message.contains("not sorted"), "{e}");
+    assert!(e.help.as_deref().unwrap_or("").contains("sort"));
+    assert_eq!(e.column_name.as_deref(), Some("t"));
+}
+
+#[test]
+fn duplicate_time_is_located() {
+    let e = series(
+        "# comment\nt,x,y\n0,0,0\n1,1,1\n1,2,2\n3,3,3\n",
+        &["t", "x", "y"],
+    )
+    .unwrap_err();
+    assert_eq!(e.line, Some(5));
+    assert!(e.message.contains("duplicate time 1"), "{e}");
+}
+
+#[test]
+fn nan_and_text_are_located_with_their_text() {
+    let e = series("t,x,y\n0,0,0\n1,NaN,1\n", &["t", "x", "y"]).unwrap_err();
+    assert_eq!((e.line, e.column), (Some(3), Some(3)));
+    assert_eq!(e.text.as_deref(), Some("NaN"));
+    assert_eq!(e.column_name.as_deref(), Some("x"));
+    assert!(e.message.contains("NaN"));
+    let e = series("t,x,y\n0,0,0\n1,abc,1\n", &["t", "x", "y"]).unwrap_err();
+    assert_eq!(
+        (e.line, e.column, e.text.as_deref()),
+        (Some(3), Some(3), Some("abc"))
+    );
+    assert!(e.message.contains("not a number"));
+    let e = series("t,x,y\n0,0,0\n1,,1\n", &["t", "x", "y"]).unwrap_err();
+    assert!(e.message.contains("missing value"), "{e}");
+}
+
+#[test]
+fn missing_column_names_the_columns_there_are() {
+    let e = series("t,x,y\n0,0,0\n", &["t", "x", "z"]).unwrap_err();
+    assert!(e.message.contains("no column named `z`"));
+    assert!(e.help.as_deref().unwrap_or("").contains("`x`"));
+    assert_eq!(e.line, Some(1));
+}
+
+#[test]
+fn header_without_rows_and_too_few_rows() {
+    let e = series("t,x,y\n\n", &["t", "x", "y"]).unwrap_err();
+    assert!(e.message.contains("header but no data rows"), "{e}");
+    let e = series("t,x,y\n0,0,0\n1,1,1\n", &["t", "x", "y"]).unwrap_err();
+    assert!(e.message.contains("at least 3"), "{e}");
+    let e = series("0,0,0\n1,1,1\n", &["t"]).unwrap_err();
+    assert!(e.message.contains("header"), "{e}");
+    let e = series("t,x,y\n0,0\n", &["t", "x", "y"]).unwrap_err();
+    assert!(e.message.contains("field"), "{e}");
+}
+
+#[test]
+fn extra_text_columns_and_other_delimiters_are_fine() {
+    let s = series(
+        "\u{feff}t;label;x;y\r\n0;a;0;0\r\n1;b;1;2\r\n2;c;4;8\r\n",
+        &["t", "x", "y"],
+    )
+    .unwrap();
+    assert_eq!(s.values[1], vec![0.0, 2.0, 8.0]);
+    let e = format!(
+        "{}",
+        series("t,x,y\n0,0,0\n1,x1,1\n", &["t", "x", "y"]).unwrap_err()
+    );
+    assert!(
+        e.starts_with("track.csv:3:3: error: not a number (column `x`, text `x1`)"),
+        "{e}"
+    );
+}
+
+/// Columns count characters, not bytes, on a line that is not ASCII.
+#[test]
+fn columns_count_characters() {
+    let e = series("t,label,x,y\n0,é,0,0\n1,ñandú,bad,1\n", &["t", "x", "y"]).unwrap_err();
+    assert_eq!((e.line, e.column), (Some(3), Some(9)), "{e}");
+    let e = series("t,x,y\n0, 0,0\n1,  bad,1\n", &["t", "x", "y"]).unwrap_err();
+    assert_eq!((e.line, e.column), (Some(3), Some(5)), "{e}");
+}
+
+#[test]
+fn arrays_are_checked_like_files() {
+    let e = Series::from_arrays(
+        vec![0.0, 1.0, 1.0],
+        vec!["x".into()],
+        vec![vec![0.0; 3]],
+        2,
+        "t",
+    )
+    .unwrap_err();
+    assert!(
+        e.message.contains("index 2") && e.message.contains("duplicate"),
+        "{e}"
+    );
+    let e = Series::from_arrays(
+        vec![0.0, 1.0, 2.0],
+        vec!["x".into()],
+        vec![vec![0.0, f64::NAN, 1.0]],
+        2,
+        "t",
+    )
+    .unwrap_err();
+    assert_eq!(e.file, "x");
+    let e = Series::from_arrays(
+        vec![0.0, 1.0, 2.0],
+        vec!["x".into()],
+        vec![vec![0.0; 2]],
+        2,
+        "t",
+    )
+    .unwrap_err();
+    assert!(e.message.contains("2 values"), "{e}");
+}
