@@ -21,6 +21,8 @@ pub mod measured;
 pub mod report;
 pub mod request;
 pub mod sweep;
+#[cfg(test)]
+mod tree_tests;
 
 pub use error::{ClosedFormError, RunFailure, SimError};
 
@@ -554,6 +556,19 @@ pub fn prepare_with_jit(
         &mut reference_model
     } else {
         model
+    };
+    // A tree of links (a chain) is solved link by link in O(n) per evaluation, from
+    // `TREE_FROM` links on unless the caller chose (`tree_from: Some(usize::MAX)` keeps the
+    // dense M). Not for a hybrid model: its contact modes' impulse form reads the matrix.
+    let tree_opts;
+    let opts = if hybrid.is_none() && opts.tree_from.is_none() {
+        tree_opts = DeriveOptions {
+            tree_from: Some(pdyn_mech::derive::TREE_FROM),
+            ..opts.clone()
+        };
+        &tree_opts
+    } else {
+        opts
     };
     // The chapter's steps: equations of motion, solved for the accelerations...
     let d = derive(model, opts).map_err(SimError::Derive)?;
