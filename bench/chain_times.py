@@ -5,8 +5,12 @@ REPEAT runs each, with the size of `pdyn derive`'s output and its longest line:
 
     cargo build --release -p pdyn-cli
     python3 bench/chain_times.py 2 3 4 8 16 32 64 100
+    python3 bench/chain_times.py --example 3 16 100
 
-Prints one Markdown table row per n and the load average before and after.
+Prints one Markdown table row per n and the load average before and after. With `--example`
+the chain has the settings of examples/pendulum_chain_3.toml (link i released at 0.3*i rad,
+rtol 1e-9, atol 1e-12; `bench/chain_model.py --example`), and only `pdyn run --t-end 10` is
+timed, with its method line (method, steps, f-evaluations).
 """
 import os
 import subprocess
@@ -33,7 +37,27 @@ def best(args):
     return min(times), out
 
 
+def example(ns):
+    print(f"load average before: {os.getloadavg()[0]:.2f}")
+    print("| n | `pdyn run --t-end 10` | method, steps, f-evaluations |")
+    print("|---|---|---|")
+    with tempfile.TemporaryDirectory() as tmp:
+        for n in ns:
+            path = os.path.join(tmp, f"chain{n}.toml")
+            with open(path, "w") as f:
+                f.write(chain_toml(n, example=True))
+            run, out = best(["run", path, "--t-end", "10"])
+            line = next(
+                (l for l in out.decode().splitlines() if l.startswith("method ")), ""
+            )
+            print(f"| {n} | {run * 1000:.1f} ms | {line.removeprefix('method ')} |")
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
+
+
 def main():
+    if "--example" in sys.argv[1:]:
+        example([int(a) for a in sys.argv[1:] if a != "--example"] or [3, 16, 100])
+        return
     ns = [int(a) for a in sys.argv[1:]] or [2, 4, 8, 16, 32, 64, 100]
     print(f"load average before: {os.getloadavg()[0]:.2f}")
     print("| n | `pdyn derive` | output (longest line) | preparation | `pdyn run --t-end 10` |")

@@ -57,7 +57,20 @@ pub struct DeriveOptions {
     /// the solution found within the budget is simplified whatever that costs (a run
     /// evaluates it).
     pub simplify_solution_within_budget: bool,
+    /// From how many free coordinates a model whose particles form a tree of links
+    /// ([`crate::tree`]) is derived in the recursive form ([`Derivation::tree`]: `O(n)` per
+    /// evaluation, no `M` assembled) instead of the projected `M q'' = f`. `None` (the
+    /// default): never here, as `pdyn derive` prints `M`; `pdyn::sim::prepare` reads `None`
+    /// as [`TREE_FROM`] for models without contacts (`Some(usize::MAX)` keeps the dense `M`).
+    pub tree_from: Option<usize>,
 }
+
+/// The number of free coordinates from which a run solves a tree of links recursively.
+/// Measured per evaluation on the n-link chain (release, `pdyn run` at the example's
+/// settings): the dense path assembles `n²` entries and factors `M` (Cholesky, `n³/6`), the
+/// recursion costs ~110 operations per link plus the link's own expressions; below 4 links
+/// the dense form is as cheap and the 2- and 3-link examples keep their exact numbers.
+pub const TREE_FROM: usize = 4;
 
 impl Default for DeriveOptions {
     fn default() -> Self {
@@ -68,6 +81,7 @@ impl Default for DeriveOptions {
             simplify_printed: true,
             solve_budget: CHEAP_SOLVE_BUDGET,
             simplify_solution_within_budget: false,
+            tree_from: None,
         }
     }
 }
@@ -185,6 +199,10 @@ pub struct Derivation {
     /// Whether a given `acceleration` entered as an equation `q'' = a` (a prescribed motion):
     /// then what drives it does work, and no quantity is known to be conserved.
     pub prescribed_acceleration: bool,
+    /// The recursive form of a tree of links ([`DeriveOptions::tree_from`]): when set,
+    /// `equations` and `system` are empty and the accelerations are
+    /// [`crate::tree::TreeForm::solve`]'s.
+    pub tree: Option<crate::tree::TreeForm>,
 }
 
 impl Derivation {
@@ -372,6 +390,57 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
     );
 
     let (mut parts, newton, mut constraint_eqs) = newton_equations(model);
+    // A tree of links (a chain, a mobile) in a run: the accelerations are found link by link
+    // in O(n) per evaluation, so the projected M (n² entries, factored at every evaluation)
+    // is not assembled at all. Newton's equations outnumber the unknowns there (no reactions
+    // declared), so `Form::Auto` would have chosen the projected form.
+    if let Some(from) = opts.tree_from {
+        if free.len() >= from
+            && matches!(opts.form, Form::Auto | Form::Projected)
+            && newton.len() > free.len()
+        {
+            if let Some(tree) = crate::tree::detect(model, &parts, &free, &qd) {
+                let p = &mut model.pool;
+                for pk in parts.iter_mut() {
+                    pk.v = pk.v.map(|c| simp(p, c, opts.simplify));
+                    pk.force = pk.force.map(|c| simp(p, c, opts.simplify));
+                }
+                let acc_unknowns: Vec<Unknown> = free
+                    .iter()
+                    .zip(&qdd)
+                    .map(|(&i, &id)| Unknown {
+                        name: format!("{}''", model.coordinates[i].name),
+                        id,
+                        kind: UnknownKind::Acceleration(i),
+                    })
+                    .collect();
+                return Ok(Derivation {
+                    form: Form::Projected,
+                    particles: parts,
+                    equations: Vec::new(),
+                    unknowns: acc_unknowns,
+                    system: LinearSystem {
+                        unknowns: qdd,
+                        a: Vec::new(),
+                        b: Vec::new(),
+                    },
+                    solution: None,
+                    free,
+                    state,
+                    state_names,
+                    notes: vec![format!(
+                        "the particles form a tree of {} links: the accelerations are solved link \
+                         by link (articulated-body recursion), without assembling M",
+                        tree.len()
+                    )],
+                    recovered: Vec::new(),
+                    assembled_collected: false,
+                    prescribed_acceleration: false,
+                    tree: Some(tree),
+                });
+            }
+        }
+    }
     let newton_all = newton.clone();
     let p = &mut model.pool;
     let mut notes = Vec::new();
@@ -666,6 +735,7 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
         recovered,
         assembled_collected: assembled && contract,
         prescribed_acceleration: given_equations,
+        tree: None,
     })
 }
 

@@ -31,6 +31,7 @@ pub mod parameters;
 pub mod prescribed;
 mod projection;
 pub mod statics;
+pub mod tree;
 pub mod units;
 pub mod validity;
 

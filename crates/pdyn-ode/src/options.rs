@@ -26,6 +26,14 @@ impl Tolerance {
         }
     }
 
+    /// The smallest component (the value itself when scalar; infinity when empty).
+    pub fn tightest(&self) -> f64 {
+        match self {
+            Tolerance::Scalar(v) => *v,
+            Tolerance::PerComponent(v) => v.iter().copied().fold(f64::INFINITY, f64::min),
+        }
+    }
+
     pub(crate) fn check(&self, n: usize, name: &str) -> Result<Vec<f64>, OdeError> {
         let v: Vec<f64> = match self {
             Tolerance::Scalar(v) => vec![*v; n],

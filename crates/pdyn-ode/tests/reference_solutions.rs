@@ -214,3 +214,139 @@ fn state_dependent_mass_matrix() {
         assert!((y[0] - 1.5 * (-2.0f64).exp()).abs() < 1e-8, "{m}: {y:?}");
     }
 }
+
+/// The Kepler problem (μ = 1) in the plane, `y = (x, y, vx, vy)`.
+fn kepler_rhs(_t: f64, y: &[f64], f: &mut [f64]) {
+    let r3 = (y[0] * y[0] + y[1] * y[1]).powf(1.5);
+    f[0] = y[2];
+    f[1] = y[3];
+    f[2] = -y[0] / r3;
+    f[3] = -y[1] / r3;
+}
+
+fn oscillator_rhs(_t: f64, y: &[f64], f: &mut [f64]) {
+    f[0] = y[1];
+    f[1] = -y[0];
+}
+
+/// A right-hand side as a plain function.
+type Rhs = fn(f64, &[f64], &mut [f64]);
+
+/// A problem with a closed-form end state, and how many times fewer f-evaluations than
+/// DOPRI5 `auto` must use at rtol 1e-9.
+struct Case {
+    sys: pdyn_ode::FnSystem<Rhs>,
+    t1: f64,
+    y0: Vec<f64>,
+    exact: Vec<f64>,
+    factor: f64,
+}
+
+#[test]
+fn auto_picks_the_order_from_rtol_and_halves_the_work_at_tight_tolerances() {
+    // A Kepler ellipse of eccentricity 0.7 (a = 1) from pericentre: period 2π, so after two
+    // periods the state is the initial one again.
+    let e: f64 = 0.7;
+    let k0 = vec![1.0 - e, 0.0, 0.0, ((1.0 + e) / (1.0 - e)).sqrt()];
+    let t1: f64 = 100.0;
+    let cases = [
+        Case {
+            sys: pdyn_ode::FnSystem::new(2, oscillator_rhs as Rhs),
+            t1,
+            y0: vec![1.0, 0.0],
+            exact: vec![t1.cos(), -t1.sin()],
+            factor: 2.0,
+        },
+        Case {
+            sys: pdyn_ode::FnSystem::new(4, kepler_rhs as Rhs),
+            t1: 4.0 * std::f64::consts::PI,
+            y0: k0.clone(),
+            exact: k0,
+            factor: 1.5,
+        },
+    ];
+    for Case {
+        sys,
+        t1,
+        y0,
+        exact,
+        factor,
+    } in &cases
+    {
+        let (t1, factor) = (*t1, *factor);
+        let opts = Options {
+            rtol: 1e-9.into(),
+            atol: 1e-12.into(),
+            ..Default::default()
+        };
+        let auto = solve(Method::Auto, sys, (0.0, t1), y0, &opts).unwrap();
+        let dopri = solve(Method::Dopri5, sys, (0.0, t1), y0, &opts).unwrap();
+        assert_eq!(auto.method, Method::Dop853);
+        assert_eq!(Method::auto_explicit(&opts.rtol), Method::Dop853);
+        eprintln!("auto {} / dopri5 {}", auto.stats.fevals, dopri.stats.fevals);
+        assert!(
+            factor * auto.stats.fevals as f64 <= dopri.stats.fevals as f64,
+            "auto {} vs dopri5 {} f-evaluations",
+            auto.stats.fevals,
+            dopri.stats.fevals
+        );
+        // The cheaper run is as accurate as DOPRI5's against the closed form (global errors
+        // are a few hundred rtol over these periods: the tolerance bounds local errors).
+        let e = max_err(auto.last().unwrap().1, exact);
+        let e_dopri = max_err(dopri.last().unwrap().1, exact);
+        eprintln!("errors: auto {e:e}, dopri5 {e_dopri:e}");
+        assert!(
+            e < 1e-6 && e <= 2.0 * e_dopri,
+            "auto error {e:e}, dopri5's {e_dopri:e}"
+        );
+        // Loose tolerance: DOPRI5 exactly, step for step.
+        let loose = Options::with_tol(1e-5);
+        let a = solve(Method::Auto, sys, (0.0, t1), y0, &loose).unwrap();
+        let d = solve(Method::Dopri5, sys, (0.0, t1), y0, &loose).unwrap();
+        assert_eq!(a.method, Method::Dopri5);
+        assert_eq!((a.stats.fevals, &a.y), (d.stats.fevals, &d.y));
+    }
+    // The tightest component decides.
+    let mixed = pdyn_ode::Tolerance::from(vec![1e-3, 1e-9]);
+    assert_eq!(Method::auto_explicit(&mixed), Method::Dop853);
+    assert_eq!(Method::auto_explicit(&1e-6.into()), Method::Dopri5);
+    assert_eq!(Method::auto_explicit(&9.9e-7.into()), Method::Dop853);
+}
+
+#[test]
+fn auto_at_tight_tolerance_still_switches_to_radau5_when_stiff() {
+    // DOP853's own stiffness detector (h|λ| > 6.1) makes the switch at rtol 1e-9.
+    let opts = Options {
+        rtol: 1e-9.into(),
+        atol: 1e-12.into(),
+        stiffness_check_interval: 50,
+        ..Default::default()
+    };
+    let sol = solve(
+        Method::Auto,
+        &robertson(),
+        (0.0, 1e3),
+        &[1.0, 0.0, 0.0],
+        &opts,
+    )
+    .unwrap();
+    assert_eq!(sol.method, Method::Radau5);
+    let ts = sol.stats.stiffness_detected_at.expect("stiffness detected");
+    assert!(ts < 1.0, "switched at {ts}");
+    let (t, y) = sol.last().unwrap();
+    assert_eq!(t, 1e3);
+    let reference = end(
+        Method::Radau5,
+        &robertson(),
+        1e3,
+        &[1.0, 0.0, 0.0],
+        &Options {
+            rtol: 1e-12.into(),
+            atol: 1e-16.into(),
+            ..Default::default()
+        },
+    );
+    for i in 0..3 {
+        assert!((y[i] - reference[i]).abs() <= 1e-6 * reference[i].abs() + 1e-12);
+    }
+}

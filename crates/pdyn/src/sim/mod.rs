@@ -21,6 +21,8 @@ pub mod measured;
 pub mod report;
 pub mod request;
 pub mod sweep;
+#[cfg(test)]
+mod tree_tests;
 
 pub use error::{ClosedFormError, RunFailure, SimError};
 
@@ -375,12 +377,41 @@ pub struct PreparedEvent {
 }
 
 /// What produced a run's result.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Solver {
     /// A pdyn-ode integrator.
     Ode(Method),
     /// The closed-form solution, evaluated (`--method exact`).
     Exact,
+    /// `--method auto`: the explicit pair it chose from `rtol`
+    /// ([`Method::auto_explicit`]), and where it switched to Radau5 if the problem became
+    /// stiff. Shown as `auto → dop853 (rtol 1e-9)` so that a reader knows what ran.
+    Auto {
+        /// DOPRI5 or DOP853.
+        explicit: Method,
+        /// The tightest relative tolerance, which made the choice.
+        rtol: f64,
+        /// The time from which Radau5 integrated, when stiffness was detected.
+        radau5_from: Option<f64>,
+    },
+}
+
+impl Solver {
+    /// What produced `sol` when it was solved with `method` at relative tolerance `rtol`.
+    pub fn of(method: Method, rtol: &pdyn_ode::Tolerance, sol: &Solution) -> Solver {
+        if method != Method::Auto {
+            return Solver::Ode(sol.method);
+        }
+        Solver::Auto {
+            explicit: Method::auto_explicit(rtol),
+            rtol: rtol.tightest(),
+            radau5_from: if sol.method == Method::Radau5 {
+                sol.stats.stiffness_detected_at
+            } else {
+                None
+            },
+        }
+    }
 }
 
 impl fmt::Display for Solver {
@@ -388,6 +419,17 @@ impl fmt::Display for Solver {
         match self {
             Solver::Ode(m) => f.write_str(m.name()),
             Solver::Exact => f.write_str("exact"),
+            Solver::Auto {
+                explicit,
+                rtol,
+                radau5_from,
+            } => {
+                write!(f, "auto → {}", explicit.name())?;
+                if let Some(t) = radau5_from {
+                    write!(f, " → radau5 from t = {t:.6e}")?;
+                }
+                write!(f, " (rtol {rtol:e})")
+            }
         }
     }
 }
@@ -514,6 +556,19 @@ pub fn prepare_with_jit(
         &mut reference_model
     } else {
         model
+    };
+    // A tree of links (a chain) is solved link by link in O(n) per evaluation, from
+    // `TREE_FROM` links on unless the caller chose (`tree_from: Some(usize::MAX)` keeps the
+    // dense M). Not for a hybrid model: its contact modes' impulse form reads the matrix.
+    let tree_opts;
+    let opts = if hybrid.is_none() && opts.tree_from.is_none() {
+        tree_opts = DeriveOptions {
+            tree_from: Some(pdyn_mech::derive::TREE_FROM),
+            ..opts.clone()
+        };
+        &tree_opts
+    } else {
+        opts
     };
     // The chapter's steps: equations of motion, solved for the accelerations...
     let d = derive(model, opts).map_err(SimError::Derive)?;
@@ -1142,7 +1197,14 @@ pub(crate) fn tabulate(
         monitors,
         warnings,
         stats: sol.stats.clone(),
-        method: Solver::Ode(sol.method),
+        method: match method_by_name(&set.method) {
+            Some(m) => Solver::of(
+                m,
+                &set.rtol.map_or(Options::default().rtol, Into::into),
+                sol,
+            ),
+            None => Solver::Ode(sol.method),
+        },
         failure,
         status,
         hybrid: None,

@@ -1,0 +1,342 @@
+//! The recursive form of a tree of point masses: the projected equations `M(q) q'' = f` of a
+//! model whose particles hang from one another link by link, solved in `O(n)` per evaluation
+//! instead of assembling and factoring the dense `M` (`O(n²)` entries, `O(n³)` Cholesky).
+//!
+//! A model is such a tree when every particle's position is its parent particle's position
+//! (or a fixed point, for a root) plus a *link vector* `s_k(q_k)` that depends on one free
+//! coordinate of its own and on parameters only: an n-link pendulum chain, a branching
+//! mobile of pendulums. Then `a_k = a_parent + s_k' q_k'' + s_k'' q_k'²`, and Lagrange's
+//! equation of `q_k` is `s_k'·f_k = 0`, where `f_k = Σ_{j in subtree(k)} (m_j a_j − F_j)` is
+//! the force the link transmits into the subtree. The articulated-body recursion (Featherstone's
+//! algorithm, here for point masses and one translational degree of freedom per link) writes
+//! `f_k = I_k a_parent + p_k` with a 3×3 articulated inertia `I_k` and a bias `p_k`, from the
+//! leaves to the roots, then finds each `q_k''` from the roots to the leaves: a few dozen
+//! operations per particle ([`TreeForm::solve`]).
+//!
+//! [`detect`] finds the tree in a model's symbols; the numbers each evaluation needs per node
+//! (`m_k`, `s_k'`, `s_k'' q_k'²`, the resultant applied force `F_k`) are plain expressions a
+//! caller compiles into one program of `O(n)` size.
+
+use crate::derive::ParticleKinematics;
+use crate::model::{CoordinateKind, Model};
+use pdyn_expr::{vector, Id};
+use rustc_hash::{FxHashMap, FxHashSet};
+
+/// One particle of the tree, with the link that carries it.
+#[derive(Clone, Debug)]
+pub struct TreeNode {
+    /// Index into [`Model::particles`].
+    pub particle: usize,
+    /// Index into [`TreeForm::nodes`] of the parent (always smaller); `None` for a root,
+    /// whose link starts at a fixed point.
+    pub parent: Option<usize>,
+    /// Index of the link's coordinate among the free coordinates (state order).
+    pub coordinate: usize,
+    /// The particle's mass.
+    pub mass: Id,
+    /// `∂s/∂q` of the link vector `s` by its coordinate.
+    pub direction: [Id; 3],
+    /// `∂²s/∂q² · q'²`: the link's centripetal acceleration.
+    pub centripetal: [Id; 3],
+    /// The resultant applied force on the particle.
+    pub force: [Id; 3],
+}
+
+/// A model's particles as a tree of links, parents before children.
+#[derive(Clone, Debug)]
+pub struct TreeForm {
+    /// The nodes, each after its parent.
+    pub nodes: Vec<TreeNode>,
+}
+
+/// Numbers per node that [`TreeForm::solve`] reads: `m, s'(3), s''q'²(3), F(3)`.
+pub const NODE_INPUTS: usize = 10;
+
+/// The arithmetic [`TreeForm::solve`] runs on: `f64` for runs, and a type that counts its
+/// operations for the test that the solve's work is linear in the nodes.
+pub trait Scalar:
+    Copy
+    + PartialOrd
+    + std::ops::Add<Output = Self>
+    + std::ops::Sub<Output = Self>
+    + std::ops::Mul<Output = Self>
+    + std::ops::Div<Output = Self>
+    + std::ops::Neg<Output = Self>
+{
+    /// The value `x`.
+    fn of(x: f64) -> Self;
+}
+
+impl Scalar for f64 {
+    #[inline(always)]
+    fn of(x: f64) -> f64 {
+        x
+    }
+}
+
+/// Why [`TreeForm::solve`] could not give the accelerations.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SingularTree {
+    /// The node whose link carries no inertia along its own direction.
+    pub node: usize,
+}
+
+/// Reusable buffers of [`TreeForm::solve`] (no allocation per evaluation).
+#[derive(Clone, Debug)]
+pub struct TreeWorkspace<T = f64> {
+    /// Per node: the children's articulated inertia (symmetric 3×3 as xx, yy, zz, xy, xz,
+    /// yz) and bias force, accumulated in the backward pass.
+    acc_in: Vec<[T; 9]>,
+    /// Per node, for the forward pass: `Î s` (3), `sᵀ p̂`, `1/(sᵀ Î s)`.
+    joint: Vec<[T; 5]>,
+    /// Each particle's acceleration in the forward pass.
+    acc: Vec<[T; 3]>,
+}
+
+impl<T> Default for TreeWorkspace<T> {
+    fn default() -> Self {
+        TreeWorkspace {
+            acc_in: Vec::new(),
+            joint: Vec::new(),
+            acc: Vec::new(),
+        }
+    }
+}
+
+#[inline(always)]
+fn sym_mul<T: Scalar>(i: &[T; 6], v: [T; 3]) -> [T; 3] {
+    [
+        i[0] * v[0] + i[3] * v[1] + i[4] * v[2],
+        i[3] * v[0] + i[1] * v[1] + i[5] * v[2],
+        i[4] * v[0] + i[5] * v[1] + i[2] * v[2],
+    ]
+}
+
+#[inline(always)]
+fn dot<T: Scalar>(a: [T; 3], b: [T; 3]) -> T {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+impl TreeForm {
+    /// Number of nodes (= free coordinates).
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Whether the tree has no node.
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// The expressions each evaluation needs, [`NODE_INPUTS`] per node in node order.
+    pub fn inputs(&self) -> Vec<Id> {
+        let mut out = Vec::with_capacity(NODE_INPUTS * self.nodes.len());
+        for nd in &self.nodes {
+            out.push(nd.mass);
+            out.extend(nd.direction);
+            out.extend(nd.centripetal);
+            out.extend(nd.force);
+        }
+        out
+    }
+
+    /// The accelerations `qdd[coordinate]` from the per-node numbers `values` (laid out as
+    /// [`TreeForm::inputs`]), in `O(n)`: the articulated-body recursion.
+    pub fn solve<T: Scalar>(
+        &self,
+        values: &[T],
+        ws: &mut TreeWorkspace<T>,
+        qdd: &mut [T],
+    ) -> Result<(), SingularTree> {
+        let n = self.nodes.len();
+        let zero = T::of(0.0);
+        let one = T::of(1.0);
+        if values.len() < NODE_INPUTS * n || qdd.len() < n {
+            return Err(SingularTree { node: 0 });
+        }
+        ws.acc_in.clear();
+        ws.acc_in.resize(n, [zero; 9]);
+        ws.joint.resize(n, [zero; 5]);
+        ws.acc.resize(n, [zero; 3]);
+        // Leaves to roots: `acc_in[k]` holds the children's articulated contributions; the
+        // node's own mass and force make Î, p̂; what it passes to its parent is
+        // Î − u uᵀ/D and Î c + p̂ − u (uᵀc + sᵀp̂)/D, with u = Î s and D = sᵀ Î s (the joint
+        // transmits no force along s).
+        for k in (0..n).rev() {
+            let v = &values[NODE_INPUTS * k..NODE_INPUTS * (k + 1)];
+            let (m, s, c) = (v[0], [v[1], v[2], v[3]], [v[4], v[5], v[6]]);
+            let a = ws.acc_in[k];
+            let ih = [a[0] + m, a[1] + m, a[2] + m, a[3], a[4], a[5]];
+            let ph = [a[6] - v[7], a[7] - v[8], a[8] - v[9]];
+            let u = sym_mul(&ih, s);
+            let d = dot(s, u);
+            // NaN is refused too (`partial_cmp` is `None` then).
+            if d.partial_cmp(&zero) != Some(std::cmp::Ordering::Greater) {
+                // No inertia along the link's direction (a massless subtree, a zero-length
+                // link): the dense form's M is singular there too.
+                return Err(SingularTree { node: k });
+            }
+            let r = one / d;
+            let sp = dot(s, ph);
+            ws.joint[k] = [u[0], u[1], u[2], sp, r];
+            if let Some(par) = self.nodes[k].parent {
+                let ic = sym_mul(&ih, c);
+                let g = (dot(u, c) + sp) * r;
+                let (w0, w1, w2) = (u[0] * r, u[1] * r, u[2] * r);
+                let pa = &mut ws.acc_in[par];
+                pa[0] = pa[0] + (ih[0] - u[0] * w0);
+                pa[1] = pa[1] + (ih[1] - u[1] * w1);
+                pa[2] = pa[2] + (ih[2] - u[2] * w2);
+                pa[3] = pa[3] + (ih[3] - u[0] * w1);
+                pa[4] = pa[4] + (ih[4] - u[0] * w2);
+                pa[5] = pa[5] + (ih[5] - u[1] * w2);
+                pa[6] = pa[6] + (ic[0] + ph[0] - u[0] * g);
+                pa[7] = pa[7] + (ic[1] + ph[1] - u[1] * g);
+                pa[8] = pa[8] + (ic[2] + ph[2] - u[2] * g);
+            }
+        }
+        // Roots to leaves: q'' = −(uᵀ(a_parent + c) + sᵀp̂)/D, a = a_parent + s q'' + c.
+        for k in 0..n {
+            let v = &values[NODE_INPUTS * k..NODE_INPUTS * (k + 1)];
+            let ap = match self.nodes[k].parent {
+                Some(par) => ws.acc[par],
+                None => [zero; 3],
+            };
+            let base = [ap[0] + v[4], ap[1] + v[5], ap[2] + v[6]];
+            let j = ws.joint[k];
+            let x = -((j[0] * base[0] + j[1] * base[1] + j[2] * base[2]) + j[3]) * j[4];
+            qdd[self.nodes[k].coordinate] = x;
+            ws.acc[k] = [base[0] + v[1] * x, base[1] + v[2] * x, base[2] + v[3] * x];
+        }
+        Ok(())
+    }
+}
+
+/// The tree of `model`'s particles, when its projected equations have that structure (see
+/// the module's documentation): no constraints, frames, reactions or given accelerations;
+/// positions free of time and of prescribed coordinates; every free coordinate the
+/// coordinate of exactly one link, whose vector depends on it alone. `parts` are the
+/// particles' kinematics and resultant forces ([`crate::derive::newton_equations`]); `free`
+/// and `qd` the free coordinates (indices into [`Model::coordinates`]) and their rates.
+pub fn detect(
+    model: &mut Model,
+    parts: &[ParticleKinematics],
+    free: &[usize],
+    qd: &[Id],
+) -> Option<TreeForm> {
+    if !model.constraints.is_empty()
+        || !model.frames.is_empty()
+        || !model.reactions.is_empty()
+        || !model.known_accelerations.is_empty()
+        || !model.contacts.is_empty()
+        || free.is_empty()
+    {
+        return None;
+    }
+    let p = &mut model.pool;
+    let q: Vec<Id> = free
+        .iter()
+        .map(|&i| p.coord(model.coordinates[i].sym, 0))
+        .collect();
+    let index: FxHashMap<Id, usize> = q.iter().enumerate().map(|(k, &c)| (c, k)).collect();
+    // Leaves that must not occur in a position: time, the rates and accelerations of the free
+    // coordinates, and every prescribed coordinate at any order.
+    let mut forbidden: FxHashSet<Id> = FxHashSet::default();
+    forbidden.insert(p.time());
+    for (i, c) in model.coordinates.iter().enumerate() {
+        let free_here = matches!(c.kind, CoordinateKind::Free { .. }) && free.contains(&i);
+        for order in 0..3u8 {
+            if order > 0 || !free_here {
+                forbidden.insert(p.coord(c.sym, order));
+            }
+        }
+    }
+    let accelerations: FxHashSet<Id> = model
+        .coordinates
+        .iter()
+        .map(|c| p.coord(c.sym, 2))
+        .collect();
+    if parts.iter().any(|pk| {
+        pk.force
+            .iter()
+            .any(|&f| !p.occurring(f, &accelerations).is_empty())
+    }) {
+        return None;
+    }
+    let wanted: FxHashSet<Id> = q.iter().copied().collect();
+    // Each moving particle's set of coordinates, sorted.
+    let mut deps: Vec<(usize, Vec<usize>)> = Vec::new();
+    for (k, part) in model.particles.iter().enumerate() {
+        let mut set: Vec<usize> = Vec::new();
+        for &c in &part.position {
+            if !p.occurring(c, &forbidden).is_empty() {
+                return None;
+            }
+            set.extend(p.occurring(c, &wanted).iter().map(|x| index[x]));
+        }
+        set.sort_unstable();
+        set.dedup();
+        if !set.is_empty() {
+            deps.push((k, set));
+        }
+    }
+    if deps.len() != q.len() {
+        return None;
+    }
+    // Parents have one coordinate fewer: shortest sets first.
+    deps.sort_by_key(|(k, set)| (set.len(), *k));
+    let mut node_of: FxHashMap<Vec<usize>, usize> = FxHashMap::default();
+    let mut owned = vec![false; q.len()];
+    let mut nodes: Vec<TreeNode> = Vec::with_capacity(deps.len());
+    for (k, set) in deps {
+        // The parent is the node whose set is this one without one coordinate.
+        let (parent, own) = if set.len() == 1 {
+            (None, set[0])
+        } else {
+            let mut found = None;
+            for (a, &own) in set.iter().enumerate() {
+                let mut rest = set.clone();
+                rest.remove(a);
+                if let Some(&par) = node_of.get(&rest) {
+                    found = Some((Some(par), own));
+                    break;
+                }
+            }
+            found?
+        };
+        if owned[own] {
+            return None;
+        }
+        owned[own] = true;
+        let r = model.particles[k].position;
+        let link = match parent {
+            Some(par) => vector::sub(p, r, model.particles[nodes[par].particle].position),
+            None => r,
+        };
+        // The link vector must move with its own coordinate only.
+        let others: FxHashSet<Id> = q
+            .iter()
+            .enumerate()
+            .filter(|&(j, _)| j != own)
+            .map(|(_, &c)| c)
+            .collect();
+        if link.iter().any(|&c| !p.occurring(c, &others).is_empty()) {
+            return None;
+        }
+        let direction = link.map(|c| p.diff(c, q[own]));
+        let curvature = direction.map(|c| p.diff(c, q[own]));
+        let rate2 = p.mul2(qd[own], qd[own]);
+        let centripetal = curvature.map(|c| p.mul2(c, rate2));
+        node_of.insert(set, nodes.len());
+        nodes.push(TreeNode {
+            particle: k,
+            parent,
+            coordinate: own,
+            mass: parts[k].mass,
+            direction,
+            centripetal,
+            force: parts[k].force,
+        });
+    }
+    Some(TreeForm { nodes })
+}
