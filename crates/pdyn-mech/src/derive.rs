@@ -394,6 +394,16 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
     // in O(n) per evaluation, so the projected M (n² entries, factored at every evaluation)
     // is not assembled at all. Newton's equations outnumber the unknowns there (no reactions
     // declared), so `Form::Auto` would have chosen the projected form.
+    // One unknown per free coordinate's acceleration, whichever form is built.
+    let acc_unknowns: Vec<Unknown> = free
+        .iter()
+        .zip(&qdd)
+        .map(|(&i, &id)| Unknown {
+            name: format!("{}''", model.coordinates[i].name),
+            id,
+            kind: UnknownKind::Acceleration(i),
+        })
+        .collect();
     if let Some(from) = opts.tree_from {
         if free.len() >= from
             && matches!(opts.form, Form::Auto | Form::Projected)
@@ -405,15 +415,6 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
                     pk.v = pk.v.map(|c| simp(p, c, opts.simplify));
                     pk.force = pk.force.map(|c| simp(p, c, opts.simplify));
                 }
-                let acc_unknowns: Vec<Unknown> = free
-                    .iter()
-                    .zip(&qdd)
-                    .map(|(&i, &id)| Unknown {
-                        name: format!("{}''", model.coordinates[i].name),
-                        id,
-                        kind: UnknownKind::Acceleration(i),
-                    })
-                    .collect();
                 return Ok(Derivation {
                     form: Form::Projected,
                     particles: parts,
@@ -484,15 +485,6 @@ pub fn derive(model: &mut Model, opts: &DeriveOptions) -> Result<Derivation, Der
             name: r.name.clone(),
             id: r.id,
             kind: UnknownKind::Reaction(k),
-        })
-        .collect();
-    let acc_unknowns: Vec<Unknown> = free
-        .iter()
-        .zip(&qdd)
-        .map(|(&i, &id)| Unknown {
-            name: format!("{}''", model.coordinates[i].name),
-            id,
-            kind: UnknownKind::Acceleration(i),
         })
         .collect();
 
