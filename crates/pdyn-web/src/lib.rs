@@ -64,7 +64,7 @@ pub fn version() -> String {
 #[wasm_bindgen]
 pub fn kind(source: &str, origin: &str) -> String {
     let file = ModelFile::from_source(source.to_string(), origin.to_string());
-    ok(json!({"kind": options::kind_name(file.kind)}))
+    ok(json!({"kind": file.kind.name()}))
 }
 
 /// `pdyn run MODEL --no-jit --json`: `summary` (what `--json` prints), `report` (the text),

@@ -3,7 +3,7 @@
 //! a value of the wrong type is an argument error naming the key and what would be valid,
 //! never ignored.
 
-use pdyn::model_file::{Kind, ModelFile};
+use pdyn::model_file::ModelFile;
 use pdyn::report::derive::DeriveRequest;
 use pdyn::report::forces::ForcesRequest;
 use pdyn::{Error, Request};
@@ -223,15 +223,6 @@ impl Options {
             message: format!("a command's JSON output does not parse: {e}"),
         })?;
         Ok(serde_json::json!({ "result": parsed }))
-    }
-}
-
-/// The name the page shows for a kind.
-pub fn kind_name(kind: Kind) -> &'static str {
-    match kind {
-        Kind::Mechanics => "mechanics",
-        Kind::Nbody => "nbody",
-        Kind::Md => "md",
     }
 }
 

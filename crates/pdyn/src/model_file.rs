@@ -18,6 +18,18 @@ pub enum Kind {
     Md,
 }
 
+impl Kind {
+    /// The kind as `summary.json` names it (`crate::summary::KINDS`).
+    pub fn name(self) -> &'static str {
+        let [mechanics, nbody, md] = crate::summary::KINDS;
+        match self {
+            Kind::Mechanics => mechanics,
+            Kind::Nbody => nbody,
+            Kind::Md => md,
+        }
+    }
+}
+
 /// A model file's text, its name for messages, and its kind.
 #[derive(Clone, Debug)]
 pub struct ModelFile {

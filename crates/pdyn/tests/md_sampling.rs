@@ -79,3 +79,37 @@ fn impossible_schedules_are_located_errors() {
         assert!(e.contains(key), "{bad}: {e}");
     }
 }
+
+/// The steps at which `md::run` reports frames (`Progress::Frame`), and whether it writes
+/// `traj.xyz` (it must not without a directory).
+fn frame_steps(text: &str, frame_every: u64) -> (Vec<u64>, u64) {
+    let spec = md::load(text, "m.toml", &[]).unwrap();
+    let mut prep = md::build(&spec, Path::new("."), JitMode::Auto).unwrap();
+    let opts = RunOptions {
+        frame_every,
+        ..RunOptions::default()
+    };
+    let mut steps = Vec::new();
+    let res = md::run(&mut prep, &opts, &mut |p| {
+        if let md::Progress::Frame { step, system } = p {
+            assert_eq!(system.particles.len(), 256);
+            steps.push(step);
+        }
+    })
+    .unwrap();
+    (steps, res.frames)
+}
+
+#[test]
+fn frames_for_a_display_follow_frame_every_else_dump_every_and_write_no_file() {
+    // asked for: every 25 steps from 0 (the thermo and dump schedules do not matter)
+    let (steps, files) = frame_steps(&model("dump_every = 30"), 25);
+    assert_eq!(steps, vec![0, 25, 50]);
+    assert_eq!(files, 0, "no directory: no traj.xyz frame written");
+    // not asked for: the model's dump_every
+    let (steps, _) = frame_steps(&model("dump_every = 30"), 0);
+    assert_eq!(steps, vec![0, 30, 60]);
+    // neither: no frames
+    let (steps, _) = frame_steps(&model(""), 0);
+    assert!(steps.is_empty(), "{steps:?}");
+}

@@ -34,7 +34,7 @@ pub struct DeriveArgs {
     #[arg(long, value_enum, default_value_t = FormArg::Auto)]
     form: FormArg,
     /// Largest system eliminated symbolically (larger ones are solved numerically when run).
-    #[arg(long, default_value_t = 6)]
+    #[arg(long, default_value_t = pdyn::report::derive::SYMBOLIC_LIMIT)]
     symbolic_limit: usize,
     /// Eliminate exactly even when it is expensive (the 3-link chain), and print
     /// explicit accelerations up to 2,000 characters (without it: elimination and

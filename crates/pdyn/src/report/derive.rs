@@ -27,13 +27,16 @@ pub struct DeriveRequest {
     pub solve: bool,
 }
 
+/// Largest system eliminated symbolically unless asked otherwise (`--symbolic-limit`).
+pub const SYMBOLIC_LIMIT: usize = 6;
+
 impl Default for DeriveRequest {
     fn default() -> DeriveRequest {
         DeriveRequest {
             latex: false,
             json: false,
             form: Form::Auto,
-            symbolic_limit: 6,
+            symbolic_limit: SYMBOLIC_LIMIT,
             solve: false,
         }
     }
