@@ -18,8 +18,8 @@ fn bench(path: &str) -> Result<(), String> {
     let t0 = Instant::now();
     let text = std::fs::read_to_string(path).map_err(|e| format!("{path}: cannot read: {e}"))?;
     let t1 = Instant::now();
-    let cols = pdyn_data::csv::read_columns(path, &text, &["t", "x", "y"])
-        .map_err(|e| e.to_string())?;
+    let cols =
+        pdyn_data::csv::read_columns(path, &text, &["t", "x", "y"]).map_err(|e| e.to_string())?;
     let series =
         pdyn_data::csv::Series::from_columns(cols, 5, "bench").map_err(|e| e.to_string())?;
     let t2 = Instant::now();

@@ -54,6 +54,16 @@ pub(crate) struct Member {
     pub bindings: Vec<(String, i64)>,
 }
 
+impl Member {
+    /// The member of family `base` at `bindings`.
+    fn of(base: &str, bindings: &[(String, i64)]) -> Member {
+        Member {
+            label: label(base, bindings),
+            bindings: bindings.to_vec(),
+        }
+    }
+}
+
 /// For each entry of each expanded table, the member it is (`None` for an ordinary entry).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Members {
@@ -535,10 +545,7 @@ impl<'l, 'a> Expander<'l, 'a> {
                             .collect();
                         let key = Spanned::new(name.span(), member(&base, &values));
                         ex.insert(&mut out, key, value.clone())?;
-                        members.push(Some(Member {
-                            label: label(&base, bindings),
-                            bindings: bindings.to_vec(),
-                        }));
+                        members.push(Some(Member::of(&base, bindings)));
                         Ok(())
                     })?;
                 }
@@ -661,10 +668,7 @@ impl<'l, 'a> Expander<'l, 'a> {
                     .force_member(&f, &base, bindings)
                     .map_err(|e| in_member(e, &label(&base, bindings)))?;
                 out.push(m);
-                members.push(Some(Member {
-                    label: label(&base, bindings),
-                    bindings: bindings.to_vec(),
-                }));
+                members.push(Some(Member::of(&base, bindings)));
                 Ok(())
             })?;
         }
