@@ -38,6 +38,11 @@ try {
   await shot(page, "md");
   await page.close();
 
+  ({ page } = await open(browser, server.url, "#example=examples/kin/polar_example.sh"));
+  await command(page, "run");
+  await shot(page, "kin");
+  await page.close();
+
   ({ page } = await open(browser, server.url, "#example=examples/satellite.toml"));
   await page.evaluate(() => (window.pdynEditor.text = window.pdynEditor.text.replace('strength = "GM*m"', 'strength = "GM*m*"')));
   await command(page, "run");

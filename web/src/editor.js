@@ -1,10 +1,17 @@
 // The model editor: CodeMirror 6 with TOML highlighting, and a loader's error shown where it
 // is — the line marked, the column's character underlined, the cursor moved there.
-import { EditorState, StateEffect, StateField } from "@codemirror/state";
+import { Compartment, EditorState, StateEffect, StateField } from "@codemirror/state";
 import { EditorView, Decoration, keymap, lineNumbers, highlightActiveLine } from "@codemirror/view";
 import { defaultKeymap, history, historyKeymap } from "@codemirror/commands";
 import { StreamLanguage, syntaxHighlighting, defaultHighlightStyle } from "@codemirror/language";
 import { toml } from "@codemirror/legacy-modes/mode/toml";
+import { shell } from "@codemirror/legacy-modes/mode/shell";
+
+// A model file is TOML; a script of `pdyn kin`/`pdyn dsolve` lines is shell.
+const LANGUAGES = {
+  toml: { mode: StreamLanguage.define(toml), label: "Model file (TOML)" },
+  shell: { mode: StreamLanguage.define(shell), label: "Script of pdyn kin and pdyn dsolve command lines" },
+};
 
 const setError = StateEffect.define();
 
@@ -20,6 +27,8 @@ const errorField = StateField.define({
 });
 
 export function createEditor(parent, onChange) {
+  const language = new Compartment();
+  let current = "toml";
   const view = new EditorView({
     parent,
     state: EditorState.create({
@@ -29,11 +38,10 @@ export function createEditor(parent, onChange) {
         history(),
         highlightActiveLine(),
         keymap.of([...defaultKeymap, ...historyKeymap]),
-        StreamLanguage.define(toml),
+        language.of([LANGUAGES.toml.mode, EditorView.contentAttributes.of({ "aria-label": LANGUAGES.toml.label })]),
         syntaxHighlighting(defaultHighlightStyle),
         errorField,
         EditorView.lineWrapping,
-        EditorView.contentAttributes.of({ "aria-label": "Model file (TOML)" }),
         EditorView.updateListener.of((u) => u.docChanged && onChange?.()),
       ],
     }),
@@ -45,6 +53,16 @@ export function createEditor(parent, onChange) {
     },
     set text(t) {
       view.dispatch({ changes: { from: 0, to: view.state.doc.length, insert: t } });
+    },
+    /** "toml" (a model) or "shell" (a script of command lines): highlighting and label. */
+    set language(name) {
+      if (name === current || !(name in LANGUAGES)) return;
+      current = name;
+      const l = LANGUAGES[name];
+      view.dispatch({ effects: language.reconfigure([l.mode, EditorView.contentAttributes.of({ "aria-label": l.label })]) });
+    },
+    get language() {
+      return current;
     },
     /** Marks line `line` (1-based) and the character at `column` (1-based). */
     markError(line, column) {

@@ -3,7 +3,7 @@
 import katex from "katex";
 import "katex/dist/katex.min.css";
 
-function tex(node, latex, display = true) {
+export function tex(node, latex, display = true) {
   const el = document.createElement("div");
   el.className = "eq";
   try {
@@ -16,7 +16,7 @@ function tex(node, latex, display = true) {
   node.appendChild(el);
 }
 
-function heading(node, text) {
+export function heading(node, text) {
   const h = document.createElement("h3");
   h.textContent = text;
   node.appendChild(h);

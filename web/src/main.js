@@ -1,15 +1,17 @@
 // The playground's page: the model editor, the commands (run, derive, check, forces, sweep)
-// sent to the engine's worker, and the results: warnings first, then the views.
+// sent to the engine's worker, and the results: warnings first, then the views. A script of
+// `pdyn kin` / `pdyn dsolve` lines (examples/kin, examples/dsolve) runs line by line instead.
 import "./style.css";
 import { createEditor } from "./editor.js";
 import { Engine } from "./engine.js";
 import { showPlots } from "./plots.js";
 import { showDerivation } from "./equations.js";
+import { showCommands, commandLine } from "./commands.js";
 import { Scene } from "./scene.js";
 import { encodeModel, readHash } from "./share.js";
 
-// Every model file of examples/, bundled as text (36 kB for 38 files).
-const files = import.meta.glob("../../examples/**/*.toml", { query: "?raw", import: "default", eager: true });
+// Every model file of examples/, and the kin/dsolve scripts, bundled as text (~45 kB).
+const files = import.meta.glob(["../../examples/**/*.toml", "../../examples/kin/*.sh", "../../examples/dsolve/*.sh"], { query: "?raw", import: "default", eager: true });
 const EXAMPLES = Object.fromEntries(
   Object.entries(files)
     .map(([path, text]) => [path.replace("../../", ""), text])
@@ -25,8 +27,26 @@ const state = { origin: DEFAULT_EXAMPLE, lastRun: null };
 
 const editor = createEditor($("editor"), () => {
   $("error").hidden = true;
-  state.origin = state.origin.startsWith("examples/") ? `${state.origin} (edited)` : state.origin;
+  state.origin = state.origin.startsWith("examples/") && !state.origin.endsWith(" (edited)") ? `${state.origin} (edited)` : state.origin;
+  updateMode();
 });
+
+// A script's first line that is not blank or a comment starts with `pdyn` (as
+// pdyn-web's `script::is_script`); anything else is a model file.
+function isScript(text) {
+  const first = text.split("\n").map((l) => l.trim()).find((l) => l && !l.startsWith("#"));
+  return first === "pdyn" || (first ?? "").startsWith("pdyn ");
+}
+
+// Scripts run with Run; the model commands and run options do not apply to them.
+function updateMode() {
+  const script = isScript(editor.text);
+  editor.language = script ? "shell" : "toml";
+  for (const id of ["derive", "check", "forces", "sweep"]) $(id).disabled = script;
+  $("options").disabled = script;
+  $("run").title = script ? "Run the script's pdyn kin / pdyn dsolve lines (Ctrl+Enter)" : "Run the model (Ctrl+Enter)";
+  document.body.dataset.mode = script ? "script" : "model";
+}
 const engine = new Engine((version) => {
   $("engine-status").textContent = `engine ready (pdyn ${version}, WebAssembly)`;
   document.body.dataset.ready = "true";
@@ -62,6 +82,7 @@ function loadExample(path, updateUrl) {
   if (!(path in EXAMPLES)) return false;
   editor.text = EXAMPLES[path];
   state.origin = path;
+  updateMode();
   $("opt-set").value = BROWSER_SET[path] ?? "";
   $("example").value = path;
   if (updateUrl) history.replaceState(null, "", `#example=${encodeURIComponent(path)}`);
@@ -117,6 +138,7 @@ function options(cmd) {
 }
 
 function cliEquivalent(cmd, o) {
+  if (cmd === "commands") return state.origin.startsWith("examples/") && !state.origin.endsWith(" (edited)") ? `sh ${state.origin}` : "the script's lines, in a shell";
   const parts = [`pdyn ${cmd}`, state.origin.replace(" (edited)", "")];
   for (const [k, v] of Object.entries(o)) {
     if (k === "json" || k === "max_frames" || k === "frame_every") continue;
@@ -184,9 +206,11 @@ function setupTabs() {
 }
 
 async function command(cmd) {
+  if (cmd === "run" && isScript(editor.text)) cmd = "commands";
+  else if (cmd !== "run" && isScript(editor.text)) return;
   let o;
   try {
-    o = options(cmd);
+    o = cmd === "commands" ? {} : options(cmd);
   } catch (err) {
     showError({ text: err.message });
     return;
@@ -234,6 +258,11 @@ function render(cmd, value) {
     showPlots($("view-plots"), value);
     scene.load(value);
     selectTab("plots");
+  } else if (cmd === "commands") {
+    showWarnings([]);
+    showCommands($("view-equations"), value.commands);
+    $("text").textContent = value.commands.map((c) => `$ ${commandLine(c.command)}\n${c.text}`).join("\n");
+    selectTab("equations");
   } else if (cmd === "derive") {
     showWarnings([]);
     showDerivation($("view-equations"), value.derivation);

@@ -1,5 +1,6 @@
 // The engine's thread: the WebAssembly module runs here so the page never freezes. Messages
-// in: {id, cmd, source, origin, options}; out: {id, type: "progress", done, all},
+// in: {id, cmd, source, origin, options} (cmd "commands": source is a script of pdyn kin /
+// pdyn dsolve lines); out: {id, type: "progress", done, all},
 // {id, type: "result", text, ms} (text: the JSON the module returned), or {id, type: "crash",
 // message} after a panic (the page then starts a fresh worker: a trapped instance is not
 // reused). Cancelling is the page terminating this worker.
@@ -30,6 +31,9 @@ self.onmessage = async (event) => {
         break;
       case "check":
         text = pdyn.check(source, origin, opts);
+        break;
+      case "commands":
+        text = pdyn.commands(source, origin);
         break;
       case "kind":
         text = pdyn.kind(source, origin);

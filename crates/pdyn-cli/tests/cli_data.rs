@@ -94,9 +94,9 @@ fn kin_data_recovers_the_ellipse() {
         if t < boundary || t > 30.0 - boundary {
             continue;
         }
-        let (vx, vy) = (-2.0 * (0.5 * t).sin(), 1.25 * (0.5 * t).cos());
-        let (ax, ay) = (-(0.5 * t).cos(), -0.625 * (0.5 * t).sin());
-        let speed = vx.hypot(vy);
+        let (vx, vy) = (-2.0 * libm::sin(0.5 * t), 1.25 * libm::cos(0.5 * t));
+        let (ax, ay) = (-libm::cos(0.5 * t), -0.625 * libm::sin(0.5 * t));
+        let speed = libm::hypot(vx, vy);
         let an = (vx * ay - vy * ax).abs() / speed;
         assert!(
             (r[isp] - speed).abs() < 4.0 * r[iss],
@@ -194,8 +194,8 @@ fn fuse_beats_the_fixes() {
     for r in &rows {
         let t = r[it];
         let (x, y) = (
-            30.0 * (0.1 * t).sin() + 2.0 * t,
-            20.0 * (1.0 - (0.15 * t).cos()),
+            30.0 * libm::sin(0.1 * t) + 2.0 * t,
+            20.0 * (1.0 - libm::cos(0.15 * t)),
         );
         sq += (r[ix] - x).powi(2) + (r[iy] - y).powi(2);
     }

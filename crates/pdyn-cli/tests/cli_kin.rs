@@ -180,8 +180,8 @@ fn at_zero_speed_the_tangent_is_undefined_and_its_limit_is_given() {
             "[t - sin(t), 1 - cos(t), 0]",
             "t=2*pi",
             2.0 * std::f64::consts::PI,
-            |t| [1.0 - t.cos(), t.sin(), 0.0],
-            |t| [t.sin(), t.cos(), 0.0],
+            |t| [1.0 - libm::cos(t), libm::sin(t), 0.0],
+            |t| [libm::sin(t), libm::cos(t), 0.0],
         ),
         (
             "[(t-1)^2, 3*(t-1)^2, (t-1)^3]",

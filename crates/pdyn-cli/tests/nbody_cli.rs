@@ -235,8 +235,8 @@ fn the_trojan_librates_about_l4() {
         let (sx, sy) = xy(&chunk[0]);
         let (jx, jy) = xy(&chunk[1]);
         let (tx, ty) = xy(&chunk[2]);
-        let ang =
-            ((ty - sy).atan2(tx - sx) - (jy - sy).atan2(jx - sx)).rem_euclid(std::f64::consts::TAU);
+        let ang = (libm::atan2(ty - sy, tx - sx) - libm::atan2(jy - sy, jx - sx))
+            .rem_euclid(std::f64::consts::TAU);
         lo = lo.min(ang.to_degrees());
         hi = hi.max(ang.to_degrees());
     }

@@ -258,7 +258,7 @@ fn filter(
         }
         *p = np;
         (
-            -0.5 * ((2.0 * std::f64::consts::PI * s).ln() + nu * nu / s),
+            -0.5 * (libm::log(2.0 * std::f64::consts::PI * s) + nu * nu / s),
             nu * nu / s,
         )
     };
@@ -466,7 +466,7 @@ pub fn fuse(
     // the fixes' own second differences (which include the motion, hence an upper scale),
     // then golden section to 0.01 decade.
     let objective = |lp: f64| {
-        let sp = 10f64.powf(lp);
+        let sp = libm::pow(10f64, lp);
         let l: f64 = axes
             .iter()
             .map(|ax| filter(ax, qa, qb, sp, noise, false).0)
@@ -480,11 +480,7 @@ pub fn fuse(
     let sp = match noise.sigma_p {
         Some(s) => s,
         None => {
-            let guess = z
-                .iter()
-                .map(|c| second_diff_sd(c))
-                .fold(0.0, f64::max)
-                .log10();
+            let guess = libm::log10(z.iter().map(|c| second_diff_sd(c)).fold(0.0, f64::max));
             let mut best = (f64::INFINITY, guess);
             for k in 0..13 {
                 let lp = guess - 5.0 + 0.5 * k as f64;
@@ -500,7 +496,7 @@ pub fn fuse(
                 )
                 .help("give σ_p"));
             }
-            10f64.powf(golden(objective, best.1 - 0.5, best.1 + 0.5))
+            libm::pow(10f64, golden(objective, best.1 - 0.5, best.1 + 0.5))
         }
     };
     let est = [noise.sigma_a.is_none(), noise.sigma_p.is_none()];

@@ -132,7 +132,7 @@ pub fn kinematics(series: &Series, smoothing: Smoothing) -> Result<KinData, Data
     };
     k.boundary = fits
         .iter()
-        .map(|f| 4.0 * std::f64::consts::SQRT_2 * (f.lambda * f.h).powf(0.25))
+        .map(|f| 4.0 * std::f64::consts::SQRT_2 * libm::pow(f.lambda * f.h, 0.25))
         .fold(0.0, f64::max);
     k.fits = fits
         .iter()
@@ -144,7 +144,7 @@ pub fn kinematics(series: &Series, smoothing: Smoothing) -> Result<KinData, Data
             sigma: f.sigma2.sqrt(),
             edf: f.edf,
             se: f.se,
-            boundary: 4.0 * std::f64::consts::SQRT_2 * (f.lambda * f.h).powf(0.25),
+            boundary: 4.0 * std::f64::consts::SQRT_2 * libm::pow(f.lambda * f.h, 0.25),
         })
         .collect();
     let se_v: Vec<f64> = fits.iter().map(|f| f.se[1]).collect();
@@ -220,8 +220,8 @@ pub fn kinematics(series: &Series, smoothing: Smoothing) -> Result<KinData, Data
         k.se_curvature[i] = if s > 0.0 { vk.sqrt() } else { f64::INFINITY };
         // Polar components in the x–y plane.
         let (x, y) = (k.position[0][i], k.position[1][i]);
-        let r = x.hypot(y);
-        let mut th = y.atan2(x);
+        let r = libm::hypot(x, y);
+        let mut th = libm::atan2(y, x);
         if prev_theta.is_finite() {
             // Unwrap: the branch nearest the previous sample's angle.
             let tau = std::f64::consts::TAU;

@@ -342,7 +342,7 @@ pub fn standard_errors(sigma2: f64, lam: f64, h: f64) -> [f64; 3] {
     let mut acc = [0.0; 3];
     for k in 0..STEPS {
         let th = std::f64::consts::PI * (k as f64 + 0.5) / STEPS as f64;
-        let (c, s) = (th.cos(), th.sin());
+        let (c, s) = (libm::cos(th), libm::sin(th));
         let q = (2.0 * c - 2.0) / h;
         let r = h * (2.0 + c) / 3.0;
         let g = q / r;
@@ -367,11 +367,11 @@ fn gcv_lambda(
 ) -> Result<f64, DataError> {
     use std::f64::consts::PI;
     // Cut-off ω_c = (λ h)^(−1/4): from π/h (no smoothing) to 2π/span (a straight line).
-    let lo = (h.powi(3) / PI.powi(4)).log10() - 1.0;
-    let hi = ((span / (2.0 * PI)).powi(4) / h).log10() + 1.0;
+    let lo = libm::log10(h.powi(3) / PI.powi(4)) - 1.0;
+    let hi = libm::log10((span / (2.0 * PI)).powi(4) / h) + 1.0;
     let mut score = |p: f64| {
         setup
-            .score(10f64.powf(p), ws)
+            .score(libm::pow(10f64, p), ws)
             .map_or(f64::INFINITY, |s| s.0)
     };
     // Two decades per grid point (a factor 3.2 in the cut-off frequency): GCV's basin is
@@ -394,7 +394,7 @@ fn gcv_lambda(
     }
     let step = (hi - lo) / steps as f64;
     let (p, fp) = brent_min(&mut score, best.1 - step, best.1 + step, 0.0025);
-    Ok(10f64.powf(if fp <= best.0 { p } else { best.1 }))
+    Ok(libm::pow(10f64, if fp <= best.0 { p } else { best.1 }))
 }
 
 /// The minimum of `f` on `[a, b]` by Brent's method (golden section with parabolic steps;
@@ -488,7 +488,7 @@ mod tests {
             .collect();
         let y: Vec<f64> = t
             .iter()
-            .map(|x| (0.3 * x).sin() + 0.1 * ((x * 13.0).sin()))
+            .map(|x| libm::sin(0.3 * x) + 0.1 * (libm::sin(x * 13.0)))
             .collect();
         let setup = Setup::new(&t, &y);
         let mut ws = Workspace::default();

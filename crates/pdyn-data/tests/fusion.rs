@@ -33,9 +33,9 @@ fn truth(axis: usize, t: f64) -> (f64, f64, f64) {
         (2.0, 0.7, -0.5)
     };
     (
-        amp * (w * t).sin() + vel * t,
-        amp * w * (w * t).cos() + vel,
-        -amp * w * w * (w * t).sin(),
+        amp * libm::sin(w * t) + vel * t,
+        amp * w * libm::cos(w * t) + vel,
+        -amp * w * w * libm::sin(w * t),
     )
 }
 

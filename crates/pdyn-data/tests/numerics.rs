@@ -14,12 +14,12 @@ use pdyn_data::spline::{fit, Smoothing};
 
 fn max_err(kind: Kind, n: usize) -> f64 {
     let t: Vec<f64> = (0..n).map(|i| 3.0 * i as f64 / (n - 1) as f64).collect();
-    let y: Vec<f64> = t.iter().map(|x| x.sin()).collect();
+    let y: Vec<f64> = t.iter().map(|x| libm::sin(*x)).collect();
     let f = Interpolant::new(kind, &t, &y, "y").unwrap();
     // Interior points only: the natural end condition is first order wrong at the ends.
     (0..400)
         .map(|k| 1.0 + 1.0 * k as f64 / 399.0)
-        .map(|x| (f.eval(x).unwrap() - x.sin()).abs())
+        .map(|x| (f.eval(x).unwrap() - libm::sin(x)).abs())
         .fold(0.0, f64::max)
 }
 
@@ -33,7 +33,7 @@ fn interpolation_orders_and_range() {
         (Kind::Pchip, 2.0, 0.4),
     ] {
         let (e1, e2) = (max_err(kind, 41), max_err(kind, 81));
-        let p = (e1 / e2).log2();
+        let p = libm::log2(e1 / e2);
         assert!((p - order).abs() < tol, "{kind:?}: order {p} ({e1}, {e2})");
     }
     let f = Interpolant::new(
@@ -68,7 +68,7 @@ fn smoothing_spline_matches_a_dense_solve() {
     }
     let y: Vec<f64> = t
         .iter()
-        .map(|x| (0.7 * x).sin() + 0.1 * rng.normal())
+        .map(|x| libm::sin(0.7 * x) + 0.1 * rng.normal())
         .collect();
     let lam = 0.37;
     let s = fit(&t, &y, Smoothing::Lambda(lam), "y").unwrap();
@@ -186,11 +186,11 @@ fn circle(sigma: f64, seed: u64) -> Circle {
     let t: Vec<f64> = (0..=400).map(|i| i as f64 * 0.05).collect();
     let x = t
         .iter()
-        .map(|s| R * (W * s).cos() + sigma * rng.normal())
+        .map(|s| R * libm::cos(W * s) + sigma * rng.normal())
         .collect();
     let y = t
         .iter()
-        .map(|s| R * (W * s).sin() + sigma * rng.normal())
+        .map(|s| R * libm::sin(W * s) + sigma * rng.normal())
         .collect();
     Circle { t, x, y }
 }
@@ -277,11 +277,11 @@ fn errors_match_the_band_and_shrink_at_the_stated_rate() {
             let t: Vec<f64> = (0..=400).map(|i| i as f64 * 0.05).collect();
             let x = t
                 .iter()
-                .map(|s| v * s + 0.5 * amp * (w * s).sin() + sigma * rng.normal())
+                .map(|s| v * s + 0.5 * amp * libm::sin(w * s) + sigma * rng.normal())
                 .collect();
             let y = t
                 .iter()
-                .map(|s| amp * (w * s).sin() + sigma * rng.normal())
+                .map(|s| amp * libm::sin(w * s) + sigma * rng.normal())
                 .collect();
             let s =
                 Series::from_arrays(t, vec!["x".into(), "y".into()], vec![x, y], 5, "k").unwrap();
@@ -289,8 +289,8 @@ fn errors_match_the_band_and_shrink_at_the_stated_rate() {
             for i in 0..k.t.len() {
                 if k.t[i] > k.boundary && k.t[i] < k.t[k.t.len() - 1] - k.boundary {
                     let s = k.t[i];
-                    ev += (k.velocity[1][i] - amp * w * (w * s).cos()).powi(2);
-                    ea += (k.acceleration[1][i] + amp * w * w * (w * s).sin()).powi(2);
+                    ev += (k.velocity[1][i] - amp * w * libm::cos(w * s)).powi(2);
+                    ea += (k.acceleration[1][i] + amp * w * w * libm::sin(w * s)).powi(2);
                     sv += k.fits[1].se[1].powi(2);
                     sa += k.fits[1].se[2].powi(2);
                     count += 1.0;
@@ -306,7 +306,7 @@ fn errors_match_the_band_and_shrink_at_the_stated_rate() {
         assert!((e / s - 1.0).abs() < 0.25, "RMS error {e}, stated {s}");
     }
     let (rv, ra) = (v1 / v2, a1 / a2);
-    let (ev, ea) = (10f64.powf(2.0 / 3.0), 10f64.powf(4.0 / 9.0));
+    let (ev, ea) = (libm::pow(10f64, 2.0 / 3.0), libm::pow(10f64, 4.0 / 9.0));
     assert!(
         (rv / ev - 1.0).abs() < 0.2,
         "velocity error ratio {rv}, expected {ev}"
@@ -328,13 +328,13 @@ fn clean_integration_converges_at_the_rule_order() {
             .map(|i| {
                 let u = i as f64 / n as f64;
                 tend * if uneven {
-                    u + 0.03 * (std::f64::consts::TAU * u).sin()
+                    u + 0.03 * libm::sin(std::f64::consts::TAU * u)
                 } else {
                     u
                 }
             })
             .collect();
-        let a: Vec<f64> = t.iter().map(|s| -w * w * amp * (w * s).cos()).collect();
+        let a: Vec<f64> = t.iter().map(|s| -w * w * amp * libm::cos(w * s)).collect();
         let r = integrate(
             &t,
             &a,
@@ -351,8 +351,8 @@ fn clean_integration_converges_at_the_rule_order() {
         // The largest error over the record (the error at one instant may pass through 0).
         (0..=n)
             .map(|i| {
-                let ex = (r.x[i] - amp * (w * t[i]).cos()).abs();
-                let ev = (r.v[i] + amp * w * (w * t[i]).sin()).abs();
+                let ex = (r.x[i] - amp * libm::cos(w * t[i])).abs();
+                let ev = (r.v[i] + amp * w * libm::sin(w * t[i])).abs();
                 ex.max(ev)
             })
             .fold(0.0, f64::max)
@@ -360,7 +360,7 @@ fn clean_integration_converges_at_the_rule_order() {
     for (rule, order) in [(Rule::Trapezoid, 2.0), (Rule::Simpson, 4.0)] {
         for uneven in [false, true] {
             let (e1, e2) = (err(200, rule, uneven), err(400, rule, uneven));
-            let p = (e1 / e2).log2();
+            let p = libm::log2(e1 / e2);
             assert!(
                 (p - order).abs() < 0.2,
                 "{rule:?} uneven={uneven}: order {p} ({e1} → {e2})"
@@ -455,11 +455,11 @@ fn helix_in_three_dimensions() {
     let t: Vec<f64> = (0..=600).map(|i| i as f64 * 0.05).collect();
     let x = t
         .iter()
-        .map(|s| r * (w * s).cos() + sigma * rng.normal())
+        .map(|s| r * libm::cos(w * s) + sigma * rng.normal())
         .collect();
     let y = t
         .iter()
-        .map(|s| r * (w * s).sin() + sigma * rng.normal())
+        .map(|s| r * libm::sin(w * s) + sigma * rng.normal())
         .collect();
     let z = t.iter().map(|s| c * s + sigma * rng.normal()).collect();
     let names = vec!["x".into(), "y".into(), "z".into()];
@@ -487,7 +487,7 @@ fn helix_in_three_dimensions() {
     assert!(cover(&k.a_t, &k.se_a_t, 0.0) >= 0.9);
     assert!(cover(&k.curvature, &k.se_curvature, kappa) >= 0.9);
     let i = interior[interior.len() / 2];
-    let toward_axis = [-(w * k.t[i]).cos(), -(w * k.t[i]).sin(), 0.0];
+    let toward_axis = [-libm::cos(w * k.t[i]), -libm::sin(w * k.t[i]), 0.0];
     let dot: f64 = (0..3).map(|c| k.normal[c][i] * toward_axis[c]).sum();
     assert!(dot > 0.99, "normal · (toward the axis) = {dot}");
 }

@@ -667,19 +667,19 @@ impl Program {
                     Op::Neg => -a,
                     Op::Sqrt => a.sqrt(),
                     Op::Powi => a.powi(ins.b as i32),
-                    Op::Powf => a.powf(reg_b()),
-                    Op::Sin => a.sin(),
-                    Op::Cos => a.cos(),
-                    Op::Tan => a.tan(),
-                    Op::Asin => a.asin(),
-                    Op::Acos => a.acos(),
-                    Op::Atan => a.atan(),
-                    Op::Atan2 => a.atan2(reg_b()),
-                    Op::Sinh => a.sinh(),
-                    Op::Cosh => a.cosh(),
-                    Op::Tanh => a.tanh(),
-                    Op::Exp => a.exp(),
-                    Op::Ln => a.ln(),
+                    Op::Powf => libm::pow(a, reg_b()),
+                    Op::Sin => libm::sin(a),
+                    Op::Cos => libm::cos(a),
+                    Op::Tan => libm::tan(a),
+                    Op::Asin => libm::asin(a),
+                    Op::Acos => libm::acos(a),
+                    Op::Atan => libm::atan(a),
+                    Op::Atan2 => libm::atan2(a, reg_b()),
+                    Op::Sinh => libm::sinh(a),
+                    Op::Cosh => libm::cosh(a),
+                    Op::Tanh => libm::tanh(a),
+                    Op::Exp => libm::exp(a),
+                    Op::Ln => libm::log(a),
                     Op::Abs => a.abs(),
                     Op::Sign => {
                         if a > 0.0 {
@@ -825,7 +825,7 @@ mod tests {
         prog.eval(&x, &mut prog.workspace(), &mut out);
         let mut acc = 0.0;
         for i in 0..n {
-            let t = (i + 1) as f64 * x[i].sin();
+            let t = (i + 1) as f64 * libm::sin(x[i]);
             acc = if i == 0 { t } else { acc + t };
             assert_eq!(out[i].to_bits(), acc.to_bits(), "x_{}", i + 1);
         }

@@ -383,7 +383,7 @@ impl Rational {
     /// Estimated decimal digits of `self^e` (numerator plus denominator), for messages.
     pub fn pow_digits(&self, e: i64) -> u64 {
         let log10 = match &self.0 {
-            Repr::Small(n, d) => (n.unsigned_abs() as f64).log10() + (*d as f64).log10(),
+            Repr::Small(n, d) => libm::log10(n.unsigned_abs() as f64) + libm::log10(*d as f64),
             Repr::Big(_) => self.bits() as f64 * std::f64::consts::LOG10_2,
         };
         (log10 * e.unsigned_abs() as f64)
@@ -463,7 +463,7 @@ fn int_root(x: u64, q: u32) -> Option<u64> {
     if q == 1 {
         return Some(x);
     }
-    let guess = (x as f64).powf(1.0 / q as f64).round() as u64;
+    let guess = libm::pow(x as f64, 1.0 / q as f64).round() as u64;
     (guess.saturating_sub(1)..=guess + 1).find(|&r| r.checked_pow(q) == Some(x))
 }
 
@@ -708,7 +708,7 @@ impl Number {
                 let root = b.exact_root(q)?;
                 root.pow(p).map(Number::Rat)
             }
-            _ => Some(Number::Float(self.to_f64().powf(e.to_f64()))),
+            _ => Some(Number::Float(libm::pow(self.to_f64(), e.to_f64()))),
         }
     }
     /// Total order used for canonical sorting (floats after rationals of equal value).

@@ -65,20 +65,20 @@ pub fn stumpff(z: f64) -> [f64; 4] {
     }
     let s = z.abs().sqrt();
     let (c0, c1, c2, c3_closed) = if z > 0.0 {
-        let h = (0.5 * s).sin();
+        let h = libm::sin(0.5 * s);
         (
-            s.cos(),
-            s.sin() / s,
+            libm::cos(s),
+            libm::sin(s) / s,
             2.0 * h * h / z,
-            (s - s.sin()) / (z * s),
+            (s - libm::sin(s)) / (z * s),
         )
     } else {
-        let h = (0.5 * s).sinh();
+        let h = libm::sinh(0.5 * s);
         (
-            s.cosh(),
-            s.sinh() / s,
+            libm::cosh(s),
+            libm::sinh(s) / s,
             -2.0 * h * h / z,
-            (s.sinh() - s) / (-z * s),
+            (libm::sinh(s) - s) / (-z * s),
         )
     };
     let c3 = if z.abs() <= 4.0 {
@@ -323,18 +323,18 @@ mod tests {
             let (c0, c1, c2, c3) = if z > 0.0 {
                 let s = z.sqrt();
                 (
-                    s.cos(),
-                    s.sin() / s,
-                    (1.0 - s.cos()) / z,
-                    (s - s.sin()) / (z * s),
+                    libm::cos(s),
+                    libm::sin(s) / s,
+                    (1.0 - libm::cos(s)) / z,
+                    (s - libm::sin(s)) / (z * s),
                 )
             } else {
                 let s = (-z).sqrt();
                 (
-                    s.cosh(),
-                    s.sinh() / s,
-                    (s.cosh() - 1.0) / -z,
-                    (s.sinh() - s) / (-z * s),
+                    libm::cosh(s),
+                    libm::sinh(s) / s,
+                    (libm::cosh(s) - 1.0) / -z,
+                    (libm::sinh(s) - s) / (-z * s),
                 )
             };
             let tol = 1e-12;

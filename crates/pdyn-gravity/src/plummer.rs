@@ -64,8 +64,8 @@ pub fn plummer_scaled(
         let sin_t = (1.0 - cos_t * cos_t).sqrt();
         let phi = rng.uniform_in(0.0, 2.0 * PI);
         Vec3::new(
-            len * sin_t * phi.cos(),
-            len * sin_t * phi.sin(),
+            len * sin_t * libm::cos(phi),
+            len * sin_t * libm::sin(phi),
             len * cos_t,
         )
     };
@@ -77,7 +77,7 @@ pub fn plummer_scaled(
             if x <= 0.0 {
                 continue;
             }
-            let r = 1.0 / (x.powf(-2.0 / 3.0) - 1.0).sqrt();
+            let r = 1.0 / (libm::pow(x, -2.0 / 3.0) - 1.0).sqrt();
             if r < 10.0 {
                 break r;
             }
@@ -85,11 +85,11 @@ pub fn plummer_scaled(
         let q = loop {
             let q = rng.uniform();
             let y = 0.1 * rng.uniform();
-            if y < q * q * (1.0 - q * q).powf(3.5) {
+            if y < q * q * libm::pow(1.0 - q * q, 3.5) {
                 break q;
             }
         };
-        let ve = 2f64.sqrt() * (1.0 + r * r).powf(-0.25);
+        let ve = 2f64.sqrt() * libm::pow(1.0 + r * r, -0.25);
         let pos = iso(&mut rng, r * scale);
         let vel = iso(&mut rng, q * ve * vscale);
         out.push(Particle { mass: m, pos, vel });

@@ -24,8 +24,8 @@ fn bisect(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
 
 /// A fixed rotation (so that no coordinate is special), applied to perifocal vectors.
 fn rotate(p: [f64; 2]) -> [f64; 3] {
-    let (ci, si) = (0.8f64.cos(), 0.8f64.sin()); // inclination
-    let (co, so) = (2.1f64.cos(), 2.1f64.sin()); // node
+    let (ci, si) = (libm::cos(0.8f64), libm::sin(0.8f64)); // inclination
+    let (co, so) = (libm::cos(2.1f64), libm::sin(2.1f64)); // node
     let (x, y) = (p[0], p[1]);
     let (x1, y1, z1) = (x, y * ci, y * si);
     [co * x1 - so * y1, so * x1 + co * y1, z1]
@@ -35,26 +35,26 @@ fn rotate(p: [f64; 2]) -> [f64; 3] {
 /// value for `e > 1`) and eccentricity `e`, about `mu`.
 fn state(mu: f64, a: f64, e: f64, m: f64) -> ([f64; 3], [f64; 3]) {
     if e < 1.0 {
-        let ea = bisect(|ea| ea - e * ea.sin() - m, m - 1.0, m + 1.0);
-        let r = a * (1.0 - e * ea.cos());
+        let ea = bisect(|ea| ea - e * libm::sin(ea) - m, m - 1.0, m + 1.0);
+        let r = a * (1.0 - e * libm::cos(ea));
         let b = (1.0 - e * e).sqrt();
         let s = (mu * a).sqrt() / r;
         (
-            rotate([a * (ea.cos() - e), a * b * ea.sin()]),
-            rotate([-s * ea.sin(), s * b * ea.cos()]),
+            rotate([a * (libm::cos(ea) - e), a * b * libm::sin(ea)]),
+            rotate([-s * libm::sin(ea), s * b * libm::cos(ea)]),
         )
     } else {
         let mut span = 1.0f64;
-        while (e * span.sinh() - span) < m.abs() {
+        while (e * libm::sinh(span) - span) < m.abs() {
             span *= 2.0;
         }
-        let h = bisect(|h| e * h.sinh() - h - m, -span, span);
-        let r = a * (e * h.cosh() - 1.0);
+        let h = bisect(|h| e * libm::sinh(h) - h - m, -span, span);
+        let r = a * (e * libm::cosh(h) - 1.0);
         let b = (e * e - 1.0).sqrt();
         let s = (mu * a).sqrt() / r;
         (
-            rotate([a * (e - h.cosh()), a * b * h.sinh()]),
-            rotate([-s * h.sinh(), s * b * h.cosh()]),
+            rotate([a * (e - libm::cosh(h)), a * b * libm::sinh(h)]),
+            rotate([-s * libm::sinh(h), s * b * libm::cosh(h)]),
         )
     }
 }

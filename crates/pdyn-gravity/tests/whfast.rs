@@ -142,9 +142,7 @@ fn outer_solar_system_run(
         {
             if let Some(k) = offset.filter(|&k| window > 0 && k <= window && k % WINDOW_STRIDE == 0)
             {
-                let weight = (std::f64::consts::PI * k as f64 / window as f64)
-                    .sin()
-                    .powi(2);
+                let weight = libm::sin(std::f64::consts::PI * k as f64 / window as f64).powi(2);
                 weights[w] += weight;
                 for j in 0..2 {
                     sums[w][j] += weight * a[j];

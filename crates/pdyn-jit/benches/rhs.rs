@@ -156,8 +156,8 @@ fn chain_handwritten<const N: usize>(input: &[f64], out: &mut [f64]) {
     let mut mu = [0.0; N];
     let mut lv2 = [0.0; N];
     for i in 0..N {
-        s[i] = q[i].sin();
-        c[i] = q[i].cos();
+        s[i] = libm::sin(q[i]);
+        c[i] = libm::cos(q[i]);
         l[i] = par[2 + 2 * i];
         lv2[i] = l[i] * v[i] * v[i];
     }

@@ -538,19 +538,21 @@ fn emit_chunk(
 }
 
 pub(crate) mod shims {
-    //! `extern "C"` wrappers of the `f64` methods the interpreter calls.
+    //! `extern "C"` wrappers of the functions the interpreter calls (`libm`'s, as everywhere
+    //! in pdyn: the same bits natively and in WebAssembly).
     macro_rules! unary {
-        ($($name:ident => $m:ident),* $(,)?) => {
-            $(pub extern "C" fn $name(x: f64) -> f64 { x.$m() })*
+        ($($name:ident => $f:path),* $(,)?) => {
+            $(pub extern "C" fn $name(x: f64) -> f64 { $f(x) })*
         };
     }
-    unary!(sin => sin, cos => cos, tan => tan, asin => asin, acos => acos, atan => atan,
-           sinh => sinh, cosh => cosh, tanh => tanh, exp => exp, ln => ln);
+    unary!(sin => libm::sin, cos => libm::cos, tan => libm::tan, asin => libm::asin,
+           acos => libm::acos, atan => libm::atan, sinh => libm::sinh, cosh => libm::cosh,
+           tanh => libm::tanh, exp => libm::exp, ln => libm::log);
     pub extern "C" fn atan2(y: f64, x: f64) -> f64 {
-        y.atan2(x)
+        libm::atan2(y, x)
     }
     pub extern "C" fn powf(x: f64, y: f64) -> f64 {
-        x.powf(y)
+        libm::pow(x, y)
     }
     pub extern "C" fn powi(x: f64, k: i32) -> f64 {
         x.powi(k)
@@ -1031,7 +1033,7 @@ mod tests {
                     let mut out = [0.0];
                     let xk = k as f64 * 0.3;
                     jit.eval(&[xk], &mut jit.workspace(), &mut out);
-                    assert_eq!(out[0].to_bits(), (xk.sin() * xk).to_bits());
+                    assert_eq!(out[0].to_bits(), (libm::sin(xk) * xk).to_bits());
                 });
             }
         });

@@ -67,7 +67,10 @@ impl BondKind {
                 if x >= 1.0 {
                     return None;
                 }
-                Some((-0.5 * k * r_max * r_max * (1.0 - x).ln(), -k / (1.0 - x)))
+                Some((
+                    -0.5 * k * r_max * r_max * libm::log(1.0 - x),
+                    -k / (1.0 - x),
+                ))
             }
             BondKind::FeneWca {
                 k,
@@ -140,7 +143,7 @@ mod fene_wca_tests {
             epsilon: 1.0,
             sigma: 1.0,
         };
-        let fene = |r: f64| -0.5 * k * r_max * r_max * (1.0 - (r / r_max).powi(2)).ln();
+        let fene = |r: f64| -0.5 * k * r_max * r_max * libm::log(1.0 - (r / r_max).powi(2));
         let r: f64 = 0.97;
         let lj = 4.0 * (r.powi(-12) - r.powi(-6)) + 1.0;
         assert!((b.energy_force(r * r).unwrap().0 - (fene(r) + lj)).abs() < 1e-12);

@@ -49,7 +49,7 @@ pub fn lattice(
         .iter()
         .try_fold(basis.len(), |a, &c| a.checked_mul(c))
         .unwrap_or(usize::MAX);
-    let a = (basis.len() as f64 / rho).cbrt();
+    let a = libm::cbrt(basis.len() as f64 / rho);
     let bx = SimBox::new(
         cells[0] as f64 * a,
         cells[1] as f64 * a,

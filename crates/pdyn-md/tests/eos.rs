@@ -73,7 +73,7 @@ fn helmholtz(rho: f64, t: f64) -> f64 {
         x(30) / (t * t) + x(31) / t.powi(3) + x(32) / t.powi(4),
     ];
     let gamma = 3.0;
-    let f = (-gamma * rho * rho).exp();
+    let f = libm::exp(-gamma * rho * rho);
     let mut g = [0.0; 6];
     g[0] = (1.0 - f) / (2.0 * gamma);
     for k in 1..6 {

@@ -147,8 +147,8 @@ fn kremer_grest_chains_run() {
             .unwrap();
         }
     }
-    let wca =
-        LennardJones::new(1.0, 1.0).truncated(2f64.powf(1.0 / 6.0), CutoffMode::ShiftedEnergy);
+    let wca = LennardJones::new(1.0, 1.0)
+        .truncated(libm::pow(2f64, 1.0 / 6.0), CutoffMode::ShiftedEnergy);
     let th = Langevin::new(LangevinParams {
         temperature: Some(1.0),
         ..Default::default()

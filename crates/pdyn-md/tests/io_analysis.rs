@@ -108,7 +108,7 @@ fn rdf_of_fcc_counts_twelve_nearest_neighbours() {
     rdf.add(&s).unwrap();
     let (r, g) = rdf.result();
     let dr = 0.01;
-    let a = (4.0 / rho).cbrt();
+    let a = libm::cbrt(4.0 / rho);
     // coordination number ∫ ρ 4π r² g dr over the first shell
     let cn: f64 = r
         .iter()

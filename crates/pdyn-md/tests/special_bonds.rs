@@ -49,7 +49,7 @@ fn chains(factors: [f64; 3], bond: BondKind) -> System {
 
 fn rng_uniform(rng: &mut Rng) -> f64 {
     // a normal deviate squashed to (0, 1) is enough for a jitter
-    0.5 + 0.5 * (rng.normal() / 3.0).tanh()
+    0.5 + 0.5 * libm::tanh(rng.normal() / 3.0)
 }
 
 /// LJ shifted to zero at `RC`, and `−du/dr / r`.

@@ -109,10 +109,10 @@ fn chain_accelerations(m: &[f64], l: &[f64], q: &[f64], qd: &[f64], g: f64) -> V
     let mu = |j: usize, k: usize| -> f64 { m[j.max(k)..].iter().sum() };
     let mut a = vec![vec![0.0; n + 1]; n];
     for j in 0..n {
-        let mut rhs = -g * l[j] * q[j].sin() * mu(j, j);
+        let mut rhs = -g * l[j] * libm::sin(q[j]) * mu(j, j);
         for k in 0..n {
-            a[j][k] = mu(j, k) * l[j] * l[k] * (q[j] - q[k]).cos();
-            rhs -= mu(j, k) * l[j] * l[k] * (q[j] - q[k]).sin() * qd[k] * qd[k];
+            a[j][k] = mu(j, k) * l[j] * l[k] * libm::cos(q[j] - q[k]);
+            rhs -= mu(j, k) * l[j] * l[k] * libm::sin(q[j] - q[k]) * qd[k] * qd[k];
         }
         a[j][n] = rhs;
     }

@@ -109,16 +109,16 @@ fn double_pendulum_in_newton_form_is_solved_by_default_and_matches_the_textbook(
                 ("th2", 1, w2),
             ],
         );
-        let den = 2.0 * m1 + m2 - m2 * (2.0 * t1 - 2.0 * t2).cos();
-        let a1 = (-g * (2.0 * m1 + m2) * t1.sin()
-            - m2 * g * (t1 - 2.0 * t2).sin()
-            - 2.0 * (t1 - t2).sin() * m2 * (w2 * w2 * l2 + w1 * w1 * l1 * (t1 - t2).cos()))
+        let den = 2.0 * m1 + m2 - m2 * libm::cos(2.0 * t1 - 2.0 * t2);
+        let a1 = (-g * (2.0 * m1 + m2) * libm::sin(t1)
+            - m2 * g * libm::sin(t1 - 2.0 * t2)
+            - 2.0 * libm::sin(t1 - t2) * m2 * (w2 * w2 * l2 + w1 * w1 * l1 * libm::cos(t1 - t2)))
             / (l1 * den);
         let a2 = 2.0
-            * (t1 - t2).sin()
+            * libm::sin(t1 - t2)
             * (w1 * w1 * l1 * (m1 + m2)
-                + g * (m1 + m2) * t1.cos()
-                + w2 * w2 * l2 * m2 * (t1 - t2).cos())
+                + g * (m1 + m2) * libm::cos(t1)
+                + w2 * w2 * l2 * m2 * libm::cos(t1 - t2))
             / (l2 * den);
         let got1 = eval(&mut model.pool, sol[0], &at);
         let got2 = eval(&mut model.pool, sol[1], &at);
@@ -146,9 +146,9 @@ fn pendulum_with_a_rod_tension_is_solved_by_default() {
     // th'' = -g/L sin th; T = m (g cos th + L w²).
     let a = eval(&mut model.pool, sol[0], &at);
     let t = eval(&mut model.pool, sol[1], &at);
-    assert!((a + 9.81 / 0.5 * 0.7f64.sin()).abs() < 1e-12, "{a}");
+    assert!((a + 9.81 / 0.5 * libm::sin(0.7f64)).abs() < 1e-12, "{a}");
     assert!(
-        (t - 2.0 * (9.81 * 0.7f64.cos() + 0.5 * 1.3 * 1.3)).abs() < 1e-12,
+        (t - 2.0 * (9.81 * libm::cos(0.7f64) + 0.5 * 1.3 * 1.3)).abs() < 1e-12,
         "{t}"
     );
 }
@@ -200,9 +200,9 @@ fn prescribed_acceleration_is_an_equation_and_the_reactions_are_solved() {
     let vals: Vec<f64> = sol.iter().map(|&s| eval(&mut model.pool, s, &at)).collect();
     let (th, w, g, m, r) = (0.4f64, 2.0, 9.81, 0.5, 0.3);
     assert_eq!(vals[0], 0.0);
-    assert!((vals[1] - m * g * th.cos()).abs() < 1e-12, "{vals:?}");
+    assert!((vals[1] - m * g * libm::cos(th)).abs() < 1e-12, "{vals:?}");
     assert!(
-        (vals[2] - (m * g * th.sin() - m * w * w * r)).abs() < 1e-12,
+        (vals[2] - (m * g * libm::sin(th) - m * w * w * r)).abs() < 1e-12,
         "{vals:?}"
     );
 }

@@ -427,7 +427,7 @@ fn two_storey_building_agrees_with_rk4() {
     let mut ws = prog.workspace();
     let mut out = vec![0.0; 4];
     let rhs = |t: f64, y: &[f64]| {
-        let u = 0.01 * (5.0 * t).sin();
+        let u = 0.01 * libm::sin(5.0 * t);
         vec![
             y[1],
             (-4e5 * (y[0] - u) - 3e5 * (y[0] - y[2]) - 800.0 * y[1]) / 2000.0,

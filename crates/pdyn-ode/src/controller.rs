@@ -112,13 +112,13 @@ impl PiState {
     /// Returns `(accepted, h_new)` for error `err` of a step of size `h`.
     #[inline]
     pub(crate) fn propose(&mut self, err: f64, h: f64) -> (bool, f64) {
-        let fac11 = err.powf(self.expo1);
+        let fac11 = libm::pow(err, self.expo1);
         if err <= 1.0 {
             // x^0 = 1 exactly: skip the power for the I-controller (β = 0, DOP853).
             let pi = if self.beta == 0.0 {
                 1.0
             } else {
-                self.facold.powf(self.beta)
+                libm::pow(self.facold, self.beta)
             };
             let fac = fac11 / pi;
             let fac = self.facc2.max(self.facc1.min(fac / self.safe));
@@ -175,7 +175,7 @@ pub(crate) fn initial_step<S: OdeSystem + ?Sized>(
     let h1 = if der12 <= 1e-15 {
         1e-6_f64.max(h.abs() * 1e-3)
     } else {
-        (0.01 / der12).powf(1.0 / order as f64)
+        libm::pow(0.01 / der12, 1.0 / order as f64)
     };
     let h = (100.0 * h.abs()).min(h1).min(hmax);
     if !h.is_finite() || h <= 0.0 {

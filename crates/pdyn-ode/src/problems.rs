@@ -25,8 +25,8 @@ pub const AREN_DOPRI5_YT: [f64; 4] = [
 pub fn arenstorf_rhs(y: &[f64], f: &mut [f64]) {
     let mu = AREN_MU;
     let mup = 1.0 - mu;
-    let d1 = ((y[0] + mu).powi(2) + y[1] * y[1]).powf(1.5);
-    let d2 = ((y[0] - mup).powi(2) + y[1] * y[1]).powf(1.5);
+    let d1 = libm::pow((y[0] + mu).powi(2) + y[1] * y[1], 1.5);
+    let d2 = libm::pow((y[0] - mup).powi(2) + y[1] * y[1], 1.5);
     f[0] = y[2];
     f[1] = y[3];
     f[2] = y[0] + 2.0 * y[3] - mup * (y[0] + mu) / d1 - mu * (y[0] - mup) / d2;

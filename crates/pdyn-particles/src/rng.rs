@@ -96,7 +96,7 @@ impl Rng {
             let v = 2.0 * self.uniform() - 1.0;
             let s = u * u + v * v;
             if s > 0.0 && s < 1.0 {
-                let k = (-2.0 * s.ln() / s).sqrt();
+                let k = (-2.0 * libm::log(s) / s).sqrt();
                 self.spare = Some(v * k);
                 return u * k;
             }

@@ -18,15 +18,15 @@ fn orbit() -> Figure {
     let th = linspace(0.0, 2.0 * PI, 400);
     let circle = Series::new(
         "circular, r = 1 AU",
-        th.iter().map(|t| t.cos()).collect(),
-        th.iter().map(|t| t.sin()).collect(),
+        th.iter().map(|t| libm::cos(*t)).collect(),
+        th.iter().map(|t| libm::sin(*t)).collect(),
     );
     let (a, e) = (1.5, 0.5);
     let b = a * (1.0f64 - e * e).sqrt();
     let ellipse = Series::new(
         "elliptic, e = 0.5",
-        th.iter().map(|t| a * t.cos() - a * e).collect(),
-        th.iter().map(|t| b * t.sin()).collect(),
+        th.iter().map(|t| a * libm::cos(*t) - a * e).collect(),
+        th.iter().map(|t| b * libm::sin(*t)).collect(),
     );
     Figure {
         title: "Kepler orbits".into(),
@@ -44,11 +44,11 @@ fn history() -> Figure {
     let t = linspace(0.0, 20.0, 2001);
     let q: Vec<f64> = t
         .iter()
-        .map(|t| (-0.15 * t).exp() * (2.0 * t).cos())
+        .map(|t| libm::exp(-0.15 * t) * libm::cos(2.0 * t))
         .collect();
     let w: Vec<f64> = t
         .iter()
-        .map(|t| -(-0.15 * t).exp() * (2.0 * (2.0 * t).sin() + 0.15 * (2.0 * t).cos()))
+        .map(|t| -libm::exp(-0.15 * t) * (2.0 * libm::sin(2.0 * t) + 0.15 * libm::cos(2.0 * t)))
         .collect();
     let e: Vec<f64> = q
         .iter()
@@ -117,10 +117,20 @@ fn grid() -> Vec<Figure> {
         ..Default::default()
     };
     vec![
-        panel("x", "m", &|t| (1.3 * t).sin(), Style::Line),
-        panel("y", "m", &|t| 0.5 * (2.1 * t).cos(), Style::Line),
-        panel("vx", "m/s", &|t| 1.3 * (1.3 * t).cos() * 1e-3, Style::Line),
-        panel("vy", "m/s", &|t| -1.05 * (2.1 * t).sin() + 1e4, Style::Line),
+        panel("x", "m", &|t| libm::sin(1.3 * t), Style::Line),
+        panel("y", "m", &|t| 0.5 * libm::cos(2.1 * t), Style::Line),
+        panel(
+            "vx",
+            "m/s",
+            &|t| 1.3 * libm::cos(1.3 * t) * 1e-3,
+            Style::Line,
+        ),
+        panel(
+            "vy",
+            "m/s",
+            &|t| -1.05 * libm::sin(2.1 * t) + 1e4,
+            Style::Line,
+        ),
     ]
 }
 
@@ -130,18 +140,22 @@ fn orbit3d() -> Figure3 {
     let inc: f64 = 0.5;
     let circ = Series3::new(
         "inclined circle",
-        th.iter().map(|t| 7000.0 * t.cos()).collect(),
-        th.iter().map(|t| 7000.0 * t.sin() * inc.cos()).collect(),
-        th.iter().map(|t| 7000.0 * t.sin() * inc.sin()).collect(),
+        th.iter().map(|t| 7000.0 * libm::cos(*t)).collect(),
+        th.iter()
+            .map(|t| 7000.0 * libm::sin(*t) * libm::cos(inc))
+            .collect(),
+        th.iter()
+            .map(|t| 7000.0 * libm::sin(*t) * libm::sin(inc))
+            .collect(),
     );
     let prec = Series3::new(
         "precessing",
-        th.iter().map(|t| 9000.0 * (t + 0.1 * t).cos()).collect(),
+        th.iter().map(|t| 9000.0 * libm::cos(t + 0.1 * t)).collect(),
         th.iter()
-            .map(|t| 9000.0 * (t * 1.1).sin() * (0.2 * t).cos())
+            .map(|t| 9000.0 * libm::sin(t * 1.1) * libm::cos(0.2 * t))
             .collect(),
         th.iter()
-            .map(|t| 9000.0 * (t * 1.1).sin() * (0.2 * t).sin())
+            .map(|t| 9000.0 * libm::sin(t * 1.1) * libm::sin(0.2 * t))
             .collect(),
     );
     Figure3 {
@@ -156,7 +170,7 @@ fn poincare() -> Figure {
     let (mut x, mut y) = (vec![], vec![]);
     let (mut q, mut p) = (0.1f64, 0.0f64);
     for _ in 0..3000 {
-        p += 0.9 * q.sin();
+        p += 0.9 * libm::sin(q);
         q += p;
         x.push(q.rem_euclid(2.0 * PI));
         y.push(p);
@@ -164,7 +178,7 @@ fn poincare() -> Figure {
     let (mut x2, mut y2) = (vec![], vec![]);
     let (mut q, mut p) = (3.0f64, 1.0f64);
     for _ in 0..3000 {
-        p += 0.9 * q.sin();
+        p += 0.9 * libm::sin(q);
         q += p;
         x2.push(q.rem_euclid(2.0 * PI));
         y2.push(p);

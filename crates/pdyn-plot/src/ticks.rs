@@ -26,7 +26,7 @@ pub(crate) fn nice_ticks(lo: f64, hi: f64, max_n: usize) -> (Vec<f64>, f64) {
     }
     let max_n = max_n.max(2);
     let raw = span / (max_n as f64 - 1.0);
-    let mag = 10f64.powf(raw.log10().floor());
+    let mag = libm::pow(10f64, libm::log10(raw).floor());
     let mut step = mag * 10.0;
     'search: for decade in [mag, mag * 10.0] {
         for m in NICE {
@@ -84,7 +84,7 @@ pub(crate) fn format_ticks(values: &[f64], step: f64) -> Vec<String> {
     let max_abs = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let scientific = max_abs >= 1e5 || (max_abs > 0.0 && max_abs < 1e-3);
     if scientific {
-        let exp = max_abs.log10().floor() as i32;
+        let exp = libm::log10(max_abs).floor() as i32;
         let scale = 10f64.powi(exp);
         let d = decimals(step / scale);
         values

@@ -46,13 +46,13 @@ fn orbit() -> Figure {
         series: vec![
             Series::new(
                 "circle",
-                th.iter().map(|t| t.cos()).collect(),
-                th.iter().map(|t| t.sin()).collect(),
+                th.iter().map(|t| libm::cos(*t)).collect(),
+                th.iter().map(|t| libm::sin(*t)).collect(),
             ),
             Series::new(
                 "ellipse",
-                th.iter().map(|t| 2.0 * t.cos()).collect(),
-                th.iter().map(|t| 0.5 * t.sin()).collect(),
+                th.iter().map(|t| 2.0 * libm::cos(*t)).collect(),
+                th.iter().map(|t| 0.5 * libm::sin(*t)).collect(),
             ),
         ],
         equal_aspect: true,
@@ -68,8 +68,8 @@ fn history() -> Figure {
         x_label: "t [s]".into(),
         y_label: "q [rad]".into(),
         series: vec![
-            Series::new("q1", t.clone(), t.iter().map(|t| t.sin()).collect()),
-            Series::new("q2", t.clone(), t.iter().map(|t| t.cos()).collect()),
+            Series::new("q1", t.clone(), t.iter().map(|t| libm::sin(*t)).collect()),
+            Series::new("q2", t.clone(), t.iter().map(|t| libm::cos(*t)).collect()),
             Series::new("q3", t.clone(), t.iter().map(|t| 0.1 * t).collect()),
         ],
         style: Style::LineAndPoints,
@@ -380,7 +380,7 @@ fn renders_from_many_threads() {
 fn long_series_give_small_svg() {
     let n = 200_000;
     let t = linspace(0.0, 100.0, n);
-    let y: Vec<f64> = t.iter().map(|t| t.sin()).collect();
+    let y: Vec<f64> = t.iter().map(|t| libm::sin(*t)).collect();
     let fig = Figure {
         series: vec![Series::new("long", t, y)],
         ..Default::default()

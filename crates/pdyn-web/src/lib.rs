@@ -2,7 +2,8 @@
 //!
 //! The third front end, beside the binary and Python: wasm-bindgen exports that take a model
 //! file's text and options as JSON, call the same library entries as `pdyn run`, `derive`,
-//! `forces`, `check` and `sweep` (`pdyn::run`, `pdyn::report::*`), and return JSON: on
+//! `forces`, `check` and `sweep` (`pdyn::run`, `pdyn::report::*`), or a script of `pdyn kin`
+//! and `pdyn dsolve` command lines (`script.rs`), and return JSON: on
 //! success `{"ok": true, …}` with the command's own text and JSON output, on failure the
 //! CLI's `{"error": {kind, message, location: {file, line, column}, exit_code}}`. Nothing
 //! here computes: it converts. Built for `wasm32-unknown-unknown` (scripts/build-web.sh),
@@ -10,6 +11,7 @@
 //! calling thread; natively it builds and is tested like any crate.
 
 mod options;
+mod script;
 mod tables;
 
 use options::Options;
@@ -172,6 +174,30 @@ pub fn sweep(
             .into();
         Ok(v)
     })
+}
+
+/// A script of `pdyn kin …` and `pdyn dsolve …` lines (`examples/kin/*.sh`), run line by
+/// line: `{"commands": [{line, command, name, text, result}]}`, each with the text and the
+/// JSON the CLI prints for it. The first failing line stops the script; its error is located
+/// at the word that caused it (`location: {file: origin, line, column}`).
+#[wasm_bindgen]
+pub fn commands(script: &str, origin: &str) -> String {
+    match script::run(script) {
+        Ok(commands) => ok(json!({ "commands": commands })),
+        Err(e) => {
+            let mut v = e.error.to_json();
+            v["error"]["location"] = json!({"file": origin, "line": e.line, "column": e.column});
+            v["ok"] = false.into();
+            v["text"] = format!("{origin}:{}:{}: {}", e.line, e.column, e.error).into();
+            v.to_string()
+        }
+    }
+}
+
+/// Whether a text is a script of command lines (true) or a model file.
+#[wasm_bindgen]
+pub fn is_script(text: &str) -> bool {
+    script::is_script(text)
 }
 
 /// `pdyn run MODEL --method help`: the methods for the model's kind.

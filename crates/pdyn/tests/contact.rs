@@ -163,9 +163,9 @@ fn block_on_incline_stops_then_holds_or_slides_back() {
     let v0 = 4.0;
     for (alpha, holds) in [(0.5f64, true), (0.7, false)] {
         let res = run(INCLINE, &[("alpha", alpha)], |_| {});
-        assert_eq!(alpha.tan() <= 0.6, holds);
+        assert_eq!(libm::tan(alpha) <= 0.6, holds);
         let h = res.hybrid.as_ref().unwrap();
-        let up = g * (alpha.sin() + 0.45 * alpha.cos());
+        let up = g * (libm::sin(alpha) + 0.45 * libm::cos(alpha));
         let t_stop = v0 / up;
         let s_stop = v0 * v0 / (2.0 * up);
         close(h.switches[0].t, t_stop, 1e-9, "stop time");
@@ -177,14 +177,14 @@ fn block_on_incline_stops_then_holds_or_slides_back() {
             // Static friction holds m g sin a.
             close(
                 last[col(&res, "F_slope")].abs(),
-                1.5 * g * alpha.sin(),
+                1.5 * g * libm::sin(alpha),
                 1e-9,
                 "holding force",
             );
         } else {
             assert_eq!(h.switches.len(), 1, "{:?}", h.switches);
             assert!(h.switches[0].to.starts_with("sliding"));
-            let down = g * (alpha.sin() - 0.45 * alpha.cos());
+            let down = g * (libm::sin(alpha) - 0.45 * libm::cos(alpha));
             let dt = 3.0 - t_stop;
             close(
                 last[col(&res, "s")],
@@ -306,10 +306,10 @@ fn hemisphere_leaves_at_two_thirds_and_lands() {
         .expect("the release is a row");
     let row = &res.rows[k];
     let (x, y) = (row[col(&res, "x")], row[col(&res, "y")]);
-    let cos_l = 2.0 / 3.0 * th0.cos();
+    let cos_l = 2.0 / 3.0 * libm::cos(th0);
     close(y / r, cos_l, 1e-9, "cos(theta) at release");
     // Projectile from the release point with the speed of the slide, along the tangent.
-    let v = (2.0 * g * r * (th0.cos() - cos_l)).sqrt();
+    let v = (2.0 * g * r * (libm::cos(th0) - cos_l)).sqrt();
     let sin_l = (1.0 - cos_l * cos_l).sqrt();
     close(x, r * sin_l, 1e-9, "x at release");
     let (vx, vy) = (v * cos_l, -v * sin_l);
@@ -609,7 +609,7 @@ fn belt_stick_slip_phases() {
     );
     let d = (mu_s - mu_k) * m * g / k;
     let a = (d * d + (v / w).powi(2)).sqrt();
-    let slip = (std::f64::consts::PI + 2.0 * (v / (a * w)).asin()) / w;
+    let slip = (std::f64::consts::PI + 2.0 * libm::asin(v / (a * w))) / w;
     close(h.switches[1].t - h.switches[0].t, slip, 1e-9, "slip phase");
     // It sticks again at mu_k m g/k - d (the slip is symmetric about mu_k m g/k), and the
     // belt carries it back to mu_s m g/k = mu_k m g/k + d.
@@ -785,14 +785,14 @@ fn incline_and_pulley_held_by_static_friction_or_sliding() {
     // The friction the slope supplies along its tangent holds mA g sin a - mB g = 9.81 N.
     close(
         last[col(&res, "F_slope")].abs(),
-        ma * g * a.sin() - mb * g,
+        ma * g * libm::sin(a) - mb * g,
         1e-9,
         "friction needed",
     );
     close(last[col(&res, "T")], mb * g, 1e-9, "tension");
     // mu_s = 0.1 cannot hold it: it slides down the slope, friction pointing up-slope.
     let res = run(INCLINE_PULLEY, &[("mu_s", 0.1)], |_| {});
-    let acc = (ma * g * a.sin() - mb * g - 0.1 * ma * g * a.cos()) / (ma + mb);
+    let acc = (ma * g * libm::sin(a) - mb * g - 0.1 * ma * g * libm::cos(a)) / (ma + mb);
     let last = res.rows.last().unwrap();
     close(last[col(&res, "s")], -0.5 * acc * 4.0, 1e-9, "slid down");
     close(last[col(&res, "s'")], -acc * 2.0, 1e-9, "speed down-slope");

@@ -138,8 +138,8 @@ fn direct_energy() -> f64 {
                 })
                 .sum();
             if i / BEADS == j / BEADS && j - i == 1 {
-                u += -0.5 * 30.0 * 1.5 * 1.5 * (1.0 - r2 / 2.25).ln();
-                if r2 < 2f64.powf(1.0 / 3.0) {
+                u += -0.5 * 30.0 * 1.5 * 1.5 * libm::log(1.0 - r2 / 2.25);
+                if r2 < libm::pow(2f64, 1.0 / 3.0) {
                     u += lj(r2) + 1.0;
                 }
             } else if r2 < RC * RC {

@@ -17,6 +17,7 @@ pub mod run;
 pub mod sweep;
 
 use clap::ValueEnum;
+use pdyn::report::notation::Notation;
 use pdyn::Error;
 use pdyn_expr::{Id, Pool, Value};
 use std::path::Path;
@@ -54,51 +55,29 @@ pub enum Format {
     Rust,
 }
 
+impl From<Format> for Notation {
+    fn from(f: Format) -> Notation {
+        match f {
+            Format::Text => Notation::Text,
+            Format::Latex => Notation::Latex,
+            Format::Rust => Notation::Rust,
+        }
+    }
+}
+
 impl Format {
     /// `id` in this notation.
     pub fn show(self, pool: &Pool, id: Id) -> String {
-        match self {
-            Format::Text => pool.to_text(id),
-            Format::Latex => pool.to_latex(id),
-            Format::Rust => pool.to_rust(id, &|p, n| p.rust_leaf_name(n)),
-        }
+        Notation::from(self).show(pool, id)
     }
 
-    /// A 3-vector in this notation (a LaTeX column matrix, or `[x, y, z]`).
-    pub fn show_vector(self, pool: &Pool, v: [Id; 3]) -> String {
-        let parts: Vec<String> = v.iter().map(|&c| self.show(pool, c)).collect();
-        match self {
-            Format::Latex => format!(
-                "\\begin{{bmatrix}} {} \\end{{bmatrix}}",
-                parts.join(" \\\\ ")
-            ),
-            _ => format!("[{}]", parts.join(", ")),
-        }
-    }
-}
-
-impl Format {
     /// A scalar or a vector in this notation.
     pub fn show_value(self, pool: &Pool, v: Value) -> String {
-        match v {
-            Value::Scalar(s) => self.show(pool, s),
-            Value::Vector(c) => self.show_vector(pool, c),
-        }
+        Notation::from(self).show_value(pool, v)
     }
 }
 
-/// A scalar as `{"text", "latex"}`, a vector as a list of three of them.
-pub fn value_json(pool: &Pool, v: Value) -> serde_json::Value {
-    match v {
-        Value::Scalar(s) => both(pool, s),
-        Value::Vector(c) => serde_json::json!(c.iter().map(|&x| both(pool, x)).collect::<Vec<_>>()),
-    }
-}
-
-/// `{"text": ..., "latex": ...}` for JSON output.
-pub fn both(pool: &Pool, id: Id) -> serde_json::Value {
-    serde_json::json!({"text": pool.to_text(id), "latex": pool.to_latex(id)})
-}
+pub use pdyn::report::notation::value_json;
 
 /// Loads a mechanics model file (read once); errors keep the file's text so that they can
 /// show the offending line, and an `[nbody]` or `[md]` model says `pdyn run` runs it.

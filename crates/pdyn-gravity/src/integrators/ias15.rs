@@ -558,7 +558,7 @@ impl Ias15 {
                 }
             }
             dt_new = if min_ts2.is_normal() {
-                min_ts2.sqrt() * dt_done * (self.params.epsilon * 5040.0).powf(1.0 / 7.0)
+                min_ts2.sqrt() * dt_done * libm::pow(self.params.epsilon * 5040.0, 1.0 / 7.0)
             } else {
                 dt_done / SAFETY
             };

@@ -41,7 +41,7 @@ impl RawPair for Morse {
     #[inline]
     fn raw(&self, r2: f64) -> (f64, f64) {
         let r = r2.sqrt();
-        let e = (-self.alpha * (r - self.r0)).exp();
+        let e = libm::exp(-self.alpha * (r - self.r0));
         let u = self.depth * ((1.0 - e) * (1.0 - e) - 1.0);
         let du = 2.0 * self.alpha * self.depth * (e - e * e);
         (u, -du / r)

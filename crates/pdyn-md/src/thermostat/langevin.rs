@@ -50,7 +50,7 @@ impl Langevin {
 
     /// The O step over `h`.
     pub(crate) fn ou_step(&mut self, p: &mut Particles, h: f64, kb: f64) {
-        let c1 = (-self.gamma * h).exp();
+        let c1 = libm::exp(-self.gamma * h);
         let c2 = (1.0 - c1 * c1).sqrt();
         for i in 0..p.len() {
             if p.m[i] <= 0.0 {

@@ -90,17 +90,17 @@ impl NoseHooverChain {
         let mut ke = ke;
         self.v[m - 1] += g(m - 1, &self.v, &self.q, ke) * h4;
         for k in (0..m - 1).rev() {
-            let a = (-self.v[k + 1] * h8).exp();
+            let a = libm::exp(-self.v[k + 1] * h8);
             self.v[k] = (self.v[k] * a + g(k, &self.v, &self.q, ke) * h4) * a;
         }
-        let s = (-self.v[0] * h2).exp();
+        let s = libm::exp(-self.v[0] * h2);
         scale_velocities(p, s);
         ke *= s * s;
         for k in 0..m {
             self.xi[k] += self.v[k] * h2;
         }
         for k in 0..m - 1 {
-            let a = (-self.v[k + 1] * h8).exp();
+            let a = libm::exp(-self.v[k + 1] * h8);
             self.v[k] = (self.v[k] * a + g(k, &self.v, &self.q, ke) * h4) * a;
         }
         self.v[m - 1] += g(m - 1, &self.v, &self.q, ke) * h4;

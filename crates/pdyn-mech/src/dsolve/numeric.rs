@@ -226,14 +226,14 @@ pub(crate) fn solve_numeric(
     let mut chi = char_poly(&a, n, dim, 1.0);
     let lead = chi[dim];
     if lead != 0.0 && chi[0] != 0.0 {
-        let rho = (chi[0].abs() / lead.abs()).powf(1.0 / dim as f64);
+        let rho = libm::pow(chi[0].abs() / lead.abs(), 1.0 / dim as f64);
         if rho.is_finite() && rho > 0.0 {
             chi = char_poly(&a, n, dim, rho);
         }
     }
     let cmax = chi.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let rho_est = if chi[dim] != 0.0 {
-        (cmax / chi[dim].abs()).powf(1.0 / dim as f64).max(1.0)
+        libm::pow(cmax / chi[dim].abs(), 1.0 / dim as f64).max(1.0)
     } else {
         1.0
     };
@@ -281,7 +281,7 @@ pub(crate) fn solve_numeric(
     let groups = numeric_roots(&chi);
     let root_scale = groups
         .iter()
-        .map(|g| g.re.hypot(g.im))
+        .map(|g| libm::hypot(g.re, g.im))
         .fold(0.0f64, f64::max)
         .max(1e-12);
     let mut families: Vec<Family> = Vec::new();
@@ -439,11 +439,11 @@ pub(crate) fn solve_numeric(
         .map(|b| {
             let f = &families[b.family];
             let trig = if b.sine {
-                (f.freq * t0v).sin()
+                libm::sin(f.freq * t0v)
             } else {
-                (f.freq * t0v).cos()
+                libm::cos(f.freq * t0v)
             };
-            t0v.powi(b.power as i32) * (f.rate * t0v).exp() * trig
+            t0v.powi(b.power as i32) * libm::exp(f.rate * t0v) * trig
         })
         .collect();
     for (r_ic, &(j, k, v)) in ic_vals.iter().enumerate() {

@@ -109,7 +109,7 @@ mod tests {
     #[test]
     fn integrates_smooth_and_peaked_functions() {
         let q = integrate(
-            &mut |x: f64| x.sin(),
+            &mut |x: f64| libm::sin(x),
             0.0,
             std::f64::consts::PI,
             1e-12,
@@ -117,7 +117,7 @@ mod tests {
         );
         assert!((q.value - 2.0).abs() < 1e-12, "{q:?}");
         let q = integrate(&mut |x: f64| 1.0 / (1e-4 + x * x), -1.0, 1.0, 1e-9, 100_000);
-        let exact = 2.0 / 1e-2 * (1.0f64 / 1e-2).atan();
+        let exact = 2.0 / 1e-2 * libm::atan(1.0f64 / 1e-2);
         assert!((q.value - exact).abs() < 1e-8, "{q:?} vs {exact}");
         assert!(q.error < 1e-8);
     }

@@ -43,10 +43,10 @@ impl C64 {
         }
     }
     pub fn abs(self) -> f64 {
-        self.re.hypot(self.im)
+        libm::hypot(self.re, self.im)
     }
     pub fn cis(theta: f64) -> C64 {
-        C64::new(theta.cos(), theta.sin())
+        C64::new(libm::cos(theta), libm::sin(theta))
     }
 }
 
@@ -97,7 +97,7 @@ pub(crate) fn numeric_roots(coeffs: &[f64]) -> Vec<RootGroup> {
     let monic: Vec<f64> = c.iter().map(|x| x / lead).collect();
     // Initial guesses on a circle of the Cauchy-bound-like radius, off the real axis.
     let radius = (0..n)
-        .map(|k| monic[k].abs().powf(1.0 / (n - k) as f64))
+        .map(|k| libm::pow(monic[k].abs(), 1.0 / (n - k) as f64))
         .fold(0.0f64, f64::max)
         .max(1e-300);
     let mut z: Vec<C64> = (0..n)

@@ -122,8 +122,8 @@ impl Consts {
         let sq6 = 6f64.sqrt();
         let c1 = (4.0 - sq6) / 10.0;
         let c2 = (4.0 + sq6) / 10.0;
-        let c81 = 81f64.powf(1.0 / 3.0);
-        let c9 = 9f64.powf(1.0 / 3.0);
+        let c81 = libm::pow(81f64, 1.0 / 3.0);
+        let c9 = libm::pow(9f64, 1.0 / 3.0);
         let u1 = (6.0 + c81 - c9) / 30.0;
         let alph = (12.0 - c81 + c9) / 60.0;
         let beta = (c81 + c9) * 3f64.sqrt() / 60.0;
@@ -217,7 +217,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
             return Err(invalid("radau5 needs atol > 0 and rtol > 1e-15"));
         }
         let quot = atol[i] / rtol[i];
-        rtol[i] = 0.1 * rtol[i].powf(2.0 / 3.0);
+        rtol[i] = 0.1 * libm::pow(rtol[i], 2.0 / 3.0);
         atol[i] = rtol[i] * quot;
     }
     let fnewt = (10.0 * UROUND / rtol[0]).max(0.03f64.min(rtol[0].sqrt()));
@@ -423,7 +423,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
             }
             // ---- simplified Newton iteration (label 40)
             let mut newt = 0usize;
-            faccon = faccon.max(UROUND).powf(0.8);
+            faccon = libm::pow(faccon.max(UROUND), 0.8);
             theta = THET.abs();
             let mut dynold = 0.0f64;
             loop {
@@ -499,7 +499,8 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                         let dyth = faccon * dyno * theta.powi((NIT - 1 - newt) as i32) / fnewt;
                         if dyth >= 1.0 {
                             let qnewt = 1e-4f64.max(20.0f64.min(dyth));
-                            let hhfac = 0.8 * qnewt.powf(-1.0 / (4.0 + (NIT - 1 - newt) as f64));
+                            let hhfac =
+                                0.8 * libm::pow(qnewt, -1.0 / (4.0 + (NIT - 1 - newt) as f64));
                             h *= hhfac;
                             reject = true;
                             last = false;
@@ -570,14 +571,14 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                 }
                 // ---- new step size
                 let fac = safe.min(cfac / (newt + 2 * NIT) as f64);
-                let mut quot = facr.max(facl.min(err.powf(0.25) / fac));
+                let mut quot = facr.max(facl.min(libm::pow(err, 0.25) / fac));
                 let mut hnew = h / quot;
                 if err < 1.0 {
                     first = false;
                     tried_min = false;
                     sol.stats.accepted += 1;
                     if sol.stats.accepted > 1 {
-                        let facgus = (hacc / h) * (err * err / erracc).powf(0.25) / safe;
+                        let facgus = (hacc / h) * libm::pow(err * err / erracc, 0.25) / safe;
                         let facgus = facr.max(facl.min(facgus));
                         quot = quot.max(facgus);
                         hnew = h / quot;

@@ -220,7 +220,7 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
                 LatticeKind::Bcc => 2.0,
                 LatticeKind::Fcc => 4.0,
             };
-            let a = (basis / density.value).cbrt();
+            let a = libm::cbrt(basis / density.value);
             let atoms = cells.iter().product::<u64>() * basis as u64;
             fits_in_memory(spec, atoms, cells.map(|c| c as f64 * a), cutoff, span)?;
             let (p, bx) = pdyn_md::lattice(

@@ -143,7 +143,7 @@ mod tests {
     /// at 32 million atoms about 21.6 GB, each term as derived in the module's text.
     #[test]
     fn the_lj_liquid_estimate_follows_its_terms() {
-        let a = (4.0f64 / 0.8442).cbrt();
+        let a = libm::cbrt(4.0f64 / 0.8442);
         let edge = 200.0 * a;
         let e = estimate(32_000_000, [edge; 3], 2.8, false);
         let pairs = 2.0 * std::f64::consts::PI / 3.0 * 0.8442 * 2.8f64.powi(3);

@@ -395,7 +395,12 @@ fn run_sim<P: PairPotential>(
         }
         let k = chunk.min(spec.steps - done);
         if let Some((a, b)) = ramp {
-            let frac = (done as f64 + 0.5 * k as f64) / spec.steps.max(1) as f64;
+            // The target steps once per thermo block, at the block's middle, whatever the
+            // stretches the run is cut into (frames, dumps, MSD samples): what is observed
+            // must not change the trajectory.
+            let block = done / every * every;
+            let block_len = every.min(spec.steps - block);
+            let frac = (block as f64 + 0.5 * block_len as f64) / spec.steps.max(1) as f64;
             set_target(&mut sim.thermostat, a + (b - a) * frac);
         }
         let mut obs = |r: &ThermoRecord, s: &System| {

@@ -435,7 +435,7 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingEr
                         vel: (1.0 / m) * (pi.mass * pi.vel + pj.mass * pj.vel),
                     };
                     // Volume is conserved (REBOUND's merge keeps the density, too).
-                    bodies[i] = (merged, (ri.powi(3) + rj.powi(3)).cbrt());
+                    bodies[i] = (merged, libm::cbrt(ri.powi(3) + rj.powi(3)));
                     bodies.remove(j);
                     alive.remove(j);
                     steps_before += sim.steps();

@@ -901,7 +901,7 @@ impl Reader<'_> {
             (None, None) => pdyn_gravity::Anomaly::True(0.0),
         };
         if let pdyn_gravity::Anomaly::True(f) = anomaly {
-            if e > 1.0 && (1.0 + e * f.cos()) <= 0.0 {
+            if e > 1.0 && (1.0 + e * libm::cos(f)) <= 0.0 {
                 let at = raw.f.as_ref().map_or(span.clone(), |sv| sv.span());
                 return Err(self.c.err(
                     at,

@@ -1,12 +1,16 @@
 //! What the commands other than `run` print, built once for every front end (the binary,
 //! the browser): the derivation (`pdyn derive`), the forces of a prescribed motion
-//! (`pdyn forces`), the check against a closed form (`pdyn check`) and a sweep
-//! (`pdyn sweep`), each as text or JSON from a loaded model and typed options.
+//! (`pdyn forces`), the check against a closed form (`pdyn check`), a sweep (`pdyn sweep`),
+//! kinematics from formulas (`pdyn kin`) and closed-form solutions (`pdyn dsolve`), each as
+//! text or JSON from typed results and options; expressions in a [`notation::Notation`].
 
 pub mod bounded;
 pub mod check;
 pub mod derive;
+pub mod dsolve;
 pub mod forces;
+pub mod kin;
+pub mod notation;
 pub mod sweep;
 
 use crate::Error;

@@ -797,7 +797,7 @@ impl State<'_> {
                     ));
                 }
                 let tangents = self.h.layout.contacts[c].tangents.len();
-                let f = f1.hypot(f2);
+                let f = libm::hypot(f1, f2);
                 if mode == ContactMode::Stuck && f > mu_s * n_force.max(0.0) + f_tol {
                     let to = self.sliding_from_force(c, [f1, f2], tangents);
                     self.switch(
@@ -825,7 +825,7 @@ impl State<'_> {
         if tangents == 1 {
             ContactMode::Sliding(if f[0] > 0.0 { -1 } else { 1 })
         } else {
-            let m = f[0].hypot(f[1]).max(1e-300);
+            let m = libm::hypot(f[0], f[1]).max(1e-300);
             self.slip_dir[c] = [-f[0] / m, -f[1] / m];
             ContactMode::Sliding(0)
         }
@@ -1018,7 +1018,7 @@ impl State<'_> {
             }
             1 => ContactMode::Stuck,
             _ => {
-                let s = slip[0].hypot(slip[1]);
+                let s = libm::hypot(slip[0], slip[1]);
                 if s > self.v_tol() {
                     self.slip_dir[c] = [slip[0] / s, slip[1] / s];
                     ContactMode::Sliding(0)
@@ -1314,7 +1314,8 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
                         }
                         Trigger::Rebase(c) => {
                             let p = probe(c);
-                            p[2] * slip_dir[c][0] + p[3] * slip_dir[c][1] - 0.5 * p[2].hypot(p[3])
+                            p[2] * slip_dir[c][0] + p[3] * slip_dir[c][1]
+                                - 0.5 * libm::hypot(p[2], p[3])
                         }
                         Trigger::Release(c) | Trigger::Tensile(c) | Trigger::Breakaway(c) => {
                             sc.out.resize(cm.forces.len(), 0.0);
@@ -1333,7 +1334,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
                             }
                             let f = &sc.out[3 * c..3 * c + 3];
                             if matches!(trig, Trigger::Breakaway(_)) {
-                                f[1].hypot(f[2]) - coef[c][1] * f[0]
+                                libm::hypot(f[1], f[2]) - coef[c][1] * f[0]
                             } else {
                                 f[0]
                             }
@@ -1622,7 +1623,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
             }
             Trigger::SlipStops(c) | Trigger::Rebase(c) => {
                 let p = st.probe(te, &st.y)[c];
-                let speed = p[2].hypot(p[3]);
+                let speed = libm::hypot(p[2], p[3]);
                 if matches!(trig, Trigger::Rebase(_)) && speed > 1e3 * st.v_tol() {
                     st.slip_dir[c] = [p[2] / speed, p[3] / speed];
                     Ok(())
@@ -1631,7 +1632,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
                     trial[c] = ContactMode::Stuck;
                     st.project(&trial, te, None)?;
                     let f = st.forces(&trial, te, &st.y)?[c];
-                    let ft = f[1].hypot(f[2]);
+                    let ft = libm::hypot(f[1], f[2]);
                     let mu_s = st.coef[c][1];
                     if ft <= mu_s * f[0].max(0.0) + 1e-12 * (ft + f[0].abs()) {
                         st.switch(

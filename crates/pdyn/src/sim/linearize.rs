@@ -52,7 +52,7 @@ pub fn linearize(prep: &Prepared, t: f64, y0: &[f64]) -> Linearization {
         let (mut yp, mut ym) = (y0.to_vec(), y0.to_vec());
         let (mut fp, mut fm) = (vec![0.0; dim], vec![0.0; dim]);
         for j in 0..dim {
-            let h = f64::EPSILON.cbrt() * y0[j].abs().max(1.0);
+            let h = libm::cbrt(f64::EPSILON) * y0[j].abs().max(1.0);
             yp[j] = y0[j] + h;
             ym[j] = y0[j] - h;
             sys.rhs(t, &yp, &mut fp);

@@ -103,7 +103,7 @@ fn disagreement(source: &str) -> f64 {
         let y: Vec<f64> = y0
             .iter()
             .enumerate()
-            .map(|(i, &v)| v + shift * ((i as f64) * 0.37).sin())
+            .map(|(i, &v)| v + shift * libm::sin((i as f64) * 0.37))
             .collect();
         let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
         tree.rhs(t, &y, &mut a);
