@@ -5,6 +5,7 @@ over `solve_ivp` (DOP853, rtol 1e-10, atol 1e-12, as pdyn's defaults), the same 
 stopping tolerances (1e-12). Prints the estimates as JSON."""
 import json
 import sys
+import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -22,9 +23,12 @@ def main(path):
                         [z0, v0], method="DOP853", t_eval=t, rtol=1e-10, atol=1e-12)
         return sol.y[0] - z
 
+    t0 = time.perf_counter()
     r = least_squares(residuals, [0.02, 49.0, -0.5], method="lm", x_scale="jac",
                       ftol=1e-12, xtol=1e-12, gtol=1e-12)
-    print(json.dumps({"x": list(r.x), "cost": r.cost, "nfev": r.nfev, "status": r.status}))
+    seconds = time.perf_counter() - t0
+    print(json.dumps({"x": list(r.x), "cost": r.cost, "nfev": r.nfev, "status": r.status,
+                      "fit_seconds": seconds}))
 
 
 if __name__ == "__main__":

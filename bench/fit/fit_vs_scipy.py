@@ -40,6 +40,8 @@ def main():
     print(f"  scipy least_squares+solve_ivp  best {s_best*1e3:8.1f} ms  median {s_med*1e3:8.1f} ms"
           f"  ({s['nfev']} evaluations + finite differences)")
     print(f"  ratio (median)                 {s_med / p_med:.1f}x   (best {s_best / p_best:.1f}x)")
+    print(f"  scipy's least_squares call alone (no start-up, no imports): {s['fit_seconds']*1e3:.1f} ms"
+          f" = {s['fit_seconds'] / p_med:.1f}x pdyn's whole process")
     print(f"  pdyn  x = {px}")
     print(f"  scipy x = {s['x']}")
     print("  max relative difference", max(abs(a - b) / abs(b) for a, b in zip(px, s["x"])))

@@ -10,7 +10,11 @@ fn root() -> PathBuf {
 }
 
 fn example(name: &str) -> String {
-    root().join("examples/data").join(name).display().to_string()
+    root()
+        .join("examples/data")
+        .join(name)
+        .display()
+        .to_string()
 }
 
 fn pdyn(args: &[&str]) -> (i32, String, String) {
@@ -43,14 +47,26 @@ fn the_drop_is_fitted_within_two_standard_errors_of_the_truth() {
     assert_eq!(code, 0, "{err}");
     let j: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(j["success"], true);
-    for (e, truth) in j["estimates"].as_array().unwrap().iter().zip([0.05, 50.0, -0.8]) {
+    for (e, truth) in j["estimates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip([0.05, 50.0, -0.8])
+    {
         let (v, se) = (e["value"].as_f64().unwrap(), e["stderr"].as_f64().unwrap());
         assert!((v - truth).abs() < 2.0 * se, "{}: {v} ± {se}", e["name"]);
     }
     // The residual RMS is the noise of the generator (0.02 m) within 10 %.
     let rms = j["experiments"][0]["rms"]["z"].as_f64().unwrap();
     assert!((rms / 0.02 - 1.0).abs() < 0.1, "{rms}");
-    for f in ["fit_drop.csv", "summary.json", "fit.svg", "fit.png", "residuals.svg", "residuals.png"] {
+    for f in [
+        "fit_drop.csv",
+        "summary.json",
+        "fit.svg",
+        "fit.png",
+        "residuals.svg",
+        "residuals.png",
+    ] {
         assert!(dir.join(f).exists(), "{f}");
     }
     let _ = std::fs::remove_dir_all(&dir);
@@ -59,12 +75,22 @@ fn the_drop_is_fitted_within_two_standard_errors_of_the_truth() {
 #[test]
 fn bad_requests_exit_with_2_and_a_location() {
     let (model, data) = (example("drop.toml"), example("drop.csv"));
-    let (code, out, _) = pdyn(&["fit", &model, "--data", &example("track.csv"), "--free", "c", "--json"]);
+    let (code, out, _) = pdyn(&[
+        "fit",
+        &model,
+        "--data",
+        &example("track.csv"),
+        "--free",
+        "c",
+        "--json",
+    ]);
     assert_eq!(code, 2);
     let j: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(j["error"]["kind"], "data");
     assert_eq!(j["error"]["location"]["line"], 1);
-    let (code, _, err) = pdyn(&["fit", &model, "--data", &data, "--free", "c", "--bounds", "c=1"]);
+    let (code, _, err) = pdyn(&[
+        "fit", &model, "--data", &data, "--free", "c", "--bounds", "c=1",
+    ]);
     assert_eq!(code, 2);
     assert!(err.contains("low..high"), "{err}");
     let (code, _, err) = pdyn(&["fit", &model, "--data", &data, "--free", "m"]);

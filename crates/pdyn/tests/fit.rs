@@ -252,3 +252,23 @@ fn a_bound_holds_the_estimate() {
     );
     assert!(fit::summary_text(&res).contains("at its bound"));
 }
+
+/// Native code and the interpreter give the same bits, so the same fit.
+#[test]
+fn native_and_interpreted_sensitivities_agree_bit_for_bit() {
+    let data = drag_data(9, 0.02, (0.45, 2.0, 0.1, 4.0));
+    let req = free(&["c", "initial.x", "rate.x"]);
+    let native = fit_text(LINEAR_DRAG, &[&data], &req).unwrap();
+    let interpreted = fit_text(
+        LINEAR_DRAG,
+        &[&data],
+        &FitRequest {
+            jit: pdyn::sim::JitMode::Off,
+            ..req
+        },
+    )
+    .unwrap();
+    for (a, b) in native.estimates.iter().zip(&interpreted.estimates) {
+        assert_eq!(a.value.to_bits(), b.value.to_bits(), "{}", a.name);
+    }
+}

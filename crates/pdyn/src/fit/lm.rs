@@ -4,7 +4,8 @@
 //! `min |J δ + r|² + λ |D δ|²` (Levenberg 1944, Marquardt 1963), with Moré's (1978) scaling
 //! `D = diag(max over iterations of the column norms of J)`, by the SVD of `J D⁻¹`
 //! ([`Svd::damped_solve`]). The step is projected onto the box (a bound that would be crossed
-//! stops the parameter at it). The gain ratio `ρ = actual / predicted reduction` accepts the
+//! stops the parameter at it), and a parameter at a bound that the gradient pushes outward is
+//! held there (left out of the step: an active set). The gain ratio `ρ = actual / predicted reduction` accepts the
 //! step when `ρ > 10⁻⁴` and updates `λ` by Nielsen's rule (1999): `λ ← λ max(1/3,
 //! 1 − (2ρ − 1)³)` after a success, `λ ← ν λ, ν ← 2ν` after a failure. A residual that cannot be
 //! evaluated (an integration that fails at a wild trial point) counts as a failed step.
@@ -86,7 +87,7 @@ pub trait Residuals {
     /// The error of an evaluation that cannot be done.
     type Error;
     /// Number of residuals `m`.
-    fn len(&self) -> usize;
+    fn n_residuals(&self) -> usize;
     /// Writes `r(x)` (length `m`) and `J(x)` column-major (`m × n`).
     fn eval(&mut self, x: &[f64], r: &mut [f64], jac: &mut [f64]) -> Result<(), Self::Error>;
 }
@@ -124,7 +125,7 @@ pub fn minimize<F: Residuals>(
     s: &Settings,
 ) -> Result<Minimum, F::Error> {
     let n = x0.len();
-    let m = f.len();
+    let m = f.n_residuals();
     let clamp = |x: &mut [f64]| {
         for i in 0..n {
             x[i] = x[i].max(lo[i]).min(hi[i]);
@@ -165,9 +166,14 @@ pub fn minimize<F: Residuals>(
         if gmax <= s.gtol {
             break Status::Gradient;
         }
+        // A parameter at a bound that the gradient pushes outward is held there: its column
+        // is left out of the step (the active set).
         for k in 0..n {
+            let col = &jac[k * m..(k + 1) * m];
+            let g: f64 = col.iter().zip(&r).map(|(a, b)| a * b).sum();
+            let held = (x[k] <= lo[k] && g > 0.0) || (x[k] >= hi[k] && g < 0.0);
             for i in 0..m {
-                scaled[k * m + i] = jac[k * m + i] / d[k];
+                scaled[k * m + i] = if held { 0.0 } else { jac[k * m + i] / d[k] };
             }
         }
         let svd = Svd::new(&scaled, m, n);
@@ -247,7 +253,7 @@ mod tests {
     struct Rosenbrock;
     impl Residuals for Rosenbrock {
         type Error = ();
-        fn len(&self) -> usize {
+        fn n_residuals(&self) -> usize {
             2
         }
         fn eval(&mut self, x: &[f64], r: &mut [f64], j: &mut [f64]) -> Result<(), ()> {

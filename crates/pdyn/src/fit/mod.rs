@@ -282,7 +282,7 @@ impl Problem<'_> {
 impl lm::Residuals for Problem<'_> {
     type Error = Error;
 
-    fn len(&self) -> usize {
+    fn n_residuals(&self) -> usize {
         self.m
     }
 
@@ -400,7 +400,7 @@ pub fn fit(
     };
     let (mut lo, mut hi) = (vec![f64::NEG_INFINITY; n_free], vec![f64::INFINITY; n_free]);
     for (name, l, h) in &req.bounds {
-        if !(l < h) {
+        if l.is_nan() || h.is_nan() || l >= h {
             return Err(Error::argument(
                 "--bounds",
                 format!("`{name}`: the lower bound {l} must be below the upper bound {h}"),

@@ -99,8 +99,8 @@ impl Svd {
                 .map(|(a, b)| a * b)
                 .sum();
             let c = proj / (s * s + lambda);
-            for i in 0..n {
-                x[i] -= self.v[i * n + k] * c;
+            for (i, xi) in x.iter_mut().enumerate() {
+                *xi -= self.v[i * n + k] * c;
             }
         }
         x
