@@ -55,6 +55,8 @@ enum Command {
     Kin(cli::kin::KinArgs),
     /// Fuse an accelerometer record with position fixes (Kalman filter + RTS smoother).
     Fuse(cli::fuse::FuseArgs),
+    /// Fit a model's parameters and initial values to measured runs (least squares, sensitivities).
+    Fit(cli::fit::FitArgs),
 }
 
 /// Stack of the thread that runs a command: 1 GiB of address space.
@@ -77,6 +79,7 @@ fn dispatch(command: Command) -> Result<Outcome, Error> {
         Command::Dsolve(a) => text(cli::dsolve::run(a)),
         Command::Kin(a) => text(cli::kin::run(a)),
         Command::Fuse(a) => text(cli::fuse::run(a)),
+        Command::Fit(a) => text(cli::fit::run(a)),
     }
 }
 

@@ -13,7 +13,7 @@ use pyo3::types::PyDict;
 
 /// A data problem as `pdyn.ModelError` (file, line, column: located like a model's), any
 /// other error as usual.
-fn data_py(py: Python<'_>, e: &Error) -> PyErr {
+pub(crate) fn data_py(py: Python<'_>, e: &Error) -> PyErr {
     match e {
         Error::Data { error } => py_error(py, "ModelError", |c| {
             c.call1((

@@ -29,6 +29,7 @@ mod data;
 mod derive;
 mod ensemble;
 mod errors;
+mod fit;
 mod interrupt;
 mod model;
 mod particles;

@@ -264,6 +264,37 @@ impl PyModel {
         })
     }
 
+    /// Parameters and initial values fitted to measured runs (see `pdyn.Model.fit`).
+    #[pyo3(signature = (data, free, params=None, bounds=Vec::new(), sigma=Vec::new(),
+                        absolute_sigma=false, rtol=1e-10, atol=1e-12, max_nfev=200))]
+    #[allow(clippy::too_many_arguments)]
+    fn fit(
+        &self,
+        py: Python<'_>,
+        data: Vec<crate::fit::DataArg>,
+        free: Vec<String>,
+        params: Option<Vec<(String, f64)>>,
+        bounds: Vec<(String, f64, f64)>,
+        sigma: Vec<(String, f64)>,
+        absolute_sigma: bool,
+        rtol: f64,
+        atol: f64,
+        max_nfev: usize,
+    ) -> PyResult<PyObject> {
+        let model = guarded(py, || self.with_params(params).map_err(|e| to_py(py, &e)))?;
+        let args = crate::fit::FitArgs {
+            data,
+            free,
+            bounds,
+            sigma,
+            absolute_sigma,
+            rtol,
+            atol,
+            max_nfev,
+        };
+        crate::fit::fit(py, model, args)
+    }
+
     /// The equations of motion, as text and LaTeX (see `pdyn.Model.derive`).
     fn derive(&self, py: Python<'_>) -> PyResult<PyObject> {
         guarded(py, || crate::derive::derive(py, &self.model))

@@ -171,6 +171,14 @@ pub enum Error {
         /// The located problem (boxed: it carries its whole location and help text).
         error: Box<pdyn_data::DataError>,
     },
+    /// A fit that could not be computed (an integration that failed at the starting values):
+    /// exit code 1.
+    Fit {
+        /// The model file.
+        origin: String,
+        /// What failed.
+        message: String,
+    },
     /// A molecular-dynamics run that stopped before its last step (exit code 1): unstable (the
     /// step, the offending atoms) or a bond stretched past its limit. What was computed up to
     /// there has been written.
@@ -205,6 +213,7 @@ impl Error {
             Error::Gravity { .. } => "gravity",
             Error::MdRun { .. } => "md_run",
             Error::Data { .. } => "data",
+            Error::Fit { .. } => "fit",
         }
     }
 
@@ -214,7 +223,8 @@ impl Error {
             Error::Integration { .. }
             | Error::NonFinite { .. }
             | Error::Gravity { .. }
-            | Error::MdRun { .. } => 1,
+            | Error::MdRun { .. }
+            | Error::Fit { .. } => 1,
             Error::Internal { .. } => 3,
             _ => 2,
         }
@@ -257,7 +267,8 @@ impl Error {
             | Error::Sim { origin, .. }
             | Error::Integration { origin, .. }
             | Error::Gravity { origin, .. }
-            | Error::MdRun { origin, .. } => Some(file(origin)),
+            | Error::MdRun { origin, .. }
+            | Error::Fit { origin, .. } => Some(file(origin)),
             Error::Data { error } if !error.file.is_empty() => Some(Location {
                 file: error.file.clone(),
                 line: error.line,
@@ -380,6 +391,7 @@ impl fmt::Display for Error {
             ),
             Error::Gravity { origin, error } => write!(f, "{origin}: error: {error}"),
             Error::Data { error } => write!(f, "{error}"),
+            Error::Fit { origin, message } => write!(f, "{origin}: error: fit: {message}"),
             Error::MdRun { origin, error } => {
                 write!(
                     f,

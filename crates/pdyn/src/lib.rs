@@ -13,6 +13,7 @@ pub mod data;
 pub mod dsolve;
 pub mod engine;
 pub mod error;
+pub mod fit;
 pub mod ivp;
 pub mod kin;
 pub mod md;

@@ -9,6 +9,7 @@ pub mod derive;
 pub mod dsolve;
 pub mod equilibrium;
 pub mod expr;
+pub mod fit;
 pub mod forces;
 pub mod fuse;
 pub mod kin;

@@ -399,6 +399,45 @@ class Model:
         return Linearization(self._mechanics().linearize(at=_params(op_point),
                                                           params=_params(params), t=float(t)))
 
+    def fit(self, data: Any, free: Sequence[str],
+            params: Optional[Mapping[str, float]] = None,
+            bounds: Optional[Mapping[str, Tuple[float, float]]] = None,
+            sigma: Optional[Mapping[str, float]] = None, absolute_sigma: bool = False,
+            rtol: float = 1e-10, atol: float = 1e-12, max_nfev: int = 200) -> "FitResult":
+        """Parameters and initial values fitted to measured runs by least squares, like
+        ``pdyn fit``: Levenberg–Marquardt within ``bounds`` (``{"c": (0, 1)}``), the Jacobian
+        from the sensitivity equations derived from the model. ``data`` is one experiment or
+        a list of them, each a CSV path or a mapping of arrays with ``"t"`` and columns named
+        as the model's coordinates (``"x"``) or rates (``"x'"``), optionally ``"sigma_x"``;
+        ``free`` names parameters, ``initial.x`` and ``rate.x`` (per experiment); ``params``
+        sets parameter values (the starting values of the free ones); ``sigma`` a column's
+        standard deviation. Returns a :class:`FitResult` (SciPy's ``least_squares`` fields
+        plus ``stderr``, ``corr``, ``cov``, ``chi2``, ``dof``)."""
+        import os
+        from ._fit import FitResult
+        items = data if isinstance(data, (list, tuple)) else [data]
+        args = []
+        for i, item in enumerate(items):
+            if isinstance(item, (str, os.PathLike)):
+                args.append((os.fspath(item), None))
+            elif isinstance(item, Mapping):
+                if "t" not in item:
+                    raise ValueError(f"data[{i}]: no array named 't' (the time)")
+                cols = [(str(k), [float(v) for v in item[k]]) for k in item if k != "t"]
+                args.append((f"data[{i}]", ([float(v) for v in item["t"]], cols)))
+            else:
+                raise TypeError(f"data[{i}]: expected a CSV path or a mapping of arrays, "
+                                f"got {type(item).__name__}")
+        if isinstance(free, str):
+            free = [f.strip() for f in free.split(",")]
+        raw = self._mechanics().fit(
+            args, list(free), params=_params(params),
+            bounds=[(k, float(lo), float(hi)) for k, (lo, hi) in (bounds or {}).items()],
+            sigma=[(k, float(v)) for k, v in (sigma or {}).items()],
+            absolute_sigma=bool(absolute_sigma), rtol=float(rtol), atol=float(atol),
+            max_nfev=int(max_nfev))
+        return FitResult(raw)
+
     def derive(self) -> Derivation:
         """The equations of motion (F = ma or the projected form), the unknowns, their exact
         solution when the system is small, and the first-order system."""

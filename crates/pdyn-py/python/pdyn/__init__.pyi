@@ -60,6 +60,26 @@ class NBody:
     def masses(self) -> npt.NDArray[np.float64]: ...
     def energy(self) -> float: ...
 
+class FitResult(Dict[str, Any]):
+    x: npt.NDArray[np.float64]
+    names: List[str]
+    stderr: npt.NDArray[np.float64]
+    corr: npt.NDArray[np.float64]
+    cov: npt.NDArray[np.float64]
+    cost: float
+    fun: npt.NDArray[np.float64]
+    jac: npt.NDArray[np.float64]
+    status: int
+    message: str
+    success: bool
+    nfev: int
+    chi2: float
+    dof: int
+    reduced_chi2: float
+    unidentifiable: List[List[str]]
+    warnings: List[str]
+    experiments: List[Dict[str, Any]]
+
 class Linearization:
     A: npt.NDArray[np.float64]
     K: npt.NDArray[np.float64]
@@ -219,6 +239,11 @@ class Model:
             ) -> Union[OdeResult, ParticleResult]: ...
     def linearize(self, op_point: Optional[Mapping[str, float]] = ...,
                   params: Optional[Mapping[str, float]] = ..., t: float = ...) -> Linearization: ...
+    def fit(self, data: Any, free: Union[str, Sequence[str]],
+            params: Optional[Mapping[str, float]] = ...,
+            bounds: Optional[Mapping[str, Tuple[float, float]]] = ...,
+            sigma: Optional[Mapping[str, float]] = ..., absolute_sigma: bool = ...,
+            rtol: float = ..., atol: float = ..., max_nfev: int = ...) -> FitResult: ...
     def derive(self) -> Derivation: ...
     def sweep(self, param: str, values: Sequence[float],
               measures: Optional[Mapping[str, Union[str, Tuple[str, str]]]] = ...,
