@@ -19,6 +19,8 @@ pub enum StaticsError {
     Equilibrium(EquilibriumError),
     /// The eigenproblem could not be solved.
     Modes(ModesError),
+    /// The damped modes could not be computed.
+    Damped(crate::damped::DampedError),
 }
 
 impl std::fmt::Display for StaticsError {
@@ -28,6 +30,7 @@ impl std::fmt::Display for StaticsError {
             StaticsError::Linearization(e) => write!(f, "{e}"),
             StaticsError::Equilibrium(e) => write!(f, "{e}"),
             StaticsError::Modes(e) => write!(f, "{e}"),
+            StaticsError::Damped(e) => write!(f, "{e}"),
         }
     }
 }
@@ -47,6 +50,11 @@ impl From<LinearizationError> for StaticsError {
 impl From<EquilibriumError> for StaticsError {
     fn from(e: EquilibriumError) -> Self {
         StaticsError::Equilibrium(e)
+    }
+}
+impl From<crate::damped::DampedError> for StaticsError {
+    fn from(e: crate::damped::DampedError) -> Self {
+        StaticsError::Damped(e)
     }
 }
 impl From<ModesError> for StaticsError {
