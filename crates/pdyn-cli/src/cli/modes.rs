@@ -7,13 +7,9 @@ use super::{load_model, set_parameters};
 use clap::{Args, ValueEnum};
 use pdyn::output::json_num;
 use pdyn::Error;
-use pdyn_mech::damped::{damped_modes, DampedMode, DAMPED_LIMIT};
-use pdyn_mech::equilibrium::{solve, EquilibriumOptions};
-use pdyn_mech::linearization::Linearization;
-use pdyn_mech::modes::{modes, Modes};
+use pdyn_mech::damped::{DampedMode, DAMPED_LIMIT};
 use pdyn_mech::sparse::Csr;
-use pdyn_mech::sparse_statics::{self, DEFAULT_SPARSE_COUNT, SPARSE_FROM};
-use pdyn_mech::statics::{linearize, StaticsError};
+use pdyn_mech::statics::{self, modes_about, ModesRequest, StaticsError};
 use serde_json::json;
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -87,86 +83,39 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
         origin: origin.clone(),
         error,
     };
-    let (_, lin) = linearize(&mut model).map_err(fail)?;
     if a.count == Some(0) {
         return Err(Error::argument(
             "--count",
             "--count must be at least 1".to_string(),
         ));
     }
-    let n = lin.len();
-    let sparse = match a.solver {
-        Solver::Auto => n >= SPARSE_FROM,
-        Solver::Dense => false,
-        Solver::Sparse => true,
+    let request = ModesRequest {
+        about: match a.about {
+            About::Equilibrium => statics::About::Equilibrium,
+            About::Initial => statics::About::Initial,
+        },
+        solver: match a.solver {
+            Solver::Auto => statics::Solver::Auto,
+            Solver::Dense => statics::Solver::Dense,
+            Solver::Sparse => statics::Solver::Sparse,
+        },
+        count: a.count,
     };
-    let start = match a.about {
-        About::Equilibrium => None,
-        About::Initial => Some(lin.initial.as_slice()),
-    };
-    let about = match a.about {
-        About::Equilibrium => "static equilibrium",
-        About::Initial => "initial state (at rest)",
-    };
-    // The modes, and the dense linearization for damped modes where it is small enough.
-    let (result, residual, dense_state, has_damping): (Modes, f64, Option<Linearization>, bool) =
-        if sparse {
-            let (state, residual) = match start {
-                None => {
-                    let eq = sparse_statics::solve(&lin, None, &EquilibriumOptions::default())
-                        .map_err(|e| fail(e.into()))?;
-                    (eq.linearization, eq.residual)
-                }
-                Some(q) => {
-                    let at = lin.at_sparse(q);
-                    let r = at.force.iter().map(|x| x * x).sum::<f64>().sqrt();
-                    (at, r)
-                }
-            };
-            if let Some(dir) = &a.matrices {
-                write_matrices(dir, &state.stiffness, &state.mass, &state.damping)?;
-            }
-            let count = a.count.unwrap_or(DEFAULT_SPARSE_COUNT).min(n);
-            let result = sparse_statics::lowest_modes(&state, count).map_err(|e| fail(e.into()))?;
-            let damped = state.damping.val.iter().any(|&c| c != 0.0);
-            let dense = (damped && n <= DAMPED_LIMIT).then(|| state.to_dense());
-            (result, residual, dense, damped)
-        } else {
-            let (state, residual) = match start {
-                None => {
-                    let eq = solve(&lin, None, &EquilibriumOptions::default())
-                        .map_err(|e| fail(e.into()))?;
-                    (eq.linearization, eq.residual)
-                }
-                Some(q) => {
-                    let at = lin.at(q);
-                    let r = at.force.norm();
-                    (at, r)
-                }
-            };
-            let damped = state.damping.iter().any(|&c| c != 0.0);
-            (
-                modes(&state).map_err(|e| fail(e.into()))?,
-                residual,
-                Some(state),
-                damped,
-            )
-        };
-    let damped: Option<Vec<DampedMode>> = match &dense_state {
-        Some(st) if st.damping.iter().any(|&c| c != 0.0) => {
-            Some(damped_modes(st).map_err(|e| fail(e.into()))?)
-        }
-        _ => None,
-    };
-    let count = a
-        .count
-        .unwrap_or(result.modes.len())
-        .min(result.modes.len());
-    let shown = &result.modes[..count];
-    let damped_shown: &[DampedMode] = match &damped {
-        Some(d) => &d[..count.min(d.len())],
-        None => &[],
-    };
+    let report = modes_about(&mut model, &request).map_err(fail)?;
+    if let Some(dir) = &a.matrices {
+        let m = &report.matrices;
+        write_matrices(dir, &m.stiffness, &m.mass, &m.damping)?;
+    }
+    let n = report.names.len();
+    let sparse = report.sparse;
+    let about = report.about.describe();
+    let residual = report.residual;
+    let result = &report.modes;
+    let lin_names = &report.names;
+    let damped = &report.damped;
+    let has_damping = report.has_damping;
+    let shown = &result.modes[..];
+    let damped_shown: &[DampedMode] = damped.as_deref().unwrap_or(&[]);
     let tau = std::f64::consts::TAU;
     if a.json {
         let v = json!({
@@ -174,7 +123,7 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
             "about": about,
             "out_of_balance_force": json_num(residual),
             "stiffness_asymmetry": json_num(result.stiffness_asymmetry),
-            "coordinates": lin.names,
+            "coordinates": lin_names,
             "modes": shown.iter().enumerate().map(|(k, m)| json!({
                 "mode": k + 1,
                 "omega_squared": json_num(m.omega_squared),
@@ -214,9 +163,8 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
     } else {
         let _ = writeln!(
             s,
-            "{}: {} modes about the {about} (|f| = {residual:.3e})",
+            "{}: {n} modes about the {about} (|f| = {residual:.3e})",
             model.name,
-            result.modes.len()
         );
     }
     if result.stiffness_asymmetry > 1e-9 {
@@ -237,7 +185,7 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
             .iter()
             .take(3)
             .filter(|&&i| m.shape[i].abs() >= 0.1)
-            .map(|&i| format!("{}:{:+.2}", lin.names[i], m.shape[i]))
+            .map(|&i| format!("{}:{:+.2}", lin_names[i], m.shape[i]))
             .collect();
         let (w, f, t) = if m.omega_squared >= 0.0 {
             (
@@ -289,7 +237,7 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
     if a.shapes {
         for (k, m) in shown.iter().enumerate() {
             let _ = writeln!(s, "\nMode {} shape (largest component +1):", k + 1);
-            for (n, x) in lin.names.iter().zip(&m.shape) {
+            for (n, x) in lin_names.iter().zip(&m.shape) {
                 let _ = writeln!(s, "  {n}  {x:+.9e}");
             }
         }
