@@ -34,6 +34,7 @@ mod model;
 mod particles;
 mod run;
 mod solve_ivp;
+mod statics;
 mod sweep;
 mod symbolic;
 
