@@ -130,3 +130,64 @@ fn the_equilibrium_is_where_a_long_damped_run_ends() {
         assert!((at_rest - q).abs() < 1e-9, "{name}: {at_rest} vs {q}");
     }
 }
+
+/// The sparse path (issue 33): the lowest 10 of a 1,000-mass chain, the model the example with
+/// its family's size changed, against ω_j = 2 sqrt(k/m) sin(jπ/(2(n+1))).
+#[test]
+fn the_lowest_modes_of_a_thousand_mass_chain_by_the_sparse_solver() {
+    let dir = std::env::temp_dir().join(format!("pdyn-sparse-modes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = dir.join("chain1000.toml");
+    let text = std::fs::read_to_string(example("chain_modes.toml")).unwrap();
+    std::fs::write(&model, text.replacen("n = 30", "n = 1000", 1)).unwrap();
+    let (ok, out, err) = pdyn(&["modes", model.to_str().unwrap(), "--count", "10", "--json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["solver"], "sparse");
+    assert_eq!(v["coordinate_count"], 1000);
+    let modes = v["modes"].as_array().unwrap();
+    assert_eq!(modes.len(), 10);
+    for (j, m) in modes.iter().enumerate() {
+        let exact = 20.0 * ((j + 1) as f64 * std::f64::consts::PI / 2002.0).sin();
+        let w = m["omega"].as_f64().unwrap();
+        assert!(
+            (w - exact).abs() < 1e-12 * exact,
+            "mode {}: {w} vs {exact}",
+            j + 1
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The net's drag is c on each particle of mass m: C = (c/m) M, so every mode is damped with
+/// ζ ω = c / (2 m) = 0.2 1/s, and ω_n is the undamped ω.
+#[test]
+fn the_damped_modes_of_the_net_follow_from_mass_proportional_drag() {
+    let (ok, out, err) = pdyn(&[
+        "modes",
+        &example("hanging_net.toml"),
+        "--count",
+        "8",
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let undamped = v["modes"].as_array().unwrap();
+    let damped = v["damped_modes"].as_array().unwrap();
+    assert_eq!(damped.len(), 8);
+    for (d, u) in damped.iter().zip(undamped) {
+        let wn = d["natural_frequency"].as_f64().unwrap();
+        let zeta = d["damping_ratio"].as_f64().unwrap();
+        let w = u["omega"].as_f64().unwrap();
+        assert!((wn - w).abs() < 1e-9 * w, "{wn} vs {w}");
+        assert!((zeta * wn - 0.2).abs() < 1e-9, "{zeta} {wn}");
+        let wd = d["damped_frequency"].as_f64().unwrap();
+        assert!((wd - wn * (1.0 - zeta * zeta).sqrt()).abs() < 1e-9 * wn);
+    }
+}
+
+#[test]
+fn a_count_of_zero_is_refused() {
+    let (ok, _, err) = pdyn(&["modes", &example("chain_modes.toml"), "--count", "0"]);
+    assert!(!ok && err.contains("--count"), "{err}");
+}

@@ -10,6 +10,7 @@
 
 use crate::derive::{Derivation, UnknownKind};
 use crate::model::Model;
+use crate::sparse::Csr;
 use nalgebra::{DMatrix, DVector};
 use pdyn_expr::{Id, Pool, Program};
 
@@ -69,6 +70,32 @@ pub struct Linearization {
     pub damping: DMatrix<f64>,
     /// `f(q0, 0)`: zero in equilibrium (the out-of-balance force otherwise).
     pub force: DVector<f64>,
+}
+
+/// The linearized equations at one state, as sparse matrices (the same entries as
+/// [`Linearization`], none of the zeros): for systems too large for dense `n × n` matrices.
+#[derive(Clone, Debug)]
+pub struct SparseLinearization {
+    /// `M(q0)`.
+    pub mass: Csr,
+    /// `K = -∂f/∂q` at `(q0, 0)`.
+    pub stiffness: Csr,
+    /// `C = -∂f/∂q'` at `(q0, 0)`.
+    pub damping: Csr,
+    /// `f(q0, 0)`.
+    pub force: Vec<f64>,
+}
+
+impl SparseLinearization {
+    /// The same matrices, dense.
+    pub fn to_dense(&self) -> Linearization {
+        Linearization {
+            mass: self.mass.to_dense(),
+            stiffness: self.stiffness.to_dense(),
+            damping: self.damping.to_dense(),
+            force: DVector::from_column_slice(&self.force),
+        }
+    }
 }
 
 /// Where each compiled output goes.
@@ -166,20 +193,30 @@ impl Linearizer {
                 }
             }
         }
-        let dq = p.jacobian(&sys.b, q);
-        let dqd = p.jacobian(&sys.b, qd);
+        // K and C row by row, each row differentiated only by the coordinates and rates it
+        // holds (a net's particle depends on its few neighbours): no n × n table of zeros.
+        let column_of: rustc_hash::FxHashMap<Id, usize> = q
+            .iter()
+            .chain(qd)
+            .enumerate()
+            .map(|(j, &v)| (v, j))
+            .collect();
+        let wanted: rustc_hash::FxHashSet<Id> = column_of.keys().copied().collect();
         for (i, &row) in row_to.iter().enumerate() {
-            for j in 0..n {
-                if dq[i * n + j] != Pool::ZERO {
-                    let k = p.neg(dq[i * n + j]);
-                    outputs.push(k);
-                    slots.push(Slot::Stiffness(row, j));
+            let mut vars = p.occurring(sys.b[i], &wanted);
+            vars.sort_by_key(|v| column_of[v]);
+            for v in vars {
+                let j = column_of[&v];
+                let dv = p.diff(sys.b[i], v);
+                if dv == Pool::ZERO {
+                    continue;
                 }
-                if dqd[i * n + j] != Pool::ZERO {
-                    let c = p.neg(dqd[i * n + j]);
-                    outputs.push(c);
-                    slots.push(Slot::Damping(row, j));
-                }
+                outputs.push(p.neg(dv));
+                slots.push(if j < n {
+                    Slot::Stiffness(row, j)
+                } else {
+                    Slot::Damping(row, j - n)
+                });
             }
         }
         let mut inputs = vec![p.time()];
@@ -222,14 +259,47 @@ impl Linearizer {
         self.names.is_empty()
     }
 
-    /// The linearization at rest at `q` (at t = 0).
-    pub fn at(&self, q: &[f64]) -> Linearization {
+    /// The compiled outputs at rest at `q` (at t = 0), one per slot.
+    fn eval(&self, q: &[f64]) -> Vec<f64> {
         let n = self.len();
         let mut input = self.input.clone();
         input[1..1 + n].copy_from_slice(q);
         let mut ws = self.program.workspace();
         let mut out = vec![0.0; self.slots.len()];
         self.program.eval(&input, &mut ws, &mut out);
+        out
+    }
+
+    /// The linearization at rest at `q` (at t = 0), sparse: memory in proportion to the
+    /// non-zero entries.
+    pub fn at_sparse(&self, q: &[f64]) -> SparseLinearization {
+        let n = self.len();
+        let out = self.eval(q);
+        let (mut m, mut k, mut c) = (Vec::new(), Vec::new(), Vec::new());
+        let mut force = vec![0.0; n];
+        for (slot, &v) in self.slots.iter().zip(&out) {
+            match *slot {
+                Slot::Force(i) => force[i] = v,
+                Slot::Mass(i, j) => m.push((i, j, v)),
+                Slot::Stiffness(i, j) => k.push((i, j, v)),
+                Slot::Damping(i, j) => c.push((i, j, v)),
+            }
+        }
+        let csr = |t: &[(usize, usize, f64)]| {
+            Csr::from_triplets(n, t).expect("slots index the free coordinates")
+        };
+        SparseLinearization {
+            mass: csr(&m),
+            stiffness: csr(&k),
+            damping: csr(&c),
+            force,
+        }
+    }
+
+    /// The linearization at rest at `q` (at t = 0).
+    pub fn at(&self, q: &[f64]) -> Linearization {
+        let n = self.len();
+        let out = self.eval(q);
         let mut lin = Linearization {
             mass: DMatrix::zeros(n, n),
             stiffness: DMatrix::zeros(n, n),

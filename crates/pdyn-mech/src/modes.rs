@@ -15,6 +15,8 @@ use nalgebra::DMatrix;
 pub enum ModesError {
     /// `M` is not symmetric positive definite.
     MassNotPositiveDefinite,
+    /// The sparse eigensolver failed ([`crate::sparse_statics::lowest_modes`]).
+    Sparse(crate::lanczos::LanczosError),
 }
 
 impl std::fmt::Display for ModesError {
@@ -24,6 +26,7 @@ impl std::fmt::Display for ModesError {
                 f,
                 "the mass matrix is not symmetric positive definite at this state"
             ),
+            ModesError::Sparse(e) => write!(f, "{e}"),
         }
     }
 }

@@ -19,6 +19,8 @@ pub enum StaticsError {
     Equilibrium(EquilibriumError),
     /// The eigenproblem could not be solved.
     Modes(ModesError),
+    /// The damped modes could not be computed.
+    Damped(crate::damped::DampedError),
 }
 
 impl std::fmt::Display for StaticsError {
@@ -28,6 +30,7 @@ impl std::fmt::Display for StaticsError {
             StaticsError::Linearization(e) => write!(f, "{e}"),
             StaticsError::Equilibrium(e) => write!(f, "{e}"),
             StaticsError::Modes(e) => write!(f, "{e}"),
+            StaticsError::Damped(e) => write!(f, "{e}"),
         }
     }
 }
@@ -44,9 +47,19 @@ impl From<LinearizationError> for StaticsError {
         StaticsError::Linearization(e)
     }
 }
+impl From<crate::lanczos::LanczosError> for StaticsError {
+    fn from(e: crate::lanczos::LanczosError) -> Self {
+        StaticsError::Modes(ModesError::Sparse(e))
+    }
+}
 impl From<EquilibriumError> for StaticsError {
     fn from(e: EquilibriumError) -> Self {
         StaticsError::Equilibrium(e)
+    }
+}
+impl From<crate::damped::DampedError> for StaticsError {
+    fn from(e: crate::damped::DampedError) -> Self {
+        StaticsError::Damped(e)
     }
 }
 impl From<ModesError> for StaticsError {
@@ -68,4 +81,137 @@ pub fn linearize(
     let d = crate::derive(model, &opts)?;
     let lin = crate::linearization::Linearizer::new(model, &d)?;
     Ok((d, lin))
+}
+
+/// The state `pdyn modes` and Python's `Model.modes` linearize about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum About {
+    /// The static equilibrium nearest the initial values.
+    Equilibrium,
+    /// The initial values, at rest (whatever forces are out of balance there).
+    Initial,
+}
+
+impl About {
+    /// How the report names it.
+    pub fn describe(self) -> &'static str {
+        match self {
+            About::Equilibrium => "static equilibrium",
+            About::Initial => "initial state (at rest)",
+        }
+    }
+}
+
+/// Dense (every mode) or sparse (the lowest few).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Solver {
+    /// Dense below [`crate::sparse_statics::SPARSE_FROM`] coordinates, sparse from there on.
+    Auto,
+    /// Every mode, dense matrices (`O(n³)`).
+    Dense,
+    /// The lowest `count` modes (default [`crate::sparse_statics::DEFAULT_SPARSE_COUNT`]) by
+    /// shift-invert Lanczos.
+    Sparse,
+}
+
+/// What modes to compute, as every front end asks for them.
+#[derive(Clone, Debug)]
+pub struct ModesRequest {
+    /// The state.
+    pub about: About,
+    /// The solver.
+    pub solver: Solver,
+    /// The lowest `count` modes (all for the dense solver by default); at least 1.
+    pub count: Option<usize>,
+}
+
+/// The modes of a model, ready to print or to hand to Python.
+#[derive(Clone, Debug)]
+pub struct ModesReport {
+    /// The free coordinates, in the order of the shapes' components.
+    pub names: Vec<String>,
+    /// The state linearized about.
+    pub about: About,
+    /// Its free coordinates.
+    pub q: Vec<f64>,
+    /// `|f|` there.
+    pub residual: f64,
+    /// True when the sparse solver was used.
+    pub sparse: bool,
+    /// The modes, lowest first (`count` of them when asked).
+    pub modes: crate::modes::Modes,
+    /// The damped modes (as many), when there is damping and the system is small enough for
+    /// the dense companion form ([`crate::damped::DAMPED_LIMIT`]).
+    pub damped: Option<Vec<crate::damped::DampedMode>>,
+    /// True when `C ≠ 0`.
+    pub has_damping: bool,
+    /// `M`, `K`, `C` at the state.
+    pub matrices: crate::linearization::SparseLinearization,
+}
+
+/// The modes of `model` as `request` asks: derivation, linearization, the state (equilibrium by
+/// Newton, or the initial values), then the dense or the sparse eigenproblem, and the damped
+/// modes where there is damping.
+pub fn modes_about(
+    model: &mut crate::Model,
+    request: &ModesRequest,
+) -> Result<ModesReport, StaticsError> {
+    use crate::equilibrium::EquilibriumOptions;
+    use crate::sparse_statics::{DEFAULT_SPARSE_COUNT, SPARSE_FROM};
+    let (_, lin) = linearize(model)?;
+    let n = lin.len();
+    let sparse = match request.solver {
+        Solver::Auto => n >= SPARSE_FROM,
+        Solver::Dense => false,
+        Solver::Sparse => true,
+    };
+    let (q, residual) = match request.about {
+        About::Equilibrium if sparse => {
+            let eq = crate::sparse_statics::solve(&lin, None, &EquilibriumOptions::default())?;
+            (eq.q, eq.residual)
+        }
+        About::Equilibrium => {
+            let eq = crate::equilibrium::solve(&lin, None, &EquilibriumOptions::default())?;
+            (eq.q, eq.residual)
+        }
+        About::Initial => (lin.initial.clone(), f64::NAN),
+    };
+    let matrices = lin.at_sparse(&q);
+    let residual = if residual.is_nan() {
+        matrices.force.iter().map(|x| x * x).sum::<f64>().sqrt()
+    } else {
+        residual
+    };
+    let has_damping = matrices.damping.val.iter().any(|&c| c != 0.0);
+    let count = request.count.map(|c| c.max(1));
+    let (mut modes, dense) = if sparse {
+        let count = count.unwrap_or(DEFAULT_SPARSE_COUNT).min(n);
+        let modes = crate::sparse_statics::lowest_modes(&matrices, count)?;
+        let dense = (has_damping && n <= crate::damped::DAMPED_LIMIT).then(|| matrices.to_dense());
+        (modes, dense)
+    } else {
+        let dense = lin.at(&q);
+        (crate::modes::modes(&dense)?, Some(dense))
+    };
+    let shown = count.unwrap_or(modes.modes.len()).min(modes.modes.len());
+    modes.modes.truncate(shown);
+    let damped = match &dense {
+        Some(d) if has_damping => {
+            let mut all = crate::damped::damped_modes(d)?;
+            all.truncate(shown);
+            Some(all)
+        }
+        _ => None,
+    };
+    Ok(ModesReport {
+        names: lin.names.clone(),
+        about: request.about,
+        q,
+        residual,
+        sparse,
+        modes,
+        damped,
+        has_damping,
+        matrices,
+    })
 }

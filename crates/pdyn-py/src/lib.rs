@@ -35,6 +35,7 @@ mod model;
 mod particles;
 mod run;
 mod solve_ivp;
+mod statics;
 mod sweep;
 mod symbolic;
 

@@ -295,6 +295,23 @@ impl PyModel {
         crate::fit::fit(py, model, args)
     }
 
+    /// Natural frequencies and mode shapes (see `pdyn.Model.modes`).
+    #[pyo3(signature = (count=None, about=None, solver=None, params=None))]
+    fn modes(
+        &self,
+        py: Python<'_>,
+        count: Option<usize>,
+        about: Option<String>,
+        solver: Option<String>,
+        params: Option<Vec<(String, f64)>>,
+    ) -> PyResult<PyObject> {
+        guarded(py, || {
+            let about = about.as_deref().unwrap_or("equilibrium");
+            let solver = solver.as_deref().unwrap_or("auto");
+            crate::statics::modes(py, self, count, about, solver, params)
+        })
+    }
+
     /// The equations of motion, as text and LaTeX (see `pdyn.Model.derive`).
     fn derive(&self, py: Python<'_>) -> PyResult<PyObject> {
         guarded(py, || crate::derive::derive(py, &self.model))

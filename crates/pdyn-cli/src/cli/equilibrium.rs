@@ -6,6 +6,7 @@ use clap::Args;
 use pdyn::output::json_num;
 use pdyn::Error;
 use pdyn_mech::equilibrium::{solve, support_reactions, EquilibriumOptions, FreeDirection};
+use pdyn_mech::sparse_statics::{self, SPARSE_FROM};
 use pdyn_mech::statics::{linearize, StaticsError};
 use serde_json::json;
 use std::fmt::Write;
@@ -37,6 +38,15 @@ fn direction_json(d: &FreeDirection) -> serde_json::Value {
     })
 }
 
+/// What either path found.
+struct Found {
+    q: Vec<f64>,
+    residual: f64,
+    scale: f64,
+    steps: usize,
+    neutral: Vec<FreeDirection>,
+}
+
 /// `pdyn equilibrium MODEL`.
 pub fn run(a: EquilibriumArgs) -> Result<String, Error> {
     let mut model = load_model(&a.model)?;
@@ -57,7 +67,27 @@ pub fn run(a: EquilibriumArgs) -> Result<String, Error> {
         tolerance: a.tolerance,
         max_steps: a.max_steps,
     };
-    let eq = solve(&lin, None, &opts).map_err(|e| fail(e.into()))?;
+    // Sparse matrices from `SPARSE_FROM` coordinates on (the same Newton steps, solved by an
+    // envelope L D Lᵀ instead of a dense LU).
+    let eq = if lin.len() >= SPARSE_FROM {
+        let e = sparse_statics::solve(&lin, None, &opts).map_err(|e| fail(e.into()))?;
+        Found {
+            q: e.q,
+            residual: e.residual,
+            scale: e.scale,
+            steps: e.steps,
+            neutral: e.neutral,
+        }
+    } else {
+        let e = solve(&lin, None, &opts).map_err(|e| fail(e.into()))?;
+        Found {
+            q: e.q,
+            residual: e.residual,
+            scale: e.scale,
+            steps: e.steps,
+            neutral: e.neutral,
+        }
+    };
     let reactions = support_reactions(&mut model, &d, &eq.q).map_err(|e| fail(e.into()))?;
     if a.json {
         let v = json!({

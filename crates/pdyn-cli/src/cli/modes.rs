@@ -1,13 +1,15 @@
 //! `pdyn modes MODEL`: natural frequencies and mode shapes of the model linearized about its
-//! static equilibrium (or its initial state), `K φ = ω² M φ`, dense.
+//! static equilibrium (or its initial state), `K φ = ω² M φ`: dense (every mode) for small
+//! systems, the lowest few by sparse shift-invert Lanczos for large ones; with damping, the
+//! damped modes of `s² M + s C + K` too (natural frequency and damping ratio).
 
 use super::{load_model, set_parameters};
 use clap::{Args, ValueEnum};
 use pdyn::output::json_num;
 use pdyn::Error;
-use pdyn_mech::equilibrium::{solve, EquilibriumOptions};
-use pdyn_mech::modes::modes;
-use pdyn_mech::statics::{linearize, StaticsError};
+use pdyn_mech::damped::{DampedMode, DAMPED_LIMIT};
+use pdyn_mech::sparse::Csr;
+use pdyn_mech::statics::{self, modes_about, ModesRequest, StaticsError};
 use serde_json::json;
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -21,6 +23,17 @@ pub enum About {
     Initial,
 }
 
+/// How the eigenproblem is solved.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum Solver {
+    /// Dense below 300 coordinates, sparse from there on.
+    Auto,
+    /// Every mode, with dense matrices (`O(n³)`).
+    Dense,
+    /// The lowest COUNT modes (default 20) by shift-invert Lanczos on sparse matrices.
+    Sparse,
+}
+
 /// `pdyn modes`.
 #[derive(Args, Debug)]
 pub struct ModesArgs {
@@ -32,15 +45,33 @@ pub struct ModesArgs {
     /// The state to linearize about.
     #[arg(long, value_enum, default_value_t = About::Equilibrium)]
     about: About,
-    /// Print the lowest COUNT modes only (all by default).
+    /// Print the lowest COUNT modes only (all by default; 20 with the sparse solver, which
+    /// computes only these).
     #[arg(long)]
     count: Option<usize>,
+    /// Dense (every mode) or sparse (the lowest COUNT, for large systems).
+    #[arg(long, value_enum, default_value_t = Solver::Auto)]
+    solver: Solver,
     /// Print each mode's shape (always in --json).
     #[arg(long)]
     shapes: bool,
+    /// Write the matrices solved (K.mtx, M.mtx, C.mtx: Matrix Market, as read by SciPy's
+    /// `scipy.io.mmread`) into this directory.
+    #[arg(long, value_name = "DIR")]
+    matrices: Option<PathBuf>,
     /// Machine-readable output (frequencies and shapes).
     #[arg(long)]
     json: bool,
+}
+
+/// K.mtx, M.mtx and C.mtx in `dir`.
+fn write_matrices(dir: &std::path::Path, k: &Csr, m: &Csr, c: &Csr) -> Result<(), Error> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "create", e))?;
+    for (name, a) in [("K.mtx", k), ("M.mtx", m), ("C.mtx", c)] {
+        let path = dir.join(name);
+        std::fs::write(&path, a.to_matrix_market()).map_err(|e| Error::io(&path, "write", e))?;
+    }
+    Ok(())
 }
 
 /// `pdyn modes MODEL`.
@@ -52,25 +83,39 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
         origin: origin.clone(),
         error,
     };
-    let (_, lin) = linearize(&mut model).map_err(fail)?;
-    let (state, about, residual) = match a.about {
-        About::Equilibrium => {
-            let eq =
-                solve(&lin, None, &EquilibriumOptions::default()).map_err(|e| fail(e.into()))?;
-            (eq.linearization, "static equilibrium", eq.residual)
-        }
-        About::Initial => {
-            let at = lin.at(&lin.initial);
-            let r = at.force.norm();
-            (at, "initial state (at rest)", r)
-        }
+    if a.count == Some(0) {
+        return Err(Error::argument(
+            "--count",
+            "--count must be at least 1".to_string(),
+        ));
+    }
+    let request = ModesRequest {
+        about: match a.about {
+            About::Equilibrium => statics::About::Equilibrium,
+            About::Initial => statics::About::Initial,
+        },
+        solver: match a.solver {
+            Solver::Auto => statics::Solver::Auto,
+            Solver::Dense => statics::Solver::Dense,
+            Solver::Sparse => statics::Solver::Sparse,
+        },
+        count: a.count,
     };
-    let result = modes(&state).map_err(|e| fail(e.into()))?;
-    let count = a
-        .count
-        .unwrap_or(result.modes.len())
-        .min(result.modes.len());
-    let shown = &result.modes[..count];
+    let report = modes_about(&mut model, &request).map_err(fail)?;
+    if let Some(dir) = &a.matrices {
+        let m = &report.matrices;
+        write_matrices(dir, &m.stiffness, &m.mass, &m.damping)?;
+    }
+    let n = report.names.len();
+    let sparse = report.sparse;
+    let about = report.about.describe();
+    let residual = report.residual;
+    let result = &report.modes;
+    let lin_names = &report.names;
+    let damped = &report.damped;
+    let has_damping = report.has_damping;
+    let shown = &result.modes[..];
+    let damped_shown: &[DampedMode] = damped.as_deref().unwrap_or(&[]);
     let tau = std::f64::consts::TAU;
     if a.json {
         let v = json!({
@@ -78,7 +123,7 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
             "about": about,
             "out_of_balance_force": json_num(residual),
             "stiffness_asymmetry": json_num(result.stiffness_asymmetry),
-            "coordinates": lin.names,
+            "coordinates": lin_names,
             "modes": shown.iter().enumerate().map(|(k, m)| json!({
                 "mode": k + 1,
                 "omega_squared": json_num(m.omega_squared),
@@ -90,15 +135,38 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
                 "shape": m.shape.iter().map(|x| json_num(*x)).collect::<Vec<_>>(),
             })).collect::<Vec<_>>(),
         });
+        let mut v = v;
+        v["solver"] = json!(if sparse { "sparse" } else { "dense" });
+        v["coordinate_count"] = json!(n);
+        if damped.is_some() {
+            v["damped_modes"] = json!(damped_shown
+                .iter()
+                .map(|d| json!({
+                    "eigenvalue": [json_num(d.re), json_num(d.im)],
+                    "natural_frequency": json_num(d.omega_n),
+                    "damping_ratio": json_num(d.damping_ratio),
+                    "damped_frequency": json_num(d.im),
+                    "oscillatory": d.oscillatory,
+                }))
+                .collect::<Vec<_>>());
+        }
         return Ok(format!("{v:#}"));
     }
     let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "{}: {} modes about the {about} (|f| = {residual:.3e})",
-        model.name,
-        result.modes.len()
-    );
+    if sparse {
+        let _ = writeln!(
+            s,
+            "{}: the lowest {} of {n} modes (sparse shift-invert Lanczos) about the {about} (|f| = {residual:.3e})",
+            model.name,
+            result.modes.len()
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "{}: {n} modes about the {about} (|f| = {residual:.3e})",
+            model.name,
+        );
+    }
     if result.stiffness_asymmetry > 1e-9 {
         let _ = writeln!(
             s,
@@ -117,7 +185,7 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
             .iter()
             .take(3)
             .filter(|&&i| m.shape[i].abs() >= 0.1)
-            .map(|&i| format!("{}:{:+.2}", lin.names[i], m.shape[i]))
+            .map(|&i| format!("{}:{:+.2}", lin_names[i], m.shape[i]))
             .collect();
         let (w, f, t) = if m.omega_squared >= 0.0 {
             (
@@ -141,10 +209,35 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
             main.join(" ")
         );
     }
+    if damped.is_some() {
+        let _ = writeln!(
+            s,
+            "\n  damped modes (roots s of det(s² M + s C + K) = 0, lowest natural frequency first)\n  mode      omega_n (rad/s)     damping ratio     omega_d (rad/s)"
+        );
+        for (k, d) in damped_shown.iter().enumerate() {
+            if d.oscillatory {
+                let _ = writeln!(
+                    s,
+                    "  {:>4}  {:>18.10e}  {:>16.10e}  {:>18.10e}",
+                    k + 1,
+                    d.omega_n,
+                    d.damping_ratio,
+                    d.im
+                );
+            } else {
+                let _ = writeln!(s, "  {:>4}  not oscillating: e^({:.6e} t)", k + 1, d.re);
+            }
+        }
+    } else if has_damping {
+        let _ = writeln!(
+            s,
+            "\n  (damped modes are computed densely, for at most {DAMPED_LIMIT} coordinates)"
+        );
+    }
     if a.shapes {
         for (k, m) in shown.iter().enumerate() {
             let _ = writeln!(s, "\nMode {} shape (largest component +1):", k + 1);
-            for (n, x) in lin.names.iter().zip(&m.shape) {
+            for (n, x) in lin_names.iter().zip(&m.shape) {
                 let _ = writeln!(s, "  {n}  {x:+.9e}");
             }
         }

@@ -35,6 +35,7 @@ from . import _pdyn
 from ._errors import DriftWarning, Interrupted, ModelError, ParameterError, PdynError
 from ._nbody import NBody, Particle
 from ._linearize import Linearization
+from ._modes import Modes
 from ._result import (Derivation, EnsembleResult, Expr, ForcesResult,
                       OdeResult, ParticleResult, SweepResult, Table,
                       _concat_raw, _from_run)
@@ -55,7 +56,7 @@ def __getattr__(name: str):
     raise AttributeError(f"module 'pdyn' has no attribute {name!r}")
 
 __all__ = [
-    "Model", "NBody", "Particle", "Linearization", "solve_ivp", "methods", "OdeResult", "Derivation", "Expr", "SweepResult",
+    "Model", "NBody", "Particle", "Linearization", "Modes", "solve_ivp", "methods", "OdeResult", "Derivation", "Expr", "SweepResult",
     "EnsembleResult", "ForcesResult",
     "kin", "dsolve", "KinResult", "KinInstant", "DsolveResult", "DsolveCase", "RuleResult",
     "Vector",
@@ -437,6 +438,18 @@ class Model:
             absolute_sigma=bool(absolute_sigma), rtol=float(rtol), atol=float(atol),
             max_nfev=int(max_nfev))
         return FitResult(raw)
+
+    def modes(self, count: Optional[int] = None, about: str = "equilibrium",
+              solver: str = "auto", params: Optional[Mapping[str, float]] = None) -> Modes:
+        """Natural frequencies and mode shapes, like ``pdyn modes``: the model linearized
+        about its static equilibrium (``about="equilibrium"``, found by Newton's method) or its
+        initial state at rest (``"initial"``), ``K φ = ω² M φ`` solved densely for every mode
+        (``solver="dense"``) or for the lowest ``count`` (default 20) by sparse shift-invert
+        Lanczos (``"sparse"``); ``"auto"`` is dense below 300 coordinates. Returns
+        :class:`Modes` (NumPy arrays: ``omega``, ``freq_hz``, ``period``, ``shapes``,
+        ``modal_mass``...; damping ratios when the model has damping)."""
+        return Modes(self._mechanics().modes(count=count, about=about, solver=solver,
+                                             params=_params(params)))
 
     def derive(self) -> Derivation:
         """The equations of motion (F = ma or the projected form), the unknowns, their exact

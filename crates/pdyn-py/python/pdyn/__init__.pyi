@@ -80,6 +80,25 @@ class FitResult(Dict[str, Any]):
     warnings: List[str]
     experiments: List[Dict[str, Any]]
 
+class Modes:
+    omega: npt.NDArray[np.float64]
+    omega_squared: npt.NDArray[np.float64]
+    freq_hz: npt.NDArray[np.float64]
+    period: npt.NDArray[np.float64]
+    shapes: npt.NDArray[np.float64]
+    modal_mass: npt.NDArray[np.float64]
+    modal_stiffness: npt.NDArray[np.float64]
+    coordinates: List[str]
+    q: npt.NDArray[np.float64]
+    residual: float
+    solver: str
+    about: str
+    stiffness_asymmetry: float
+    natural_frequency: Optional[npt.NDArray[np.float64]]
+    damping_ratio: Optional[npt.NDArray[np.float64]]
+    damped_frequency: Optional[npt.NDArray[np.float64]]
+    def __len__(self) -> int: ...
+
 class Linearization:
     A: npt.NDArray[np.float64]
     K: npt.NDArray[np.float64]
@@ -244,6 +263,9 @@ class Model:
             bounds: Optional[Mapping[str, Tuple[float, float]]] = ...,
             sigma: Optional[Mapping[str, float]] = ..., absolute_sigma: bool = ...,
             rtol: float = ..., atol: float = ..., max_nfev: int = ...) -> FitResult: ...
+
+    def modes(self, count: Optional[int] = ..., about: str = ..., solver: str = ...,
+              params: Optional[Mapping[str, float]] = ...) -> Modes: ...
     def derive(self) -> Derivation: ...
     def sweep(self, param: str, values: Sequence[float],
               measures: Optional[Mapping[str, Union[str, Tuple[str, str]]]] = ...,

@@ -1,0 +1,49 @@
+"""The result of :meth:`pdyn.Model.modes`."""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Dict, List, Optional
+
+
+class Modes:
+    """Natural frequencies and mode shapes of ``K φ = ω² M φ`` about a state at rest, lowest
+    first (what ``pdyn modes`` prints).
+
+    ``omega`` (rad/s; NaN for an unstable mode, ``omega_squared < 0``), ``freq_hz``, ``period``
+    (s), ``omega_squared``, ``shapes`` (``n × k``: column ``j`` is mode ``j``, scaled so that its
+    largest component is +1, rows in the order of ``coordinates``), ``modal_mass`` and
+    ``modal_stiffness`` (``φᵀ M φ``, ``φᵀ K φ`` with that scaling), ``q`` (the state),
+    ``residual`` (``|f|`` there), ``solver`` (``"dense"``: every mode; ``"sparse"``: the lowest
+    ``count`` by shift-invert Lanczos), ``about``. With damping (``C ≠ 0``) and up to 1,000
+    coordinates, ``natural_frequency``, ``damping_ratio`` and ``damped_frequency`` of the roots
+    of ``det(s² M + s C + K) = 0``; else ``None``."""
+
+    def __init__(self, raw: Dict[str, Any]):
+        import numpy as np
+        self.omega = raw["omega"]
+        self.omega_squared = raw["omega_squared"]
+        self.freq_hz = self.omega / (2 * math.pi)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            self.period = 2 * math.pi / self.omega
+        self.shapes = raw["shapes"]
+        self.modal_mass = raw["modal_mass"]
+        self.modal_stiffness = raw["modal_stiffness"]
+        self.coordinates: List[str] = list(raw["coordinates"])
+        self.q = raw["q"]
+        self.residual: float = float(raw["residual"])
+        self.solver: str = raw["solver"]
+        self.about: str = raw["about"]
+        self.stiffness_asymmetry: float = float(raw["stiffness_asymmetry"])
+        damped: Optional[Dict[str, Any]] = raw["damped"]
+        self.natural_frequency = damped["natural_frequency"] if damped else None
+        self.damping_ratio = damped["damping_ratio"] if damped else None
+        self.damped_frequency = damped["damped_frequency"] if damped else None
+
+    def __len__(self) -> int:
+        return len(self.omega)
+
+    def __repr__(self) -> str:
+        shown = ", ".join(f"{w:.6g}" for w in self.omega[:4])
+        more = ", ..." if len(self.omega) > 4 else ""
+        return f"Modes({len(self)} modes, {self.solver}, omega = [{shown}{more}] rad/s)"
