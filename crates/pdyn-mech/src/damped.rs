@@ -83,7 +83,7 @@ pub fn damped_modes(lin: &Linearization) -> Result<Vec<DampedMode>, DampedError>
         .iter()
         .filter(|s| s.im >= 0.0)
         .map(|s| {
-            let omega_n = s.re.hypot(s.im);
+            let omega_n = libm::hypot(s.re, s.im);
             let oscillatory = s.im > 1e-10 * omega_n.max(f64::MIN_POSITIVE);
             DampedMode {
                 re: s.re,

@@ -15,7 +15,7 @@ impl Rng {
     }
     fn normal(&mut self) -> f64 {
         let (u, v) = (self.next().max(1e-300), self.next());
-        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
+        (-2.0 * libm::log(u)).sqrt() * libm::cos(2.0 * std::f64::consts::PI * v)
     }
 }
 
@@ -57,7 +57,7 @@ fn drag_data(seed: u64, sigma: f64, (c, m, x0, v0): (f64, f64, f64, f64)) -> Str
     let t: Vec<f64> = (0..40).map(|i| 0.1 * f64::from(i)).collect();
     let x: Vec<f64> = t
         .iter()
-        .map(|&t| x0 + v0 * m / c * (1.0 - (-c * t / m).exp()) + sigma * rng.normal())
+        .map(|&t| x0 + v0 * m / c * (1.0 - libm::exp(-c * t / m)) + sigma * rng.normal())
         .collect();
     csv(&t, &[("x", x)])
 }
@@ -144,7 +144,9 @@ length = "x"
 "#;
     let (k, c, m, x0) = (40.0f64, 0.8f64, 1.5f64, 0.2f64);
     let (zeta_w, wd) = (c / (2.0 * m), (k / m - (c / (2.0 * m)).powi(2)).sqrt());
-    let exact = |t: f64| x0 * (-zeta_w * t).exp() * ((wd * t).cos() + zeta_w / wd * (wd * t).sin());
+    let exact = |t: f64| {
+        x0 * libm::exp(-zeta_w * t) * (libm::cos(wd * t) + zeta_w / wd * libm::sin(wd * t))
+    };
     let mut rng = Rng(7);
     let t: Vec<f64> = (0..150).map(|i| 0.02 * f64::from(i)).collect();
     let x: Vec<f64> = t.iter().map(|&t| exact(t) + 1e-3 * rng.normal()).collect();
