@@ -11,6 +11,7 @@ pub mod equilibrium;
 pub mod expr;
 pub mod forces;
 pub mod fuse;
+pub mod interrupt;
 pub mod kin;
 pub mod modes;
 pub mod run;

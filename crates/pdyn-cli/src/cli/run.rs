@@ -100,7 +100,7 @@ pub fn request(a: &RunArgs) -> Result<pdyn::Request, Error> {
         jit: a.jit(),
         out: a.out.clone(),
         plots: a.plot,
-        // Ctrl-C ends the process (a clean stop with files kept is issue 29's).
+        // `run` installs the signal handler and sets it (SIGINT/SIGTERM: a clean stop).
         interrupt: None,
         frame_every: None,
     })
@@ -116,7 +116,8 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
     if a.method.as_deref() == Some("help") {
         return Ok(Outcome::text(pdyn::engine::methods_help(file.kind)));
     }
-    let req = request(&a)?;
+    let mut req = request(&a)?;
+    req.interrupt = super::interrupt::install();
     // The run's log (an MD run's thermo table) goes live to stderr unless --json.
     let live = !a.json;
     let mut bar = indicatif::ProgressBar::hidden();
@@ -135,7 +136,12 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
         Progress::Log(line) if live => bar.suspend(|| eprintln!("{line}")),
         _ => {}
     };
-    let mut output = pdyn::run(&file, &req, &mut progress)?;
+    let long = pdyn::engine::LongRun {
+        // Rows go only to the files as the run goes; plots need the history in memory.
+        stream_only: true,
+        ..Default::default()
+    };
+    let mut output = pdyn::engine::run_long(&file, &req, &long, &mut progress)?;
     bar.finish_and_clear();
     let mut stderr: String = output
         .warnings()

@@ -259,13 +259,17 @@ pub struct Monitor {
 pub struct NbodyResult {
     /// Names of all bodies that existed during the run (a merged body keeps the first name).
     pub names: Vec<String>,
-    /// Output times.
+    /// Output times (with a streaming run that keeps no history, the last one only:
+    /// [`NbodyResult::outputs`] counts them all).
     pub times: Vec<f64>,
+    /// Outputs recorded.
+    pub outputs: usize,
     /// Per output time, the bodies' states (empty unless trajectories are recorded).
     pub states: Vec<Vec<BodyState>>,
     /// Elements over time (empty unless trajectories are recorded).
     pub elements: Vec<ElementsRow>,
-    /// Invariants at each output.
+    /// Invariants at each output (with a streaming run that keeps no history, the first and
+    /// the last).
     pub conservation: Vec<ConservationRow>,
     /// Events.
     pub events: Vec<NbodyEvent>,
@@ -285,6 +289,8 @@ pub struct NbodyResult {
     pub final_positions: Vec<[f64; 3]>,
     /// The numerical failure that stopped the run early, if any (output up to it is kept).
     pub failure: Option<GravityError>,
+    /// Stopped early by [`RunOptions::interrupt`].
+    pub interrupted: bool,
 }
 
 /// What the engine knows of the bodies, for a rebuild after an event.
@@ -346,15 +352,46 @@ impl Segment {
     }
 }
 
-/// Integrates `built` as `options` say.
+/// Why a run could not go on: its output times, or a file it writes.
+#[derive(Debug)]
+pub enum RunError {
+    /// The output times asked for.
+    Sampling(SamplingError),
+    /// Writing an output file.
+    Write(crate::Error),
+}
+
+impl From<crate::Error> for RunError {
+    fn from(e: crate::Error) -> Self {
+        RunError::Write(e)
+    }
+}
+
+/// Integrates `built` as `options` say, keeping the whole history in memory.
 pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingError> {
+    run_with(built, options, None, &mut |_| {}).map_err(|e| match e {
+        RunError::Sampling(s) => s,
+        // nothing is written without a stream
+        RunError::Write(_) => SamplingError::Interval(f64::NAN),
+    })
+}
+
+/// Integrates `built` as `options` say, appending each output's rows to `stream` as it is
+/// recorded (keeping only the first and last output in memory unless `stream.keep`), and
+/// telling `steps` the steps taken so far at each output.
+pub fn run_with(
+    built: Built,
+    options: &RunOptions,
+    mut stream: Option<&mut super::output::Stream>,
+    steps: &mut dyn FnMut(u64),
+) -> Result<NbodyResult, RunError> {
     let Built {
         mut sim,
         config,
         names,
         primaries,
     } = built;
-    let mut times = output_times(options.t_end, &options.sampling)?;
+    let mut times = output_times(options.t_end, &options.sampling).map_err(RunError::Sampling)?;
     if options.integrator != IntegratorKind::Ias15 {
         times = on_step_grid(&times, config.dt);
     }
@@ -362,8 +399,9 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingEr
     let mut alive: Vec<usize> = (0..names.len()).collect();
     let primary_of: Vec<Option<usize>> = primaries;
     let mut res = NbodyResult {
-        names: Vec::new(),
+        names: names.clone(),
         times: Vec::new(),
+        outputs: 0,
         states: Vec::new(),
         elements: Vec::new(),
         conservation: Vec::new(),
@@ -376,6 +414,7 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingEr
         t_reached: 0.0,
         final_positions: Vec::new(),
         failure: None,
+        interrupted: false,
     };
     let mut seg = Segment::start(&sim);
     let mut e_worst = 0.0f64;
@@ -391,13 +430,15 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingEr
         options.trajectory,
         &mut res,
         &mut seg,
-    );
+        stream.as_deref_mut(),
+    )?;
     'outer: for &tk in &times[1..] {
         if options
             .interrupt
             .as_ref()
             .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
         {
+            res.interrupted = true;
             break;
         }
         loop {
@@ -421,7 +462,8 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingEr
                             options.trajectory,
                             &mut res,
                             &mut seg,
-                        );
+                            stream.as_deref_mut(),
+                        )?;
                         break 'outer;
                     }
                     let e_before = sim.energy();
@@ -487,7 +529,8 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingEr
                             options.trajectory,
                             &mut res,
                             &mut seg,
-                        );
+                            stream.as_deref_mut(),
+                        )?;
                         break 'outer;
                     }
                     let mut bodies = bodies_of(&sim);
@@ -551,7 +594,9 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingEr
             options.trajectory,
             &mut res,
             &mut seg,
-        );
+            stream.as_deref_mut(),
+        )?;
+        steps(steps_before + sim.steps());
     }
     e_worst = max_nan(e_worst, seg.e_drift);
     l_worst = max_nan(l_worst, seg.l_drift);
@@ -625,7 +670,9 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingEr
     }
     let p = sim.particles();
     res.final_positions = (0..p.len()).map(|i| p.pos(i).0).collect();
-    res.names = names;
+    if let Some(s) = stream {
+        s.flush()?;
+    }
     Ok(res)
 }
 
@@ -657,6 +704,7 @@ fn max_nan(a: f64, b: f64) -> f64 {
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 fn record(
     sim: &Simulation,
     t: f64,
@@ -665,7 +713,17 @@ fn record(
     trajectory: bool,
     res: &mut NbodyResult,
     seg: &mut Segment,
-) {
+    stream: Option<&mut super::output::Stream>,
+) -> Result<(), crate::Error> {
+    let keep = stream.as_ref().is_none_or(|s| s.keep);
+    if !keep {
+        // Bounded memory: the first conservation row (the monitors' reference), and the
+        // output being recorded.
+        res.times.clear();
+        res.states.clear();
+        res.elements.clear();
+        res.conservation.truncate(1);
+    }
     let p = sim.particles();
     let kinetic = p.kinetic_energy();
     let energy = sim.energy();
@@ -680,31 +738,45 @@ fn record(
     seg.update(&row);
     res.conservation.push(row);
     res.times.push(t);
-    if !trajectory {
-        return;
-    }
-    res.states.push(
-        (0..p.len())
-            .map(|i| BodyState {
+    res.outputs += 1;
+    let elements_from = res.elements.len();
+    if trajectory {
+        res.states.push(
+            (0..p.len())
+                .map(|i| BodyState {
+                    body: alive[i],
+                    mass: p.m[i],
+                    pos: p.pos(i).0,
+                    vel: p.vel(i).0,
+                })
+                .collect(),
+        );
+        for i in 1..p.len() {
+            // The declared primary if it still exists, otherwise the interior bodies (Jacobi).
+            let primary = primary_of[alive[i]]
+                .and_then(|k| alive.iter().position(|&a| a == k))
+                .filter(|&j| j != i)
+                .map_or(Primary::Interior, Primary::Body);
+            res.elements.push(ElementsRow {
+                t,
                 body: alive[i],
-                mass: p.m[i],
-                pos: p.pos(i).0,
-                vel: p.vel(i).0,
-            })
-            .collect(),
-    );
-    for i in 1..p.len() {
-        // The declared primary if it still exists, otherwise the interior bodies (Jacobi).
-        let primary = primary_of[alive[i]]
-            .and_then(|k| alive.iter().position(|&a| a == k))
-            .filter(|&j| j != i)
-            .map_or(Primary::Interior, Primary::Body);
-        res.elements.push(ElementsRow {
-            t,
-            body: alive[i],
-            orbit: sim.orbit(i, primary).ok(),
-        });
+                orbit: sim.orbit(i, primary).ok(),
+            });
+        }
     }
+    let Some(stream) = stream else {
+        return Ok(());
+    };
+    let names = &res.names;
+    if let (Some(f), Some(states)) = (&mut stream.trajectory, res.states.last()) {
+        f.rows(|w| super::output::trajectory_rows(w, t, states, names))?;
+    }
+    if let Some(f) = &mut stream.elements {
+        f.rows(|w| super::output::elements_rows(w, &res.elements[elements_from..], names))?;
+    }
+    stream
+        .conservation
+        .rows(|w| super::output::conservation_row(w, &row))
 }
 
 #[cfg(test)]
