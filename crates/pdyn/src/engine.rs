@@ -307,25 +307,72 @@ fn run_nbody(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<NbodyRun, Error> {
     let streaming = long.stream_only && !req.plots;
+    let restart = match &long.restart {
+        Some(path) => {
+            if req.out.is_none() || !streaming {
+                return Err(Error::argument(
+                    "--restart",
+                    "--restart continues the files of --out DIR (and draws no plots: --plot needs the whole history)",
+                ));
+            }
+            Some(crate::checkpoint::read(path, "nbody", file, req)?)
+        }
+        None => None,
+    };
     let planned = nbody::request::plan_with(&file.source, &file.origin, req, streaming)?;
     let trajectory = planned.trajectory;
     // The files are written as the run goes: the directory exists before it starts.
-    let mut stream = match &req.out {
-        Some(dir) => {
+    let mut stream = match (&req.out, &restart) {
+        (Some(dir), None) => {
             create_dir(dir)?;
-            let keep = !streaming;
-            Some(nbody::output::Stream::create(dir, trajectory, keep)?)
+            Some(nbody::output::Stream::create(dir, trajectory, !streaming)?)
         }
-        None => None,
+        (Some(dir), Some(r)) => {
+            let len = |k: usize| r.files.get(k).and_then(serde_json::Value::as_u64);
+            Some(nbody::output::Stream::resume(
+                dir,
+                [len(0), len(1), len(2)],
+                false,
+            )?)
+        }
+        (None, _) => None,
+    };
+    let every = match long.checkpoint_every {
+        Some(e) => e,
+        None => crate::checkpoint::Every::Seconds(crate::checkpoint::DEFAULT_SECONDS),
+    };
+    let mut checkpoints = match &req.out {
+        Some(dir) if every != crate::checkpoint::Every::Off && long.stream_only => Some(
+            crate::checkpoint::Checkpointer::new(dir, every, "nbody", file, req)
+                .starting_at(restart.as_ref().map_or(0, |r| r.steps)),
+        ),
+        _ => None,
     };
     let steps = planned.estimated_steps();
     progress(Progress::Started {
         steps,
         work: steps.saturating_mul(planned.info.n_bodies as u64),
     });
-    let (spec, info, result) =
-        planned.execute_with(stream.as_mut(), &mut |s| progress(Progress::Step(s)))?;
-    let (summary, failure) = nbody::output::outcome(&spec, &info, &result);
+    let (spec, info, result) = planned.execute_with(
+        stream.as_mut(),
+        &mut |s| progress(Progress::Step(s)),
+        checkpoints.as_mut(),
+        restart.as_ref().map(|r| &r.state),
+    )?;
+    let (mut summary, failure) = nbody::output::outcome(&spec, &info, &result);
+    if let Some(cp) = &checkpoints {
+        summary["checkpoint"] = serde_json::json!({
+            "file": cp.path().display().to_string(),
+            "written": cp.written,
+            "last_t": cp.last_time,
+        });
+    }
+    if let Some(r) = &restart {
+        summary["restarted_from"] = serde_json::json!({
+            "file": r.path.display().to_string(),
+            "t": r.t,
+        });
+    }
     if let Some(dir) = &req.out {
         nbody::output::write_summary(dir, &summary)?;
         if req.plots {

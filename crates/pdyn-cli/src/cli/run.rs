@@ -69,6 +69,15 @@ pub struct RunArgs {
     /// slower; for platforms without the JIT or to rule it out).
     #[arg(long = "no-jit")]
     pub no_jit: bool,
+    /// Write DIR/checkpoint.json this often: a wall time (`15min`, `30s`, `2h`), a number of
+    /// steps (`500steps`), or `off`; default 15min with --out (N-body runs; see
+    /// docs/long-runs.md). Also written when SIGINT/SIGTERM stops the run.
+    #[arg(long = "checkpoint-every", value_name = "WHEN")]
+    pub checkpoint_every: Option<String>,
+    /// Continue the run of this checkpoint bit for bit, appending to the files of --out
+    /// (the same model file and options; a foreign or damaged checkpoint is refused, exit 2).
+    #[arg(long, value_name = "CHECKPOINT")]
+    pub restart: Option<PathBuf>,
 }
 
 impl RunArgs {
@@ -139,7 +148,13 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
     let long = pdyn::engine::LongRun {
         // Rows go only to the files as the run goes; plots need the history in memory.
         stream_only: true,
-        ..Default::default()
+        checkpoint_every: match &a.checkpoint_every {
+            Some(text) => Some(pdyn::checkpoint::Every::parse(text).map_err(|m| {
+                Error::argument("--checkpoint-every", format!("--checkpoint-every {m}"))
+            })?),
+            None => None,
+        },
+        restart: a.restart.clone(),
     };
     let mut output = pdyn::engine::run_long(&file, &req, &long, &mut progress)?;
     bar.finish_and_clear();

@@ -262,24 +262,31 @@ impl Planned {
     /// Integrates. A run that stops early (a collision, an escape, a failed step) is a result
     /// with its `failure` set; an error here is about the output times only.
     pub fn execute(self) -> Result<(NbodySpec, RunInfo, NbodyResult), Error> {
-        self.execute_with(None, &mut |_| {})
+        self.execute_with(None, &mut |_| {}, None, None)
     }
 
     /// Integrates, appending rows to `stream` as they are recorded and telling `steps` the
-    /// steps taken at each output.
+    /// steps taken at each output; checkpoints and a restart as in [`super::run::run_with`].
     pub fn execute_with(
         self,
         stream: Option<&mut super::output::Stream>,
         steps: &mut dyn FnMut(u64),
+        checkpoints: Option<&mut crate::checkpoint::Checkpointer>,
+        resume: Option<&serde_json::Value>,
     ) -> Result<(NbodySpec, RunInfo, NbodyResult), Error> {
         let option = self.sampling_option;
-        let res =
-            super::run::run_with(self.built, &self.options, stream, steps).map_err(
-                |e| match e {
-                    super::run::RunError::Sampling(m) => Error::argument(option, m.to_string()),
-                    super::run::RunError::Write(e) => e,
-                },
-            )?;
+        let res = super::run::run_with(
+            self.built,
+            &self.options,
+            stream,
+            steps,
+            checkpoints,
+            resume,
+        )
+        .map_err(|e| match e {
+            super::run::RunError::Sampling(m) => Error::argument(option, m.to_string()),
+            super::run::RunError::Write(e) => e,
+        })?;
         Ok((self.spec, self.info, res))
     }
 }

@@ -299,6 +299,7 @@ fn bodies_of(sim: &Simulation) -> Vec<(Particle, f64)> {
     (0..p.len()).map(|i| (p.get(i), sim.radii()[i])).collect()
 }
 
+#[derive(Clone, Copy, Debug)]
 struct Segment {
     e0: f64,
     e_scale: f64,
@@ -369,7 +370,7 @@ impl From<crate::Error> for RunError {
 
 /// Integrates `built` as `options` say, keeping the whole history in memory.
 pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingError> {
-    run_with(built, options, None, &mut |_| {}).map_err(|e| match e {
+    run_with(built, options, None, &mut |_| {}, None, None).map_err(|e| match e {
         RunError::Sampling(s) => s,
         // nothing is written without a stream
         RunError::Write(_) => SamplingError::Interval(f64::NAN),
@@ -379,11 +380,17 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingEr
 /// Integrates `built` as `options` say, appending each output's rows to `stream` as it is
 /// recorded (keeping only the first and last output in memory unless `stream.keep`), and
 /// telling `steps` the steps taken so far at each output.
+///
+/// With `checkpoints`, a checkpoint is written at each output where one is due and when the
+/// run is interrupted; with `resume` (a checkpoint's `state`), the run continues from there
+/// (the stream's files already truncated to the checkpoint's lengths).
 pub fn run_with(
     built: Built,
     options: &RunOptions,
     mut stream: Option<&mut super::output::Stream>,
     steps: &mut dyn FnMut(u64),
+    mut checkpoints: Option<&mut crate::checkpoint::Checkpointer>,
+    resume: Option<&serde_json::Value>,
 ) -> Result<NbodyResult, RunError> {
     let Built {
         mut sim,
@@ -422,23 +429,89 @@ pub fn run_with(
     let mut t_offset = 0.0;
     let mut steps_before = 0u64;
     let mut engine_warnings: Vec<Warning> = Vec::new();
-    record(
-        &sim,
-        0.0,
-        &alive,
-        &primary_of,
-        options.trajectory,
-        &mut res,
-        &mut seg,
-        stream.as_deref_mut(),
-    )?;
-    'outer: for &tk in &times[1..] {
+    let start = match resume {
+        Some(state) => {
+            let r = Resumed::read(state).ok_or_else(|| {
+                RunError::Write(crate::Error::argument(
+                    "--restart",
+                    "the checkpoint's N-body state is incomplete or of another version",
+                ))
+            })?;
+            sim.restore(&r.snapshot).map_err(|e| {
+                RunError::Write(crate::Error::argument(
+                    "--restart",
+                    format!("the checkpoint does not fit this model: {e}"),
+                ))
+            })?;
+            alive = r.alive;
+            [t_offset, e_worst, l_worst] = r.scalars;
+            seg = r.seg;
+            steps_before = r.steps_before;
+            res.outputs = r.outputs;
+            res.conservation = r.conservation;
+            res.times = vec![r.t_last];
+            res.events = r.events;
+            r.next
+        }
+        None => {
+            record(
+                &sim,
+                0.0,
+                &alive,
+                &primary_of,
+                options.trajectory,
+                &mut res,
+                &mut seg,
+                stream.as_deref_mut(),
+            )?;
+            1
+        }
+    };
+    let mut checkpoint = |force: bool,
+                          next: usize,
+                          sim: &Simulation,
+                          alive: &[usize],
+                          scalars: [f64; 3],
+                          seg: &Segment,
+                          steps_before: u64,
+                          res: &NbodyResult,
+                          stream: Option<&mut super::output::Stream>|
+     -> Result<(), crate::Error> {
+        let Some(cp) = checkpoints.as_deref_mut() else {
+            return Ok(());
+        };
+        if !force && !cp.due(steps_before + sim.steps()) {
+            return Ok(());
+        }
+        let files = match stream {
+            Some(s) => {
+                s.sync()?;
+                serde_json::json!(s.lengths())
+            }
+            None => serde_json::Value::Null,
+        };
+        let t = res.times.last().copied().unwrap_or(0.0);
+        let state = save_state(next, sim, alive, scalars, seg, steps_before, res);
+        cp.write(t, steps_before + sim.steps(), files, state)
+    };
+    'outer: for (k, &tk) in times.iter().enumerate().skip(start) {
         if options
             .interrupt
             .as_ref()
             .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
         {
             res.interrupted = true;
+            checkpoint(
+                true,
+                k,
+                &sim,
+                &alive,
+                [t_offset, e_worst, l_worst],
+                &seg,
+                steps_before,
+                &res,
+                stream.as_deref_mut(),
+            )?;
             break;
         }
         loop {
@@ -596,7 +669,21 @@ pub fn run_with(
             &mut seg,
             stream.as_deref_mut(),
         )?;
-        steps(steps_before + sim.steps());
+        let done = steps_before + sim.steps();
+        steps(done);
+        if k + 1 < times.len() {
+            checkpoint(
+                false,
+                k + 1,
+                &sim,
+                &alive,
+                [t_offset, e_worst, l_worst],
+                &seg,
+                steps_before,
+                &res,
+                stream.as_deref_mut(),
+            )?;
+        }
     }
     e_worst = max_nan(e_worst, seg.e_drift);
     l_worst = max_nan(l_worst, seg.l_drift);
@@ -701,6 +788,150 @@ fn max_nan(a: f64, b: f64) -> f64 {
         f64::NAN
     } else {
         a.max(b)
+    }
+}
+
+const EVENT_KINDS: [&str; 5] = [
+    "collision",
+    "merger",
+    "escape",
+    "removal",
+    "close_encounter",
+];
+
+/// The loop's state at an output, for a checkpoint: every number as its bits.
+fn save_state(
+    next: usize,
+    sim: &Simulation,
+    alive: &[usize],
+    scalars: [f64; 3],
+    seg: &Segment,
+    steps_before: u64,
+    res: &NbodyResult,
+) -> serde_json::Value {
+    use crate::checkpoint::bits;
+    let snap = sim.snapshot();
+    let row = |r: &ConservationRow| {
+        serde_json::json!({
+            "n": r.n,
+            "x": bits(&[r.t, r.energy, r.kinetic, r.potential, r.angular_momentum[0], r.angular_momentum[1], r.angular_momentum[2]]),
+        })
+    };
+    serde_json::json!({
+        "next": next,
+        "alive": alive,
+        "scalars": bits(&scalars),
+        "segment": bits(&[seg.e0, seg.e_scale, seg.l0[0], seg.l0[1], seg.l0[2], seg.l_scale, seg.e_drift, seg.l_drift]),
+        "steps_before": steps_before,
+        "outputs": res.outputs,
+        "t_last": res.times.last().copied().unwrap_or(0.0).to_bits(),
+        "conservation": [res.conservation.first().map(row), res.conservation.last().map(row)],
+        "events": res.events.iter().map(|e| serde_json::json!({
+            "t": e.t.to_bits(), "kind": e.kind, "bodies": e.bodies, "message": e.message,
+        })).collect::<Vec<_>>(),
+        "engine": {
+            "workspace": snap.workspace,
+            "scalars": bits(&snap.scalars),
+            "counters": snap.counters,
+            "arrays": snap.arrays.iter().map(|a| bits(a)).collect::<Vec<_>>(),
+        },
+    })
+}
+
+/// What [`save_state`] wrote.
+struct Resumed {
+    next: usize,
+    alive: Vec<usize>,
+    scalars: [f64; 3],
+    seg: Segment,
+    steps_before: u64,
+    outputs: usize,
+    t_last: f64,
+    conservation: Vec<ConservationRow>,
+    events: Vec<NbodyEvent>,
+    snapshot: pdyn_gravity::Snapshot,
+}
+
+impl Resumed {
+    fn read(v: &serde_json::Value) -> Option<Resumed> {
+        use crate::checkpoint::unbits;
+        let usize_of = |v: &serde_json::Value| v.as_u64().map(|x| x as usize);
+        let row = |v: &serde_json::Value| -> Option<ConservationRow> {
+            let x = unbits(&v["x"])?;
+            let [t, energy, kinetic, potential, lx, ly, lz] = x[..] else {
+                return None;
+            };
+            Some(ConservationRow {
+                t,
+                n: usize_of(&v["n"])?,
+                energy,
+                kinetic,
+                potential,
+                angular_momentum: [lx, ly, lz],
+            })
+        };
+        let sc = unbits(&v["scalars"])?;
+        let sg = unbits(&v["segment"])?;
+        let [e0, e_scale, l0x, l0y, l0z, l_scale, e_drift, l_drift] = sg[..] else {
+            return None;
+        };
+        let mut conservation = Vec::new();
+        for r in v["conservation"].as_array()? {
+            if !r.is_null() {
+                conservation.push(row(r)?);
+            }
+        }
+        let mut events = Vec::new();
+        for e in v["events"].as_array()? {
+            let kind = e["kind"].as_str()?;
+            events.push(NbodyEvent {
+                t: f64::from_bits(e["t"].as_u64()?),
+                kind: EVENT_KINDS.iter().find(|k| **k == kind)?,
+                bodies: e["bodies"]
+                    .as_array()?
+                    .iter()
+                    .map(|b| b.as_str().map(String::from))
+                    .collect::<Option<_>>()?,
+                message: e["message"].as_str()?.to_string(),
+            });
+        }
+        let eng = &v["engine"];
+        Some(Resumed {
+            next: usize_of(&v["next"])?,
+            alive: v["alive"]
+                .as_array()?
+                .iter()
+                .map(usize_of)
+                .collect::<Option<_>>()?,
+            scalars: sc.try_into().ok()?,
+            seg: Segment {
+                e0,
+                e_scale,
+                l0: [l0x, l0y, l0z],
+                l_scale,
+                e_drift,
+                l_drift,
+            },
+            steps_before: v["steps_before"].as_u64()?,
+            outputs: usize_of(&v["outputs"])?,
+            t_last: f64::from_bits(v["t_last"].as_u64()?),
+            conservation,
+            events,
+            snapshot: pdyn_gravity::Snapshot {
+                workspace: eng["workspace"].as_str()?.to_string(),
+                scalars: unbits(&eng["scalars"])?,
+                counters: eng["counters"]
+                    .as_array()?
+                    .iter()
+                    .map(serde_json::Value::as_u64)
+                    .collect::<Option<_>>()?,
+                arrays: eng["arrays"]
+                    .as_array()?
+                    .iter()
+                    .map(unbits)
+                    .collect::<Option<_>>()?,
+            },
+        })
     }
 }
 
