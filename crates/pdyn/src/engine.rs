@@ -219,6 +219,25 @@ pub fn run_long(
             ),
         ));
     }
+    if file.kind != Kind::Nbody
+        && (long.restart.is_some()
+            || long
+                .checkpoint_every
+                .is_some_and(|e| e != crate::checkpoint::Every::Off))
+    {
+        let option = if long.restart.is_some() {
+            "--restart"
+        } else {
+            "--checkpoint-every"
+        };
+        return Err(Error::argument(
+            option,
+            format!(
+                "{option}: checkpoints and restarts are made for N-body runs only so far; a {} run is not checkpointed (see docs/long-runs.md)",
+                file.kind.name()
+            ),
+        ));
+    }
     Ok(match file.kind {
         Kind::Mechanics => {
             let mut model = file.mechanics()?;

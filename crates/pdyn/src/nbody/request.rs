@@ -167,9 +167,10 @@ pub fn plan_with(
     } else {
         (Sampling::Points(spec.points.unwrap_or(201)), "points")
     };
-    let n_outputs = super::run::output_times(t_end, &sampling)
+    // Counted, not listed (a list of 10⁷ times would be most of a streaming run's memory).
+    let n_outputs = super::run::Schedule::new(t_end, &sampling, None)
         .map_err(|m| Error::argument(option, format!("{option}: {m}")))?
-        .len();
+        .raw_len();
 
     // A fixed step absurdly small for the span would run for days: say so instead.
     if let (Some((dt, span)), true) = (&spec.dt, spec.integrator != IntegratorKind::Ias15) {

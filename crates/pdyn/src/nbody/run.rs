@@ -185,6 +185,126 @@ pub fn output_times(t_end: f64, sampling: &Sampling) -> Result<Vec<f64>, Samplin
     }
 }
 
+/// The output times of a run, one at a time: those of [`output_times`], moved onto the step
+/// grid as [`on_step_grid`] does for a fixed step, without a list of them in memory (a run of
+/// 10⁷ outputs holds none; times given one by one are the list they came in).
+#[derive(Debug, Clone)]
+pub struct Schedule {
+    raw: Raw,
+    len: usize,
+    k: usize,
+    grid: Option<f64>,
+    last: Option<f64>,
+}
+
+#[derive(Debug, Clone)]
+enum Raw {
+    Points { n: usize, t_end: f64 },
+    Every { dt: f64, n: usize, t_end: f64 },
+    List(Vec<f64>),
+}
+
+impl Schedule {
+    /// The times of `sampling` up to `t_end`, on the grid of `grid` (a fixed step) if given;
+    /// refused as [`output_times`] refuses them.
+    pub fn new(
+        t_end: f64,
+        sampling: &Sampling,
+        grid: Option<f64>,
+    ) -> Result<Schedule, SamplingError> {
+        let (raw, len) = match sampling {
+            Sampling::Points(n) => {
+                if *n < 2 || *n > MAX_POINTS {
+                    return Err(SamplingError::Points {
+                        n: *n,
+                        max: MAX_POINTS,
+                    });
+                }
+                (Raw::Points { n: *n, t_end }, *n)
+            }
+            Sampling::Every(dt) => {
+                if !(dt.is_finite() && *dt > 0.0) {
+                    return Err(SamplingError::Interval(*dt));
+                }
+                let n = (t_end / dt).floor();
+                if n > MAX_POINTS as f64 {
+                    return Err(SamplingError::TooMany {
+                        dt: *dt,
+                        t_end,
+                        n,
+                        max: MAX_POINTS,
+                    });
+                }
+                let n = n as usize;
+                // The last output is t_end itself (unless within round-off of the previous one).
+                let extra = t_end - n as f64 * dt > 1e-9 * dt;
+                (Raw::Every { dt: *dt, n, t_end }, n + 1 + usize::from(extra))
+            }
+            Sampling::Times(_) => {
+                let v = output_times(t_end, sampling)?;
+                let len = v.len();
+                (Raw::List(v), len)
+            }
+        };
+        Ok(Schedule {
+            raw,
+            len,
+            k: 0,
+            grid,
+            last: None,
+        })
+    }
+
+    /// The number of times before moving them to the step grid.
+    pub fn raw_len(&self) -> usize {
+        self.len
+    }
+
+    fn raw_at(&self, k: usize) -> f64 {
+        match &self.raw {
+            Raw::Points { n, t_end } => t_end * k as f64 / (*n - 1) as f64,
+            Raw::Every { dt, n, t_end } => {
+                if k <= *n {
+                    k as f64 * dt
+                } else {
+                    *t_end
+                }
+            }
+            Raw::List(v) => v[k],
+        }
+    }
+}
+
+impl Iterator for Schedule {
+    type Item = f64;
+
+    fn next(&mut self) -> Option<f64> {
+        while self.k < self.len {
+            let t = self.raw_at(self.k);
+            self.k += 1;
+            let Some(dt) = self.grid else {
+                self.last = Some(t);
+                return Some(t);
+            };
+            if self.k == self.len {
+                // t_end stays where it is
+                if self.last.is_none_or(|l| t > l) {
+                    self.last = Some(t);
+                    return Some(t);
+                }
+                return None;
+            }
+            let t_end = self.raw_at(self.len - 1);
+            let snapped = (t / dt).round() * dt;
+            if snapped < t_end && self.last.is_none_or(|l| snapped > l) {
+                self.last = Some(snapped);
+                return Some(snapped);
+            }
+        }
+        None
+    }
+}
+
 /// The state of one body at an output time.
 #[derive(Debug, Clone, Copy)]
 pub struct BodyState {
@@ -398,10 +518,11 @@ pub fn run_with(
         names,
         primaries,
     } = built;
-    let mut times = output_times(options.t_end, &options.sampling).map_err(RunError::Sampling)?;
-    if options.integrator != IntegratorKind::Ias15 {
-        times = on_step_grid(&times, config.dt);
-    }
+    let grid = (options.integrator != IntegratorKind::Ias15).then_some(config.dt);
+    let mut times = Schedule::new(options.t_end, &options.sampling, grid)
+        .map_err(RunError::Sampling)?
+        .enumerate()
+        .peekable();
     // Current index → name index; primaries by name index (they survive mergers).
     let mut alive: Vec<usize> = (0..names.len()).collect();
     let primary_of: Vec<Option<usize>> = primaries;
@@ -494,7 +615,10 @@ pub fn run_with(
         let state = save_state(next, sim, alive, scalars, seg, steps_before, res);
         cp.write(t, steps_before + sim.steps(), files, state)
     };
-    'outer: for (k, &tk) in times.iter().enumerate().skip(start) {
+    for _ in 0..start {
+        times.next();
+    }
+    'outer: while let Some((k, tk)) = times.next() {
         if options
             .interrupt
             .as_ref()
@@ -671,7 +795,7 @@ pub fn run_with(
         )?;
         let done = steps_before + sim.steps();
         steps(done);
-        if k + 1 < times.len() {
+        if times.peek().is_some() {
             checkpoint(
                 false,
                 k + 1,
@@ -1037,6 +1161,29 @@ mod tests {
         assert!(output_times(1.0, &Sampling::Every(1e-300)).is_err());
         assert!(output_times(1.0, &Sampling::Times(vec![0.5, 0.2])).is_err());
         assert!(output_times(1.0, &Sampling::Times(vec![2.0])).is_err());
+    }
+
+    #[test]
+    fn the_schedule_gives_the_times_of_the_lists_one_at_a_time() {
+        for (t_end, sampling) in [
+            (1.0, Sampling::Points(3)),
+            (1.0, Sampling::Every(0.4)),
+            (1.0, Sampling::Every(0.5)),
+            (1000.0, Sampling::Every(0.3)),
+            (1000.0, Sampling::Points(777)),
+            (2.0, Sampling::Times(vec![0.5, 2.0])),
+            (2.0, Sampling::Times(vec![0.0, 0.26, 0.5, 0.51, 2.0])),
+        ] {
+            let list = output_times(t_end, &sampling).unwrap();
+            let lazy: Vec<f64> = Schedule::new(t_end, &sampling, None).unwrap().collect();
+            assert_eq!(lazy, list, "{sampling:?}");
+            for dt in [0.25, 0.3, 0.07] {
+                let grid: Vec<f64> = Schedule::new(t_end, &sampling, Some(dt)).unwrap().collect();
+                assert_eq!(grid, on_step_grid(&list, dt), "{sampling:?} dt = {dt}");
+            }
+        }
+        assert!(Schedule::new(1.0, &Sampling::Every(1e-300), None).is_err());
+        assert!(Schedule::new(1.0, &Sampling::Points(1), None).is_err());
     }
 
     #[test]
