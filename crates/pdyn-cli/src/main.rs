@@ -1,7 +1,8 @@
 //! `pdyn`: the command-line front end. Thin by design: parse arguments, call the library,
 //! print. Every failure becomes a message, a `--json` error object and an exit code here, and
 //! only here (codes: 0 success, 1 numerical failure after partial output, 2 bad input,
-//! 3 internal error — see `pdyn::error`).
+//! 3 internal error, 4 interrupted by a signal, 5 stopped at once by a second one — see
+//! `pdyn::error` and `cli::interrupt`).
 
 mod cli;
 
@@ -18,7 +19,9 @@ use std::process::ExitCode;
     about,
     long_about = None,
     after_help = "Exit codes: 0 success; 1 a numerical failure after partial output was written; \
-                  2 bad input; 3 an internal error (please report it)."
+                  2 bad input; 3 an internal error (please report it); 4 `pdyn run` interrupted by \
+                  SIGINT/SIGTERM (stopped after a whole step, files whole, summary.json status \
+                  \"interrupted\"); 5 stopped at once by a second signal (files hold whole rows)."
 )]
 struct Cli {
     #[command(subcommand)]

@@ -70,6 +70,11 @@ pub enum GravityError {
     },
     /// WHFast needs a massive central body (particle 0) to define Jacobi coordinates.
     MasslessPrimary,
+    /// A [`crate::Snapshot`] that does not fit the simulation it is restored into.
+    BadSnapshot {
+        /// What does not fit.
+        what: &'static str,
+    },
     /// The universal-variable Kepler solver did not converge.
     KeplerNotConverged {
         /// Simulation time at the start of the failed drift.
@@ -141,6 +146,9 @@ impl fmt::Display for GravityError {
                 write!(f, "parameter {name} = {value} out of range")
             }
             MasslessPrimary => write!(f, "WHFast needs a massive body 0 (the primary)"),
+            BadSnapshot { what } => {
+                write!(f, "the saved state does not fit this simulation: {what}")
+            }
             KeplerNotConverged { t, body } => {
                 write!(
                     f,

@@ -57,6 +57,6 @@ pub use integrators::{Ias15Params, Integrator, WhFastParams};
 pub use orbit::{Anomaly, Elements, Orbit};
 pub use pdyn_particles::{Particle, Particles, Vec3};
 pub use simulation::{
-    EventParams, Outcome, Primary, Simulation, MAX_CRAWL_STEPS, MIN_RELATIVE_STEP,
+    EventParams, Outcome, Primary, Simulation, Snapshot, MAX_CRAWL_STEPS, MIN_RELATIVE_STEP,
 };
 pub use units::Units;

@@ -78,6 +78,23 @@ pub const MIN_RELATIVE_STEP: f64 = 1e-12;
 /// Consecutive steps below [`MIN_RELATIVE_STEP`] that stop a run.
 pub const MAX_CRAWL_STEPS: u64 = 10_000;
 
+/// Everything a [`Simulation`] needs to continue bit for bit (a checkpoint, issue 29), as
+/// plain numbers: the particles, the radii, the clock, the step and the integrator's
+/// workspace (WHFast's Jacobi state, IAS15's predictor and compensated sums). The layout is
+/// this crate's; a reader stores the numbers exactly (as bits) and hands them back to
+/// [`Simulation::restore`] on a simulation built from the same model.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Snapshot {
+    /// `none` (no step taken yet), `whfast`, `ias15` or `leapfrog`.
+    pub workspace: String,
+    /// `t`, `dt`, `t_origin`, then the workspace's own.
+    pub scalars: Vec<f64>,
+    /// `steps`, `crawl`, `n_fixed`, then the workspace's own.
+    pub counters: Vec<u64>,
+    /// `x, y, z, vx, vy, vz, ax, ay, az, m`, radii, then the workspace's arrays.
+    pub arrays: Vec<Vec<f64>>,
+}
+
 /// A self-gravitating system of point masses and how to integrate it.
 #[derive(Debug, Clone)]
 pub struct Simulation {
@@ -314,6 +331,87 @@ impl Simulation {
             .map(|i| (key(self.particles.pos(i)), i))
             .collect();
         self.reset_workspace();
+        Ok(())
+    }
+
+    /// The state to continue from, exactly ([`Snapshot`]).
+    pub fn snapshot(&self) -> Snapshot {
+        let p = &self.particles;
+        let mut s = Snapshot {
+            workspace: "none".into(),
+            scalars: vec![self.t, self.dt, self.t_origin],
+            counters: vec![self.steps, self.crawl, self.n_fixed],
+            arrays: [
+                &p.x, &p.y, &p.z, &p.vx, &p.vy, &p.vz, &p.ax, &p.ay, &p.az, &p.m,
+            ]
+            .into_iter()
+            .cloned()
+            .chain(std::iter::once(self.radii.clone()))
+            .collect(),
+        };
+        if let Some(ws) = &self.workspace {
+            s.workspace = ws
+                .save(&mut s.scalars, &mut s.counters, &mut s.arrays)
+                .into();
+        }
+        s
+    }
+
+    /// Continues from `s`, taken by [`Simulation::snapshot`] of a simulation built the same
+    /// way (integrator, forces, units). A snapshot that does not fit is refused and the
+    /// simulation is left as it was.
+    pub fn restore(&mut self, s: &Snapshot) -> Result<(), GravityError> {
+        let bad = |what: &'static str| GravityError::BadSnapshot { what };
+        if s.scalars.len() < 3 || s.counters.len() < 3 || s.arrays.len() < 11 {
+            return Err(bad("too few numbers"));
+        }
+        let n = s.arrays[0].len();
+        if s.arrays[..11].iter().any(|a| a.len() != n) {
+            return Err(bad("particle arrays of different lengths"));
+        }
+        let mut particles = Particles::new();
+        {
+            let p = &mut particles;
+            for (dst, src) in [
+                &mut p.x, &mut p.y, &mut p.z, &mut p.vx, &mut p.vy, &mut p.vz, &mut p.ax,
+                &mut p.ay, &mut p.az, &mut p.m,
+            ]
+            .into_iter()
+            .zip(&s.arrays)
+            {
+                dst.clone_from(src);
+            }
+        }
+        let mut warnings = Vec::new();
+        let workspace = match s.workspace.as_str() {
+            "none" => None,
+            name => {
+                if name != Workspace::name_of(self.integrator) {
+                    return Err(bad("another integrator"));
+                }
+                let mut ws = Workspace::new(
+                    self.integrator,
+                    &particles,
+                    self.forces.g,
+                    s.scalars[1],
+                    &mut warnings,
+                )?;
+                ws.load(&s.scalars[3..], &s.counters[3..], &s.arrays[11..])
+                    .map_err(bad)?;
+                Some(ws)
+            }
+        };
+        self.particles = particles;
+        self.radii.clone_from(&s.arrays[10]);
+        self.seen.clear();
+        self.t = s.scalars[0];
+        self.dt = s.scalars[1];
+        self.t_origin = s.scalars[2];
+        self.steps = s.counters[0];
+        self.crawl = s.counters[1];
+        self.n_fixed = s.counters[2];
+        self.workspace = workspace;
+        self.warnings.extend(warnings);
         Ok(())
     }
 

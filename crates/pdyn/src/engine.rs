@@ -10,6 +10,7 @@
 //!                                      └─ Md:        md::request::plan → md::build → md::run
 //! ```
 
+pub use crate::checkpoint::LongRun;
 use crate::model_file::{Kind, ModelFile};
 use crate::options::RunOption;
 use crate::sim::{self, Prepared, RunResult, RunSettings};
@@ -196,6 +197,17 @@ pub fn run(
     req: &Request,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<RunOutput, Error> {
+    run_long(file, req, &LongRun::default(), progress)
+}
+
+/// [`run`] with the options of long runs (issue 29): rows kept only in the files
+/// (`stream_only`), checkpoints, a restart from one.
+pub fn run_long(
+    file: &ModelFile,
+    req: &Request,
+    long: &LongRun,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<RunOutput, Error> {
     plots_available(req)?;
     if req.plots && req.out.is_none() {
         return Err(Error::argument(
@@ -207,13 +219,32 @@ pub fn run(
             ),
         ));
     }
+    if file.kind != Kind::Nbody
+        && (long.restart.is_some()
+            || long
+                .checkpoint_every
+                .is_some_and(|e| e != crate::checkpoint::Every::Off))
+    {
+        let option = if long.restart.is_some() {
+            "--restart"
+        } else {
+            "--checkpoint-every"
+        };
+        return Err(Error::argument(
+            option,
+            format!(
+                "{option}: checkpoints and restarts are made for N-body runs only so far; a {} run is not checkpointed (see docs/long-runs.md)",
+                file.kind.name()
+            ),
+        ));
+    }
     Ok(match file.kind {
         Kind::Mechanics => {
             let mut model = file.mechanics()?;
             crate::params::set_parameter_values(&mut model, &req.params, RunOption::Set.name())?;
             RunOutput::Mechanics(Box::new(run_mechanics(model, req)?))
         }
-        Kind::Nbody => RunOutput::Nbody(Box::new(run_nbody(file, req)?)),
+        Kind::Nbody => RunOutput::Nbody(Box::new(run_nbody(file, req, long, progress)?)),
         Kind::Md => RunOutput::Md(Box::new(run_md(file, req, progress)?)),
     })
 }
@@ -231,6 +262,10 @@ pub fn run_mechanics(mut model: Model, req: &Request) -> Result<MechanicsRun, Er
         settings.points = Some(2001);
     }
     let prepared = sim::request::prepare(&mut model, req.jit)?;
+    if let Some(dir) = &req.out {
+        // Before the run: a run stopped early still has its directory.
+        create_dir(dir)?;
+    }
     let (result, failure) = sim::request::execute(&mut model, &prepared, &settings)?;
     let mut summary = output::summary(
         &result,
@@ -238,7 +273,23 @@ pub fn run_mechanics(mut model: Model, req: &Request) -> Result<MechanicsRun, Er
         &prepared.state_names,
         settings.drift_tolerance,
     );
-    if let Some(f) = &failure {
+    // A run stopped by the front end's interrupt (a signal) is not a numerical failure.
+    let failure = match failure {
+        Some(Error::Integration { origin, failure })
+            if matches!(failure.error, pdyn_ode::OdeError::Interrupted { .. }) =>
+        {
+            Some(crate::summary::interrupted(
+                &mut summary,
+                &origin,
+                failure.t,
+            ))
+        }
+        f => f,
+    };
+    if let Some(f) = failure
+        .as_ref()
+        .filter(|f| !matches!(f, Error::Interrupted { .. }))
+    {
         summary["error"] = f.to_json()["error"].clone();
         // A table with NaN is a failure too, though the integration finished.
         summary["ok"] = false.into();
@@ -268,13 +319,81 @@ pub fn run_mechanics(mut model: Model, req: &Request) -> Result<MechanicsRun, Er
     })
 }
 
-fn run_nbody(file: &ModelFile, req: &Request) -> Result<NbodyRun, Error> {
-    let planned = nbody::request::plan(&file.source, &file.origin, req)?;
+fn run_nbody(
+    file: &ModelFile,
+    req: &Request,
+    long: &LongRun,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<NbodyRun, Error> {
+    let streaming = long.stream_only && !req.plots;
+    let restart = match &long.restart {
+        Some(path) => {
+            if req.out.is_none() || !streaming {
+                return Err(Error::argument(
+                    "--restart",
+                    "--restart continues the files of --out DIR (and draws no plots: --plot needs the whole history)",
+                ));
+            }
+            Some(crate::checkpoint::read(path, "nbody", file, req)?)
+        }
+        None => None,
+    };
+    let planned = nbody::request::plan_with(&file.source, &file.origin, req, streaming)?;
     let trajectory = planned.trajectory;
-    let (spec, info, result) = planned.execute()?;
-    let (summary, failure) = nbody::output::outcome(&spec, &info, &result);
+    // The files are written as the run goes: the directory exists before it starts.
+    let mut stream = match (&req.out, &restart) {
+        (Some(dir), None) => {
+            create_dir(dir)?;
+            Some(nbody::output::Stream::create(dir, trajectory, !streaming)?)
+        }
+        (Some(dir), Some(r)) => {
+            let len = |k: usize| r.files.get(k).and_then(serde_json::Value::as_u64);
+            Some(nbody::output::Stream::resume(
+                dir,
+                [len(0), len(1), len(2)],
+                false,
+            )?)
+        }
+        (None, _) => None,
+    };
+    let every = match long.checkpoint_every {
+        Some(e) => e,
+        None => crate::checkpoint::Every::Seconds(crate::checkpoint::DEFAULT_SECONDS),
+    };
+    let mut checkpoints = match &req.out {
+        Some(dir) if every != crate::checkpoint::Every::Off && long.stream_only => Some(
+            crate::checkpoint::Checkpointer::new(dir, every, "nbody", file, req)
+                .starting_at(restart.as_ref().map_or(0, |r| r.steps)),
+        ),
+        _ => None,
+    };
+    let steps = planned.estimated_steps();
+    progress(Progress::Started {
+        steps,
+        work: steps.saturating_mul(planned.info.n_bodies as u64),
+    });
+    let (spec, info, result) = planned.execute_with(
+        stream.as_mut(),
+        &mut |s| progress(Progress::Step(s)),
+        checkpoints.as_mut(),
+        restart.as_ref().map(|r| &r.state),
+    )?;
+    let (mut summary, failure) = nbody::output::outcome(&spec, &info, &result);
+    if let Some(cp) = &checkpoints {
+        summary["checkpoint"] = serde_json::json!({
+            "file": cp.path().display().to_string(),
+            "written": cp.written,
+            "last_t": cp.last_time,
+        });
+    }
+    if let Some(r) = &restart {
+        summary["restarted_from"] = serde_json::json!({
+            "file": r.path.display().to_string(),
+            "t": r.t,
+        });
+    }
     if let Some(dir) = &req.out {
-        nbody::output::write_files(dir, &result, &summary, trajectory)?;
+        nbody::output::write_summary(dir, &summary)?;
         if req.plots {
             #[cfg(feature = "plots")]
             nbody::plots::write(&spec.name, &result, &spec.units, dir)?;

@@ -188,6 +188,15 @@ pub enum Error {
         /// Where and why (carries the step and the atoms).
         error: pdyn_md::MdError,
     },
+    /// A run stopped by a signal (SIGINT, SIGTERM) or a front end's interrupt after a whole
+    /// step: every file written so far is whole and `summary.json` says `"interrupted"` (exit
+    /// code 4).
+    Interrupted {
+        /// The model file.
+        origin: String,
+        /// The time the run reached.
+        time: f64,
+    },
 }
 
 impl Error {
@@ -214,6 +223,7 @@ impl Error {
             Error::MdRun { .. } => "md_run",
             Error::Data { .. } => "data",
             Error::Fit { .. } => "fit",
+            Error::Interrupted { .. } => "interrupted",
         }
     }
 
@@ -226,6 +236,7 @@ impl Error {
             | Error::MdRun { .. }
             | Error::Fit { .. } => 1,
             Error::Internal { .. } => 3,
+            Error::Interrupted { .. } => 4,
             _ => 2,
         }
     }
@@ -269,6 +280,7 @@ impl Error {
             | Error::Gravity { origin, .. }
             | Error::MdRun { origin, .. }
             | Error::Fit { origin, .. } => Some(file(origin)),
+            | Error::Interrupted { origin, .. } => Some(file(origin)),
             Error::Data { error } if !error.file.is_empty() => Some(Location {
                 file: error.file.clone(),
                 line: error.line,
@@ -392,6 +404,10 @@ impl fmt::Display for Error {
             Error::Gravity { origin, error } => write!(f, "{origin}: error: {error}"),
             Error::Data { error } => write!(f, "{error}"),
             Error::Fit { origin, message } => write!(f, "{origin}: error: fit: {message}"),
+            Error::Interrupted { origin, time } => write!(
+                f,
+                "{origin}: interrupted at t = {time}: the output up to there is written (summary.json has status \"interrupted\")"
+            ),
             Error::MdRun { origin, error } => {
                 write!(
                     f,

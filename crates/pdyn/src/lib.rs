@@ -8,6 +8,7 @@
 #![warn(missing_docs)]
 
 pub mod args;
+pub mod checkpoint;
 pub mod clock;
 pub mod data;
 pub mod dsolve;
@@ -26,6 +27,7 @@ pub mod plots;
 pub mod report;
 pub mod request;
 pub mod sim;
+pub mod stream;
 pub mod summary;
 
 pub use engine::{run, Progress, RunOutput};

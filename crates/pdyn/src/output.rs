@@ -150,6 +150,25 @@ pub fn json_num(x: f64) -> serde_json::Value {
     }
 }
 
+/// Writes `bytes` to `path` whole: into a temporary file beside it, synced, then renamed over
+/// it, so that a reader (or a run killed meanwhile) sees the old file or the new one, never a
+/// part of one.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), crate::Error> {
+    let mut name = path.file_name().unwrap_or_default().to_os_string();
+    name.push(".tmp");
+    let tmp = path.with_file_name(name);
+    let write = || -> std::io::Result<()> {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()
+    };
+    if let Err(e) = write() {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(crate::Error::io(&tmp, "write", e));
+    }
+    std::fs::rename(&tmp, path).map_err(|e| crate::Error::io(path, "rename into", e))
+}
+
 #[cfg(test)]
 mod tests {
     use super::push_number;

@@ -103,6 +103,21 @@ pub const MONITOR_FIELDS: [&str; 9] = [
     "ok",
 ];
 
+/// Marks `sum` as the summary of an interrupted run (`status: "interrupted"`, `ok: false`,
+/// `t_reached`, the error) and returns the error (exit code 4).
+pub fn interrupted(sum: &mut Value, origin: &str, time: f64) -> crate::Error {
+    let e = crate::Error::Interrupted {
+        origin: origin.to_string(),
+        time,
+    };
+    sum["status"] = json!("interrupted");
+    sum["ok"] = json!(false);
+    sum["failure"] = json!(e.to_string());
+    sum["t_reached"] = json_num(time);
+    sum["error"] = e.to_json()["error"].clone();
+    e
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

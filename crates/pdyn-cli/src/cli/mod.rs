@@ -12,6 +12,7 @@ pub mod expr;
 pub mod fit;
 pub mod forces;
 pub mod fuse;
+pub mod interrupt;
 pub mod kin;
 pub mod modes;
 pub mod run;

@@ -69,6 +69,15 @@ pub struct RunArgs {
     /// slower; for platforms without the JIT or to rule it out).
     #[arg(long = "no-jit")]
     pub no_jit: bool,
+    /// Write DIR/checkpoint.json this often: a wall time (`15min`, `30s`, `2h`), a number of
+    /// steps (`500steps`), or `off`; default 15min with --out (N-body runs; see
+    /// docs/long-runs.md). Also written when SIGINT/SIGTERM stops the run.
+    #[arg(long = "checkpoint-every", value_name = "WHEN")]
+    pub checkpoint_every: Option<String>,
+    /// Continue the run of this checkpoint bit for bit, appending to the files of --out
+    /// (the same model file and options; a foreign or damaged checkpoint is refused, exit 2).
+    #[arg(long, value_name = "CHECKPOINT")]
+    pub restart: Option<PathBuf>,
 }
 
 impl RunArgs {
@@ -100,7 +109,7 @@ pub fn request(a: &RunArgs) -> Result<pdyn::Request, Error> {
         jit: a.jit(),
         out: a.out.clone(),
         plots: a.plot,
-        // Ctrl-C ends the process (a clean stop with files kept is issue 29's).
+        // `run` installs the signal handler and sets it (SIGINT/SIGTERM: a clean stop).
         interrupt: None,
         frame_every: None,
     })
@@ -116,7 +125,8 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
     if a.method.as_deref() == Some("help") {
         return Ok(Outcome::text(pdyn::engine::methods_help(file.kind)));
     }
-    let req = request(&a)?;
+    let mut req = request(&a)?;
+    req.interrupt = super::interrupt::install();
     // The run's log (an MD run's thermo table) goes live to stderr unless --json.
     let live = !a.json;
     let mut bar = indicatif::ProgressBar::hidden();
@@ -135,7 +145,18 @@ pub fn run(a: RunArgs) -> Result<Outcome, Error> {
         Progress::Log(line) if live => bar.suspend(|| eprintln!("{line}")),
         _ => {}
     };
-    let mut output = pdyn::run(&file, &req, &mut progress)?;
+    let long = pdyn::engine::LongRun {
+        // Rows go only to the files as the run goes; plots need the history in memory.
+        stream_only: true,
+        checkpoint_every: match &a.checkpoint_every {
+            Some(text) => Some(pdyn::checkpoint::Every::parse(text).map_err(|m| {
+                Error::argument("--checkpoint-every", format!("--checkpoint-every {m}"))
+            })?),
+            None => None,
+        },
+        restart: a.restart.clone(),
+    };
+    let mut output = pdyn::engine::run_long(&file, &req, &long, &mut progress)?;
     bar.finish_and_clear();
     let mut stderr: String = output
         .warnings()

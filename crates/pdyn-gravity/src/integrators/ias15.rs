@@ -299,6 +299,86 @@ pub(crate) struct Ias15 {
 }
 
 impl Ias15 {
+    /// Everything that carries over from one step to the next: the start-of-step state and
+    /// its compensated sums, the predictor's coefficients (`b`, `e`, `br`, `er`), the last
+    /// step, the iteration count.
+    pub fn save(
+        &self,
+        scalars: &mut Vec<f64>,
+        counters: &mut Vec<u64>,
+        arrays: &mut Vec<Vec<f64>>,
+    ) {
+        scalars.push(self.dt_last_done);
+        counters.push(self.iterations_exceeded);
+        for a in self.arrays() {
+            arrays.push(a.clone());
+        }
+    }
+
+    /// Takes back what [`Ias15::save`] wrote.
+    pub fn load(
+        &mut self,
+        scalars: &[f64],
+        counters: &[u64],
+        arrays: &[Vec<f64>],
+    ) -> Result<(), &'static str> {
+        let ([dt, ..], [it, ..]) = (scalars, counters) else {
+            return Err("too few IAS15 numbers");
+        };
+        let mut src = arrays.iter();
+        for dst in self.arrays_mut() {
+            super::load_array(dst, src.next().ok_or("too few IAS15 arrays")?)?;
+        }
+        self.dt_last_done = *dt;
+        self.iterations_exceeded = *it;
+        Ok(())
+    }
+
+    fn arrays(&self) -> impl Iterator<Item = &Vec<f64>> {
+        [
+            &self.x0,
+            &self.v0,
+            &self.a0,
+            &self.at,
+            &self.csx,
+            &self.csv,
+            &self.gk,
+            &self.delta,
+        ]
+        .into_iter()
+        .chain(
+            [&self.g, &self.b, &self.e, &self.csb, &self.br, &self.er]
+                .into_iter()
+                .flat_map(|c| c.iter()),
+        )
+    }
+
+    fn arrays_mut(&mut self) -> impl Iterator<Item = &mut Vec<f64>> {
+        [
+            &mut self.x0,
+            &mut self.v0,
+            &mut self.a0,
+            &mut self.at,
+            &mut self.csx,
+            &mut self.csv,
+            &mut self.gk,
+            &mut self.delta,
+        ]
+        .into_iter()
+        .chain(
+            [
+                &mut self.g,
+                &mut self.b,
+                &mut self.e,
+                &mut self.csb,
+                &mut self.br,
+                &mut self.er,
+            ]
+            .into_iter()
+            .flat_map(|c| c.iter_mut()),
+        )
+    }
+
     /// Allocates the workspace for `n` particles.
     pub fn new(params: Ias15Params, n: usize) -> Result<Self, GravityError> {
         if !(params.epsilon >= 0.0 && params.epsilon.is_finite()) {

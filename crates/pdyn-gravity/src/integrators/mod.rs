@@ -94,6 +94,51 @@ impl Workspace {
         }
     }
 
+    /// The name a snapshot gives the workspace of `integrator`.
+    pub fn name_of(integrator: Integrator) -> &'static str {
+        match integrator {
+            Integrator::WhFast(_) => "whfast",
+            Integrator::Ias15(_) => "ias15",
+            Integrator::Leapfrog => "leapfrog",
+        }
+    }
+
+    /// Appends the state that carries over from step to step to a snapshot's numbers;
+    /// returns the workspace's name.
+    pub fn save(
+        &self,
+        scalars: &mut Vec<f64>,
+        counters: &mut Vec<u64>,
+        arrays: &mut Vec<Vec<f64>>,
+    ) -> &'static str {
+        match self {
+            Workspace::WhFast(w) => {
+                w.save(scalars, counters, arrays);
+                "whfast"
+            }
+            Workspace::Ias15(w) => {
+                w.save(scalars, counters, arrays);
+                "ias15"
+            }
+            Workspace::Leapfrog(_) => "leapfrog",
+        }
+    }
+
+    /// Takes back what [`Workspace::save`] wrote (a freshly made workspace of the same
+    /// integrator and size).
+    pub fn load(
+        &mut self,
+        scalars: &[f64],
+        counters: &[u64],
+        arrays: &[Vec<f64>],
+    ) -> Result<(), &'static str> {
+        match self {
+            Workspace::WhFast(w) => w.load(scalars, counters, arrays),
+            Workspace::Ias15(w) => w.load(scalars, counters, arrays),
+            Workspace::Leapfrog(_) => Ok(()),
+        }
+    }
+
     /// Whether the step is fixed (the simulation then keeps time as `t₀ + n dt`).
     pub fn is_fixed_step(&self) -> bool {
         matches!(self, Workspace::WhFast(_) | Workspace::Leapfrog(_))
@@ -111,4 +156,28 @@ impl Workspace {
             Workspace::Leapfrog(_) | Workspace::Ias15(_) => Ok(()),
         }
     }
+}
+
+/// Copies `src` into `dst` when the lengths agree.
+pub(crate) fn load_array(dst: &mut [f64], src: &[f64]) -> Result<(), &'static str> {
+    if dst.len() != src.len() {
+        return Err("an integrator array of another length");
+    }
+    dst.copy_from_slice(src);
+    Ok(())
+}
+
+/// `[x, y, z]` rows flattened, and back.
+pub(crate) fn flatten3(v: &[[f64; 3]]) -> Vec<f64> {
+    v.iter().flatten().copied().collect()
+}
+
+pub(crate) fn load3(dst: &mut [[f64; 3]], src: &[f64]) -> Result<(), &'static str> {
+    if 3 * dst.len() != src.len() {
+        return Err("an integrator array of another length");
+    }
+    for (d, s) in dst.iter_mut().zip(src.chunks_exact(3)) {
+        d.copy_from_slice(s);
+    }
+    Ok(())
 }

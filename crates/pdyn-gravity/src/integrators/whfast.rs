@@ -138,6 +138,45 @@ fn from_jacobi(m: &[f64], eta: &[f64], src: &[[f64; 3]], dst: [&mut [f64]; 3]) {
 }
 
 impl WhFast {
+    /// The Jacobi state (positions, velocities, accelerations, the backup), whether it is
+    /// synchronized, and the step (the masses' `eta` and `mu` are rebuilt from the particles).
+    pub fn save(
+        &self,
+        scalars: &mut Vec<f64>,
+        counters: &mut Vec<u64>,
+        arrays: &mut Vec<Vec<f64>>,
+    ) {
+        scalars.push(self.dt);
+        counters.push(u64::from(self.synchronized));
+        for a in [&self.jr, &self.jv, &self.ja, &self.backup_r, &self.backup_v] {
+            arrays.push(super::flatten3(a));
+        }
+    }
+
+    /// Takes back what [`WhFast::save`] wrote.
+    pub fn load(
+        &mut self,
+        scalars: &[f64],
+        counters: &[u64],
+        arrays: &[Vec<f64>],
+    ) -> Result<(), &'static str> {
+        let ([dt, ..], [sync, ..], [jr, jv, ja, br, bv, ..]) = (scalars, counters, arrays) else {
+            return Err("too few WHFast numbers");
+        };
+        for (dst, src) in [
+            (&mut self.jr, jr),
+            (&mut self.jv, jv),
+            (&mut self.ja, ja),
+            (&mut self.backup_r, br),
+            (&mut self.backup_v, bv),
+        ] {
+            super::load3(dst, src)?;
+        }
+        self.dt = *dt;
+        self.synchronized = *sync != 0;
+        Ok(())
+    }
+
     /// Validates the parameters and converts `p` to Jacobi coordinates.
     pub fn new(
         params: WhFastParams,

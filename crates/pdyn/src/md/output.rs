@@ -6,7 +6,6 @@ use super::run::{Average, MdResult};
 use super::spec::{Ensemble, Units};
 use crate::output::json_num;
 use crate::Error;
-use pdyn_md::THERMO_CSV_HEADER;
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -179,22 +178,25 @@ pub fn outcome(
     if let Some(f) = &failure {
         sum["error"] = f.to_json()["error"].clone();
     }
+    let failure = failure.or_else(|| {
+        res.interrupted.then(|| {
+            let time = res.records.last().map_or(0.0, |r| r.time);
+            crate::summary::interrupted(&mut sum, origin, time)
+        })
+    });
     (sum, failure)
 }
 
 /// [`write_files`] and `summary.json` (`sum`): what `pdyn run --out DIR` writes.
 pub fn write_all(res: &MdResult, sum: &serde_json::Value, dir: &Path) -> Result<(), Error> {
     write_files(res, dir)?;
-    write(&dir.join("summary.json"), &format!("{sum:#}\n"))
+    crate::output::write_atomic(&dir.join("summary.json"), format!("{sum:#}\n").as_bytes())
 }
 
-/// `thermo.csv`, plus `rdf.csv` and `msd.csv` when computed, into `dir`.
+/// `rdf.csv` and `msd.csv` when computed, into `dir` (`thermo.csv` and `traj.xyz` are
+/// written during the run).
 pub fn write_files(res: &MdResult, dir: &Path) -> Result<(), Error> {
-    let mut s = format!("{THERMO_CSV_HEADER}\n");
-    for r in &res.records {
-        let _ = writeln!(s, "{r}");
-    }
-    write(&dir.join("thermo.csv"), &s)?;
+    // thermo.csv was written as the run went.
     if let Some((r, g)) = &res.rdf {
         // `error`: the standard error of g from 5 blocks of frames, when there are two or more
         let mut s = String::from(if res.rdf_error.is_some() {

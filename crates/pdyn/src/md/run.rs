@@ -10,6 +10,7 @@
 use super::build::{Engine, Prepared, UnitSystem};
 use super::rdf_blocks::RdfBlocks;
 use super::spec::{Ensemble, MdSpec, Mode, Units};
+use crate::stream::RowFile;
 use crate::Error;
 use pdyn_md::analysis::Msd;
 use pdyn_md::potential::PairPotential;
@@ -110,6 +111,8 @@ pub struct MdResult {
     pub average_from: u64,
     /// How the temperature was measured.
     pub temperature_convention: Box<TemperatureConvention>,
+    /// Stopped early by [`RunOptions::interrupt`].
+    pub interrupted: bool,
 }
 
 /// How a run's temperature `T = 2K/(N_f k_B)` is measured (stated in `summary.json`).
@@ -285,14 +288,22 @@ fn run_sim<P: PairPotential>(
     let n = sim.system.particles.len();
     let dt = spec.dt.value;
     let names: Vec<&str> = spec.species.iter().map(|s| s.name.as_str()).collect();
+    // Frames and thermo rows go to the files as the run goes, whole (a frame is one "row").
     let mut traj = match (&opts.out, spec.dump_every) {
         (Some(dir), d) if d > 0 => {
             let path = dir.join("traj.xyz");
-            let f = std::fs::File::create(&path).map_err(|e| io_err(&path, "create", e))?;
-            Some((std::io::BufWriter::new(f), path))
+            Some((RowFile::create(&path, "")?, path))
         }
         _ => None,
     };
+    let mut thermo_file = match &opts.out {
+        Some(dir) => Some(RowFile::create(
+            &dir.join("thermo.csv"),
+            &format!("{}\n", pdyn_md::THERMO_CSV_HEADER),
+        )?),
+        None => None,
+    };
+    let mut write_error: Option<Error> = None;
     let traj_err = |path: &Path, e: MdError| match e {
         MdError::Io { kind } => io_err(path, "write", std::io::Error::from(kind)),
         e => Error::Internal {
@@ -313,8 +324,17 @@ fn run_sim<P: PairPotential>(
         });
     }
     if let Some((w, path)) = &mut traj {
-        write_frame(w, &sim.system, &names, u, sim.step, sim.step as f64 * dt)
-            .map_err(|e| traj_err(path, e))?;
+        let mut buf = Vec::new();
+        write_frame(
+            &mut buf,
+            &sim.system,
+            &names,
+            u,
+            sim.step,
+            sim.step as f64 * dt,
+        )
+        .map_err(|e| traj_err(path, e))?;
+        w.rows(|b| b.extend_from_slice(&buf))?;
         frames += 1;
     }
     let msd0 = spec.msd.then(|| Msd::new(&sim.system));
@@ -388,9 +408,11 @@ fn run_sim<P: PairPotential>(
     let mut failure = None;
     let mut builds = 0;
     let mut done = 0u64;
+    let mut interrupted = false;
     while done < spec.steps || (done == 0 && records.is_empty()) {
         let stop = opts.interrupt.as_ref();
         if done > 0 && stop.is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed)) {
+            interrupted = true;
             break;
         }
         let k = chunk.min(spec.steps - done);
@@ -406,6 +428,13 @@ fn run_sim<P: PairPotential>(
         let mut obs = |r: &ThermoRecord, s: &System| {
             let c = convert(r, u, dt);
             progress(Progress::Record(&c));
+            if let Some(f) = &mut thermo_file {
+                if let Err(e) = f.rows(|b| {
+                    let _ = writeln!(b, "{c}");
+                }) {
+                    write_error.get_or_insert(e);
+                }
+            }
             records.push(c);
             if let (Some(h), None) = (&mut rdf, spec.rdf_every) {
                 if r.step >= half && r.step > 0 {
@@ -450,10 +479,22 @@ fn run_sim<P: PairPotential>(
         }
         if let Some((w, path)) = &mut traj {
             if dump || failure.is_some() {
-                write_frame(w, &sim.system, &names, u, sim.step, sim.step as f64 * dt)
-                    .map_err(|e| traj_err(path, e))?;
+                let mut buf = Vec::new();
+                write_frame(
+                    &mut buf,
+                    &sim.system,
+                    &names,
+                    u,
+                    sim.step,
+                    sim.step as f64 * dt,
+                )
+                .map_err(|e| traj_err(path, e))?;
+                w.rows(|b| b.extend_from_slice(&buf))?;
                 frames += 1;
             }
+        }
+        if let Some(e) = write_error.take() {
+            return Err(e);
         }
         if failure.is_some() || k == 0 {
             break;
@@ -464,6 +505,11 @@ fn run_sim<P: PairPotential>(
         // the last step, when it is not a multiple of thermo_every
         let c = convert(&sim.thermo(), u, dt);
         progress(Progress::Record(&c));
+        if let Some(f) = &mut thermo_file {
+            f.rows(|b| {
+                let _ = writeln!(b, "{c}");
+            })?;
+        }
         records.push(c);
         if let Some(h) = &mut rdf {
             if spec.rdf_every.is_none() && c.step > 0 && (h.frames() as usize) < spec.rdf_frames {
@@ -491,8 +537,11 @@ fn run_sim<P: PairPotential>(
             spec.rdf_frames
         ));
     }
-    if let Some((w, path)) = &mut traj {
-        w.flush().map_err(|e| io_err(path, "write", e))?;
+    if let Some((w, _)) = &mut traj {
+        w.flush()?;
+    }
+    if let Some(f) = &mut thermo_file {
+        f.flush()?;
     }
     let drift = match spec.thermostat.ensemble {
         Ensemble::Nve | Ensemble::NoseHoover { .. } if records.len() >= 2 => {
@@ -561,6 +610,7 @@ fn run_sim<P: PairPotential>(
         seconds,
         average_from: spec.equilibrate,
         temperature_convention: Box::new(temperature_convention),
+        interrupted,
     };
     if res.failure.is_none() {
         if let Some(w) = time_step_bias_warning(&res, dt) {

@@ -3,8 +3,9 @@
 //! `conservation.csv` (energy, its parts, the virial ratio and the angular momentum at each
 //! output), `summary.json`, and the text report.
 
-use super::run::NbodyResult;
+use super::run::{BodyState, ConservationRow, ElementsRow, NbodyResult};
 use super::spec::NbodySpec;
+use crate::stream::RowFile;
 use std::fmt::Write as _;
 use std::io::Write;
 use std::path::Path;
@@ -31,41 +32,41 @@ fn num(x: f64) -> String {
     format!("{x:e}")
 }
 
-/// `trajectory.csv`: `t,body,x,y,z,vx,vy,vz`.
-pub fn write_trajectory(res: &NbodyResult, path: &Path) -> std::io::Result<()> {
-    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
-    writeln!(w, "t,body,x,y,z,vx,vy,vz")?;
-    for (t, states) in res.times.iter().zip(&res.states) {
-        for s in states {
-            writeln!(
-                w,
-                "{},{},{},{},{},{},{},{}",
-                num(*t),
-                res.names[s.body],
-                num(s.pos[0]),
-                num(s.pos[1]),
-                num(s.pos[2]),
-                num(s.vel[0]),
-                num(s.vel[1]),
-                num(s.vel[2])
-            )?;
-        }
+/// `trajectory.csv`'s header.
+pub const TRAJECTORY_HEADER: &str = "t,body,x,y,z,vx,vy,vz\n";
+/// `elements.csv`'s header.
+pub const ELEMENTS_HEADER: &str = "t,body,a,e,inc,Omega,omega,f,M,period\n";
+/// `conservation.csv`'s header.
+pub const CONSERVATION_HEADER: &str = "t,n,energy,kinetic,potential,virial_ratio,Lx,Ly,Lz\n";
+
+/// The rows of `trajectory.csv` (`t,body,x,y,z,vx,vy,vz`) of one output time.
+pub fn trajectory_rows(w: &mut Vec<u8>, t: f64, states: &[BodyState], names: &[String]) {
+    for s in states {
+        let _ = writeln!(
+            w,
+            "{},{},{},{},{},{},{},{}",
+            num(t),
+            names[s.body],
+            num(s.pos[0]),
+            num(s.pos[1]),
+            num(s.pos[2]),
+            num(s.vel[0]),
+            num(s.vel[1]),
+            num(s.vel[2])
+        );
     }
-    w.flush()
 }
 
-/// `elements.csv`: `t,body,a,e,inc,Omega,omega,f,M,period` (angles in radians; empty cells
-/// where a body has no elements).
-pub fn write_elements(res: &NbodyResult, path: &Path) -> std::io::Result<()> {
-    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
-    writeln!(w, "t,body,a,e,inc,Omega,omega,f,M,period")?;
-    for r in &res.elements {
-        match r.orbit {
+/// Rows of `elements.csv` (`t,body,a,e,inc,Omega,omega,f,M,period`, angles in radians; empty
+/// cells where a body has no elements).
+pub fn elements_rows(w: &mut Vec<u8>, rows: &[ElementsRow], names: &[String]) {
+    for r in rows {
+        let _ = match r.orbit {
             Some(o) => writeln!(
                 w,
                 "{},{},{},{},{},{},{},{},{},{}",
                 num(r.t),
-                res.names[r.body],
+                names[r.body],
                 num(o.a),
                 num(o.e),
                 num(o.inc),
@@ -74,33 +75,119 @@ pub fn write_elements(res: &NbodyResult, path: &Path) -> std::io::Result<()> {
                 num(o.f),
                 num(o.M),
                 num(o.period)
-            )?,
-            None => writeln!(w, "{},{},,,,,,,,", num(r.t), res.names[r.body])?,
-        }
+            ),
+            None => writeln!(w, "{},{},,,,,,,,", num(r.t), names[r.body]),
+        };
     }
-    w.flush()
 }
 
-/// `conservation.csv`: `t,n,energy,kinetic,potential,virial_ratio,Lx,Ly,Lz`.
-pub fn write_conservation(res: &NbodyResult, path: &Path) -> std::io::Result<()> {
-    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
-    writeln!(w, "t,n,energy,kinetic,potential,virial_ratio,Lx,Ly,Lz")?;
-    for r in &res.conservation {
-        writeln!(
-            w,
-            "{},{},{},{},{},{},{},{},{}",
-            num(r.t),
-            r.n,
-            num(r.energy),
-            num(r.kinetic),
-            num(r.potential),
-            num(virial(r.kinetic, r.potential)),
-            num(r.angular_momentum[0]),
-            num(r.angular_momentum[1]),
-            num(r.angular_momentum[2])
-        )?;
+/// One row of `conservation.csv` (`t,n,energy,kinetic,potential,virial_ratio,Lx,Ly,Lz`).
+pub fn conservation_row(w: &mut Vec<u8>, r: &ConservationRow) {
+    let _ = writeln!(
+        w,
+        "{},{},{},{},{},{},{},{},{}",
+        num(r.t),
+        r.n,
+        num(r.energy),
+        num(r.kinetic),
+        num(r.potential),
+        num(virial(r.kinetic, r.potential)),
+        num(r.angular_momentum[0]),
+        num(r.angular_momentum[1]),
+        num(r.angular_momentum[2])
+    );
+}
+
+/// The files of an N-body run written as it goes (`pdyn run --out DIR`): `trajectory.csv`
+/// and `elements.csv` when trajectories are kept, `conservation.csv`; every output time's
+/// rows appended whole ([`RowFile`]).
+#[derive(Debug)]
+pub struct Stream {
+    /// `trajectory.csv`.
+    pub trajectory: Option<RowFile>,
+    /// `elements.csv`.
+    pub elements: Option<RowFile>,
+    /// `conservation.csv`.
+    pub conservation: RowFile,
+    /// Keep the whole history in memory as well (Python's arrays, plots); otherwise the
+    /// result keeps only the first and last output (bounded memory).
+    pub keep: bool,
+}
+
+impl Stream {
+    /// Creates the files in `dir` (which exists) with their headers.
+    pub fn create(dir: &Path, trajectory: bool, keep: bool) -> Result<Stream, crate::Error> {
+        let (trajectory, elements) = if trajectory {
+            (
+                Some(RowFile::create(
+                    &dir.join("trajectory.csv"),
+                    TRAJECTORY_HEADER,
+                )?),
+                Some(RowFile::create(&dir.join("elements.csv"), ELEMENTS_HEADER)?),
+            )
+        } else {
+            (None, None)
+        };
+        Ok(Stream {
+            trajectory,
+            elements,
+            conservation: RowFile::create(&dir.join("conservation.csv"), CONSERVATION_HEADER)?,
+            keep,
+        })
     }
-    w.flush()
+
+    /// The files in `dir`, each truncated to the length a checkpoint recorded
+    /// (`[trajectory, elements, conservation]`, `None` for a file the run does not write).
+    pub fn resume(
+        dir: &Path,
+        lengths: [Option<u64>; 3],
+        keep: bool,
+    ) -> Result<Stream, crate::Error> {
+        let open = |name: &str, len: Option<u64>| {
+            len.map(|l| RowFile::resume(&dir.join(name), l)).transpose()
+        };
+        let missing = || crate::Error::Internal {
+            message: "checkpoint without conservation.csv's length".into(),
+        };
+        Ok(Stream {
+            trajectory: open("trajectory.csv", lengths[0])?,
+            elements: open("elements.csv", lengths[1])?,
+            conservation: open("conservation.csv", lengths[2])?.ok_or_else(missing)?,
+            keep,
+        })
+    }
+
+    /// Every file's buffered rows written out.
+    pub fn flush(&mut self) -> Result<(), crate::Error> {
+        for f in self.files() {
+            f.flush()?;
+        }
+        Ok(())
+    }
+
+    /// Flushed and synced to the disk (before a checkpoint records the lengths).
+    pub fn sync(&mut self) -> Result<(), crate::Error> {
+        for f in self.files() {
+            f.sync()?;
+        }
+        Ok(())
+    }
+
+    /// The files' lengths after the last flush (`[trajectory, elements, conservation]`).
+    pub fn lengths(&self) -> [Option<u64>; 3] {
+        [
+            self.trajectory.as_ref().map(RowFile::len),
+            self.elements.as_ref().map(RowFile::len),
+            Some(self.conservation.len()),
+        ]
+    }
+
+    fn files(&mut self) -> impl Iterator<Item = &mut RowFile> {
+        self.trajectory
+            .iter_mut()
+            .chain(self.elements.iter_mut())
+            .chain(std::iter::once(&mut self.conservation))
+    }
 }
 
 /// `2T/|V|`: 1 for a system in virial equilibrium.
@@ -161,7 +248,7 @@ pub fn summary(spec: &NbodySpec, info: &RunInfo, res: &NbodyResult) -> serde_jso
         res.failure.as_ref().map(|f| f.to_string()),
         &res.warnings,
         &monitors,
-        serde_json::json!({"steps": res.steps, "final_dt": res.final_dt, "outputs": res.times.len()}),
+        serde_json::json!({"steps": res.steps, "final_dt": res.final_dt, "outputs": res.outputs}),
         serde_json::json!({
             "units": spec.units.label,
             "G": spec.units.units.g(),
@@ -203,33 +290,17 @@ pub fn outcome(
     if let Some(f) = &failure {
         sum["error"] = f.to_json()["error"].clone();
     }
+    let failure = failure.or_else(|| {
+        res.interrupted
+            .then(|| crate::summary::interrupted(&mut sum, &spec.origin, res.t_reached))
+    });
     (sum, failure)
 }
 
-/// The files of `pdyn run --out DIR`: `trajectory.csv` and `elements.csv` when trajectories
-/// were kept, `conservation.csv`, and `summary.json` (`sum`).
-pub fn write_files(
-    dir: &Path,
-    res: &NbodyResult,
-    sum: &serde_json::Value,
-    trajectory: bool,
-) -> Result<(), crate::Error> {
-    let io = |path: std::path::PathBuf, action: &'static str, e: std::io::Error| crate::Error::Io {
-        path,
-        action,
-        error: std::sync::Arc::new(e),
-    };
-    std::fs::create_dir_all(dir).map_err(|e| io(dir.to_path_buf(), "create", e))?;
-    let write = |name: &str, f: &dyn Fn(&Path) -> std::io::Result<()>| {
-        let path = dir.join(name);
-        f(&path).map_err(|e| io(path.clone(), "write", e))
-    };
-    if trajectory {
-        write("trajectory.csv", &|p| write_trajectory(res, p))?;
-        write("elements.csv", &|p| write_elements(res, p))?;
-    }
-    write("conservation.csv", &|p| write_conservation(res, p))?;
-    write("summary.json", &|p| std::fs::write(p, format!("{sum:#}\n")))
+/// `summary.json` (`sum`) in `dir`, written whole (a temporary file renamed over it); the
+/// CSV files were streamed during the run ([`Stream`]).
+pub fn write_summary(dir: &Path, sum: &serde_json::Value) -> Result<(), crate::Error> {
+    crate::output::write_atomic(&dir.join("summary.json"), format!("{sum:#}\n").as_bytes())
 }
 
 /// The text report of `pdyn run`.
@@ -251,7 +322,7 @@ pub fn text_report(
         info.dt,
         res.t_reached,
         res.steps,
-        res.times.len()
+        res.outputs
     );
     let _ = writeln!(
         s,

@@ -35,6 +35,17 @@ pub struct Planned {
 /// request and builds the simulation. Every problem is an [`Error`]: located in the file, or
 /// naming the option.
 pub fn plan(source: &str, origin: &str, req: &Request) -> Result<Planned, Error> {
+    plan_with(source, origin, req, false)
+}
+
+/// [`plan`] for a run whose rows go only to files as it runs (`streaming`): then no limit on
+/// the trajectory rows held in memory applies.
+pub fn plan_with(
+    source: &str,
+    origin: &str,
+    req: &Request,
+    streaming: bool,
+) -> Result<Planned, Error> {
     let ias15_accuracy = "IAS15's accuracy is `epsilon` in [nbody]";
     for (given, option, instead) in [
         (
@@ -156,9 +167,10 @@ pub fn plan(source: &str, origin: &str, req: &Request) -> Result<Planned, Error>
     } else {
         (Sampling::Points(spec.points.unwrap_or(201)), "points")
     };
-    let n_outputs = super::run::output_times(t_end, &sampling)
+    // Counted, not listed (a list of 10⁷ times would be most of a streaming run's memory).
+    let n_outputs = super::run::Schedule::new(t_end, &sampling, None)
         .map_err(|m| Error::argument(option, format!("{option}: {m}")))?
-        .len();
+        .raw_len();
 
     // A fixed step absurdly small for the span would run for days: say so instead.
     if let (Some((dt, span)), true) = (&spec.dt, spec.integrator != IntegratorKind::Ias15) {
@@ -186,7 +198,10 @@ pub fn plan(source: &str, origin: &str, req: &Request) -> Result<Planned, Error>
         .trajectory
         .unwrap_or(n_bodies <= super::run::TRAJECTORY_LIMIT);
     // Trajectories are kept in memory until written: refuse what would not fit.
-    if trajectory && n_bodies.saturating_mul(n_outputs) > MAX_TRAJECTORY_ROWS {
+    if trajectory
+        && !(streaming && req.out.is_some())
+        && n_bodies.saturating_mul(n_outputs) > MAX_TRAJECTORY_ROWS
+    {
         return Err(Error::argument(
             option,
             format!(
@@ -235,12 +250,44 @@ pub fn plan(source: &str, origin: &str, req: &Request) -> Result<Planned, Error>
 }
 
 impl Planned {
+    /// The steps the run will take (for IAS15, `t_end` over the first step: a guess).
+    pub fn estimated_steps(&self) -> u64 {
+        let n = self.options.t_end / self.info.dt;
+        if n.is_finite() && n > 0.0 {
+            n.ceil().min(u64::MAX as f64) as u64
+        } else {
+            0
+        }
+    }
+
     /// Integrates. A run that stops early (a collision, an escape, a failed step) is a result
     /// with its `failure` set; an error here is about the output times only.
     pub fn execute(self) -> Result<(NbodySpec, RunInfo, NbodyResult), Error> {
+        self.execute_with(None, &mut |_| {}, None, None)
+    }
+
+    /// Integrates, appending rows to `stream` as they are recorded and telling `steps` the
+    /// steps taken at each output; checkpoints and a restart as in [`super::run::run_with`].
+    pub fn execute_with(
+        self,
+        stream: Option<&mut super::output::Stream>,
+        steps: &mut dyn FnMut(u64),
+        checkpoints: Option<&mut crate::checkpoint::Checkpointer>,
+        resume: Option<&serde_json::Value>,
+    ) -> Result<(NbodySpec, RunInfo, NbodyResult), Error> {
         let option = self.sampling_option;
-        let res = super::run::run(self.built, &self.options)
-            .map_err(|m| Error::argument(option, m.to_string()))?;
+        let res = super::run::run_with(
+            self.built,
+            &self.options,
+            stream,
+            steps,
+            checkpoints,
+            resume,
+        )
+        .map_err(|e| match e {
+            super::run::RunError::Sampling(m) => Error::argument(option, m.to_string()),
+            super::run::RunError::Write(e) => e,
+        })?;
         Ok((self.spec, self.info, res))
     }
 }

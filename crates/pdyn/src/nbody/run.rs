@@ -185,6 +185,126 @@ pub fn output_times(t_end: f64, sampling: &Sampling) -> Result<Vec<f64>, Samplin
     }
 }
 
+/// The output times of a run, one at a time: those of [`output_times`], moved onto the step
+/// grid as [`on_step_grid`] does for a fixed step, without a list of them in memory (a run of
+/// 10⁷ outputs holds none; times given one by one are the list they came in).
+#[derive(Debug, Clone)]
+pub struct Schedule {
+    raw: Raw,
+    len: usize,
+    k: usize,
+    grid: Option<f64>,
+    last: Option<f64>,
+}
+
+#[derive(Debug, Clone)]
+enum Raw {
+    Points { n: usize, t_end: f64 },
+    Every { dt: f64, n: usize, t_end: f64 },
+    List(Vec<f64>),
+}
+
+impl Schedule {
+    /// The times of `sampling` up to `t_end`, on the grid of `grid` (a fixed step) if given;
+    /// refused as [`output_times`] refuses them.
+    pub fn new(
+        t_end: f64,
+        sampling: &Sampling,
+        grid: Option<f64>,
+    ) -> Result<Schedule, SamplingError> {
+        let (raw, len) = match sampling {
+            Sampling::Points(n) => {
+                if *n < 2 || *n > MAX_POINTS {
+                    return Err(SamplingError::Points {
+                        n: *n,
+                        max: MAX_POINTS,
+                    });
+                }
+                (Raw::Points { n: *n, t_end }, *n)
+            }
+            Sampling::Every(dt) => {
+                if !(dt.is_finite() && *dt > 0.0) {
+                    return Err(SamplingError::Interval(*dt));
+                }
+                let n = (t_end / dt).floor();
+                if n > MAX_POINTS as f64 {
+                    return Err(SamplingError::TooMany {
+                        dt: *dt,
+                        t_end,
+                        n,
+                        max: MAX_POINTS,
+                    });
+                }
+                let n = n as usize;
+                // The last output is t_end itself (unless within round-off of the previous one).
+                let extra = t_end - n as f64 * dt > 1e-9 * dt;
+                (Raw::Every { dt: *dt, n, t_end }, n + 1 + usize::from(extra))
+            }
+            Sampling::Times(_) => {
+                let v = output_times(t_end, sampling)?;
+                let len = v.len();
+                (Raw::List(v), len)
+            }
+        };
+        Ok(Schedule {
+            raw,
+            len,
+            k: 0,
+            grid,
+            last: None,
+        })
+    }
+
+    /// The number of times before moving them to the step grid.
+    pub fn raw_len(&self) -> usize {
+        self.len
+    }
+
+    fn raw_at(&self, k: usize) -> f64 {
+        match &self.raw {
+            Raw::Points { n, t_end } => t_end * k as f64 / (*n - 1) as f64,
+            Raw::Every { dt, n, t_end } => {
+                if k <= *n {
+                    k as f64 * dt
+                } else {
+                    *t_end
+                }
+            }
+            Raw::List(v) => v[k],
+        }
+    }
+}
+
+impl Iterator for Schedule {
+    type Item = f64;
+
+    fn next(&mut self) -> Option<f64> {
+        while self.k < self.len {
+            let t = self.raw_at(self.k);
+            self.k += 1;
+            let Some(dt) = self.grid else {
+                self.last = Some(t);
+                return Some(t);
+            };
+            if self.k == self.len {
+                // t_end stays where it is
+                if self.last.is_none_or(|l| t > l) {
+                    self.last = Some(t);
+                    return Some(t);
+                }
+                return None;
+            }
+            let t_end = self.raw_at(self.len - 1);
+            let snapped = (t / dt).round() * dt;
+            if snapped < t_end && self.last.is_none_or(|l| snapped > l) {
+                self.last = Some(snapped);
+                return Some(snapped);
+            }
+        }
+        None
+    }
+}
+
 /// The state of one body at an output time.
 #[derive(Debug, Clone, Copy)]
 pub struct BodyState {
@@ -259,13 +379,17 @@ pub struct Monitor {
 pub struct NbodyResult {
     /// Names of all bodies that existed during the run (a merged body keeps the first name).
     pub names: Vec<String>,
-    /// Output times.
+    /// Output times (with a streaming run that keeps no history, the last one only:
+    /// [`NbodyResult::outputs`] counts them all).
     pub times: Vec<f64>,
+    /// Outputs recorded.
+    pub outputs: usize,
     /// Per output time, the bodies' states (empty unless trajectories are recorded).
     pub states: Vec<Vec<BodyState>>,
     /// Elements over time (empty unless trajectories are recorded).
     pub elements: Vec<ElementsRow>,
-    /// Invariants at each output.
+    /// Invariants at each output (with a streaming run that keeps no history, the first and
+    /// the last).
     pub conservation: Vec<ConservationRow>,
     /// Events.
     pub events: Vec<NbodyEvent>,
@@ -285,6 +409,8 @@ pub struct NbodyResult {
     pub final_positions: Vec<[f64; 3]>,
     /// The numerical failure that stopped the run early, if any (output up to it is kept).
     pub failure: Option<GravityError>,
+    /// Stopped early by [`RunOptions::interrupt`].
+    pub interrupted: bool,
 }
 
 /// What the engine knows of the bodies, for a rebuild after an event.
@@ -293,6 +419,7 @@ fn bodies_of(sim: &Simulation) -> Vec<(Particle, f64)> {
     (0..p.len()).map(|i| (p.get(i), sim.radii()[i])).collect()
 }
 
+#[derive(Clone, Copy, Debug)]
 struct Segment {
     e0: f64,
     e_scale: f64,
@@ -346,24 +473,63 @@ impl Segment {
     }
 }
 
-/// Integrates `built` as `options` say.
+/// Why a run could not go on: its output times, or a file it writes.
+#[derive(Debug)]
+pub enum RunError {
+    /// The output times asked for.
+    Sampling(SamplingError),
+    /// Writing an output file.
+    Write(crate::Error),
+}
+
+impl From<crate::Error> for RunError {
+    fn from(e: crate::Error) -> Self {
+        RunError::Write(e)
+    }
+}
+
+/// Integrates `built` as `options` say, keeping the whole history in memory.
 pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingError> {
+    run_with(built, options, None, &mut |_| {}, None, None).map_err(|e| match e {
+        RunError::Sampling(s) => s,
+        // nothing is written without a stream
+        RunError::Write(_) => SamplingError::Interval(f64::NAN),
+    })
+}
+
+/// Integrates `built` as `options` say, appending each output's rows to `stream` as it is
+/// recorded (keeping only the first and last output in memory unless `stream.keep`), and
+/// telling `steps` the steps taken so far at each output.
+///
+/// With `checkpoints`, a checkpoint is written at each output where one is due and when the
+/// run is interrupted; with `resume` (a checkpoint's `state`), the run continues from there
+/// (the stream's files already truncated to the checkpoint's lengths).
+pub fn run_with(
+    built: Built,
+    options: &RunOptions,
+    mut stream: Option<&mut super::output::Stream>,
+    steps: &mut dyn FnMut(u64),
+    mut checkpoints: Option<&mut crate::checkpoint::Checkpointer>,
+    resume: Option<&serde_json::Value>,
+) -> Result<NbodyResult, RunError> {
     let Built {
         mut sim,
         config,
         names,
         primaries,
     } = built;
-    let mut times = output_times(options.t_end, &options.sampling)?;
-    if options.integrator != IntegratorKind::Ias15 {
-        times = on_step_grid(&times, config.dt);
-    }
+    let grid = (options.integrator != IntegratorKind::Ias15).then_some(config.dt);
+    let mut times = Schedule::new(options.t_end, &options.sampling, grid)
+        .map_err(RunError::Sampling)?
+        .enumerate()
+        .peekable();
     // Current index → name index; primaries by name index (they survive mergers).
     let mut alive: Vec<usize> = (0..names.len()).collect();
     let primary_of: Vec<Option<usize>> = primaries;
     let mut res = NbodyResult {
-        names: Vec::new(),
+        names: names.clone(),
         times: Vec::new(),
+        outputs: 0,
         states: Vec::new(),
         elements: Vec::new(),
         conservation: Vec::new(),
@@ -376,6 +542,7 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingEr
         t_reached: 0.0,
         final_positions: Vec::new(),
         failure: None,
+        interrupted: false,
     };
     let mut seg = Segment::start(&sim);
     let mut e_worst = 0.0f64;
@@ -383,21 +550,92 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingEr
     let mut t_offset = 0.0;
     let mut steps_before = 0u64;
     let mut engine_warnings: Vec<Warning> = Vec::new();
-    record(
-        &sim,
-        0.0,
-        &alive,
-        &primary_of,
-        options.trajectory,
-        &mut res,
-        &mut seg,
-    );
-    'outer: for &tk in &times[1..] {
+    let start = match resume {
+        Some(state) => {
+            let r = Resumed::read(state).ok_or_else(|| {
+                RunError::Write(crate::Error::argument(
+                    "--restart",
+                    "the checkpoint's N-body state is incomplete or of another version",
+                ))
+            })?;
+            sim.restore(&r.snapshot).map_err(|e| {
+                RunError::Write(crate::Error::argument(
+                    "--restart",
+                    format!("the checkpoint does not fit this model: {e}"),
+                ))
+            })?;
+            alive = r.alive;
+            [t_offset, e_worst, l_worst] = r.scalars;
+            seg = r.seg;
+            steps_before = r.steps_before;
+            res.outputs = r.outputs;
+            res.conservation = r.conservation;
+            res.times = vec![r.t_last];
+            res.events = r.events;
+            r.next
+        }
+        None => {
+            record(
+                &sim,
+                0.0,
+                &alive,
+                &primary_of,
+                options.trajectory,
+                &mut res,
+                &mut seg,
+                stream.as_deref_mut(),
+            )?;
+            1
+        }
+    };
+    let mut checkpoint = |force: bool,
+                          next: usize,
+                          sim: &Simulation,
+                          alive: &[usize],
+                          scalars: [f64; 3],
+                          seg: &Segment,
+                          steps_before: u64,
+                          res: &NbodyResult,
+                          stream: Option<&mut super::output::Stream>|
+     -> Result<(), crate::Error> {
+        let Some(cp) = checkpoints.as_deref_mut() else {
+            return Ok(());
+        };
+        if !force && !cp.due(steps_before + sim.steps()) {
+            return Ok(());
+        }
+        let files = match stream {
+            Some(s) => {
+                s.sync()?;
+                serde_json::json!(s.lengths())
+            }
+            None => serde_json::Value::Null,
+        };
+        let t = res.times.last().copied().unwrap_or(0.0);
+        let state = save_state(next, sim, alive, scalars, seg, steps_before, res);
+        cp.write(t, steps_before + sim.steps(), files, state)
+    };
+    for _ in 0..start {
+        times.next();
+    }
+    'outer: while let Some((k, tk)) = times.next() {
         if options
             .interrupt
             .as_ref()
             .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
         {
+            res.interrupted = true;
+            checkpoint(
+                true,
+                k,
+                &sim,
+                &alive,
+                [t_offset, e_worst, l_worst],
+                &seg,
+                steps_before,
+                &res,
+                stream.as_deref_mut(),
+            )?;
             break;
         }
         loop {
@@ -421,7 +659,8 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingEr
                             options.trajectory,
                             &mut res,
                             &mut seg,
-                        );
+                            stream.as_deref_mut(),
+                        )?;
                         break 'outer;
                     }
                     let e_before = sim.energy();
@@ -487,7 +726,8 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingEr
                             options.trajectory,
                             &mut res,
                             &mut seg,
-                        );
+                            stream.as_deref_mut(),
+                        )?;
                         break 'outer;
                     }
                     let mut bodies = bodies_of(&sim);
@@ -551,7 +791,23 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingEr
             options.trajectory,
             &mut res,
             &mut seg,
-        );
+            stream.as_deref_mut(),
+        )?;
+        let done = steps_before + sim.steps();
+        steps(done);
+        if times.peek().is_some() {
+            checkpoint(
+                false,
+                k + 1,
+                &sim,
+                &alive,
+                [t_offset, e_worst, l_worst],
+                &seg,
+                steps_before,
+                &res,
+                stream.as_deref_mut(),
+            )?;
+        }
     }
     e_worst = max_nan(e_worst, seg.e_drift);
     l_worst = max_nan(l_worst, seg.l_drift);
@@ -625,7 +881,9 @@ pub fn run(built: Built, options: &RunOptions) -> Result<NbodyResult, SamplingEr
     }
     let p = sim.particles();
     res.final_positions = (0..p.len()).map(|i| p.pos(i).0).collect();
-    res.names = names;
+    if let Some(s) = stream {
+        s.flush()?;
+    }
     Ok(res)
 }
 
@@ -657,6 +915,151 @@ fn max_nan(a: f64, b: f64) -> f64 {
     }
 }
 
+const EVENT_KINDS: [&str; 5] = [
+    "collision",
+    "merger",
+    "escape",
+    "removal",
+    "close_encounter",
+];
+
+/// The loop's state at an output, for a checkpoint: every number as its bits.
+fn save_state(
+    next: usize,
+    sim: &Simulation,
+    alive: &[usize],
+    scalars: [f64; 3],
+    seg: &Segment,
+    steps_before: u64,
+    res: &NbodyResult,
+) -> serde_json::Value {
+    use crate::checkpoint::bits;
+    let snap = sim.snapshot();
+    let row = |r: &ConservationRow| {
+        serde_json::json!({
+            "n": r.n,
+            "x": bits(&[r.t, r.energy, r.kinetic, r.potential, r.angular_momentum[0], r.angular_momentum[1], r.angular_momentum[2]]),
+        })
+    };
+    serde_json::json!({
+        "next": next,
+        "alive": alive,
+        "scalars": bits(&scalars),
+        "segment": bits(&[seg.e0, seg.e_scale, seg.l0[0], seg.l0[1], seg.l0[2], seg.l_scale, seg.e_drift, seg.l_drift]),
+        "steps_before": steps_before,
+        "outputs": res.outputs,
+        "t_last": res.times.last().copied().unwrap_or(0.0).to_bits(),
+        "conservation": [res.conservation.first().map(row), res.conservation.last().map(row)],
+        "events": res.events.iter().map(|e| serde_json::json!({
+            "t": e.t.to_bits(), "kind": e.kind, "bodies": e.bodies, "message": e.message,
+        })).collect::<Vec<_>>(),
+        "engine": {
+            "workspace": snap.workspace,
+            "scalars": bits(&snap.scalars),
+            "counters": snap.counters,
+            "arrays": snap.arrays.iter().map(|a| bits(a)).collect::<Vec<_>>(),
+        },
+    })
+}
+
+/// What [`save_state`] wrote.
+struct Resumed {
+    next: usize,
+    alive: Vec<usize>,
+    scalars: [f64; 3],
+    seg: Segment,
+    steps_before: u64,
+    outputs: usize,
+    t_last: f64,
+    conservation: Vec<ConservationRow>,
+    events: Vec<NbodyEvent>,
+    snapshot: pdyn_gravity::Snapshot,
+}
+
+impl Resumed {
+    fn read(v: &serde_json::Value) -> Option<Resumed> {
+        use crate::checkpoint::unbits;
+        let usize_of = |v: &serde_json::Value| v.as_u64().map(|x| x as usize);
+        let row = |v: &serde_json::Value| -> Option<ConservationRow> {
+            let x = unbits(&v["x"])?;
+            let [t, energy, kinetic, potential, lx, ly, lz] = x[..] else {
+                return None;
+            };
+            Some(ConservationRow {
+                t,
+                n: usize_of(&v["n"])?,
+                energy,
+                kinetic,
+                potential,
+                angular_momentum: [lx, ly, lz],
+            })
+        };
+        let sc = unbits(&v["scalars"])?;
+        let sg = unbits(&v["segment"])?;
+        let [e0, e_scale, l0x, l0y, l0z, l_scale, e_drift, l_drift] = sg[..] else {
+            return None;
+        };
+        let mut conservation = Vec::new();
+        for r in v["conservation"].as_array()? {
+            if !r.is_null() {
+                conservation.push(row(r)?);
+            }
+        }
+        let mut events = Vec::new();
+        for e in v["events"].as_array()? {
+            let kind = e["kind"].as_str()?;
+            events.push(NbodyEvent {
+                t: f64::from_bits(e["t"].as_u64()?),
+                kind: EVENT_KINDS.iter().find(|k| **k == kind)?,
+                bodies: e["bodies"]
+                    .as_array()?
+                    .iter()
+                    .map(|b| b.as_str().map(String::from))
+                    .collect::<Option<_>>()?,
+                message: e["message"].as_str()?.to_string(),
+            });
+        }
+        let eng = &v["engine"];
+        Some(Resumed {
+            next: usize_of(&v["next"])?,
+            alive: v["alive"]
+                .as_array()?
+                .iter()
+                .map(usize_of)
+                .collect::<Option<_>>()?,
+            scalars: sc.try_into().ok()?,
+            seg: Segment {
+                e0,
+                e_scale,
+                l0: [l0x, l0y, l0z],
+                l_scale,
+                e_drift,
+                l_drift,
+            },
+            steps_before: v["steps_before"].as_u64()?,
+            outputs: usize_of(&v["outputs"])?,
+            t_last: f64::from_bits(v["t_last"].as_u64()?),
+            conservation,
+            events,
+            snapshot: pdyn_gravity::Snapshot {
+                workspace: eng["workspace"].as_str()?.to_string(),
+                scalars: unbits(&eng["scalars"])?,
+                counters: eng["counters"]
+                    .as_array()?
+                    .iter()
+                    .map(serde_json::Value::as_u64)
+                    .collect::<Option<_>>()?,
+                arrays: eng["arrays"]
+                    .as_array()?
+                    .iter()
+                    .map(unbits)
+                    .collect::<Option<_>>()?,
+            },
+        })
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
 fn record(
     sim: &Simulation,
     t: f64,
@@ -665,7 +1068,17 @@ fn record(
     trajectory: bool,
     res: &mut NbodyResult,
     seg: &mut Segment,
-) {
+    stream: Option<&mut super::output::Stream>,
+) -> Result<(), crate::Error> {
+    let keep = stream.as_ref().is_none_or(|s| s.keep);
+    if !keep {
+        // Bounded memory: the first conservation row (the monitors' reference), and the
+        // output being recorded.
+        res.times.clear();
+        res.states.clear();
+        res.elements.clear();
+        res.conservation.truncate(1);
+    }
     let p = sim.particles();
     let kinetic = p.kinetic_energy();
     let energy = sim.energy();
@@ -680,31 +1093,45 @@ fn record(
     seg.update(&row);
     res.conservation.push(row);
     res.times.push(t);
-    if !trajectory {
-        return;
-    }
-    res.states.push(
-        (0..p.len())
-            .map(|i| BodyState {
+    res.outputs += 1;
+    let elements_from = res.elements.len();
+    if trajectory {
+        res.states.push(
+            (0..p.len())
+                .map(|i| BodyState {
+                    body: alive[i],
+                    mass: p.m[i],
+                    pos: p.pos(i).0,
+                    vel: p.vel(i).0,
+                })
+                .collect(),
+        );
+        for i in 1..p.len() {
+            // The declared primary if it still exists, otherwise the interior bodies (Jacobi).
+            let primary = primary_of[alive[i]]
+                .and_then(|k| alive.iter().position(|&a| a == k))
+                .filter(|&j| j != i)
+                .map_or(Primary::Interior, Primary::Body);
+            res.elements.push(ElementsRow {
+                t,
                 body: alive[i],
-                mass: p.m[i],
-                pos: p.pos(i).0,
-                vel: p.vel(i).0,
-            })
-            .collect(),
-    );
-    for i in 1..p.len() {
-        // The declared primary if it still exists, otherwise the interior bodies (Jacobi).
-        let primary = primary_of[alive[i]]
-            .and_then(|k| alive.iter().position(|&a| a == k))
-            .filter(|&j| j != i)
-            .map_or(Primary::Interior, Primary::Body);
-        res.elements.push(ElementsRow {
-            t,
-            body: alive[i],
-            orbit: sim.orbit(i, primary).ok(),
-        });
+                orbit: sim.orbit(i, primary).ok(),
+            });
+        }
     }
+    let Some(stream) = stream else {
+        return Ok(());
+    };
+    let names = &res.names;
+    if let (Some(f), Some(states)) = (&mut stream.trajectory, res.states.last()) {
+        f.rows(|w| super::output::trajectory_rows(w, t, states, names))?;
+    }
+    if let Some(f) = &mut stream.elements {
+        f.rows(|w| super::output::elements_rows(w, &res.elements[elements_from..], names))?;
+    }
+    stream
+        .conservation
+        .rows(|w| super::output::conservation_row(w, &row))
 }
 
 #[cfg(test)]
@@ -734,6 +1161,29 @@ mod tests {
         assert!(output_times(1.0, &Sampling::Every(1e-300)).is_err());
         assert!(output_times(1.0, &Sampling::Times(vec![0.5, 0.2])).is_err());
         assert!(output_times(1.0, &Sampling::Times(vec![2.0])).is_err());
+    }
+
+    #[test]
+    fn the_schedule_gives_the_times_of_the_lists_one_at_a_time() {
+        for (t_end, sampling) in [
+            (1.0, Sampling::Points(3)),
+            (1.0, Sampling::Every(0.4)),
+            (1.0, Sampling::Every(0.5)),
+            (1000.0, Sampling::Every(0.3)),
+            (1000.0, Sampling::Points(777)),
+            (2.0, Sampling::Times(vec![0.5, 2.0])),
+            (2.0, Sampling::Times(vec![0.0, 0.26, 0.5, 0.51, 2.0])),
+        ] {
+            let list = output_times(t_end, &sampling).unwrap();
+            let lazy: Vec<f64> = Schedule::new(t_end, &sampling, None).unwrap().collect();
+            assert_eq!(lazy, list, "{sampling:?}");
+            for dt in [0.25, 0.3, 0.07] {
+                let grid: Vec<f64> = Schedule::new(t_end, &sampling, Some(dt)).unwrap().collect();
+                assert_eq!(grid, on_step_grid(&list, dt), "{sampling:?} dt = {dt}");
+            }
+        }
+        assert!(Schedule::new(1.0, &Sampling::Every(1e-300), None).is_err());
+        assert!(Schedule::new(1.0, &Sampling::Points(1), None).is_err());
     }
 
     #[test]

@@ -1,0 +1,299 @@
+//! Long runs (issue 29): a run killed with SIGKILL at random (seeded) instants and restarted
+//! from its last checkpoint ends with the same files, byte for byte, as the same run left
+//! alone; after every kill the files end with a whole row; a signal stops a run cleanly (exit
+//! 4, summary status "interrupted"); bad checkpoints are refused (exit 2).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::Duration;
+
+fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_pdyn")
+}
+
+fn example(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(rel)
+}
+
+fn fresh_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("pdyn-longrun-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+/// A small seeded generator (SplitMix64): the kill instants are the same on every run.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    fn below(&mut self, n: u64) -> u64 {
+        self.next() % n
+    }
+}
+
+const CSV: [&str; 3] = ["trajectory.csv", "elements.csv", "conservation.csv"];
+
+/// Every line of every CSV file present is a whole row (the header's columns, numbers that
+/// parse), up to the last newline. After `after_kill` the file may end with one fragment
+/// without a newline: rows are handed to the system whole (one `write` of whole rows), but
+/// Linux checks for a fatal signal between the pages of a `write`, so SIGKILL can cut one
+/// there; a restart truncates the file back to the checkpoint's length. After a clean stop
+/// the file must end with a newline.
+fn assert_whole_rows(dir: &Path, when: &str, after_kill: bool) {
+    for name in CSV {
+        let path = dir.join(name);
+        let Ok(text) = std::fs::read_to_string(&path) else {
+            continue;
+        };
+        if text.is_empty() {
+            continue;
+        }
+        let whole = match text.rfind('\n') {
+            Some(i) => &text[..=i],
+            None => "",
+        };
+        assert!(
+            after_kill || whole.len() == text.len(),
+            "{when}: {name} ends inside a row: {:?}",
+            &text[text.len().saturating_sub(80)..]
+        );
+        let mut lines = whole.lines();
+        let columns = lines.next().map_or(0, |h| h.split(',').count());
+        for (k, line) in lines.enumerate() {
+            let cells: Vec<&str> = line.split(',').collect();
+            assert_eq!(
+                cells.len(),
+                columns,
+                "{when}: {name} row {} has other columns: {line}",
+                k + 2
+            );
+            assert!(
+                cells[0].parse::<f64>().is_ok(),
+                "{when}: {name} row {} does not start with a time: {line}",
+                k + 2
+            );
+        }
+    }
+}
+
+/// `summary.json` without what only says how the run was carried out (the checkpoint file,
+/// where it restarted from).
+fn summary_without_bookkeeping(dir: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json");
+    let mut v: serde_json::Value = serde_json::from_str(&text).expect("summary is JSON");
+    let m = v.as_object_mut().expect("an object");
+    m.remove("checkpoint");
+    m.remove("restarted_from");
+    v
+}
+
+fn run_args(model: &Path, extra: &[&str], out: &Path) -> Vec<String> {
+    let mut a = vec!["run".to_string(), model.display().to_string()];
+    a.extend(extra.iter().map(|s| s.to_string()));
+    a.extend(["--out".to_string(), out.display().to_string()]);
+    a
+}
+
+/// Runs `model` with `extra` options once uninterrupted, then again killed `kills` times at
+/// seeded random instants within `window_ms`, each time restarted from its last checkpoint
+/// (or from the start when none was written yet), and compares the files.
+fn killed_and_restarted_equals_uninterrupted(
+    tag: &str,
+    model: &str,
+    extra: &[&str],
+    kills: usize,
+    window_ms: u64,
+    seed: u64,
+) {
+    let model = example(model);
+    let reference = fresh_dir(&format!("{tag}-ref"));
+    let st = Command::new(bin())
+        .args(run_args(&model, extra, &reference))
+        .stdout(Stdio::null())
+        .status()
+        .expect("run pdyn");
+    assert!(st.success(), "the reference run failed: {st:?}");
+
+    let dir = fresh_dir(&format!("{tag}-killed"));
+    let ckpt = dir.join("checkpoint.json");
+    let mut rng = Rng(seed);
+    let mut restarts = 0;
+    for k in 0..kills {
+        let mut args = run_args(&model, extra, &dir);
+        if ckpt.exists() {
+            args.extend(["--restart".to_string(), ckpt.display().to_string()]);
+            restarts += 1;
+        }
+        let mut child = Command::new(bin())
+            .args(&args)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("start pdyn");
+        std::thread::sleep(Duration::from_millis(50 + rng.below(window_ms)));
+        // SIGKILL: no handler runs, nothing is flushed
+        let _ = child.kill();
+        let _ = child.wait();
+        assert_whole_rows(&dir, &format!("{tag}: after kill {}", k + 1), true);
+    }
+    let mut args = run_args(&model, extra, &dir);
+    if ckpt.exists() {
+        args.extend(["--restart".to_string(), ckpt.display().to_string()]);
+        restarts += 1;
+    }
+    let st = Command::new(bin())
+        .args(&args)
+        .stdout(Stdio::null())
+        .status()
+        .expect("run pdyn");
+    assert!(st.success(), "{tag}: the last restart failed: {st:?}");
+    assert!(restarts > 0, "{tag}: no checkpoint was ever written");
+    assert_whole_rows(&dir, &format!("{tag}: at the end"), false);
+    for name in CSV {
+        let a = std::fs::read(reference.join(name)).ok();
+        let b = std::fs::read(dir.join(name)).ok();
+        assert!(
+            a == b,
+            "{tag}: {name} differs from the uninterrupted run's ({:?} vs {:?} bytes)",
+            a.map(|x| x.len()),
+            b.map(|x| x.len())
+        );
+    }
+    assert_eq!(
+        summary_without_bookkeeping(&reference),
+        summary_without_bookkeeping(&dir),
+        "{tag}: summary.json differs"
+    );
+    let _ = std::fs::remove_dir_all(&reference);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn whfast_killed_at_random_and_restarted_matches_the_uninterrupted_run() {
+    killed_and_restarted_equals_uninterrupted(
+        "whfast",
+        "examples/nbody/outer_solar_system.toml",
+        &["--t-end", "3000000", "--checkpoint-every", "2000steps"],
+        4,
+        900,
+        29,
+    );
+}
+
+#[test]
+fn ias15_killed_at_random_and_restarted_matches_the_uninterrupted_run() {
+    killed_and_restarted_equals_uninterrupted(
+        "ias15",
+        "examples/nbody/figure_eight.toml",
+        &[
+            "--t-end",
+            "2000",
+            "--points",
+            "10001",
+            "--checkpoint-every",
+            "4000steps",
+        ],
+        4,
+        900,
+        2017,
+    );
+}
+
+#[cfg(unix)]
+#[test]
+fn sigterm_stops_cleanly_with_an_interrupted_summary_and_whole_files() {
+    let model = example("examples/nbody/outer_solar_system.toml");
+    let extra = ["--t-end", "40000000", "--checkpoint-every", "off"];
+    let dir = fresh_dir("sigterm");
+    let mut child = Command::new(bin())
+        .args(run_args(&model, &extra, &dir))
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("start pdyn");
+    std::thread::sleep(Duration::from_millis(600));
+    let st = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(st.success());
+    let status = child.wait().expect("wait");
+    assert_eq!(status.code(), Some(4), "exit code of an interrupted run");
+    let sum: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(sum["status"], "interrupted");
+    assert_eq!(sum["ok"], false);
+    let t = sum["t_reached"].as_f64().expect("t_reached");
+    assert!(t > 0.0 && t < 4e7, "t_reached = {t}");
+    assert!(!sum["final_state"].as_array().unwrap().is_empty());
+    assert_whole_rows(&dir, "after SIGTERM", false);
+    // The last conservation row is the time reached.
+    let cons = std::fs::read_to_string(dir.join("conservation.csv")).unwrap();
+    let last_t: f64 = cons
+        .lines()
+        .last()
+        .and_then(|l| l.split(',').next())
+        .and_then(|x| x.parse().ok())
+        .unwrap();
+    assert_eq!(last_t, t);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_checkpoints_are_refused_saying_what_differs() {
+    let model = example("examples/nbody/outer_solar_system.toml");
+    let extra = ["--t-end", "400000", "--checkpoint-every", "500steps"];
+    let dir = fresh_dir("bad");
+    let st = Command::new(bin())
+        .args(run_args(&model, &extra, &dir))
+        .stdout(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let ckpt = dir.join("checkpoint.json");
+    let good = std::fs::read_to_string(&ckpt).unwrap();
+    let restart = |args: &[&str], expect: &str| {
+        let mut a = run_args(&model, args, &dir);
+        a.extend(["--restart".to_string(), ckpt.display().to_string()]);
+        let out = Command::new(bin()).args(&a).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{expect}: {err}");
+        assert!(err.contains(expect), "expected `{expect}` in: {err}");
+    };
+    // truncated
+    std::fs::write(&ckpt, &good[..good.len() - 10]).unwrap();
+    restart(&extra, "truncated");
+    // tampered: one digit changed, the length kept
+    let pos = good.rfind("\"steps\":").unwrap() + 8;
+    let mut bytes = good.clone().into_bytes();
+    bytes[pos] = if bytes[pos] == b'1' { b'2' } else { b'1' };
+    std::fs::write(&ckpt, &bytes).unwrap();
+    restart(&extra, "checksum");
+    // other options
+    std::fs::write(&ckpt, &good).unwrap();
+    restart(
+        &["--t-end", "500000", "--checkpoint-every", "500steps"],
+        "t_end",
+    );
+    // another model
+    let other = example("examples/nbody/figure_eight.toml");
+    let mut a = run_args(&other, &extra, &dir);
+    a.extend(["--restart".to_string(), ckpt.display().to_string()]);
+    let out = Command::new(bin()).args(&a).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("another model"));
+    // not a checkpoint, and a missing one
+    std::fs::write(&ckpt, "hello\n").unwrap();
+    restart(&extra, "not a pdyn checkpoint");
+    std::fs::remove_file(&ckpt).unwrap();
+    restart(&extra, "checkpoint");
+    let _ = std::fs::remove_dir_all(&dir);
+}
