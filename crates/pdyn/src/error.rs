@@ -280,7 +280,7 @@ impl Error {
             | Error::Gravity { origin, .. }
             | Error::MdRun { origin, .. }
             | Error::Fit { origin, .. } => Some(file(origin)),
-            | Error::Interrupted { origin, .. } => Some(file(origin)),
+            Error::Interrupted { origin, .. } => Some(file(origin)),
             Error::Data { error } if !error.file.is_empty() => Some(Location {
                 file: error.file.clone(),
                 line: error.line,
