@@ -278,6 +278,27 @@ fn write_frame(
     pdyn_md::io::write_xyz(w, &c, names, step, time)
 }
 
+/// Appends one XYZ frame at `step` to `traj.xyz` in a single row write: a stopped run leaves
+/// whole frames.
+fn append_frame(
+    file: &mut RowFile,
+    path: &Path,
+    s: &System,
+    names: &[&str],
+    u: UnitSystem,
+    step: u64,
+    dt: f64,
+) -> Result<(), Error> {
+    let mut buf = Vec::new();
+    write_frame(&mut buf, s, names, u, step, step as f64 * dt).map_err(|e| match e {
+        MdError::Io { kind } => io_err(path, "write", std::io::Error::from(kind)),
+        e => Error::Internal {
+            message: format!("writing a trajectory frame: {e}"),
+        },
+    })?;
+    file.rows(|b| b.extend_from_slice(&buf))
+}
+
 fn run_sim<P: PairPotential>(
     sim: &mut Simulation<P>,
     spec: &MdSpec,
@@ -304,12 +325,6 @@ fn run_sim<P: PairPotential>(
         None => None,
     };
     let mut write_error: Option<Error> = None;
-    let traj_err = |path: &Path, e: MdError| match e {
-        MdError::Io { kind } => io_err(path, "write", std::io::Error::from(kind)),
-        e => Error::Internal {
-            message: format!("writing a trajectory frame: {e}"),
-        },
-    };
     let mut frames = 0u64;
     // Frames shown live: as the front end asks, else at dump_every.
     let frame_every = if opts.frame_every > 0 {
@@ -324,17 +339,7 @@ fn run_sim<P: PairPotential>(
         });
     }
     if let Some((w, path)) = &mut traj {
-        let mut buf = Vec::new();
-        write_frame(
-            &mut buf,
-            &sim.system,
-            &names,
-            u,
-            sim.step,
-            sim.step as f64 * dt,
-        )
-        .map_err(|e| traj_err(path, e))?;
-        w.rows(|b| b.extend_from_slice(&buf))?;
+        append_frame(w, path, &sim.system, &names, u, sim.step, dt)?;
         frames += 1;
     }
     let msd0 = spec.msd.then(|| Msd::new(&sim.system));
@@ -479,17 +484,7 @@ fn run_sim<P: PairPotential>(
         }
         if let Some((w, path)) = &mut traj {
             if dump || failure.is_some() {
-                let mut buf = Vec::new();
-                write_frame(
-                    &mut buf,
-                    &sim.system,
-                    &names,
-                    u,
-                    sim.step,
-                    sim.step as f64 * dt,
-                )
-                .map_err(|e| traj_err(path, e))?;
-                w.rows(|b| b.extend_from_slice(&buf))?;
+                append_frame(w, path, &sim.system, &names, u, sim.step, dt)?;
                 frames += 1;
             }
         }
