@@ -297,3 +297,21 @@ fn bad_checkpoints_are_refused_saying_what_differs() {
     restart(&extra, "checkpoint");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn check_refuses_the_flags_of_long_runs_instead_of_ignoring_them() {
+    for flags in [
+        &["--restart", "x.json"][..],
+        &["--checkpoint-every", "100"][..],
+    ] {
+        let out = Command::new(bin())
+            .arg("check")
+            .arg(example("examples/building.toml"))
+            .args(flags)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{flags:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(flags[0]) && err.contains("pdyn run"), "{err}");
+    }
+}

@@ -197,6 +197,19 @@ pub struct CheckArgs {
 /// `pdyn check MODEL`: integrate numerically and compare with the closed-form solution.
 pub fn check(a: CheckArgs) -> Result<Outcome, Error> {
     let a = a.run;
+    // The flags are shared with `pdyn run`; these two mean nothing for a check: refused, not
+    // ignored.
+    for (flag, given) in [
+        ("--checkpoint-every", a.checkpoint_every.is_some()),
+        ("--restart", a.restart.is_some()),
+    ] {
+        if given {
+            return Err(Error::argument(
+                flag,
+                format!("{flag} is for `pdyn run`: `pdyn check` writes no checkpoints and continues none"),
+            ));
+        }
+    }
     let mut model = load_model(&a.model)?;
     set_parameters(&mut model, &a.set)?;
     let rep = pdyn::report::check::report(model, &request(&a)?, a.json)?;
