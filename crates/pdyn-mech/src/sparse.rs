@@ -107,11 +107,14 @@ impl Csr {
             let row = &mut cv[count[i]..count[i + 1]];
             row.sort_by_key(|e| e.0);
             for &(c, v) in row.iter() {
-                if col.len() > ptr[i] && col.last() == Some(&c) {
-                    *val.last_mut().expect("a previous entry") += v;
-                } else {
-                    col.push(c);
-                    val.push(v);
+                // A repeated (row, column) adds to the entry just pushed for this row.
+                let same = col.len() > ptr[i] && col.last() == Some(&c);
+                match val.last_mut() {
+                    Some(last) if same => *last += v,
+                    _ => {
+                        col.push(c);
+                        val.push(v);
+                    }
                 }
             }
             ptr.push(col.len());
@@ -292,10 +295,12 @@ pub fn rcm(a: &Csr) -> Vec<usize> {
         // Start from the least-degree vertex of this component, then move to a pseudo-peripheral
         // one (the far end of the deepest level structure; a few passes suffice).
         let (comp, _, _) = bfs(s0, &placed);
-        let mut s = *comp
+        // (The component holds s0 itself, so the minimum exists.)
+        let mut s = comp
             .iter()
-            .min_by_key(|&&v| (degree(v), v))
-            .expect("a component holds its start");
+            .copied()
+            .min_by_key(|&v| (degree(v), v))
+            .unwrap_or(s0);
         let (mut levels, mut far, mut depth) = bfs(s, &placed);
         for _ in 0..4 {
             let (l2, f2, d2) = bfs(far, &placed);

@@ -378,9 +378,14 @@ fn dsolve_input(p: &Parsed) -> DsolveInput {
 }
 
 /// Where in the script an error of a command belongs: the word of the expression that failed
-/// (and the column inside it), the option named, or else the command's first word.
-fn place(error: &Error, parsed: Option<&Parsed>, words: &[Word]) -> (usize, usize) {
-    let first = (words[0].line, words[0].column);
+/// (and the column inside it), the option named, or else `fallback` (the command's first
+/// word; `words`, its arguments, may be empty).
+fn place(
+    error: &Error,
+    parsed: Option<&Parsed>,
+    words: &[Word],
+    fallback: (usize, usize),
+) -> (usize, usize) {
     let at_word = |w: &Word, offset: usize| (w.line, w.column + w.quote + offset);
     if let Error::Expr { text, error: e, .. } = error {
         let hit = words.iter().find(|w| w.text == *text).or_else(|| {
@@ -388,9 +393,9 @@ fn place(error: &Error, parsed: Option<&Parsed>, words: &[Word]) -> (usize, usiz
             words.iter().find(|w| w.text.contains(text.as_str()))
         });
         if let Some(w) = hit {
+            let chars = |s: &str, end: usize| s.get(..end).map_or(0, |p| p.chars().count());
             let before = w.text.find(text.as_str()).unwrap_or(0);
-            let offset = w.text[..before].chars().count()
-                + text[..e.span.start.min(text.len())].chars().count();
+            let offset = chars(&w.text, before) + chars(text, e.span.start);
             return at_word(w, offset);
         }
     }
@@ -403,7 +408,7 @@ fn place(error: &Error, parsed: Option<&Parsed>, words: &[Word]) -> (usize, usiz
             return at_word(w, 0);
         }
     }
-    first
+    fallback
 }
 
 /// One command's output: its text and JSON, as `pdyn kin`/`pdyn dsolve` print them.
@@ -481,7 +486,12 @@ fn run_command(line: &CommandLine) -> Result<Value, Located> {
         }))
     })();
     result.map_err(|error: Error| {
-        let at = place(&error, Some(&parsed), args);
+        let at = place(
+            &error,
+            Some(&parsed),
+            args,
+            (words[0].line, words[0].column),
+        );
         fail(Box::new(error), at)
     })
 }
@@ -612,6 +622,14 @@ mod tests {
         let e = run("ls -l").unwrap_err();
         assert_eq!((e.line, e.column), (1, 1));
         assert!(run("# only a comment\n").is_err());
+        // A command with no arguments: the library's error, at the command (was a panic).
+        for bare in ["pdyn kin", "pdyn dsolve", "  pdyn kin --at"] {
+            let e = run(bare).unwrap_err();
+            assert_eq!(e.line, 1, "{bare}");
+        }
+        // A word with characters of several bytes before the error.
+        let e = run("pdyn kin \"[θ*t, t^, 0]\"").unwrap_err();
+        assert!(e.column > 10, "column {}", e.column);
     }
 
     #[test]

@@ -127,65 +127,36 @@ impl std::fmt::Display for SamplingError {
 
 impl std::error::Error for SamplingError {}
 
-/// The output times of `options`, or what is wrong with them.
+/// The output times of `options`, or what is wrong with them (the times of a [`Schedule`]
+/// without a step grid, as a list).
 pub fn output_times(t_end: f64, sampling: &Sampling) -> Result<Vec<f64>, SamplingError> {
-    match sampling {
-        Sampling::Points(n) => {
-            if *n < 2 || *n > MAX_POINTS {
-                return Err(SamplingError::Points {
-                    n: *n,
-                    max: MAX_POINTS,
-                });
-            }
-            Ok((0..*n)
-                .map(|k| t_end * k as f64 / (*n - 1) as f64)
-                .collect())
-        }
-        Sampling::Every(dt) => {
-            if !(dt.is_finite() && *dt > 0.0) {
-                return Err(SamplingError::Interval(*dt));
-            }
-            let n = (t_end / dt).floor();
-            if n > MAX_POINTS as f64 {
-                return Err(SamplingError::TooMany {
-                    dt: *dt,
-                    t_end,
-                    n,
-                    max: MAX_POINTS,
-                });
-            }
-            let mut v: Vec<f64> = (0..=n as usize).map(|k| k as f64 * dt).collect();
-            // The last output is t_end itself (unless within round-off of the previous one).
-            if v.last().is_some_and(|&l| t_end - l > 1e-9 * dt) {
-                v.push(t_end);
-            }
-            Ok(v)
-        }
-        Sampling::Times(ts) => {
-            let mut v = Vec::with_capacity(ts.len() + 1);
-            if ts.first() != Some(&0.0) {
-                v.push(0.0);
-            }
-            for &t in ts {
-                if !(t.is_finite() && (0.0..=t_end).contains(&t)) {
-                    return Err(SamplingError::Outside { t, t_end });
-                }
-                if v.last().is_some_and(|&l| t <= l) && !(v.len() == 1 && t == 0.0) {
-                    return Err(SamplingError::NotIncreasing {
-                        t,
-                        previous: v.last().copied(),
-                    });
-                }
-                if t > 0.0 || v.is_empty() {
-                    v.push(t);
-                }
-            }
-            Ok(v)
-        }
-    }
+    Ok(Schedule::new(t_end, sampling, None)?.collect())
 }
 
-/// The output times of a run, one at a time: those of [`output_times`], moved onto the step
+/// Output times given one by one: within [0, t_end], increasing, with 0 first.
+fn listed_times(t_end: f64, ts: &[f64]) -> Result<Vec<f64>, SamplingError> {
+    let mut v = Vec::with_capacity(ts.len() + 1);
+    if ts.first() != Some(&0.0) {
+        v.push(0.0);
+    }
+    for &t in ts {
+        if !(t.is_finite() && (0.0..=t_end).contains(&t)) {
+            return Err(SamplingError::Outside { t, t_end });
+        }
+        if v.last().is_some_and(|&l| t <= l) && !(v.len() == 1 && t == 0.0) {
+            return Err(SamplingError::NotIncreasing {
+                t,
+                previous: v.last().copied(),
+            });
+        }
+        if t > 0.0 || v.is_empty() {
+            v.push(t);
+        }
+    }
+    Ok(v)
+}
+
+/// The output times of a run, one at a time, moved onto the step
 /// grid as [`on_step_grid`] does for a fixed step, without a list of them in memory (a run of
 /// 10⁷ outputs holds none; times given one by one are the list they came in).
 #[derive(Debug, Clone)]
@@ -206,7 +177,7 @@ enum Raw {
 
 impl Schedule {
     /// The times of `sampling` up to `t_end`, on the grid of `grid` (a fixed step) if given;
-    /// refused as [`output_times`] refuses them.
+    /// refused with the reason when they cannot be.
     pub fn new(
         t_end: f64,
         sampling: &Sampling,
@@ -240,8 +211,8 @@ impl Schedule {
                 let extra = t_end - n as f64 * dt > 1e-9 * dt;
                 (Raw::Every { dt: *dt, n, t_end }, n + 1 + usize::from(extra))
             }
-            Sampling::Times(_) => {
-                let v = output_times(t_end, sampling)?;
+            Sampling::Times(ts) => {
+                let v = listed_times(t_end, ts)?;
                 let len = v.len();
                 (Raw::List(v), len)
             }
