@@ -42,6 +42,30 @@ pub struct FreeDirection {
     pub moved: usize,
 }
 
+impl FreeDirection {
+    /// The direction of the vector `v` over the coordinates `names`: its components of at
+    /// least a tenth of the largest, largest first, signed so that the largest is positive
+    /// (a stable report).
+    pub fn of(v: &[f64], names: &[String]) -> FreeDirection {
+        let big = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let sign = v
+            .iter()
+            .find(|x| x.abs() == big)
+            .map_or(1.0, |x| x.signum());
+        let mut components: Vec<(String, f64)> = v
+            .iter()
+            .zip(names)
+            .filter(|(x, _)| x.abs() >= 0.1 * big)
+            .map(|(&x, n)| (n.clone(), sign * x))
+            .collect();
+        components.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()).then(a.0.cmp(&b.0)));
+        FreeDirection {
+            moved: components.len(),
+            components,
+        }
+    }
+}
+
 impl std::fmt::Display for FreeDirection {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         const SHOWN: usize = 6;
@@ -222,24 +246,8 @@ pub fn free_directions(names: &[String], stiffness: &DMatrix<f64>) -> Vec<FreeDi
         if lambda.abs() > 1e-9 * largest && largest > 0.0 {
             continue;
         }
-        let v = eig.eigenvectors.column(k);
-        let big = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        // The sign that makes the largest component positive, for a stable report.
-        let sign = v
-            .iter()
-            .find(|x| x.abs() == big)
-            .map_or(1.0, |x| x.signum());
-        let mut comps: Vec<(String, f64)> = v
-            .iter()
-            .enumerate()
-            .filter(|(_, x)| x.abs() >= 0.1 * big)
-            .map(|(i, &x)| (names[i].clone(), sign * x))
-            .collect();
-        comps.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()).then(a.0.cmp(&b.0)));
-        out.push(FreeDirection {
-            moved: comps.len(),
-            components: comps,
-        });
+        let v: Vec<f64> = eig.eigenvectors.column(k).iter().copied().collect();
+        out.push(FreeDirection::of(&v, names));
     }
     out
 }

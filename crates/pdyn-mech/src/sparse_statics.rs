@@ -167,22 +167,7 @@ pub fn free_directions(names: &[String], ks: &Csr, diag: &[f64]) -> Vec<FreeDire
         // Unit Euclidean length, as the dense path reports them.
         let len = norm(v);
         let v: Vec<f64> = v.iter().map(|x| x / len).collect();
-        let big = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let sign = v
-            .iter()
-            .find(|x| x.abs() == big)
-            .map_or(1.0, |x| x.signum());
-        let mut comps: Vec<(String, f64)> = v
-            .iter()
-            .enumerate()
-            .filter(|(_, x)| x.abs() >= 0.1 * big)
-            .map(|(i, &x)| (names[i].clone(), sign * x))
-            .collect();
-        comps.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()).then(a.0.cmp(&b.0)));
-        out.push(FreeDirection {
-            moved: comps.len(),
-            components: comps,
-        });
+        out.push(FreeDirection::of(&v, names));
     }
     out
 }
