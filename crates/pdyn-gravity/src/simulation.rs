@@ -25,8 +25,10 @@ pub enum Primary {
 ///
 /// Events are checked after every step on the positions the step leaves in the particle
 /// arrays: the end-of-step positions for IAS15 and leapfrog, the mid-step (kick) positions
-/// for WHFast, which keeps Jacobi coordinates between steps. The simulation is synchronised
-/// before `integrate` returns, so [`Simulation::particles`] is the state at the reported time.
+/// for WHFast, which keeps Jacobi coordinates between steps. The particles are synchronised
+/// before `integrate` returns, so [`Simulation::particles`] is the state at the reported time;
+/// WHFast synchronises a copy and continues from its own state, so integrating to `t₁` and
+/// then to `t₂` is bit for bit integrating to `t₂` (when `t₁` is on the step grid).
 /// Collision detection is a direct `O(N²)` pair test, run only when some radius is positive.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
@@ -506,7 +508,9 @@ impl Simulation {
                 }
             }
         }
-        self.synchronize()?;
+        // The particles show the state at `self.t`; the integrator goes on from its own
+        // (for WHFast: unsynchronised, uncorrected) state, so outputs do not perturb the run.
+        ws.synchronized_view(&mut self.particles, &mut self.forces, self.t)?;
         if let Some(i) = self.particles.first_non_finite() {
             return Err(GravityError::NonFinite {
                 t: self.t,

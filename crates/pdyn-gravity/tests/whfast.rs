@@ -375,3 +375,48 @@ fn close_encounter_is_reported() {
     let de = ((sim.energy() - e0) / e0).abs();
     assert!(de < 1e-12, "{de:e}");
 }
+
+/// Looking at a WHFast run does not change it: the outputs synchronise a copy (REBOUND's
+/// `keep_unsynchronized`), so the outer Solar System with the 11th-order corrector, stopped
+/// at every other step for output, ends bit for bit where one call to `integrate` ends; and
+/// each output equals the state of a run that stops there and synchronises for real.
+#[test]
+fn outputs_do_not_perturb_the_run() {
+    let dt = 4332.59 / 20.0;
+    let start = || {
+        let mut sim = common::outer_solar_system();
+        sim.set_dt(dt).unwrap();
+        sim.set_integrator(whfast(11)).unwrap();
+        sim
+    };
+    let steps = 400;
+    let t_end = steps as f64 * dt;
+    let mut direct = start();
+    direct.integrate(t_end).unwrap();
+    let mut watched = start();
+    for k in 1..=steps / 2 {
+        watched.integrate(2.0 * k as f64 * dt).unwrap();
+        if k == 50 {
+            // A run that ends here has synchronised for real (nothing after it).
+            let mut alone = start();
+            alone.integrate(100.0 * dt).unwrap();
+            for i in 0..5 {
+                assert_eq!(watched.particles().pos(i).0, alone.particles().pos(i).0);
+                assert_eq!(watched.particles().vel(i).0, alone.particles().vel(i).0);
+            }
+        }
+    }
+    assert_eq!(watched.steps(), direct.steps());
+    for i in 0..5 {
+        assert_eq!(
+            watched.particles().pos(i).0,
+            direct.particles().pos(i).0,
+            "body {i}"
+        );
+        assert_eq!(
+            watched.particles().vel(i).0,
+            direct.particles().vel(i).0,
+            "body {i}"
+        );
+    }
+}

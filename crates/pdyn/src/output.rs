@@ -48,6 +48,12 @@ pub fn push_number(line: &mut String, x: f64) {
     line.push_str(buf.format(x));
 }
 
+/// [`push_number`] into a byte buffer (rows of files written as a run goes).
+pub fn append_number(out: &mut Vec<u8>, x: f64) {
+    let mut buf = ryu::Buffer::new();
+    out.extend_from_slice(buf.format(x).as_bytes());
+}
+
 /// The JSON summary: the fields every kind shares ([`crate::summary::common`]: monitors with
 /// their verdict against `drift_tolerance`, solver statistics, warnings), then the final
 /// state, events, method and number of outputs.

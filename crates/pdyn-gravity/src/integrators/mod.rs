@@ -139,6 +139,20 @@ impl Workspace {
         }
     }
 
+    /// Writes the state at the current time into `p` without changing what the next step
+    /// starts from (WHFast synchronises a copy; the others are always synchronised).
+    pub fn synchronized_view(
+        &mut self,
+        p: &mut Particles,
+        f: &mut Forces,
+        t: f64,
+    ) -> Result<(), GravityError> {
+        match self {
+            Workspace::WhFast(w) => w.synchronized_view(p, f, t),
+            Workspace::Leapfrog(_) | Workspace::Ias15(_) => Ok(()),
+        }
+    }
+
     /// Whether the step is fixed (the simulation then keeps time as `t₀ + n dt`).
     pub fn is_fixed_step(&self) -> bool {
         matches!(self, Workspace::WhFast(_) | Workspace::Leapfrog(_))

@@ -448,6 +448,39 @@ impl WhFast {
         Ok(())
     }
 
+    /// Writes into `p` the state [`WhFast::synchronize`] would, but keeps integrating from
+    /// the unsynchronised Jacobi state (REBOUND's `keep_unsynchronized`): the half drift and
+    /// the inverse corrector are applied to a copy. Outputs then cost one corrector, not two
+    /// (undoing it and applying it again at the next step), and a run's trajectory does not
+    /// depend on when it was looked at: integrating to `t₁` then `t₂` is bit for bit
+    /// integrating to `t₂`.
+    pub fn synchronized_view(
+        &mut self,
+        p: &mut Particles,
+        f: &mut Forces,
+        t: f64,
+    ) -> Result<(), GravityError> {
+        if self.synchronized {
+            self.write_back(p);
+            return Ok(());
+        }
+        self.backup_r.copy_from_slice(&self.jr);
+        self.backup_v.copy_from_slice(&self.jv);
+        let result = self.kepler(f.g, 0.5 * self.dt, t).and_then(|()| {
+            if self.params.corrector > 0 {
+                self.apply_corrector(p, f, -1.0, t)
+            } else {
+                Ok(())
+            }
+        });
+        if result.is_ok() {
+            self.write_back(p);
+        }
+        self.jr.copy_from_slice(&self.backup_r);
+        self.jv.copy_from_slice(&self.backup_v);
+        result
+    }
+
     fn write_back(&self, p: &mut Particles) {
         from_jacobi(&p.m, &self.eta, &self.jr, [&mut p.x, &mut p.y, &mut p.z]);
         from_jacobi(&p.m, &self.eta, &self.jv, [&mut p.vx, &mut p.vy, &mut p.vz]);

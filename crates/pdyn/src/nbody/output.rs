@@ -27,11 +27,6 @@ pub struct RunInfo {
     pub drift_tolerance: f64,
 }
 
-fn num(x: f64) -> String {
-    // Shortest representation that reads back exactly.
-    format!("{x:e}")
-}
-
 /// `trajectory.csv`'s header.
 pub const TRAJECTORY_HEADER: &str = "t,body,x,y,z,vx,vy,vz\n";
 /// `elements.csv`'s header.
@@ -39,21 +34,29 @@ pub const ELEMENTS_HEADER: &str = "t,body,a,e,inc,Omega,omega,f,M,period\n";
 /// `conservation.csv`'s header.
 pub const CONSERVATION_HEADER: &str = "t,n,energy,kinetic,potential,virial_ratio,Lx,Ly,Lz\n";
 
-/// The rows of `trajectory.csv` (`t,body,x,y,z,vx,vy,vz`) of one output time.
+/// Appends `,x` for each value, then the end of the line.
+fn fields(w: &mut Vec<u8>, values: impl IntoIterator<Item = f64>) {
+    for x in values {
+        w.push(b',');
+        crate::output::append_number(w, x);
+    }
+    w.push(b'\n');
+}
+
+/// Appends `t,NAME` (a row's first two cells).
+fn time_and_name(w: &mut Vec<u8>, t: f64, name: &str) {
+    crate::output::append_number(w, t);
+    w.push(b',');
+    w.extend_from_slice(name.as_bytes());
+}
+
+/// The rows of `trajectory.csv` (`t,body,x,y,z,vx,vy,vz`) of one output time. Numbers in the
+/// shortest form that reads back exactly (`ryu`, as every pdyn CSV): an output row is a few
+/// dozen numbers, and formatting them was most of an output's cost.
 pub fn trajectory_rows(w: &mut Vec<u8>, t: f64, states: &[BodyState], names: &[String]) {
     for s in states {
-        let _ = writeln!(
-            w,
-            "{},{},{},{},{},{},{},{}",
-            num(t),
-            names[s.body],
-            num(s.pos[0]),
-            num(s.pos[1]),
-            num(s.pos[2]),
-            num(s.vel[0]),
-            num(s.vel[1]),
-            num(s.vel[2])
-        );
+        time_and_name(w, t, &names[s.body]);
+        fields(w, s.pos.into_iter().chain(s.vel));
     }
 }
 
@@ -61,40 +64,30 @@ pub fn trajectory_rows(w: &mut Vec<u8>, t: f64, states: &[BodyState], names: &[S
 /// cells where a body has no elements).
 pub fn elements_rows(w: &mut Vec<u8>, rows: &[ElementsRow], names: &[String]) {
     for r in rows {
-        let _ = match r.orbit {
-            Some(o) => writeln!(
-                w,
-                "{},{},{},{},{},{},{},{},{},{}",
-                num(r.t),
-                names[r.body],
-                num(o.a),
-                num(o.e),
-                num(o.inc),
-                num(o.Omega),
-                num(o.omega),
-                num(o.f),
-                num(o.M),
-                num(o.period)
-            ),
-            None => writeln!(w, "{},{},,,,,,,,", num(r.t), names[r.body]),
-        };
+        time_and_name(w, r.t, &names[r.body]);
+        match r.orbit {
+            Some(o) => fields(w, [o.a, o.e, o.inc, o.Omega, o.omega, o.f, o.M, o.period]),
+            None => w.extend_from_slice(b",,,,,,,,\n"),
+        }
     }
 }
 
 /// One row of `conservation.csv` (`t,n,energy,kinetic,potential,virial_ratio,Lx,Ly,Lz`).
 pub fn conservation_row(w: &mut Vec<u8>, r: &ConservationRow) {
-    let _ = writeln!(
+    crate::output::append_number(w, r.t);
+    let _ = write!(w, ",{}", r.n);
+    let [lx, ly, lz] = r.angular_momentum;
+    fields(
         w,
-        "{},{},{},{},{},{},{},{},{}",
-        num(r.t),
-        r.n,
-        num(r.energy),
-        num(r.kinetic),
-        num(r.potential),
-        num(virial(r.kinetic, r.potential)),
-        num(r.angular_momentum[0]),
-        num(r.angular_momentum[1]),
-        num(r.angular_momentum[2])
+        [
+            r.energy,
+            r.kinetic,
+            r.potential,
+            virial(r.kinetic, r.potential),
+            lx,
+            ly,
+            lz,
+        ],
     );
 }
 
