@@ -315,3 +315,76 @@ fn check_refuses_the_flags_of_long_runs_instead_of_ignoring_them() {
         assert!(err.contains(flags[0]) && err.contains("pdyn run"), "{err}");
     }
 }
+
+/// A full disk, simulated by a file-size limit (`ulimit -f`, in 512-byte blocks): the run
+/// stops with exit code 1 and an error naming the file, the last whole row and the intact
+/// checkpoint; every file ends with a whole row; and once the limit is gone, `--restart`
+/// from that checkpoint ends with the files of a run that never hit the limit, byte for byte.
+#[cfg(unix)]
+#[test]
+fn a_full_disk_stops_the_run_with_whole_files_and_the_last_checkpoint_intact() {
+    let model = example("examples/nbody/outer_solar_system.toml");
+    let extra = ["--t-end", "3000000", "--checkpoint-every", "1000steps"];
+    let reference = fresh_dir("fsize-ref");
+    let st = Command::new(bin())
+        .args(run_args(&model, &extra, &reference))
+        .stdout(Stdio::null())
+        .status()
+        .expect("run pdyn");
+    assert!(st.success());
+    let full = std::fs::metadata(reference.join("trajectory.csv"))
+        .expect("trajectory.csv")
+        .len();
+
+    let dir = fresh_dir("fsize");
+    // Room for about 40 % of trajectory.csv (the largest file).
+    let blocks = full * 2 / 5 / 512;
+    let script = format!("ulimit -f {blocks} && exec \"$0\" \"$@\"",);
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg(&script)
+        .arg(bin())
+        .args(run_args(&model, &extra, &dir))
+        .arg("--json")
+        .output()
+        .expect("run pdyn under a file-size limit");
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "a write that fails mid-run is a failure after output (exit 1), not a crash: {:?}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let v: serde_json::Value = serde_json::from_str(&text).expect("--json prints JSON on failure");
+    let message = v["error"]["message"]
+        .as_str()
+        .unwrap_or_default()
+        .to_string();
+    assert_eq!(v["error"]["kind"], "io", "{v}");
+    assert!(message.contains("trajectory.csv"), "{message}");
+    assert!(message.contains("last whole row"), "{message}");
+    assert!(message.contains("--restart"), "{message}");
+    assert_whole_rows(&dir, "after the file-size limit", false);
+    let ckpt = dir.join("checkpoint.json");
+    assert!(ckpt.exists(), "the checkpoint before the failure is kept");
+
+    let st = Command::new(bin())
+        .args(run_args(&model, &extra, &dir))
+        .args(["--restart", &ckpt.display().to_string()])
+        .stdout(Stdio::null())
+        .status()
+        .expect("restart pdyn");
+    assert!(
+        st.success(),
+        "the restart after freeing space failed: {st:?}"
+    );
+    for name in CSV {
+        assert!(
+            std::fs::read(reference.join(name)).ok() == std::fs::read(dir.join(name)).ok(),
+            "{name} differs from the run that never hit the limit"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&reference);
+    let _ = std::fs::remove_dir_all(&dir);
+}

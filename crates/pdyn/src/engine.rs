@@ -372,12 +372,24 @@ fn run_nbody(
         steps,
         work: steps.saturating_mul(planned.info.n_bodies as u64),
     });
-    let (spec, info, result) = planned.execute_with(
-        stream.as_mut(),
-        &mut |s| progress(Progress::Step(s)),
-        checkpoints.as_mut(),
-        restart.as_ref().map(|r| &r.state),
-    )?;
+    let (spec, info, result) = planned
+        .execute_with(
+            stream.as_mut(),
+            &mut |s| progress(Progress::Step(s)),
+            checkpoints.as_mut(),
+            restart.as_ref().map(|r| &r.state),
+        )
+        .map_err(|e| match e {
+            // Files are only written once the run is going: an I/O error here is a write
+            // that failed mid-run (a full disk), not bad input.
+            Error::Io { .. } if req.out.is_some() => Error::WriteDuringRun {
+                error: Box::new(e),
+                checkpoint: checkpoints
+                    .as_ref()
+                    .map(|cp| (cp.path().to_path_buf(), cp.last_time)),
+            },
+            e => e,
+        })?;
     let (mut summary, failure) = nbody::output::outcome(&spec, &info, &result);
     if let Some(cp) = &checkpoints {
         summary["checkpoint"] = serde_json::json!({

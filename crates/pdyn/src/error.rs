@@ -46,6 +46,16 @@ pub enum Error {
         /// The operating system's reason.
         error: Arc<std::io::Error>,
     },
+    /// An output file could not be written while a run was going (a full disk, a file-size
+    /// limit): the run stopped there. Every file still ends with a whole row
+    /// ([`crate::stream::RowFile::flush`]) and the last checkpoint, written atomically, is
+    /// intact: after freeing space the run continues from it.
+    WriteDuringRun {
+        /// The failed write ([`Error::Io`]).
+        error: Box<Error>,
+        /// The checkpoint file, if the run writes one, and the time of the last one written.
+        checkpoint: Option<(PathBuf, Option<f64>)>,
+    },
     /// A model file that does not load; rendered with the offending line.
     Model {
         /// The located problem.
@@ -203,7 +213,7 @@ impl Error {
     /// A short machine-readable name of the kind of failure (the `kind` of `--json` errors).
     pub fn kind(&self) -> &'static str {
         match self {
-            Error::Io { .. } => "io",
+            Error::Io { .. } | Error::WriteDuringRun { .. } => "io",
             Error::Model { .. } => "model",
             Error::Expr { .. } => "expression",
             Error::Argument { .. } => "argument",
@@ -234,7 +244,8 @@ impl Error {
             | Error::NonFinite { .. }
             | Error::Gravity { .. }
             | Error::MdRun { .. }
-            | Error::Fit { .. } => 1,
+            | Error::Fit { .. }
+            | Error::WriteDuringRun { .. } => 1,
             Error::Internal { .. } => 3,
             Error::Interrupted { .. } => 4,
             _ => 2,
@@ -266,6 +277,7 @@ impl Error {
             Error::Io { path, .. } | Error::Plot { path, .. } => {
                 Some(file(&path.display().to_string()))
             }
+            Error::WriteDuringRun { error, .. } => error.location(),
             Error::Argument { argument, .. } if !argument.is_empty() => Some(file(argument)),
             Error::Derive { origin, error } => Some(Location {
                 file: origin.clone(),
@@ -362,6 +374,26 @@ impl fmt::Display for Error {
                 action,
                 error,
             } => write!(f, "cannot {action} {}: {error}", path.display()),
+            Error::WriteDuringRun { error, checkpoint } => {
+                write!(
+                    f,
+                    "{error}\nthe run stopped there; every output file ends with a whole row"
+                )?;
+                match checkpoint {
+                    Some((path, Some(t))) => write!(
+                        f,
+                        "; the last checkpoint ({}, t = {t}) is intact: free space and continue with --restart {}",
+                        path.display(),
+                        path.display()
+                    ),
+                    Some((path, None)) => write!(
+                        f,
+                        "; no checkpoint was written yet ({} would have been the first)",
+                        path.display()
+                    ),
+                    None => write!(f, "; the run writes no checkpoint"),
+                }
+            }
             Error::Model { error, source } => f.write_str(&error.render(source)),
             Error::Expr {
                 argument,

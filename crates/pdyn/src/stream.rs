@@ -82,14 +82,34 @@ impl RowFile {
         Ok(())
     }
 
-    /// Hands the buffered rows to the operating system.
+    /// Hands the buffered rows to the operating system. A write that fails part-way (a full
+    /// disk, a file-size limit) is undone: the file is cut back to its length after the last
+    /// flush, so it still ends with a whole row, and the error says so.
     pub fn flush(&mut self) -> Result<(), Error> {
         if self.buf.is_empty() {
             return Ok(());
         }
-        self.file
-            .write_all(&self.buf)
-            .map_err(|e| Error::io(&self.path, "write", e))?;
+        if let Err(e) = self.file.write_all(&self.buf) {
+            let cut = self
+                .file
+                .set_len(self.written)
+                .and_then(|()| self.file.seek(SeekFrom::Start(self.written)));
+            let kept = match cut {
+                Ok(_) => format!(
+                    "{e}; the file was cut back to its last whole row ({} bytes)",
+                    self.written
+                ),
+                Err(c) => format!(
+                    "{e}; cutting the file back to its last whole row ({} bytes) failed too ({c}): its last line may be partial",
+                    self.written
+                ),
+            };
+            return Err(Error::io(
+                &self.path,
+                "write",
+                std::io::Error::new(e.kind(), kept),
+            ));
+        }
         self.written += self.buf.len() as u64;
         self.buf.clear();
         Ok(())

@@ -21,6 +21,15 @@ pub fn install() -> Option<Interrupt> {
         signal_hook::flag::register_conditional_shutdown(sig, EXIT_AT_ONCE, flag.clone()).ok()?;
         signal_hook::flag::register(sig, flag.clone()).ok()?;
     }
+    // A file-size limit (`ulimit -f`) would kill the process with SIGXFSZ in the middle of a
+    // row; handled (by a flag nobody reads), the write fails with EFBIG instead, and the run
+    // stops as on a full disk: the file cut back to its last whole row, the last checkpoint
+    // kept, a located error (`pdyn::stream::RowFile::flush`).
+    signal_hook::flag::register(
+        signal_hook::consts::SIGXFSZ,
+        Arc::new(AtomicBool::new(false)),
+    )
+    .ok()?;
     Some(flag)
 }
 
