@@ -116,6 +116,10 @@ pub struct Linearizer {
     pub initial: Vec<f64>,
     program: Program,
     slots: Vec<Slot>,
+    /// `M r_d` for d = x, y, z (see [`Linearizer::inertia_at`]): a program and, for each of
+    /// its outputs, the direction and the coordinate it adds to.
+    inertia: Program,
+    inertia_slots: Vec<(usize, usize)>,
     /// `[t, q, q', parameters]`, with the parameters' values set.
     input: Vec<f64>,
 }
@@ -219,10 +223,35 @@ impl Linearizer {
                 });
             }
         }
+        // M r_d: entry i is Σ_p m_p ∂(r_p · e_d)/∂q_i, the generalized momentum of every
+        // particle moving at unit speed along e_d (the inertia load of a unit ground
+        // acceleration along e_d). Each particle is differentiated only by the coordinates
+        // its position holds.
+        let coordinate_of: rustc_hash::FxHashMap<Id, usize> =
+            q.iter().enumerate().map(|(j, &v)| (v, j)).collect();
+        let coordinates: rustc_hash::FxHashSet<Id> = q.iter().copied().collect();
+        let mut inertia_outputs: Vec<Id> = Vec::new();
+        let mut inertia_slots = Vec::new();
+        for particle in &model.particles {
+            for (dir, &component) in particle.position.iter().enumerate() {
+                let mut vars = p.occurring(component, &coordinates);
+                vars.sort_by_key(|v| coordinate_of[v]);
+                for v in vars {
+                    let dv = p.diff(component, v);
+                    if dv == Pool::ZERO {
+                        continue;
+                    }
+                    inertia_outputs.push(p.mul(&[particle.mass, dv]));
+                    inertia_slots.push((dir, coordinate_of[&v]));
+                }
+            }
+        }
         let mut inputs = vec![p.time()];
         inputs.extend(&d.state);
         inputs.extend(model.parameters.iter().map(|par| par.id));
         let program = Program::compile(p, &inputs, &outputs)
+            .map_err(|e| LinearizationError::Compile(e.to_string()))?;
+        let inertia = Program::compile(p, &inputs, &inertia_outputs)
             .map_err(|e| LinearizationError::Compile(e.to_string()))?;
         let mut input = vec![0.0; inputs.len()];
         for (k, par) in model.parameters.iter().enumerate() {
@@ -245,8 +274,28 @@ impl Linearizer {
             initial,
             program,
             slots,
+            inertia,
+            inertia_slots,
             input,
         })
+    }
+
+    /// `M r_d` at rest at `q`, for d = x, y, z: entry i is `Σ_p m_p ∂(r_p · e_d)/∂q_i`, the
+    /// generalized inertia force when every particle accelerates at unit rate along `e_d`
+    /// (a ground acceleration), whatever the coordinates. A mode's participation factor
+    /// along `e_d` is `φᵀ M r_d / φᵀ M φ` ([`crate::modes::Mode::participation`]).
+    pub fn inertia_at(&self, q: &[f64]) -> [Vec<f64>; 3] {
+        let n = self.len();
+        let mut input = self.input.clone();
+        input[1..1 + n].copy_from_slice(q);
+        let mut ws = self.inertia.workspace();
+        let mut out = vec![0.0; self.inertia_slots.len()];
+        self.inertia.eval(&input, &mut ws, &mut out);
+        let mut b = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        for (&(dir, i), v) in self.inertia_slots.iter().zip(out) {
+            b[dir][i] += v;
+        }
+        b
     }
 
     /// Number of free coordinates.

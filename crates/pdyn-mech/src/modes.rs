@@ -46,6 +46,13 @@ pub struct Mode {
     pub modal_mass: f64,
     /// `φᵀ K φ` with that scaling.
     pub modal_stiffness: f64,
+    /// Participation factor along x, y, z: `Γ_d = φᵀ M r_d / φᵀ M φ`, how much a ground
+    /// acceleration along `e_d` excites this mode ([`Modes::add_participation`]; NaN until
+    /// then). Its sign follows the shape's.
+    pub participation: [f64; 3],
+    /// Effective modal mass along x, y, z: `(φᵀ M r_d)² / φᵀ M φ`, independent of the shape's
+    /// scaling; over all modes they add up to [`Modes::total_mass`].
+    pub effective_mass: [f64; 3],
 }
 
 /// The modes, lowest `ω²` first.
@@ -55,6 +62,39 @@ pub struct Modes {
     pub modes: Vec<Mode>,
     /// `max |K - Kᵀ| / max |K|`: zero for conservative forces.
     pub stiffness_asymmetry: f64,
+    /// The mass that moves with a rigid translation along x, y, z: `(M r_d)ᵀ M⁻¹ (M r_d)`,
+    /// the sum of every mode's effective mass (NaN until [`Modes::add_participation`]).
+    /// The share the modes found carry of it says whether enough were computed (the
+    /// structural engineer's 90 % rule).
+    pub total_mass: [f64; 3],
+}
+
+impl Modes {
+    /// Fills each mode's participation factors and effective masses and the total mass
+    /// along x, y, z, from `M r_d` ([`crate::linearization::Linearizer::inertia_at`]) and
+    /// `solve_mass(b) = M⁻¹ b`.
+    pub fn add_participation(
+        &mut self,
+        inertia: &[Vec<f64>; 3],
+        solve_mass: impl Fn(&[f64]) -> Option<Vec<f64>>,
+    ) {
+        for (d, b) in inertia.iter().enumerate() {
+            self.total_mass[d] = if b.iter().all(|&x| x == 0.0) {
+                0.0
+            } else {
+                solve_mass(b).map_or(f64::NAN, |x| dot(b, &x))
+            };
+            for m in &mut self.modes {
+                let l = dot(&m.shape, b);
+                m.participation[d] = l / m.modal_mass;
+                m.effective_mass[d] = l * l / m.modal_mass;
+            }
+        }
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 /// The modes of `lin`.
@@ -112,12 +152,15 @@ pub fn modes(lin: &Linearization) -> Result<Modes, ModesError> {
             shape: phi.iter().copied().collect(),
             modal_mass,
             modal_stiffness,
+            participation: [f64::NAN; 3],
+            effective_mass: [f64::NAN; 3],
         });
     }
     out.sort_by(|a, b| a.omega_squared.total_cmp(&b.omega_squared));
     Ok(Modes {
         modes: out,
         stiffness_asymmetry: if kmax > 0.0 { asym / kmax } else { 0.0 },
+        total_mass: [f64::NAN; 3],
     })
 }
 

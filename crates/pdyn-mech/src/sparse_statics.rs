@@ -218,10 +218,13 @@ pub fn lowest_modes(lin: &SparseLinearization, count: usize) -> Result<Modes, Mo
             modal_mass: m.form(&phi, &phi),
             modal_stiffness: phi.iter().zip(&kphi).map(|(a, b)| a * b).sum(),
             shape: phi,
+            participation: [f64::NAN; 3],
+            effective_mass: [f64::NAN; 3],
         });
     }
     Ok(Modes {
         modes,
         stiffness_asymmetry,
+        total_mass: [f64::NAN; 3],
     })
 }

@@ -193,6 +193,22 @@ pub fn modes_about(
         let dense = lin.at(&q);
         (crate::modes::modes(&dense)?, Some(dense))
     };
+    let inertia = lin.inertia_at(&q);
+    match &dense {
+        Some(d) if !sparse => {
+            let chol = d.mass.clone().cholesky();
+            modes.add_participation(&inertia, |b| {
+                let x = chol
+                    .as_ref()?
+                    .solve(&nalgebra::DVector::from_column_slice(b));
+                Some(x.iter().copied().collect())
+            });
+        }
+        _ => {
+            let ldl = crate::sparse::EnvelopeLdlt::new(&matrices.mass).ok();
+            modes.add_participation(&inertia, |b| Some(ldl.as_ref()?.solve(b)));
+        }
+    }
     let shown = count.unwrap_or(modes.modes.len()).min(modes.modes.len());
     modes.modes.truncate(shown);
     let damped = match &dense {

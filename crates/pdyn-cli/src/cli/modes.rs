@@ -117,6 +117,19 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
     let shown = &result.modes[..];
     let damped_shown: &[DampedMode] = damped.as_deref().unwrap_or(&[]);
     let tau = std::f64::consts::TAU;
+    // The directions a rigid translation of the particles moves some mass along.
+    let biggest = result
+        .total_mass
+        .iter()
+        .copied()
+        .filter(|x| x.is_finite())
+        .fold(0.0f64, f64::max);
+    let active: Vec<usize> = (0..3)
+        .filter(|&d| result.total_mass[d].is_finite() && result.total_mass[d] > 1e-12 * biggest)
+        .collect();
+    const AXES: [&str; 3] = ["x", "y", "z"];
+    let by_axis =
+        |v: &[f64; 3]| json!({"x": json_num(v[0]), "y": json_num(v[1]), "z": json_num(v[2])});
     if a.json {
         let v = json!({
             "model": model.name,
@@ -132,10 +145,13 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
                 "period": json_num(tau / m.omega),
                 "modal_mass": json_num(m.modal_mass),
                 "modal_stiffness": json_num(m.modal_stiffness),
+                "participation": by_axis(&m.participation),
+                "effective_mass": by_axis(&m.effective_mass),
                 "shape": m.shape.iter().map(|x| json_num(*x)).collect::<Vec<_>>(),
             })).collect::<Vec<_>>(),
         });
         let mut v = v;
+        v["total_mass"] = by_axis(&result.total_mass);
         v["solver"] = json!(if sparse { "sparse" } else { "dense" });
         v["coordinate_count"] = json!(n);
         if damped.is_some() {
@@ -174,9 +190,13 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
             result.stiffness_asymmetry
         );
     }
+    let mass_heads: String = active
+        .iter()
+        .map(|&d| format!("  eff. mass {} %", AXES[d]))
+        .collect();
     let _ = writeln!(
         s,
-        "\n  mode      omega (rad/s)       f (Hz)           period (s)       modal mass   largest components"
+        "\n  mode      omega (rad/s)       f (Hz)           period (s)       modal mass{mass_heads}   largest components"
     );
     for (k, m) in shown.iter().enumerate() {
         let mut order: Vec<usize> = (0..m.shape.len()).collect();
@@ -201,12 +221,40 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
                 String::new(),
             )
         };
+        let shares: String = active
+            .iter()
+            .map(|&d| {
+                format!(
+                    "  {:>15.3}",
+                    100.0 * m.effective_mass[d] / result.total_mass[d]
+                )
+            })
+            .collect();
         let _ = writeln!(
             s,
-            "  {:>4}  {w:>18}  {f:>16}  {t:>16}  {:>12.4e}   {}",
+            "  {:>4}  {w:>18}  {f:>16}  {t:>16}  {:>12.4e}{shares}   {}",
             k + 1,
             m.modal_mass,
             main.join(" ")
+        );
+    }
+    if !active.is_empty() {
+        let captured: Vec<String> = active
+            .iter()
+            .map(|&d| {
+                let sum: f64 = shown.iter().map(|m| m.effective_mass[d]).sum();
+                format!(
+                    "{} {:.3} % of {:.6e}",
+                    AXES[d],
+                    100.0 * sum / result.total_mass[d],
+                    result.total_mass[d]
+                )
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "\n  effective mass of these modes (a ground acceleration along an axis excites each mode in this share): {}",
+            captured.join(", ")
         );
     }
     if damped.is_some() {
