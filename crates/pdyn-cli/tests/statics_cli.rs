@@ -191,3 +191,66 @@ fn a_count_of_zero_is_refused() {
     let (ok, _, err) = pdyn(&["modes", &example("chain_modes.toml"), "--count", "0"]);
     assert!(!ok && err.contains("--count"), "{err}");
 }
+
+/// The Warren truss of `examples/truss.toml` against the method of joints (θ = 60°, load P
+/// at the lower chord's middle, pin A, roller B): AD = EB = −P/(2 sin θ), AC = CB =
+/// P/(2 tan θ), DC = EC = P/(2 sin θ), DE = −P/tan θ, the pin's reaction [0, P/2]. The bars
+/// are springs of stiffness EA/a, so the equilibrium differs from the rigid-bar statics by
+/// the change of geometry, of order P/EA: about 3e-5 at steel's EA, 100 times less at 100
+/// times the stiffness, and the forces tend to the method of joints'.
+#[test]
+fn the_trusss_bar_forces_tend_to_the_method_of_joints() {
+    let p = 1.0e4;
+    let (s, t) = (
+        libm::sin(std::f64::consts::PI / 3.0),
+        libm::tan(std::f64::consts::PI / 3.0),
+    );
+    let joints = [
+        ("AC", p / (2.0 * t)),
+        ("CB", p / (2.0 * t)),
+        ("AD", -p / (2.0 * s)),
+        ("DC", p / (2.0 * s)),
+        ("DE", -p / t),
+        ("EC", p / (2.0 * s)),
+        ("EB", -p / (2.0 * s)),
+    ];
+    let worst = |ea: &str| -> f64 {
+        let (ok, out, err) = pdyn(&[
+            "equilibrium",
+            &example("truss.toml"),
+            "--set",
+            &format!("EA={ea}"),
+            "--json",
+        ]);
+        assert!(ok, "{err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        let bars = v["axial_forces"].as_array().unwrap();
+        assert_eq!(bars.len(), 7);
+        let mut worst: f64 = 0.0;
+        for (name, exact) in joints {
+            let bar = bars
+                .iter()
+                .find(|b| {
+                    b["element"]
+                        .as_str()
+                        .unwrap()
+                        .starts_with(&format!("{name} ("))
+                })
+                .unwrap_or_else(|| panic!("bar {name} in {bars:?}"));
+            let got = bar["tension"].as_f64().unwrap();
+            assert_eq!(got.signum(), exact.signum(), "{name}: {got} vs {exact}");
+            worst = worst.max((got - exact).abs() / p);
+        }
+        let r = &v["reactions"][0]["force"];
+        worst = worst
+            .max(r[0].as_f64().unwrap().abs() / p)
+            .max((r[1].as_f64().unwrap() - p / 2.0).abs() / p);
+        worst
+    };
+    let steel = worst("2e8");
+    let stiff = worst("2e10");
+    assert!(steel < 1e-4, "steel: {steel:e}");
+    assert!(stiff < 1e-6, "100x stiffer: {stiff:e}");
+    // The difference is the geometry's change, of order P/EA: it falls with the stiffness.
+    assert!(stiff < steel / 30.0, "{steel:e} then {stiff:e}");
+}

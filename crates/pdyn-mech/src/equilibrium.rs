@@ -280,12 +280,44 @@ pub fn support_reactions(
         names.push(name.clone());
         sums.push(total.map(|c| model.pool.neg(c)));
     }
+    let outputs: Vec<pdyn_expr::Id> = sums.iter().flatten().copied().collect();
+    let out = at_rest(model, d, q, &outputs)?;
+    Ok(names
+        .into_iter()
+        .enumerate()
+        .map(|(k, name)| (name, [out[3 * k], out[3 * k + 1], out[3 * k + 2]]))
+        .collect())
+}
+
+/// The tension of every spring and damper ([`crate::model::AxialForce`]) at rest at `q`
+/// (t = 0): a truss's bar forces, positive in tension.
+pub fn axial_forces(
+    model: &mut crate::Model,
+    d: &crate::Derivation,
+    q: &[f64],
+) -> Result<Vec<(String, f64)>, crate::linearization::LinearizationError> {
+    let outputs: Vec<pdyn_expr::Id> = model.axial.iter().map(|a| a.tension).collect();
+    let out = at_rest(model, d, q, &outputs)?;
+    Ok(model
+        .axial
+        .iter()
+        .map(|a| a.label.clone())
+        .zip(out)
+        .collect())
+}
+
+/// `outputs` evaluated at rest at `q` (t = 0, rates zero), the parameters at their values.
+fn at_rest(
+    model: &mut crate::Model,
+    d: &crate::Derivation,
+    q: &[f64],
+    outputs: &[pdyn_expr::Id],
+) -> Result<Vec<f64>, crate::linearization::LinearizationError> {
     let p = &mut model.pool;
     let mut inputs = vec![p.time()];
     inputs.extend(&d.state);
     inputs.extend(model.parameters.iter().map(|par| par.id));
-    let outputs: Vec<pdyn_expr::Id> = sums.iter().flatten().copied().collect();
-    let prog = pdyn_expr::Program::compile(p, &inputs, &outputs)
+    let prog = pdyn_expr::Program::compile(p, &inputs, outputs)
         .map_err(|e| crate::linearization::LinearizationError::Compile(e.to_string()))?;
     let n = d.free.len();
     let mut input = vec![0.0; inputs.len()];
@@ -296,9 +328,5 @@ pub fn support_reactions(
     let mut ws = prog.workspace();
     let mut out = vec![0.0; outputs.len()];
     prog.eval(&input, &mut ws, &mut out);
-    Ok(names
-        .into_iter()
-        .enumerate()
-        .map(|(k, name)| (name, [out[3 * k], out[3 * k + 1], out[3 * k + 2]]))
-        .collect())
+    Ok(out)
 }

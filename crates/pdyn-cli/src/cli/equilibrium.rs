@@ -5,7 +5,9 @@ use super::{load_model, set_parameters};
 use clap::Args;
 use pdyn::output::json_num;
 use pdyn::Error;
-use pdyn_mech::equilibrium::{solve, support_reactions, EquilibriumOptions, FreeDirection};
+use pdyn_mech::equilibrium::{
+    axial_forces, solve, support_reactions, EquilibriumOptions, FreeDirection,
+};
 use pdyn_mech::sparse_statics::{self, SPARSE_FROM};
 use pdyn_mech::statics::{linearize, StaticsError};
 use serde_json::json;
@@ -48,6 +50,9 @@ struct Found {
 }
 
 /// `pdyn equilibrium MODEL`.
+/// Spring and damper forces printed (a net has thousands; `--json` has them all).
+const AXIAL_SHOWN: usize = 40;
+
 pub fn run(a: EquilibriumArgs) -> Result<String, Error> {
     let mut model = load_model(&a.model)?;
     set_parameters(&mut model, &a.set)?;
@@ -89,6 +94,7 @@ pub fn run(a: EquilibriumArgs) -> Result<String, Error> {
         }
     };
     let reactions = support_reactions(&mut model, &d, &eq.q).map_err(|e| fail(e.into()))?;
+    let axial = axial_forces(&mut model, &d, &eq.q).map_err(|e| fail(e.into()))?;
     if a.json {
         let v = json!({
             "model": model.name,
@@ -97,6 +103,7 @@ pub fn run(a: EquilibriumArgs) -> Result<String, Error> {
             "force_scale": json_num(eq.scale),
             "coordinates": lin.names.iter().zip(&eq.q).map(|(n, q)| json!({"name": n, "value": json_num(*q)})).collect::<Vec<_>>(),
             "reactions": reactions.iter().map(|(n, r)| json!({"point": n, "force": r.iter().map(|x| json_num(*x)).collect::<Vec<_>>()})).collect::<Vec<_>>(),
+            "axial_forces": axial.iter().map(|(n, t)| json!({"element": n, "tension": json_num(*t)})).collect::<Vec<_>>(),
             "neutral_directions": eq.neutral.iter().map(direction_json).collect::<Vec<_>>(),
         });
         return Ok(format!("{v:#}"));
@@ -120,6 +127,23 @@ pub fn run(a: EquilibriumArgs) -> Result<String, Error> {
         );
         for (n, r) in &reactions {
             let _ = writeln!(s, "  {n}: [{:.6e}, {:.6e}, {:.6e}]", r[0], r[1], r[2]);
+        }
+    }
+    if !axial.is_empty() {
+        let _ = writeln!(
+            s,
+            "\nSpring and damper forces (positive in tension, negative in compression):"
+        );
+        let width = axial.iter().map(|(n, _)| n.len()).max().unwrap_or(0);
+        for (n, t) in axial.iter().take(AXIAL_SHOWN) {
+            let _ = writeln!(s, "  {n:width$}  {t:+.6e}");
+        }
+        if axial.len() > AXIAL_SHOWN {
+            let _ = writeln!(
+                s,
+                "  ... and {} more (--json lists every one)",
+                axial.len() - AXIAL_SHOWN
+            );
         }
     }
     if !eq.neutral.is_empty() {

@@ -129,6 +129,17 @@ pub struct Particle {
     pub position: [Id; 3],
 }
 
+/// The scalar force of a spring or damper along its line: positive in tension (pulling its
+/// ends together), negative in compression. `pdyn equilibrium` reports it (a truss's bar
+/// forces).
+#[derive(Clone, Debug)]
+pub struct AxialForce {
+    /// `NAME (A, B)`: the entry's name (or family member) and its two ends.
+    pub label: String,
+    /// `k (l − l0)` of a spring, `c l'` of a damper.
+    pub tension: Id,
+}
+
 /// A massless frame carrying one particle: ΣF = m a for the pair and ΣM = 0 about the particle.
 #[derive(Clone, Debug)]
 pub struct Frame {
@@ -257,6 +268,8 @@ pub struct Model {
     pub contacts: Vec<Contact>,
     /// Potential energies of the conservative forces.
     pub potentials: Vec<PotentialTerm>,
+    /// The tension of every spring and damper (a bar of a truss is a stiff spring).
+    pub axial: Vec<AxialForce>,
     /// True when every force has a potential or is a reaction (energy is then conserved
     /// unless something is prescribed as a function of time).
     pub conservative: bool,
@@ -330,6 +343,7 @@ fn read(ld: &mut Loader, raw: &RawModel) -> Result<Model, ModelError> {
         point_loads,
         reactions,
         potentials,
+        axial,
         conservative,
     } = ld.read_forces(raw, &particles, &frames, &points)?;
     let constraints = ld.read_constraints(raw)?;
@@ -368,6 +382,7 @@ fn read(ld: &mut Loader, raw: &RawModel) -> Result<Model, ModelError> {
         constraints,
         contacts,
         potentials,
+        axial,
         conservative,
     })
 }

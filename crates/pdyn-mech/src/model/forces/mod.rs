@@ -145,6 +145,7 @@ pub(super) struct Built {
     pub point_loads: Vec<PointLoad>,
     pub reactions: Vec<Reaction>,
     pub potentials: Vec<PotentialTerm>,
+    pub axial: Vec<super::AxialForce>,
     pub conservative: bool,
 }
 
@@ -160,6 +161,7 @@ pub(super) struct ForceBuilder<'a> {
     point_loads: Vec<PointLoad>,
     reactions: Vec<Reaction>,
     potentials: Vec<PotentialTerm>,
+    axial: Vec<super::AxialForce>,
     conservative: bool,
     friction_forces: Vec<String>,
     contacts: Vec<super::Contact>,
@@ -204,6 +206,7 @@ impl<'a> ForceBuilder<'a> {
             point_loads: Vec::new(),
             reactions: Vec::new(),
             potentials: Vec::new(),
+            axial: Vec::new(),
             conservative: true,
             friction_forces: Vec::new(),
             contacts: Vec::new(),
@@ -223,6 +226,7 @@ impl<'a> ForceBuilder<'a> {
             point_loads: self.point_loads,
             reactions: self.reactions,
             potentials: self.potentials,
+            axial: self.axial,
             conservative: self.conservative,
         }
     }
@@ -416,6 +420,10 @@ impl<'a> ForceBuilder<'a> {
 
     /// Pushes `-mag dir` on the first end and the opposite on the second.
     fn push_axial(&mut self, ld: &mut Loader, e: &Entry, ends: &[End; 2], mag: Id, dir: [Id; 3]) {
+        self.axial.push(super::AxialForce {
+            label: format!("{} ({}, {})", e.label, ends[0].2, ends[1].2),
+            tension: mag,
+        });
         let neg = ld.pool.neg(mag);
         let force = vector::scale(&mut ld.pool, neg, dir);
         self.push_pair_labelled(ld, e, ends, force);
