@@ -30,7 +30,7 @@ pub struct RunOptions {
     pub out: Option<PathBuf>,
     /// Relative drift of the conserved energy that triggers a warning.
     pub drift_tolerance: f64,
-    /// Set by another thread to stop after the current stretch of steps (Ctrl-C in Python).
+    /// Set by another thread to stop the run after the current step (Ctrl-C in Python).
     pub interrupt: Option<pdyn_ode::Interrupt>,
     /// Frames for a live display (`Progress::Frame`) every this many steps; 0: at the model's
     /// `dump_every` (none without).
@@ -317,10 +317,15 @@ fn run_sim<P: PairPotential>(
         }
         _ => None,
     };
+    // The degrees of freedom of the temperature column ride along as a last column `dof`
+    // (the same value on every row): the header stays one line of plain names, which pandas,
+    // spreadsheets and `csv` readers take as they are, `temperature` keeps its name, and the
+    // convention (3N − 3 as LAMMPS's `compute temp`, or 3N under Langevin) is in the file.
+    let dof = sim.dof();
     let mut thermo_file = match &opts.out {
         Some(dir) => Some(RowFile::create(
             &dir.join("thermo.csv"),
-            &format!("{}\n", pdyn_md::THERMO_CSV_HEADER),
+            &format!("{},dof\n", pdyn_md::THERMO_CSV_HEADER),
         )?),
         None => None,
     };
@@ -435,7 +440,7 @@ fn run_sim<P: PairPotential>(
             progress(Progress::Record(&c));
             if let Some(f) = &mut thermo_file {
                 if let Err(e) = f.rows(|b| {
-                    let _ = writeln!(b, "{c}");
+                    let _ = writeln!(b, "{c},{dof}");
                 }) {
                     write_error.get_or_insert(e);
                 }
@@ -451,7 +456,9 @@ fn run_sim<P: PairPotential>(
                 }
             }
         };
-        let outcome = sim.run(k, &mut obs);
+        // the interrupt is also checked after every step inside the stretch (a long stretch
+        // of a large system would otherwise keep Ctrl-C waiting for seconds)
+        let outcome = sim.run_interruptible(k, &mut obs, opts.interrupt.as_deref());
         match outcome {
             Ok(rep) => {
                 builds += rep.builds;
@@ -502,7 +509,7 @@ fn run_sim<P: PairPotential>(
         progress(Progress::Record(&c));
         if let Some(f) = &mut thermo_file {
             f.rows(|b| {
-                let _ = writeln!(b, "{c}");
+                let _ = writeln!(b, "{c},{dof}");
             })?;
         }
         records.push(c);
