@@ -203,9 +203,8 @@ impl<P: PairPotential> ForceField<P> {
                 add_into(&mut total[c as usize], v);
             }
         }
-        for (c, t) in total.iter().enumerate() {
-            for l in 0..CL {
-                let k = nl.slot[c * CL + l];
+        for (t, slots) in total.iter().zip(nl.slot.chunks_exact(CL)) {
+            for (l, &k) in slots.iter().enumerate() {
                 if k != EMPTY {
                     forces[k as usize] = [t[0][l], t[1][l], t[2][l]];
                 }
@@ -357,9 +356,9 @@ fn kernel_avx2<E: RowEval>(
 #[inline(always)]
 fn shifted(x: &ClusterVec, s: &[f64; 3]) -> ClusterVec {
     let mut y = *x;
-    for k in 0..3 {
-        for l in 0..CL {
-            y[k][l] += s[k];
+    for (row, sk) in y.iter_mut().zip(s) {
+        for v in row.iter_mut() {
+            *v += sk;
         }
     }
     y

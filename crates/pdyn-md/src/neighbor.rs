@@ -282,9 +282,8 @@ impl NeighborList {
 
     /// Copies the particles' positions into the clusters (between builds).
     pub fn update_positions(&mut self, p: &Particles) {
-        for (c, q) in self.xc.iter_mut().enumerate() {
-            for l in 0..CL {
-                let k = self.slot[c * CL + l];
+        for (q, slots) in self.xc.iter_mut().zip(self.slot.chunks_exact(CL)) {
+            for (l, &k) in slots.iter().enumerate() {
                 if k != EMPTY {
                     let k = k as usize;
                     q[0][l] = p.x[k];
@@ -382,8 +381,8 @@ impl NeighborList {
                     }
                     q
                 };
-                for d in 0..3 {
-                    self.xc[c][d][lane] = q[d];
+                for (row, v) in self.xc[c].iter_mut().zip(q) {
+                    row[lane] = v;
                 }
             }
         }
@@ -564,6 +563,7 @@ impl NeighborList {
 /// than `sqrt(r2)` (empty slots are far away, so they never are). Branch-free over the four
 /// lanes of `b`, so that it runs on packed registers.
 #[inline]
+#[allow(clippy::needless_range_loop)] // `i` picks one particle across the three component rows
 fn any_pair_within(a: &ClusterVec, shift: &[f64; 3], b: &ClusterVec, r2: f64) -> bool {
     let mut near = [false; CL];
     for i in 0..CL {
