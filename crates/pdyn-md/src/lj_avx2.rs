@@ -3,11 +3,13 @@
 //!
 //! It performs the operations of the portable kernel (`forces::kernel` with
 //! `Truncated<LennardJones>`), in the same order and without fused multiply-add: per row,
-//! `d = xᵢ − xⱼ`, `r² = (dx² + dy²) + dz²`, `r²` replaced by `r_c²` outside the cutoff,
-//! `1/r²`, `s = σ²/r²`, `s⁶ = (s·s)·s`, `u = (4ε·s⁶)(s⁶ − 1) − u_c`,
-//! `f/r = ((24ε·s⁶)(2s⁶ − 1))/r²`, both zeroed outside the cutoff (and below the diagonal),
-//! then the same sums. Each operation is exactly rounded IEEE arithmetic, so the two give the
-//! same bits (test `avx2_and_portable_kernels_agree_bit_for_bit`).
+//! `d = xᵢ − xⱼ`, `r² = (dx² + dy²) + dz²`, `1/r²`, `s = σ²/r²`, `s⁶ = (s·s)·s`,
+//! `f/r = ((24ε·s⁶)(2s⁶ − 1))/r²` and, when energies are asked for, `u = (4ε·s⁶)(s⁶ − 1) − u_c`
+//! and the virial, both cleared bit by bit outside the cutoff and below the diagonal, then the
+//! same sums. (The portable kernel evaluates the lanes outside the cutoff at `r_c` before
+//! clearing them; here they are evaluated where they are, which changes nothing that is kept.)
+//! Each operation is exactly rounded IEEE arithmetic, so the two give the same bits (test
+//! `avx2_and_portable_kernels_agree_bit_for_bit`).
 
 use crate::forces::ListView;
 use crate::neighbor::{ClusterVec, Segment, CL};
