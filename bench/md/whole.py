@@ -3,6 +3,11 @@
 usage (from the repository root, after bash bench/md/run.sh has made bench/md/.venv and
 `cargo build --release -p pdyn-cli`):
     bench/md/.venv/bin/python bench/md/whole.py [--repeat 5] [--steps 300] [--pdyn target/release/pdyn]
+in.melt (LAMMPS's settings, then exact checks on both sides):
+    bench/md/.venv/bin/python bench/md/whole.py --steps 250 --toml bench/md/in_melt.toml \
+        --lammps-input bench/md/in.melt --cases pdyn1,lmp1
+    bench/md/.venv/bin/python bench/md/whole.py --steps 250 --toml bench/md/in_melt_exact.toml \
+        --lammps-input bench/md/in.melt.exact --cases pdyn1,lmp1
 
 Cases (each the command a user types, timed from fork to exit):
   pdyn 1 thread     RAYON_NUM_THREADS=1 pdyn run bench/md/in_lj.toml --out DIR
@@ -35,6 +40,7 @@ ap.add_argument("--pdyn-before", default=None,
                 help="a second pdyn binary (e.g. built from the commit before a change): adds "
                      "the cases before1 and before2")
 a = ap.parse_args()
+a.toml, a.lammps_input, a.pdyn = (os.path.abspath(x) for x in (a.toml, a.lammps_input, a.pdyn))
 
 env = dict(os.environ)
 env["LD_LIBRARY_PATH"] = os.path.join(venv, "lib") + (
@@ -81,7 +87,8 @@ for r in range(a.repeat):
         res[c].append(timed(cases[c][1], cases[c][2]))
 print(f"`uptime` after: {os.popen('uptime').read().strip()}")
 print()
-print(f"in.lj, 32,000 atoms, {a.steps} steps, {a.repeat} alternating repetitions, medians")
+print(f"{os.path.basename(a.toml)} against {os.path.basename(a.lammps_input)}, {a.steps} steps, "
+      f"{a.repeat} alternating repetitions, medians")
 print()
 print("| case | wall s (median) | CPU s (median) | wall s, all runs |")
 print("|---|---|---|---|")
