@@ -51,6 +51,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let n = sim.system.particles.len();
     let pairs = sim.pairs_within_cutoff() as f64;
     let last = sim.thermo();
+    let nl = sim.neighbor_list();
+    eprintln!(
+        "clusters {}, cluster pairs {} ({} pair evaluations, {:.1} % of them inside the cutoff)",
+        nl.clusters(),
+        nl.cluster_pairs(),
+        16 * nl.cluster_pairs(),
+        100.0 * pairs / (16.0 * nl.cluster_pairs() as f64)
+    );
     println!(
         "{n},{steps},{threads},{setup:.4},{dt:.4},{:.4e},{:.4e},{},{:.5},{:.5},{:.5},{cpu:.4}",
         n as f64 * steps as f64 / dt,

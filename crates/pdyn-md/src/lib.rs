@@ -27,6 +27,8 @@ mod error;
 mod forces;
 pub mod io;
 mod lattice;
+#[cfg(target_arch = "x86_64")]
+mod lj_avx2;
 mod minimize;
 mod neighbor;
 pub mod potential;
@@ -46,6 +48,6 @@ pub use neighbor::NeighborList;
 pub use pdyn_particles::rng::Rng;
 pub use pdyn_particles::{Particle, Particles, Vec3};
 pub use sim_box::SimBox;
-pub use simulation::{Observer, RunReport, SimParams, Simulation, System};
+pub use simulation::{Observer, RunReport, SimParams, Simulation, System, ENERGY_CHECK_EVERY};
 pub use thermo::{KineticEstimator, ThermoRecord, THERMO_CSV_HEADER};
 pub use velocities::maxwell_boltzmann;

@@ -85,9 +85,9 @@ pub fn minimize_fire<P: PairPotential>(
         if nl.needs_rebuild(&s.particles) {
             nl.build(&mut s.particles, &mut s.images, &s.sim_box);
         } else {
-            nl.update_ghosts(&s.particles);
+            nl.update_positions(&s.particles);
         }
-        let (u_p, _) = ff.compute(nl, &s.types, &mut scratch, &mut out);
+        let (u_p, _) = ff.compute(nl, &s.types, &mut scratch, &mut out, true);
         let (u_s, _) = special.correct(s, ff, &mut out);
         let (u_b, _) = bond_forces(s, &mut out)?;
         let u = u_p + u_s + u_b;

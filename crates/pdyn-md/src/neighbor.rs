@@ -1,100 +1,154 @@
-//! Verlet neighbour list (half, with ghosts) built through a bin list, with particles in a
-//! spatially sorted internal order.
+//! Cluster-pair neighbour list (GROMACS style: Páll & Hess, Comput. Phys. Commun. 184, 2641
+//! (2013)) over particles in a spatially sorted internal order.
 //!
 //! At a build every particle is wrapped into the box (image counters keep the unwrapped
-//! trajectory), and the particles are given an *internal* order: sorted by bin (bins of edge
-//! `≥ r_s/2`, `r_s = r_c + δ`, x-major), so that neighbours in space are neighbours in memory
-//! (LAMMPS `atom_modify sort`). The particles themselves are not permuted: [`NeighborList`]
-//! keeps `perm` (internal → particle index) and its own position array. Every periodic image
-//! lying within `r_s` of the box is added as a *ghost* with a fixed shift (as LAMMPS's ghost
-//! atoms); between builds ghosts follow their owners (`r_g = r_owner + shift`), so the force
-//! loop needs no minimum image.
+//! trajectory) and the particles are put into *clusters* of [`CL`] = 4: the box is cut into
+//! columns along z (square in x and y, of the edge that holds four particles in a cube at the
+//! mean density), the particles of a column are sorted by z, and each run of four consecutive
+//! particles of a column is a cluster (the last one of a column padded with empty slots). The
+//! particles themselves are not permuted: the list keeps the particle index of every slot and
+//! its own positions, cluster by cluster, component by component (`[[f64; 4]; 3]`), so that
+//! the force kernel loads the four particles of a cluster as one packed vector per component.
 //!
-//! The list is *half*: internal particle `i` lists the extended indices `j` with
-//! `owner(j) > i` and `|rᵢ − rⱼ| < r_s`, so each pair appears once (Newton's third law in the
-//! force loop). Bins are scanned in a fixed order (a 5×5×5 stencil of half-`r_s` bins), so the
-//! list, and every sum over it, does not depend on the number of threads. It stays exact while
-//! the two largest displacements since the build add up to at most `δ` (a pair approaches by
-//! at most the sum of its two displacements); [`NeighborList::needs_rebuild`] checks that.
+//! The list holds pairs of clusters `(i, j, s)` whose bounding boxes, `i`'s shifted by the
+//! periodic image `s ∈ {−1, 0, 1}³` (times the box), come within `r_s = r_c + δ`, and at least
+//! one of whose 16 particle pairs is within `r_s` at the build. Each pair of particles appears
+//! once: `(i, j, s)` is kept for `j > i`, and for `j = i` only for `s = 0` (the *diagonal*
+//! entry, of which the kernel takes the particle pairs `a < b`) or `s` lexicographically
+//! positive. Periodic images are handled by the shift of the entry, so there are no ghost
+//! particles and every force lands on a real cluster (Newton's third law in the kernel). The
+//! box must be at least `2 r_s` long so that one image per pair suffices.
+//!
+//! Empty slots sit far away from everything and from each other (at distinct points more than
+//! `r_s` apart), so that every pair involving one falls outside the cutoff without a mask.
+//!
+//! The entries are sorted by `i`, built in fixed chunks of `i` clusters, and cut into a fixed
+//! number of *segments* (a function of the number of particles only): the force loop gives
+//! each segment a buffer of its own clusters plus the clusters beyond it that its entries
+//! touch (`Segment::foreign`), and adds the buffers in segment order. Every sum is therefore
+//! taken in an order fixed by the particles alone: results do not depend on the number of
+//! threads. The list stays exact while the two largest displacements since the build add up
+//! to at most `δ` (a pair approaches by at most the sum of its two displacements);
+//! [`NeighborList::needs_rebuild`] checks that.
 
 use crate::{MdError, SimBox};
 use pdyn_particles::Particles;
 use rayon::prelude::*;
+use std::ops::Range;
 
-/// Atoms per task when the list is built: a fixed size, so that the concatenated list is the
-/// same for any number of threads.
-const BUILD_CHUNK: usize = 512;
+/// Particles per cluster (the SIMD width of the kernel over `j`, four `f64` in AVX2).
+pub(crate) const CL: usize = 4;
 
-/// Verlet list (half, with ghosts, internal spatial order) and the buffers it is rebuilt in.
+/// Positions (or forces) of one cluster: component, then slot.
+pub(crate) type ClusterVec = [[f64; CL]; 3];
+
+/// Slot without a particle.
+pub(crate) const EMPTY: u32 = u32::MAX;
+
+/// Clusters per task when the list is built: a fixed size, so that the concatenated list is
+/// the same for any number of threads.
+const BUILD_CHUNK: usize = 64;
+
+/// Most segments the force loop is cut into (and so the most threads it can use).
+const MAX_SEGMENTS: usize = 4;
+/// Fewest particles per segment: below that a buffer costs more than the parallelism gains.
+const MIN_SEGMENT: usize = 1000;
+
+/// The `j` clusters of one `i` cluster under one periodic shift.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct IEntry {
+    /// The `i` cluster.
+    pub ci: u32,
+    /// Added to the positions of `i` (a multiple of the box lengths).
+    pub shift: [f64; 3],
+    /// The first `j` is `i` itself with no shift: only its pairs `a < b` count.
+    pub diag: bool,
+    /// Range of the `j` clusters in `NeighborList::jglobal` / `jlocal`.
+    pub js: (u32, u32),
+}
+
+/// A range of `i` clusters whose forces go into one buffer.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Segment {
+    /// First `i` cluster.
+    pub lo: usize,
+    /// One past the last `i` cluster.
+    pub hi: usize,
+    /// Its entries in `NeighborList::entries`.
+    pub entries: Range<usize>,
+    /// Clusters `≥ hi` that its entries touch, ascending: buffer slot `hi − lo + k` is
+    /// cluster `foreign[k]`.
+    pub foreign: Vec<u32>,
+}
+
+/// Cluster-pair list (periodic shifts, internal spatial order) and the buffers it is rebuilt
+/// in.
 #[derive(Debug, Clone, Default)]
 pub struct NeighborList {
     cutoff: f64,
     skin: f64,
     n_local: usize,
-    /// Extended positions: `n_local` real particles in internal order, then ghosts.
-    pub(crate) pos: Vec<[f64; 3]>,
-    /// Internal index of the real particle of every extended index.
-    pub(crate) owner: Vec<u32>,
-    /// Particle index of every internal index (`perm[k]` is the particle stored at `pos[k]`).
-    pub(crate) perm: Vec<u32>,
-    shift: Vec<[f64; 3]>,
-    /// Neighbours of internal particle `i`: `neigh[offsets[i]..offsets[i + 1]]` (CSR).
-    pub(crate) offsets: Vec<u32>,
-    pub(crate) neigh: Vec<u32>,
-    bin_of: Vec<u32>,
-    bin_start: Vec<u32>,
-    bin_fill: Vec<u32>,
-    /// Extended indices in bin order, with their positions and owners (scanned contiguously).
-    bin_atoms: Vec<u32>,
-    bin_pos: Vec<[f64; 3]>,
-    bin_owner: Vec<u32>,
+    /// Positions by cluster (empty slots far away, see the module documentation).
+    pub(crate) xc: Vec<ClusterVec>,
+    /// Particle index of every slot `4c + l` ([`EMPTY`] for padding).
+    pub(crate) slot: Vec<u32>,
+    /// Cluster pairs, by `i` cluster, then shift.
+    pub(crate) entries: Vec<IEntry>,
+    /// `j` cluster of every `j` entry.
+    pub(crate) jglobal: Vec<u32>,
+    /// Buffer slot of every `j` entry in its segment's buffer.
+    pub(crate) jlocal: Vec<u32>,
+    pub(crate) segments: Vec<Segment>,
+    bbox: Vec<[[f64; 3]; 2]>,
+    col_start: Vec<u32>,
+    order: Vec<u32>,
     x0: Vec<[f64; 3]>,
-    /// Verified at the last build: every neighbour `j` of every `i` has `i < j < pos.len()`
-    /// (true by construction; the force loop skips its bounds checks only when this holds).
-    pub(crate) verified: bool,
     /// Number of builds so far.
     pub builds: u64,
 }
 
-/// Bin grid over `[-r_s, L + r_s)` per axis, bins of edge `≥ r_s / 2`.
+/// Columns along z over the box, square in x and y.
 #[derive(Debug, Clone, Copy)]
-struct Grid {
-    rs: f64,
-    nb: [usize; 3],
-    inv: [f64; 3],
+struct Columns {
+    n: [usize; 2],
+    scale: [f64; 2],
 }
 
-impl Grid {
-    fn new(l: [f64; 3], rs: f64) -> Grid {
-        let mut nb = [1usize; 3];
-        let mut inv = [0.0; 3];
-        for k in 0..3 {
-            let ext = l[k] + 2.0 * rs;
-            nb[k] = ((ext / (0.5 * rs)).floor() as usize).max(1);
-            inv[k] = nb[k] as f64 / ext;
+impl Columns {
+    /// Columns of edge about `(4/ρ)^{1/3}`: a cluster of four is then about a cube.
+    fn new(l: [f64; 3], n_particles: usize) -> Columns {
+        let rho = n_particles.max(1) as f64 / (l[0] * l[1] * l[2]);
+        let edge = libm::cbrt(CL as f64 / rho);
+        let mut n = [1usize; 2];
+        let mut scale = [0.0; 2];
+        for k in 0..2 {
+            let m = (l[k] / edge).floor();
+            // at most ~2^16 per axis: far more than any density needs, and no overflow
+            n[k] = if m.is_finite() {
+                (m as usize).clamp(1, 65_536)
+            } else {
+                1
+            };
+            scale[k] = n[k] as f64 / l[k];
         }
-        Grid { rs, nb, inv }
+        Columns { n, scale }
     }
 
     fn len(&self) -> usize {
-        self.nb[0] * self.nb[1] * self.nb[2]
+        self.n[0] * self.n[1]
     }
 
-    /// Bin coordinates of `q` (clamped: a NaN or far-away position lands in an edge bin rather
-    /// than out of range).
+    /// Column coordinate along axis `k` of coordinate `x`, clamped into the grid (a NaN
+    /// lands in column 0).
     #[inline]
-    fn coords(&self, q: &[f64; 3]) -> [usize; 3] {
-        let mut c = [0; 3];
-        for k in 0..3 {
-            let v = ((q[k] + self.rs) * self.inv[k]).floor();
-            c[k] = (v.max(0.0) as usize).min(self.nb[k] - 1);
-        }
-        c
+    fn coord(&self, k: usize, x: f64) -> usize {
+        let v = (x * self.scale[k]).floor();
+        (v.max(0.0) as usize).min(self.n[k] - 1)
     }
 
     #[inline]
-    fn index(&self, c: [usize; 3]) -> usize {
-        (c[0] * self.nb[1] + c[1]) * self.nb[2] + c[2]
+    fn index(&self, q: &[f64; 3]) -> usize {
+        self.coord(0, q[0]) * self.n[1] + self.coord(1, q[1])
     }
 }
 
@@ -155,26 +209,50 @@ impl NeighborList {
         self.n_local == 0
     }
 
-    /// Half list of internal particle `i`: extended indices `j` with owner index `> i`, within
-    /// `r_c + δ` at the build (see [`NeighborList::particle`] and
-    /// [`NeighborList::owner_particle`] for particle indices).
-    pub fn neighbors(&self, i: usize) -> &[u32] {
-        &self.neigh[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+    /// Number of clusters (each of [`CL`] slots).
+    pub fn clusters(&self) -> usize {
+        self.xc.len()
     }
 
-    /// Particle index of internal index `i`.
-    pub fn particle(&self, i: usize) -> usize {
-        self.perm[i] as usize
+    /// Number of cluster pairs in the list (each costs `CL²` pair evaluations).
+    pub fn cluster_pairs(&self) -> usize {
+        self.jglobal.len()
     }
 
-    /// Particle index of the owner of extended index `j` (a real particle or a ghost).
-    pub fn owner_particle(&self, j: usize) -> usize {
-        self.perm[self.owner[j] as usize] as usize
-    }
-
-    /// Position of extended index `j` (ghosts at their shifted place).
-    pub fn position(&self, j: usize) -> [f64; 3] {
-        self.pos[j]
+    /// Calls `f(a, b, r²)` for every pair of particles `a ≠ b` listed (each pair once, in
+    /// list order) whose distance (nearest listed image) is below `sqrt(r2_max)`, at the
+    /// current positions.
+    pub fn for_each_pair(&self, r2_max: f64, mut f: impl FnMut(usize, usize, f64)) {
+        for e in &self.entries {
+            let ci = e.ci as usize;
+            for (n, &cj) in self.jglobal[e.js.0 as usize..e.js.1 as usize]
+                .iter()
+                .enumerate()
+            {
+                let cj = cj as usize;
+                for a in 0..CL {
+                    let pa = self.slot[ci * CL + a];
+                    if pa == EMPTY {
+                        continue;
+                    }
+                    let start = if e.diag && n == 0 { a + 1 } else { 0 };
+                    for b in start..CL {
+                        let pb = self.slot[cj * CL + b];
+                        if pb == EMPTY {
+                            continue;
+                        }
+                        let mut r2 = 0.0;
+                        for k in 0..3 {
+                            let d = self.xc[ci][k][a] + e.shift[k] - self.xc[cj][k][b];
+                            r2 += d * d;
+                        }
+                        if r2 < r2_max {
+                            f(pa as usize, pb as usize, r2);
+                        }
+                    }
+                }
+            }
+        }
     }
 
     /// Whether the list may have become inexact: the two largest displacements since the last
@@ -202,23 +280,22 @@ impl NeighborList {
         total > self.skin || total.is_nan()
     }
 
-    /// Copies real positions into the extended array (internal order) and moves ghosts with
-    /// their owners.
-    pub fn update_ghosts(&mut self, p: &Particles) {
-        let n = self.n_local;
-        let (real, ghosts) = self.pos.split_at_mut(n);
-        for (q, &k) in real.iter_mut().zip(&self.perm) {
-            let k = k as usize;
-            *q = [p.x[k], p.y[k], p.z[k]];
-        }
-        for ((q, &o), s) in ghosts.iter_mut().zip(&self.owner[n..]).zip(&self.shift) {
-            let r = real[o as usize];
-            *q = [r[0] + s[0], r[1] + s[1], r[2] + s[2]];
+    /// Copies the particles' positions into the clusters (between builds).
+    pub fn update_positions(&mut self, p: &Particles) {
+        for (q, slots) in self.xc.iter_mut().zip(self.slot.chunks_exact(CL)) {
+            for (l, &k) in slots.iter().enumerate() {
+                if k != EMPTY {
+                    let k = k as usize;
+                    q[0][l] = p.x[k];
+                    q[1][l] = p.y[k];
+                    q[2][l] = p.z[k];
+                }
+            }
         }
     }
 
-    /// Wraps particles into the box (updating `images`), sorts them by bin, makes ghosts, bins
-    /// and builds the half list.
+    /// Wraps particles into the box (updating `images`), sorts them into clusters and builds
+    /// the cluster-pair list.
     pub fn build(&mut self, p: &mut Particles, images: &mut [[i32; 3]], bx: &SimBox) {
         let n = p.len();
         let rs = self.cutoff + self.skin;
@@ -233,151 +310,268 @@ impl NeighborList {
         self.x0.clear();
         self.x0.extend((0..n).map(|i| [p.x[i], p.y[i], p.z[i]]));
         let l = bx.l;
-        let grid = Grid::new(l, rs);
-        let nbin = grid.len();
+        let cols = Columns::new(l, n);
+        self.sort_into_clusters(&cols);
+        self.fill_clusters(l, rs);
+        self.pair_search(&cols, l, rs);
+        self.cut_segments();
+        self.builds += 1;
+    }
 
-        // internal order: real particles by bin (counting sort, stable in particle index)
+    /// Internal order: by column (x-major), then by z (ties by particle index); each column
+    /// padded to a multiple of [`CL`]. Fills `slot` and `col_start` (first cluster of each
+    /// column).
+    fn sort_into_clusters(&mut self, cols: &Columns) {
         let x0 = &self.x0;
-        self.bin_of.clear();
-        self.bin_of
-            .extend(x0.iter().map(|q| grid.index(grid.coords(q)) as u32));
-        counting_sort(
-            &self.bin_of,
-            nbin,
-            &mut self.bin_start,
-            &mut self.bin_fill,
-            &mut self.perm,
-        );
-        self.pos.clear();
-        self.pos.extend(self.perm.iter().map(|&k| x0[k as usize]));
-        self.owner.clear();
-        self.owner.extend(0..n as u32);
+        let ncol = cols.len();
+        let col_of: Vec<u32> = x0.iter().map(|q| cols.index(q) as u32).collect();
+        let mut count = vec![0u32; ncol + 1];
+        for &c in &col_of {
+            count[c as usize + 1] += 1;
+        }
+        for c in 0..ncol {
+            count[c + 1] += count[c];
+        }
+        let mut fill = count.clone();
+        self.order.clear();
+        self.order.resize(x0.len(), 0);
+        for (a, &c) in col_of.iter().enumerate() {
+            self.order[fill[c as usize] as usize] = a as u32;
+            fill[c as usize] += 1;
+        }
+        self.col_start.clear();
+        self.col_start.push(0);
+        self.slot.clear();
+        for c in 0..ncol {
+            let members = &mut self.order[count[c] as usize..count[c + 1] as usize];
+            // stable: equal z keeps the particle order
+            members.sort_by(|&a, &b| x0[a as usize][2].total_cmp(&x0[b as usize][2]));
+            self.slot.extend_from_slice(members);
+            while self.slot.len() % CL != 0 {
+                self.slot.push(EMPTY);
+            }
+            self.col_start.push((self.slot.len() / CL) as u32);
+        }
+    }
 
-        // ghosts: every image within r_s of the box, in internal order of their owners
-        self.shift.clear();
-        for i in 0..n {
-            let r = self.pos[i];
-            for sx in -1i32..=1 {
-                for sy in -1i32..=1 {
-                    for sz in -1i32..=1 {
-                        if sx == 0 && sy == 0 && sz == 0 {
-                            continue;
-                        }
-                        let s = [sx as f64 * l[0], sy as f64 * l[1], sz as f64 * l[2]];
-                        let q = [r[0] + s[0], r[1] + s[1], r[2] + s[2]];
-                        if (0..3).all(|k| q[k] >= -rs && q[k] < l[k] + rs) {
-                            self.pos.push(q);
-                            self.owner.push(i as u32);
-                            self.shift.push(s);
-                        }
+    /// Positions and bounding boxes of the clusters; empty slots at distinct far points.
+    fn fill_clusters(&mut self, l: [f64; 3], rs: f64) {
+        let nc = self.slot.len() / CL;
+        // farther than rs from any particle (in [0, L) at the build, shifted by at most L,
+        // moving by at most δ/2 before the next build) and from each other
+        let far = 4.0 * (l[0].max(l[1]).max(l[2]) + rs) + 1.0;
+        self.xc.clear();
+        self.xc.resize(nc, [[0.0; CL]; 3]);
+        self.bbox.clear();
+        self.bbox
+            .resize(nc, [[f64::INFINITY; 3], [f64::NEG_INFINITY; 3]]);
+        for c in 0..nc {
+            for lane in 0..CL {
+                let s = c * CL + lane;
+                let k = self.slot[s];
+                let q = if k == EMPTY {
+                    let v = -far * (1.0 + s as f64);
+                    [v, v, v]
+                } else {
+                    let q = self.x0[k as usize];
+                    let b = &mut self.bbox[c];
+                    for d in 0..3 {
+                        b[0][d] = b[0][d].min(q[d]);
+                        b[1][d] = b[1][d].max(q[d]);
                     }
+                    q
+                };
+                for (row, v) in self.xc[c].iter_mut().zip(q) {
+                    row[lane] = v;
                 }
             }
         }
+    }
 
-        // bin the extended set; positions and owners copied in bin order
-        let pos = &self.pos;
-        self.bin_of.clear();
-        self.bin_of
-            .extend(pos.iter().map(|q| grid.index(grid.coords(q)) as u32));
-        counting_sort(
-            &self.bin_of,
-            nbin,
-            &mut self.bin_start,
-            &mut self.bin_fill,
-            &mut self.bin_atoms,
-        );
-        self.bin_pos.clear();
-        self.bin_pos
-            .extend(self.bin_atoms.iter().map(|&a| pos[a as usize]));
-        self.bin_owner.clear();
-        let owner = &self.owner;
-        self.bin_owner
-            .extend(self.bin_atoms.iter().map(|&a| owner[a as usize]));
-
-        // half lists, built in fixed chunks of internal indices and concatenated in order
+    /// The cluster pairs within `rs` (see the module documentation), by `i` cluster, in
+    /// fixed chunks.
+    fn pair_search(&mut self, cols: &Columns, l: [f64; 3], rs: f64) {
+        let nc = self.xc.len();
         let rs2 = rs * rs;
-        let (bs, ba, bp, bo) = (
-            &self.bin_start,
-            &self.bin_atoms,
-            &self.bin_pos,
-            &self.bin_owner,
-        );
-        let pieces: Vec<(Vec<u32>, Vec<u32>)> = (0..n.div_ceil(BUILD_CHUNK))
+        let (xc, bbox, col_start) = (&self.xc, &self.bbox, &self.col_start);
+        let pieces: Vec<(Vec<IEntry>, Vec<u32>)> = (0..nc.div_ceil(BUILD_CHUNK))
             .into_par_iter()
-            .map(|c| {
-                let lo = c * BUILD_CHUNK;
-                let hi = (lo + BUILD_CHUNK).min(n);
-                let mut list = Vec::with_capacity((hi - lo) * 48);
-                let mut counts = Vec::with_capacity(hi - lo);
-                for (i, &ri) in pos.iter().enumerate().take(hi).skip(lo) {
-                    let c = grid.coords(&ri);
-                    let before = list.len();
-                    let range = |k: usize| c[k].saturating_sub(2)..=(c[k] + 2).min(grid.nb[k] - 1);
-                    for cx in range(0) {
-                        for cy in range(1) {
-                            let row = grid.index([cx, cy, 0]);
-                            let zr = range(2);
-                            // bins (cx, cy, z) for z in zr are contiguous
-                            let a = bs[row + *zr.start()] as usize;
-                            let b = bs[row + *zr.end() + 1] as usize;
-                            for ((&j, q), &o) in ba[a..b].iter().zip(&bp[a..b]).zip(&bo[a..b]) {
-                                let d = [ri[0] - q[0], ri[1] - q[1], ri[2] - q[2]];
-                                let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                                if r2 < rs2 && o as usize > i {
-                                    list.push(j);
+            .map(|chunk| {
+                let lo = chunk * BUILD_CHUNK;
+                let hi = (lo + BUILD_CHUNK).min(nc);
+                let mut entries = vec![];
+                let mut js = Vec::with_capacity((hi - lo) * 64);
+                let mut found = vec![];
+                for ci in lo..hi {
+                    let bi = bbox[ci];
+                    if bi[0][0] > bi[1][0] {
+                        continue; // no particle (cannot happen: columns pad only their end)
+                    }
+                    // shifts in a fixed order; an image of i is needed only near a face
+                    let allowed = |k: usize, s: i32| match s {
+                        0 => true,
+                        1 => bi[0][k] < rs,
+                        _ => bi[1][k] > l[k] - rs,
+                    };
+                    for sx in -1i32..=1 {
+                        for sy in -1i32..=1 {
+                            for sz in -1i32..=1 {
+                                let s = [sx, sy, sz];
+                                if !(0..3).all(|k| allowed(k, s[k])) {
+                                    continue;
                                 }
+                                let positive = s.iter().find(|&&v| v != 0).is_some_and(|&v| v > 0);
+                                let zero = s == [0, 0, 0];
+                                let shift = [sx as f64 * l[0], sy as f64 * l[1], sz as f64 * l[2]];
+                                let lo_b = [0, 1, 2].map(|k| bi[0][k] + shift[k]);
+                                let hi_b = [0, 1, 2].map(|k| bi[1][k] + shift[k]);
+                                found.clear();
+                                let mut diag = false;
+                                let xr = cols.coord(0, lo_b[0] - rs)..=cols.coord(0, hi_b[0] + rs);
+                                for cx in xr {
+                                    let yr =
+                                        cols.coord(1, lo_b[1] - rs)..=cols.coord(1, hi_b[1] + rs);
+                                    for cy in yr {
+                                        let col = cx * cols.n[1] + cy;
+                                        // clusters below i are listed from their side;
+                                        // the column's clusters are sorted by z, so those
+                                        // entirely below i's reach are skipped at once
+                                        let (c0, c1) =
+                                            (col_start[col] as usize, col_start[col + 1] as usize);
+                                        let c0 = c0.max(ci).min(c1);
+                                        let zlo = lo_b[2] - rs;
+                                        let first =
+                                            c0 + bbox[c0..c1].partition_point(|b| b[1][2] < zlo);
+                                        for cj in first..c1 {
+                                            if cj == ci && !zero && !positive {
+                                                continue;
+                                            }
+                                            let bj = bbox[cj];
+                                            if bj[0][2] > hi_b[2] + rs {
+                                                break; // sorted by z within the column
+                                            }
+                                            let mut d2 = 0.0;
+                                            for k in 0..3 {
+                                                let g = (bj[0][k] - hi_b[k])
+                                                    .max(lo_b[k] - bj[1][k])
+                                                    .max(0.0);
+                                                d2 += g * g;
+                                            }
+                                            if d2 >= rs2 {
+                                                continue;
+                                            }
+                                            if cj == ci && zero {
+                                                diag = true;
+                                            } else if any_pair_within(&xc[ci], &shift, &xc[cj], rs2)
+                                            {
+                                                found.push(cj as u32);
+                                            }
+                                        }
+                                    }
+                                }
+                                if !diag && found.is_empty() {
+                                    continue;
+                                }
+                                let start = js.len() as u32;
+                                if diag {
+                                    js.push(ci as u32);
+                                }
+                                js.extend_from_slice(&found);
+                                entries.push(IEntry {
+                                    ci: ci as u32,
+                                    shift,
+                                    diag,
+                                    js: (start, js.len() as u32),
+                                });
                             }
                         }
                     }
-                    counts.push((list.len() - before) as u32);
                 }
-                (list, counts)
+                (entries, js)
             })
             .collect();
-        self.neigh.clear();
-        self.offsets.clear();
-        self.offsets.push(0);
-        let mut total = 0u32;
-        for (list, counts) in &pieces {
-            self.neigh.extend_from_slice(list);
-            for &c in counts {
-                total += c;
-                self.offsets.push(total);
-            }
+        self.entries.clear();
+        self.jglobal.clear();
+        for (entries, js) in pieces {
+            let base = self.jglobal.len() as u32;
+            self.entries.extend(entries.into_iter().map(|mut e| {
+                e.js = (e.js.0 + base, e.js.1 + base);
+                e
+            }));
+            self.jglobal.extend_from_slice(&js);
         }
-        self.verified = (0..n).all(|i| {
-            self.neigh[self.offsets[i] as usize..self.offsets[i + 1] as usize]
-                .iter()
-                .all(|&j| i < j as usize && (j as usize) < self.pos.len())
-        });
-        self.builds += 1;
+    }
+
+    /// Cuts the `i` clusters into segments (their number a function of the particle count
+    /// only) and maps every `j` entry to its slot in its segment's buffer.
+    fn cut_segments(&mut self) {
+        let nc = self.xc.len();
+        let nseg = (self.n_local / MIN_SEGMENT).clamp(1, MAX_SEGMENTS);
+        let entries = &self.entries;
+        let jglobal = &self.jglobal;
+        let segs: Vec<(Segment, Vec<u32>)> = (0..nseg)
+            .into_par_iter()
+            .map(|s| {
+                let (lo, hi) = (s * nc / nseg, (s + 1) * nc / nseg);
+                let e0 = entries.partition_point(|e| (e.ci as usize) < lo);
+                let e1 = entries.partition_point(|e| (e.ci as usize) < hi);
+                let jr = if e0 < e1 {
+                    entries[e0].js.0 as usize..entries[e1 - 1].js.1 as usize
+                } else {
+                    0..0
+                };
+                let mut foreign: Vec<u32> = jglobal[jr.clone()]
+                    .iter()
+                    .copied()
+                    .filter(|&c| c as usize >= hi)
+                    .collect();
+                foreign.sort_unstable();
+                foreign.dedup();
+                let own = (hi - lo) as u32;
+                let local: Vec<u32> = jglobal[jr]
+                    .iter()
+                    .map(|&c| {
+                        if (c as usize) < hi {
+                            c - lo as u32
+                        } else {
+                            // present by construction
+                            own + foreign.binary_search(&c).unwrap_or(0) as u32
+                        }
+                    })
+                    .collect();
+                (
+                    Segment {
+                        lo,
+                        hi,
+                        entries: e0..e1,
+                        foreign,
+                    },
+                    local,
+                )
+            })
+            .collect();
+        self.segments.clear();
+        self.jlocal.clear();
+        for (seg, local) in segs {
+            self.segments.push(seg);
+            self.jlocal.extend_from_slice(&local);
+        }
     }
 }
 
-/// Stable counting sort of indices `0..key.len()` by `key` (< `nbin`): fills `order` and
-/// `start` (`start[b]..start[b + 1]` are the positions of bin `b` in `order`).
-fn counting_sort(
-    key: &[u32],
-    nbin: usize,
-    start: &mut Vec<u32>,
-    fill: &mut Vec<u32>,
-    order: &mut Vec<u32>,
-) {
-    start.clear();
-    start.resize(nbin + 1, 0);
-    for &b in key {
-        start[b as usize + 1] += 1;
+/// Whether any of the 16 pairs of cluster `a` (shifted by `shift`) and cluster `b` is closer
+/// than `sqrt(r2)` (empty slots are far away, so they never are). Branch-free over the four
+/// lanes of `b`, so that it runs on packed registers.
+#[inline]
+#[allow(clippy::needless_range_loop)] // `i` picks one particle across the three component rows
+fn any_pair_within(a: &ClusterVec, shift: &[f64; 3], b: &ClusterVec, r2: f64) -> bool {
+    let mut near = [false; CL];
+    for i in 0..CL {
+        let q = [a[0][i] + shift[0], a[1][i] + shift[1], a[2][i] + shift[2]];
+        for l in 0..CL {
+            let d = [q[0] - b[0][l], q[1] - b[1][l], q[2] - b[2][l]];
+            near[l] |= d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < r2;
+        }
     }
-    for b in 0..nbin {
-        start[b + 1] += start[b];
-    }
-    fill.clear();
-    fill.extend_from_slice(&start[..nbin]);
-    order.clear();
-    order.resize(key.len(), 0);
-    for (a, &b) in key.iter().enumerate() {
-        order[fill[b as usize] as usize] = a as u32;
-        fill[b as usize] += 1;
-    }
+    near.iter().any(|&x| x)
 }

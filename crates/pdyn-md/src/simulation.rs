@@ -20,6 +20,7 @@ use crate::{
     ForceField, KineticEstimator, MdError, NeighborList, RunFailure, SimBox, ThermoRecord,
 };
 use pdyn_particles::{Particles, Vec3};
+use std::sync::atomic::Ordering;
 
 /// Particles in a periodic box, with types and bonds.
 #[derive(Debug, Clone)]
@@ -205,6 +206,14 @@ pub struct Simulation<P> {
     half_step_kinetic: Option<f64>,
 }
 
+/// Steps between two checks of the conserved energy (NVE, Nosé–Hoover) during a run. The
+/// potential energy and the virial are summed only at these steps, at thermo steps and at the
+/// last step of [`Simulation::run`] (as LAMMPS computes energies only when output needs
+/// them): the sums cost about a fifth of the pair kernel, and the forces, hence the
+/// trajectory, are the same bits either way. Non-finite states and jumps are still checked at
+/// every step.
+pub const ENERGY_CHECK_EVERY: u64 = 10;
+
 impl<P: PairPotential> Simulation<P> {
     /// Checks the set-up (box against cutoff + skin, types, bonds, overlaps) and computes the
     /// initial forces.
@@ -257,7 +266,7 @@ impl<P: PairPotential> Simulation<P> {
         };
         sim.rebuild();
         sim.check_overlap()?;
-        sim.forces().map_err(|e| e.with_step(0))?;
+        sim.forces(true).map_err(|e| e.with_step(0))?;
         Ok(sim)
     }
 
@@ -268,24 +277,15 @@ impl<P: PairPotential> Simulation<P> {
 
     fn check_overlap(&self) -> Result<(), MdError> {
         let d2 = self.params.overlap_distance.powi(2);
-        let p = &self.system.particles;
         // of the pairs below the threshold, the first in particle order (i < j), whatever the
         // list's internal order
         let mut worst: Option<(usize, usize, f64)> = None;
-        for k in 0..p.len() {
-            let ri = self.nl.position(k);
-            for &j in self.nl.neighbors(k) {
-                let q = self.nl.position(j as usize);
-                let r2 = (ri[0] - q[0]).powi(2) + (ri[1] - q[1]).powi(2) + (ri[2] - q[2]).powi(2);
-                if r2 < d2 {
-                    let (a, b) = (self.nl.particle(k), self.nl.owner_particle(j as usize));
-                    let pair = (a.min(b), a.max(b), r2);
-                    if worst.is_none_or(|w| pair < w) {
-                        worst = Some(pair);
-                    }
-                }
+        self.nl.for_each_pair(d2, |a, b, r2| {
+            let pair = (a.min(b), a.max(b), r2);
+            if worst.is_none_or(|w| pair < w) {
+                worst = Some(pair);
             }
-        }
+        });
         match worst {
             Some((i, j, r2)) => Err(MdError::Overlap {
                 i,
@@ -297,12 +297,13 @@ impl<P: PairPotential> Simulation<P> {
         }
     }
 
-    /// Pair and bond forces into accelerations; potential energy and virial.
-    fn forces(&mut self) -> Result<(), MdError> {
+    /// Pair and bond forces into accelerations; potential energy and virial when `energy`
+    /// (else the two keep their last values, see [`ENERGY_CHECK_EVERY`]).
+    fn forces(&mut self, energy: bool) -> Result<(), MdError> {
         let s = &mut self.system;
         let (u_p, w_p) =
             self.force_field
-                .compute(&self.nl, &s.types, &mut self.scratch, &mut self.out);
+                .compute(&self.nl, &s.types, &mut self.scratch, &mut self.out, energy);
         let (u_s, w_s) = self.special.correct(s, &self.force_field, &mut self.out);
         let (u_b, w_b) = bond_forces(s, &mut self.out)?;
         let p = &mut s.particles;
@@ -312,8 +313,10 @@ impl<P: PairPotential> Simulation<P> {
             p.ay[i] = f[1] * inv_m;
             p.az[i] = f[2] * inv_m;
         }
-        self.potential = u_p + u_s + u_b;
-        self.virial = w_p + w_s + w_b;
+        if energy {
+            self.potential = u_p + u_s + u_b;
+            self.virial = w_p + w_s + w_b;
+        }
         Ok(())
     }
 
@@ -348,22 +351,17 @@ impl<P: PairPotential> Simulation<P> {
         self.potential
     }
 
+    /// The neighbour list (cluster and cluster-pair counts, builds: diagnostics).
+    pub fn neighbor_list(&self) -> &NeighborList {
+        &self.nl
+    }
+
     /// Number of distinct pairs currently inside their cutoff (a diagnostic, `O(N)` work).
     pub fn pairs_within_cutoff(&self) -> usize {
         let rc2 = self.force_field.max_cutoff().powi(2);
-        let nl = &self.nl;
-        (0..nl.len())
-            .map(|i| {
-                let r = nl.position(i);
-                nl.neighbors(i)
-                    .iter()
-                    .filter(|&&j| {
-                        let q = nl.position(j as usize);
-                        (r[0] - q[0]).powi(2) + (r[1] - q[1]).powi(2) + (r[2] - q[2]).powi(2) < rc2
-                    })
-                    .count()
-            })
-            .sum::<usize>()
+        let mut count = 0;
+        self.nl.for_each_pair(rc2, |_, _, _| count += 1);
+        count
     }
 
     /// Forces `mᵢ aᵢ` of particle `i` at the current positions.
@@ -408,6 +406,19 @@ impl<P: PairPotential> Simulation<P> {
         steps: u64,
         observer: &mut dyn Observer,
     ) -> Result<RunReport, RunFailure> {
+        self.run_interruptible(steps, observer, None)
+    }
+
+    /// [`Simulation::run`], stopping early once `stop` is set (checked after every step, so
+    /// within one step's work of the request; the steps taken are the same bits as without
+    /// it). `RunReport::steps` says how many steps were taken; the energy and virial are
+    /// those of the last step taken.
+    pub fn run_interruptible(
+        &mut self,
+        steps: u64,
+        observer: &mut dyn Observer,
+        stop: Option<&std::sync::atomic::AtomicBool>,
+    ) -> Result<RunReport, RunFailure> {
         let mut report = RunReport::default();
         let builds0 = self.nl.builds;
         let every = self.params.thermo_every;
@@ -423,8 +434,13 @@ impl<P: PairPotential> Simulation<P> {
         if self.e0.is_none() {
             self.e0 = Some(self.thermo().conserved);
         }
+        let last = self.step + steps;
         for _ in 0..steps {
-            if let Err(error) = self.one_step(checks_energy) {
+            let next = self.step + 1;
+            let energy = next == last
+                || (every > 0 && next % every == 0)
+                || (checks_energy && next % ENERGY_CHECK_EVERY == 0);
+            if let Err(error) = self.one_step(checks_energy && energy, energy) {
                 report.builds = self.nl.builds - builds0;
                 return Err(RunFailure {
                     error,
@@ -437,6 +453,20 @@ impl<P: PairPotential> Simulation<P> {
                 observer.observe(&r, &self.system);
                 report.records.push(r);
             }
+            if self.step < last && stop.is_some_and(|f| f.load(Ordering::Relaxed)) {
+                if !energy {
+                    // the sums of the stopping step, from the same positions and list: the
+                    // forces come out the same bits
+                    if let Err(error) = self.forces(true) {
+                        report.builds = self.nl.builds - builds0;
+                        return Err(RunFailure {
+                            error: error.with_step(self.step),
+                            partial: report,
+                        });
+                    }
+                }
+                break;
+            }
         }
         if every == 0 {
             let r = self.thermo();
@@ -447,7 +477,7 @@ impl<P: PairPotential> Simulation<P> {
         Ok(report)
     }
 
-    fn one_step(&mut self, checks_energy: bool) -> Result<(), MdError> {
+    fn one_step(&mut self, checks_energy: bool, energy: bool) -> Result<(), MdError> {
         let h = self.params.dt;
         let kb = self.params.boltzmann;
         let nf = self.dof();
@@ -489,9 +519,9 @@ impl<P: PairPotential> Simulation<P> {
         {
             self.rebuild();
         } else {
-            self.nl.update_ghosts(&self.system.particles);
+            self.nl.update_positions(&self.system.particles);
         }
-        self.forces().map_err(|e| e.with_step(step))?;
+        self.forces(energy).map_err(|e| e.with_step(step))?;
         let p = &mut self.system.particles;
         p.kick(0.5 * h);
         match &mut self.thermostat {
@@ -505,7 +535,7 @@ impl<P: PairPotential> Simulation<P> {
             }
             _ => {}
         }
-        if checks_energy || !self.potential.is_finite() {
+        if checks_energy || (energy && !self.potential.is_finite()) {
             let e = self.thermo().conserved;
             let de = (e - self.e0.unwrap_or(e)).abs() / self.system.particles.len().max(1) as f64;
             if !within(de, self.params.max_energy_change) {

@@ -29,6 +29,13 @@ fn msd_follows_msd_every_not_thermo_every() {
     assert_eq!(steps, vec![0, 7, 14, 21, 28, 35, 42, 49, 56, 60]);
     assert_eq!(res.msd[0][2], 0.0);
     assert!(res.msd.windows(2).all(|w| w[1][1] > w[0][1]));
+    // block error bars beside every value: zero at the origin, then positive and well below
+    // the MSD itself (256 atoms, 5 blocks)
+    assert_eq!(res.msd_error.len(), res.msd.len());
+    assert_eq!(res.msd_error[0], 0.0);
+    for (m, e) in res.msd.iter().zip(&res.msd_error).skip(1) {
+        assert!(*e > 0.0 && *e < 0.5 * m[2], "msd {} ± {e}", m[2]);
+    }
     // thermo records are unchanged by the MSD's schedule
     let rec: Vec<u64> = res.records.iter().map(|r| r.step).collect();
     assert_eq!(rec, vec![0, 20, 40, 60]);

@@ -66,7 +66,32 @@ impl LennardJones {
     }
 }
 
+/// Lennard-Jones constants of the kernel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LjConstants {
+    /// `σ²`.
+    pub sigma2: f64,
+    /// `4ε`.
+    pub eps4: f64,
+    /// `24ε`.
+    pub eps24: f64,
+    /// Energy shift `u(r_c)` (0 for a plain cutoff).
+    pub u_c: f64,
+    /// Cutoff `r_c`.
+    pub rc: f64,
+}
+
 impl RawPair for LennardJones {
+    fn lennard_jones(&self) -> Option<LjConstants> {
+        Some(LjConstants {
+            sigma2: self.sigma2,
+            eps4: self.eps4,
+            eps24: self.eps24,
+            u_c: 0.0,
+            rc: f64::INFINITY,
+        })
+    }
+
     #[inline(always)]
     fn raw(&self, r2: f64) -> (f64, f64) {
         let inv = 1.0 / r2;
@@ -76,5 +101,22 @@ impl RawPair for LennardJones {
             self.eps4 * sr6 * (sr6 - 1.0),
             self.eps24 * sr6 * (2.0 * sr6 - 1.0) * inv,
         )
+    }
+
+    #[inline(always)]
+    fn raw4(&self, r2: [f64; 4]) -> ([f64; 4], [f64; 4]) {
+        // the operations of `raw`, in its order, one array at a time
+        let inv = r2.map(|s| 1.0 / s);
+        let sr2 = inv.map(|i| self.sigma2 * i);
+        let sr6 = sr2.map(|s| s * s * s);
+        let mut u = [0.0; 4];
+        let mut f = [0.0; 4];
+        for l in 0..4 {
+            u[l] = self.eps4 * sr6[l] * (sr6[l] - 1.0);
+        }
+        for l in 0..4 {
+            f[l] = self.eps24 * sr6[l] * (2.0 * sr6[l] - 1.0) * inv[l];
+        }
+        (u, f)
     }
 }

@@ -12,7 +12,7 @@ mod lj;
 mod morse;
 mod truncated;
 
-pub use lj::LennardJones;
+pub use lj::{LennardJones, LjConstants};
 pub use morse::Morse;
 pub use truncated::{CutoffMode, Truncated};
 
@@ -56,6 +56,12 @@ pub trait PairPotential: Send + Sync {
         }
     }
 
+    /// The constants of a Lennard-Jones with a plain or energy-shifted cutoff, for the
+    /// dedicated SIMD kernel; `None` (default) for anything else.
+    fn lennard_jones(&self) -> Option<LjConstants> {
+        None
+    }
+
     /// Whether the force loop should gather a particle's neighbours and call
     /// [`PairPotential::energy_force_batch`] once for them (a compiled formula, whose cost is
     /// per call), rather than [`PairPotential::energy_force4`] per block of four (default).
@@ -68,6 +74,25 @@ pub trait PairPotential: Send + Sync {
 pub trait RawPair: Send + Sync {
     /// `(u, f/r)` at squared distance `r2`.
     fn raw(&self, r2: f64) -> (f64, f64);
+
+    /// The untruncated Lennard-Jones constants (`u_c = 0`, `rc = ∞`), if this is one.
+    fn lennard_jones(&self) -> Option<LjConstants> {
+        None
+    }
+
+    /// [`RawPair::raw`] at four squared distances. The default calls `raw` per lane; kernels
+    /// override it with lane-wise array arithmetic (one operation for all four lanes at a
+    /// time), which the compiler turns into packed instructions, giving the same bits as
+    /// `raw` lane by lane.
+    #[inline(always)]
+    fn raw4(&self, r2: [f64; 4]) -> ([f64; 4], [f64; 4]) {
+        let mut u = [0.0; 4];
+        let mut f = [0.0; 4];
+        for l in 0..4 {
+            (u[l], f[l]) = self.raw(r2[l]);
+        }
+        (u, f)
+    }
 
     /// [`RawPair::raw`] for a batch (slices of the same length); the default calls `raw` for
     /// each element, a compiled formula evaluates its program once for the whole batch.
@@ -103,5 +128,8 @@ impl<P: PairPotential + ?Sized> PairPotential for Box<P> {
     }
     fn prefers_batch(&self) -> bool {
         (**self).prefers_batch()
+    }
+    fn lennard_jones(&self) -> Option<LjConstants> {
+        (**self).lennard_jones()
     }
 }

@@ -5,7 +5,7 @@
 //! * shifted energy: `u_c(r) = u(r) − u(r_c)` (continuous energy, same forces);
 //! * shifted force: `u_c(r) = u(r) − u(r_c) − (r − r_c) u'(r_c)` (continuous energy and force).
 
-use super::{PairPotential, RawPair};
+use super::{LjConstants, PairPotential, RawPair};
 use crate::MdError;
 
 /// How the potential is cut at `r_c`.
@@ -90,22 +90,17 @@ impl<P: RawPair> PairPotential for Truncated<P> {
     fn energy_force4(&self, r2: [f64; 4]) -> ([f64; 4], [f64; 4]) {
         // the mode is tested once per block, and the parameters are copied into locals, so
         // the four lanes vectorise
-        let inner = &self.inner;
         let (u_c, f_c, rc) = (self.u_c, self.f_c, self.rc);
-        let mut u = [0.0; 4];
-        let mut f = [0.0; 4];
+        let (mut u, mut f) = self.inner.raw4(r2);
         if self.mode == CutoffMode::ShiftedForce {
+            let r = r2.map(f64::sqrt);
             for l in 0..4 {
-                let (a, b) = inner.raw(r2[l]);
-                let r = r2[l].sqrt();
-                u[l] = a - u_c + (r - rc) * f_c;
-                f[l] = b - f_c / r;
+                u[l] = u[l] - u_c + (r[l] - rc) * f_c;
+                f[l] -= f_c / r[l];
             }
         } else {
-            for l in 0..4 {
-                let (a, b) = inner.raw(r2[l]);
-                u[l] = a - u_c;
-                f[l] = b;
+            for v in u.iter_mut() {
+                *v -= u_c;
             }
         }
         (u, f)
@@ -132,6 +127,17 @@ impl<P: RawPair> PairPotential for Truncated<P> {
 
     fn prefers_batch(&self) -> bool {
         self.inner.prefers_batch()
+    }
+
+    fn lennard_jones(&self) -> Option<LjConstants> {
+        if self.mode == CutoffMode::ShiftedForce {
+            return None;
+        }
+        self.inner.lennard_jones().map(|c| LjConstants {
+            u_c: self.u_c,
+            rc: self.rc,
+            ..c
+        })
     }
 }
 

@@ -214,9 +214,10 @@ pub fn write_files(res: &MdResult, dir: &Path) -> Result<(), Error> {
         write(&dir.join("rdf.csv"), &s)?;
     }
     if !res.msd.is_empty() {
-        let mut s = String::from("step,time,msd\n");
-        for m in &res.msd {
-            let _ = writeln!(s, "{},{},{}", m[0], m[1], m[2]);
+        // `error`: the standard error of the MSD from 5 blocks of particles
+        let mut s = String::from("step,time,msd,error\n");
+        for (m, e) in res.msd.iter().zip(&res.msd_error) {
+            let _ = writeln!(s, "{},{},{},{e}", m[0], m[1], m[2]);
         }
         write(&dir.join("msd.csv"), &s)?;
     }

@@ -20,6 +20,9 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+/// Blocks of particles for the MSD's error bar.
+const MSD_BLOCKS: usize = 5;
+
 /// Largest system for the RDF (an all-pairs histogram, `O(N²)` per frame).
 pub const RDF_MAX_ATOMS: usize = 100_000;
 
@@ -30,7 +33,7 @@ pub struct RunOptions {
     pub out: Option<PathBuf>,
     /// Relative drift of the conserved energy that triggers a warning.
     pub drift_tolerance: f64,
-    /// Set by another thread to stop after the current stretch of steps (Ctrl-C in Python).
+    /// Set by another thread to stop the run after the current step (Ctrl-C in Python).
     pub interrupt: Option<pdyn_ode::Interrupt>,
     /// Frames for a live display (`Progress::Frame`) every this many steps; 0: at the model's
     /// `dump_every` (none without).
@@ -101,6 +104,9 @@ pub struct MdResult {
     pub rdf_error: Option<Box<[f64]>>,
     /// `(step, time, msd)` every `msd_every` steps (and the last step) when asked for.
     pub msd: Vec<[f64; 3]>,
+    /// Standard error of each `msd` value from 5 blocks of particles (`Msd::block_error`;
+    /// NaN with fewer than 5 particles).
+    pub msd_error: Vec<f64>,
     /// Energy conservation (NVE, Nosé–Hoover).
     pub drift: Option<Box<Drift>>,
     /// Warnings for the user.
@@ -317,10 +323,15 @@ fn run_sim<P: PairPotential>(
         }
         _ => None,
     };
+    // The degrees of freedom of the temperature column ride along as a last column `dof`
+    // (the same value on every row): the header stays one line of plain names, which pandas,
+    // spreadsheets and `csv` readers take as they are, `temperature` keeps its name, and the
+    // convention (3N − 3 as LAMMPS's `compute temp`, or 3N under Langevin) is in the file.
+    let dof = sim.dof();
     let mut thermo_file = match &opts.out {
         Some(dir) => Some(RowFile::create(
             &dir.join("thermo.csv"),
-            &format!("{}\n", pdyn_md::THERMO_CSV_HEADER),
+            &format!("{},dof\n", pdyn_md::THERMO_CSV_HEADER),
         )?),
         None => None,
     };
@@ -387,8 +398,11 @@ fn run_sim<P: PairPotential>(
     };
     let mut records: Vec<ThermoRecord> = vec![];
     let mut msd = vec![];
+    let mut msd_error = vec![];
+    let msd_err = |m: &Msd, s: &System| m.block_error(s, MSD_BLOCKS).unwrap_or(f64::NAN);
     if let (Some(m), true) = (&msd0, sim.step == 0) {
         msd.push([0.0, 0.0, m.value(&sim.system)]);
+        msd_error.push(msd_err(m, &sim.system));
     }
     let mut rdf_seen = 0u64;
     let every = spec.thermo_every.max(1);
@@ -435,7 +449,7 @@ fn run_sim<P: PairPotential>(
             progress(Progress::Record(&c));
             if let Some(f) = &mut thermo_file {
                 if let Err(e) = f.rows(|b| {
-                    let _ = writeln!(b, "{c}");
+                    let _ = writeln!(b, "{c},{dof}");
                 }) {
                     write_error.get_or_insert(e);
                 }
@@ -451,7 +465,9 @@ fn run_sim<P: PairPotential>(
                 }
             }
         };
-        let outcome = sim.run(k, &mut obs);
+        // the interrupt is also checked after every step inside the stretch (a long stretch
+        // of a large system would otherwise keep Ctrl-C waiting for seconds)
+        let outcome = sim.run_interruptible(k, &mut obs, opts.interrupt.as_deref());
         match outcome {
             Ok(rep) => {
                 builds += rep.builds;
@@ -468,6 +484,7 @@ fn run_sim<P: PairPotential>(
         if let Some(m) = &msd0 {
             if step % spec.msd_every.max(1) == 0 && step > 0 {
                 msd.push([step as f64, step as f64 * dt, m.value(&sim.system)]);
+                msd_error.push(msd_err(m, &sim.system));
             }
         }
         if let (Some(h), Some(e)) = (&mut rdf, spec.rdf_every) {
@@ -502,7 +519,7 @@ fn run_sim<P: PairPotential>(
         progress(Progress::Record(&c));
         if let Some(f) = &mut thermo_file {
             f.rows(|b| {
-                let _ = writeln!(b, "{c}");
+                let _ = writeln!(b, "{c},{dof}");
             })?;
         }
         records.push(c);
@@ -516,6 +533,7 @@ fn run_sim<P: PairPotential>(
         // the last step, when it is not a multiple of msd_every
         if failure.is_none() && msd.last().map(|x| x[0]) != Some(sim.step as f64) {
             msd.push([sim.step as f64, sim.step as f64 * dt, m.value(&sim.system)]);
+            msd_error.push(msd_err(m, &sim.system));
         }
     }
     let rdf_frames = rdf.as_ref().map_or(0, |h| h.frames());
@@ -600,6 +618,7 @@ fn run_sim<P: PairPotential>(
             .map(Vec::into_boxed_slice),
         rdf: rdf_result.map(|b| (b.r, b.g)),
         msd,
+        msd_error,
         drift,
         warnings,
         seconds,
