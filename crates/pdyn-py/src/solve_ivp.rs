@@ -185,6 +185,7 @@ fn integrate(
     o: &IvpOptions,
     err: &RefCell<Option<PyErr>>,
     calls: &Calls,
+    watch: Option<&crate::interrupt::SignalWatch>,
 ) -> Result<Solution, pdyn_ode::OdeError> {
     let n = o.y0.len();
     // Calls a Python function of (t, y) with y of shape (n,), or (n, k) for `k` states given
@@ -248,7 +249,12 @@ fn integrate(
         None => dy.fill(f64::NAN),
     };
     let f = |t: f64, y: &[f64], dy: &mut [f64]| match (rhs, &evaluator) {
-        (Rhs::Compiled(_), Some(ev)) => ev.eval(t, y, dy),
+        (Rhs::Compiled(_), Some(ev)) => {
+            if let Some(w) = watch {
+                w.tick();
+            }
+            ev.eval(t, y, dy)
+        }
         (Rhs::Callable(func), _) => {
             calls.fun.set(calls.fun.get() + 1);
             let v = call_py(func, t, y, o.vectorized.then_some(1));
@@ -619,22 +625,38 @@ pub(crate) fn _solve_ivp(
         let calls = Calls::default();
         let mut interrupted = false;
         let result = if all_compiled {
-            // No Python in the loop: the GIL is released for the whole integration.
-            // Ctrl-C stops it at the next step (the calling thread watches for signals).
+            // No Python in the loop: the GIL is released for the whole integration, which
+            // runs on this thread; Ctrl-C stops it at the next step (`SignalWatch`: Python's
+            // signal handlers run every 20 ms from the right-hand side's evaluations).
             let stop: pdyn_ode::Interrupt = Default::default();
             o.opts.interrupt = Some(stop.clone());
             let rhs_ref = &rhs;
             let evs = &ivp_events;
             let args_ref = &args;
             let o_ref = &o;
-            let finished = crate::interrupt::with_flag(py, stop, move || {
+            let (value, raised) = py.allow_threads(move || {
                 let err = RefCell::new(None);
-                integrate(None, rhs_ref, evs, args_ref, o_ref, &err, &Calls::default())
-            })?;
-            interrupted = finished.interrupted;
-            finished.value
+                let watch = crate::interrupt::SignalWatch::new(stop);
+                let r = integrate(
+                    None,
+                    rhs_ref,
+                    evs,
+                    args_ref,
+                    o_ref,
+                    &err,
+                    &Calls::default(),
+                    Some(&watch),
+                );
+                (r, watch.into_raised())
+            });
+            match raised {
+                Some(e) if !e.is_instance_of::<PyKeyboardInterrupt>(py) => return Err(e),
+                Some(_) => interrupted = true,
+                None => {}
+            }
+            value
         } else {
-            integrate(Some(py), &rhs, &ivp_events, &args, &o, &err, &calls)
+            integrate(Some(py), &rhs, &ivp_events, &args, &o, &err, &calls, None)
         };
         if let Some(e) = err.into_inner() {
             // Ctrl-C while a Python callback ran: the solve stopped there (the callback's

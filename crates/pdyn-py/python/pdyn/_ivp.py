@@ -112,6 +112,8 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
     ``sol.native`` says which ran.
     """
     import warnings
+
+    import numpy as np  # the module itself, not the lazy stand-in: this runs once per call
     if isinstance(method, type):
         method = method.__name__
     # Structure hints of the Jacobian, used by the implicit methods' finite differences as
@@ -215,20 +217,34 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
             raise ValueError("`first_step` exceeds bounds.")
     if not (min_step >= 0) or math.isinf(min_step):
         raise ValueError("`min_step` must be finite and non-negative.")
-    r = _tol(rtol, "rtol", n)
-    if np.any(r < 100 * _EPS):
-        warnings.warn("At least one element of `rtol` is too small. Setting "
-                      f"`rtol = np.maximum(rtol, {100 * _EPS})`.", stacklevel=2)
-        r = np.maximum(r, 100 * _EPS)
-    a = _tol(atol, "atol", n)
-    if np.any(a < 0):
-        raise ValueError("`atol` must be positive.")
-    if key in ("radau", "radau5"):
-        # Hairer's Radau5 reads its tolerances as rtol' = 0.1 rtol^(2/3), atol' = rtol' atol/rtol
-        # (radau5.f); SciPy's Radau applies rtol and atol as given. These are the tolerances
-        # that Radau5 turns into the requested ones, so that the error test is SciPy's.
-        rh = np.maximum((10.0 * r) ** 1.5, 1e-14)
-        a, r = a * rh / r, rh
+    radau = key in ("radau", "radau5")
+    if type(rtol) in (float, int) and type(atol) in (float, int) and not radau:
+        # The common case, checked without NumPy (this runs once per call, and a compiled
+        # solve can take less than 0.1 ms).
+        r, a = [float(rtol)], [float(atol)]
+        if r[0] < 100 * _EPS:
+            warnings.warn("At least one element of `rtol` is too small. Setting "
+                          f"`rtol = np.maximum(rtol, {100 * _EPS})`.", stacklevel=2)
+            r = [100 * _EPS]
+        if a[0] < 0:
+            raise ValueError("`atol` must be positive.")
+    else:
+        r = _tol(rtol, "rtol", n)
+        if np.any(r < 100 * _EPS):
+            warnings.warn("At least one element of `rtol` is too small. Setting "
+                          f"`rtol = np.maximum(rtol, {100 * _EPS})`.", stacklevel=2)
+            r = np.maximum(r, 100 * _EPS)
+        a = _tol(atol, "atol", n)
+        if np.any(a < 0):
+            raise ValueError("`atol` must be positive.")
+        if radau:
+            # Hairer's Radau5 reads its tolerances as rtol' = 0.1 rtol^(2/3),
+            # atol' = rtol' atol/rtol (radau5.f); SciPy's Radau applies rtol and atol as
+            # given. These are the tolerances that Radau5 turns into the requested ones, so
+            # that the error test is SciPy's.
+            rh = np.maximum((10.0 * r) ** 1.5, 1e-14)
+            a, r = a * rh / r, rh
+        r, a = r.tolist(), a.tolist()
     pattern = None
     if sparsity is not None and jac is None:
         if hasattr(sparsity, "toarray"):
@@ -245,8 +261,7 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
         pattern = [bool(v) for v in ((j - i <= up) & (i - j <= lo)).ravel()]
     if max_steps is not None and int(max_steps) < 1:
         raise ValueError("`max_steps` must be a positive integer")
-    raw = _pdyn._solve_ivp(fun, t0, tf, y0a, key, te, [float(v) for v in r],
-                           [float(v) for v in a],
+    raw = _pdyn._solve_ivp(fun, t0, tf, y0a, key, te, r, a,
                            None if math.isinf(max_step) else float(max_step),
                            None if first_step is None else float(first_step),
                            float(min_step) if min_step > 0 else None,
