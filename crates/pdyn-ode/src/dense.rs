@@ -12,10 +12,11 @@
 //! | DOP853 | Hairer's (dop853.f `CONTD8`, three extra stages) | 7 |
 //! | RK23 | Bogacki–Shampine's free interpolant (cubic Hermite) | 3 |
 //! | Radau5 | the collocation polynomial (radau5.f `CONTR5`) | 3 |
+//! | BDF | the interpolating polynomial through the last `k + 1` points (SciPy's `BdfDenseOutput`) | the step's order `k` (1–5) |
 //! | Vern9, fixed-step methods | cubic Hermite through the step's ends | 3 |
 //!
 //! Storage: one block of coefficients per step (`5n` doubles for DOPRI5, `8n` for DOP853, `8n`
-//! for Tsit5, `4n` otherwise), plus the step's bounds.
+//! for Tsit5, `(k + 1)n` for BDF of order `k`, `4n` otherwise), plus the step's bounds.
 
 /// The interpolant of one recorded step.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -35,6 +36,12 @@ pub enum Interpolant {
         c1m1: f64,
         /// `c2 − 1`.
         c2m1: f64,
+    },
+    /// BDF's interpolating polynomial of the step's order (`order + 1` backward differences),
+    /// `s = (t − t_ref)/h` with `t_ref` the end of the step.
+    Bdf {
+        /// The order (1–5).
+        order: u8,
     },
 }
 
@@ -139,6 +146,7 @@ impl DenseSolution {
             Interpolant::Dopri5 => 5 * n,
             Interpolant::Tsit5 | Interpolant::Dop853 => 8 * n,
             Interpolant::Hermite | Interpolant::Radau5 { .. } => 4 * n,
+            Interpolant::Bdf { order } => (usize::from(order) + 1) * n,
         }
     }
 
@@ -171,6 +179,9 @@ impl DenseSolution {
             Interpolant::Hermite => hermite(c, n, s, p.h, out),
             Interpolant::Radau5 { c1m1, c2m1 } => {
                 crate::methods::radau5::eval_cont(c, n, s, c1m1, c2m1, out)
+            }
+            Interpolant::Bdf { order } => {
+                crate::methods::bdf::eval_cont(c, n, usize::from(order), s, out)
             }
         }
     }

@@ -96,6 +96,24 @@ pub enum OdeError {
 }
 
 impl OdeError {
+    /// Moves the partial solution out of the error (leaving an empty one), for a caller that
+    /// keeps both the error and the solution without copying the solution.
+    pub fn take_partial(&mut self) -> Option<Solution> {
+        let at = match self {
+            OdeError::InvalidInput { .. } => return None,
+            OdeError::StepSizeUnderflow { at, .. }
+            | OdeError::NonFinite { at }
+            | OdeError::MaxSteps { at, .. }
+            | OdeError::MinStep { at, .. }
+            | OdeError::Stiff { at }
+            | OdeError::SingularMatrix { at }
+            | OdeError::NoConvergence { at }
+            | OdeError::Interrupted { at } => at,
+        };
+        let empty = Solution::new(at.partial.method, at.partial.n);
+        Some(std::mem::replace(&mut *at.partial, empty))
+    }
+
     /// The failure point (time, state, partial solution), for numerical failures.
     pub fn failure_point(&self) -> Option<&FailurePoint> {
         match self {
@@ -154,10 +172,13 @@ pub(crate) fn invalid(reason: impl Into<String>) -> OdeError {
     }
 }
 
-pub(crate) fn point(t: f64, y: &[f64], partial: &Solution) -> FailurePoint {
+/// The solve ends here: its solution is moved into the error (not copied: a long run's
+/// outputs can be gigabytes, and an interrupted one should stop at once).
+pub(crate) fn point(t: f64, y: &[f64], partial: &mut Solution) -> FailurePoint {
+    let empty = Solution::new(partial.method, partial.n);
     FailurePoint {
         t,
         y: y.to_vec(),
-        partial: Box::new(partial.clone()),
+        partial: Box::new(std::mem::replace(partial, empty)),
     }
 }

@@ -213,19 +213,19 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
     loop {
         if opts.interrupted() {
             return Err(OdeError::Interrupted {
-                at: point(t, &y, &sol),
+                at: point(t, &y, &mut sol),
             });
         }
         if nstep >= opts.max_steps {
             return Err(OdeError::MaxSteps {
                 max_steps: opts.max_steps,
-                at: point(t, &y, &sol),
+                at: point(t, &y, &mut sol),
             });
         }
         if 0.1 * h.abs() <= t.abs() * f64::EPSILON || h == 0.0 {
             return Err(OdeError::StepSizeUnderflow {
                 h,
-                at: point(t, &y, &sol),
+                at: point(t, &y, &mut sol),
             });
         }
         if (t + 1.01 * h - tf) * dir > 0.0 {
@@ -239,7 +239,7 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
             nonfinite_in_row += 1;
             if nonfinite_in_row > 20 {
                 return Err(OdeError::NonFinite {
-                    at: point(t, &y, &sol),
+                    at: point(t, &y, &mut sol),
                 });
             }
         } else {
@@ -265,7 +265,7 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
                         sol.stats.stiffness_detected_at.get_or_insert(t);
                         if stiff_action == StiffnessAction::Error {
                             return Err(OdeError::Stiff {
-                                at: point(t, &y, &sol),
+                                at: point(t, &y, &mut sol),
                             });
                         }
                     }
@@ -311,7 +311,7 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
             if hmin > 0.0 && h.abs() <= hmin {
                 return Err(OdeError::MinStep {
                     min_step: hmin,
-                    at: point(t, &y, &sol),
+                    at: point(t, &y, &mut sol),
                 });
             }
             reject = true;

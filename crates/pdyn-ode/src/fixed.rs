@@ -131,7 +131,7 @@ pub(crate) fn integrate_fixed<P: ?Sized, F: OdeSystem + ?Sized, M: FixedStepper<
     if nsteps > opts.max_steps {
         return Err(OdeError::MaxSteps {
             max_steps: opts.max_steps,
-            at: point(t0, y0, &sol),
+            at: point(t0, y0, &mut sol),
         });
     }
     let h = if nsteps > 0 {
@@ -148,7 +148,7 @@ pub(crate) fn integrate_fixed<P: ?Sized, F: OdeSystem + ?Sized, M: FixedStepper<
     for k in 1..=nsteps {
         if opts.interrupted() {
             return Err(OdeError::Interrupted {
-                at: point(t, &y, &sol),
+                at: point(t, &y, &mut sol),
             });
         }
         let t_new = if k == nsteps { tf } else { t0 + k as f64 * h };
@@ -157,12 +157,12 @@ pub(crate) fn integrate_fixed<P: ?Sized, F: OdeSystem + ?Sized, M: FixedStepper<
             .is_err()
         {
             return Err(OdeError::NoConvergence {
-                at: point(t, &y, &sol),
+                at: point(t, &y, &mut sol),
             });
         }
         if y_new.iter().any(|v| !v.is_finite()) {
             return Err(OdeError::NonFinite {
-                at: point(t, &y, &sol),
+                at: point(t, &y, &mut sol),
             });
         }
         sol.stats.accepted += 1;

@@ -38,6 +38,8 @@
 //! | `methods/dop853.rs` | **DOP853**, Prince & Dormand 1981 / Hairer: 8(5,3), 7th-order dense output |
 //! | `methods/vern9.rs` | **Vern9**, Verner 2010: 9(8), for very tight tolerances (cubic Hermite dense output) |
 //! | `methods/rk4.rs` | **RK4**, Kutta 1901: classical order 4, fixed step |
+//! | `jacobian.rs` | finite-difference Jacobians of the implicit methods, columns grouped by a [`Sparsity`] pattern (SciPy's `jac_sparsity`) |
+//! | `methods/bdf.rs` | **BDF**, Shampine & Reichelt 1997: variable order 1–5, quasi-constant step size, NDF coefficients (MATLAB `ode15s`, SciPy's `BDF`), its own interpolating polynomial as dense output |
 //! | `methods/radau5.rs` | **Radau5**, Hairer & Wanner 1996: Radau IIA order 5, stiff, mass matrices / index-1 DAEs |
 //! | `methods/symplectic.rs` | **Velocity Verlet** (Verlet 1967), **Yoshida 4** (Yoshida 1990), **Kahan–Li 6 / 8** (Kahan & Li 1997): explicit symplectic, fixed step |
 //! | `methods/gauss.rs` | **Gauss–Legendre 4 / 6** (Butcher 1964): implicit symplectic for any Hamiltonian, fixed step |
@@ -71,6 +73,7 @@ mod error;
 pub mod events;
 mod explicit;
 mod fixed;
+pub mod jacobian;
 pub mod linalg;
 pub mod methods;
 mod options;
@@ -83,6 +86,7 @@ pub use controller::Controller;
 pub use dense::{DenseSolution, Interpolant};
 pub use error::{FailurePoint, OdeError};
 pub use events::{DenseOutput, Event};
+pub use jacobian::Sparsity;
 pub use options::{Interrupt, Options, StiffnessAction, Tolerance};
 pub use problem::{
     FirstOrderForm, FnSecondOrder, FnSystem, FnSystemWithJacobian, MassInverse, MassKind,
@@ -121,6 +125,9 @@ pub enum Method {
     Gauss6,
     /// Radau IIA order 5 ([`methods::radau5`]), implicit, adaptive, for stiff problems.
     Radau5,
+    /// Variable-order (1–5) BDF with NDF coefficients ([`methods::bdf`]), implicit, adaptive,
+    /// for stiff problems; MATLAB's `ode15s`, SciPy's `BDF`.
+    Bdf,
     /// The explicit pair chosen from `rtol` by [`Method::auto_explicit`] (DOPRI5 at loose
     /// tolerances, DOP853 at tight ones) while the problem is non-stiff, switching to Radau5
     /// for the rest of the integration when that pair's stiffness detector fires (checked every
@@ -180,7 +187,7 @@ impl MethodInfo {
 
 /// Every method, in the order `--method help` lists them. Adding a method: a variant of
 /// [`Method`], a row here, an arm in `dispatch` (which calls the method's generic code).
-pub const METHODS: [MethodInfo; 14] = {
+pub const METHODS: [MethodInfo; 15] = {
     use methods::*;
     const fn row(
         method: Method,
@@ -257,6 +264,10 @@ pub const METHODS: [MethodInfo; 14] = {
         row(Method::Gauss4, "gauss4", 4, Symplectic, gauss::DOC_GAUSS4),
         row(Method::Gauss6, "gauss6", 6, Symplectic, gauss::DOC_GAUSS6),
         row(Method::Radau5, "radau5", 5, Stiff, radau5::DOC),
+        MethodInfo {
+            aliases: &["ode15s"],
+            ..row(Method::Bdf, "bdf", 5, Stiff, bdf::DOC)
+        },
         row(Method::Auto, "auto", 5, Stiff, AUTO_DOC),
     ]
 };
@@ -466,6 +477,7 @@ fn dispatch<S: OdeSystem + ?Sized>(
             events,
         ),
         Method::Radau5 => methods::radau5::integrate(sys, t0, tf, y0, opts, events),
+        Method::Bdf => methods::bdf::integrate(sys, t0, tf, y0, opts, events),
         Method::Auto => auto(sys, t0, tf, y0, opts, events),
         Method::VelocityVerlet | Method::Yoshida4 | Method::KahanLi6 | Method::KahanLi8 => {
             Err(error::invalid("unreachable: second-order method"))

@@ -128,6 +128,11 @@ pub struct Options {
     /// before every step attempt; the solve then ends with [`OdeError::Interrupted`] and the
     /// partial solution. Default `None`.
     pub interrupt: Option<Interrupt>,
+    /// Which entries of `∂f/∂y` may be nonzero (SciPy's `jac_sparsity`): the implicit
+    /// methods' finite-difference Jacobians then perturb columns that share no row together,
+    /// one evaluation of `f` per group of columns ([`crate::jacobian`]). Unused when the system
+    /// has an analytic Jacobian. Default `None` (dense).
+    pub jac_sparsity: Option<std::sync::Arc<crate::jacobian::Sparsity>>,
 }
 
 /// A stop request shared with the thread that may set it.
@@ -158,6 +163,7 @@ impl Default for Options {
             min_step: None,
             output_terminal_event: true,
             interrupt: None,
+            jac_sparsity: None,
         }
     }
 }

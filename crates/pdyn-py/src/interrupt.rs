@@ -100,3 +100,72 @@ impl Drop for Done<'_> {
         self.0 .1.notify_all();
     }
 }
+
+/// Ctrl-C for work that runs on the calling thread itself with the GIL released (a compiled
+/// `solve_ivp`, most of which last well under a millisecond: a worker thread per call cost
+/// ~50 µs, more than the solve). The work calls [`SignalWatch::tick`] often (every evaluation
+/// of its right-hand side); every `stride` ticks the watch reads the clock, and once [`POLL`]
+/// has passed it takes the GIL and runs Python's signal handlers. A handler that raises sets
+/// the stop flag (the solver stops at its next step) and the exception is kept. The stride
+/// adapts so that the clock is read about every millisecond whatever one tick costs.
+pub(crate) struct SignalWatch {
+    flag: Interrupt,
+    ticks: std::cell::Cell<u32>,
+    stride: std::cell::Cell<u32>,
+    last_clock: std::cell::Cell<std::time::Instant>,
+    last_poll: std::cell::Cell<std::time::Instant>,
+    raised: std::cell::RefCell<Option<PyErr>>,
+}
+
+impl SignalWatch {
+    /// A watch that sets `flag` when a signal handler raises.
+    pub(crate) fn new(flag: Interrupt) -> Self {
+        let now = std::time::Instant::now();
+        SignalWatch {
+            flag,
+            ticks: 0.into(),
+            stride: 16.into(),
+            last_clock: now.into(),
+            last_poll: now.into(),
+            raised: None.into(),
+        }
+    }
+
+    /// One unit of work done.
+    #[inline]
+    pub(crate) fn tick(&self) {
+        let t = self.ticks.get() + 1;
+        if t < self.stride.get() {
+            self.ticks.set(t);
+            return;
+        }
+        self.ticks.set(0);
+        self.look();
+    }
+
+    #[cold]
+    fn look(&self) {
+        let now = std::time::Instant::now();
+        let since = now.duration_since(self.last_clock.get());
+        self.last_clock.set(now);
+        let stride = self.stride.get();
+        if since < Duration::from_micros(500) && stride < 1 << 20 {
+            self.stride.set(stride * 2);
+        } else if since > Duration::from_millis(4) && stride > 1 {
+            self.stride.set(stride / 2);
+        }
+        if now.duration_since(self.last_poll.get()) < POLL || self.raised.borrow().is_some() {
+            return;
+        }
+        self.last_poll.set(now);
+        if let Err(e) = Python::with_gil(|py| py.check_signals()) {
+            self.flag.store(true, Ordering::Relaxed);
+            *self.raised.borrow_mut() = Some(e);
+        }
+    }
+
+    /// The exception a signal handler raised, if one did.
+    pub(crate) fn into_raised(self) -> Option<PyErr> {
+        self.raised.into_inner()
+    }
+}

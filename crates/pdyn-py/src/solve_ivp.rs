@@ -6,11 +6,11 @@
 
 use crate::convert::{f64_array, f64_matrix, method_name, stats_dict};
 use crate::errors::{guarded, pdyn_error};
-use numpy::{PyArray1, PyReadonlyArray1};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pdyn_ode::{Direction, Event, Method, OdeSystem, Options, Solution, Status};
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyDict, PyFloat, PyInt, PyList, PyTuple};
 use std::cell::{Cell, RefCell};
 use std::sync::Arc;
 
@@ -127,7 +127,43 @@ fn keep(err: &RefCell<Option<PyErr>>, e: PyErr) {
 }
 
 /// `v` as a flat float64 vector (row-major for a matrix; a SciPy sparse matrix is made dense).
+/// What a right-hand side usually returns (a list or tuple of floats, a 1-D float64 array) is
+/// read directly, without calling NumPy: this runs once per evaluation.
 fn to_vec(py: Python<'_>, v: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    if let Ok(a) = v.downcast::<PyArray1<f64>>() {
+        if let Ok(ro) = a.try_readonly() {
+            if let Ok(s) = ro.as_slice() {
+                return Ok(s.to_vec());
+            }
+        }
+    }
+    let floats = |items: &mut dyn Iterator<Item = Bound<'_, PyAny>>, len: usize| {
+        let mut out = Vec::with_capacity(len);
+        for x in items {
+            // Python floats (NumPy's float64 is one) and ints; anything else (a 0-d or
+            // 1-element array, a nested list) goes through numpy.asarray.
+            if x.is_instance_of::<PyFloat>() || x.is_instance_of::<PyInt>() {
+                out.push(x.extract::<f64>().ok()?);
+            } else {
+                return None;
+            }
+        }
+        Some(out)
+    };
+    if let Ok(l) = v.downcast::<PyList>() {
+        if let Some(out) = floats(&mut l.iter(), l.len()) {
+            return Ok(out);
+        }
+    } else if let Ok(t) = v.downcast::<PyTuple>() {
+        if let Some(out) = floats(&mut t.iter(), t.len()) {
+            return Ok(out);
+        }
+    }
+    to_vec_numpy(py, v)
+}
+
+/// [`to_vec`] through `numpy.asarray`.
+fn to_vec_numpy(py: Python<'_>, v: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
     let np = py.import("numpy")?;
     let v = if v.hasattr("toarray")? && !v.is_instance(&np.getattr("ndarray")?)? {
         v.call_method0("toarray")?
@@ -149,6 +185,7 @@ fn integrate(
     o: &IvpOptions,
     err: &RefCell<Option<PyErr>>,
     calls: &Calls,
+    watch: Option<&crate::interrupt::SignalWatch>,
 ) -> Result<Solution, pdyn_ode::OdeError> {
     let n = o.y0.len();
     // Calls a Python function of (t, y) with y of shape (n,), or (n, k) for `k` states given
@@ -212,7 +249,12 @@ fn integrate(
         None => dy.fill(f64::NAN),
     };
     let f = |t: f64, y: &[f64], dy: &mut [f64]| match (rhs, &evaluator) {
-        (Rhs::Compiled(_), Some(ev)) => ev.eval(t, y, dy),
+        (Rhs::Compiled(_), Some(ev)) => {
+            if let Some(w) = watch {
+                w.tick();
+            }
+            ev.eval(t, y, dy)
+        }
         (Rhs::Callable(func), _) => {
             calls.fun.set(calls.fun.get() + 1);
             let v = call_py(func, t, y, o.vectorized.then_some(1));
@@ -368,16 +410,27 @@ impl IvpDense {
 
     /// The interpolant's name and order.
     #[getter]
-    fn interpolant(&self) -> &'static str {
+    fn interpolant(&self) -> String {
         if self.inner.is_empty() {
-            return "none";
+            return "none".into();
         }
         match self.inner.interpolant(self.inner.len() - 1) {
-            pdyn_ode::Interpolant::Dopri5 => "dopri5 (order 4)",
-            pdyn_ode::Interpolant::Tsit5 => "tsit5 (order 4)",
-            pdyn_ode::Interpolant::Dop853 => "dop853 (order 7)",
-            pdyn_ode::Interpolant::Radau5 { .. } => "radau5 collocation (order 3)",
-            pdyn_ode::Interpolant::Hermite => "cubic Hermite (order 3)",
+            pdyn_ode::Interpolant::Dopri5 => "dopri5 (order 4)".into(),
+            pdyn_ode::Interpolant::Tsit5 => "tsit5 (order 4)".into(),
+            pdyn_ode::Interpolant::Dop853 => "dop853 (order 7)".into(),
+            pdyn_ode::Interpolant::Radau5 { .. } => "radau5 collocation (order 3)".into(),
+            pdyn_ode::Interpolant::Hermite => "cubic Hermite (order 3)".into(),
+            pdyn_ode::Interpolant::Bdf { .. } => {
+                // Each step's own order: the highest used.
+                let top = (0..self.inner.len())
+                    .filter_map(|k| match self.inner.interpolant(k) {
+                        pdyn_ode::Interpolant::Bdf { order } => Some(order),
+                        _ => None,
+                    })
+                    .max()
+                    .unwrap_or(1);
+                format!("bdf interpolating polynomial (each step's order, up to {top})")
+            }
         }
     }
 
@@ -401,7 +454,7 @@ const MEMORY_GUARD_DOUBLES: usize = 1 << 28;
 /// `OdeResult`). `fun` is a callable `fun(t, y)` (arguments already bound) or a list of
 /// expression strings; `jac` a callable, a matrix (row-major, flat) or `None`.
 #[pyfunction]
-#[pyo3(signature = (fun, t0, tf, y0, method, t_eval, rtol, atol, max_step, first_step, min_step, max_steps, events, args, dense=false, jit=true, jac=None, vectorized=false))]
+#[pyo3(signature = (fun, t0, tf, y0, method, t_eval, rtol, atol, max_step, first_step, min_step, max_steps, events, args, dense=false, jit=true, jac=None, vectorized=false, jac_sparsity=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn _solve_ivp(
     py: Python<'_>,
@@ -423,6 +476,7 @@ pub(crate) fn _solve_ivp(
     jit: bool,
     jac: Option<Bound<'_, PyAny>>,
     vectorized: bool,
+    jac_sparsity: Option<Vec<bool>>,
 ) -> PyResult<PyObject> {
     guarded(py, || {
         let y0 = y0.as_slice()?.to_vec();
@@ -541,6 +595,14 @@ pub(crate) fn _solve_ivp(
         if let Some(te) = t_eval {
             opts.t_eval = Some(te.as_slice()?.to_vec());
         }
+        if let Some(pattern) = jac_sparsity {
+            if pattern.len() != n * n {
+                return Err(PyValueError::new_err("`jac_sparsity` has wrong shape."));
+            }
+            opts.jac_sparsity = Some(Arc::new(pdyn_ode::Sparsity::new(n, |i, j| {
+                pattern[i * n + j]
+            })));
+        }
         if m == Method::Auto {
             // LSODA: the stiffness test at every step (as LSODA weighs a switch at every
             // step), not every 1000 steps as dopri5.f.
@@ -561,36 +623,55 @@ pub(crate) fn _solve_ivp(
                 .all(|e| matches!(e.function, Rhs::Compiled(_)));
         let err = RefCell::new(None);
         let calls = Calls::default();
+        let mut interrupted = false;
         let result = if all_compiled {
-            // No Python in the loop: the GIL is released for the whole integration.
-            // Ctrl-C stops it at the next step (the calling thread watches for signals).
+            // No Python in the loop: the GIL is released for the whole integration, which
+            // runs on this thread; Ctrl-C stops it at the next step (`SignalWatch`: Python's
+            // signal handlers run every 20 ms from the right-hand side's evaluations).
             let stop: pdyn_ode::Interrupt = Default::default();
             o.opts.interrupt = Some(stop.clone());
             let rhs_ref = &rhs;
             let evs = &ivp_events;
             let args_ref = &args;
             let o_ref = &o;
-            let finished = crate::interrupt::with_flag(py, stop, move || {
+            let (value, raised) = py.allow_threads(move || {
                 let err = RefCell::new(None);
-                integrate(None, rhs_ref, evs, args_ref, o_ref, &err, &Calls::default())
-            })?;
-            if finished.interrupted {
-                let at = match &finished.value {
-                    Err(e) => e.failure_point().map_or(f64::NAN, |f| f.t),
-                    Ok(_) => o.t_span.1,
-                };
-                return Err(crate::errors::py_error(py, "Interrupted", |c| {
-                    c.call1((format!("solve_ivp interrupted (Ctrl-C) at t = {at}"),))
-                }));
+                let watch = crate::interrupt::SignalWatch::new(stop);
+                let r = integrate(
+                    None,
+                    rhs_ref,
+                    evs,
+                    args_ref,
+                    o_ref,
+                    &err,
+                    &Calls::default(),
+                    Some(&watch),
+                );
+                (r, watch.into_raised())
+            });
+            match raised {
+                Some(e) if !e.is_instance_of::<PyKeyboardInterrupt>(py) => return Err(e),
+                Some(_) => interrupted = true,
+                None => {}
             }
-            finished.value
+            value
         } else {
-            integrate(Some(py), &rhs, &ivp_events, &args, &o, &err, &calls)
+            integrate(Some(py), &rhs, &ivp_events, &args, &o, &err, &calls, None)
         };
         if let Some(e) = err.into_inner() {
-            return Err(e);
+            // Ctrl-C while a Python callback ran: the solve stopped there (the callback's
+            // NaN), and what it computed goes back with the interrupt, as for compiled
+            // expressions.
+            if e.is_instance_of::<PyKeyboardInterrupt>(py) && result.is_err() {
+                interrupted = true;
+            } else {
+                return Err(e);
+            }
         }
-        let (sol, message, status) = match result {
+        let (sol, message, status) = match result.map_err(|mut e| {
+            let partial = e.take_partial();
+            (e, partial)
+        }) {
             Ok(sol) => {
                 let (msg, status) = match sol.status {
                     Status::Finished => (
@@ -602,8 +683,8 @@ pub(crate) fn _solve_ivp(
                 };
                 (sol, msg, status)
             }
-            Err(e) => match e.failure_point() {
-                Some(fp) => {
+            Err((e, partial)) => match (e.failure_point(), partial) {
+                (Some(fp), Some(partial)) => {
                     let msg = match (&e, guard) {
                         (pdyn_ode::OdeError::MaxSteps { at, .. }, Some(g)) => format!(
                             "pdyn's memory guard: more than {g} steps would store over 2 GiB \
@@ -612,14 +693,19 @@ pub(crate) fn _solve_ivp(
                             if dense { " and dense output" } else { "" },
                             at.t
                         ),
+                        _ if interrupted => format!(
+                            "interrupted (Ctrl-C) at t = {}; the result holds what was \
+                             computed until then",
+                            fp.t
+                        ),
                         (pdyn_ode::OdeError::StepSizeUnderflow { .. }, _) => format!(
                             "Required step size is less than spacing between numbers. ({e})"
                         ),
                         _ => e.to_string(),
                     };
-                    ((*fp.partial).clone(), msg, -1)
+                    (partial, msg, -1)
                 }
-                None => return Err(pdyn_error(py, "ParameterError", e.to_string())),
+                _ => return Err(pdyn_error(py, "ParameterError", e.to_string())),
             },
         };
         let d = PyDict::new(py);
@@ -652,6 +738,7 @@ pub(crate) fn _solve_ivp(
         d.set_item("njev", njev)?;
         d.set_item("nlu", nlu)?;
         d.set_item("message", message)?;
+        d.set_item("interrupted", interrupted)?;
         d.set_item("status", status)?;
         d.set_item("method", sol.method.name())?;
         d.set_item("gil_released", all_compiled)?;

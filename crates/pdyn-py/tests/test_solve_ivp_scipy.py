@@ -91,7 +91,7 @@ def test_exponential_with_args_and_default_method_rk45():
 
 # --- dense output at the method's own order ----------------------------------------------------
 
-@pytest.mark.parametrize("method", ["RK45", "RK23", "DOP853", "Radau"])
+@pytest.mark.parametrize("method", ["RK45", "RK23", "DOP853", "Radau", "BDF"])
 @pytest.mark.parametrize("rtol", [1e-3, 1e-6, 1e-9])
 def test_dense_output_error_within_twice_scipys(method, rtol):
     atol = rtol * 1e-3
@@ -274,7 +274,7 @@ def test_njev_nlu_with_a_jacobian_callable():
                          rtol=1e-8, atol=1e-10)
     np.testing.assert_allclose(res.y[:, -1], [math.exp(-1), math.exp(-100)], rtol=1e-5,
                                atol=1e-10)
-    assert "Radau" in res.message  # BDF runs as Radau, and says so
+    assert res.method == "bdf" and "ran as" not in res.message  # pdyn's own BDF
 
 
 def test_vectorized_calls_fun_with_2d_states():
@@ -309,6 +309,84 @@ def test_robertson(method):
     assert res.success
     np.testing.assert_allclose(res.y[:, -1], ref, rtol=1e-4)
     assert len(res.t) < 1000  # a stiff method, not an explicit one crawling
+
+
+def vdp_scaled(t, y):
+    return [y[1], ((1 - y[0] ** 2) * y[1] - y[0]) / 1e-6]
+
+
+def vdp_scaled_jac(t, y):
+    return [[0.0, 1.0], [(-2 * y[0] * y[1] - 1) / 1e-6, (1 - y[0] ** 2) / 1e-6]]
+
+
+@pytest.mark.parametrize("tol", [1e-4, 1e-6])
+def test_bdf_takes_scipys_bdf_steps_on_stiff_van_der_pol(tol):
+    # Van der Pol mu = 1000 in the scaled form (t in units of mu), y(2) from the Bari test
+    # set (RADAU5 at tol 1.1e-18). pdyn's BDF is SciPy's algorithm (NDF coefficients,
+    # orders 1-5, Jacobian and LU reuse): the same work within a few per cent, side by side,
+    # and clearly less than Radau.
+    ref = [1.706167732170483, -0.8928097010247975]
+    kw = dict(method="BDF", rtol=tol, atol=tol, jac=vdp_scaled_jac)
+    s = scipy_integrate.solve_ivp(vdp_scaled, (0, 2), [2.0, 0.0], **kw)
+    p = pdyn.solve_ivp(vdp_scaled, (0, 2), [2.0, 0.0], **kw)
+    assert p.success and p.method == "bdf"
+    assert abs(p.nfev - s.nfev) <= 0.05 * s.nfev, (p.nfev, s.nfev)
+    assert abs(len(p.t) - len(s.t)) <= 0.05 * len(s.t), (len(p.t), len(s.t))
+    assert abs(p.njev - s.njev) <= 0.1 * s.njev + 2, (p.njev, s.njev)
+    err_s, err_p = np.abs(s.y[:, -1] - ref).max(), np.abs(p.y[:, -1] - ref).max()
+    assert err_p <= 2 * err_s, (err_p, err_s)
+    r = pdyn.solve_ivp(vdp_scaled, (0, 2), [2.0, 0.0], **{**kw, "method": "Radau"})
+    assert p.nfev < 0.75 * r.nfev, (p.nfev, r.nfev)  # 0.71 at 1e-4, 0.55 at 1e-6
+    # The dense output is BDF's own polynomial, of the orders the steps used.
+    d = pdyn.solve_ivp(vdp_scaled, (0, 2), [2.0, 0.0], dense_output=True, **kw)
+    assert d.sol.interpolant.startswith("bdf interpolating polynomial")
+    np.testing.assert_allclose(d.sol(d.t), d.y, rtol=1e-12, atol=1e-12)
+
+
+def heat(t, y):
+    # The 1-D heat equation on 30 interior points: a tridiagonal Jacobian.
+    dx = 1.0 / (len(y) + 1)
+    yp = np.concatenate([[0.0], y, [0.0]])
+    return (yp[:-2] - 2 * yp[1:-1] + yp[2:]) / dx ** 2
+
+
+@pytest.mark.parametrize("method", ["BDF", "Radau", "LSODA"])
+def test_jac_sparsity_groups_the_finite_differences(method):
+    n = 30
+    x = np.arange(1, n + 1) / (n + 1)
+    y0 = np.sin(np.pi * x)
+    lam = -4 * (n + 1) ** 2 * np.sin(np.pi / (2 * (n + 1))) ** 2  # a discrete eigenvector
+    pattern = np.eye(n) + np.eye(n, k=1) + np.eye(n, k=-1)
+    calls = [0]
+
+    def counted(t, y):
+        calls[0] += 1
+        return heat(t, y)
+    dense = pdyn.solve_ivp(counted, (0, 0.05), y0, method=method, rtol=1e-8, atol=1e-10)
+    dense_calls, calls[0] = calls[0], 0
+    kw = dict(lband=1, uband=1) if method == "LSODA" else dict(jac_sparsity=pattern)
+    sparse = pdyn.solve_ivp(counted, (0, 0.05), y0, method=method, rtol=1e-8, atol=1e-10,
+                            **kw)
+    for r in (dense, sparse):
+        np.testing.assert_allclose(r.y[:, -1], np.exp(lam * 0.05) * y0, atol=1e-6)
+    # Three groups of columns: 3 calls per Jacobian instead of 30.
+    assert sparse.njev >= 1
+    assert calls[0] <= dense_calls - sparse.njev * (n - 3) + 5, (calls[0], dense_calls)
+    # A scipy.sparse pattern is accepted too; a wrong shape is refused as SciPy refuses it.
+    if method != "LSODA":
+        from scipy import sparse as sp
+        pdyn.solve_ivp(heat, (0, 0.01), y0, method=method, jac_sparsity=sp.csc_matrix(pattern))
+        with pytest.raises(ValueError, match="jac_sparsity"):
+            pdyn.solve_ivp(heat, (0, 0.01), y0, method=method, jac_sparsity=np.eye(n + 1))
+
+
+def test_structure_hints_of_other_methods_warn():
+    # SciPy's explicit methods ignore jac_sparsity, and every method but LSODA lband/uband,
+    # with a warning: so does pdyn (no silently ignored option).
+    with pytest.warns(UserWarning, match="jac_sparsity"):
+        pdyn.solve_ivp(osc, (0, 1), [1, 0], method="RK45", jac_sparsity=np.ones((2, 2)))
+    with pytest.warns(UserWarning, match="lband"):
+        pdyn.solve_ivp(osc, (0, 1), [1, 0], method="BDF", lband=1)
 
 
 # --- options ------------------------------------------------------------------------------------

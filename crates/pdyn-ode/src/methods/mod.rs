@@ -1,5 +1,6 @@
 //! One integrator family per file; each file opens with its mathematics and its paper.
 
+pub mod bdf;
 pub mod dop853;
 pub mod dopri5;
 pub mod gauss;

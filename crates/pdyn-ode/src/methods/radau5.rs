@@ -17,7 +17,8 @@
 //! * Jacobian reuse: after an accepted step the Jacobian is kept when `θ ≤ 0.001`, and the
 //!   factorisations too when moreover `1 ≤ h_new/h ≤ 1.2` (then the step is not changed).
 //!   The Jacobian is analytic when [`OdeSystem::has_jacobian`], else forward differences with
-//!   increments `sqrt(u · max(1e-5, |y_j|))`.
+//!   increments `sqrt(u · max(1e-5, |y_j|))` ([`crate::jacobian`], columns grouped by
+//!   [`Options::jac_sparsity`] when given).
 //! * Error estimate `err = ‖(γ/h M − J)⁻¹ (f(y0) + M (d1 Z1 + d2 Z2 + d3 Z3)/h)‖`, refined by
 //!   one more solve after a rejection or at the first step; step ratio
 //!   `h_new/h = 1/clamp(err^{1/4}/fac, 1/8, 5)` with `fac = min(0.9, 0.9(1+2·7)/(newt+14))`,
@@ -194,6 +195,14 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
 ) -> Result<Solution, OdeError> {
     let su = setup(sys, t0, tf, y_init, opts)?;
     let n = su.n;
+    if let Some(s) = &opts.jac_sparsity {
+        if s.dim() != n {
+            return Err(invalid(format!(
+                "jac_sparsity is {0} × {0}, the system has {n} components",
+                s.dim()
+            )));
+        }
+    }
     let mass = match sys.mass_kind() {
         MassKind::Identity => None,
         MassKind::Constant => {
@@ -264,7 +273,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
     let mut tmp = vec![0.0; n];
     let mut ytmp = vec![0.0; n];
     let mut fjac = vec![0.0; n * n]; // row-major ∂f_i/∂y_j
-    let (mut fd_states, mut fd_out) = (Vec::new(), Vec::new());
+    let mut fd = crate::jacobian::FdJacobian::default();
     let mut e1 = Lu::new(n);
     let mut e2 = LuComplex::new(n);
     let mut dense = Radau5Dense {
@@ -296,26 +305,18 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                 if sys.has_jacobian() {
                     sys.jacobian(x, &y, &mut fjac);
                 } else {
-                    // The n perturbed states, evaluated in one batch (one call of a
-                    // vectorized right-hand side).
-                    if fd_states.is_empty() {
-                        fd_states = vec![0.0; n * n];
-                        fd_out = vec![0.0; n * n];
-                    }
-                    for i in 0..n {
-                        let row = &mut fd_states[i * n..(i + 1) * n];
-                        row.copy_from_slice(&y);
-                        row[i] = y[i] + (UROUND * 1e-5f64.max(y[i].abs())).sqrt();
-                    }
-                    sys.rhs_batch(x, &fd_states, &mut fd_out);
-                    for i in 0..n {
-                        let delt = (UROUND * 1e-5f64.max(y[i].abs())).sqrt();
-                        for j in 0..n {
-                            fjac[j * n + i] = (fd_out[i * n + j] - y0f[j]) / delt;
-                        }
-                    }
-                    sol.stats.fevals += n;
-                    sol.stats.jac_fevals += n;
+                    // The n perturbed states (or one per group of columns of
+                    // `jac_sparsity`), evaluated in one batch (one call of a vectorized
+                    // right-hand side).
+                    fd.eval(
+                        sys,
+                        opts.jac_sparsity.as_deref(),
+                        x,
+                        &y,
+                        &y0f,
+                        &mut fjac,
+                        &mut sol.stats,
+                    );
                 }
                 caljac = true;
                 next = Next::Decompose;
@@ -326,7 +327,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                     if tried_min {
                         return Err(OdeError::MinStep {
                             min_step: su.hmin,
-                            at: point(x, &y, &sol),
+                            at: point(x, &y, &mut sol),
                         });
                     }
                     h = su.hmin * posneg;
@@ -378,19 +379,19 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
             sol.stats.steps += 1;
             if opts.interrupted() {
                 return Err(OdeError::Interrupted {
-                    at: point(x, &y, &sol),
+                    at: point(x, &y, &mut sol),
                 });
             }
             if nstep > opts.max_steps {
                 return Err(OdeError::MaxSteps {
                     max_steps: opts.max_steps,
-                    at: point(x, &y, &sol),
+                    at: point(x, &y, &mut sol),
                 });
             }
             if 0.1 * h.abs() <= x.abs() * UROUND || h == 0.0 || !h.is_finite() {
                 return Err(OdeError::StepSizeUnderflow {
                     h,
-                    at: point(x, &y, &sol),
+                    at: point(x, &y, &mut sol),
                 });
             }
             let xph = x + h;
@@ -609,7 +610,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                     caljac = false;
                     if y.iter().any(|v| !v.is_finite()) {
                         return Err(OdeError::NonFinite {
-                            at: point(x_old, &y, &sol),
+                            at: point(x_old, &y, &mut sol),
                         });
                     }
                     // events and outputs
@@ -681,7 +682,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                 nsing += 1;
                 if nsing >= 5 {
                     return Err(OdeError::SingularMatrix {
-                        at: point(x, &y, &sol),
+                        at: point(x, &y, &mut sol),
                     });
                 }
             }

@@ -52,12 +52,14 @@ class DriftWarning(UserWarning):
 
 
 class Interrupted(KeyboardInterrupt):
-    """Ctrl-C (SIGINT) stopped a long call: ``Model.run``, ``sweep`` or ``ensemble``.
+    """Ctrl-C (SIGINT) stopped a long call: ``Model.run``, ``sweep``, ``ensemble`` or
+    ``solve_ivp``.
 
     A subclass of ``KeyboardInterrupt`` (``except KeyboardInterrupt`` catches it): the call
     stopped at its next step, within tens of milliseconds, and ``result`` holds what was
     computed until then (the partial :class:`OdeResult`, ``ParticleResult``, ``SweepResult`` or
-    ``EnsembleResult``; runs that had not finished carry their failure, measures NaN).
+    ``EnsembleResult``; runs that had not finished carry their failure, measures NaN;
+    ``solve_ivp``'s partial ``OdeResult``, ``status`` -1).
     """
 
     def __init__(self, message: str, result=None):

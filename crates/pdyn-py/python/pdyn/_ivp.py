@@ -16,11 +16,10 @@ from ._result import OdeResult, _from_ivp
 
 # SciPy's names of methods pdyn runs with another of its own methods, and what it says.
 _MAPPED = {
-    "bdf": ("radau5", "BDF ran as pdyn's Radau (Radau IIA order 5, implicit, for stiff "
-                      "problems; pdyn has no BDF)"),
     "lsoda": ("auto", "LSODA ran as pdyn's auto (DOPRI5, switching to Radau when it detects "
                       "stiffness, as LSODA switches from Adams to BDF)"),
 }
+_IMPLICIT = {"radau", "radau5", "bdf", "ode15s", "lsoda", "auto"}
 _EXPLICIT = {"rk45", "rk23", "dop853", "dopri5", "tsit5", "vern9", "ode45", "ode23", "rk4"}
 _EPS = 2.220446049250313e-16
 
@@ -67,9 +66,14 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
     function, as SciPy does.
 
     ``method``: ``"RK45"`` (default; DOPRI5), ``"RK23"`` (Bogacki-Shampine), ``"DOP853"``,
-    ``"Radau"``; ``"BDF"`` runs as pdyn's Radau and ``"LSODA"`` as pdyn's ``auto`` (DOPRI5
-    switching to Radau when stiff) -- the ``message`` says so; or pdyn's own (``"Tsit5"``,
-    ``"Vern9"``, ...; :func:`pdyn.methods`).
+    ``"Radau"``, ``"BDF"`` (variable order 1-5 with the NDF coefficients, as SciPy's);
+    ``"LSODA"`` runs as pdyn's ``auto`` (DOPRI5 switching to Radau when stiff) -- the
+    ``message`` says so; or pdyn's own (``"Tsit5"``, ``"Vern9"``, ...; :func:`pdyn.methods`).
+
+    ``jac_sparsity`` (an ``(n, n)`` array or sparse matrix, nonzero where the Jacobian may be)
+    groups the columns of the finite-difference Jacobian of Radau, BDF and LSODA, one
+    evaluation of ``fun`` per group; ``lband``/``uband`` give LSODA a banded pattern. Other
+    methods warn about them, as SciPy's do.
 
     ``t_eval``: the result's ``t`` is exactly these times (up to a terminal event, whose time
     and state are in ``t_events``/``y_events``). ``events``: callables with SciPy's
@@ -91,6 +95,10 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
     Jacobians); ``nlu``: LU factorizations (Radau factors a real and a complex matrix per
     iteration matrix: 2). ``stats`` has pdyn's counts.
 
+    Ctrl-C stops the solve at its next step and raises :class:`pdyn.Interrupted` (a
+    ``KeyboardInterrupt``) whose ``result`` is the :class:`OdeResult` of what was computed
+    (``status=-1``, the ``message`` says where it stopped).
+
     There is no step cap unless ``max_steps`` is given, but a memory guard: when what is
     stored grows with the steps (the outputs without ``t_eval``, the dense output), a solve
     that would store more than 2^28 doubles (2 GiB) stops with ``status=-1`` and a message
@@ -104,13 +112,27 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
     ``sol.native`` says which ran.
     """
     import warnings
-    for k in ("jac_sparsity", "lband", "uband"):
-        options.pop(k, None)  # structure hints: pdyn's Jacobians are dense
+
+    import numpy as np  # the module itself, not the lazy stand-in: this runs once per call
+    if isinstance(method, type):
+        method = method.__name__
+    # Structure hints of the Jacobian, used by the implicit methods' finite differences as
+    # SciPy uses them: `jac_sparsity` (Radau, BDF; pdyn's LSODA too) groups the columns,
+    # `lband`/`uband` (LSODA's) give a band. For a method that does not use them they are
+    # warned about, as SciPy warns.
+    sparsity = options.pop("jac_sparsity", None)
+    lband, uband = options.pop("lband", None), options.pop("uband", None)
+    implicit = isinstance(method, str) and method.lower() in _IMPLICIT
+    if not implicit and sparsity is not None:
+        options["jac_sparsity"] = sparsity
+    if not (isinstance(method, str) and method.lower() == "lsoda"):
+        for k, v in (("lband", lband), ("uband", uband)):
+            if v is not None:
+                options[k] = v
+        lband = uband = None
     if options:
         warnings.warn("The following arguments have no effect for a chosen solver: "
                       + ", ".join(f"`{k}`" for k in options) + ".", stacklevel=2)
-    if isinstance(method, type):
-        method = method.__name__
     if not isinstance(method, str):
         raise ValueError("`method` must be one of RK45, RK23, DOP853, Radau, BDF, LSODA, "
                          "pdyn's methods, or an OdeSolver class.")
@@ -195,32 +217,63 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
             raise ValueError("`first_step` exceeds bounds.")
     if not (min_step >= 0) or math.isinf(min_step):
         raise ValueError("`min_step` must be finite and non-negative.")
-    r = _tol(rtol, "rtol", n)
-    if np.any(r < 100 * _EPS):
-        warnings.warn("At least one element of `rtol` is too small. Setting "
-                      f"`rtol = np.maximum(rtol, {100 * _EPS})`.", stacklevel=2)
-        r = np.maximum(r, 100 * _EPS)
-    a = _tol(atol, "atol", n)
-    if np.any(a < 0):
-        raise ValueError("`atol` must be positive.")
-    if key in ("radau", "radau5"):
-        # Hairer's Radau5 reads its tolerances as rtol' = 0.1 rtol^(2/3), atol' = rtol' atol/rtol
-        # (radau5.f); SciPy's Radau applies rtol and atol as given. These are the tolerances
-        # that Radau5 turns into the requested ones, so that the error test is SciPy's.
-        rh = np.maximum((10.0 * r) ** 1.5, 1e-14)
-        a, r = a * rh / r, rh
+    radau = key in ("radau", "radau5")
+    if type(rtol) in (float, int) and type(atol) in (float, int) and not radau:
+        # The common case, checked without NumPy (this runs once per call, and a compiled
+        # solve can take less than 0.1 ms).
+        r, a = [float(rtol)], [float(atol)]
+        if r[0] < 100 * _EPS:
+            warnings.warn("At least one element of `rtol` is too small. Setting "
+                          f"`rtol = np.maximum(rtol, {100 * _EPS})`.", stacklevel=2)
+            r = [100 * _EPS]
+        if a[0] < 0:
+            raise ValueError("`atol` must be positive.")
+    else:
+        r = _tol(rtol, "rtol", n)
+        if np.any(r < 100 * _EPS):
+            warnings.warn("At least one element of `rtol` is too small. Setting "
+                          f"`rtol = np.maximum(rtol, {100 * _EPS})`.", stacklevel=2)
+            r = np.maximum(r, 100 * _EPS)
+        a = _tol(atol, "atol", n)
+        if np.any(a < 0):
+            raise ValueError("`atol` must be positive.")
+        if radau:
+            # Hairer's Radau5 reads its tolerances as rtol' = 0.1 rtol^(2/3),
+            # atol' = rtol' atol/rtol (radau5.f); SciPy's Radau applies rtol and atol as
+            # given. These are the tolerances that Radau5 turns into the requested ones, so
+            # that the error test is SciPy's.
+            rh = np.maximum((10.0 * r) ** 1.5, 1e-14)
+            a, r = a * rh / r, rh
+        r, a = r.tolist(), a.tolist()
+    pattern = None
+    if sparsity is not None and jac is None:
+        if hasattr(sparsity, "toarray"):
+            sparsity = sparsity.toarray()
+        sp = np.asarray(sparsity)
+        if sp.shape != (n, n):
+            raise ValueError("`jac_sparsity` has wrong shape.")
+        pattern = [bool(v) for v in (sp != 0).ravel()]
+    elif (lband is not None or uband is not None) and jac is None:
+        lo, up = int(lband or 0), int(uband or 0)
+        if lo < 0 or up < 0:
+            raise ValueError("`lband` and `uband` must be non-negative")
+        i, j = np.indices((n, n))
+        pattern = [bool(v) for v in ((j - i <= up) & (i - j <= lo)).ravel()]
     if max_steps is not None and int(max_steps) < 1:
         raise ValueError("`max_steps` must be a positive integer")
-    raw = _pdyn._solve_ivp(fun, t0, tf, y0a, key, te, [float(v) for v in r],
-                           [float(v) for v in a],
+    raw = _pdyn._solve_ivp(fun, t0, tf, y0a, key, te, r, a,
                            None if math.isinf(max_step) else float(max_step),
                            None if first_step is None else float(first_step),
                            float(min_step) if min_step > 0 else None,
                            None if max_steps is None else int(max_steps), ev_list, named_args,
-                           bool(dense_output), bool(jit), jac, bool(vectorized))
+                           bool(dense_output), bool(jit), jac, bool(vectorized), pattern)
     if note is not None:
         raw["message"] = f"{raw['message']} ({note})"
     res = _from_ivp(raw, len(ev_list), n)
     res["nfev"], res["njev"], res["nlu"] = raw["nfev"], raw["njev"], raw["nlu"]
     res["sol"] = raw.get("sol")
+    if raw.get("interrupted"):
+        from ._errors import Interrupted
+        raise Interrupted(f"solve_ivp {raw['message'].split(';')[0]}; what was computed is in "
+                          ".result", res)
     return res

@@ -1393,8 +1393,8 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
             );
             let (sol, fail) = match result {
                 Ok(s) => (s, None),
-                Err(e) => match e.failure_point() {
-                    Some(fp) => ((*fp.partial).clone(), Some(e.clone())),
+                Err(mut e) => match e.take_partial() {
+                    Some(partial) => (partial, Some(e)),
                     None => return Err(SimError::Integrator(e)),
                 },
             };

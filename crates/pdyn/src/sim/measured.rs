@@ -56,6 +56,12 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
         return measure_hybrid(prep, h, set, stats);
     }
     let (sol, failure) = integrate(prep, set)?;
+    let failure = match failure {
+        Some(f) if matches!(f.error, pdyn_ode::OdeError::Interrupted { .. }) => {
+            return Ok(interrupted(prep, &sol, f));
+        }
+        other => other,
+    };
     let sys = &prep.system;
     let n_meas = prep.measures.as_ref().map_or(0, |m| m.len());
     let conserved: Vec<usize> = (0..prep.observer.len())
@@ -164,6 +170,31 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
         status,
         stats: sol.stats.clone(),
     })
+}
+
+/// What an interrupted run keeps: where it stopped and the events it met, nothing reduced
+/// from its outputs (its measures are NaN anyway, and Ctrl-C should not wait for a pass over
+/// a long run's rows).
+fn interrupted(prep: &Prepared, sol: &Solution, failure: RunFailure) -> Measured {
+    let mut first_hits = vec![None; prep.events.len()];
+    for h in &sol.events {
+        if let Some(slot @ None) = first_hits.get_mut(h.index) {
+            *slot = Some((h.t, h.y.clone()));
+        }
+    }
+    let n_meas = prep.measures.as_ref().map_or(0, |m| m.len());
+    Measured {
+        measures: vec![f64::NAN; n_meas],
+        last: sol.last().map(|(t, y)| (t, y.to_vec())),
+        events: Vec::new(),
+        first_hits,
+        non_finite: None,
+        monitors: Vec::new(),
+        warnings: Vec::new(),
+        failure: Some(failure),
+        status: RunStatus::Failed,
+        stats: sol.stats.clone(),
+    }
 }
 
 /// [`measure`] of a hybrid model: the run with its table (a run switches between modes,

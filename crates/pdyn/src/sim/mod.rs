@@ -1088,24 +1088,34 @@ pub(crate) fn integrate(
     };
     let (sol, failure) = match result {
         Ok(s) => (s, None),
-        Err(e) => match e.failure_point() {
-            Some(fp) => {
-                let failure = RunFailure {
-                    t: fp.t,
-                    state: prep
-                        .state_names
-                        .iter()
-                        .cloned()
-                        .zip(fp.y.iter().copied())
-                        .collect(),
-                    error: e.clone(),
-                    stiff_at: fp.partial.stats.stiffness_detected_at,
-                    non_finite: non_finite_at(prep, sys, fp.t, &fp.y),
-                };
-                ((*fp.partial).clone(), Some(failure))
-            }
-            None => return Err(SimError::Integrator(e)),
-        },
+        Err(mut e) => {
+            let Some(fp) = e.failure_point() else {
+                return Err(SimError::Integrator(e));
+            };
+            let (t, state, stiff_at) = (
+                fp.t,
+                prep.state_names
+                    .iter()
+                    .cloned()
+                    .zip(fp.y.iter().copied())
+                    .collect(),
+                fp.partial.stats.stiffness_detected_at,
+            );
+            let non_finite = non_finite_at(prep, sys, fp.t, &fp.y);
+            // The partial solution moves out of the error (a long run's outputs are not
+            // copied); the failure keeps the time and state.
+            let Some(partial) = e.take_partial() else {
+                return Err(SimError::Integrator(e));
+            };
+            let failure = RunFailure {
+                t,
+                state,
+                error: e,
+                stiff_at,
+                non_finite,
+            };
+            (partial, Some(failure))
+        }
     };
     Ok((sol, failure))
 }
