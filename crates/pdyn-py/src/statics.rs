@@ -66,6 +66,22 @@ pub(crate) fn modes(
         "modal_stiffness",
         f64_array(py, col(&|m| m.modal_stiffness)),
     )?;
+    // Per mode and axis (k × 3): how a ground acceleration along x, y, z excites the mode.
+    let per_axis = |f: &dyn Fn(&pdyn_mech::modes::Mode) -> [f64; 3]| {
+        modes.iter().flat_map(f).collect::<Vec<f64>>()
+    };
+    d.set_item(
+        "participation",
+        f64_matrix(py, per_axis(&|m| m.participation), k, 3)?,
+    )?;
+    d.set_item(
+        "effective_mass",
+        f64_matrix(py, per_axis(&|m| m.effective_mass), k, 3)?,
+    )?;
+    d.set_item(
+        "total_mass",
+        f64_array(py, report.modes.total_mass.to_vec()),
+    )?;
     // Shapes as columns: shapes[:, j] is mode j.
     let mut shapes = vec![0.0; n * k];
     for (j, m) in modes.iter().enumerate() {

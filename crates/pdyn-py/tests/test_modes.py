@@ -39,6 +39,22 @@ def test_dense_modes_of_the_thirty_mass_chain():
     assert m.damping_ratio is None
 
 
+def test_effective_masses_of_the_chain_follow_the_closed_form():
+    # Mode j of the fixed-fixed chain is sin(i j pi/(n+1)): its effective mass along x is
+    # 2 cot^2(theta/2)/(n+1) for odd j (theta = j pi/(n+1)), 0 for even j; they add up to
+    # the n unit masses, and nothing moves along y or z.
+    n = 30
+    m = chain(n).modes()
+    assert m.effective_mass.shape == (n, 3) and m.participation.shape == (n, 3)
+    np.testing.assert_allclose(m.total_mass, [n, 0, 0], atol=1e-9)
+    j = np.arange(1, n + 1)
+    half = j * math.pi / (2 * (n + 1))
+    exact = np.where(j % 2 == 1, 2 / np.tan(half) ** 2 / (n + 1), 0.0)
+    np.testing.assert_allclose(m.effective_mass[:, 0], exact, atol=1e-9)
+    np.testing.assert_allclose(m.effective_mass.sum(axis=0), m.total_mass, atol=1e-9)
+    np.testing.assert_allclose(m.participation[:, 0] ** 2 * m.modal_mass, m.effective_mass[:, 0], atol=1e-9)
+
+
 def test_the_lowest_ten_of_a_thousand_mass_chain_by_the_sparse_solver():
     m = chain(1000).modes(count=10)
     assert m.solver == "sparse" and len(m) == 10

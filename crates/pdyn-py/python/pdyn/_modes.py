@@ -15,7 +15,11 @@ class Modes:
     largest component is +1, rows in the order of ``coordinates``), ``modal_mass`` and
     ``modal_stiffness`` (``φᵀ M φ``, ``φᵀ K φ`` with that scaling), ``q`` (the state),
     ``residual`` (``|f|`` there), ``solver`` (``"dense"``: every mode; ``"sparse"``: the lowest
-    ``count`` by shift-invert Lanczos), ``about``. With damping (``C ≠ 0``) and up to 1,000
+    ``count`` by shift-invert Lanczos), ``about``. ``participation`` and ``effective_mass``
+    (``k × 3``: per mode, along x, y, z) are ``Γ = φᵀ M r / φᵀ M φ`` and ``(φᵀ M r)² / φᵀ M φ``,
+    with ``M r`` the inertia load of a unit ground acceleration along the axis; ``total_mass``
+    (3) is what all modes' effective masses add up to, so ``effective_mass.sum(axis=0) /
+    total_mass`` is the share the modes found carry. With damping (``C ≠ 0``) and up to 1,000
     coordinates, ``natural_frequency``, ``damping_ratio`` and ``damped_frequency`` of the roots
     of ``det(s² M + s C + K) = 0``; else ``None``."""
 
@@ -29,6 +33,9 @@ class Modes:
         self.shapes = raw["shapes"]
         self.modal_mass = raw["modal_mass"]
         self.modal_stiffness = raw["modal_stiffness"]
+        self.participation = raw["participation"]
+        self.effective_mass = raw["effective_mass"]
+        self.total_mass = raw["total_mass"]
         self.coordinates: List[str] = list(raw["coordinates"])
         self.q = raw["q"]
         self.residual: float = float(raw["residual"])
