@@ -286,11 +286,7 @@ impl Linearizer {
     /// along `e_d` is `φᵀ M r_d / φᵀ M φ` ([`crate::modes::Mode::participation`]).
     pub fn inertia_at(&self, q: &[f64]) -> [Vec<f64>; 3] {
         let n = self.len();
-        let mut input = self.input.clone();
-        input[1..1 + n].copy_from_slice(q);
-        let mut ws = self.inertia.workspace();
-        let mut out = vec![0.0; self.inertia_slots.len()];
-        self.inertia.eval(&input, &mut ws, &mut out);
+        let out = self.eval_program(&self.inertia, q);
         let mut b = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
         for (&(dir, i), v) in self.inertia_slots.iter().zip(out) {
             b[dir][i] += v;
@@ -310,12 +306,17 @@ impl Linearizer {
 
     /// The compiled outputs at rest at `q` (at t = 0), one per slot.
     fn eval(&self, q: &[f64]) -> Vec<f64> {
+        self.eval_program(&self.program, q)
+    }
+
+    /// `program`'s outputs at rest at `q` (t = 0, the parameters' values).
+    fn eval_program(&self, program: &Program, q: &[f64]) -> Vec<f64> {
         let n = self.len();
         let mut input = self.input.clone();
         input[1..1 + n].copy_from_slice(q);
-        let mut ws = self.program.workspace();
-        let mut out = vec![0.0; self.slots.len()];
-        self.program.eval(&input, &mut ws, &mut out);
+        let mut ws = program.workspace();
+        let mut out = vec![0.0; program.n_outputs()];
+        program.eval(&input, &mut ws, &mut out);
         out
     }
 
