@@ -156,7 +156,7 @@ impl Scalar {
 
 /// Brent's method for a zero of `g` in `[a, b]`, `g(a) g(b) < 0`: the final bracket
 /// `(lo, hi)` (adjacent or within `4 ε |x|`) with the signs still opposite.
-fn brent(mut g: impl FnMut(f64) -> f64, a: f64, b: f64, ga: f64, gb: f64) -> (f64, f64) {
+pub fn brent_root(mut g: impl FnMut(f64) -> f64, a: f64, b: f64, ga: f64, gb: f64) -> (f64, f64) {
     let (mut a, mut b, mut fa, mut fb) = (a, b, ga, gb);
     let (mut c, mut fc) = (a, fa);
     let mut d = b - a;
@@ -283,7 +283,7 @@ pub fn scalar_roots(
         // The scale of f nearby, for "small": its rounding cannot be below ε times it.
         let scale = fa.abs().max(fb.abs());
         if fa.signum() != fb.signum() {
-            let (l, h) = brent(|v| s.at(v)[0], a, b, fa, fb);
+            let (l, h) = brent_root(|v| s.at(v)[0], a, b, fa, fb);
             let mid = if l == h { l } else { 0.5 * (l + h) };
             let at = s.at(mid);
             let [fl, ..] = s.at(l);
@@ -316,7 +316,7 @@ pub fn scalar_roots(
             && da.signum() != db.signum()
         {
             // f keeps its sign, f' changes it: a critical point, perhaps a double root.
-            let (l, h) = brent(|v| s.at(v)[1], a, b, da, db);
+            let (l, h) = brent_root(|v| s.at(v)[1], a, b, da, db);
             let xc = if s.at(l)[0].abs() <= s.at(h)[0].abs() {
                 l
             } else {
@@ -338,7 +338,7 @@ pub fn scalar_roots(
             } else if fc.signum() != fa.signum() && fc.is_finite() {
                 // f crosses zero twice within the step: two simple roots around xc.
                 for (p, q, fp, fq) in [(a, xc, fa, fc), (xc, b, fc, fb)] {
-                    let (l, h) = brent(|v| s.at(v)[0], p, q, fp, fq);
+                    let (l, h) = brent_root(|v| s.at(v)[0], p, q, fp, fq);
                     let [fl, ..] = s.at(l);
                     let [fh, ..] = s.at(h);
                     let (x, fx) = if fl.abs() <= fh.abs() {
