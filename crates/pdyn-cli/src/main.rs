@@ -60,6 +60,8 @@ enum Command {
     Fuse(cli::fuse::FuseArgs),
     /// Fit a model's parameters and initial values to measured runs (least squares, sensitivities).
     Fit(cli::fit::FitArgs),
+    /// The parameter values within bounds that maximise or minimise a measure of the runs.
+    Optimize(cli::optimize::OptimizeArgs),
 }
 
 /// Stack of the thread that runs a command: 1 GiB of address space.
@@ -83,6 +85,7 @@ fn dispatch(command: Command) -> Result<Outcome, Error> {
         Command::Kin(a) => text(cli::kin::run(a)),
         Command::Fuse(a) => text(cli::fuse::run(a)),
         Command::Fit(a) => text(cli::fit::run(a)),
+        Command::Optimize(a) => cli::optimize::run(a),
     }
 }
 

@@ -316,3 +316,63 @@ fn options_of_the_other_mode_are_errors() {
     assert_eq!(code, 2);
     assert!(stderr.contains("is not `position` or `accel`"), "{stderr}");
 }
+
+/// `[data.ground]` in a model: the building shaken by the shipped record. At the record's
+/// sample times the monitored `ground_a(t)` is the recorded value itself (linear
+/// interpolation passes through its samples); a run past the record's 20 s is a data error
+/// naming the time and the range, in JSON too.
+#[test]
+fn earthquake_record_drives_the_building() {
+    let out = temp("quake");
+    let model = example("earthquake.toml");
+    let (code, stdout, stderr) = pdyn(&["run", &model, "--out", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let (names, rows) = read_table(&out.join("trajectory.csv"));
+    let (ti, ai, di) = (
+        col(&names, "t"),
+        col(&names, "ground_acceleration"),
+        col(&names, "deflection2"),
+    );
+    let record = std::fs::read_to_string(example("ground.csv")).unwrap();
+    let samples: Vec<(f64, f64)> = record
+        .lines()
+        .skip(2)
+        .map(|l| {
+            let (t, a) = l.split_once(',').unwrap();
+            (t.parse().unwrap(), a.parse().unwrap())
+        })
+        .collect();
+    assert_eq!(samples.len(), 4001);
+    // Output every 0.01 s, samples every 0.005 s: every output time is sample 2k.
+    let mut matched = 0;
+    for r in &rows {
+        let k = (r[ti] / 0.005).round() as usize;
+        if (samples[k].0 - r[ti]).abs() < 1e-9 {
+            assert_eq!(r[ai], samples[k].1, "t = {}", r[ti]);
+            matched += 1;
+        }
+    }
+    assert_eq!(matched, rows.len());
+    // The top floor moves: a peak deflection of millimetres to centimetres.
+    let peak = rows.iter().map(|r| r[di].abs()).fold(0.0, f64::max);
+    assert!(peak > 1e-3 && peak < 0.5, "peak deflection {peak}");
+
+    let (code, stdout, stderr) = pdyn(&[
+        "run",
+        &model,
+        "--out",
+        out.to_str().unwrap(),
+        "--t-end",
+        "25",
+        "--json",
+    ]);
+    assert_eq!(code, 2, "{stdout}{stderr}");
+    assert!(
+        stderr.contains("left the time range of the data")
+            && stderr.contains("t = 20.0000")
+            && stderr.contains("[0, 20]"),
+        "{stderr}"
+    );
+    let json: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(json["error"]["kind"], "data", "{stdout}");
+}

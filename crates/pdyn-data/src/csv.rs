@@ -40,6 +40,18 @@ impl Columns {
         self.lines.is_empty()
     }
 
+    /// Moves column `i` to the front (the time column of a file read whole).
+    pub fn move_first(&mut self, i: usize) {
+        if i < self.names.len() {
+            let n = self.names.remove(i);
+            self.names.insert(0, n);
+            let v = self.values.remove(i);
+            self.values.insert(0, v);
+            let s = self.starts.remove(i);
+            self.starts.insert(0, s);
+        }
+    }
+
     /// An error located at row `row` (0-based) of column `col` (index into `names`).
     pub fn error_at(&self, row: usize, col: usize, message: impl Into<String>) -> DataError {
         let line = self.lines.get(row).copied().unwrap_or(self.header_line);

@@ -103,6 +103,74 @@ impl Interpolant {
     }
 }
 
+impl Interpolant {
+    /// The first and last sample times.
+    pub fn range(&self) -> (f64, f64) {
+        (self.t[0], self.t[self.t.len() - 1])
+    }
+
+    /// The highest derivative order that is not identically zero between samples: 1 for
+    /// linear interpolation (its derivative is piecewise constant), 3 for the cubics.
+    pub fn degree(&self) -> u8 {
+        if self.d.is_empty() {
+            1
+        } else {
+            3
+        }
+    }
+
+    /// The derivative of order `order` (0: the value) at `x`, `None` outside the samples'
+    /// time range. The interval is found by binary search (O(log n)); at a sample time the
+    /// piece to its right is used (the last piece at the last sample), which matters only for
+    /// the derivatives that jump there (linear's first, the cubics' third). Past the degree
+    /// the derivative is zero.
+    pub fn derivative(&self, order: u8, x: f64) -> Option<f64> {
+        let n = self.t.len();
+        if !(x >= self.t[0] && x <= self.t[n - 1]) {
+            return None;
+        }
+        let i = (self.t.partition_point(|&s| s <= x)).clamp(1, n - 1) - 1;
+        let h = self.t[i + 1] - self.t[i];
+        let s = (x - self.t[i]) / h;
+        let (y0, y1) = (self.y[i], self.y[i + 1]);
+        if self.d.is_empty() {
+            return Some(match order {
+                0 => y0 + s * (y1 - y0),
+                1 => (y1 - y0) / h,
+                _ => 0.0,
+            });
+        }
+        let (d0, d1) = (h * self.d[i], h * self.d[i + 1]);
+        // The Hermite basis and its derivatives in s; d/dx = (1/h) d/ds.
+        let (b00, b10, b01, b11, scale) = match order {
+            0 => (
+                (1.0 + 2.0 * s) * (1.0 - s) * (1.0 - s),
+                s * (1.0 - s) * (1.0 - s),
+                s * s * (3.0 - 2.0 * s),
+                s * s * (s - 1.0),
+                1.0,
+            ),
+            1 => (
+                6.0 * s * s - 6.0 * s,
+                3.0 * s * s - 4.0 * s + 1.0,
+                -6.0 * s * s + 6.0 * s,
+                3.0 * s * s - 2.0 * s,
+                h,
+            ),
+            2 => (
+                12.0 * s - 6.0,
+                6.0 * s - 4.0,
+                -12.0 * s + 6.0,
+                6.0 * s - 2.0,
+                h * h,
+            ),
+            3 => (12.0, 6.0, -12.0, 6.0, h * h * h),
+            _ => return Some(0.0),
+        };
+        Some((b00 * y0 + b10 * d0 + b01 * y1 + b11 * d1) / scale)
+    }
+}
+
 /// The slopes of the natural cubic spline: the second derivatives `M` solve the tridiagonal
 /// system of C² continuity with `M_0 = M_{n−1} = 0`; slopes follow from them.
 fn natural_slopes(h: &[f64], delta: &[f64], name: &str) -> Result<Vec<f64>, DataError> {

@@ -691,6 +691,7 @@ impl Pool {
                     return self.call(f, &[v, u]);
                 }
             }
+            Func::Table(_) => {}
             Func::Atan2 => {
                 // atan2(y, x) = atan(y/x) when x > 0.
                 if self.is_positive(args[1]) {

@@ -20,7 +20,9 @@ use crate::hoist::{HoistedInputs, HoistedProgram};
 use crate::lu::{DenseSolver, SingularMatrix};
 use crate::number::Number;
 use crate::pool::{Func, Id, Node, Pool};
+use crate::tabulated::{TableFn, Tabulated};
 use rustc_hash::FxHashMap;
+use std::sync::Arc;
 
 /// The operation of one [`Instr`]. Unary operations read `a` only; `Powi` reads `a` and takes
 /// its integer exponent from `b` (not a register); every other binary operation reads `a`, `b`.
@@ -52,6 +54,9 @@ pub enum Op {
     Sign,
     Min,
     Max,
+    /// A tabulated function at `reg[a]`: `b` is the index of the call in
+    /// [`Program::tables`] (not a register).
+    Table,
 }
 
 impl Op {
@@ -61,6 +66,12 @@ impl Op {
             self,
             Op::Add | Op::Sub | Op::Mul | Op::Div | Op::Powf | Op::Atan2 | Op::Min | Op::Max
         )
+    }
+
+    /// True when `b` holds a number that is not a register (`Powi`'s exponent, `Table`'s
+    /// call index): renumbering registers leaves it as it is.
+    pub fn b_is_immediate(self) -> bool {
+        matches!(self, Op::Powi | Op::Table)
     }
 }
 
@@ -128,6 +139,24 @@ pub struct Program {
     consts: Vec<f64>,
     instrs: Vec<Instr>,
     outputs: Vec<u32>,
+    tables: Arc<[TableCall]>,
+}
+
+/// One tabulated function (or derivative) a program calls ([`Op::Table`]).
+#[derive(Clone, Debug)]
+pub struct TableCall {
+    /// The function.
+    pub function: Arc<dyn Tabulated>,
+    /// Which derivative (0: the value).
+    pub order: u8,
+}
+
+impl TableCall {
+    /// The value at `x`: what the interpreter and native code both compute.
+    #[inline]
+    pub fn eval(&self, x: f64) -> f64 {
+        self.function.eval(self.order, x)
+    }
 }
 
 pub(crate) struct Compiler<'a> {
@@ -149,6 +178,8 @@ pub(crate) struct Compiler<'a> {
     sums: FxHashMap<u64, Vec<(Id, u32)>>,
     /// Memo of `Compiler::split_sum`.
     split_sums: FxHashMap<Id, Option<(Id, Id)>>,
+    /// The tabulated functions called, in order of first call (`Op::Table`'s `b`).
+    pub(crate) table_calls: Vec<(TableFn, TableCall)>,
 }
 
 /// A hash of a set of terms that is the sum of the terms' hashes (wrapping), so that the
@@ -194,6 +225,7 @@ impl<'a> Compiler<'a> {
             hoist,
             sums: FxHashMap::default(),
             split_sums: FxHashMap::default(),
+            table_calls: Vec::new(),
         };
         for (i, &x) in inputs.iter().enumerate() {
             c.reg.insert(x, i as u32);
@@ -325,6 +357,21 @@ impl<'a> Compiler<'a> {
                 }
             }
             Node::Pow(b, e) => self.power(b, e)?,
+            Node::Call(Func::Table(t), args) => {
+                let a = self.value(args[0])?;
+                let k = match self.table_calls.iter().position(|(u, _)| *u == t) {
+                    Some(k) => k,
+                    None => {
+                        let call = TableCall {
+                            function: self.pool.table(t.table).function.clone(),
+                            order: t.order,
+                        };
+                        self.table_calls.push((t, call));
+                        self.table_calls.len() - 1
+                    }
+                };
+                self.emit(Op::Table, a, k as u32)
+            }
             Node::Call(f, args) => {
                 let a = self.value(args[0])?;
                 let b = if args.len() > 1 {
@@ -349,6 +396,7 @@ impl<'a> Compiler<'a> {
                     Func::Sign => Op::Sign,
                     Func::Min => Op::Min,
                     Func::Max => Op::Max,
+                    Func::Table(_) => unreachable!("tabulated calls are compiled above"),
                 };
                 self.emit(op, a, b)
             }
@@ -562,7 +610,11 @@ impl Program {
             .map(|i| Instr {
                 op: i.op,
                 a: remap(i.a),
-                b: if i.op == Op::Powi { i.b } else { remap(i.b) },
+                b: if i.op.b_is_immediate() {
+                    i.b
+                } else {
+                    remap(i.b)
+                },
             })
             .collect();
         Ok(Program {
@@ -570,6 +622,7 @@ impl Program {
             consts: c.consts,
             instrs,
             outputs: outs.into_iter().map(remap).collect(),
+            tables: c.table_calls.into_iter().map(|(_, call)| call).collect(),
         })
     }
 
@@ -579,13 +632,20 @@ impl Program {
         consts: Vec<f64>,
         instrs: Vec<Instr>,
         outputs: Vec<u32>,
+        tables: Arc<[TableCall]>,
     ) -> Program {
         Program {
             n_inputs,
             consts,
             instrs,
             outputs,
+            tables,
         }
+    }
+
+    /// The tabulated functions the program calls: [`Op::Table`]'s `b` indexes them.
+    pub fn tables(&self) -> &Arc<[TableCall]> {
+        &self.tables
     }
 
     /// Number of instructions (the program's size).
@@ -692,6 +752,7 @@ impl Program {
                     }
                     Op::Min => a.min(reg_b()),
                     Op::Max => a.max(reg_b()),
+                    Op::Table => self.tables[ins.b as usize].eval(a),
                 };
                 *regs.add(start + k) = v;
             }

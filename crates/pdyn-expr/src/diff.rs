@@ -229,6 +229,9 @@ impl Pool {
                     return Pool::ZERO;
                 }
                 let outer = match f {
+                    // A measured column's derivative is its interpolant's (piecewise
+                    // constant for linear interpolation); zero past its degree.
+                    Func::Table(t) => self.tabulated(t.table, t.order + 1, u),
                     Func::Sin => self.call(Func::Cos, &[u]),
                     Func::Cos => {
                         let s = self.call(Func::Sin, &[u]);

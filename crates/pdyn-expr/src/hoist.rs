@@ -14,7 +14,7 @@
 //! notification, and the main program is an ordinary [`Program`] for the interpreter or the
 //! JIT alike.
 
-use crate::compile::{CompileError, Compiler, Instr, Op, Program, CONST_BASE, TEMP_BASE};
+use crate::compile::{CompileError, Compiler, Instr, Program, CONST_BASE, TEMP_BASE};
 use crate::pool::{Id, Pool};
 
 /// A program split into its parameter-only prelude and its main part; see the module
@@ -134,7 +134,7 @@ impl HoistedProgram {
             }
         };
         let remap_instr = |ins: &Instr, f: &dyn Fn(u32) -> u32| {
-            let b = if ins.op() == Op::Powi {
+            let b = if ins.op().b_is_immediate() {
                 ins.b()
             } else if ins.op().reads_b() {
                 f(ins.b())
@@ -153,17 +153,21 @@ impl HoistedProgram {
         };
         let pre_instrs = kept(true).map(|i| remap_instr(i, &pre_remap)).collect();
         let main_instrs = kept(false).map(|i| remap_instr(i, &main_remap)).collect();
+        let tables: std::sync::Arc<[crate::compile::TableCall]> =
+            c.table_calls.iter().map(|(_, call)| call.clone()).collect();
         let prelude = Program::from_parts(
             n_in as usize,
             c.consts.clone(),
             pre_instrs,
             hoisted.iter().map(|&r| pre_remap(r)).collect(),
+            tables.clone(),
         );
         let main = Program::from_parts(
             main_base as usize,
             c.consts,
             main_instrs,
             outs.iter().map(|&r| main_remap(r)).collect(),
+            tables,
         );
         Ok(HoistedProgram {
             prelude,

@@ -47,6 +47,7 @@ pub mod print;
 pub mod simplify;
 pub mod subs;
 pub mod syntax;
+pub mod tabulated;
 pub mod units;
 pub mod vector;
 
@@ -57,3 +58,4 @@ pub use error::ExprError;
 pub use lower::{Binding, FreeScope, Scope, Value};
 pub use number::{Number, Rational};
 pub use pool::{Constant, Func, Id, Node, Pool, SymId};
+pub use tabulated::{TableFn, Tabulated};

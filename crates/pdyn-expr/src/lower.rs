@@ -141,7 +141,7 @@ impl Scope for FreeScope {
     }
 }
 
-const VECTOR_FUNCS: [&str; 5] = ["dot", "cross", "norm", "unit", "sqrt"];
+pub(crate) const VECTOR_FUNCS: [&str; 5] = ["dot", "cross", "norm", "unit", "sqrt"];
 
 /// Converts a numeric literal exactly (`1.3806503e-23` is `13806503/10^30`); `None` when it
 /// is not a number or its exact value would exceed the size budget of exact numbers
@@ -608,6 +608,11 @@ impl Lowerer<'_> {
             }
             return Ok(Value::Scalar(self.pool.call(f, &xs)));
         }
+        if let Some(table) = self.pool.table_named(name) {
+            arity(1)?;
+            let x = self.scalar(&args[0], &format!("the argument of `{name}`"))?;
+            return Ok(Value::Scalar(self.pool.tabulated(table, 0, x)));
+        }
         // `x(t)`: a coordinate written as a function of time, MATLAB style.
         if let [Ast::Ident { name: tn, .. }] = args {
             if tn == "t" {
@@ -616,10 +621,12 @@ impl Lowerer<'_> {
                 }
             }
         }
+        let tables: Vec<String> = self.pool.tables().iter().map(|t| t.name.clone()).collect();
         let known = Func::ALL
             .iter()
             .map(|f| f.name())
-            .chain(VECTOR_FUNCS.iter().copied());
+            .chain(VECTOR_FUNCS.iter().copied())
+            .chain(tables.iter().map(String::as_str));
         let mut err = ExprError::new(name_span.clone(), format!("unknown function `{name}`"));
         err = match suggest(name, known) {
             Some(s) => err.with_help(format!("did you mean `{s}`?")),

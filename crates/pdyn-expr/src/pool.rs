@@ -64,6 +64,9 @@ pub enum Func {
     Sign,
     Min,
     Max,
+    /// A tabulated function (measured data) or one of its derivatives: see
+    /// [`crate::tabulated`]. Its name is the pool's ([`Pool::table_fn_name`]).
+    Table(crate::tabulated::TableFn),
 }
 
 impl Func {
@@ -105,6 +108,7 @@ impl Func {
             Func::Sign => "sign",
             Func::Min => "min",
             Func::Max => "max",
+            Func::Table(_) => "data",
         }
     }
     /// Number of arguments.
@@ -199,6 +203,8 @@ pub struct Pool {
     symbol_ids: FxHashMap<String, SymId>,
     pub(crate) memo: crate::memo::Memo,
     pub(crate) spare: crate::build::Spare,
+    /// Tabulated functions callable by name (`crate::tabulated`).
+    pub(crate) tables: Vec<crate::tabulated::TableEntry>,
 }
 
 impl Default for Pool {
@@ -217,6 +223,7 @@ impl Pool {
             symbol_ids: FxHashMap::default(),
             memo: Default::default(),
             spare: Default::default(),
+            tables: Vec::new(),
         };
         p.intern(Node::Num(Number::ZERO));
         p.intern(Node::Num(Number::ONE));

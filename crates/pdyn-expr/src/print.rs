@@ -253,6 +253,9 @@ impl TextPrinter<'_> {
             Node::Time => "t".into(),
             Node::Sym(s) => p.name(*s).to_string(),
             Node::Coord(s, k) => format!("{}{}", p.name(*s), "'".repeat(*k as usize)),
+            Node::Call(Func::Table(f), args) => {
+                format!("{}({})", p.table_fn_name(*f), self.expr(args[0]))
+            }
             Node::Call(f, args) => {
                 let a: Vec<String> = args.iter().map(|&x| self.expr(x)).collect();
                 format!("{}({})", f.name(), a.join(", "))
@@ -492,6 +495,13 @@ impl LatexPrinter<'_> {
                     Func::Atan2 | Func::Sign => {
                         format!("\\operatorname{{{}}}\\left({a}\\right)", f.name())
                     }
+                    Func::Table(t) => {
+                        let name = self.pool.table(t.table).name.replace('_', "\\_");
+                        format!(
+                            "\\operatorname{{{name}}}{}\\left({a}\\right)",
+                            "'".repeat(t.order as usize)
+                        )
+                    }
                 }
             }
         }
@@ -664,6 +674,11 @@ impl RustPrinter<'_> {
                     Func::Log => format!("{a}.ln()"),
                     Func::Sign => format!(
                         "{{ let s: f64 = {a}; if s > 0.0 {{ 1.0 }} else if s < 0.0 {{ -1.0 }} else {{ 0.0 }} }}"
+                    ),
+                    Func::Table(t) => format!(
+                        "{}_d{}({a})",
+                        self.pool.table(t.table).name,
+                        t.order
                     ),
                     _ => format!("{a}.{}()", f.name()),
                 }

@@ -10,7 +10,7 @@ use cranelift_codegen::Context;
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_jit::{JITBuilder, JITModule};
 use cranelift_module::{default_libcall_names, FuncId, Linkage, Module, ModuleReloc};
-use pdyn_expr::compile::Op;
+use pdyn_expr::compile::{Op, TableCall};
 use pdyn_expr::Program;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
@@ -93,6 +93,9 @@ pub struct JitProgram {
     len: usize,
     /// Values passed between chunks.
     n_spill: usize,
+    /// The tabulated functions the code calls by address (see `shims::table`): kept alive
+    /// with the code.
+    _tables: Arc<[TableCall]>,
 }
 
 impl std::fmt::Debug for JitProgram {
@@ -188,6 +191,7 @@ fn is_call(ins: &pdyn_expr::compile::Instr) -> bool {
     let op = ins.op();
     match op {
         Op::Powi => !(0..=MAX_INLINE_POWI).contains(&(ins.b() as i32)),
+        Op::Table => true,
         _ => unary_shim(op).is_some() || binary_shim(op).is_some(),
     }
 }
@@ -416,6 +420,11 @@ fn emit_chunk(
     sigi.params.push(AbiParam::new(types::I32));
     sigi.returns.push(AbiParam::new(types::F64));
     let sigi = b.import_signature(sigi);
+    let mut sigt = Signature::new(call_conv);
+    sigt.params.push(AbiParam::new(ptr));
+    sigt.params.push(AbiParam::new(types::F64));
+    sigt.returns.push(AbiParam::new(types::F64));
+    let sigt = b.import_signature(sigt);
 
     // Registers, per segment (see `SpillPlan`): inputs loaded and constants materialised on
     // first use in the segment, temporaries of earlier segments loaded from the spill array,
@@ -496,6 +505,25 @@ fn emit_chunk(
                         b.inst_results(call)[0]
                     }
                 }
+                Op::Table => {
+                    // The interpreter's own call (`TableCall::eval`) through a shim, on the
+                    // `TableCall` the program holds: the same bits. `JitProgram` keeps the
+                    // program's calls alive as long as the code.
+                    let Some(call) = prog.tables().get(ins.b() as usize) else {
+                        return Err(JitError::UnsupportedOp {
+                            op: "Table without its call".to_string(),
+                        });
+                    };
+                    let f = b.ins().iconst(
+                        ptr,
+                        shims::table as extern "C" fn(*const TableCall, f64) -> f64 as usize as i64,
+                    );
+                    let at = b
+                        .ins()
+                        .iconst(ptr, call as *const TableCall as usize as i64);
+                    let call = b.ins().call_indirect(sigt, f, &[at, a]);
+                    b.inst_results(call)[0]
+                }
                 op => {
                     if let Some(s) = unary_shim(op) {
                         let f = b.ins().iconst(ptr, s as usize as i64);
@@ -550,6 +578,13 @@ pub(crate) mod shims {
            tanh => libm::tanh, exp => libm::exp, ln => libm::log);
     pub extern "C" fn atan2(y: f64, x: f64) -> f64 {
         libm::atan2(y, x)
+    }
+    /// A tabulated function's value: `call` points into the `Program::tables` that the
+    /// `JitProgram` holds.
+    pub extern "C" fn table(call: *const pdyn_expr::compile::TableCall, x: f64) -> f64 {
+        // SAFETY: generated code passes the address of an element of the tables the
+        // `JitProgram` keeps alive (see `JitProgram::compile`).
+        unsafe { (*call).eval(x) }
     }
     pub extern "C" fn powf(x: f64, y: f64) -> f64 {
         libm::pow(x, y)
@@ -731,6 +766,7 @@ impl JitProgram {
             n_outputs: prog.n_outputs(),
             len: prog.len(),
             n_spill: plan.n_slots,
+            _tables: prog.tables().clone(),
         })
     }
 
@@ -920,6 +956,69 @@ mod tests {
             assert_eq!(o2[o2.len() - 5], input[7]);
             assert_eq!(o2[o2.len() - 4], 2.5);
         }
+    }
+
+    /// A tabulated function for tests: `x³ - order` in [-1, 1] (any bits will do), NaN
+    /// outside.
+    #[derive(Debug)]
+    struct Cubed;
+
+    impl pdyn_expr::Tabulated for Cubed {
+        fn eval(&self, order: u8, x: f64) -> f64 {
+            if (-1.0..=1.0).contains(&x) {
+                x * x * x - order as f64
+            } else {
+                f64::NAN
+            }
+        }
+        fn degree(&self) -> u8 {
+            3
+        }
+        fn as_any(&self) -> &dyn std::any::Any {
+            self
+        }
+    }
+
+    #[test]
+    fn tabulated_calls_agree_with_the_interpreter_across_spills() {
+        // The table's calls clobber registers like `sin`'s: values live across them (and
+        // across chunks, in a long program) must come back the same.
+        let mut p = Pool::new();
+        let table = p.add_table("g", Arc::new(Cubed)).unwrap();
+        let x = p.var("x");
+        let mut outs = Vec::new();
+        for k in 0..300 {
+            let arg = p
+                .parse_scalar(&format!("x*{}/301 + sin(x)/7", k + 1))
+                .unwrap();
+            let g = p.tabulated(table, (k % 3) as u8, arg);
+            let w = p.parse_scalar(&format!("x^2 + {k}")).unwrap();
+            outs.push(p.mul2(g, w));
+            let dg = p.dt(g);
+            outs.push(dg);
+        }
+        let prog = Program::compile(&mut p, &[x], &outs).unwrap();
+        let jit = JitProgram::compile(&prog).unwrap();
+        let (mut o1, mut o2) = (vec![0.0; outs.len()], vec![f64::NAN; outs.len()]);
+        for input in [-0.9, -0.3, 0.0, 0.41, 0.77, 2.0] {
+            prog.eval(&[input], &mut prog.workspace(), &mut o1);
+            jit.eval(&[input], &mut jit.workspace(), &mut o2);
+            for (k, (a, b)) in o1.iter().zip(&o2).enumerate() {
+                assert!(
+                    same(*a, *b),
+                    "output {k} at {input}: interpreter {a:e}, jit {b:e}"
+                );
+            }
+        }
+        // The value really is the table's: g(x) x^2 at x = 0.5 for k = 300 - 1 (order 2).
+        prog.eval(&[0.5], &mut prog.workspace(), &mut o1);
+        let arg = 0.5 * 300.0 / 301.0 + libm::sin(0.5) / 7.0;
+        let want = (arg * arg * arg - 2.0) * (0.25 + 299.0);
+        assert!(
+            (o1[2 * 299] - want).abs() < 1e-12 * want.abs(),
+            "{} vs {want}",
+            o1[598]
+        );
     }
 
     #[test]

@@ -28,6 +28,7 @@ pub mod linearization;
 pub mod matrix_form;
 pub mod model;
 pub mod modes;
+pub mod numeric_roots;
 pub mod options;
 pub mod parameters;
 pub mod prescribed;

@@ -32,6 +32,7 @@ mod errors;
 mod fit;
 mod interrupt;
 mod model;
+mod optimize;
 mod particles;
 mod run;
 mod solve_ivp;
@@ -73,6 +74,7 @@ fn _pdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(particles::load_model, m)?)?;
     m.add_function(wrap_pyfunction!(solve_ivp::_solve_ivp, m)?)?;
     m.add_function(wrap_pyfunction!(methods, m)?)?;
+    m.add_function(wrap_pyfunction!(optimize::_optimize, m)?)?;
     m.add_function(wrap_pyfunction!(symbolic::_kin, m)?)?;
     m.add_function(wrap_pyfunction!(symbolic::_dsolve, m)?)?;
     m.add_function(wrap_pyfunction!(data::_read_csv, m)?)?;

@@ -693,3 +693,24 @@ pub fn fuse_summary_text(f: &Fused, names: &[String]) -> String {
     }
     out
 }
+
+/// Forgets which data columns a previous run asked for outside their range (before a run).
+pub fn reset_data_range(model: &pdyn_mech::Model) {
+    for column in pdyn_mech::model::data::columns(&model.pool) {
+        column.reset();
+    }
+}
+
+/// A failed run that asked a `[data.NAME]` column outside its time range, as the error to
+/// report instead of the integrator's (which only saw NaN): the column, its file, the time
+/// and the data's range.
+pub fn left_data_range(model: &pdyn_mech::Model) -> Option<Error> {
+    let (column, t) = pdyn_mech::model::data::left_range(&model.pool)?;
+    let message = pdyn_mech::model::data::left_range_message(column, t);
+    Some(Error::Data {
+        error: Box::new(DataError::new(&column.file, message).help(
+            "end the run within the data (--t-end, [simulate] t_end) or extend the record: \
+             data say nothing outside their samples",
+        )),
+    })
+}

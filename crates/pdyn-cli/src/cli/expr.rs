@@ -65,6 +65,20 @@ pub struct SolveArgs {
     /// Unknowns to solve for, comma separated.
     #[arg(long = "for", value_delimiter = ',', required = true)]
     unknowns: Vec<String>,
+    /// Every root of one equation in an interval, numerically: `--in x=0..10` (bounds may
+    /// be expressions: `E=0..2*pi`). Each root is certified by a sign change (or, for a
+    /// double root, a residual bound).
+    #[arg(long = "in", value_name = "NAME=LO..HI")]
+    interval: Option<String>,
+    /// Sampling steps of the `--in` interval: roots closer than a step may be missed in pairs.
+    #[arg(long, default_value_t = pdyn_mech::numeric_roots::DEFAULT_SAMPLES)]
+    samples: usize,
+    /// A start for Newton's method on a system, `--start x=1,y=2` (repeat for several).
+    #[arg(long = "start", value_name = "NAME=VALUE,...")]
+    starts: Vec<String>,
+    /// Values of the other names of the equations, `--at e=0.3,M=1` (numeric roots only).
+    #[arg(long, value_delimiter = ',')]
+    at: Vec<String>,
     #[command(flatten)]
     common: Common,
 }
@@ -244,6 +258,23 @@ pub fn solve(a: SolveArgs) -> Result<String, Error> {
             }
         }
     }
+    if a.interval.is_some() || !a.starts.is_empty() {
+        let request = super::roots::Request {
+            unknown_names: &a.unknowns,
+            interval: a.interval.as_deref(),
+            samples: a.samples,
+            starts: &a.starts,
+            at: &a.at,
+            json: a.common.json,
+        };
+        return super::roots::solve_numerically(&mut pool, &eqs, &unknowns, &request);
+    }
+    if !a.at.is_empty() {
+        return Err(Error::argument(
+            "--at",
+            "--at gives values for numeric roots: add --in NAME=LO..HI or --start",
+        ));
+    }
     let solutions = match pool.linear_system(&eqs, &unknowns) {
         // Linear: exact elimination, printed as it always was.
         Ok(sys) => vec![pool
@@ -262,7 +293,13 @@ pub fn solve(a: SolveArgs) -> Result<String, Error> {
         // Not linear: substitution, the quadratic formula, real roots of polynomials.
         Err(pdyn_expr::linsolve::LinearError::NotLinear { .. }) => {
             pdyn_mech::algebra::solve(&mut pool, &eqs, &unknowns).map_err(|error| {
-                Error::argument("", format!("{error}"))
+                let hint = if matches!(error, pdyn_mech::algebra::AlgebraError::NoClosedForm { .. }) {
+                    "\n  help: for numeric roots give an interval (one equation: --in x=0..10) or \
+                     starts for Newton's method (--start x=1,y=2)"
+                } else {
+                    ""
+                };
+                Error::argument("", format!("{error}{hint}"))
             })?
         }
         Err(e) => return Err(Error::argument("", e.to_string())),

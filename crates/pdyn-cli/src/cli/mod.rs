@@ -15,6 +15,8 @@ pub mod fuse;
 pub mod interrupt;
 pub mod kin;
 pub mod modes;
+pub mod optimize;
+pub mod roots;
 pub mod run;
 pub mod sweep;
 

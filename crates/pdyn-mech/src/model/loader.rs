@@ -220,6 +220,16 @@ impl<'a> Loader<'a> {
                 .err(span, format!("`{name}` is an index (declared under [indices]): it cannot also be a {what}"))
                 .help("rename the index or this entry"));
         }
+        if self.pool.table_named(name).is_some() {
+            return Err(self
+                .err(
+                    span,
+                    format!("duplicate name `{name}`: already a column of a [data] table"),
+                )
+                .help(
+                    "a [data.NAME] table's column `c` is the function `NAME_c`: rename one of them",
+                ));
+        }
         let reserved = (RESERVED.contains(&name) && what != "reaction")
             || pdyn_expr::Func::from_name(name).is_some()
             || ["sqrt", "dot", "cross", "norm", "unit"].contains(&name);

@@ -9,6 +9,7 @@
 
 pub mod constants;
 mod contacts;
+pub mod data;
 pub mod families;
 mod forces;
 pub mod index_expr;
@@ -315,6 +316,7 @@ pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
 }
 
 fn read(ld: &mut Loader, raw: &RawModel) -> Result<Model, ModelError> {
+    ld.read_data(raw)?;
     ld.read_parameters(raw)?;
     let unknowns = ld.read_unknowns(raw)?;
     ld.unknown_ids = unknowns.iter().map(|u| (u.name.clone(), u.id)).collect();

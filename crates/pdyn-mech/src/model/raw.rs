@@ -50,6 +50,23 @@ pub struct RawModel {
     pub unknowns: IndexMap<Name, Spanned<RawUnknown>>,
     #[serde(default)]
     pub checks: Vec<Spanned<RawCheck>>,
+    /// `[data.NAME]`: measured time series ([`super::data`]).
+    #[serde(default)]
+    pub data: IndexMap<Name, Spanned<RawData>>,
+}
+
+/// `[data.NAME]`: a CSV time series whose columns become functions of time.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawData {
+    /// The CSV file, relative to the model file.
+    pub file: Option<Spanned<String>>,
+    /// The time column's name (default `t`).
+    pub time: Option<Name>,
+    /// The value columns used (default: every other column).
+    pub columns: Option<Spanned<Vec<Name>>>,
+    /// `linear` (default), `cubic` or `pchip`.
+    pub interpolation: Option<Name>,
 }
 
 /// `[unknowns]`: a quantity to solve for in `pdyn forces` (thrust, bank angle...).

@@ -624,3 +624,6 @@ def methods() -> Dict[str, str]:
     """pdyn's integration methods: name -> description (order, adaptivity, paper)."""
     return dict(_pdyn.methods())
 
+
+from ._optimize import OptimizeResult, optimize as _model_optimize  # noqa: E402 (issue 26)
+Model.optimize = _model_optimize  # type: ignore[attr-defined]

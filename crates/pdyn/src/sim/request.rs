@@ -144,6 +144,7 @@ pub fn execute(
     prep: &Prepared,
     set: &RunSettings,
 ) -> Result<(RunResult, Option<Error>), Error> {
+    crate::data::reset_data_range(model);
     let res = if set.method == "exact" {
         if prep.initial_overridden {
             return Err(Error::argument(
@@ -166,14 +167,17 @@ pub fn execute(
     } else {
         super::run(prep, set).map_err(|e| located(model, "", e))?
     };
+    let left_data = || crate::data::left_data_range(model);
     let failure = res
         .failure
         .clone()
-        .map(|failure| Error::Integration {
-            origin: model.origin.clone(),
-            failure: Box::new(failure),
+        .map(|failure| {
+            left_data().unwrap_or(Error::Integration {
+                origin: model.origin.clone(),
+                failure: Box::new(failure),
+            })
         })
-        .or_else(|| non_finite(&model.origin, &res).map(|(_, e)| e));
+        .or_else(|| non_finite(&model.origin, &res).map(|(_, e)| left_data().unwrap_or(e)));
     Ok((res, failure))
 }
 
