@@ -20,7 +20,7 @@ const bin = process.env.PDYN_BIN ?? path.join(root, "target", "debug", "pdyn");
 // which call glibc natively and a libm port in WebAssembly). Chaotic and stochastic runs too:
 // the same seeds, the same arithmetic in the same order.
 // Files the browser cannot read (the model names another file on disk).
-const NEEDS_FILES = new Set(["examples/nbody/outer_solar_system_csv.toml"]);
+const NEEDS_FILES = new Set(["examples/nbody/outer_solar_system_csv.toml", "examples/data/earthquake.toml"]);
 
 const examples = (function list(dir) {
   return fs
@@ -66,6 +66,16 @@ for (const ex of examples) {
     const runs = kind !== "mechanics" || /^\[simulate\]/m.test(source);
     const { page, errors } = await open(chromium.browser, server.url, `#example=${ex}`);
     assert.equal(await page.evaluate(() => document.getElementById("example").value), ex);
+    if (NEEDS_FILES.has(ex)) {
+      const r = await command(page, "run");
+      assert.equal(r, null);
+      const box = page.locator("#error");
+      assert.match(await box.textContent(), /cannot read the (bodies|data) file .* not supported on this platform/);
+      assert.ok(Number(await box.getAttribute("data-line")) > 0, "the error is located");
+      assert.equal(await page.locator(".cm-error-line").count(), 1);
+      await page.close();
+      return;
+    }
     if (kind === "mechanics") {
       // Derive: the equations typeset, and the same derivation as `pdyn derive --json`.
       const d = await command(page, "derive");
@@ -73,16 +83,6 @@ for (const ex of examples) {
       assert.ok((await page.locator("#view-equations .katex").count()) > 0, `${ex}: no equation typeset`);
       const want = cli(["derive", ex, "--json"]);
       assert.deepEqual(d.value.derivation.equations, want.equations, `${ex}: equations differ from the CLI's`);
-    }
-    if (NEEDS_FILES.has(ex)) {
-      const r = await command(page, "run");
-      assert.equal(r, null);
-      const box = page.locator("#error");
-      assert.match(await box.textContent(), /cannot read the bodies file .* not supported on this platform/);
-      assert.ok(Number(await box.getAttribute("data-line")) > 0, "the error is located");
-      assert.equal(await page.locator(".cm-error-line").count(), 1);
-      await page.close();
-      return;
     }
     if (runs) {
       const r = await command(page, "run");
