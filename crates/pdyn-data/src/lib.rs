@@ -30,6 +30,7 @@ pub mod integrate;
 pub mod interp;
 pub mod kinematics;
 mod linalg;
+pub mod minimize;
 pub mod spline;
 
 pub use error::DataError;

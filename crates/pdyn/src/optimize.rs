@@ -115,7 +115,13 @@ pub fn optimize(
     };
     if goal.over.len() == 1 {
         let (_, lo, hi) = goal.over[0];
-        let (x, _) = brent_min(|x| obj.cost(&[x]), lo, hi, 1e-10);
+        let (x, _) = pdyn_data::minimize::brent_min(
+            &mut |x| obj.cost(&[x]),
+            lo,
+            hi,
+            1e-10,
+            1e-12 * (hi - lo),
+        );
         let width = hi - lo;
         let at_bound = (x - lo).abs() <= 1e-12 * width.max(1.0) * 1e3
             || (hi - x).abs() <= 1e-12 * width.max(1.0) * 1e3;
@@ -159,88 +165,6 @@ pub fn optimize(
         slope_bracket: None,
         at_bound,
     })
-}
-
-/// Brent's minimisation on `[a, b]` (golden section and parabolic interpolation) to the
-/// tolerance `rel·|x| + 1e-12·(b − a)`: the point and the value.
-pub fn brent_min(mut f: impl FnMut(f64) -> f64, a: f64, b: f64, rel: f64) -> (f64, f64) {
-    const GOLD: f64 = 0.381_966_011_250_105_1; // (3 − √5)/2
-    let (mut a, mut b) = (a, b);
-    let mut x = a + GOLD * (b - a);
-    let (mut w, mut v) = (x, x);
-    let mut fx = f(x);
-    let (mut fw, mut fv) = (fx, fx);
-    let (mut d, mut e) = (0.0f64, 0.0f64);
-    let abs_tol = 1e-12 * (b - a);
-    for _ in 0..500 {
-        let m = 0.5 * (a + b);
-        let tol = rel * x.abs() + abs_tol;
-        let t2 = 2.0 * tol;
-        if (x - m).abs() <= t2 - 0.5 * (b - a) {
-            break;
-        }
-        let mut golden = true;
-        if e.abs() > tol {
-            // A parabola through x, w, v.
-            let r = (x - w) * (fx - fv);
-            let mut q = (x - v) * (fx - fw);
-            let mut p = (x - v) * q - (x - w) * r;
-            q = 2.0 * (q - r);
-            if q > 0.0 {
-                p = -p;
-            } else {
-                q = -q;
-            }
-            if p.abs() < (0.5 * q * e).abs() && p > q * (a - x) && p < q * (b - x) {
-                e = d;
-                d = p / q;
-                let u = x + d;
-                if u - a < t2 || b - u < t2 {
-                    d = if x < m { tol } else { -tol };
-                }
-                golden = false;
-            }
-        }
-        if golden {
-            e = if x < m { b - x } else { a - x };
-            d = GOLD * e;
-        }
-        let u = if d.abs() >= tol {
-            x + d
-        } else {
-            x + tol.copysign(d)
-        };
-        let fu = f(u);
-        if fu <= fx {
-            if u < x {
-                b = x;
-            } else {
-                a = x;
-            }
-            v = w;
-            fv = fw;
-            w = x;
-            fw = fx;
-            x = u;
-            fx = fu;
-        } else {
-            if u < x {
-                a = u;
-            } else {
-                b = u;
-            }
-            if fu <= fw || w == x {
-                v = w;
-                fv = fw;
-                w = u;
-                fw = fu;
-            } else if fu <= fv || v == x || v == w {
-                v = u;
-                fv = fu;
-            }
-        }
-    }
-    (x, fx)
 }
 
 /// Nelder–Mead (reflection 1, expansion 2, contraction ½, shrink ½) on the box of
