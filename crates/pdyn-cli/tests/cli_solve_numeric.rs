@@ -124,3 +124,24 @@ fn bad_intervals_are_located_errors() {
     assert_eq!(code, 2);
     assert!(stderr.contains("--in x=0..10"), "{stderr}");
 }
+
+/// `sqrt(x - 20) = 1` is defined only from x = 20: on [0, 10] there is no root because f has
+/// no value there, which is said, not left as a bare "0 roots"; on [0, 30] the root 21 is
+/// found and the undefined part counted (x < 20: 1,334 of the 2,001 samples, the step 0.015).
+#[test]
+fn samples_outside_the_functions_domain_are_counted_and_reported() {
+    let v = json(&["solve", "--for", "x", "--in", "x=0..10", "sqrt(x-20)=1"]);
+    assert_eq!(v["roots"].as_array().unwrap().len(), 0);
+    assert_eq!(v["undefined_samples"], 2001);
+    let (code, out, _) = pdyn(&["solve", "--for", "x", "--in", "x=0..10", "sqrt(x-20)=1"]);
+    assert_eq!(code, 0);
+    assert!(
+        out.contains("not a number at 2001 of the 2001 sample points"),
+        "{out}"
+    );
+    let v = json(&["solve", "--for", "x", "--in", "x=0..30", "sqrt(x-20)=1"]);
+    let roots = v["roots"].as_array().unwrap();
+    assert_eq!(roots.len(), 1);
+    assert!((roots[0]["x"].as_f64().unwrap() - 21.0).abs() < 1e-12);
+    assert_eq!(v["undefined_samples"], 1334);
+}

@@ -118,6 +118,11 @@ pub struct ScalarRoots {
     pub discontinuities: Vec<(f64, f64)>,
     /// The sampling step: roots closer than it may be missed in pairs.
     pub step: f64,
+    /// Sample points where `f` is not a number (outside its domain, `sqrt` of a negative):
+    /// no root can be found there, and saying "no root" alone would be silent about it.
+    pub undefined: usize,
+    /// Sample points, `samples + 1`.
+    pub sampled: usize,
 }
 
 /// One equation's compiled `f`, `f'`, `f''`.
@@ -362,6 +367,8 @@ pub fn scalar_roots(
         roots,
         discontinuities,
         step,
+        undefined: vals.iter().filter(|v| !v[0].is_finite()).count(),
+        sampled: vals.len(),
     })
 }
 

@@ -222,16 +222,26 @@ fn render_scalar(
             json!({
                 "interval": {name: [lo, hi]},
                 "sampling_step": found.step,
+                "undefined_samples": found.undefined,
                 "roots": roots,
                 "discontinuities": disc,
             })
         );
     }
+    let (mut lo_text, mut hi_text) = (String::new(), String::new());
+    pdyn::output::push_number(&mut lo_text, lo);
+    pdyn::output::push_number(&mut hi_text, hi);
     let mut out = format!(
-        "{} root(s) in {name} = {lo}..{hi} (sampling step {:.3e}: roots closer than it may be missed in pairs)\n",
+        "{} root(s) in {name} = {lo_text}..{hi_text} (sampling step {:.3e}: roots closer than it may be missed in pairs)\n",
         found.roots.len(),
         found.step
     );
+    if found.undefined > 0 {
+        out += &format!(
+            "warning: f is not a number at {} of the {} sample points (outside its domain): no root can be found there\n",
+            found.undefined, found.sampled
+        );
+    }
     for root in &found.roots {
         out += &format!(
             "{name} = {:.17e}   f = {:.1e}, f' = {:.3e}; {}\n",
