@@ -379,16 +379,14 @@ fn run_nbody(
             checkpoints.as_mut(),
             restart.as_ref().map(|r| &r.state),
         )
-        .map_err(|e| match e {
-            // Files are only written once the run is going: an I/O error here is a write
-            // that failed mid-run (a full disk), not bad input.
-            Error::Io { .. } if req.out.is_some() => Error::WriteDuringRun {
-                error: Box::new(e),
-                checkpoint: checkpoints
+        .map_err(|e| {
+            stopped_writing(
+                e,
+                req,
+                checkpoints
                     .as_ref()
                     .map(|cp| (cp.path().to_path_buf(), cp.last_time)),
-            },
-            e => e,
+            )
         })?;
     let (mut summary, failure) = nbody::output::outcome(&spec, &info, &result);
     if let Some(cp) = &checkpoints {
@@ -418,6 +416,23 @@ fn run_nbody(
         summary,
         failure,
     })
+}
+
+/// An I/O error from an engine that streams its files into `--out`: a write that failed
+/// mid-run (a full disk), not bad input ([`Error::WriteDuringRun`], with the checkpoint to
+/// continue from, if the run writes them).
+fn stopped_writing(
+    e: Error,
+    req: &Request,
+    checkpoint: Option<(std::path::PathBuf, Option<f64>)>,
+) -> Error {
+    match e {
+        Error::Io { .. } if req.out.is_some() => Error::WriteDuringRun {
+            error: Box::new(e),
+            checkpoint,
+        },
+        e => e,
+    }
 }
 
 fn run_md(
@@ -462,7 +477,8 @@ fn run_md(
                 z: &p.z,
             })
         }
-    })?;
+    })
+    .map_err(|e| stopped_writing(e, req, None))?;
     let (summary, failure) = md::output::outcome(&prepared, &result, drift_tolerance, &file.origin);
     if let Some(dir) = &req.out {
         md::output::write_all(&result, &summary, dir)?;
