@@ -388,3 +388,32 @@ fn a_full_disk_stops_the_run_with_whole_files_and_the_last_checkpoint_intact() {
     let _ = std::fs::remove_dir_all(&reference);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The same for MD, which streams `thermo.csv` and `traj.xyz` and writes no checkpoint: a
+/// file-size limit smaller than one frame stops the run with exit 1, the frame cut back.
+#[cfg(unix)]
+#[test]
+fn a_full_disk_stops_an_md_run_with_exit_1_and_whole_files() {
+    let model = example("examples/md/argon_melting.toml");
+    let dir = fresh_dir("fsize-md");
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg("ulimit -f 20 && exec \"$0\" \"$@\"")
+        .arg(bin())
+        .args(run_args(&model, &[], &dir))
+        .output()
+        .expect("run pdyn under a file-size limit");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{:?}\n{err}", out.status);
+    assert!(
+        err.contains("traj.xyz") && err.contains("last whole row"),
+        "{err}"
+    );
+    assert!(err.contains("the run writes no checkpoint"), "{err}");
+    let traj = std::fs::read_to_string(dir.join("traj.xyz")).unwrap_or_default();
+    assert!(
+        traj.is_empty() || traj.ends_with('\n'),
+        "traj.xyz ends inside a line"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
