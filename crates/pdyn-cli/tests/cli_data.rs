@@ -376,3 +376,54 @@ fn earthquake_record_drives_the_building() {
     let json: serde_json::Value = serde_json::from_str(&stdout).unwrap();
     assert_eq!(json["error"]["kind"], "data", "{stdout}");
 }
+
+/// `kin --data` reads a Parquet file written by pandas (told by its bytes, whatever its name)
+/// and gives the table its CSV twin gives, to the bit; a NaN in it is located by row.
+#[test]
+fn kin_data_reads_parquet_as_its_csv_twin() {
+    let fixtures = root().join("crates/pdyn-data/tests/fixtures");
+    let parquet = fixtures.join("track_snappy.parquet");
+    let twin = temp("twin.csv");
+    let mut csv = String::from("t,x,y\n");
+    for i in 0..100 {
+        let f = i as f64;
+        // -i/4 as pandas computed it: an integer negated (0, not -0.0), then divided.
+        let y = -(i as i64) as f64 / 4.0;
+        csv.push_str(&format!("{:e},{:e},{y:e}\n", f / 64.0, f * f / 8.0));
+    }
+    std::fs::write(&twin, csv).unwrap();
+    let run = |input: &PathBuf, name: &str| {
+        let out = temp(name);
+        let (code, _, stderr) = pdyn(&[
+            "kin",
+            "--data",
+            input.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{stderr}");
+        std::fs::read_to_string(out).unwrap()
+    };
+    let from_parquet = run(&parquet, "from_parquet.csv");
+    assert_eq!(from_parquet.lines().count(), 101);
+    let from_csv = run(&twin, "from_csv.csv");
+    if let Some((k, (a, b))) = from_parquet
+        .lines()
+        .zip(from_csv.lines())
+        .enumerate()
+        .find(|(_, (a, b))| a != b)
+    {
+        panic!("line {} differs:\n{a}\n{b}", k + 1);
+    }
+
+    let (code, stdout, _) = pdyn(&[
+        "kin",
+        "--data",
+        fixtures.join("nan_row12.parquet").to_str().unwrap(),
+        "--columns",
+        "t,x,x",
+        "--json",
+    ]);
+    assert_eq!(code, 2);
+    assert!(stdout.contains("row 12: the value is NaN"), "{stdout}");
+}

@@ -25,8 +25,11 @@ pub struct Columns {
     pub lines: Vec<usize>,
     /// For each column, the 1-based character column where its field starts, per row.
     starts: Vec<Vec<u32>>,
-    /// The 1-based line of the header.
+    /// The 1-based line of the header (0 for a file without lines: Parquet).
     pub header_line: usize,
+    /// The rows are records of a binary file (Parquet): problems are located by row, and
+    /// `lines` holds the 1-based row numbers.
+    records: bool,
 }
 
 impl Columns {
@@ -52,8 +55,41 @@ impl Columns {
         }
     }
 
+    /// Columns of records (a Parquet file's rows): located by row number, not by line.
+    pub fn of_records(file: &str, names: Vec<String>, values: Vec<Vec<f64>>) -> Columns {
+        let rows = values.first().map_or(0, Vec::len);
+        Columns {
+            file: file.to_string(),
+            names,
+            values,
+            lines: (1..=rows).collect(),
+            starts: Vec::new(),
+            header_line: 0,
+            records: true,
+        }
+    }
+
+    /// `e` located at the header line (nothing for records, which have no lines).
+    pub fn at_header(&self, e: DataError) -> DataError {
+        if self.records {
+            e
+        } else {
+            e.at(self.header_line, None)
+        }
+    }
+
     /// An error located at row `row` (0-based) of column `col` (index into `names`).
     pub fn error_at(&self, row: usize, col: usize, message: impl Into<String>) -> DataError {
+        if self.records {
+            let mut e = DataError::new(&self.file, format!("row {}: {}", row + 1, message.into()));
+            if let Some(name) = self.names.get(col) {
+                e = e.column_name(name);
+            }
+            if let Some(v) = self.values.get(col).and_then(|v| v.get(row)) {
+                e = e.text(&v.to_string());
+            }
+            return e;
+        }
         let line = self.lines.get(row).copied().unwrap_or(self.header_line);
         let column = self
             .starts
@@ -134,6 +170,24 @@ fn number(text: &str) -> Result<f64, (String, String)> {
             "write a decimal number such as 1.5, -2e-3 or 42 (a decimal point, not a comma)".into(),
         )),
     }
+}
+
+/// The header's line (1-based) and names: the first line that is not blank or a comment. A
+/// text with no such line gives line 1 and no names.
+pub fn header(text: &str) -> (usize, Vec<String>) {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    for (i, line) in text.split('\n').enumerate() {
+        let l = line.strip_suffix('\r').unwrap_or(line).trim();
+        if l.is_empty() || l.starts_with('#') {
+            continue;
+        }
+        let names = fields(l, delimiter(l))
+            .into_iter()
+            .map(|(_, n)| n.to_string())
+            .collect();
+        return (i + 1, names);
+    }
+    (1, Vec::new())
 }
 
 /// Reads the columns `wanted` (by header name) from CSV `text` of the file named `file`. When
@@ -288,6 +342,7 @@ pub fn read_columns(file: &str, text: &str, wanted: &[&str]) -> Result<Columns, 
         lines: row_lines,
         starts,
         header_line,
+        records: false,
     })
 }
 
@@ -320,14 +375,13 @@ impl Series {
         }
         check_times(&columns.values[0], |row, msg| columns.error_at(row, 0, msg))?;
         if columns.len() < min_len {
-            return Err(DataError::new(
+            return Err(columns.at_header(DataError::new(
                 &columns.file,
                 format!(
                     "{} data row(s), but {what} needs at least {min_len}",
                     columns.len()
                 ),
-            )
-            .at(columns.header_line, None));
+            )));
         }
         let mut values = columns.values;
         let t = values.remove(0);

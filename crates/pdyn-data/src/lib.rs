@@ -2,6 +2,8 @@
 //!
 //! - [`csv`]: a time series read from CSV text, every problem located (file, line, column, the
 //!   offending text, and what would be valid): [`csv::Table`], [`csv::Series`].
+//! - [`parquet`]: the same columns from a Parquet file (pandas, polars, Arrow), and
+//!   [`source`]: a data file told CSV or Parquet by its bytes, read by either.
 //! - [`interp`]: interpolation of samples: linear, natural cubic spline, PCHIP.
 //! - [`spline`]: the cubic smoothing spline (Reinsch's algorithm, banded O(n)), its smoothing
 //!   parameter chosen by generalized cross-validation.
@@ -31,6 +33,12 @@ pub mod interp;
 pub mod kinematics;
 mod linalg;
 pub mod minimize;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod parquet;
+#[cfg(target_arch = "wasm32")]
+#[path = "parquet_unavailable.rs"]
+pub mod parquet;
+pub mod source;
 pub mod spline;
 
 pub use error::DataError;

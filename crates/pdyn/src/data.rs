@@ -6,10 +6,11 @@
 
 use crate::error::Error;
 pub use pdyn_data as lib;
-use pdyn_data::csv::{read_columns, Series};
+use pdyn_data::csv::Series;
 use pdyn_data::fusion::{Fused, Noise};
 use pdyn_data::integrate::{AccelOptions, Integrated};
 use pdyn_data::kinematics::KinData;
+use pdyn_data::source::Source;
 use pdyn_data::spline::Smoothing;
 use pdyn_data::DataError;
 use serde_json::json;
@@ -101,52 +102,15 @@ pub fn data_error(error: DataError) -> Error {
     }
 }
 
-/// Reads a CSV file's text (not UTF-8: a located data error at the first bad byte).
-fn read_text(path: &Path) -> Result<String, Error> {
+/// Reads a data file: CSV text (not UTF-8: a located data error at the first bad byte) or
+/// Parquet, told apart by its bytes.
+pub fn read_source(path: &Path) -> Result<Source, Error> {
     let bytes = std::fs::read(path).map_err(|e| Error::Io {
         path: path.to_path_buf(),
         action: "read the data file",
         error: std::sync::Arc::new(e),
     })?;
-    String::from_utf8(bytes).map_err(|e| {
-        let at = e.utf8_error().valid_up_to();
-        let before = &e.as_bytes()[..at];
-        let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
-        let col_start = before
-            .iter()
-            .rposition(|&b| b == b'\n')
-            .map_or(0, |p| p + 1);
-        let column = String::from_utf8_lossy(&before[col_start..])
-            .chars()
-            .count()
-            + 1;
-        data_error(
-            DataError::new(
-                &path.display().to_string(),
-                format!("the byte 0x{:02X} is not UTF-8", e.as_bytes()[at]),
-            )
-            .at(line, Some(column))
-            .help("save the file as UTF-8 (or ASCII) text"),
-        )
-    })
-}
-
-/// The header's names (the first line that is not blank or a comment), for defaults.
-fn header_names(text: &str) -> Vec<String> {
-    text.trim_start_matches('\u{feff}')
-        .lines()
-        .map(str::trim)
-        .find(|l| !l.is_empty() && !l.starts_with('#'))
-        .map(|l| {
-            let d = [',', ';', '\t']
-                .into_iter()
-                .find(|&d| l.contains(d))
-                .unwrap_or(',');
-            l.split(d)
-                .map(|s| s.trim().trim_matches('"').to_string())
-                .collect()
-        })
-        .unwrap_or_default()
+    Source::from_bytes(&path.display().to_string(), bytes).map_err(data_error)
 }
 
 /// What the columns of a file hold.
@@ -163,14 +127,14 @@ pub enum DataKind {
 /// `ay`, `a_z`...).
 fn choose_columns(
     file: &str,
-    text: &str,
+    source: &Source,
     given: &[String],
     kind: DataKind,
 ) -> Result<Vec<String>, Error> {
     if !given.is_empty() {
         return Ok(given.to_vec());
     }
-    let header = header_names(text);
+    let (header_line, header) = source.header(file).map_err(data_error)?;
     let has = |n: &str| header.iter().any(|h| h == n);
     let listed = || {
         header
@@ -180,10 +144,16 @@ fn choose_columns(
             .join(", ")
     };
     let missing = |what: &str, defaults: &str| {
+        let e = DataError::new(
+            file,
+            format!("no {what} (the default columns are {defaults})"),
+        );
+        let e = match header_line {
+            Some(line) => e.at(line, None),
+            None => e,
+        };
         data_error(
-            DataError::new(file, format!("no {what} (the default columns are {defaults})"))
-                .at(1, None)
-                .help(format!(
+            e.help(format!(
                     "name the columns to use with --columns (Python: columns=), the time first; the header has {}",
                     listed()
                 )),
@@ -222,8 +192,8 @@ fn choose_columns(
     Ok(cols)
 }
 
-/// Reads the series of `columns` (time first) from the CSV file `path`, at least `min_len`
-/// rows.
+/// Reads the series of `columns` (time first) from the data file `path` (CSV or Parquet), at
+/// least `min_len` rows.
 pub fn read_series(
     path: &Path,
     columns: &[String],
@@ -232,10 +202,10 @@ pub fn read_series(
     what: &str,
 ) -> Result<Series, Error> {
     let file = path.display().to_string();
-    let text = read_text(path)?;
-    let cols = choose_columns(&file, &text, columns, kind)?;
+    let source = read_source(path)?;
+    let cols = choose_columns(&file, &source, columns, kind)?;
     let wanted: Vec<&str> = cols.iter().map(String::as_str).collect();
-    let table = read_columns(&file, &text, &wanted).map_err(data_error)?;
+    let table = source.read_columns(&file, &wanted).map_err(data_error)?;
     Series::from_columns(table, min_len, what).map_err(data_error)
 }
 

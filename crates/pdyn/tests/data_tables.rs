@@ -287,3 +287,101 @@ fn a_column_is_differentiated_as_its_interpolant() {
     assert!((out[0] - secant).abs() < 1e-9, "{} vs {secant}", out[0]);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A Parquet fixture written by pandas (`pdyn-data/tests/fixtures/make_parquet.py`).
+fn parquet_fixture(name: &str) -> Vec<u8> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../pdyn-data/tests/fixtures")
+        .join(name);
+    std::fs::read(path).unwrap()
+}
+
+/// x'' = drive_x(t) from `file` (t = i/64, x = i²/8 for i < 100).
+fn parquet_model(file: &str) -> String {
+    format!(
+        r#"
+[data.drive]
+file = "{file}"
+columns = ["x"]
+interpolation = "cubic"
+
+[coordinates]
+q = {{ initial = 0.0, rate = 0.0 }}
+
+[particles.p]
+mass = 1
+position = "[q, 0, 0]"
+
+[[forces]]
+kind = "applied"
+on = "p"
+force = "[drive_x(t), 0, 0]"
+
+[simulate]
+t_end = 1.5
+points = 31
+"#
+    )
+}
+
+#[test]
+fn a_parquet_table_drives_the_run_as_its_csv_twin_does_bit_for_bit() {
+    let dir = scratch("parquet");
+    std::fs::write(
+        dir.join("track.parquet"),
+        parquet_fixture("track_zstd.parquet"),
+    )
+    .unwrap();
+    // The same numbers as CSV, each written exactly (`{:e}` round-trips).
+    let mut csv = String::from("t,x\n");
+    for i in 0..100 {
+        let f = i as f64;
+        csv.push_str(&format!("{:e},{:e}\n", f / 64.0, f * f / 8.0));
+    }
+    std::fs::write(dir.join("track.csv"), csv).unwrap();
+    let run = |file: &str| {
+        let mut model = load(&dir, &parquet_model(file)).unwrap();
+        let set = RunSettings::from_spec(&model.run.simulate).unwrap();
+        let prep = sim::prepare(&mut model).unwrap();
+        let res = sim::run(&prep, &set).unwrap();
+        assert!(res.failure.is_none(), "{:?}", res.failure);
+        assert_eq!(res.rows.len(), 31);
+        res.rows
+            .iter()
+            .flatten()
+            .map(|v| v.to_bits())
+            .collect::<Vec<u64>>()
+    };
+    let from_parquet = run("track.parquet");
+    assert_eq!(from_parquet, run("track.csv"));
+    // And q'' = x = 512 t² (i = 64 t) integrates to q = 128 t⁴/3, up to the spline's error.
+    let mut model = load(&dir, &parquet_model("track.parquet")).unwrap();
+    let set = RunSettings::from_spec(&model.run.simulate).unwrap();
+    let prep = sim::prepare(&mut model).unwrap();
+    let res = sim::run(&prep, &set).unwrap();
+    let last = res.rows.last().unwrap();
+    let exact = 128.0 * libm::pow(1.5, 4.0) / 3.0;
+    assert!(
+        (last[1] - exact).abs() < 1e-5 * exact,
+        "{} vs {exact}",
+        last[1]
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_parquet_data_are_located_by_row_and_column() {
+    let dir = scratch("parquet-bad");
+    for (fixture, expected) in [
+        ("nan_row12.parquet", "row 12: the value is NaN"),
+        ("null_row8.parquet", "row 8: missing value (null)"),
+        ("unsorted_row51.parquet", "row 51: time 0.5 comes after"),
+        ("timestamps.parquet", "holds dates or times"),
+    ] {
+        std::fs::write(dir.join(fixture), parquet_fixture(fixture)).unwrap();
+        let e = load(&dir, &parquet_model(fixture)).unwrap_err();
+        assert!(e.contains(expected), "{fixture}: {e}");
+        assert!(e.contains(fixture), "{fixture}: the file is named: {e}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

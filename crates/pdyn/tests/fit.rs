@@ -274,3 +274,28 @@ fn native_and_interpreted_sensitivities_agree_bit_for_bit() {
         assert_eq!(a.value.to_bits(), b.value.to_bits(), "{}", a.name);
     }
 }
+
+/// `pdyn fit --data run.parquet`: an experiment read from a Parquet file written by pandas
+/// (`pdyn-data/tests/fixtures`), columns named as the state; other columns are not read.
+#[test]
+fn an_experiment_is_read_from_parquet() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../pdyn-data/tests/fixtures/track_gzip.parquet");
+    let e = experiment::read(&path, &["x".to_string(), "x'".to_string()]).unwrap();
+    assert_eq!(e.name, "track_gzip");
+    assert_eq!(e.observed.len(), 1);
+    assert_eq!(e.observed[0].name, "x");
+    for i in 0..100 {
+        let f = i as f64;
+        assert_eq!(e.t[i], f / 64.0);
+        assert_eq!(e.observed[0].values[i], f * f / 8.0);
+    }
+    // No column named as the state: the error names the file's columns (no line: Parquet).
+    let err = experiment::read(&path, &["q".to_string()]).unwrap_err();
+    let text = err.to_string();
+    assert!(
+        text.contains("no column is named as a coordinate"),
+        "{text}"
+    );
+    assert!(text.contains("`label`"), "{text}");
+}

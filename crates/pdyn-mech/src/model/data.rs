@@ -1,7 +1,7 @@
-//! `[data.NAME]`: a measured time series read from a CSV file, each of its columns a function
-//! of time in the model's expressions (`NAME_COLUMN(t)`, or of any argument).
+//! `[data.NAME]`: a measured time series read from a CSV or Parquet file, each of its columns a
+//! function of time in the model's expressions (`NAME_COLUMN(t)`, or of any argument).
 //!
-//! The file is read with `pdyn_data::csv` (every value a finite number, times strictly
+//! The file is read with `pdyn_data::source` (CSV or Parquet, told by its bytes; every value a finite number, times strictly
 //! increasing, problems located by file, line and column) and each column interpolated with
 //! `pdyn_data::interp` (linear, natural cubic or PCHIP). The interpolants are registered in
 //! the model's expression pool as tabulated functions ([`pdyn_expr::tabulated`]), so that
@@ -13,6 +13,7 @@
 use super::raw::{Name, RawData, RawModel};
 use super::{Loader, ModelError};
 use pdyn_data::interp::{Interpolant, Kind};
+use pdyn_data::source::Source;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
@@ -136,7 +137,7 @@ impl Loader<'_> {
         let Some(file) = &t.file else {
             return Err(self
                 .err(name.span(), format!("[data.{}] needs `file`", name.get_ref()))
-                .help("file = \"record.csv\": a CSV file with a header line, relative to the model file"));
+                .help("file = \"record.csv\": a CSV file with a header line (or a Parquet file), relative to the model file"));
         };
         let kind = match &t.interpolation {
             None => Kind::Linear,
@@ -154,7 +155,7 @@ impl Loader<'_> {
             .map_or_else(|| "t".to_string(), |n| n.get_ref().clone());
         let path = data_path(self.origin, file.get_ref());
         let shown = path.display().to_string();
-        let text = std::fs::read_to_string(&path).map_err(|e| {
+        let bytes = std::fs::read(&path).map_err(|e| {
             self.err(
                 file.span(),
                 format!("cannot read the data file {shown}: {e}"),
@@ -180,24 +181,26 @@ impl Loader<'_> {
                 }
             }
         };
+        let source = Source::from_bytes(&shown, bytes).map_err(|e| data_error(self, e))?;
         let columns = if all_columns {
-            let mut c = pdyn_data::csv::read_columns(&shown, &text, &[])
+            let mut c = source
+                .read_columns(&shown, &[])
                 .map_err(|e| data_error(self, e))?;
             let Some(i) = c.names.iter().position(|n| *n == time) else {
+                let e = c.at_header(pdyn_data::DataError::new(
+                    &shown,
+                    format!("no column named `{time}` (the time)"),
+                ));
                 return Err(self
-                    .err(
-                        file.span(),
-                        format!(
-                            "{shown}:{}: no column named `{time}` (the time)",
-                            c.header_line
-                        ),
-                    )
+                    .err(file.span(), located(&e))
                     .help("name the time column with `time = \"...\"`"));
             };
             c.move_first(i);
             c
         } else {
-            pdyn_data::csv::read_columns(&shown, &text, &wanted).map_err(|e| data_error(self, e))?
+            source
+                .read_columns(&shown, &wanted)
+                .map_err(|e| data_error(self, e))?
         };
         let series = pdyn_data::csv::Series::from_columns(columns, 2, "a [data] table")
             .map_err(|e| data_error(self, e))?;

@@ -8,7 +8,7 @@
 
 use crate::data::data_error;
 use crate::Error;
-use pdyn_data::csv::read_columns;
+use pdyn_data::source::Source;
 use pdyn_data::DataError;
 use std::path::Path;
 
@@ -51,31 +51,23 @@ pub fn state_names(model: &pdyn_mech::Model) -> Vec<String> {
     names
 }
 
-/// The header's names.
-fn header(text: &str) -> (usize, Vec<String>) {
-    for (i, l) in text.trim_start_matches('\u{feff}').lines().enumerate() {
-        let l = l.trim();
-        if l.is_empty() || l.starts_with('#') {
-            continue;
-        }
-        let d = [',', ';', '\t']
-            .into_iter()
-            .find(|&d| l.contains(d))
-            .unwrap_or(',');
-        return (
-            i + 1,
-            l.split(d)
-                .map(|s| s.trim().trim_matches('"').to_string())
-                .collect(),
-        );
-    }
-    (1, Vec::new())
-}
-
 /// Reads an experiment from CSV text: `t`, then every column named as a state component
 /// (`state_names`), with `sigma_NAME` columns as their standard deviations.
 pub fn from_csv(file: &str, text: &str, state_names: &[String]) -> Result<Experiment, Error> {
-    let (header_line, names) = header(text);
+    from_source(file, &Source::Csv(text.to_string()), state_names)
+}
+
+/// Reads an experiment from a data file's contents (CSV or Parquet), as [`from_csv`].
+pub fn from_source(
+    file: &str,
+    source: &Source,
+    state_names: &[String],
+) -> Result<Experiment, Error> {
+    let (header_line, names) = source.header(file).map_err(data_error)?;
+    let at_header = |e: DataError| match header_line {
+        Some(line) => e.at(line, None),
+        None => e,
+    };
     let listed = || {
         names
             .iter()
@@ -85,8 +77,7 @@ pub fn from_csv(file: &str, text: &str, state_names: &[String]) -> Result<Experi
     };
     if !names.iter().any(|h| h == "t") {
         return Err(data_error(
-            DataError::new(file, "no column named `t` (the time)")
-                .at(header_line, None)
+            at_header(DataError::new(file, "no column named `t` (the time)"))
                 .help(format!("the header has {}", listed())),
         ));
     }
@@ -96,7 +87,7 @@ pub fn from_csv(file: &str, text: &str, state_names: &[String]) -> Result<Experi
         .collect();
     if measured.is_empty() {
         return Err(data_error(
-            DataError::new(
+            at_header(DataError::new(
                 file,
                 format!(
                     "no column is named as a coordinate or rate of the model ({})",
@@ -106,8 +97,7 @@ pub fn from_csv(file: &str, text: &str, state_names: &[String]) -> Result<Experi
                         .collect::<Vec<_>>()
                         .join(", ")
                 ),
-            )
-            .at(header_line, None)
+            ))
             .help(format!(
                 "name the measured columns as the model's coordinates (`x`) or rates (`x'`); \
                  the header has {}",
@@ -124,11 +114,12 @@ pub fn from_csv(file: &str, text: &str, state_names: &[String]) -> Result<Experi
         }
     }
     let w: Vec<&str> = wanted.iter().map(String::as_str).collect();
-    let cols = read_columns(file, text, &w).map_err(data_error)?;
+    let cols = source.read_columns(file, &w).map_err(data_error)?;
     if cols.is_empty() {
-        return Err(data_error(
-            DataError::new(file, "the file has a header but no data rows").at(header_line, None),
-        ));
+        return Err(data_error(at_header(DataError::new(
+            file,
+            "the file has a header but no data rows",
+        ))));
     }
     let t = cols.values[0].clone();
     if t[0] < 0.0 {
@@ -189,14 +180,10 @@ pub fn from_csv(file: &str, text: &str, state_names: &[String]) -> Result<Experi
     })
 }
 
-/// Reads an experiment from a CSV file.
+/// Reads an experiment from a data file (CSV or Parquet).
 pub fn read(path: &Path, state_names: &[String]) -> Result<Experiment, Error> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
-        path: path.to_path_buf(),
-        action: "read the data file",
-        error: std::sync::Arc::new(e),
-    })?;
-    from_csv(&path.display().to_string(), &text, state_names)
+    let source = crate::data::read_source(path)?;
+    from_source(&path.display().to_string(), &source, state_names)
 }
 
 /// An experiment from arrays (Python's): `columns` named as the state (`x`, `x'`) or as their
