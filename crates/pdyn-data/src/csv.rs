@@ -194,15 +194,20 @@ pub fn header(text: &str) -> (usize, Vec<String>) {
 /// `wanted` is empty, every column is read.
 pub fn read_columns(file: &str, text: &str, wanted: &[&str]) -> Result<Columns, DataError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut lines = text
-        .split('\n')
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.strip_suffix('\r').unwrap_or(l)))
-        .filter(|(_, l)| {
-            let t = l.trim();
-            !t.is_empty() && !t.starts_with('#')
-        });
-    let Some((header_line, header)) = lines.next() else {
+    // The header: the first line that is not blank or a comment; `rest` is what follows it.
+    let mut found = None;
+    let mut offset = 0;
+    for (i, raw) in text.split_inclusive('\n').enumerate() {
+        offset += raw.len();
+        let l = raw.strip_suffix('\n').unwrap_or(raw);
+        let l = l.strip_suffix('\r').unwrap_or(l);
+        if !is_skipped(l) {
+            found = Some((i + 1, l));
+            break;
+        }
+    }
+    let rest = &text[offset..];
+    let Some((header_line, header)) = found else {
         return Err(
             DataError::new(file, "the file has no header line and no data").help(
                 "the first line names the columns (e.g. `t,x,y`); one row per sample follows",
@@ -260,73 +265,65 @@ pub fn read_columns(file: &str, text: &str, wanted: &[&str]) -> Result<Columns, 
         }
     }
     let needed = index.iter().copied().max().map_or(0, |m| m + 1);
+    let rows = Rows {
+        file,
+        delim,
+        names: &names,
+        wanted: &wanted,
+        index: &index,
+        needed,
+    };
+    // Large files are parsed in parts on several threads (each part starts at a line), the
+    // parts' rows then joined in order; the first error in the file's order is reported.
+    let parts = split_at_lines(rest, parse_threads(rest.len()));
+    let parsed: Vec<Result<Part, DataError>> = if parts.len() == 1 {
+        vec![rows.parse(parts[0])]
+    } else {
+        std::thread::scope(|s| {
+            let handles: Vec<_> = parts
+                .iter()
+                .map(|&part| {
+                    let rows = &rows;
+                    s.spawn(move || rows.parse(part))
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| {
+                    h.join().unwrap_or_else(|_| {
+                        Err(DataError::new(
+                            file,
+                            "internal error: a parsing thread panicked",
+                        ))
+                    })
+                })
+                .collect()
+        })
+    };
     let mut values: Vec<Vec<f64>> = vec![Vec::new(); wanted.len()];
     let mut starts: Vec<Vec<u32>> = vec![Vec::new(); wanted.len()];
     let mut row_lines = Vec::new();
-    // The hot loop: fields split without allocating; only the wanted ones are parsed. The
-    // column (in characters) of a field is counted only for a line that is not ASCII.
-    let mut fs: Vec<(usize, &str)> = Vec::with_capacity(names.len());
-    for (line_no, line) in lines {
-        fs.clear();
-        let ascii = line.is_ascii();
-        let mut start = 0;
-        for (k, f) in line.split(delim).enumerate() {
-            if k >= needed {
-                break;
+    // Line numbers: a part's are counted from 0; the first line after the header is
+    // `header_line + 1`.
+    let mut base = header_line + 1;
+    for part in parsed {
+        let mut part = part.map_err(|mut e| {
+            e.line = e.line.map(|l| l + base);
+            e
+        })?;
+        if values[0].is_empty() {
+            values = std::mem::take(&mut part.values);
+            starts = std::mem::take(&mut part.starts);
+        } else {
+            for (v, pv) in values.iter_mut().zip(&part.values) {
+                v.extend_from_slice(pv);
             }
-            let lead = f.len() - f.trim_start().len();
-            let col = if ascii {
-                start + lead + 1
-            } else {
-                line[..start + lead].chars().count() + 1
-            };
-            let t = f.trim();
-            let t = t
-                .strip_prefix('"')
-                .and_then(|x| x.strip_suffix('"'))
-                .unwrap_or(t);
-            fs.push((col, t));
-            start += f.len() + delim.len_utf8();
-        }
-        if fs.len() < needed {
-            return Err(DataError::new(
-                file,
-                format!(
-                    "the row has {} field(s) but column `{}` is field {} of the header",
-                    fields(line, delim).len(),
-                    names[needed - 1],
-                    needed
-                ),
-            )
-            .at(line_no, None)
-            .text(line)
-            .help(format!(
-                "every row needs a value for each of the {} header columns, separated by `{}`",
-                names.len(),
-                if delim == '\t' {
-                    "\\t".to_string()
-                } else {
-                    delim.to_string()
-                }
-            )));
-        }
-        for (k, &i) in index.iter().enumerate() {
-            let (col, f) = fs[i];
-            match number(f) {
-                Ok(v) => {
-                    values[k].push(v);
-                    starts[k].push(u32::try_from(col).unwrap_or(u32::MAX));
-                }
-                Err((message, help)) => {
-                    return Err(DataError::new(file, message)
-                        .at(line_no, Some(col))
-                        .column_name(&wanted[k])
-                        .text(f)
-                        .help(help))
-                }
+            for (s, ps) in starts.iter_mut().zip(&part.starts) {
+                s.extend_from_slice(ps);
             }
         }
-        row_lines.push(line_no);
+        row_lines.extend(part.lines.iter().map(|l| l + base));
+        base += part.newlines;
     }
     if row_lines.is_empty() {
         return Err(
@@ -344,6 +341,153 @@ pub fn read_columns(file: &str, text: &str, wanted: &[&str]) -> Result<Columns, 
         header_line,
         records: false,
     })
+}
+
+/// A blank line or a comment: not a header, not a row.
+fn is_skipped(line: &str) -> bool {
+    let t = line.trim();
+    t.is_empty() || t.starts_with('#')
+}
+
+/// Below this many bytes a file is parsed on one thread (a thread costs more than it saves).
+const PARALLEL_FROM_BYTES: usize = 4 << 20;
+
+/// The threads to parse `len` bytes with: one per 4 MB, at most the machine's cores and 8.
+fn parse_threads(len: usize) -> usize {
+    if len < PARALLEL_FROM_BYTES {
+        return 1;
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    cores.min(8).min(len / PARALLEL_FROM_BYTES).max(1)
+}
+
+/// `text` cut into at most `parts` pieces of about equal length, each ending after a `\n`
+/// (the last one at the end of the text).
+fn split_at_lines(text: &str, parts: usize) -> Vec<&str> {
+    let mut out = Vec::with_capacity(parts);
+    let mut rest = text;
+    for k in (1..parts).rev() {
+        let target = rest.len() / (k + 1);
+        match rest.as_bytes()[target..].iter().position(|&b| b == b'\n') {
+            Some(p) => {
+                let (a, b) = rest.split_at(target + p + 1);
+                out.push(a);
+                rest = b;
+            }
+            None => break,
+        }
+    }
+    out.push(rest);
+    out
+}
+
+/// What parsing the rows needs to know of the header and the columns asked for.
+struct Rows<'a> {
+    file: &'a str,
+    delim: char,
+    names: &'a [String],
+    wanted: &'a [String],
+    /// For each wanted column, its field in the header.
+    index: &'a [usize],
+    /// The fields a row must have (the last wanted one's position + 1).
+    needed: usize,
+}
+
+/// The rows of one part of a file: line numbers counted from 0 at the part's start.
+struct Part {
+    values: Vec<Vec<f64>>,
+    starts: Vec<Vec<u32>>,
+    lines: Vec<usize>,
+    /// The line ends in the part (to number the next part's lines).
+    newlines: usize,
+}
+
+impl Rows<'_> {
+    /// Parses the rows of `part` (whole lines). Errors carry lines counted from 0 at the
+    /// part's start.
+    fn parse(&self, part: &str) -> Result<Part, DataError> {
+        let (file, delim, needed) = (self.file, self.delim, self.needed);
+        let mut values: Vec<Vec<f64>> = vec![Vec::new(); self.wanted.len()];
+        let mut starts: Vec<Vec<u32>> = vec![Vec::new(); self.wanted.len()];
+        let mut row_lines = Vec::new();
+        let mut newlines = 0;
+        // The hot loop: fields split without allocating; only the wanted ones are parsed. The
+        // column (in characters) of a field is counted only for a line that is not ASCII.
+        let mut fs: Vec<(usize, &str)> = Vec::with_capacity(self.names.len());
+        for (line_no, raw) in part.split('\n').enumerate() {
+            newlines = line_no;
+            let line = raw.strip_suffix('\r').unwrap_or(raw);
+            if is_skipped(line) {
+                continue;
+            }
+            fs.clear();
+            let ascii = line.is_ascii();
+            let mut start = 0;
+            for (k, f) in line.split(delim).enumerate() {
+                if k >= needed {
+                    break;
+                }
+                let lead = f.len() - f.trim_start().len();
+                let col = if ascii {
+                    start + lead + 1
+                } else {
+                    line[..start + lead].chars().count() + 1
+                };
+                let t = f.trim();
+                let t = t
+                    .strip_prefix('"')
+                    .and_then(|x| x.strip_suffix('"'))
+                    .unwrap_or(t);
+                fs.push((col, t));
+                start += f.len() + delim.len_utf8();
+            }
+            if fs.len() < needed {
+                return Err(DataError::new(
+                    file,
+                    format!(
+                        "the row has {} field(s) but column `{}` is field {} of the header",
+                        fields(line, delim).len(),
+                        self.names[needed - 1],
+                        needed
+                    ),
+                )
+                .at(line_no, None)
+                .text(line)
+                .help(format!(
+                    "every row needs a value for each of the {} header columns, separated by `{}`",
+                    self.names.len(),
+                    if delim == '\t' {
+                        "\\t".to_string()
+                    } else {
+                        delim.to_string()
+                    }
+                )));
+            }
+            for (k, &i) in self.index.iter().enumerate() {
+                let (col, f) = fs[i];
+                match number(f) {
+                    Ok(v) => {
+                        values[k].push(v);
+                        starts[k].push(u32::try_from(col).unwrap_or(u32::MAX));
+                    }
+                    Err((message, help)) => {
+                        return Err(DataError::new(file, message)
+                            .at(line_no, Some(col))
+                            .column_name(&self.wanted[k])
+                            .text(f)
+                            .help(help))
+                    }
+                }
+            }
+            row_lines.push(line_no);
+        }
+        Ok(Part {
+            values,
+            starts,
+            lines: row_lines,
+            newlines,
+        })
+    }
 }
 
 fn default_names(n: usize) -> Vec<String> {

@@ -55,15 +55,18 @@ pub fn read_columns(file: &str, bytes: &[u8], wanted: &[&str]) -> Result<Columns
     for w in &wanted {
         match names.iter().position(|n| n == w) {
             Some(i) => index.push(i),
-            None => return Err(DataError::new(file, format!("no column named `{w}`"))
-                .help(format!(
+            None => {
+                return Err(
+                    DataError::new(file, format!("no column named `{w}`")).help(format!(
                 "the file's columns are {}; choose the columns with --columns (Python: columns=)",
                 names
                     .iter()
                     .map(|n| format!("`{n}`"))
                     .collect::<Vec<_>>()
                     .join(", ")
-            ))),
+            )),
+                )
+            }
         }
     }
     for (k, &i) in index.iter().enumerate() {

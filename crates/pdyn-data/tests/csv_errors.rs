@@ -124,3 +124,55 @@ fn arrays_are_checked_like_files() {
     .unwrap_err();
     assert!(e.message.contains("2 values"), "{e}");
 }
+
+/// A file large enough to be parsed in parts on several threads (over 4 MB): values and line
+/// numbers as one pass would give them, comments and blank lines anywhere, and the first error
+/// in the file's order located at its line, whichever part it falls in.
+#[test]
+fn a_large_file_parsed_in_parts_keeps_its_lines() {
+    let rows = 300_000;
+    let mut text = String::from("# a long record\nt,x,label\n");
+    let mut line_of_row = Vec::with_capacity(rows);
+    let mut line = 2;
+    for i in 0..rows {
+        if i % 1000 == 500 {
+            text.push_str("# a comment\n\n");
+            line += 2;
+        }
+        line += 1;
+        line_of_row.push(line);
+        text.push_str(&format!("{},{},row{i}\n", i as f64 * 0.5, (i * i) as f64));
+    }
+    assert!(
+        text.len() > 8 << 20,
+        "{} bytes: big enough for two parts",
+        text.len()
+    );
+    let c = read_columns("big.csv", &text, &["t", "x"]).unwrap();
+    assert_eq!(c.len(), rows);
+    assert_eq!(c.lines, line_of_row);
+    for i in (0..rows).step_by(997) {
+        assert_eq!(c.values[0][i], i as f64 * 0.5);
+        assert_eq!(c.values[1][i], (i * i) as f64);
+    }
+    // Errors late in the file (in the last part) and early (in the first): each at its line.
+    for bad_row in [rows - 3, 10, rows / 2 + 1] {
+        let target = line_of_row[bad_row];
+        let broken: String = text
+            .split_inclusive('\n')
+            .enumerate()
+            .map(|(i, l)| {
+                if i + 1 == target {
+                    format!("{},NaN,x\n", bad_row as f64 * 0.5)
+                } else {
+                    l.to_string()
+                }
+            })
+            .collect();
+        let e = read_columns("big.csv", &broken, &["t", "x"]).unwrap_err();
+        assert_eq!(e.line, Some(target), "{e}");
+        // The field after `t,`: column len(t) + 2.
+        let t_len = format!("{}", bad_row as f64 * 0.5).len();
+        assert_eq!(e.column, Some(t_len + 2), "{e}");
+    }
+}
