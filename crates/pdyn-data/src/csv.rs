@@ -246,24 +246,7 @@ pub fn read_columns(file: &str, text: &str, wanted: &[&str]) -> Result<Columns, 
     } else {
         wanted.iter().map(|s| s.to_string()).collect()
     };
-    let mut index = Vec::with_capacity(wanted.len());
-    for w in &wanted {
-        match names.iter().position(|n| n == w) {
-            Some(i) => index.push(i),
-            None => {
-                return Err(DataError::new(file, format!("no column named `{w}`"))
-                    .at(header_line, None)
-                    .help(format!(
-                        "the header has {}; choose the columns with --columns (Python: columns=)",
-                        names
-                            .iter()
-                            .map(|n| format!("`{n}`"))
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    )))
-            }
-        }
-    }
+    let index = column_indices(file, &names, &wanted, Some(header_line))?;
     let needed = index.iter().copied().max().map_or(0, |m| m + 1);
     let rows = Rows {
         file,
@@ -276,30 +259,7 @@ pub fn read_columns(file: &str, text: &str, wanted: &[&str]) -> Result<Columns, 
     // Large files are parsed in parts on several threads (each part starts at a line), the
     // parts' rows then joined in order; the first error in the file's order is reported.
     let parts = split_at_lines(rest, parse_threads(rest.len()));
-    let parsed: Vec<Result<Part, DataError>> = if parts.len() == 1 {
-        vec![rows.parse(parts[0])]
-    } else {
-        std::thread::scope(|s| {
-            let handles: Vec<_> = parts
-                .iter()
-                .map(|&part| {
-                    let rows = &rows;
-                    s.spawn(move || rows.parse(part))
-                })
-                .collect();
-            handles
-                .into_iter()
-                .map(|h| {
-                    h.join().unwrap_or_else(|_| {
-                        Err(DataError::new(
-                            file,
-                            "internal error: a parsing thread panicked",
-                        ))
-                    })
-                })
-                .collect()
-        })
-    };
+    let parsed = crate::parallel::map(&parts, "CSV parsing", |part| rows.parse(part));
     let mut values: Vec<Vec<f64>> = vec![Vec::new(); wanted.len()];
     let mut starts: Vec<Vec<u32>> = vec![Vec::new(); wanted.len()];
     let mut row_lines = Vec::new();
@@ -341,6 +301,36 @@ pub fn read_columns(file: &str, text: &str, wanted: &[&str]) -> Result<Columns, 
         header_line,
         records: false,
     })
+}
+
+/// The position of each of the `wanted` columns among `names`, or an error naming the first
+/// one missing and listing the file's columns (at the header's line when there is one).
+pub(crate) fn column_indices(
+    file: &str,
+    names: &[String],
+    wanted: &[String],
+    header_line: Option<usize>,
+) -> Result<Vec<usize>, DataError> {
+    wanted
+        .iter()
+        .map(|w| {
+            names.iter().position(|n| n == w).ok_or_else(|| {
+                let e = DataError::new(file, format!("no column named `{w}`"));
+                let e = match header_line {
+                    Some(line) => e.at(line, None),
+                    None => e,
+                };
+                e.help(format!(
+                    "the file's columns are {}; choose the columns with --columns (Python: columns=)",
+                    names
+                        .iter()
+                        .map(|n| format!("`{n}`"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+            })
+        })
+        .collect()
 }
 
 /// A blank line or a comment: not a header, not a row.

@@ -106,24 +106,9 @@ pub fn kinematics(series: &Series, smoothing: Smoothing) -> Result<KinData, Data
     let t = &series.t;
     let n = t.len();
     // The coordinates are independent fits: one thread each.
-    let fits: Vec<Result<SmoothingSpline, DataError>> = std::thread::scope(|s| {
-        let handles: Vec<_> = series
-            .values
-            .iter()
-            .zip(&series.names)
-            .map(|(y, name)| s.spawn(move || fit(t, y, smoothing, name)))
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| {
-                h.join().unwrap_or_else(|_| {
-                    Err(DataError::new(
-                        "",
-                        "internal error: a smoothing thread panicked",
-                    ))
-                })
-            })
-            .collect()
+    let columns: Vec<(&Vec<f64>, &String)> = series.values.iter().zip(&series.names).collect();
+    let fits = crate::parallel::map(&columns, "smoothing", |&(y, name)| {
+        fit(t, y, smoothing, name)
     });
     let fits: Vec<SmoothingSpline> = fits.into_iter().collect::<Result<_, _>>()?;
     let mut k = KinData {

@@ -33,6 +33,7 @@ pub mod interp;
 pub mod kinematics;
 mod linalg;
 pub mod minimize;
+mod parallel;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod parquet;
 #[cfg(target_arch = "wasm32")]

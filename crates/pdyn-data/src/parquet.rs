@@ -51,24 +51,7 @@ pub fn read_columns(file: &str, bytes: &[u8], wanted: &[&str]) -> Result<Columns
     } else {
         wanted.iter().map(|s| s.to_string()).collect()
     };
-    let mut index = Vec::with_capacity(wanted.len());
-    for w in &wanted {
-        match names.iter().position(|n| n == w) {
-            Some(i) => index.push(i),
-            None => {
-                return Err(
-                    DataError::new(file, format!("no column named `{w}`")).help(format!(
-                "the file's columns are {}; choose the columns with --columns (Python: columns=)",
-                names
-                    .iter()
-                    .map(|n| format!("`{n}`"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )),
-                )
-            }
-        }
-    }
+    let index = crate::csv::column_indices(file, &names, &wanted, None)?;
     for (k, &i) in index.iter().enumerate() {
         check_numeric(file, &wanted[k], schema.column(i).as_ref())?;
     }
