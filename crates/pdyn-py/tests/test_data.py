@@ -171,3 +171,30 @@ def test_interp_matches_numpy_and_scipy():
     assert pdyn.interp(t, y, t[3]) == pytest.approx(y[3])
     with pytest.raises(pdyn.ModelError, match="outside the data's time range"):
         pdyn.interp(t, y, [t[-1] + 1])
+
+
+def test_a_parquet_file_from_pandas_reads_as_its_csv(tmp_path):
+    """``pdyn.kin_data(path)`` and ``pdyn.read_csv`` take a Parquet file written by pandas
+    (its default Snappy and Zstandard): the same numbers as the CSV pandas writes of the same
+    frame, and a NaN located by row and column."""
+    pd = pytest.importorskip("pandas")
+    pytest.importorskip("pyarrow")
+    t, x, y = noisy_circle(0.01, 7)
+    frame = pd.DataFrame({"t": t, "x": x, "y": y, "note": ["ok"] * len(t)})
+    frame.to_csv(tmp_path / "track.csv", index=False, float_format="%.17g")
+    frame.to_parquet(tmp_path / "track.parquet", index=False)
+    frame.to_parquet(tmp_path / "track_zstd.data", index=False, compression="zstd")
+    from_csv = pdyn.kin_data(str(tmp_path / "track.csv"))
+    for name in ["track.parquet", "track_zstd.data"]:
+        names, tt, values = pdyn.read_csv(tmp_path / name)
+        assert names == ["x", "y"]
+        np.testing.assert_array_equal(tt, t)
+        np.testing.assert_array_equal(values[0], x)
+        got = pdyn.kin_data(str(tmp_path / name))
+        for col in ["speed", "a_n", "curvature"]:
+            np.testing.assert_array_equal(got[col], from_csv[col])
+    bad = frame.copy()
+    bad.loc[41, "y"] = float("nan")
+    bad.to_parquet(tmp_path / "bad.parquet", index=False)
+    with pytest.raises(pdyn.ModelError, match=r"row 42: missing value \(null\)"):
+        pdyn.kin_data(str(tmp_path / "bad.parquet"))

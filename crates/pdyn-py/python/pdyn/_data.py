@@ -33,9 +33,11 @@ def _array1(x: Any, name: str):
 
 def read_csv(path: _PathLike, columns: Optional[Sequence[str]] = None,
              kind: str = "position") -> Tuple[List[str], Any, List[Any]]:
-    """Reads a time series from a CSV file as ``pdyn kin --data`` does: ``(names, t, values)``,
+    """Reads a time series from a CSV or Parquet file (told apart by its bytes) as ``pdyn kin
+    --data`` does: ``(names, t, values)``,
     the time first in ``columns`` (default ``t,x,y[,z]``, or with ``kind="accel"`` ``t`` and
-    every column whose name starts with ``a``). Errors are located (file, line, column)."""
+    every column whose name starts with ``a``). Errors are located (file, line, column; a
+    Parquet file's by row)."""
     return _pdyn._read_csv(os.fspath(path), list(columns or []), kind)
 
 
@@ -109,7 +111,7 @@ def kin_data(t: Any, x: Any = None, y: Any = None, z: Any = None, *,
     ``"gcv"``) or given (``lam=1e-3``; 0 interpolates), differentiated at the sample times.
 
     ``t`` is the array of times (strictly increasing) with ``x``, ``y`` [, ``z``] arrays, or a
-    CSV file's path (then ``columns`` names the time and position columns, default
+    CSV or Parquet file's path (then ``columns`` names the time and position columns, default
     ``t,x,y[,z]``)."""
     if isinstance(t, (str, os.PathLike)):
         if x is not None:
