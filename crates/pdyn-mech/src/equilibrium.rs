@@ -164,8 +164,8 @@ pub fn solve(
     opts: &EquilibriumOptions,
 ) -> Result<Equilibrium, EquilibriumError> {
     let n = lin.len();
-    let mut q = DVector::from_column_slice(start.unwrap_or(&lin.initial));
-    let mut at = lin.at(q.as_slice());
+    let q = DVector::from_column_slice(start.unwrap_or(&lin.initial));
+    let at = lin.at(q.as_slice());
     let stiff = (0..n).fold(0.0f64, |m, i| m.max(at.stiffness[(i, i)].abs()));
     let length = max_abs(&q).max(1.0);
     let scale = at.force.norm().max(stiff * length).max(f64::MIN_POSITIVE);
@@ -176,63 +176,55 @@ pub fn solve(
     );
     // μ is relative to K's scale over D's: μ = 1 makes the two comparable.
     let ratio = stiff.max(f64::MIN_POSITIVE) / diag.max();
-    let mut mu = 0.0f64;
-    let mut steps = 0;
-    let mut residual = at.force.norm();
-    while residual > target {
-        if steps >= opts.max_steps {
-            return Err(EquilibriumError::NotConverged { steps, residual });
-        }
-        steps += 1;
-        let mut improved = false;
-        // Try the step with the current μ, raising it until |f| decreases.
-        for _ in 0..40 {
-            let mut a = at.stiffness.clone();
-            for i in 0..n {
-                a[(i, i)] += mu * ratio * diag[i];
-            }
-            if let Some(dq) = a.lu().solve(&at.force) {
-                let trial = &q + &dq;
-                let next = lin.at(trial.as_slice());
-                let r = next.force.norm();
-                if r.is_finite() && r < residual {
-                    q = trial;
-                    at = next;
-                    residual = r;
-                    improved = true;
-                    break;
-                }
-            }
-            mu = if mu == 0.0 { 1e-6 } else { mu * 10.0 };
-            if mu > 1e12 {
-                break;
-            }
-        }
-        if !improved {
-            let directions = free_directions(&lin.names, &at.stiffness);
-            return Err(if directions.is_empty() {
-                EquilibriumError::NotConverged { steps, residual }
-            } else {
-                EquilibriumError::Mechanism {
-                    residual,
-                    directions,
-                }
-            });
-        }
-        mu /= 10.0;
-        if mu < 1e-12 {
-            mu = 0.0;
-        }
-    }
+    let dense = Dense(lin);
+    let end = crate::damped_newton::solve(
+        &dense,
+        q.iter().copied().collect(),
+        at,
+        diag.as_slice(),
+        ratio,
+        target,
+        opts,
+    )?;
+    let (q, at, residual, steps) = (end.q, end.at, end.residual, end.steps);
     let neutral = free_directions(&lin.names, &at.stiffness);
     Ok(Equilibrium {
-        q: q.iter().copied().collect(),
+        q,
         residual,
         scale,
         steps,
         linearization: at,
         neutral,
     })
+}
+
+/// The dense path of damped Newton: `K` as it is, solved by LU.
+struct Dense<'a>(&'a Linearizer);
+
+impl crate::damped_newton::NewtonSystem for Dense<'_> {
+    type At = Linearization;
+
+    fn at(&self, q: &[f64]) -> Linearization {
+        self.0.at(q)
+    }
+
+    fn residual(&self, at: &Linearization) -> f64 {
+        at.force.norm()
+    }
+
+    fn step(&self, at: &Linearization, damping: &[f64]) -> Option<Vec<f64>> {
+        let mut a = at.stiffness.clone();
+        for (i, d) in damping.iter().enumerate() {
+            a[(i, i)] += d;
+        }
+        a.lu()
+            .solve(&at.force)
+            .map(|dq| dq.iter().copied().collect())
+    }
+
+    fn free_directions(&self, at: &Linearization) -> Vec<FreeDirection> {
+        free_directions(&self.0.names, &at.stiffness)
+    }
 }
 
 /// The null space of the stiffness's symmetric part: eigenvectors whose eigenvalue is below

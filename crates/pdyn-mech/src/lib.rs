@@ -17,6 +17,7 @@ pub mod algebra;
 pub mod conservation;
 mod constraint_rank;
 pub mod damped;
+mod damped_newton;
 pub mod derive;
 pub mod dimensions;
 pub mod dsolve;

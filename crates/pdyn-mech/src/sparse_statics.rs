@@ -53,8 +53,8 @@ pub fn solve(
     start: Option<&[f64]>,
     opts: &EquilibriumOptions,
 ) -> Result<SparseEquilibrium, EquilibriumError> {
-    let mut q: Vec<f64> = start.unwrap_or(&lin.initial).to_vec();
-    let mut at = lin.at_sparse(&q);
+    let q: Vec<f64> = start.unwrap_or(&lin.initial).to_vec();
+    let at = lin.at_sparse(&q);
     let kd = at.stiffness.diag();
     let stiff = kd.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let length = q.iter().fold(1.0f64, |m, x| m.max(x.abs()));
@@ -68,56 +68,17 @@ pub fn solve(
         .collect();
     let dmax = diag.iter().fold(0.0f64, |m, x| m.max(*x));
     let ratio = stiff.max(f64::MIN_POSITIVE) / dmax;
-    let mut ks = symmetric_part(&at.stiffness);
+    let ks = symmetric_part(&at.stiffness);
     // One ordering for every step: the pattern of K + D does not change.
     let order = rcm(&ks.add(1.0, &Csr::diagonal(&diag), 1.0));
-    let mut mu = 0.0f64;
-    let mut steps = 0;
-    let mut residual = norm(&at.force);
-    while residual > target {
-        if steps >= opts.max_steps {
-            return Err(EquilibriumError::NotConverged { steps, residual });
-        }
-        steps += 1;
-        let mut improved = false;
-        for _ in 0..40 {
-            let damping: Vec<f64> = diag.iter().map(|d| mu * ratio * d).collect();
-            let a = ks.add(1.0, &Csr::diagonal(&damping), 1.0);
-            if let Ok(f) = EnvelopeLdlt::with_order(&a, order.clone()) {
-                let dq = f.solve(&at.force);
-                let trial: Vec<f64> = q.iter().zip(&dq).map(|(a, b)| a + b).collect();
-                let next = lin.at_sparse(&trial);
-                let r = norm(&next.force);
-                if r.is_finite() && r < residual {
-                    q = trial;
-                    at = next;
-                    ks = symmetric_part(&at.stiffness);
-                    residual = r;
-                    improved = true;
-                    break;
-                }
-            }
-            mu = if mu == 0.0 { 1e-6 } else { mu * 10.0 };
-            if mu > 1e12 {
-                break;
-            }
-        }
-        if !improved {
-            let directions = free_directions(&lin.names, &ks, &diag);
-            return Err(if directions.is_empty() {
-                EquilibriumError::NotConverged { steps, residual }
-            } else {
-                EquilibriumError::Mechanism {
-                    residual,
-                    directions,
-                }
-            });
-        }
-        mu /= 10.0;
-        if mu < 1e-12 {
-            mu = 0.0;
-        }
-    }
+    let sparse = Sparse {
+        lin,
+        order,
+        diag: &diag,
+    };
+    let end =
+        crate::damped_newton::solve(&sparse, q, SparseAt { at, ks }, &diag, ratio, target, opts)?;
+    let (q, SparseAt { at, ks }, residual, steps) = (end.q, end.at, end.residual, end.steps);
     let neutral = free_directions(&lin.names, &ks, &diag);
     Ok(SparseEquilibrium {
         q,
@@ -127,6 +88,44 @@ pub fn solve(
         linearization: at,
         neutral,
     })
+}
+
+/// The sparse path of damped Newton: the symmetric part of `K`, by envelope `L D Lᵀ` in one
+/// reverse Cuthill–McKee order.
+struct Sparse<'a> {
+    lin: &'a Linearizer,
+    order: Vec<usize>,
+    diag: &'a [f64],
+}
+
+/// A sparse linearization with the symmetric part of its stiffness.
+struct SparseAt {
+    at: SparseLinearization,
+    ks: Csr,
+}
+
+impl crate::damped_newton::NewtonSystem for Sparse<'_> {
+    type At = SparseAt;
+
+    fn at(&self, q: &[f64]) -> SparseAt {
+        let at = self.lin.at_sparse(q);
+        let ks = symmetric_part(&at.stiffness);
+        SparseAt { at, ks }
+    }
+
+    fn residual(&self, at: &SparseAt) -> f64 {
+        norm(&at.at.force)
+    }
+
+    fn step(&self, at: &SparseAt, damping: &[f64]) -> Option<Vec<f64>> {
+        let a = at.ks.add(1.0, &Csr::diagonal(damping), 1.0);
+        let f = EnvelopeLdlt::with_order(&a, self.order.clone()).ok()?;
+        Some(f.solve(&at.at.force))
+    }
+
+    fn free_directions(&self, at: &SparseAt) -> Vec<FreeDirection> {
+        free_directions(&self.lin.names, &at.ks, self.diag)
+    }
 }
 
 /// `(A + Aᵀ) / 2`.
