@@ -228,23 +228,7 @@ fn run(
         let b = b2.sqrt();
         let m = basis.len();
         if m >= next_check || m >= limit {
-            // Ritz pairs of T.
-            let mut t = nalgebra::DMatrix::zeros(m, m);
-            for i in 0..m {
-                t[(i, i)] = alpha[i];
-                if i + 1 < m {
-                    t[(i, i + 1)] = beta[i];
-                    t[(i + 1, i)] = beta[i];
-                }
-            }
-            let eig = t.symmetric_eigen();
-            let mut idx: Vec<usize> = (0..m).collect();
-            idx.sort_by(|&x, &y| {
-                eig.eigenvalues[y]
-                    .abs()
-                    .total_cmp(&eig.eigenvalues[x].abs())
-            });
-            idx.truncate(want);
+            let (eig, idx) = ritz(&alpha, &beta, m, want);
             let full = m >= limit;
             let rel: Vec<f64> = idx
                 .iter()
@@ -264,13 +248,7 @@ fn run(
                 let pairs = idx
                     .iter()
                     .zip(&rel)
-                    .map(|(&i, &r)| {
-                        let mut x = vec![0.0; n];
-                        for (k, (q, _)) in basis.iter().enumerate() {
-                            axpy(eig.eigenvectors[(k, i)], q, &mut x);
-                        }
-                        (eig.eigenvalues[i], x, r)
-                    })
+                    .map(|(&i, &r)| (eig.eigenvalues[i], ritz_vector(&basis, &eig, i, n), r))
                     .collect();
                 return Ok((pairs, m, done));
             }
@@ -297,16 +275,15 @@ fn run(
     }
 }
 
-/// The Ritz pairs of a basis that spans an invariant subspace (no room for another vector).
-#[allow(clippy::type_complexity)]
-fn run_exact_tail(
-    basis: &[(Vec<f64>, Vec<f64>)],
+/// The eigen-decomposition of the `m × m` tridiagonal `T` (`alpha` on the diagonal, `beta`
+/// beside it) and the indices of its `want` eigenvalues largest in magnitude (of the
+/// shift-inverted problem: nearest the shift), largest first.
+fn ritz(
     alpha: &[f64],
     beta: &[f64],
+    m: usize,
     want: usize,
-    n: usize,
-) -> Result<(Vec<(f64, Vec<f64>, f64)>, usize, bool), LanczosError> {
-    let m = basis.len();
+) -> (nalgebra::SymmetricEigen<f64, nalgebra::Dyn>, Vec<usize>) {
     let mut t = nalgebra::DMatrix::zeros(m, m);
     for i in 0..m {
         t[(i, i)] = alpha[i];
@@ -323,15 +300,37 @@ fn run_exact_tail(
             .total_cmp(&eig.eigenvalues[x].abs())
     });
     idx.truncate(want);
+    (eig, idx)
+}
+
+/// The Ritz vector of `T`'s eigenvector `i`: `Σ_k v_ik q_k` over the basis.
+fn ritz_vector(
+    basis: &[(Vec<f64>, Vec<f64>)],
+    eig: &nalgebra::SymmetricEigen<f64, nalgebra::Dyn>,
+    i: usize,
+    n: usize,
+) -> Vec<f64> {
+    let mut x = vec![0.0; n];
+    for (k, (q, _)) in basis.iter().enumerate() {
+        axpy(eig.eigenvectors[(k, i)], q, &mut x);
+    }
+    x
+}
+
+/// The Ritz pairs of a basis that spans an invariant subspace (no room for another vector).
+#[allow(clippy::type_complexity)]
+fn run_exact_tail(
+    basis: &[(Vec<f64>, Vec<f64>)],
+    alpha: &[f64],
+    beta: &[f64],
+    want: usize,
+    n: usize,
+) -> Result<(Vec<(f64, Vec<f64>, f64)>, usize, bool), LanczosError> {
+    let m = basis.len();
+    let (eig, idx) = ritz(alpha, beta, m, want);
     let pairs = idx
         .iter()
-        .map(|&i| {
-            let mut x = vec![0.0; n];
-            for (k, (q, _)) in basis.iter().enumerate() {
-                axpy(eig.eigenvectors[(k, i)], q, &mut x);
-            }
-            (eig.eigenvalues[i], x, 0.0)
-        })
+        .map(|&i| (eig.eigenvalues[i], ritz_vector(basis, &eig, i, n), 0.0))
         .collect();
     Ok((pairs, m, true))
 }
