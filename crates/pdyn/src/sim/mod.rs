@@ -32,7 +32,6 @@ use compiled::{CompiledModel, Observer};
 use measured::report;
 use pdyn_expr::{Id, Pool};
 pub use pdyn_jit::JitMode;
-use pdyn_mech::conservation::conserved_quantities;
 use pdyn_mech::model::spec::{Crossing, SimulateSpec};
 use pdyn_mech::parameters::DerivedParameters;
 use pdyn_mech::validity::{InvalidValue, ValueChecks};
@@ -760,7 +759,7 @@ fn observations(
         conserved.push(false);
     }
     let (mut scale_names, mut scale_exprs) = (Vec::new(), Vec::new());
-    for c in conserved_quantities(model, d) {
+    for c in net::conserved_quantities(model, d, system) {
         scale_names.push(c.name.clone());
         scale_exprs.push(c.scale);
         names.push(c.name);

@@ -29,6 +29,10 @@ struct Kernel {
     /// Per axis: per element, the index of the acceleration it adds to (a free coordinate
     /// in state order), or [`NONE`].
     scatter: [Vec<u32>; 3],
+    /// Per element, its own particle (the one the load acts on).
+    own: Vec<u32>,
+    /// Which components of the template are not identically zero.
+    nonzero: [bool; 3],
     /// The derivatives of the outputs by the slot inputs, not identically zero: `(axis,
     /// input)` of each output of `jacobian_program`.
     jacobian_entries: Vec<(u8, u32)>,
@@ -123,6 +127,8 @@ impl NetKernels {
                 kernel,
                 gather,
                 scatter,
+                own: (0..elements).map(|e| g.particles[e * g.slots]).collect(),
+                nonzero: g.template.map(|c| c != Pool::ZERO),
                 jacobian_entries,
                 jacobian_program,
                 jacobian_kernel: OnceCell::new(),
@@ -200,6 +206,61 @@ impl NetKernels {
         }
     }
 
+    /// True when no load acts along a particle's component that is constant in time: the
+    /// generic derivation then has Newton's equations (one per coordinate) and checks the
+    /// momenta; otherwise it projects them, and does not.
+    pub fn newton_form(&self) -> bool {
+        self.kernels
+            .iter()
+            .all(|k| (0..3).all(|axis| !k.nonzero[axis] || !k.scatter[axis].contains(&NONE)))
+    }
+
+    /// The resultant force `Σ F` and moment about the origin `Σ r × F` of every load at
+    /// `input = [t, q, q', parameters]`, each component with the sum of its terms' sizes:
+    /// `[(F_x, Σ|F_x|), (F_y, ...), (F_z, ...), (M_x, Σ|y F_z| + |z F_y|), ...]`. `mass` and
+    /// `position` are each particle's, numbers.
+    pub fn resultants(
+        &self,
+        input: &[f64],
+        mass: &[f64],
+        position: &[[f64; 3]],
+    ) -> [(f64, f64); 6] {
+        let mut out = [(0.0, 0.0); 6];
+        let cols = &mut *self.columns.borrow_mut();
+        for k in &self.kernels {
+            if k.elements == 0 {
+                continue;
+            }
+            gather(k, input, cols, k.kernel.n_inputs(), 3);
+            let ins: Vec<&[f64]> = cols.inputs[..k.kernel.n_inputs()]
+                .iter()
+                .map(|c| &c[..k.elements])
+                .collect();
+            let mut outs: Vec<&mut [f64]> = cols.outputs[..3]
+                .iter_mut()
+                .map(|c| &mut c[..k.elements])
+                .collect();
+            k.kernel.run(&ins, &mut outs);
+            for (e, &own) in k.own.iter().enumerate() {
+                let m = mass[own as usize];
+                let f = [0, 1, 2].map(|c| m * outs[c][e]);
+                let r = position[own as usize];
+                let terms = [
+                    (r[1] * f[2], r[2] * f[1]),
+                    (r[2] * f[0], r[0] * f[2]),
+                    (r[0] * f[1], r[1] * f[0]),
+                ];
+                for (c, (&fc, (a, b))) in f.iter().zip(terms).enumerate() {
+                    out[c].0 += fc;
+                    out[c].1 += fc.abs();
+                    out[3 + c].0 += a - b;
+                    out[3 + c].1 += a.abs() + b.abs();
+                }
+            }
+        }
+        out
+    }
+
     /// Adds `∂q''/∂w` into rows `n..2n` of the dense Jacobian `jac` (`2n × 2n`, row-major)
     /// of the first-order system, at `input = [t, q, q', parameters]`. The caller zeroes
     /// `jac` and sets the identity block.
@@ -233,13 +294,12 @@ impl NetKernels {
             for (&(axis, input_k), out) in k.jacobian_entries.iter().zip(&outs) {
                 let rows = &k.scatter[axis as usize];
                 let from = &k.gather[input_k as usize];
-                for e in 0..k.elements {
-                    if rows[e] == NONE {
+                for ((&row, &at), &value) in rows.iter().zip(from).zip(out.iter()) {
+                    if row == NONE {
                         continue;
                     }
                     // The gathered index is 1 + the state index of the input.
-                    let col = from[e] as usize - 1;
-                    jac[(n + rows[e] as usize) * m + col] += out[e];
+                    jac[(n + row as usize) * m + at as usize - 1] += value;
                 }
             }
         }
