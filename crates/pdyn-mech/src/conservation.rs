@@ -83,8 +83,19 @@ pub fn conserved_quantities(model: &mut Model, d: &Derivation) -> Vec<Conserved>
     if d.prescribed_acceleration {
         return Vec::new();
     }
+    let mut out: Vec<Conserved> = conserved_energy(model, d).into_iter().collect();
+    if d.form != Form::Projected {
+        momenta(model, d, &mut out);
+    }
+    out
+}
+
+/// Energy, when the rules of [`conserved_quantities`] say it is conserved.
+pub fn conserved_energy(model: &mut Model, d: &Derivation) -> Option<Conserved> {
+    if d.prescribed_acceleration {
+        return None;
+    }
     let p = &mut model.pool;
-    let mut out = Vec::new();
     let explicit_time = model
         .particles
         .iter()
@@ -96,15 +107,63 @@ pub fn conserved_quantities(model: &mut Model, d: &Derivation) -> Vec<Conserved>
     if model.conservative && !explicit_time && !model.potentials.is_empty() {
         let e = energy(p, &d.particles, &model.potentials);
         let expr = p.add(&[e.kinetic, e.potential]);
-        out.push(Conserved {
+        return Some(Conserved {
             name: "energy".into(),
             expr,
             scale: e.scale,
         });
     }
-    if d.form == Form::Projected {
-        return out;
+    None
+}
+
+/// Linear and angular momentum components whose resultant vanishes (Newton's form only), in
+/// the order of [`conserved_quantities`].
+fn momenta(model: &mut Model, d: &Derivation, out: &mut Vec<Conserved>) {
+    let p = &mut model.pool;
+    // The resultant force and moment first, from each particle's terms: a sum of every
+    // particle's force is formed (and its scale, and the momentum itself) only when it may
+    // vanish. On a net of 10^4 particles nothing is conserved, and forming those sums of
+    // 10^4 terms (sorting them) took 2 s.
+    let mut forces: [Vec<Id>; 3] = Default::default();
+    let mut moments: [Vec<Id>; 3] = Default::default();
+    for pk in &d.particles {
+        let mr = vector::cross(p, pk.r, pk.force);
+        for c in 0..3 {
+            forces[c].push(pk.force[c]);
+            moments[c].push(mr[c]);
+        }
     }
+    let mut scales: Option<(Id, Id)> = None;
+    for (kind, resultants) in [("angular_momentum", &moments), ("momentum", &forces)] {
+        for (c, axis) in ["x", "y", "z"].iter().enumerate() {
+            if !resultant_vanishes(p, &resultants[c]) {
+                continue;
+            }
+            let mut terms = Vec::with_capacity(d.particles.len());
+            for pk in &d.particles {
+                let mv = vector::scale(p, pk.mass, pk.v);
+                terms.push(if kind == "momentum" {
+                    mv[c]
+                } else {
+                    vector::cross(p, pk.r, mv)[c]
+                });
+            }
+            let quantity = p.add(&terms);
+            if quantity == Pool::ZERO {
+                continue;
+            }
+            let (linear, angular) = *scales.get_or_insert_with(|| momentum_scales(p, d));
+            out.push(Conserved {
+                name: format!("{kind}.{axis}"),
+                expr: quantity,
+                scale: if kind == "momentum" { linear } else { angular },
+            });
+        }
+    }
+}
+
+/// `Σ m |v|` and `Σ m |r| |v|`: the scales of linear and angular momentum.
+fn momentum_scales(p: &mut Pool, d: &Derivation) -> (Id, Id) {
     let (mut linear_scale, mut angular_scale) = (Vec::new(), Vec::new());
     for pk in &d.particles {
         let speed = vector::norm(p, pk.v);
@@ -112,40 +171,71 @@ pub fn conserved_quantities(model: &mut Model, d: &Derivation) -> Vec<Conserved>
         linear_scale.push(p.mul(&[pk.mass, speed]));
         angular_scale.push(p.mul(&[pk.mass, speed, r]));
     }
-    let linear_scale = p.add(&linear_scale);
-    let angular_scale = p.add(&angular_scale);
-    // The terms are gathered and each sum formed once: adding particle by particle re-sorted
-    // the growing sum at every step, quadratic in the particles of a net.
-    let mut terms: [[Vec<Id>; 3]; 4] = Default::default();
-    for pk in &d.particles {
-        let mv = vector::scale(p, pk.mass, pk.v);
-        let hr = vector::cross(p, pk.r, mv);
-        let mr = vector::cross(p, pk.r, pk.force);
-        for (k, v) in [hr, mr, mv, pk.force].into_iter().enumerate() {
-            for c in 0..3 {
-                terms[k][c].push(v[c]);
-            }
-        }
-    }
-    let [h, moment, momentum, total_force] = terms.map(|t| t.map(|c| p.add(&c)));
+    (p.add(&linear_scale), p.add(&angular_scale))
+}
+
+/// Whether the sum of `terms` is identically zero: proved by [`Pool::provably_equal`] when
+/// the sum is below [`PROOF_SIZE_LIMIT`]. The terms are first cancelled against each other by
+/// their numeric coefficients (a spring's pull on one end against its pull on the other), as
+/// the sum's own collection of like terms would; when what is left is already over the limit
+/// the sum is not formed at all.
+fn resultant_vanishes(p: &mut Pool, terms: &[Id]) -> bool {
     let vanishes = |p: &mut Pool, e: Id| {
         p.tree_size(e, PROOF_SIZE_LIMIT + 1) < PROOF_SIZE_LIMIT && p.provably_equal(e, Pool::ZERO)
     };
-    for (kind, quantity, resultant, scale) in [
-        ("angular_momentum", h, moment, angular_scale),
-        ("momentum", momentum, total_force, linear_scale),
-    ] {
-        for (c, axis) in ["x", "y", "z"].iter().enumerate() {
-            if quantity[c] != Pool::ZERO && vanishes(p, resultant[c]) {
-                out.push(Conserved {
-                    name: format!("{kind}.{axis}"),
-                    expr: quantity[c],
-                    scale,
-                });
+    let mut flat = Vec::with_capacity(terms.len());
+    for &t in terms {
+        match p.node(t) {
+            Node::Add(ts) => flat.extend(ts.iter().copied()),
+            _ => flat.push(t),
+        }
+    }
+    let mut size = 0;
+    for &t in &flat {
+        size += p.tree_size(t, PROOF_SIZE_LIMIT + 1);
+        if size > PROOF_SIZE_LIMIT {
+            break;
+        }
+    }
+    if size <= PROOF_SIZE_LIMIT {
+        let sum = p.add(&flat);
+        return vanishes(p, sum);
+    }
+    // Like terms collected: coefficient by the rest of each term.
+    let mut collected: rustc_hash::FxHashMap<Id, Number> = rustc_hash::FxHashMap::default();
+    let mut order = Vec::new();
+    for &t in &flat {
+        let (c, rest) = p.split_coeff(t);
+        match collected.get_mut(&rest) {
+            Some(sum) => *sum = sum.add(&c),
+            None => {
+                collected.insert(rest, c);
+                order.push(rest);
             }
         }
     }
-    out
+    let mut left = Vec::new();
+    let mut size = 0;
+    for rest in order {
+        let c = &collected[&rest];
+        if c.is_zero() {
+            continue;
+        }
+        size += p.tree_size(rest, PROOF_SIZE_LIMIT + 1);
+        if size >= PROOF_SIZE_LIMIT {
+            return false;
+        }
+        left.push((c.clone(), rest));
+    }
+    let left: Vec<Id> = left
+        .into_iter()
+        .map(|(c, rest)| {
+            let c = p.num(c);
+            p.mul2(c, rest)
+        })
+        .collect();
+    let sum = p.add(&left);
+    vanishes(p, sum)
 }
 
 #[cfg(test)]

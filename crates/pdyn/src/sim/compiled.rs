@@ -14,6 +14,7 @@
 //! [`Program::eval`] as the fallback and under `--no-jit` ([`JitMode::Off`]); both give the
 //! same bits (pdyn-jit's agreement tests).
 
+use super::net::kernels::NetKernels;
 use pdyn_expr::compile::{CompileError, CompiledLinearSystem};
 use pdyn_expr::{Id, Node, Pool, Program};
 use pdyn_jit::{Evaluator, JitLinearSystem, JitMode};
@@ -33,6 +34,9 @@ enum Engine {
     /// A tree of links: the program gives each link's numbers
     /// ([`TreeForm::inputs`]), [`TreeForm::solve`] the accelerations.
     Tree(Evaluator, Box<TreeForm>),
+    /// Free particles in Cartesian coordinates: one kernel per load template
+    /// ([`super::net`]), its Jacobian too.
+    Net(Box<NetKernels>),
 }
 
 #[derive(Clone)]
@@ -183,6 +187,7 @@ impl CompiledModel {
             (Engine::Exact(e), _) | (Engine::Tree(e, _), _) => (e.workspace(), e.is_native()),
             (Engine::Numeric, Some(sys)) => (Vec::new(), sys.is_native()),
             (Engine::Numeric, None) => (Vec::new(), false),
+            (Engine::Net(k), _) => (Vec::new(), k.is_native()),
         };
         let (jac_ws, jac_out) = match &jacobian {
             Some(j) => (j.workspace(), vec![0.0; j.n_outputs()]),
@@ -214,6 +219,48 @@ impl CompiledModel {
             inputs,
             observation_inputs,
         })
+    }
+
+    /// The accelerations of free particles in Cartesian coordinates by `kernels`
+    /// ([`super::net::derive_and_compile`], which gave `d`).
+    pub fn for_net(model: &mut Model, d: &Derivation, kernels: NetKernels) -> CompiledModel {
+        let n = d.free.len();
+        let (inputs, observation_inputs) = input_leaves(model, d);
+        let mut input = vec![0.0; inputs.len()];
+        for (k, par) in model.parameters.iter().enumerate() {
+            input[1 + 2 * n + k] = par.value;
+        }
+        CompiledModel {
+            n,
+            n_reactions: 0,
+            slots: (0..n).map(Ok).collect(),
+            native: kernels.is_native(),
+            separable: !kernels.reads_rates(),
+            engine: Engine::Net(Box::new(kernels)),
+            jacobian: None,
+            jacobian_entries: Vec::new(),
+            scratch: RefCell::new(Scratch {
+                input,
+                ws: Vec::new(),
+                out: vec![0.0; n],
+                numeric: None,
+                jac_ws: Vec::new(),
+                jac_out: Vec::new(),
+                tree_values: Vec::new(),
+                tree_ws: TreeWorkspace::default(),
+            }),
+            inputs,
+            observation_inputs,
+        }
+    }
+
+    /// The per-template kernels of a model of free particles ([`super::net`]), if it runs on
+    /// them.
+    pub fn net_kernels(&self) -> Option<&NetKernels> {
+        match &self.engine {
+            Engine::Net(k) => Some(k),
+            _ => None,
+        }
     }
 
     /// True when the right-hand side runs as native code (not under `--no-jit`, and where
@@ -266,6 +313,7 @@ impl CompiledModel {
                     }
                 }
             }
+            Engine::Net(kernels) => kernels.accelerations(&s.input, &mut s.out),
             Engine::Tree(prog, tree) => {
                 prog.eval(&s.input, &mut s.ws, &mut s.tree_values);
                 // The unknowns are the accelerations in state order, as the tree's
@@ -367,13 +415,24 @@ impl OdeSystem for CompiledModel {
     }
 
     fn has_jacobian(&self) -> bool {
-        self.jacobian.is_some()
+        self.jacobian.is_some() || matches!(self.engine, Engine::Net(_))
     }
 
     fn jacobian(&self, t: f64, y: &[f64], jac: &mut [f64]) {
-        let Some(prog) = &self.jacobian else { return };
         let n = self.n;
         let s = &mut *self.scratch.borrow_mut();
+        if let Engine::Net(kernels) = &self.engine {
+            s.input[0] = t;
+            s.input[1..1 + 2 * n].copy_from_slice(y);
+            let m = 2 * n;
+            jac[..m * m].iter_mut().for_each(|x| *x = 0.0);
+            for i in 0..n {
+                jac[i * m + n + i] = 1.0;
+            }
+            kernels.add_jacobian(&s.input, jac);
+            return;
+        }
+        let Some(prog) = &self.jacobian else { return };
         s.input[0] = t;
         s.input[1..1 + 2 * n].copy_from_slice(y);
         prog.eval(&s.input, &mut s.jac_ws, &mut s.jac_out);

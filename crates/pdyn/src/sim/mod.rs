@@ -18,6 +18,7 @@ pub mod exact;
 pub mod hybrid;
 pub mod linearize;
 pub mod measured;
+pub mod net;
 pub mod report;
 pub mod request;
 pub mod sweep;
@@ -31,7 +32,6 @@ use compiled::{CompiledModel, Observer};
 use measured::report;
 use pdyn_expr::{Id, Pool};
 pub use pdyn_jit::JitMode;
-use pdyn_mech::conservation::conserved_quantities;
 use pdyn_mech::model::spec::{Crossing, SimulateSpec};
 use pdyn_mech::parameters::DerivedParameters;
 use pdyn_mech::validity::{InvalidValue, ValueChecks};
@@ -547,6 +547,28 @@ pub fn prepare_with_jit(
     opts: &DeriveOptions,
     jit: JitMode,
 ) -> Result<Prepared, SimError> {
+    prepare_on(model, opts, jit, NetPath::Auto)
+}
+
+/// Whether [`prepare_on`] evaluates a model of free particles in Cartesian coordinates by
+/// per-template kernels ([`net`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NetPath {
+    /// From [`net::NET_FROM`] particles on (what [`prepare`] does).
+    Auto,
+    /// Never: the symbolic derivation of the whole model (to compare with).
+    Never,
+    /// Whatever the number of particles (to compare small models).
+    Always,
+}
+
+/// [`prepare_with_jit`], choosing when free particles take the per-template kernels.
+pub fn prepare_on(
+    model: &mut Model,
+    opts: &DeriveOptions,
+    jit: JitMode,
+    path: NetPath,
+) -> Result<Prepared, SimError> {
     // A rate left to `pdyn forces` (`rate = "omega"`, an unknown) has no number to start from.
     if let Some(e) = model.unknown_initial_error() {
         return Err(SimError::UnknownInitialCondition(Box::new(e)));
@@ -576,11 +598,31 @@ pub fn prepare_with_jit(
     } else {
         opts
     };
-    // The chapter's steps: equations of motion, solved for the accelerations...
-    let d = derive(model, opts).map_err(SimError::Derive)?;
-    // ... as a first-order system the integrators can step...
-    let system =
-        CompiledModel::with_jit(model, &d, jit).map_err(|error| compile_error("", error))?;
+    // Many free particles in Cartesian coordinates: each load family's template compiled
+    // once and evaluated over its members, instead of the symbolic derivation below.
+    let from = match path {
+        NetPath::Auto => net::NET_FROM,
+        NetPath::Never => usize::MAX,
+        NetPath::Always => 0,
+    };
+    let net = match (&hybrid, opts.form) {
+        (None, pdyn_mech::derive::Form::Auto) => net::derive_and_compile(model, jit, from),
+        _ => None,
+    };
+    let (d, system) = match net {
+        Some((d, kernels)) => {
+            let system = CompiledModel::for_net(model, &d, kernels);
+            (d, system)
+        }
+        None => {
+            // The chapter's steps: equations of motion, solved for the accelerations...
+            let d = derive(model, opts).map_err(SimError::Derive)?;
+            // ... as a first-order system the integrators can step...
+            let system = CompiledModel::with_jit(model, &d, jit)
+                .map_err(|error| compile_error("", error))?;
+            (d, system)
+        }
+    };
     // ... what to tabulate and which laws the result must obey...
     let (observer, conserved, scales) = observations(model, &d, &system)?;
     // ... when to stop or record, what a sweep measures, and where it starts.
@@ -717,7 +759,7 @@ fn observations(
         conserved.push(false);
     }
     let (mut scale_names, mut scale_exprs) = (Vec::new(), Vec::new());
-    for c in conserved_quantities(model, d) {
+    for c in net::conserved_quantities(model, d, system) {
         scale_names.push(c.name.clone());
         scale_exprs.push(c.scale);
         names.push(c.name);
@@ -901,8 +943,14 @@ fn compile_initial_conditions(
     let param_ids: Vec<Id> = model.parameters.iter().map(|q| q.id).collect();
     let mut ic_exprs = Vec::new();
     let mut ic_rates = Vec::new();
-    for &i in &d.free {
-        if let Some(&(_, e, r)) = model.initial_exprs.iter().find(|(k, _, _)| *k == i) {
+    // By coordinate (the first entry of each), not searched per coordinate: quadratic in a
+    // net's 30,000 coordinates.
+    let mut initial: rustc_hash::FxHashMap<usize, (Id, Id)> = rustc_hash::FxHashMap::default();
+    for &(k, e, r) in &model.initial_exprs {
+        initial.entry(k).or_insert((e, r));
+    }
+    for i in &d.free {
+        if let Some(&(e, r)) = initial.get(i) {
             ic_exprs.push(e);
             ic_rates.push(r);
         }

@@ -1,0 +1,252 @@
+//! Many free particles in Cartesian coordinates (`pdyn::sim::net`, issue 33): the per-template
+//! kernels against the generic symbolic derivation on small nets, energy conservation on an
+//! undamped net, and set-up that grows linearly (counted, not timed).
+
+use pdyn::sim::{self, NetPath, RunSettings};
+use pdyn_jit::JitMode;
+use pdyn_mech::Model;
+use pdyn_ode::OdeSystem;
+
+/// An `nx × ny` net as `examples/hanging_net.toml` writes it (corners `P[0,0]` and
+/// `P[nx-1,0]` pinned), with drag coefficient `c` (none when `None`).
+fn net_source(nx: i64, ny: i64, c: Option<f64>) -> String {
+    let mut s = format!(
+        r#"
+name = "net"
+gravity = "[0, 0, -g]"
+[indices]
+nx = {nx}
+ny = {ny}
+i = "0..nx-1"
+j = "0..ny-1"
+[parameters]
+m = 0.05
+k = 400.0
+kd = 100.0
+a = 0.1
+g = 9.81
+c = {c}
+[coordinates]
+"x[i,j]" = {{ initial = "i*a", rate = 0, where = "not (j == 0 and (i == 0 or i == nx-1))" }}
+"y[i,j]" = {{ initial = "j*a", rate = 0, where = "not (j == 0 and (i == 0 or i == nx-1))" }}
+"z[i,j]" = {{ initial = 0, rate = 0, where = "not (j == 0 and (i == 0 or i == nx-1))" }}
+[points]
+"P[i,j]" = {{ position = "[i*a, j*a, 0]", where = "j == 0 and (i == 0 or i == nx-1)" }}
+[particles."P[i,j]"]
+where = "not (j == 0 and (i == 0 or i == nx-1))"
+mass = "m"
+position = "[x[i,j], y[i,j], z[i,j]]"
+[[forces]]
+kind = "spring"
+name = "horizontal"
+for = "i in 0..nx-2, j"
+between = ["P[i,j]", "P[i+1,j]"]
+k = "k"
+l0 = "a"
+[[forces]]
+kind = "spring"
+name = "vertical"
+for = "i, j in 0..ny-2"
+between = ["P[i,j]", "P[i,j+1]"]
+k = "k"
+l0 = "a"
+[[forces]]
+kind = "spring"
+name = "diagonal"
+for = "i in 0..nx-2, j in 0..ny-2"
+between = ["P[i,j]", "P[i+1,j+1]"]
+k = "kd"
+l0 = "sqrt(2)*a"
+[[forces]]
+kind = "spring"
+name = "antidiagonal"
+for = "i in 0..nx-2, j in 0..ny-2"
+between = ["P[i+1,j]", "P[i,j+1]"]
+k = "kd"
+l0 = "sqrt(2)*a"
+"#,
+        c = c.unwrap_or(0.0)
+    );
+    if c.is_some() {
+        s += r#"
+[[forces]]
+kind = "linear_drag"
+name = "drag"
+for = "i, j"
+where = "not (j == 0 and (i == 0 or i == nx-1))"
+on = "P[i,j]"
+c = "c"
+"#;
+    }
+    s + "[simulate]\nt_end = 0.3\nmethod = \"dop853\"\nrtol = 1e-11\natol = 1e-13\npoints = 4\n"
+}
+
+fn load(src: &str) -> Model {
+    pdyn_mech::load(src, "<net>").unwrap_or_else(|e| panic!("{}", e.render(src)))
+}
+
+fn prepare(src: &str, path: NetPath) -> (Model, sim::Prepared) {
+    let mut m = load(src);
+    let prep = sim::prepare_on(&mut m, &sim::run_options(), JitMode::Auto, path).unwrap();
+    (m, prep)
+}
+
+/// A state away from the initial one, deterministic: every coordinate moved and moving.
+fn perturbed(y0: &[f64]) -> Vec<f64> {
+    y0.iter()
+        .enumerate()
+        .map(|(k, &v)| v + 0.01 * libm::sin(1.7 * k as f64 + 0.3))
+        .collect()
+}
+
+fn max_relative_difference(a: &[f64], b: &[f64]) -> f64 {
+    let scale = a.iter().fold(0.0f64, |s, x| s.max(x.abs())).max(1e-300);
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs() / scale)
+        .fold(0.0, f64::max)
+}
+
+/// The right-hand side, its Jacobian and a short run agree with the generic symbolic path
+/// (A x = b solved by the diagonal rule, the Jacobian differentiated entry by entry) on nets
+/// of 4, 10 and 23 particles, to round-off.
+#[test]
+fn kernels_agree_with_the_generic_derivation() {
+    for (nx, ny) in [(3, 2), (3, 4), (5, 5)] {
+        let src = net_source(nx, ny, Some(0.02));
+        let (_, fast) = prepare(&src, NetPath::Always);
+        let (_, generic) = prepare(&src, NetPath::Never);
+        assert!(fast.system.net_kernels().is_some(), "{nx}x{ny}: not a net");
+        assert!(generic.system.net_kernels().is_none());
+        assert_eq!(fast.state_names, generic.state_names);
+        assert_eq!(fast.y0, generic.y0);
+        assert_eq!(fast.observer.names, generic.observer.names);
+        let dim = generic.system.dim();
+        for y in [generic.y0.clone(), perturbed(&generic.y0)] {
+            let (mut f1, mut f2) = (vec![0.0; dim], vec![0.0; dim]);
+            fast.system.rhs(0.0, &y, &mut f1);
+            generic.system.rhs(0.0, &y, &mut f2);
+            let d = max_relative_difference(&f2, &f1);
+            assert!(d < 1e-13, "{nx}x{ny}: right-hand sides differ by {d:e}");
+            assert!(fast.system.has_jacobian() && generic.system.has_jacobian());
+            let (mut j1, mut j2) = (vec![0.0; dim * dim], vec![0.0; dim * dim]);
+            fast.system.jacobian(0.0, &y, &mut j1);
+            generic.system.jacobian(0.0, &y, &mut j2);
+            let d = max_relative_difference(&j2, &j1);
+            assert!(d < 1e-12, "{nx}x{ny}: Jacobians differ by {d:e}");
+        }
+        let set = RunSettings::from_spec(&load(&src).run.simulate).unwrap();
+        let r1 = sim::run(&fast, &set).unwrap();
+        let r2 = sim::run(&generic, &set).unwrap();
+        assert!(r1.failure.is_none() && r2.failure.is_none());
+        let (a, b) = (r1.rows.last().unwrap(), r2.rows.last().unwrap());
+        // Positions are ~0.1-0.5 m, speeds ~1 m/s: the adaptive steps amplify round-off.
+        let d = max_relative_difference(b, a);
+        assert!(d < 1e-9, "{nx}x{ny}: final rows differ by {d:e}");
+    }
+}
+
+/// A Jacobian by central differences of the kernels' own right-hand side agrees with their
+/// analytic one (a wrong derivative or scatter index fails it).
+#[test]
+fn analytic_jacobian_matches_finite_differences() {
+    let src = net_source(3, 3, Some(0.5));
+    let (_, prep) = prepare(&src, NetPath::Always);
+    let sys = &prep.system;
+    let dim = sys.dim();
+    let y = perturbed(&prep.y0);
+    let mut jac = vec![0.0; dim * dim];
+    sys.jacobian(0.0, &y, &mut jac);
+    let (mut fp, mut fm) = (vec![0.0; dim], vec![0.0; dim]);
+    for j in 0..dim {
+        let h = 1e-6;
+        let (mut yp, mut ym) = (y.clone(), y.clone());
+        yp[j] += h;
+        ym[j] -= h;
+        sys.rhs(0.0, &yp, &mut fp);
+        sys.rhs(0.0, &ym, &mut fm);
+        for i in 0..dim {
+            let fd = (fp[i] - fm[i]) / (2.0 * h);
+            let an = jac[i * dim + j];
+            assert!(
+                (fd - an).abs() <= 1e-5 * (1.0 + an.abs()),
+                "∂f{i}/∂y{j}: analytic {an}, finite differences {fd}"
+            );
+        }
+    }
+}
+
+/// Without drag the net conserves its energy (springs and gravity have potentials): the run
+/// monitors it, and a tight tolerance keeps its drift at round-off.
+#[test]
+fn undamped_net_conserves_energy() {
+    let src = net_source(4, 4, None);
+    let (_, prep) = prepare(&src, NetPath::Auto);
+    assert!(prep.system.net_kernels().is_some());
+    let set = RunSettings::from_spec(&load(&src).run.simulate).unwrap();
+    let res = sim::run(&prep, &set).unwrap();
+    let energy = res
+        .monitors
+        .iter()
+        .find(|m| m.name == "energy")
+        .expect("energy is monitored");
+    assert!(energy.conserved && energy.relative);
+    assert!(energy.drift < 1e-8, "energy drift {:e}", energy.drift);
+    assert!(res.warnings.is_empty(), "{:?}", res.warnings);
+    // It moved: the net fell (a run that did nothing would conserve energy too).
+    let z = RunSettings::final_value(&res, "z[3,3]").unwrap();
+    assert!(z < -0.05, "far corner z = {z}");
+}
+
+/// With drag, energy is not monitored as conserved.
+#[test]
+fn damped_net_monitors_no_energy() {
+    let (_, prep) = prepare(&net_source(4, 4, Some(0.02)), NetPath::Auto);
+    assert!(prep.system.net_kernels().is_some());
+    assert!(!prep.observer.names.iter().any(|n| n == "energy"));
+}
+
+/// Set-up grows linearly with the particles (counts, not times): the templates are the same
+/// dozen at every size, the kernels' operations per particle and the expression nodes per
+/// particle stay constant from ~10^2 to ~10^4 particles.
+#[test]
+fn setup_counts_grow_linearly() {
+    let mut rows = Vec::new();
+    for n in [10, 32, 100] {
+        let src = net_source(n, n, Some(0.02));
+        let (m, prep) = prepare(&src, NetPath::Auto);
+        let k = prep.system.net_kernels().expect("a net");
+        let particles = (n * n - 2) as f64;
+        rows.push((
+            n,
+            k.len(),
+            k.operations() as f64 / particles,
+            m.pool.len() as f64 / particles,
+        ));
+    }
+    // What one more particle costs, between consecutive sizes: the boundary (fewer springs
+    // per edge particle) makes small nets a little cheaper per particle, so the increments,
+    // not the averages, are compared.
+    let templates = rows[0].1;
+    let increments: Vec<(f64, f64)> = rows
+        .windows(2)
+        .map(|w| {
+            let (a, b) = (w[0], w[1]);
+            let (pa, pb) = ((a.0 * a.0 - 2) as f64, (b.0 * b.0 - 2) as f64);
+            let d = pb - pa;
+            ((b.2 * pb - a.2 * pa) / d, (b.3 * pb - a.3 * pa) / d)
+        })
+        .collect();
+    for &(n, t, _, _) in &rows {
+        assert_eq!(t, templates, "templates at n = {n}: {rows:?}");
+    }
+    let (first, second) = (increments[0], increments[1]);
+    assert!(
+        (second.0 / first.0 - 1.0).abs() < 0.1,
+        "operations per particle: {increments:?}"
+    );
+    assert!(
+        (second.1 / first.1 - 1.0).abs() < 0.1,
+        "nodes per particle: {increments:?}"
+    );
+}
