@@ -402,3 +402,63 @@ fn foreign_and_mismatched_checkpoints_are_refused() {
     assert!(err.contains("rows are missing"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A full disk, simulated by a file-size limit (`ulimit -f`, 512-byte blocks): the streamed
+/// run stops with exit 1 and an error naming the table, its last whole row and the intact
+/// checkpoint; once the limit is gone, `--restart` finishes with the table of a run that
+/// never hit it.
+#[cfg(unix)]
+#[test]
+fn a_full_disk_stops_the_run_with_a_whole_table_and_the_restart_finishes_it() {
+    let model = example("examples/pendulum_chain_3.toml");
+    let extra = [
+        "--method",
+        "dopri5",
+        "--t-end",
+        "200",
+        "--points",
+        "20001",
+        "--checkpoint-every",
+        "1000steps",
+    ];
+    let reference = fresh_dir("fsize-ref");
+    let st = Command::new(bin())
+        .args(run_args(&model, &extra, &reference))
+        .stdout(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let full = std::fs::metadata(reference.join("trajectory.csv"))
+        .unwrap()
+        .len();
+    let dir = fresh_dir("fsize");
+    let blocks = full * 2 / 5 / 512;
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -f {blocks} && exec \"$0\" \"$@\""))
+        .arg(bin())
+        .args(run_args(&model, &extra, &dir))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("trajectory.csv")
+            && err.contains("last whole row")
+            && err.contains("--restart"),
+        "{err}"
+    );
+    assert_whole_rows(&dir, "after the file-size limit", false);
+    let ckpt = dir.join("checkpoint.json");
+    assert!(ckpt.exists());
+    let st = Command::new(bin())
+        .args(run_args(&model, &extra, &dir))
+        .args(["--restart", &ckpt.display().to_string()])
+        .stdout(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(st.success());
+    assert_same_files(&reference, &dir, "after the full disk");
+    let _ = std::fs::remove_dir_all(&reference);
+    let _ = std::fs::remove_dir_all(&dir);
+}
