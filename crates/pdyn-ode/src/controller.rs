@@ -109,6 +109,16 @@ impl PiState {
         }
     }
 
+    /// The memory of the PI term: the error norm of the last accepted step (at least 1e-4).
+    pub(crate) fn memory(&self) -> f64 {
+        self.facold
+    }
+
+    /// Sets the memory of the PI term (a solve resumed from a saved state).
+    pub(crate) fn restore(&mut self, facold: f64) {
+        self.facold = facold;
+    }
+
     /// Returns `(accepted, h_new)` for error `err` of a step of size `h`.
     #[inline]
     pub(crate) fn propose(&mut self, err: f64, h: f64) -> (bool, f64) {

@@ -117,6 +117,27 @@ impl<'e, 'a> EventState<'e, 'a> {
         }
     }
 
+    /// The memory carried from one step to the next (for a saved state).
+    pub(crate) fn memory(&self) -> crate::resume::EventMemory {
+        crate::resume::EventMemory {
+            g_prev: self.g_prev.clone(),
+            g_prev2: self.g_prev2.clone(),
+            t_prev: self.t_prev,
+            t_prev2: self.t_prev2,
+            counts: self.counts.clone(),
+        }
+    }
+
+    /// Continues from a saved memory (its lengths checked by the caller).
+    pub(crate) fn restore(&mut self, m: &crate::resume::EventMemory) {
+        self.g_prev.copy_from_slice(&m.g_prev);
+        self.g_prev2.copy_from_slice(&m.g_prev2);
+        self.g_new.copy_from_slice(&m.g_prev);
+        self.t_prev = m.t_prev;
+        self.t_prev2 = m.t_prev2;
+        self.counts.copy_from_slice(&m.counts);
+    }
+
     /// The suspicious intervals recorded since the last call, as [`PossibleMiss`]es.
     pub(crate) fn drain_suspects(&mut self, into: &mut Vec<PossibleMiss>) {
         into.extend(self.suspects.drain(..).map(|(index, a, b)| PossibleMiss {
@@ -396,6 +417,16 @@ impl<'a> Output<'a> {
             dir,
             event_point: opts.output_terminal_event,
         }
+    }
+
+    /// Continues a saved solve: the next output time is `t_eval[next]`.
+    pub(crate) fn resume_at(&mut self, next: usize) {
+        self.next = next;
+    }
+
+    /// Index into `t_eval` of the next output time.
+    pub(crate) fn next_index(&self) -> usize {
+        self.next
     }
 
     /// Records the initial point.

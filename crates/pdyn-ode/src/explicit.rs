@@ -12,6 +12,7 @@ use crate::error::{invalid, point, OdeError};
 use crate::events::{check_t_eval, DenseOutput, Event, EventState, Output};
 use crate::options::{Options, StiffnessAction};
 use crate::problem::OdeSystem;
+use crate::resume::{Accepted, Observer, ResumeState, StateView};
 use crate::solution::{Solution, Stats, Status};
 use crate::Method;
 
@@ -151,6 +152,36 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
     events: &[Event<'_>],
     stiff_action: StiffnessAction,
 ) -> Result<Solution, OdeError> {
+    let hooks = Hooks {
+        resume: None,
+        observer: None,
+    };
+    integrate_with::<M, S>(sys, t0, tf, y0, opts, events, stiff_action, hooks)
+}
+
+/// What [`crate::resume::solve_observed`] adds to a solve: a saved state to start from, an
+/// observer of the accepted steps.
+pub(crate) struct Hooks<'r, 'o, 'p> {
+    pub resume: Option<&'r ResumeState>,
+    pub observer: Option<&'o mut Observer<'p>>,
+}
+
+/// [`integrate`] with [`Hooks`].
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn integrate_with<M: ExplicitRk, S: OdeSystem + ?Sized>(
+    sys: &S,
+    t0: f64,
+    tf: f64,
+    y0: &[f64],
+    opts: &Options,
+    events: &[Event<'_>],
+    stiff_action: StiffnessAction,
+    hooks: Hooks<'_, '_, '_>,
+) -> Result<Solution, OdeError> {
+    let Hooks {
+        resume,
+        mut observer,
+    } = hooks;
     let Setup {
         n,
         dir,
@@ -163,53 +194,78 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
     if opts.dense_output {
         sol.dense = Some(crate::DenseSolution::new(n));
     }
-    let mut y = y0.to_vec();
     let mut y_new = vec![0.0; n];
     let mut ytmp = vec![0.0; n];
     let mut ytmp2 = vec![0.0; n];
     let mut rk = M::new(n);
     let ctrl = opts.controller.unwrap_or_else(M::default_controller);
     let mut pi = PiState::new(&ctrl, M::alpha(&ctrl));
+    let nstiff = opts.stiffness_check_interval.max(1);
 
     let mut out = Output::new(opts, dir);
-    out.start(&mut sol, t0, y0);
-    if t0 == tf {
-        return Ok(sol);
-    }
-    sys.rhs(t0, &y, rk.f_start());
-    sol.stats.fevals += 1;
-    let mut h = match opts.h0 {
-        Some(h0) => h0.abs().min(hmax) * dir,
+    let mut ev;
+    let mut t;
+    let mut y;
+    let mut h;
+    let mut nstep;
+    let (mut iasti, mut nonsti, mut stiff_countdown);
+    let mut nonfinite_in_row;
+    match resume {
         None => {
-            let f0 = rk.f_start().to_vec();
+            y = y0.to_vec();
+            out.start(&mut sol, t0, y0);
+            if t0 == tf {
+                return Ok(sol);
+            }
+            sys.rhs(t0, &y, rk.f_start());
             sol.stats.fevals += 1;
-            initial_step(
-                sys,
-                t0,
-                &y,
-                &f0,
-                dir,
-                M::ORDER,
-                hmax,
-                &atol,
-                &rtol,
-                &mut ytmp,
-                &mut ytmp2,
-            )
+            h = match opts.h0 {
+                Some(h0) => h0.abs().min(hmax) * dir,
+                None => {
+                    let f0 = rk.f_start().to_vec();
+                    sol.stats.fevals += 1;
+                    initial_step(
+                        sys,
+                        t0,
+                        &y,
+                        &f0,
+                        dir,
+                        M::ORDER,
+                        hmax,
+                        &atol,
+                        &rtol,
+                        &mut ytmp,
+                        &mut ytmp2,
+                    )
+                }
+            };
+            if h.abs() < hmin {
+                h = hmin * dir;
+            }
+            ev = EventState::new(events, n, t0, y0);
+            t = t0;
+            nstep = 0usize;
+            (iasti, nonsti, stiff_countdown) = (0usize, 0usize, nstiff);
+            nonfinite_in_row = 0usize;
         }
-    };
-    if h.abs() < hmin {
-        h = hmin * dir;
+        Some(r) => {
+            // Everything the loop below reads, as it was after the saved step.
+            y = r.y.clone();
+            rk.f_start().copy_from_slice(&r.first_stage);
+            sol.stats = r.stats.clone();
+            pi.restore(r.facold);
+            out.resume_at(r.next_output);
+            ev = EventState::new(events, n, t0, y0);
+            ev.restore(&r.events);
+            t = r.t;
+            h = r.h;
+            nstep = r.attempts;
+            [iasti, nonsti, stiff_countdown] = r.stiffness;
+            nonfinite_in_row = r.non_finite_in_row;
+        }
     }
-    let mut ev = EventState::new(events, n, t0, y0);
-    let mut t = t0;
     let mut reject = false;
     let mut last = false;
-    let mut nstep = 0usize;
-    let (mut iasti, mut nonsti) = (0usize, 0usize);
-    let nstiff = opts.stiffness_check_interval.max(1);
-    let mut stiff_countdown = nstiff;
-    let mut nonfinite_in_row = 0usize;
     loop {
         if opts.interrupted() {
             return Err(OdeError::Interrupted {
@@ -321,6 +377,30 @@ pub(crate) fn integrate<M: ExplicitRk, S: OdeSystem + ?Sized>(
             }
         }
         h = if hnew.abs() < hmin { hmin * dir } else { hnew };
+        if let (true, Some(watch)) = (accepted, observer.as_mut()) {
+            // Between two steps: the state the loop continues from is complete here.
+            let mut step = Accepted {
+                t,
+                view: StateView {
+                    method: M::METHOD,
+                    y: &y,
+                    first_stage: rk.f_start(),
+                    h,
+                    facold: pi.memory(),
+                    attempts: nstep,
+                    stiffness: [iasti, nonsti, stiff_countdown],
+                    non_finite_in_row: nonfinite_in_row,
+                    events: &ev,
+                    next_output: out.next_index(),
+                },
+                solution: &mut sol,
+            };
+            if watch(&mut step).is_break() {
+                return Err(OdeError::Interrupted {
+                    at: point(t, &y, &mut sol),
+                });
+            }
+        }
     }
 }
 

@@ -30,6 +30,7 @@
 //! | `controller.rs` | the shared PI step-size controller and initial-step estimate (Hairer) |
 //! | `events.rs` | [`Event`]s and the shared locator (Brent's method on the dense output), output at `t_eval` |
 //! | `explicit.rs`, `fixed.rs` | drivers shared by the explicit adaptive pairs, and by the fixed-step methods |
+//! | `resume.rs` | [`solve_observed`]: an explicit pair watched step by step (outputs taken as they come) and resumed bit for bit from a saved [`ResumeState`] |
 //! | `tableau.rs` | Butcher tableaus as data; order-condition checker over rooted trees |
 //! | `linalg.rs` | dense real/complex LU with partial pivoting (decsol.f), allocation-free |
 //! | `methods/dopri5.rs` | **DOPRI5**, Dormand & Prince 1980: 5(4), FSAL, 4th-order dense output, stiffness detection (MATLAB `ode45`) |
@@ -79,6 +80,7 @@ pub mod methods;
 mod options;
 pub mod problem;
 pub mod problems;
+pub mod resume;
 mod solution;
 pub mod tableau;
 
@@ -92,6 +94,7 @@ pub use problem::{
     FirstOrderForm, FnSecondOrder, FnSystem, FnSystemWithJacobian, MassInverse, MassKind,
     OdeSystem, SecondOrderSystem,
 };
+pub use resume::{solve_observed, Accepted, EventMemory, ResumeState};
 pub use solution::{Direction, EventHit, PossibleMiss, Solution, Stats, Status};
 
 /// The integration methods. Everything descriptive about a method (name, aliases, order,

@@ -219,7 +219,7 @@ pub fn run_long(
             ),
         ));
     }
-    if file.kind != Kind::Nbody
+    if !matches!(file.kind, Kind::Nbody | Kind::Mechanics)
         && (long.restart.is_some()
             || long
                 .checkpoint_every
@@ -242,7 +242,7 @@ pub fn run_long(
         Kind::Mechanics => {
             let mut model = file.mechanics()?;
             crate::params::set_parameter_values(&mut model, &req.params, RunOption::Set.name())?;
-            RunOutput::Mechanics(Box::new(run_mechanics(model, req)?))
+            RunOutput::Mechanics(Box::new(run_mechanics_long(model, Some(file), req, long)?))
         }
         Kind::Nbody => RunOutput::Nbody(Box::new(run_nbody(file, req, long, progress)?)),
         Kind::Md => RunOutput::Md(Box::new(run_md(file, req, progress)?)),
@@ -251,7 +251,19 @@ pub fn run_long(
 
 /// Runs a mechanics model already loaded (with its parameters set): Python's `Model` holds
 /// one.
-pub fn run_mechanics(mut model: Model, req: &Request) -> Result<MechanicsRun, Error> {
+pub fn run_mechanics(model: Model, req: &Request) -> Result<MechanicsRun, Error> {
+    run_mechanics_long(model, None, req, &LongRun::default())
+}
+
+/// [`run_mechanics`] with the options of long runs (`file`: the model's file, which a
+/// checkpoint names): the table streamed into `--out`, checkpoints, a restart
+/// ([`sim::long_run`]).
+fn run_mechanics_long(
+    mut model: Model,
+    file: Option<&ModelFile>,
+    req: &Request,
+    long: &LongRun,
+) -> Result<MechanicsRun, Error> {
     let mut settings = sim::request::settings(&model, req)?;
     if req.plots
         && settings.points.is_none()
@@ -262,11 +274,21 @@ pub fn run_mechanics(mut model: Model, req: &Request) -> Result<MechanicsRun, Er
         settings.points = Some(2001);
     }
     let prepared = sim::request::prepare(&mut model, req.jit)?;
+    let streamed = sim::long_run::plan(&prepared, &settings, file, req, long)?;
     if let Some(dir) = &req.out {
         // Before the run: a run stopped early still has its directory.
         create_dir(dir)?;
     }
-    let (result, failure) = sim::request::execute(&mut model, &prepared, &settings)?;
+    let (result, failure, long_fields) = match streamed {
+        Some(plan) => {
+            let s = sim::long_run::execute(&mut model, &prepared, &settings, plan)?;
+            (s.result, s.failure, Some((s.checkpoint, s.restarted_from)))
+        }
+        None => {
+            let (result, failure) = sim::request::execute(&mut model, &prepared, &settings)?;
+            (result, failure, None)
+        }
+    };
     let mut summary = output::summary(
         &result,
         &model.name,
@@ -297,10 +319,22 @@ pub fn run_mechanics(mut model: Model, req: &Request) -> Result<MechanicsRun, Er
             summary["failure"] = f.to_string().into();
         }
     }
+    if let Some((checkpoint, restarted_from)) = &long_fields {
+        for (key, value) in [
+            ("checkpoint", checkpoint),
+            ("restarted_from", restarted_from),
+        ] {
+            if !value.is_null() {
+                summary[key] = value.clone();
+            }
+        }
+    }
     if let Some(dir) = &req.out {
         create_dir(dir)?;
-        let csv = dir.join("trajectory.csv");
-        output::write_csv(&result, &csv).map_err(|e| Error::io(&csv, "write", e))?;
+        if long_fields.is_none() {
+            let csv = dir.join("trajectory.csv");
+            output::write_csv(&result, &csv).map_err(|e| Error::io(&csv, "write", e))?;
+        }
         let js = dir.join("summary.json");
         let text = output::summary_text(&summary, result.hybrid.as_ref());
         std::fs::write(&js, text).map_err(|e| Error::io(&js, "write", e))?;

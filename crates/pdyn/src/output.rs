@@ -111,7 +111,7 @@ pub fn summary(
                 "direction": if e.rising { "rising" } else { "falling" },
                 "state": state_names.iter().zip(&e.state).map(|(n, v)| (n.clone(), json_num(*v))).collect::<serde_json::Map<_, _>>(),
             })).collect::<Vec<_>>(),
-            "outputs": res.rows.len(),
+            "outputs": res.outputs,
         }),
     )
 }

@@ -1796,6 +1796,7 @@ pub fn run(prep: &Prepared, h: &Hybrid, set: &RunSettings) -> Result<RunResult, 
     }
     Ok(RunResult {
         columns,
+        outputs: rows.len(),
         rows,
         events,
         monitors,

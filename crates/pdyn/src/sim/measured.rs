@@ -302,14 +302,14 @@ impl NonFinite {
 
 /// [`NonFinite`] gathered row by row.
 #[derive(Default)]
-struct NonFiniteScan {
-    first_t: Option<f64>,
-    bad: Vec<bool>,
+pub(crate) struct NonFiniteScan {
+    pub(crate) first_t: Option<f64>,
+    pub(crate) bad: Vec<bool>,
 }
 
 impl NonFiniteScan {
     /// One row (its time `t` and its cells, `t` first).
-    fn row(&mut self, t: f64, cells: impl Iterator<Item = f64>) {
+    pub(crate) fn row(&mut self, t: f64, cells: impl Iterator<Item = f64>) {
         for (j, x) in cells.enumerate() {
             if !x.is_finite() {
                 if self.bad.len() <= j {
@@ -321,7 +321,7 @@ impl NonFiniteScan {
         }
     }
 
-    fn finish(self) -> Option<NonFinite> {
+    pub(crate) fn finish(self) -> Option<NonFinite> {
         let t = self.first_t?;
         let columns = (0..self.bad.len()).filter(|&j| self.bad[j]).collect();
         Some(NonFinite { t, columns })

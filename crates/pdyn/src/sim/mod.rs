@@ -17,6 +17,7 @@ mod error;
 pub mod exact;
 pub mod hybrid;
 pub mod linearize;
+pub mod long_run;
 pub mod measured;
 pub mod net;
 pub mod report;
@@ -471,6 +472,9 @@ pub struct MonitorReport {
 pub struct RunResult {
     /// Column names: `t`, state, observer outputs.
     pub columns: Vec<String>,
+    /// Output rows produced: `rows.len()`, unless the table was streamed into a file (a long
+    /// run, [`long_run`]): `rows` then holds only the last.
+    pub outputs: usize,
     /// One row per output time.
     pub rows: Vec<Vec<f64>>,
     /// Events in time order.
@@ -840,7 +844,7 @@ pub(crate) struct FrictionWatch {
     out: Vec<f64>,
     /// Per friction: the first time and power where it did positive work, and the largest
     /// power.
-    first: Vec<Option<(f64, f64, f64)>>,
+    pub(crate) first: Vec<Option<(f64, f64, f64)>>,
 }
 
 impl FrictionWatch {
@@ -889,7 +893,7 @@ impl FrictionWatch {
 #[derive(Default)]
 pub(crate) struct PushWatch {
     /// Per reaction: the first `(t, value)` where it pulled, and its largest magnitude.
-    seen: Vec<(Option<(f64, f64)>, f64)>,
+    pub(crate) seen: Vec<(Option<(f64, f64)>, f64)>,
 }
 
 impl PushWatch {
@@ -1039,6 +1043,22 @@ pub(crate) fn integrate(
     prep: &Prepared,
     set: &RunSettings,
 ) -> Result<(Solution, Option<RunFailure>), SimError> {
+    integrate_observed(prep, set, None)
+}
+
+/// What [`integrate_observed`] adds to [`integrate`]: an observer of the accepted steps and a
+/// saved state to start from ([`pdyn_ode::solve_observed`]; explicit adaptive pairs only).
+pub(crate) type Watch<'a, 'o> = (
+    &'a mut pdyn_ode::resume::Observer<'o>,
+    Option<&'a pdyn_ode::ResumeState>,
+);
+
+/// [`integrate`], watched step by step when `watch` is given.
+pub(crate) fn integrate_observed(
+    prep: &Prepared,
+    set: &RunSettings,
+    watch: Option<Watch<'_, '_>>,
+) -> Result<(Solution, Option<RunFailure>), SimError> {
     let method = method_by_name(&set.method).ok_or_else(|| SimError::UnknownMethod {
         name: set.method.clone(),
     })?;
@@ -1116,7 +1136,20 @@ pub(crate) fn integrate(
         })
         .collect();
 
-    let result = if method.kind() == MethodKind::Symplectic {
+    let result = if let Some((observer, resume)) = watch {
+        // The observer stops the run itself on an interrupt, after its last checkpoint.
+        opts.interrupt = None;
+        pdyn_ode::solve_observed(
+            method,
+            sys,
+            (0.0, t_end),
+            &prep.y0,
+            &opts,
+            &events,
+            resume,
+            observer,
+        )
+    } else if method.kind() == MethodKind::Symplectic {
         if !sys.separable && !matches!(method, Method::Gauss4 | Method::Gauss6) {
             return Err(SimError::NotSeparable {
                 method: set.method.clone(),
@@ -1256,6 +1289,7 @@ pub(crate) fn tabulate(
     warnings.extend(push.warnings(prep));
     RunResult {
         columns,
+        outputs: rows.len(),
         rows,
         events,
         monitors,

@@ -20,7 +20,7 @@ pub fn text_report(
         res.stats.accepted,
         res.stats.rejected,
         res.stats.fevals,
-        res.rows.len()
+        res.outputs
     );
     if let Some(last) = res.rows.last() {
         s += "\nfinal values:\n";
