@@ -15,8 +15,8 @@
 //! the output files' lengths when it was written (a restart truncates each file to its length
 //! before appending: no row twice, none lost) and the engine's state, every floating-point
 //! number as its bit pattern (`f64::to_bits`), so that the continuation is bit for bit the
-//! uninterrupted run. Kinds: N-body (WHFast, IAS15, leapfrog). Mechanics and MD runs do not
-//! write checkpoints yet.
+//! uninterrupted run. Kinds: N-body (WHFast, IAS15, leapfrog) and MD (`crate::md::checkpoint`).
+//! Mechanics runs do not write checkpoints yet.
 
 use crate::model_file::ModelFile;
 use crate::{Error, Request};
