@@ -107,6 +107,16 @@ pub enum MdError {
         /// Kind of the underlying error.
         kind: std::io::ErrorKind,
     },
+    /// A snapshot (a checkpoint's state) that does not fit the simulation it is restored
+    /// into: another number of particles, another thermostat, another chain length.
+    SnapshotMismatch {
+        /// What differs.
+        what: &'static str,
+        /// The simulation's count (or kind index).
+        expected: usize,
+        /// The snapshot's.
+        found: usize,
+    },
 }
 
 impl From<ParticleError> for MdError {
@@ -197,6 +207,14 @@ impl fmt::Display for MdError {
                 message,
             } => write!(f, "{format} line {line}: {message}"),
             Io { kind } => write!(f, "I/O error: {kind}"),
+            SnapshotMismatch {
+                what,
+                expected,
+                found,
+            } => write!(
+                f,
+                "the saved state does not fit this simulation: {what} {found}, this simulation has {expected}"
+            ),
         }
     }
 }

@@ -48,6 +48,9 @@ pub use neighbor::NeighborList;
 pub use pdyn_particles::rng::Rng;
 pub use pdyn_particles::{Particle, Particles, Vec3};
 pub use sim_box::SimBox;
-pub use simulation::{Observer, RunReport, SimParams, Simulation, System, ENERGY_CHECK_EVERY};
+pub use simulation::{
+    Observer, RunReport, SimParams, Simulation, Snapshot, System, ThermostatState,
+    ENERGY_CHECK_EVERY,
+};
 pub use thermo::{KineticEstimator, ThermoRecord, THERMO_CSV_HEADER};
 pub use velocities::maxwell_boltzmann;

@@ -298,7 +298,6 @@ impl NeighborList {
     /// the cluster-pair list.
     pub fn build(&mut self, p: &mut Particles, images: &mut [[i32; 3]], bx: &SimBox) {
         let n = p.len();
-        let rs = self.cutoff + self.skin;
         self.n_local = n;
         for i in 0..n {
             for (k, c) in [&mut p.x, &mut p.y, &mut p.z].into_iter().enumerate() {
@@ -309,13 +308,38 @@ impl NeighborList {
         }
         self.x0.clear();
         self.x0.extend((0..n).map(|i| [p.x[i], p.y[i], p.z[i]]));
-        let l = bx.l;
-        let cols = Columns::new(l, n);
+        self.index_reference(bx.l);
+        self.builds += 1;
+    }
+
+    /// Clusters, pairs and segments from the reference positions `x0` (a function of them,
+    /// the box and the cutoffs only).
+    fn index_reference(&mut self, l: [f64; 3]) {
+        let rs = self.cutoff + self.skin;
+        let cols = Columns::new(l, self.x0.len());
         self.sort_into_clusters(&cols);
         self.fill_clusters(l, rs);
         self.pair_search(&cols, l, rs);
         self.cut_segments();
-        self.builds += 1;
+    }
+
+    /// The positions of the last build (wrapped into the box): with [`NeighborList::builds`],
+    /// what [`NeighborList::restore`] needs to make the same list again.
+    pub fn reference(&self) -> &[[f64; 3]] {
+        &self.x0
+    }
+
+    /// The list a build at `reference` (the positions [`NeighborList::reference`] returned)
+    /// made, `builds` builds counted, holding the particles' current positions `p`: the same
+    /// clusters, pairs and segments, so the same order of the force sums, as the list that
+    /// was saved. `reference` must have one entry per particle of `p`.
+    pub fn restore(&mut self, reference: &[[f64; 3]], builds: u64, p: &Particles, bx: &SimBox) {
+        self.n_local = reference.len();
+        self.x0.clear();
+        self.x0.extend_from_slice(reference);
+        self.index_reference(bx.l);
+        self.builds = builds;
+        self.update_positions(p);
     }
 
     /// Internal order: by column (x-major), then by z (ties by particle index); each column

@@ -22,6 +22,9 @@ use crate::{
 use pdyn_particles::{Particles, Vec3};
 use std::sync::atomic::Ordering;
 
+mod snapshot;
+pub use snapshot::{Snapshot, ThermostatState};
+
 /// Particles in a periodic box, with types and bonds.
 #[derive(Debug, Clone)]
 pub struct System {

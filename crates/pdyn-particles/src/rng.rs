@@ -68,6 +68,18 @@ impl Rng {
         }
     }
 
+    /// The generator's whole state: the four xoshiro256** words and the normal deviate the
+    /// polar method holds back for the next call, if any (a checkpoint saves them to continue
+    /// the stream exactly: [`Rng::from_state`]).
+    pub fn state(&self) -> ([u64; 4], Option<f64>) {
+        (self.s, self.spare)
+    }
+
+    /// The generator whose state [`Rng::state`] returned.
+    pub fn from_state(words: [u64; 4], spare: Option<f64>) -> Self {
+        Rng { s: words, spare }
+    }
+
     /// Next 64 random bits.
     pub fn next_u64(&mut self) -> u64 {
         let r = self.s[1].wrapping_mul(5).rotate_left(7).wrapping_mul(9);

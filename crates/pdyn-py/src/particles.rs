@@ -91,8 +91,12 @@ impl PyParticleModel {
     }
 
     /// Runs the model as `pdyn run` does (see `pdyn.Model.run`), through the same library
-    /// entry (`pdyn::run`); `out` writes the CLI's files there, and its plots with `plots`.
-    #[pyo3(signature = (t_end=None, method=None, dt=None, points=None, t_eval=None, drift_tolerance=None, params=None, out=None, plots=false, jit=true, rtol=None, atol=None, max_step=None, max_steps=None))]
+    /// entry (`pdyn::engine::run_long`); `out` writes the CLI's files there, and its plots
+    /// with `plots`. `checkpoint_every` (`"15min"`, `"500steps"`, `"off"`) writes
+    /// `out/checkpoint.json` as `pdyn run --checkpoint-every` does, `restart` continues from
+    /// one as `--restart` does; with either, the rows go to the files as the run goes and an
+    /// N-body result keeps only the first and last output (the files hold every row).
+    #[pyo3(signature = (t_end=None, method=None, dt=None, points=None, t_eval=None, drift_tolerance=None, params=None, out=None, plots=false, jit=true, rtol=None, atol=None, max_step=None, max_steps=None, checkpoint_every=None, restart=None))]
     #[allow(clippy::too_many_arguments)]
     fn run(
         &self,
@@ -111,8 +115,26 @@ impl PyParticleModel {
         atol: Option<f64>,
         max_step: Option<f64>,
         max_steps: Option<usize>,
+        checkpoint_every: Option<String>,
+        restart: Option<PathBuf>,
     ) -> PyResult<PyObject> {
         guarded(py, || {
+            let every = checkpoint_every
+                .as_deref()
+                .map(pdyn::checkpoint::Every::parse)
+                .transpose()
+                .map_err(|m| {
+                    to_py(
+                        py,
+                        &Error::argument("checkpoint_every", format!("checkpoint_every={m}")),
+                    )
+                })?;
+            let long = pdyn::engine::LongRun {
+                stream_only: restart.is_some()
+                    || every.is_some_and(|e| e != pdyn::checkpoint::Every::Off),
+                checkpoint_every: every,
+                restart,
+            };
             let req = pdyn::Request {
                 method,
                 rtol,
@@ -139,7 +161,7 @@ impl PyParticleModel {
                     interrupt: Some(stop),
                     ..req
                 };
-                pdyn::run(&self.file, &req, &mut |_| {})
+                pdyn::engine::run_long(&self.file, &req, &long, &mut |_| {})
             })?;
             let ran = finished.value.map_err(|e| to_py(py, &e))?;
             let d = to_dict(py, ran)?;

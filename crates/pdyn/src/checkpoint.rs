@@ -15,8 +15,8 @@
 //! the output files' lengths when it was written (a restart truncates each file to its length
 //! before appending: no row twice, none lost) and the engine's state, every floating-point
 //! number as its bit pattern (`f64::to_bits`), so that the continuation is bit for bit the
-//! uninterrupted run. Kinds: N-body (WHFast, IAS15, leapfrog); mechanics (smooth models by an
-//! explicit adaptive pair: `sim::long_run`). MD runs do not write checkpoints yet.
+//! uninterrupted run. Kinds: N-body (WHFast, IAS15, leapfrog); MD (`crate::md::checkpoint`);
+//! mechanics (smooth models by an explicit adaptive pair: `sim::long_run`).
 
 use crate::model_file::ModelFile;
 use crate::{Error, Request};

@@ -219,25 +219,8 @@ pub fn run_long(
             ),
         ));
     }
-    if !matches!(file.kind, Kind::Nbody | Kind::Mechanics)
-        && (long.restart.is_some()
-            || long
-                .checkpoint_every
-                .is_some_and(|e| e != crate::checkpoint::Every::Off))
-    {
-        let option = if long.restart.is_some() {
-            "--restart"
-        } else {
-            "--checkpoint-every"
-        };
-        return Err(Error::argument(
-            option,
-            format!(
-                "{option}: checkpoints and restarts are made for N-body runs only so far; a {} run is not checkpointed (see docs/long-runs.md)",
-                file.kind.name()
-            ),
-        ));
-    }
+    // Every kind writes checkpoints; what a kind cannot checkpoint (a hybrid mechanics
+    // model, an implicit method) it refuses itself, by name.
     Ok(match file.kind {
         Kind::Mechanics => {
             let mut model = file.mechanics()?;
@@ -245,7 +228,7 @@ pub fn run_long(
             RunOutput::Mechanics(Box::new(run_mechanics_long(model, Some(file), req, long)?))
         }
         Kind::Nbody => RunOutput::Nbody(Box::new(run_nbody(file, req, long, progress)?)),
-        Kind::Md => RunOutput::Md(Box::new(run_md(file, req, progress)?)),
+        Kind::Md => RunOutput::Md(Box::new(run_md(file, req, long, progress)?)),
     })
 }
 
@@ -472,8 +455,33 @@ fn stopped_writing(
 fn run_md(
     file: &ModelFile,
     req: &Request,
+    long: &LongRun,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<MdRun, Error> {
+    let restart = match &long.restart {
+        Some(path) => {
+            if req.out.is_none() {
+                return Err(Error::argument(
+                    "--restart",
+                    "--restart continues the files of --out DIR",
+                ));
+            }
+            Some(crate::checkpoint::read(path, "md", file, req)?)
+        }
+        None => None,
+    };
+    let every = long
+        .checkpoint_every
+        .unwrap_or(crate::checkpoint::Every::Seconds(
+            crate::checkpoint::DEFAULT_SECONDS,
+        ));
+    let mut checkpoints = match &req.out {
+        Some(dir) if every != crate::checkpoint::Every::Off && long.stream_only => Some(
+            crate::checkpoint::Checkpointer::new(dir, every, "md", file, req)
+                .starting_at(restart.as_ref().map_or(0, |r| r.steps)),
+        ),
+        _ => None,
+    };
     let (spec, drift_tolerance) = md::request::plan(&file.source, &file.origin, req)?;
     // Files named in the model (a lattice, a data file) are relative to the model file.
     let base = Path::new(&file.origin).parent().unwrap_or(Path::new("."));
@@ -499,21 +507,49 @@ fn run_md(
         interrupt: req.interrupt.clone(),
         frame_every: req.frame_every.unwrap_or(0),
     };
-    let result = md::run(&mut prepared, &opts, &mut |p| match p {
-        md::Progress::Record(r) => progress(Progress::Log(&md::report::thermo_line(r))),
-        md::Progress::Step(s) => progress(Progress::Step(s)),
-        md::Progress::Frame { step, system } => {
-            let p = &system.particles;
-            progress(Progress::Frame {
-                time: step as f64 * spec.dt.value,
-                x: &p.x,
-                y: &p.y,
-                z: &p.z,
-            })
-        }
-    })
-    .map_err(|e| stopped_writing(e, req, None))?;
-    let (summary, failure) = md::output::outcome(&prepared, &result, drift_tolerance, &file.origin);
+    let result = md::run_with(
+        &mut prepared,
+        &opts,
+        &mut |p| match p {
+            md::Progress::Record(r) => progress(Progress::Log(&md::report::thermo_line(r))),
+            md::Progress::Step(s) => progress(Progress::Step(s)),
+            md::Progress::Frame { step, system } => {
+                let p = &system.particles;
+                progress(Progress::Frame {
+                    time: step as f64 * spec.dt.value,
+                    x: &p.x,
+                    y: &p.y,
+                    z: &p.z,
+                })
+            }
+        },
+        checkpoints.as_mut(),
+        restart.as_ref(),
+    )
+    .map_err(|e| {
+        stopped_writing(
+            e,
+            req,
+            checkpoints
+                .as_ref()
+                .map(|cp| (cp.path().to_path_buf(), cp.last_time)),
+        )
+    })?;
+    let (mut summary, failure) =
+        md::output::outcome(&prepared, &result, drift_tolerance, &file.origin);
+    if let Some(cp) = &checkpoints {
+        summary["checkpoint"] = serde_json::json!({
+            "file": cp.path().display().to_string(),
+            "written": cp.written,
+            "last_t": cp.last_time,
+        });
+    }
+    if let Some(r) = &restart {
+        summary["restarted_from"] = serde_json::json!({
+            "file": r.path.display().to_string(),
+            "t": r.t,
+        });
+    }
     if let Some(dir) = &req.out {
         md::output::write_all(&result, &summary, dir)?;
         if req.plots {

@@ -70,7 +70,7 @@ pub struct RunArgs {
     #[arg(long = "no-jit")]
     pub no_jit: bool,
     /// Write DIR/checkpoint.json this often: a wall time (`15min`, `30s`, `2h`), a number of
-    /// steps (`500steps`), or `off`; default 15min with --out (N-body runs; see
+    /// steps (`500steps`), or `off`; default 15min with --out (N-body and MD runs; see
     /// docs/long-runs.md). Also written when SIGINT/SIGTERM stops the run.
     #[arg(long = "checkpoint-every", value_name = "WHEN")]
     pub checkpoint_every: Option<String>,

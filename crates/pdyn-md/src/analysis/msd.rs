@@ -23,6 +23,16 @@ impl Msd {
         }
     }
 
+    /// The time origin: the unwrapped positions at construction (a checkpoint saves them).
+    pub fn origin(&self) -> &[Vec3] {
+        &self.origin
+    }
+
+    /// The MSD relative to `origin` (unwrapped positions, as [`Msd::origin`] returned them).
+    pub fn from_origin(origin: Vec<Vec3>) -> Self {
+        Msd { origin }
+    }
+
     /// `MSD` of `s` relative to the origin (particles beyond the origin's count are ignored).
     pub fn value(&self, s: &System) -> f64 {
         let n = self.origin.len().min(s.particles.len());

@@ -70,6 +70,28 @@ impl Rdf {
         self.frames
     }
 
+    /// The accumulated histogram (pair counts per bin), frames and `Σ N·ρ` over the frames:
+    /// what a checkpoint saves to continue the average ([`Rdf::restore`]).
+    pub fn accumulated(&self) -> (&[u64], u64, f64) {
+        (&self.counts, self.frames, self.norm)
+    }
+
+    /// Sets the accumulations [`Rdf::accumulated`] returned (the counts must have this
+    /// histogram's number of bins).
+    pub fn restore(&mut self, counts: &[u64], frames: u64, norm: f64) -> Result<(), MdError> {
+        if counts.len() != self.counts.len() {
+            return Err(MdError::SnapshotMismatch {
+                what: "RDF bins",
+                expected: self.counts.len(),
+                found: counts.len(),
+            });
+        }
+        self.counts.copy_from_slice(counts);
+        self.frames = frames;
+        self.norm = norm;
+        Ok(())
+    }
+
     /// Adds the frames of `other` (same range and bins, else an error).
     pub fn merge(&mut self, other: &Rdf) -> Result<(), MdError> {
         if other.r_max != self.r_max || other.counts.len() != self.counts.len() {

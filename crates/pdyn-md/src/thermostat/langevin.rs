@@ -48,6 +48,16 @@ impl Langevin {
         })
     }
 
+    /// The noise generator's state (xoshiro256** words, the held-back normal deviate).
+    pub(crate) fn rng_state(&self) -> ([u64; 4], Option<f64>) {
+        self.rng.state()
+    }
+
+    /// Continues the noise from a saved [`Langevin::rng_state`].
+    pub(crate) fn set_rng_state(&mut self, words: [u64; 4], spare: Option<f64>) {
+        self.rng = Rng::from_state(words, spare);
+    }
+
     /// The O step over `h`.
     pub(crate) fn ou_step(&mut self, p: &mut Particles, h: f64, kb: f64) {
         let c1 = libm::exp(-self.gamma * h);

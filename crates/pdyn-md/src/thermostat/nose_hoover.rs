@@ -60,6 +60,27 @@ impl NoseHooverChain {
         })
     }
 
+    /// The chain's positions `ξₖ` and velocities `vₖ` (the masses follow from the target).
+    pub(crate) fn chain(&self) -> (&[f64], &[f64]) {
+        (&self.xi, &self.v)
+    }
+
+    /// Sets the chain's positions and velocities (of its length: else an error).
+    pub(crate) fn set_chain(&mut self, xi: &[f64], v: &[f64]) -> Result<(), MdError> {
+        for given in [xi.len(), v.len()] {
+            if given != self.xi.len() {
+                return Err(MdError::SnapshotMismatch {
+                    what: "Nosé–Hoover chain length",
+                    expected: self.xi.len(),
+                    found: given,
+                });
+            }
+        }
+        self.xi.copy_from_slice(xi);
+        self.v.copy_from_slice(v);
+        Ok(())
+    }
+
     fn masses(&mut self, nf: f64, kt: f64) {
         let t2 = self.tau * self.tau;
         for (k, q) in self.q.iter_mut().enumerate() {

@@ -322,7 +322,10 @@ class Model:
             points: Optional[int] = None, drift_tolerance: Optional[float] = None,
             params: Optional[Mapping[str, float]] = None,
             plots: Optional[Union[str, "os.PathLike[str]"]] = None,
-            jit: bool = True, initial: Optional[Mapping[str, float]] = None) -> OdeResult:
+            jit: bool = True, initial: Optional[Mapping[str, float]] = None,
+            out: Optional[Union[str, "os.PathLike[str]"]] = None,
+            restart: Optional[Union[str, "os.PathLike[str]"]] = None,
+            checkpoint_every: Optional[str] = None) -> OdeResult:
         """Integrates the equations of motion, like ``pdyn run``.
 
         Every argument left ``None`` takes the model's ``[simulate]`` value, then pdyn's
@@ -341,8 +344,15 @@ class Model:
         An ``[nbody]`` or ``[md]`` model runs on its own engine, as ``pdyn run`` runs it
         (``method``: ``whfast``, ``ias15``, ``leapfrog`` for N-body; ``dt``, ``t_end``,
         ``points``/``t_eval``, ``drift_tolerance``, ``params``; ``plots``: a directory for the
-        files and plots ``pdyn run --out DIR --plot`` writes) and returns a
-        :class:`ParticleResult`.
+        files and plots ``pdyn run --out DIR --plot`` writes; ``out``: a directory for the
+        files without plots, as ``pdyn run --out DIR``) and returns a :class:`ParticleResult`.
+        Long runs (docs/long-runs.md): ``checkpoint_every`` (``"15min"``, ``"30s"``,
+        ``"500steps"``, ``"off"``) writes ``out/checkpoint.json`` as ``pdyn run
+        --checkpoint-every`` does (also when Ctrl-C stops the run), and ``restart`` (a
+        checkpoint's path) continues that run bit for bit, appending to the files of ``out``
+        as ``pdyn run --restart`` does (the same model, options and ``out``). With either,
+        the rows go to the files as the run goes and an N-body result holds only the first
+        and last output (the files hold every row); an MD result keeps its thermo records.
 
         Returns an :class:`OdeResult` (``success=False`` with the partial solution when the
         integration fails, or when an output column becomes NaN or infinite: ``status``
@@ -359,7 +369,14 @@ class Model:
                     f"initial= applies to mechanics models; a {m.kind} model's initial state is "
                     "its bodies or atoms in the file")
             return self._run_particles(m, t_end, method, rtol, atol, t_eval, max_step, dt,
-                                       max_steps, points, drift_tolerance, params, plots, jit)
+                                       max_steps, points, drift_tolerance, params, plots, jit,
+                                       out, restart, checkpoint_every)
+        for name, given in (("out", out), ("restart", restart),
+                            ("checkpoint_every", checkpoint_every)):
+            if given is not None:
+                raise ParameterError(
+                    f"{name}= applies to [nbody] and [md] models (streamed files, checkpoints); "
+                    "a mechanics model's files are written with plots=DIR")
         te = None if t_eval is None else _array1(t_eval, "t_eval")
         raw = self._m.run(t_end=t_end, method=method, rtol=rtol, atol=atol, t_eval=te,
                           max_step=max_step, dt=dt, max_steps=max_steps, points=points,
@@ -375,15 +392,22 @@ class Model:
 
     def _run_particles(self, m: "_pdyn.ParticleModel", t_end, method, rtol, atol, t_eval,
                        max_step, dt, max_steps, points, drift_tolerance, params, plots,
-                       jit) -> ParticleResult:
+                       jit, out=None, restart=None, checkpoint_every=None) -> ParticleResult:
         # Options with no meaning for the kind (rtol for WHFast, method for MD) are refused by
         # the library, by name, as `pdyn run` refuses them.
         te = None if t_eval is None else [float(x) for x in _array1(t_eval, "t_eval")]
+        if out is not None and plots is not None and os.fspath(out) != os.fspath(plots):
+            raise ParameterError("out= and plots= name two directories: give one (plots= "
+                                 "writes the files and the plots, out= the files only)")
+        directory = plots if plots is not None else out
         raw = m.run(t_end=t_end, method=method, dt=dt, points=points, t_eval=te,
                     drift_tolerance=drift_tolerance, params=_params(params),
-                    out=None if plots is None else os.fspath(plots), plots=plots is not None,
+                    out=None if directory is None else os.fspath(directory),
+                    plots=plots is not None,
                     jit=bool(jit), rtol=rtol, atol=atol, max_step=max_step,
-                    max_steps=max_steps)
+                    max_steps=max_steps,
+                    checkpoint_every=None if checkpoint_every is None else str(checkpoint_every),
+                    restart=None if restart is None else os.fspath(restart))
         if raw.get("interrupted"):
             _interrupted("Model.run", ParticleResult(raw))
         return ParticleResult(raw)

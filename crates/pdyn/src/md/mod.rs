@@ -11,6 +11,7 @@
 //! everything about the model file lives here. See `docs/md.md` for the format.
 
 pub mod build;
+pub mod checkpoint;
 pub mod data_file;
 pub mod formula;
 pub mod memory;
@@ -23,7 +24,7 @@ pub mod run;
 pub mod spec;
 
 pub use build::{build, Prepared};
-pub use run::{run, MdResult, Progress, RunOptions};
+pub use run::{run, run_with, MdResult, Progress, RunOptions};
 pub use spec::{parse, MdSpec};
 
 use crate::options::RunOption;

@@ -8,6 +8,9 @@ use pdyn_md::{MdError, System};
 /// Blocks of an RDF's frames.
 pub const RDF_BLOCKS: usize = 5;
 
+/// One block's pair counts per bin, frames and `Σ N·ρ`.
+pub type BlockAccumulation<'a> = (&'a [u64], u64, f64);
+
 /// Frames of the RDF, gathered into consecutive blocks.
 #[derive(Debug, Clone)]
 pub struct RdfBlocks {
@@ -41,6 +44,32 @@ impl RdfBlocks {
     /// Frames added.
     pub fn frames(&self) -> u64 {
         self.taken
+    }
+
+    /// Each block's accumulations (`pdyn_md::analysis::Rdf::accumulated`) and the frames
+    /// taken: what a checkpoint saves.
+    pub fn accumulated(&self) -> (Vec<BlockAccumulation<'_>>, u64) {
+        (
+            self.blocks.iter().map(Rdf::accumulated).collect(),
+            self.taken,
+        )
+    }
+
+    /// Sets the accumulations [`RdfBlocks::accumulated`] returned (as many blocks, as many
+    /// bins, else an error).
+    pub fn restore(&mut self, blocks: &[(Vec<u64>, u64, f64)], taken: u64) -> Result<(), MdError> {
+        if blocks.len() != self.blocks.len() {
+            return Err(MdError::SnapshotMismatch {
+                what: "RDF blocks",
+                expected: self.blocks.len(),
+                found: blocks.len(),
+            });
+        }
+        for (b, (counts, frames, norm)) in self.blocks.iter_mut().zip(blocks) {
+            b.restore(counts, *frames, *norm)?;
+        }
+        self.taken = taken;
+        Ok(())
     }
 
     /// `g(r)` and its block errors.

@@ -8,8 +8,10 @@
 //! the trajectory written so far ends with the failing configuration.
 
 use super::build::{Engine, Prepared, UnitSystem};
+use super::checkpoint::Gathered;
 use super::rdf_blocks::RdfBlocks;
 use super::spec::{Ensemble, MdSpec, Mode, Units};
+use crate::checkpoint::{Checkpointer, Restart};
 use crate::stream::RowFile;
 use crate::Error;
 use pdyn_md::analysis::Msd;
@@ -227,11 +229,70 @@ pub fn run(
     opts: &RunOptions,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<MdResult, Error> {
+    run_with(prep, opts, progress, None, None)
+}
+
+/// [`run`] with checkpoints (issue 29): with `checkpoints`, one is written after a stretch of
+/// steps when it is due and when the run is interrupted; with `restart` (a checkpoint read
+/// and checked by `crate::checkpoint::read`), the run continues from it, `thermo.csv` and
+/// `traj.xyz` truncated to the lengths it recorded and appended to.
+pub fn run_with(
+    prep: &mut Prepared,
+    opts: &RunOptions,
+    progress: &mut dyn FnMut(Progress),
+    checkpoints: Option<&mut Checkpointer>,
+    restart: Option<&Restart>,
+) -> Result<MdResult, Error> {
     let spec = prep.spec.clone();
     let u = prep.units;
+    let resumed = match restart {
+        Some(r) => Some(super::checkpoint::read_state(&r.state).ok_or_else(|| {
+            Error::argument(
+                "--restart",
+                "the checkpoint's MD state is incomplete or of another version",
+            )
+        })?),
+        None => None,
+    };
+    let lengths = restart.map(|r| {
+        let len = |k: usize| r.files.get(k).and_then(serde_json::Value::as_u64);
+        [len(0), len(1)]
+    });
+    let go = Continuation {
+        checkpoints,
+        resumed,
+        lengths,
+    };
     match &mut prep.engine {
-        Engine::Lj(sim) => run_sim(sim, &spec, u, opts, progress),
-        Engine::General(sim) => run_sim(sim, &spec, u, opts, progress),
+        Engine::Lj(sim) => run_sim(sim, &spec, u, opts, progress, go),
+        Engine::General(sim) => run_sim(sim, &spec, u, opts, progress, go),
+    }
+}
+
+/// How a run continues: the checkpoints it writes, the state and file lengths it resumes from.
+struct Continuation<'a> {
+    checkpoints: Option<&'a mut Checkpointer>,
+    resumed: Option<super::checkpoint::Resumed>,
+    /// `thermo.csv`, `traj.xyz`.
+    lengths: Option<[Option<u64>; 2]>,
+}
+
+fn restart_error(message: String) -> Error {
+    Error::argument(
+        "--restart",
+        format!("the checkpoint does not fit this model: {message}"),
+    )
+}
+
+/// Opens an output file: created with `header`, or resumed at the checkpoint's length.
+fn open_rows(path: &Path, header: &str, resume: Option<Option<u64>>) -> Result<RowFile, Error> {
+    match resume {
+        None => RowFile::create(path, header),
+        Some(Some(len)) => RowFile::resume(path, len),
+        Some(None) => Err(restart_error(format!(
+            "it recorded no length for {}",
+            path.display()
+        ))),
     }
 }
 
@@ -311,15 +372,31 @@ fn run_sim<P: PairPotential>(
     u: UnitSystem,
     opts: &RunOptions,
     progress: &mut dyn FnMut(Progress),
+    go: Continuation,
 ) -> Result<MdResult, Error> {
+    let Continuation {
+        mut checkpoints,
+        resumed,
+        lengths,
+    } = go;
     let n = sim.system.particles.len();
+    let mut g = Gathered::default();
+    let mut resumed_rdf = None;
+    let mut resumed_msd = None;
+    if let Some(r) = resumed {
+        sim.restore(&r.snapshot)
+            .map_err(|e| restart_error(e.to_string()))?;
+        g = r.gathered;
+        resumed_rdf = r.rdf;
+        resumed_msd = r.msd_origin;
+    }
     let dt = spec.dt.value;
     let names: Vec<&str> = spec.species.iter().map(|s| s.name.as_str()).collect();
     // Frames and thermo rows go to the files as the run goes, whole (a frame is one "row").
     let mut traj = match (&opts.out, spec.dump_every) {
         (Some(dir), d) if d > 0 => {
             let path = dir.join("traj.xyz");
-            Some((RowFile::create(&path, "")?, path))
+            Some((open_rows(&path, "", lengths.map(|l| l[1]))?, path))
         }
         _ => None,
     };
@@ -329,14 +406,15 @@ fn run_sim<P: PairPotential>(
     // convention (3N − 3 as LAMMPS's `compute temp`, or 3N under Langevin) is in the file.
     let dof = sim.dof();
     let mut thermo_file = match &opts.out {
-        Some(dir) => Some(RowFile::create(
+        Some(dir) => Some(open_rows(
             &dir.join("thermo.csv"),
             &format!("{},dof\n", pdyn_md::THERMO_CSV_HEADER),
+            lengths.map(|l| l[0]),
         )?),
         None => None,
     };
     let mut write_error: Option<Error> = None;
-    let mut frames = 0u64;
+    let resuming = lengths.is_some();
     // Frames shown live: as the front end asks, else at dump_every.
     let frame_every = if opts.frame_every > 0 {
         opts.frame_every
@@ -349,11 +427,14 @@ fn run_sim<P: PairPotential>(
             system: &sim.system,
         });
     }
-    if let Some((w, path)) = &mut traj {
+    if let (Some((w, path)), false) = (&mut traj, resuming) {
         append_frame(w, path, &sim.system, &names, u, sim.step, dt)?;
-        frames += 1;
+        g.frames += 1;
     }
-    let msd0 = spec.msd.then(|| Msd::new(&sim.system));
+    let msd0 = spec.msd.then(|| match resumed_msd.take() {
+        Some(origin) => Msd::from_origin(origin),
+        None => Msd::new(&sim.system),
+    });
     let half = spec.steps / 2;
     // At most `rdf_frames` frames, equally spaced over the records of the second half.
     let second_half_records = {
@@ -384,6 +465,10 @@ fn run_sim<P: PairPotential>(
     } else {
         None
     };
+    if let (Some(h), Some((blocks, taken))) = (&mut rdf, &resumed_rdf) {
+        h.restore(blocks, *taken)
+            .map_err(|e| restart_error(e.to_string()))?;
+    }
     let mut warnings = vec![];
     if spec.rdf && rdf.is_none() {
         warnings.push(format!(
@@ -396,15 +481,11 @@ fn run_sim<P: PairPotential>(
         let (f, r) = (spec.rdf_frames as u64, second_half_records.max(1));
         (j % r) * (f % r) % r < f || f >= r
     };
-    let mut records: Vec<ThermoRecord> = vec![];
-    let mut msd = vec![];
-    let mut msd_error = vec![];
     let msd_err = |m: &Msd, s: &System| m.block_error(s, MSD_BLOCKS).unwrap_or(f64::NAN);
     if let (Some(m), true) = (&msd0, sim.step == 0) {
-        msd.push([0.0, 0.0, m.value(&sim.system)]);
-        msd_error.push(msd_err(m, &sim.system));
+        g.msd.push([0.0, 0.0, m.value(&sim.system)]);
+        g.msd_error.push(msd_err(m, &sim.system));
     }
-    let mut rdf_seen = 0u64;
     let every = spec.thermo_every.max(1);
     // the run stops at every step where something is due: thermo, a frame, an MSD or RDF sample
     let chunk = [
@@ -424,17 +505,61 @@ fn run_sim<P: PairPotential>(
         _ => None,
     };
     let start = crate::clock::Stopwatch::start();
+    let seconds_before = g.seconds;
     let mut failure = None;
-    let mut builds = 0;
-    let mut done = 0u64;
     let mut interrupted = false;
-    while done < spec.steps || (done == 0 && records.is_empty()) {
+    // Flushes and syncs the files, then writes the checkpoint of the state now.
+    let mut checkpoint = |sim: &Simulation<P>,
+                          g: &mut Gathered,
+                          rdf: Option<&RdfBlocks>,
+                          msd0: Option<&Msd>,
+                          thermo_file: &mut Option<RowFile>,
+                          traj: &mut Option<(RowFile, PathBuf)>,
+                          force: bool|
+     -> Result<(), Error> {
+        let Some(cp) = checkpoints.as_deref_mut() else {
+            return Ok(());
+        };
+        if !force && !cp.due(g.done) {
+            return Ok(());
+        }
+        let mut files = [None, None];
+        if let Some(f) = thermo_file {
+            f.sync()?;
+            files[0] = Some(f.len());
+        }
+        if let Some((f, _)) = traj {
+            f.sync()?;
+            files[1] = Some(f.len());
+        }
+        g.seconds = seconds_before + start.seconds();
+        let state = super::checkpoint::state(&sim.snapshot(), g, rdf, msd0);
+        cp.write(
+            sim.step as f64 * dt,
+            g.done,
+            serde_json::json!(files),
+            state,
+        )
+    };
+    while g.done < spec.steps || (g.done == 0 && g.records.is_empty()) {
         let stop = opts.interrupt.as_ref();
-        if done > 0 && stop.is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed)) {
+        if g.done > 0 && stop.is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed)) {
             interrupted = true;
+            checkpoint(
+                sim,
+                &mut g,
+                rdf.as_ref(),
+                msd0.as_ref(),
+                &mut thermo_file,
+                &mut traj,
+                true,
+            )?;
             break;
         }
-        let k = chunk.min(spec.steps - done);
+        let done = g.done;
+        // Up to the next multiple of the stretch: a run restarted from a stop inside a
+        // stretch (an interrupt) falls back onto the uninterrupted run's stretches.
+        let k = (chunk - done % chunk).min(spec.steps - done);
         if let Some((a, b)) = ramp {
             // The target steps once per thermo block, at the block's middle, whatever the
             // stretches the run is cut into (frames, dumps, MSD samples): what is observed
@@ -454,14 +579,14 @@ fn run_sim<P: PairPotential>(
                     write_error.get_or_insert(e);
                 }
             }
-            records.push(c);
+            g.records.push(c);
             if let (Some(h), None) = (&mut rdf, spec.rdf_every) {
                 if r.step >= half && r.step > 0 {
-                    if rdf_take(rdf_seen) {
+                    if rdf_take(g.rdf_seen) {
                         // the box is fixed, so `add` cannot refuse r_max here
                         let _ = h.add(s);
                     }
-                    rdf_seen += 1;
+                    g.rdf_seen += 1;
                 }
             }
         };
@@ -470,21 +595,22 @@ fn run_sim<P: PairPotential>(
         let outcome = sim.run_interruptible(k, &mut obs, opts.interrupt.as_deref());
         match outcome {
             Ok(rep) => {
-                builds += rep.builds;
-                done += rep.steps;
+                g.builds += rep.builds;
+                g.done += rep.steps;
             }
             Err(f) => {
-                builds += f.partial.builds;
-                done += f.partial.steps;
+                g.builds += f.partial.builds;
+                g.done += f.partial.steps;
                 failure = Some(f.error);
             }
         }
-        progress(Progress::Step(done));
+        progress(Progress::Step(g.done));
         let step = sim.step;
         if let Some(m) = &msd0 {
             if step % spec.msd_every.max(1) == 0 && step > 0 {
-                msd.push([step as f64, step as f64 * dt, m.value(&sim.system)]);
-                msd_error.push(msd_err(m, &sim.system));
+                g.msd
+                    .push([step as f64, step as f64 * dt, m.value(&sim.system)]);
+                g.msd_error.push(msd_err(m, &sim.system));
             }
         }
         if let (Some(h), Some(e)) = (&mut rdf, spec.rdf_every) {
@@ -502,7 +628,7 @@ fn run_sim<P: PairPotential>(
         if let Some((w, path)) = &mut traj {
             if dump || failure.is_some() {
                 append_frame(w, path, &sim.system, &names, u, sim.step, dt)?;
-                frames += 1;
+                g.frames += 1;
             }
         }
         if let Some(e) = write_error.take() {
@@ -511,8 +637,28 @@ fn run_sim<P: PairPotential>(
         if failure.is_some() || k == 0 {
             break;
         }
+        if g.done < spec.steps {
+            checkpoint(
+                sim,
+                &mut g,
+                rdf.as_ref(),
+                msd0.as_ref(),
+                &mut thermo_file,
+                &mut traj,
+                false,
+            )?;
+        }
     }
-    let seconds = start.seconds();
+    let seconds = seconds_before + start.seconds();
+    let Gathered {
+        done,
+        builds,
+        frames,
+        mut records,
+        mut msd,
+        mut msd_error,
+        ..
+    } = g;
     if failure.is_none() && records.last().map(|r| r.step) != Some(sim.step) {
         // the last step, when it is not a multiple of thermo_every
         let c = convert(&sim.thermo(), u, dt);
