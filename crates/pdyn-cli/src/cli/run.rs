@@ -70,8 +70,9 @@ pub struct RunArgs {
     #[arg(long = "no-jit")]
     pub no_jit: bool,
     /// Write DIR/checkpoint.json this often: a wall time (`15min`, `30s`, `2h`), a number of
-    /// steps (`500steps`), or `off`; default 15min with --out (N-body and MD runs; see
-    /// docs/long-runs.md). Also written when SIGINT/SIGTERM stops the run.
+    /// steps (`500steps`), or `off`; default 15min with --out (N-body, MD, and mechanics runs
+    /// by an explicit pair such as dopri5 or dop853; see docs/long-runs.md). Also written when
+    /// SIGINT/SIGTERM stops the run.
     #[arg(long = "checkpoint-every", value_name = "WHEN")]
     pub checkpoint_every: Option<String>,
     /// Continue the run of this checkpoint bit for bit, appending to the files of --out
