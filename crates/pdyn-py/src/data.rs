@@ -96,7 +96,8 @@ pub(crate) fn _kin_data<'py>(
             .allow_threads(|| {
                 let s = series(t, names, values, 5, "kinematics from samples")?;
                 let k = lib::kinematics::kinematics(&s, smoothing).map_err(data::data_error)?;
-                Ok::<_, Error>((data::kin_table(&k, &[])?, data::kin_summary(&k)))
+                let summary = data::kin_summary(&k);
+                Ok::<_, Error>((data::kin_table(k, &[])?, summary))
             })
             .map_err(|e| data_py(py, &e))?;
         Ok((table_dict(py, table)?, summary.to_string()))

@@ -265,8 +265,9 @@ pub const KIN_GROUPS: [&str; 11] = [
 /// The kinematics table: `t`, then the groups asked for (all when `groups` is empty), each
 /// column named after the data's: `x`, `v_x`, `a_x`, `T_x`, `N_x`, `speed`, `curvature`,
 /// `a_t`, `a_n`, `r`, `theta`, `v_r`, `v_theta`, `a_r`, `a_theta`, `se_speed`, `se_a_t`,
-/// `se_a_n`, `se_curvature`.
-pub fn kin_table(k: &KinData, groups: &[String]) -> Result<Table, Error> {
+/// `se_a_n`, `se_curvature`. The columns are moved out of `k`, not copied (take its summaries
+/// first).
+pub fn kin_table(mut k: KinData, groups: &[String]) -> Result<Table, Error> {
     for g in groups {
         if !KIN_GROUPS.contains(&g.as_str()) {
             return Err(Error::argument(
@@ -279,55 +280,55 @@ pub fn kin_table(k: &KinData, groups: &[String]) -> Result<Table, Error> {
         }
     }
     let want = |g: &str| groups.is_empty() || groups.iter().any(|x| x == g);
-    let names: Vec<&str> = k.fits.iter().map(|f| f.name.as_str()).collect();
+    let names: Vec<String> = k.fits.iter().map(|f| f.name.clone()).collect();
     let mut t = Table::default();
-    t.push("t", k.t.clone());
-    let vectors: [(&str, &str, &Vec<Vec<f64>>); 5] = [
-        ("position", "", &k.position),
-        ("velocity", "v_", &k.velocity),
-        ("acceleration", "a_", &k.acceleration),
-        ("tangent", "T_", &k.tangent),
-        ("normal", "N_", &k.normal),
+    t.push("t", std::mem::take(&mut k.t));
+    let vectors: [(&str, &str, Vec<Vec<f64>>); 5] = [
+        ("position", "", std::mem::take(&mut k.position)),
+        ("velocity", "v_", std::mem::take(&mut k.velocity)),
+        ("acceleration", "a_", std::mem::take(&mut k.acceleration)),
+        ("tangent", "T_", std::mem::take(&mut k.tangent)),
+        ("normal", "N_", std::mem::take(&mut k.normal)),
     ];
     for (group, prefix, cols) in vectors {
         if want(group) {
-            for (n, c) in names.iter().zip(cols.iter()) {
-                t.push(format!("{prefix}{n}"), c.clone());
+            for (n, c) in names.iter().zip(cols) {
+                t.push(format!("{prefix}{n}"), c);
             }
         }
         if group == "acceleration" && want("speed") {
-            t.push("speed", k.speed.clone());
+            t.push("speed", std::mem::take(&mut k.speed));
         }
     }
     for (group, name, col) in [
-        ("curvature", "curvature", &k.curvature),
-        ("a_t", "a_t", &k.a_t),
-        ("a_n", "a_n", &k.a_n),
+        ("curvature", "curvature", std::mem::take(&mut k.curvature)),
+        ("a_t", "a_t", std::mem::take(&mut k.a_t)),
+        ("a_n", "a_n", std::mem::take(&mut k.a_n)),
     ] {
         if want(group) {
-            t.push(name, col.clone());
+            t.push(name, col);
         }
     }
     if want("polar") {
         for (name, col) in [
-            ("r", &k.r),
-            ("theta", &k.theta),
-            ("v_r", &k.v_r),
-            ("v_theta", &k.v_theta),
-            ("a_r", &k.a_r),
-            ("a_theta", &k.a_theta),
+            ("r", std::mem::take(&mut k.r)),
+            ("theta", std::mem::take(&mut k.theta)),
+            ("v_r", std::mem::take(&mut k.v_r)),
+            ("v_theta", std::mem::take(&mut k.v_theta)),
+            ("a_r", std::mem::take(&mut k.a_r)),
+            ("a_theta", std::mem::take(&mut k.a_theta)),
         ] {
-            t.push(name, col.clone());
+            t.push(name, col);
         }
     }
     if want("se") {
         for (name, col) in [
-            ("se_speed", &k.se_speed),
-            ("se_a_t", &k.se_a_t),
-            ("se_a_n", &k.se_a_n),
-            ("se_curvature", &k.se_curvature),
+            ("se_speed", std::mem::take(&mut k.se_speed)),
+            ("se_a_t", std::mem::take(&mut k.se_a_t)),
+            ("se_a_n", std::mem::take(&mut k.se_a_n)),
+            ("se_curvature", std::mem::take(&mut k.se_curvature)),
         ] {
-            t.push(name, col.clone());
+            t.push(name, col);
         }
     }
     Ok(t)
