@@ -222,8 +222,9 @@ fn check(
     }
     if r.y.len() != n || r.first_stage.len() != n {
         return bad(format!(
-            "the state has {} components, the system {n}",
-            r.y.len()
+            "the state has {} components and its first stage {}, but the system has {n}",
+            r.y.len(),
+            r.first_stage.len()
         ));
     }
     let m = &r.events;

@@ -186,16 +186,7 @@ impl NetKernels {
             if k.elements == 0 {
                 continue;
             }
-            gather(k, input, cols, k.kernel.n_inputs(), 3);
-            let ins: Vec<&[f64]> = cols.inputs[..k.kernel.n_inputs()]
-                .iter()
-                .map(|c| &c[..k.elements])
-                .collect();
-            let mut outs: Vec<&mut [f64]> = cols.outputs[..3]
-                .iter_mut()
-                .map(|c| &mut c[..k.elements])
-                .collect();
-            k.kernel.run(&ins, &mut outs);
+            let outs = run_kernel(k, input, cols);
             for (axis, out) in outs.iter().enumerate() {
                 for (&to, &v) in k.scatter[axis].iter().zip(out.iter()) {
                     if to != NONE {
@@ -231,16 +222,7 @@ impl NetKernels {
             if k.elements == 0 {
                 continue;
             }
-            gather(k, input, cols, k.kernel.n_inputs(), 3);
-            let ins: Vec<&[f64]> = cols.inputs[..k.kernel.n_inputs()]
-                .iter()
-                .map(|c| &c[..k.elements])
-                .collect();
-            let mut outs: Vec<&mut [f64]> = cols.outputs[..3]
-                .iter_mut()
-                .map(|c| &mut c[..k.elements])
-                .collect();
-            k.kernel.run(&ins, &mut outs);
+            let outs = run_kernel(k, input, cols);
             for (e, &own) in k.own.iter().enumerate() {
                 let m = mass[own as usize];
                 let f = [0, 1, 2].map(|c| m * outs[c][e]);
@@ -308,6 +290,22 @@ impl NetKernels {
 
 /// Fills the first `inputs` input columns of kernel `k` from `input`, and makes room for
 /// `outputs` output columns.
+/// Runs `k` over its elements at `input`: its three acceleration columns, one value per
+/// element.
+fn run_kernel<'c>(k: &Kernel, input: &[f64], cols: &'c mut Columns) -> Vec<&'c mut [f64]> {
+    gather(k, input, cols, k.kernel.n_inputs(), 3);
+    let ins: Vec<&[f64]> = cols.inputs[..k.kernel.n_inputs()]
+        .iter()
+        .map(|c| &c[..k.elements])
+        .collect();
+    let mut outs: Vec<&mut [f64]> = cols.outputs[..3]
+        .iter_mut()
+        .map(|c| &mut c[..k.elements])
+        .collect();
+    k.kernel.run(&ins, &mut outs);
+    outs
+}
+
 fn gather(k: &Kernel, input: &[f64], cols: &mut Columns, inputs: usize, outputs: usize) {
     let len = k.elements;
     if cols.inputs.len() < inputs {
