@@ -11,7 +11,7 @@ use std::process::{Command, Stdio};
 use std::time::Duration;
 
 mod long_run_common;
-use long_run_common::{bin, example, fresh_dir, Rng};
+use long_run_common::{bin, example, fresh_dir, kill_repeatedly, Rng};
 
 const FILES: [&str; 4] = ["thermo.csv", "traj.xyz", "rdf.csv", "msd.csv"];
 
@@ -161,32 +161,14 @@ fn killed_and_restarted_equals_uninterrupted(
 ) {
     let reference = reference_run(tag, model, extra);
     let dir = fresh_dir(&format!("{tag}-killed"));
-    let ckpt = dir.join("checkpoint.json");
-    let mut rng = Rng(seed);
-    let mut restarts = 0;
-    for k in 0..kills {
-        let mut args = run_args(model, extra, &dir);
-        if ckpt.exists() {
-            args.extend(["--restart".to_string(), ckpt.display().to_string()]);
-            restarts += 1;
-        }
-        let mut child = Command::new(bin())
-            .args(&args)
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect("start pdyn");
-        std::thread::sleep(Duration::from_millis(50 + rng.below(window_ms)));
-        // SIGKILL: no handler runs, nothing is flushed
-        let _ = child.kill();
-        let _ = child.wait();
-        assert_whole_rows(&dir, &format!("{tag}: after kill {}", k + 1), true);
-    }
-    let mut args = run_args(model, extra, &dir);
-    if ckpt.exists() {
-        args.extend(["--restart".to_string(), ckpt.display().to_string()]);
-        restarts += 1;
-    }
+    let (args, restarts) = kill_repeatedly(
+        &dir,
+        &run_args(model, extra, &dir),
+        kills,
+        window_ms,
+        seed,
+        |k| assert_whole_rows(&dir, &format!("{tag}: after kill {k}"), true),
+    );
     let out = Command::new(bin()).args(&args).output().expect("run pdyn");
     assert!(
         out.status.success(),

@@ -38,3 +38,45 @@ impl Rng {
         self.next() % n
     }
 }
+
+/// The run `args` (writing into `dir`) started `kills` times, each killed with SIGKILL after
+/// 50 ms plus a seeded random delay below `window_ms`, each continuing with `--restart
+/// DIR/checkpoint.json` once a checkpoint exists; `after_kill(k)` checks the files after kill
+/// `k` (1-based). Returns the arguments of the run that finishes (from the last checkpoint,
+/// if any) and how many of the runs, that one included, were restarts.
+pub fn kill_repeatedly(
+    dir: &Path,
+    args: &[String],
+    kills: usize,
+    window_ms: u64,
+    seed: u64,
+    after_kill: impl Fn(usize),
+) -> (Vec<String>, usize) {
+    let ckpt = dir.join("checkpoint.json");
+    let mut rng = Rng(seed);
+    let mut restarts = 0;
+    let with_restart = |restarts: &mut usize| {
+        let mut a = args.to_vec();
+        if ckpt.exists() {
+            a.extend(["--restart".to_string(), ckpt.display().to_string()]);
+            *restarts += 1;
+        }
+        a
+    };
+    for k in 0..kills {
+        let a = with_restart(&mut restarts);
+        let mut child = std::process::Command::new(bin())
+            .args(&a)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .expect("start pdyn");
+        std::thread::sleep(std::time::Duration::from_millis(50 + rng.below(window_ms)));
+        // SIGKILL: no handler runs, nothing is flushed.
+        let _ = child.kill();
+        let _ = child.wait();
+        after_kill(k + 1);
+    }
+    let last = with_restart(&mut restarts);
+    (last, restarts)
+}
