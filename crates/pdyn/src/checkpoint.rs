@@ -161,6 +161,16 @@ pub struct Checkpointer {
 }
 
 impl Checkpointer {
+    /// The summary's `checkpoint` field: the file, how many were written, the time of the
+    /// last.
+    pub fn summary_field(&self) -> Value {
+        json!({
+            "file": self.path().display().to_string(),
+            "written": self.written,
+            "last_t": self.last_time,
+        })
+    }
+
     /// Checkpoints of the run of `file` with `req` into `dir/checkpoint.json`.
     pub fn new(
         dir: &Path,
@@ -245,6 +255,28 @@ pub struct Restart {
     pub files: Value,
     /// The engine's state.
     pub state: Value,
+}
+
+impl Restart {
+    /// The summary's `restarted_from` field: the checkpoint and its time.
+    pub fn summary_field(&self) -> Value {
+        json!({ "file": self.path.display().to_string(), "t": self.t })
+    }
+}
+
+/// Sets the summary's `checkpoint` (the file, how many were written, the time of the last)
+/// and `restarted_from` fields for the checkpoints and restart there are.
+pub fn add_summary_fields(
+    summary: &mut Value,
+    checkpoints: Option<&Checkpointer>,
+    restart: Option<&Restart>,
+) {
+    if let Some(cp) = checkpoints {
+        summary["checkpoint"] = cp.summary_field();
+    }
+    if let Some(r) = restart {
+        summary["restarted_from"] = r.summary_field();
+    }
 }
 
 fn refuse(path: &Path, message: String) -> Error {

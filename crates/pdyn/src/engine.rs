@@ -406,19 +406,7 @@ fn run_nbody(
             )
         })?;
     let (mut summary, failure) = nbody::output::outcome(&spec, &info, &result);
-    if let Some(cp) = &checkpoints {
-        summary["checkpoint"] = serde_json::json!({
-            "file": cp.path().display().to_string(),
-            "written": cp.written,
-            "last_t": cp.last_time,
-        });
-    }
-    if let Some(r) = &restart {
-        summary["restarted_from"] = serde_json::json!({
-            "file": r.path.display().to_string(),
-            "t": r.t,
-        });
-    }
+    crate::checkpoint::add_summary_fields(&mut summary, checkpoints.as_ref(), restart.as_ref());
     if let Some(dir) = &req.out {
         nbody::output::write_summary(dir, &summary)?;
         if req.plots {
@@ -537,19 +525,7 @@ fn run_md(
     })?;
     let (mut summary, failure) =
         md::output::outcome(&prepared, &result, drift_tolerance, &file.origin);
-    if let Some(cp) = &checkpoints {
-        summary["checkpoint"] = serde_json::json!({
-            "file": cp.path().display().to_string(),
-            "written": cp.written,
-            "last_t": cp.last_time,
-        });
-    }
-    if let Some(r) = &restart {
-        summary["restarted_from"] = serde_json::json!({
-            "file": r.path.display().to_string(),
-            "t": r.t,
-        });
-    }
+    crate::checkpoint::add_summary_fields(&mut summary, checkpoints.as_ref(), restart.as_ref());
     if let Some(dir) = &req.out {
         md::output::write_all(&result, &summary, dir)?;
         if req.plots {

@@ -242,18 +242,14 @@ pub fn execute(
         .or_else(|| {
             non_finite.map(|nf| left_data().unwrap_or(nf.error(&model.origin, &result.columns)))
         });
-    let checkpoint = match &plan.checkpoints {
-        Some(cp) => json!({
-            "file": cp.path().display().to_string(),
-            "written": cp.written,
-            "last_t": cp.last_time,
-        }),
-        None => Value::Null,
-    };
-    let restarted_from = match &plan.restart {
-        Some(r) => json!({ "file": r.path.display().to_string(), "t": r.t }),
-        None => Value::Null,
-    };
+    let checkpoint = plan
+        .checkpoints
+        .as_ref()
+        .map_or(Value::Null, |cp| cp.summary_field());
+    let restarted_from = plan
+        .restart
+        .as_ref()
+        .map_or(Value::Null, |r| r.summary_field());
     Ok(Streamed {
         result,
         failure,
