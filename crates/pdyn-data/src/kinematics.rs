@@ -104,7 +104,6 @@ pub fn kinematics(series: &Series, smoothing: Smoothing) -> Result<KinData, Data
         .help("choose the columns with --columns t,x,y[,z]"));
     }
     let t = &series.t;
-    let n = t.len();
     // The coordinates are independent fits: one thread each.
     let columns: Vec<(&Vec<f64>, &String)> = series.values.iter().zip(&series.names).collect();
     let fits = crate::parallel::map(&columns, "smoothing", |&(y, name)| {
@@ -140,34 +139,81 @@ pub fn kinematics(series: &Series, smoothing: Smoothing) -> Result<KinData, Data
         k.velocity.push(std::mem::take(&mut f.d1));
         k.acceleration.push(std::mem::take(&mut f.d2));
     }
-    k.tangent = vec![vec![0.0; n]; dim];
-    k.normal = vec![vec![0.0; n]; dim];
-    for v in [
-        &mut k.speed,
-        &mut k.curvature,
-        &mut k.a_t,
-        &mut k.a_n,
-        &mut k.r,
-        &mut k.theta,
-        &mut k.v_r,
-        &mut k.v_theta,
-        &mut k.a_r,
-        &mut k.a_theta,
-        &mut k.se_speed,
-        &mut k.se_a_t,
-        &mut k.se_a_n,
-        &mut k.se_curvature,
-    ] {
-        *v = vec![0.0; n];
-    }
-    let mut prev_theta = f64::NAN;
+    // The Frenet quantities with their errors and the polar components read the same
+    // columns and write different ones: one thread each.
+    let KinData {
+        position,
+        velocity,
+        acceleration,
+        ..
+    } = &k;
+    let (frenet, polar) = std::thread::scope(|s| {
+        let polar = s.spawn(|| polar(position, velocity, acceleration));
+        let frenet = frenet(velocity, acceleration, &se_v, &se_a);
+        (frenet, polar.join())
+    });
+    let polar = polar.map_err(|_| {
+        DataError::new(
+            "",
+            "internal error: the thread of the polar components panicked",
+        )
+    })?;
+    (k.speed, k.tangent, k.a_t, k.a_n, k.normal, k.curvature) = (
+        frenet.speed,
+        frenet.tangent,
+        frenet.a_t,
+        frenet.a_n,
+        frenet.normal,
+        frenet.curvature,
+    );
+    (k.se_speed, k.se_a_t, k.se_a_n, k.se_curvature) = (
+        frenet.se_speed,
+        frenet.se_a_t,
+        frenet.se_a_n,
+        frenet.se_curvature,
+    );
+    [k.r, k.theta, k.v_r, k.v_theta, k.a_r, k.a_theta] = polar;
+    Ok(k)
+}
+
+/// Speed, tangent, a_t, a_n, normal, curvature and their standard errors at every sample.
+struct Frenet {
+    speed: Vec<f64>,
+    tangent: Vec<Vec<f64>>,
+    a_t: Vec<f64>,
+    a_n: Vec<f64>,
+    normal: Vec<Vec<f64>>,
+    curvature: Vec<f64>,
+    se_speed: Vec<f64>,
+    se_a_t: Vec<f64>,
+    se_a_n: Vec<f64>,
+    se_curvature: Vec<f64>,
+}
+
+/// [`Frenet`] from the velocity and acceleration columns (2 or 3) and each coordinate's
+/// standard errors of velocity and acceleration (module documentation).
+fn frenet(velocity: &[Vec<f64>], acceleration: &[Vec<f64>], se_v: &[f64], se_a: &[f64]) -> Frenet {
+    let dim = velocity.len();
+    let n = velocity[0].len();
+    let mut f = Frenet {
+        speed: vec![0.0; n],
+        tangent: vec![vec![0.0; n]; dim],
+        a_t: vec![0.0; n],
+        a_n: vec![0.0; n],
+        normal: vec![vec![0.0; n]; dim],
+        curvature: vec![0.0; n],
+        se_speed: vec![0.0; n],
+        se_a_t: vec![0.0; n],
+        se_a_n: vec![0.0; n],
+        se_curvature: vec![0.0; n],
+    };
     for i in 0..n {
         // Fixed-size vectors (a third component of 0 in the plane): no allocation per sample.
         let mut v = [0.0; 3];
         let mut a = [0.0; 3];
         for c in 0..dim {
-            v[c] = k.velocity[c][i];
-            a[c] = k.acceleration[c][i];
+            v[c] = velocity[c][i];
+            a[c] = acceleration[c][i];
         }
         let s = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         let tan = if s > 0.0 { v.map(|x| x / s) } else { [0.0; 3] };
@@ -191,20 +237,34 @@ pub fn kinematics(series: &Series, smoothing: Smoothing) -> Result<KinData, Data
                     + ((at * nor[c] + 2.0 * an * tan[c]) / (s * s * s)).powi(2) * sv;
             }
         }
-        k.speed[i] = s;
-        k.a_t[i] = at;
-        k.a_n[i] = an;
-        k.curvature[i] = kappa;
+        f.speed[i] = s;
+        f.a_t[i] = at;
+        f.a_n[i] = an;
+        f.curvature[i] = kappa;
         for c in 0..dim {
-            k.tangent[c][i] = tan[c];
-            k.normal[c][i] = nor[c];
+            f.tangent[c][i] = tan[c];
+            f.normal[c][i] = nor[c];
         }
-        k.se_speed[i] = vs.sqrt();
-        k.se_a_t[i] = if s > 0.0 { vat.sqrt() } else { f64::INFINITY };
-        k.se_a_n[i] = if s > 0.0 { van.sqrt() } else { f64::INFINITY };
-        k.se_curvature[i] = if s > 0.0 { vk.sqrt() } else { f64::INFINITY };
-        // Polar components in the x–y plane.
-        let (x, y) = (k.position[0][i], k.position[1][i]);
+        f.se_speed[i] = vs.sqrt();
+        f.se_a_t[i] = if s > 0.0 { vat.sqrt() } else { f64::INFINITY };
+        f.se_a_n[i] = if s > 0.0 { van.sqrt() } else { f64::INFINITY };
+        f.se_curvature[i] = if s > 0.0 { vk.sqrt() } else { f64::INFINITY };
+    }
+    f
+}
+
+/// Polar components in the x–y plane: `[r, θ, v_r, v_θ, a_r, a_θ]`, θ continuous (unwrapped).
+fn polar(position: &[Vec<f64>], velocity: &[Vec<f64>], acceleration: &[Vec<f64>]) -> [Vec<f64>; 6] {
+    let n = position[0].len();
+    let mut out: [Vec<f64>; 6] = std::array::from_fn(|_| vec![0.0; n]);
+    let [r_col, theta, v_r, v_theta, a_r, a_theta] = &mut out;
+    let mut prev_theta = f64::NAN;
+    for i in 0..n {
+        let (x, y) = (position[0][i], position[1][i]);
+        let (v, a) = (
+            [velocity[0][i], velocity[1][i]],
+            [acceleration[0][i], acceleration[1][i]],
+        );
         let r = libm::hypot(x, y);
         let mut th = libm::atan2(y, x);
         if prev_theta.is_finite() {
@@ -213,15 +273,15 @@ pub fn kinematics(series: &Series, smoothing: Smoothing) -> Result<KinData, Data
             th += tau * ((prev_theta - th) / tau).round();
         }
         prev_theta = th;
-        k.r[i] = r;
-        k.theta[i] = th;
+        r_col[i] = r;
+        theta[i] = th;
         if r > 0.0 {
             let (c, sn) = (x / r, y / r);
-            k.v_r[i] = c * v[0] + sn * v[1];
-            k.v_theta[i] = c * v[1] - sn * v[0];
-            k.a_r[i] = c * a[0] + sn * a[1];
-            k.a_theta[i] = c * a[1] - sn * a[0];
+            v_r[i] = c * v[0] + sn * v[1];
+            v_theta[i] = c * v[1] - sn * v[0];
+            a_r[i] = c * a[0] + sn * a[1];
+            a_theta[i] = c * a[1] - sn * a[0];
         }
     }
-    Ok(k)
+    out
 }

@@ -69,28 +69,40 @@ pub struct SmoothingSpline {
 }
 
 /// Buffers reused by [`Setup::score`] across the values of λ tried.
+/// One row per interior knot, `[1/d, l1, l2, g]` (the `L D Lᵀ` factors and the solution),
+/// interleaved: one memory stream instead of four.
 #[derive(Default)]
 struct Workspace {
-    d: Vec<f64>,
-    l1: Vec<f64>,
-    l2: Vec<f64>,
-    g: Vec<f64>,
+    rows: Vec<[[f64; 4]; 1]>,
 }
 
-/// The pieces of the Reinsch system that do not depend on λ.
+/// The pieces of the Reinsch system that do not depend on λ: the spacings and their
+/// reciprocals, from which every coefficient of `Q`, `R` and `QᵀQ` is formed on the fly
+/// ([`Setup::coeffs`]), and `Qᵀ y`. Three arrays instead of nine: a GCV score is bound by
+/// memory traffic on long records, and recomputing ~12 flops per knot is cheaper than reading
+/// six more arrays (the same operations in the same order, so the same bits).
 struct Setup {
     n: usize,
-    /// Second divided differences: the column of `Q` for interior knot `j+1` has `qa[j]`,
-    /// `qb[j]`, `qc[j]` in rows `j`, `j+1`, `j+2`.
-    qa: Vec<f64>,
-    qb: Vec<f64>,
-    qc: Vec<f64>,
-    r0: Vec<f64>,
-    r1: Vec<f64>,
-    p0: Vec<f64>,
-    p1: Vec<f64>,
-    p2: Vec<f64>,
+    /// `t[i+1] − t[i]`.
+    h: Vec<f64>,
+    /// `1 / h[i]`.
+    ih: Vec<f64>,
     qty: Vec<f64>,
+}
+
+/// The coefficients at interior knot `j + 1`: the column of `Q` (`qa`, `qb`, `qc` in rows `j`,
+/// `j+1`, `j+2`), the band of `R` (`r0` diagonal, `r1` the next) and of `QᵀQ` (`p0`, `p1`,
+/// `p2`).
+#[derive(Clone, Copy)]
+struct Coeffs {
+    qa: f64,
+    qb: f64,
+    qc: f64,
+    r0: f64,
+    r1: f64,
+    p0: f64,
+    p1: f64,
+    p2: f64,
 }
 
 impl Setup {
@@ -98,48 +110,51 @@ impl Setup {
         let n = t.len();
         let m = n - 2;
         let h: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-        let qa: Vec<f64> = (0..m).map(|j| 1.0 / h[j]).collect();
-        let qc: Vec<f64> = (0..m).map(|j| 1.0 / h[j + 1]).collect();
-        let qb: Vec<f64> = (0..m).map(|j| -qa[j] - qc[j]).collect();
-        let r0: Vec<f64> = (0..m).map(|j| (h[j] + h[j + 1]) / 3.0).collect();
-        let r1: Vec<f64> = (0..m)
-            .map(|j| if j + 1 < m { h[j + 1] / 6.0 } else { 0.0 })
-            .collect();
-        let mut p0 = vec![0.0; m];
-        let mut p1 = vec![0.0; m];
-        let mut p2 = vec![0.0; m];
-        for j in 0..m {
-            p0[j] = qa[j] * qa[j] + qb[j] * qb[j] + qc[j] * qc[j];
-            if j + 1 < m {
-                p1[j] = qb[j] * qa[j + 1] + qc[j] * qb[j + 1];
-            }
-            if j + 2 < m {
-                p2[j] = qc[j] * qa[j + 2];
-            }
-        }
+        let ih: Vec<f64> = h.iter().map(|h| 1.0 / h).collect();
         let qty: Vec<f64> = (0..m)
-            .map(|j| qa[j] * y[j] + qb[j] * y[j + 1] + qc[j] * y[j + 2])
+            .map(|j| {
+                let (qa, qc) = (ih[j], ih[j + 1]);
+                let qb = -qa - qc;
+                qa * y[j] + qb * y[j + 1] + qc * y[j + 2]
+            })
             .collect();
-        Setup {
-            n,
+        Setup { n, h, ih, qty }
+    }
+
+    /// [`Coeffs`] at interior knot `j + 1` (`j < n − 2`).
+    #[inline(always)]
+    fn coeffs(&self, j: usize) -> Coeffs {
+        let m = self.n - 2;
+        let (qa, qc) = (self.ih[j], self.ih[j + 1]);
+        let qb = -qa - qc;
+        let (r1, p1, p2) = if j + 1 < m {
+            // Column j + 2 of Q: qa' = ih[j+1] = qc, qb' = −qc − ih[j+2], qc' = ih[j+2].
+            let qc2 = self.ih[j + 2];
+            let qb2 = -qc - qc2;
+            let p2 = if j + 2 < m { qc * self.ih[j + 2] } else { 0.0 };
+            (self.h[j + 1] * (1.0 / 6.0), qb * qc + qc * qb2, p2)
+        } else {
+            (0.0, 0.0, 0.0)
+        };
+        Coeffs {
             qa,
             qb,
             qc,
-            r0,
+            r0: (self.h[j] + self.h[j + 1]) * (1.0 / 3.0),
             r1,
-            p0,
+            p0: qa * qa + qb * qb + qc * qc,
             p1,
             p2,
-            qty,
         }
     }
 
     #[cfg(test)]
     fn factor(&self, lam: f64) -> Option<Penta> {
         let m = self.n - 2;
-        let m0: Vec<f64> = (0..m).map(|j| self.r0[j] + lam * self.p0[j]).collect();
-        let m1: Vec<f64> = (0..m).map(|j| self.r1[j] + lam * self.p1[j]).collect();
-        let m2: Vec<f64> = (0..m).map(|j| lam * self.p2[j]).collect();
+        let c: Vec<Coeffs> = (0..m).map(|j| self.coeffs(j)).collect();
+        let m0: Vec<f64> = c.iter().map(|c| c.r0 + lam * c.p0).collect();
+        let m1: Vec<f64> = c.iter().map(|c| c.r1 + lam * c.p1).collect();
+        let m2: Vec<f64> = c.iter().map(|c| lam * c.p2).collect();
         Penta::factor(&m0, &m1, &m2)
     }
 
@@ -151,9 +166,10 @@ impl Setup {
         let mut value = y.to_vec();
         for (j, g) in gamma.iter().enumerate() {
             let lg = lam * g;
-            value[j] -= lg * self.qa[j];
-            value[j + 1] -= lg * self.qb[j];
-            value[j + 2] -= lg * self.qc[j];
+            let c = self.coeffs(j);
+            value[j] -= lg * c.qa;
+            value[j + 1] -= lg * c.qb;
+            value[j + 2] -= lg * c.qc;
         }
         (gamma, value)
     }
@@ -164,7 +180,8 @@ impl Setup {
         let (s0, s1, s2) = f.inverse_band();
         let mut tr = 0.0;
         for j in 0..s0.len() {
-            tr += s0[j] * self.p0[j] + 2.0 * (s1[j] * self.p1[j] + s2[j] * self.p2[j]);
+            let c = self.coeffs(j);
+            tr += s0[j] * c.p0 + 2.0 * (s1[j] * c.p1 + s2[j] * c.p2);
         }
         lam * tr
     }
@@ -172,79 +189,128 @@ impl Setup {
     /// (GCV, RSS, n − tr A) for λ, or `None` when λ is numerically unusable: the same
     /// numbers as [`Setup::score_reference`] in one pass per stage over reused buffers
     /// (factorisation with the forward solve, back substitution, then the residuals and the
-    /// trace with the band of the inverse kept in rolling variables). GCV's search calls this
-    /// ~40 times; for 10⁶ samples the allocations of the reference path dominated.
+    /// trace with the band of the inverse kept in rolling variables).
     fn score(&self, lam: f64, ws: &mut Workspace) -> Option<(f64, f64, f64)> {
+        self.score_lanes([lam], &mut ws.rows)[0]
+    }
+
+    /// [`Setup::score`] for `K` values of λ in one sweep. Each pass is a recurrence whose
+    /// every step waits for the one before (a division on the path): one λ leaves the core
+    /// mostly idle, and `K` independent recurrences interleaved cost little more than one.
+    /// A λ whose factorisation breaks down (a pivot not positive and finite) gives `None`;
+    /// its lane goes on with zeros, and the sweep stops when every lane has broken down.
+    fn score_lanes<const K: usize>(
+        &self,
+        lams: [f64; K],
+        rows: &mut Vec<[[f64; 4]; K]>,
+    ) -> [Option<(f64, f64, f64)>; K] {
         let m = self.n - 2;
-        ws.d.resize(m, 0.0);
-        ws.l1.resize(m, 0.0);
-        ws.l2.resize(m, 0.0);
-        ws.g.resize(m, 0.0);
-        let (d, l1, l2, g) = (&mut ws.d, &mut ws.l1, &mut ws.l2, &mut ws.g);
-        for j in 0..m {
-            let mut dj = self.r0[j] + lam * self.p0[j];
-            let mut z = self.qty[j];
-            let mut off = self.r1[j] + lam * self.p1[j];
-            if j >= 1 {
-                dj -= l1[j - 1] * l1[j - 1] * d[j - 1];
-                z -= l1[j - 1] * g[j - 1];
-                off -= l2[j - 1] * d[j - 1] * l1[j - 1];
+        rows.resize(m, [[0.0; 4]; K]);
+        let mut ok = [true; K];
+        // The factors of rows j − 1 and j − 2 of each lane, rolled.
+        let (mut d1, mut l11, mut l21, mut g1) = ([0.0; K], [0.0; K], [0.0; K], [0.0; K]);
+        let (mut d2, mut l22, mut g2) = ([0.0; K], [0.0; K], [0.0; K]);
+        let (mut off1, mut lp2) = ([0.0; K], [0.0; K]);
+        for (j, row) in rows.iter_mut().enumerate() {
+            let c = self.coeffs(j);
+            for k in 0..K {
+                let lam = lams[k];
+                // The terms of row j − 2 first, those of row j − 1 last: the recurrence's
+                // critical path runs through row j − 1's factors.
+                let mut dj = c.r0 + lam * c.p0;
+                let mut z = self.qty[j];
+                let mut off = c.r1 + lam * c.p1;
+                if j >= 2 {
+                    dj -= l22[k] * l22[k] * d2[k];
+                    z -= l22[k] * g2[k];
+                }
+                if j >= 1 {
+                    // l1·l1·d = l1·off and l2·d = λ p2 of row j − 1 (its `off1` and `lp2`):
+                    // one multiplication on the path instead of two.
+                    dj -= l11[k] * (l11[k] * d1[k]);
+                    z -= l11[k] * g1[k];
+                    off -= (l21[k] * d1[k]) * l11[k];
+                }
+                ok[k] &= dj > 0.0 && dj.is_finite();
+                // One division per knot, off the other passes: the reciprocal is kept for
+                // the back substitution and the band of the inverse.
+                let lp = if j + 2 < m { lam * c.p2 } else { 0.0 };
+                let (e, l1, l2) = if ok[k] {
+                    let e = 1.0 / dj;
+                    let l1 = if j + 1 < m { off * e } else { 0.0 };
+                    (e, l1, lp * e)
+                } else {
+                    (dj, z, off) = (1.0, 0.0, 0.0);
+                    (0.0, 0.0, 0.0)
+                };
+                off1[k] = if j + 1 < m { off } else { 0.0 };
+                lp2[k] = lp;
+                row[k] = [e, l1, l2, z];
+                [d2[k], l22[k], g2[k]] = [d1[k], l21[k], g1[k]];
+                [d1[k], l11[k], l21[k], g1[k]] = [dj, l1, l2, z];
             }
-            if j >= 2 {
-                dj -= l2[j - 2] * l2[j - 2] * d[j - 2];
-                z -= l2[j - 2] * g[j - 2];
+            if !ok.contains(&true) {
+                return [None; K];
             }
-            if !(dj > 0.0) || !dj.is_finite() {
-                return None;
-            }
-            d[j] = dj;
-            g[j] = z;
-            l1[j] = if j + 1 < m { off / dj } else { 0.0 };
-            l2[j] = if j + 2 < m {
-                lam * self.p2[j] / dj
-            } else {
-                0.0
-            };
         }
         // Back substitution, and in the same reverse sweep the residuals y − f = λ Q γ (row
         // j + 2 is complete once γ_j is known) and tr(M⁻¹ QᵀQ) with the band of M⁻¹
         // (Hutchinson–de Hoog) in rolling variables: s0_1 = Σ[j+1][j+1], s0_2 = Σ[j+2][j+2],
         // s1_1 = Σ[j+1][j+2].
-        let (mut g1, mut g2) = (0.0, 0.0);
-        let (mut s0_1, mut s0_2, mut s1_1) = (0.0, 0.0, 0.0);
-        let (mut rss, mut tr) = (0.0, 0.0);
+        let (mut g1, mut g2) = ([0.0; K], [0.0; K]);
+        let (mut s0_1, mut s0_2, mut s1_1) = ([0.0; K], [0.0; K], [0.0; K]);
+        let (mut rss, mut tr) = ([0.0; K], [0.0; K]);
+        // Q's entries of the two columns to the right: qb of column j + 1, qa of j + 2.
+        let (mut qb1, mut qa2) = (0.0, 0.0);
         for j in (0..m).rev() {
-            let (a, b) = (l1[j], l2[j]);
-            let gj = g[j] / d[j] - a * g1 - b * g2;
-            g[j] = gj;
-            let mut r = self.qc[j] * gj;
-            if j + 1 < m {
-                r += self.qb[j + 1] * g1;
+            let c = self.coeffs(j);
+            for k in 0..K {
+                let [e, a, b, zj] = rows[j][k];
+                let gj = zj * e - a * g1[k] - b * g2[k];
+                rows[j][k][3] = gj;
+                let mut r = c.qc * gj;
+                if j + 1 < m {
+                    r += qb1 * g1[k];
+                }
+                if j + 2 < m {
+                    r += qa2 * g2[k];
+                }
+                rss[k] += r * r;
+                // Newest values last (the critical path): s0_1 is last sweep's s0.
+                let s2 = -b * s0_2[k] - a * s1_1[k];
+                let s1 = -b * s1_1[k] - a * s0_1[k];
+                let s0 = e - b * s2 - a * s1;
+                tr[k] += s0 * c.p0 + 2.0 * (s1 * c.p1 + s2 * c.p2);
+                s0_2[k] = s0_1[k];
+                s0_1[k] = s0;
+                s1_1[k] = s1;
+                g2[k] = g1[k];
+                g1[k] = gj;
             }
-            if j + 2 < m {
-                r += self.qa[j + 2] * g2;
+            // For j − 1: column j's qb, column j + 1's qa (= 1/h[j+1], this column's qc).
+            qb1 = c.qb;
+            qa2 = c.qc;
+        }
+        std::array::from_fn(|k| {
+            let mut rss = rss[k];
+            // Rows 0 and 1.
+            if m >= 1 {
+                let c0 = self.coeffs(0);
+                let g0 = rows[0][k][3];
+                let r1 = if m > 1 {
+                    self.coeffs(1).qa * rows[1][k][3]
+                } else {
+                    0.0
+                } + c0.qb * g0;
+                let r0 = c0.qa * g0;
+                rss += r1 * r1 + r0 * r0;
             }
-            rss += r * r;
-            let s2 = -a * s1_1 - b * s0_2;
-            let s1 = -a * s0_1 - b * s1_1;
-            let s0 = 1.0 / d[j] - a * s1 - b * s2;
-            tr += s0 * self.p0[j] + 2.0 * (s1 * self.p1[j] + s2 * self.p2[j]);
-            s0_2 = s0_1;
-            s0_1 = s0;
-            s1_1 = s1;
-            g2 = g1;
-            g1 = gj;
-        }
-        // Rows 0 and 1.
-        if m >= 1 {
-            let r1 = if m > 1 { self.qa[1] * g[1] } else { 0.0 } + self.qb[0] * g[0];
-            let r0 = self.qa[0] * g[0];
-            rss += r1 * r1 + r0 * r0;
-        }
-        rss *= lam * lam;
-        let dof = lam * tr;
-        let gcv = self.n as f64 * rss / (dof * dof);
-        (gcv.is_finite() && dof > 0.0).then_some((gcv, rss, dof))
+            let lam = lams[k];
+            rss *= lam * lam;
+            let dof = lam * tr[k];
+            let gcv = self.n as f64 * rss / (dof * dof);
+            (ok[k] && gcv.is_finite() && dof > 0.0).then_some((gcv, rss, dof))
+        })
     }
 
     /// The straightforward (GCV, RSS, n − tr A), kept to test [`Setup::score`] against.
@@ -299,14 +365,17 @@ pub fn fit(
     let sigma2 = if dof > 0.0 { rss / dof } else { 0.0 };
     let gcv = if dof > 0.0 { gcv } else { f64::INFINITY };
     let mut d2 = vec![0.0; n];
-    d2[1..n - 1].copy_from_slice(&ws.g);
+    for (d, row) in d2[1..n - 1].iter_mut().zip(&ws.rows) {
+        *d = row[0][3];
+    }
     // f = y − λ Q γ.
     let mut value = y.to_vec();
-    for (j, g) in ws.g.iter().enumerate() {
+    for (j, g) in ws.rows.iter().map(|r| r[0][3]).enumerate() {
         let lg = lam * g;
-        value[j] -= lg * setup.qa[j];
-        value[j + 1] -= lg * setup.qb[j];
-        value[j + 2] -= lg * setup.qc[j];
+        let c = setup.coeffs(j);
+        value[j] -= lg * c.qa;
+        value[j + 1] -= lg * c.qb;
+        value[j + 2] -= lg * c.qc;
     }
     let mut d1 = vec![0.0; n];
     for i in 0..n - 1 {
@@ -375,26 +444,56 @@ fn gcv_lambda(
             .map_or(f64::INFINITY, |s| s.0)
     };
     // Two decades per grid point (a factor 3.2 in the cut-off frequency): GCV's basin is
-    // wider than that; the grid guards against the spurious minimum at λ → 0.
+    // wider than that; the grid guards against the spurious minimum at λ → 0. The grid's
+    // points are scored two at a time ([`Setup::score_lanes`]), in a buffer of their own
+    // freed before the refinement.
     let steps = (((hi - lo) / 2.0).ceil() as usize).max(2);
-    let mut best = (f64::INFINITY, lo);
-    for k in 0..=steps {
-        let p = lo + (hi - lo) * k as f64 / steps as f64;
-        let s = score(p);
-        if s < best.0 {
-            best = (s, p);
+    let grid: Vec<f64> = (0..=steps)
+        .map(|k| lo + (hi - lo) * k as f64 / steps as f64)
+        .collect();
+    let mut values = Vec::with_capacity(grid.len());
+    let mut rows = Vec::new();
+    for pair in grid.chunks(2) {
+        match *pair {
+            [p, q] => values.extend(
+                setup
+                    .score_lanes([libm::pow(10f64, p), libm::pow(10f64, q)], &mut rows)
+                    .map(|s| s.map_or(f64::INFINITY, |s| s.0)),
+            ),
+            _ => values.push(score(pair[0])),
         }
     }
-    if !best.0.is_finite() {
+    drop(rows);
+    let best = (0..grid.len())
+        .filter(|&k| values[k].is_finite())
+        .min_by(|&a, &b| values[a].total_cmp(&values[b]));
+    let Some(k) = best else {
         return Err(DataError::new(
             name,
             "generalized cross-validation found no usable smoothing (are the values all equal, or the times nearly coincident?)",
         )
         .help("give the smoothing parameter explicitly"));
-    }
+    };
     let step = (hi - lo) / steps as f64;
-    let (p, fp) = crate::minimize::brent_min(&mut score, best.1 - step, best.1 + step, 0.0, 0.0025);
-    Ok(libm::pow(10f64, if fp <= best.0 { p } else { best.1 }))
+    // Brent's method between the best grid point's neighbours, from the three known values
+    // (a neighbour off the grid's end, never scored, counts as +∞).
+    let at = |i: Option<usize>, p: f64| {
+        (
+            p,
+            i.and_then(|i| values.get(i))
+                .copied()
+                .unwrap_or(f64::INFINITY),
+        )
+    };
+    let (p, fp) = crate::minimize::brent_min_bracketed(
+        &mut score,
+        at(k.checked_sub(1), grid[k] - step),
+        (grid[k], values[k]),
+        at(Some(k + 1), grid[k] + step),
+        0.0,
+        0.0025,
+    );
+    Ok(libm::pow(10f64, if fp <= values[k] { p } else { grid[k] }))
 }
 
 #[cfg(test)]
@@ -421,6 +520,31 @@ mod tests {
             let b = setup.score_reference(lam, &y).unwrap();
             for (x, r) in [(a.0, b.0), (a.1, b.1), (a.2, b.2)] {
                 assert!((x - r).abs() <= 1e-9 * r.abs(), "λ = {lam}: {x} vs {r}");
+            }
+        }
+    }
+
+    /// Scored two at a time, each λ gets exactly the numbers it gets alone, also when the
+    /// other lane breaks down (a negative λ makes a pivot negative), and when both do.
+    #[test]
+    fn lanes_score_as_one_at_a_time() {
+        let n = 200;
+        let t: Vec<f64> = (0..n)
+            .map(|i| i as f64 * 0.1 + 0.02 * ((i * 3) % 7) as f64)
+            .collect();
+        let y: Vec<f64> = t
+            .iter()
+            .map(|&x| libm::cos(x) + 0.05 * libm::sin(x * 17.0))
+            .collect();
+        let setup = Setup::new(&t, &y);
+        let mut ws = Workspace::default();
+        let mut rows = Vec::new();
+        for pair in [[1e-3, 10.0], [0.5, -50.0], [-50.0, 2e-2], [-1.0, -50.0]] {
+            let both = setup.score_lanes(pair, &mut rows);
+            for (k, lam) in pair.into_iter().enumerate() {
+                let alone = setup.score(lam, &mut ws);
+                assert_eq!(both[k], alone, "λ = {lam} beside {pair:?}");
+                assert_eq!(alone.is_none(), lam < 0.0, "λ = {lam}");
             }
         }
     }
