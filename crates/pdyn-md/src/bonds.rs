@@ -76,25 +76,14 @@ impl BondKind {
                 let d = r - r0;
                 Some((if ENERGY { 0.5 * k * d * d } else { 0.0 }, -k * d / r))
             }
-            BondKind::Fene { k, r_max } => {
-                let x = r2 / (r_max * r_max);
-                if x >= 1.0 {
-                    return None;
-                }
-                let u = if ENERGY {
-                    -0.5 * k * r_max * r_max * libm::log(1.0 - x)
-                } else {
-                    0.0
-                };
-                Some((u, -k / (1.0 - x)))
-            }
+            BondKind::Fene { k, r_max } => fene::<ENERGY>(k, r_max, r2),
             BondKind::FeneWca {
                 k,
                 r_max,
                 epsilon,
                 sigma,
             } => {
-                let (u, fr) = BondKind::Fene { k, r_max }.evaluate::<ENERGY>(r2)?;
+                let (u, fr) = fene::<ENERGY>(k, r_max, r2)?;
                 // (r/σ)² at the WCA cutoff r = 2^{1/6} σ is 2^{1/3} (LAMMPS's MY_CUBEROOT2)
                 const CUBE_ROOT_2: f64 = 1.259_921_049_894_873_2;
                 if r2 >= CUBE_ROOT_2 * sigma * sigma {
@@ -112,6 +101,23 @@ impl BondKind {
             }
         }
     }
+}
+
+/// The FENE term `(u, f/r)` (`u` = 0 unless `ENERGY`), `None` at or beyond `R₀`. A function of
+/// its own rather than a call of [`BondKind::evaluate`] from the `FeneWca` arm, which being
+/// recursive was not inlined.
+#[inline(always)]
+fn fene<const ENERGY: bool>(k: f64, r_max: f64, r2: f64) -> Option<(f64, f64)> {
+    let x = r2 / (r_max * r_max);
+    if x >= 1.0 {
+        return None;
+    }
+    let u = if ENERGY {
+        -0.5 * k * r_max * r_max * libm::log(1.0 - x)
+    } else {
+        0.0
+    };
+    Some((u, -k / (1.0 - x)))
 }
 
 #[cfg(test)]

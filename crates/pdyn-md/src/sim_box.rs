@@ -43,9 +43,13 @@ impl SimBox {
     pub fn minimum_image(&self, d: [f64; 3]) -> [f64; 3] {
         let mut o = d;
         for k in 0..3 {
+            // below a quarter box (the common case: bonds, special pairs) round(d/L) is ±0 and
+            // the result is d: skip the division and the call `round` is on the baseline
+            // x86-64 target; likewise when d/L is below one half
+            if d[k].abs() < 0.25 * self.l[k] {
+                continue;
+            }
             let q = d[k] / self.l[k];
-            // round(q) is ±0 below one half (the common case): skip the call `round` is on
-            // the baseline x86-64 target, with the same result
             if q.abs() >= 0.5 {
                 o[k] -= self.l[k] * q.round();
             }
@@ -88,6 +92,9 @@ mod tests {
         let b = SimBox::new(10.0, 20.0, 5.0).unwrap();
         let d = b.minimum_image([9.0, -11.0, 2.0]);
         assert_eq!(d, [-1.0, 9.0, 2.0]);
+        // below a quarter, between a quarter and a half, beyond a half, several boxes away
+        assert_eq!(b.minimum_image([2.0, 6.0, -2.6]), [2.0, 6.0, 2.4]);
+        assert_eq!(b.minimum_image([-4.9, -31.0, 12.0]), [-4.9, 9.0, 2.0]);
         assert_eq!(b.wrap(0, -0.5), (9.5, -1));
         assert_eq!(b.wrap(2, 12.0), (2.0, 2));
         assert_eq!(b.wrap(2, 4.5), (4.5, 0));
