@@ -56,29 +56,34 @@ impl BondKind {
     /// `(u, f/r)` at squared length `r2`, or `None` if a FENE bond is at or beyond `R₀`.
     #[inline]
     pub fn energy_force(&self, r2: f64) -> Option<(f64, f64)> {
+        self.evaluate::<true>(r2)
+    }
+
+    /// `f/r` at squared length `r2` (the same bits as [`BondKind::energy_force`]'s), or `None`
+    /// if a FENE bond is at or beyond `R₀`; skips the energy, whose logarithm is most of a
+    /// FENE bond's cost.
+    #[inline]
+    pub fn force(&self, r2: f64) -> Option<f64> {
+        self.evaluate::<false>(r2).map(|(_, fr)| fr)
+    }
+
+    /// `(u, f/r)`, with `u` = 0 unless `ENERGY`.
+    #[inline(always)]
+    fn evaluate<const ENERGY: bool>(&self, r2: f64) -> Option<(f64, f64)> {
         match *self {
             BondKind::Harmonic { k, r0 } => {
                 let r = r2.sqrt();
                 let d = r - r0;
-                Some((0.5 * k * d * d, -k * d / r))
+                Some((if ENERGY { 0.5 * k * d * d } else { 0.0 }, -k * d / r))
             }
-            BondKind::Fene { k, r_max } => {
-                let x = r2 / (r_max * r_max);
-                if x >= 1.0 {
-                    return None;
-                }
-                Some((
-                    -0.5 * k * r_max * r_max * libm::log(1.0 - x),
-                    -k / (1.0 - x),
-                ))
-            }
+            BondKind::Fene { k, r_max } => fene::<ENERGY>(k, r_max, r2),
             BondKind::FeneWca {
                 k,
                 r_max,
                 epsilon,
                 sigma,
             } => {
-                let (u, fr) = BondKind::Fene { k, r_max }.energy_force(r2)?;
+                let (u, fr) = fene::<ENERGY>(k, r_max, r2)?;
                 // (r/σ)² at the WCA cutoff r = 2^{1/6} σ is 2^{1/3} (LAMMPS's MY_CUBEROOT2)
                 const CUBE_ROOT_2: f64 = 1.259_921_049_894_873_2;
                 if r2 >= CUBE_ROOT_2 * sigma * sigma {
@@ -86,12 +91,33 @@ impl BondKind {
                 }
                 let s2 = sigma * sigma / r2;
                 let s6 = s2 * s2 * s2;
-                let wca = 4.0 * epsilon * (s6 * s6 - s6) + epsilon;
                 let wca_fr = 24.0 * epsilon * (2.0 * s6 * s6 - s6) / r2;
-                Some((u + wca, fr + wca_fr))
+                let u = if ENERGY {
+                    u + 4.0 * epsilon * (s6 * s6 - s6) + epsilon
+                } else {
+                    0.0
+                };
+                Some((u, fr + wca_fr))
             }
         }
     }
+}
+
+/// The FENE term `(u, f/r)` (`u` = 0 unless `ENERGY`), `None` at or beyond `R₀`. A function of
+/// its own rather than a call of [`BondKind::evaluate`] from the `FeneWca` arm, which being
+/// recursive was not inlined.
+#[inline(always)]
+fn fene<const ENERGY: bool>(k: f64, r_max: f64, r2: f64) -> Option<(f64, f64)> {
+    let x = r2 / (r_max * r_max);
+    if x >= 1.0 {
+        return None;
+    }
+    let u = if ENERGY {
+        -0.5 * k * r_max * r_max * libm::log(1.0 - x)
+    } else {
+        0.0
+    };
+    Some((u, -k / (1.0 - x)))
 }
 
 #[cfg(test)]
@@ -118,6 +144,8 @@ mod tests {
                 let u = |r: f64| kind.energy_force(r * r).unwrap().0;
                 let du = (u(r + h) - u(r - h)) / (2.0 * h);
                 let fr = kind.energy_force(r * r).unwrap().1;
+                // the force-only path gives the same bits
+                assert_eq!(kind.force(r * r).unwrap().to_bits(), fr.to_bits());
                 assert!((fr * r + du).abs() < 1e-6 * (1.0 + du.abs()));
             }
         }
@@ -126,6 +154,12 @@ mod tests {
             r_max: 1.5
         }
         .energy_force(2.25)
+        .is_none());
+        assert!(BondKind::Fene {
+            k: 30.0,
+            r_max: 1.5
+        }
+        .force(2.25)
         .is_none());
     }
 }

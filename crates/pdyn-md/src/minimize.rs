@@ -89,7 +89,7 @@ pub fn minimize_fire<P: PairPotential>(
         }
         let (u_p, _) = ff.compute(nl, &s.types, &mut scratch, &mut out, true);
         let (u_s, _) = special.correct(s, ff, &mut out);
-        let (u_b, _) = bond_forces(s, &mut out)?;
+        let (u_b, _) = bond_forces(s, &mut out, true)?;
         let u = u_p + u_s + u_b;
         let mut fmax2: f64 = 0.0;
         let p = &mut s.particles;

@@ -142,7 +142,8 @@ impl Columns {
     /// lands in column 0).
     #[inline]
     fn coord(&self, k: usize, x: f64) -> usize {
-        let v = (x * self.scale[k]).floor();
+        // truncation is the floor for v ≥ 0, and below 0 both clamp to 0: no call to `floor`
+        let v = x * self.scale[k];
         (v.max(0.0) as usize).min(self.n[k] - 1)
     }
 

@@ -308,7 +308,7 @@ impl<P: PairPotential> Simulation<P> {
             self.force_field
                 .compute(&self.nl, &s.types, &mut self.scratch, &mut self.out, energy);
         let (u_s, w_s) = self.special.correct(s, &self.force_field, &mut self.out);
-        let (u_b, w_b) = bond_forces(s, &mut self.out)?;
+        let (u_b, w_b) = bond_forces(s, &mut self.out, energy)?;
         let p = &mut s.particles;
         for (i, f) in self.out.iter().enumerate() {
             let inv_m = if p.m[i] > 0.0 { 1.0 / p.m[i] } else { 0.0 };
@@ -591,14 +591,24 @@ impl MdError {
     }
 }
 
-/// Adds bond forces to `out` (in bond order); returns bond energy and virial.
-pub(crate) fn bond_forces(s: &System, out: &mut [[f64; 3]]) -> Result<(f64, f64), MdError> {
+/// Adds bond forces to `out` (in bond order); returns bond energy and virial when `energy`
+/// (else anything: the forces are the same bits either way).
+pub(crate) fn bond_forces(
+    s: &System,
+    out: &mut [[f64; 3]],
+    energy: bool,
+) -> Result<(f64, f64), MdError> {
     let (mut u, mut w) = (0.0, 0.0);
     let p = &s.particles;
     for (b, bond) in s.bonds.iter().enumerate() {
         let d = s.sim_box.delta(p.pos(bond.i), p.pos(bond.j)).0;
         let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-        let Some((e, fr)) = bond.kind.energy_force(r2) else {
+        let evaluated = if energy {
+            bond.kind.energy_force(r2)
+        } else {
+            bond.kind.force(r2).map(|fr| (0.0, fr))
+        };
+        let Some((e, fr)) = evaluated else {
             let max = match bond.kind {
                 crate::BondKind::Fene { r_max, .. } | crate::BondKind::FeneWca { r_max, .. } => {
                     r_max

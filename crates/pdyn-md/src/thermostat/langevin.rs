@@ -2,7 +2,9 @@
 //! Matthews, Appl. Math. Res. Express 2013, 34 (2013)): the O step is the exact
 //! Ornstein–Uhlenbeck update `v ← c₁ v + √((1 − c₁²) k_B T/m) ξ`, `c₁ = e^{−γh}`, with one
 //! seeded normal deviate per component drawn in particle order (reproducible, thread-count
-//! independent). Configurational averages carry an `O(h²)` error only.
+//! independent), by the ziggurat method ([`Rng::normal_ziggurat`]: Gaussian noise as BAOAB
+//! requires, at a fraction of the polar method's cost, which was a sixth of an in.chain
+//! step). Configurational averages carry an `O(h²)` error only.
 
 use super::{positive, target};
 use crate::{MdError, Rng};
@@ -67,9 +69,9 @@ impl Langevin {
                 continue;
             }
             let s = c2 * (kb * self.temperature / p.m[i]).sqrt();
-            p.vx[i] = c1 * p.vx[i] + s * self.rng.normal();
-            p.vy[i] = c1 * p.vy[i] + s * self.rng.normal();
-            p.vz[i] = c1 * p.vz[i] + s * self.rng.normal();
+            p.vx[i] = c1 * p.vx[i] + s * self.rng.normal_ziggurat();
+            p.vy[i] = c1 * p.vy[i] + s * self.rng.normal_ziggurat();
+            p.vz[i] = c1 * p.vz[i] + s * self.rng.normal_ziggurat();
         }
     }
 }
