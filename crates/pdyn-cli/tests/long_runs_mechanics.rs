@@ -179,6 +179,27 @@ fn dop853_at_every_step_killed_at_random_and_restarted_matches_the_uninterrupted
     );
 }
 
+/// The default method, `auto` (DOP853 at the example's rtol 1e-9): streamed, checkpointed,
+/// restarted bit for bit as the explicit pair it runs.
+#[test]
+fn auto_killed_at_random_and_restarted_matches_the_uninterrupted_run() {
+    killed_and_restarted_equals_uninterrupted(
+        "auto",
+        "examples/pendulum_chain_3.toml",
+        &[
+            "--t-end",
+            "300",
+            "--points",
+            "30001",
+            "--checkpoint-every",
+            "300steps",
+        ],
+        3,
+        1000,
+        7,
+    );
+}
+
 /// SIGTERM: the run stops after its current step with exit 4, an "interrupted" summary,
 /// whole rows, and a checkpoint at the stop; `--restart` from it finishes with the files of
 /// the run never stopped.
@@ -270,8 +291,8 @@ fn what_cannot_be_checkpointed_is_refused_by_name() {
             "{err}"
         );
     }
-    // Methods whose state is not saved: the stiff ones, auto, fixed steps, the closed form.
-    for method in ["radau5", "bdf", "auto", "rk4", "exact"] {
+    // Methods whose state is not saved: the stiff ones, fixed steps, the closed form.
+    for method in ["radau5", "bdf", "rk4", "exact"] {
         let mut args = vec!["--method", method, "--checkpoint-every", "100steps"];
         if method == "rk4" {
             args.extend(["--dt", "0.01"]);

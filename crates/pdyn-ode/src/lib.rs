@@ -512,6 +512,21 @@ fn auto<S: OdeSystem + ?Sized>(
         }
         _ => explicit::integrate::<methods::dopri5::Dopri5, S>(sys, t0, tf, y0, opts, events, stop),
     };
+    auto_after_explicit(sys, t0, tf, opts, events, first)
+}
+
+/// The rest of [`Method::Auto`] once its explicit pair has returned (run with
+/// `StiffnessAction::Error`): its result as it is, or, when it stopped because the problem
+/// became stiff, Radau5 from there to `tf`, the two solutions merged. Also the end of an
+/// observed `Auto` solve ([`resume::solve_observed`]), whose Radau5 part is not observed.
+pub(crate) fn auto_after_explicit<S: OdeSystem + ?Sized>(
+    sys: &S,
+    t0: f64,
+    tf: f64,
+    opts: &Options,
+    events: &[Event<'_>],
+    first: Result<Solution, OdeError>,
+) -> Result<Solution, OdeError> {
     let at = match first {
         Err(OdeError::Stiff { at }) => at,
         other => return other,

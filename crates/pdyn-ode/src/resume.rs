@@ -12,8 +12,11 @@
 //! locator's last values and occurrence counts, the index of the next output time.
 //!
 //! Why only the explicit pairs: their state between steps is small and plain. Radau5 and BDF
-//! carry Jacobians, factorizations and difference tables; `Auto` may switch to Radau5; the
-//! fixed-step methods do not need it as much. Those are refused by name.
+//! carry Jacobians, factorizations and difference tables; the fixed-step methods do not need
+//! it as much. Those are refused by name. `Auto` is observed and resumable while it runs its
+//! explicit pair ([`crate::Method::auto_explicit`]); when the stiffness detector fires it
+//! continues with Radau5 to the end unobserved (no more observer calls: that part's outputs
+//! are in the returned solution), as the unobserved `Auto` does at the same step.
 
 use crate::error::invalid;
 use crate::events::{Event, EventState};
@@ -147,10 +150,17 @@ pub fn solve_observed<S: OdeSystem + ?Sized>(
     resume: Option<&ResumeState>,
     observer: &mut Observer<'_>,
 ) -> Result<Solution, OdeError> {
+    if method == Method::Auto {
+        let explicit = Method::auto_explicit(&opts.rtol);
+        let mut o = opts.clone();
+        o.on_stiffness = crate::StiffnessAction::Error;
+        let first = solve_observed(explicit, sys, t_span, y0, &o, events, resume, observer);
+        return crate::auto_after_explicit(sys, t_span.0, t_span.1, opts, events, first);
+    }
     if !RESUMABLE.contains(&method) {
         let names: Vec<&str> = RESUMABLE.iter().map(|m| m.name()).collect();
         return Err(invalid(format!(
-            "{method} cannot be observed step by step or resumed: only the explicit adaptive pairs can ({})",
+            "{method} cannot be observed step by step or resumed: only the explicit adaptive pairs can ({}), and auto while it runs one",
             names.join(", ")
         )));
     }

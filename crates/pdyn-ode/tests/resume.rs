@@ -279,7 +279,7 @@ fn methods_that_cannot_resume_and_foreign_states_are_refused() {
     let (opts, tf) = setup();
     let sys = problems::arenstorf();
     let mut go_on = |_: &mut pdyn_ode::Accepted<'_>| ControlFlow::Continue(());
-    for method in [Method::Radau5, Method::Bdf, Method::Auto, Method::Rk4] {
+    for method in [Method::Radau5, Method::Bdf, Method::Rk4] {
         let e = solve_observed(
             method,
             &sys,
@@ -327,4 +327,82 @@ fn methods_that_cannot_resume_and_foreign_states_are_refused() {
         .unwrap_err()
         .to_string()
         .contains("event functions"));
+}
+
+/// `auto` observed is the plain `auto`, and stopped after any step before its switch to
+/// Radau5 and resumed, it continues bit for bit, switches at the same step and ends with the
+/// same solution: van der Pol at ε = 1e-4 with `rtol` 1e-7 (DOP853 first), which turns stiff
+/// on its slow branch (the stiffness test at every step). The rows produced after the switch come back in the solution (Radau5
+/// is not observed), the ones before it went to the observer.
+#[test]
+fn auto_is_observed_and_resumed_until_it_switches_to_radau5() {
+    let sys = problems::van_der_pol(1e-4);
+    let (y0, tf) = ([2.0, 0.0], 2.0);
+    let opts = Options {
+        rtol: 1e-7.into(),
+        atol: 1e-7.into(),
+        stiffness_check_interval: 1,
+        t_eval: Some((0..=200).map(|k| tf * k as f64 / 200.0).collect()),
+        ..Default::default()
+    };
+    let plain = solve_with_events(Method::Auto, &sys, (0.0, tf), &y0, &opts, &[]).unwrap();
+    let switched = plain
+        .stats
+        .stiffness_detected_at
+        .expect("the test needs a switch");
+    assert_eq!(plain.method, Method::Radau5);
+    // Observed, the observer taking every output out as a streamed run does.
+    let mut seen = Vec::new();
+    let mut states = Vec::new();
+    let mut take = |step: &mut pdyn_ode::Accepted<'_>| {
+        seen.append(&mut step.solution.t);
+        step.solution.y.clear();
+        states.push(step.state());
+        ControlFlow::Continue(())
+    };
+    let observed = solve_observed(
+        Method::Auto,
+        &sys,
+        (0.0, tf),
+        &y0,
+        &opts,
+        &[],
+        None,
+        &mut take,
+    )
+    .unwrap();
+    seen.extend_from_slice(&observed.t);
+    assert!(same_bits(&seen, &plain.t), "the outputs, observed or not");
+    assert_eq!(observed.stats, plain.stats);
+    assert_eq!(observed.method, Method::Radau5);
+    assert!(states
+        .iter()
+        .all(|s| s.method == Method::Dop853 && s.t <= switched));
+    // Resumed from states before the switch.
+    let n = states.len();
+    for k in [0, n / 2, n - 1] {
+        let mut go_on = |_: &mut pdyn_ode::Accepted<'_>| ControlFlow::Continue(());
+        let rest = solve_observed(
+            Method::Auto,
+            &sys,
+            (0.0, tf),
+            &y0,
+            &opts,
+            &[],
+            Some(&states[k]),
+            &mut go_on,
+        )
+        .unwrap();
+        assert_eq!(rest.stats, plain.stats, "resumed from state {k}");
+        let tail = &plain.y[plain.y.len() - 2..];
+        assert!(
+            same_bits(&rest.y[rest.y.len() - 2..], tail),
+            "resumed from state {k}"
+        );
+        let from = plain.t.len() - rest.t.len();
+        assert!(
+            same_bits(&rest.t, &plain.t[from..]),
+            "resumed from state {k}"
+        );
+    }
 }

@@ -15,9 +15,12 @@
 //! restart truncates the file to that length and continues bit for bit.
 //!
 //! Supported: smooth models integrated by an explicit adaptive pair (DOPRI5, Tsit5, RK23,
-//! DOP853, Vern9). A hybrid model (contacts, impacts), the closed form, `auto`, the stiff and
-//! the fixed-step methods are written at the end as before, and refuse `--restart` and
-//! `--checkpoint-every` by name.
+//! DOP853, Vern9) or by `auto` (the default), which runs one of them; if `auto` finds the
+//! problem stiff and switches to Radau5, the rest of the run is integrated unobserved: its
+//! rows are written when it ends, and the last checkpoint is the one before the switch (a
+//! restart from it switches again at the same step). A hybrid model (contacts, impacts), the
+//! closed form, the stiff and the fixed-step methods are written at the end as before, and
+//! refuse `--restart` and `--checkpoint-every` by name.
 
 use super::measured::{report, NonFinite, NonFiniteScan};
 use super::{
@@ -42,7 +45,7 @@ pub const KIND: &str = "mechanics";
 pub fn unsupported(prep: &Prepared, set: &RunSettings) -> Option<String> {
     let names: Vec<&str> = RESUMABLE.iter().map(|m| m.name()).collect();
     let supported = format!(
-        "mechanics runs are checkpointed when the model is smooth and integrated by an explicit adaptive method ({})",
+        "mechanics runs are checkpointed when the model is smooth and integrated by auto or an explicit adaptive method ({})",
         names.join(", ")
     );
     if prep.hybrid.is_some() {
@@ -51,7 +54,7 @@ pub fn unsupported(prep: &Prepared, set: &RunSettings) -> Option<String> {
         ));
     }
     match method_by_name(&set.method) {
-        Some(m) if RESUMABLE.contains(&m) => None,
+        Some(m) if m == pdyn_ode::Method::Auto || RESUMABLE.contains(&m) => None,
         _ => Some(format!(
             "{supported}; this run's method is `{}`, which is not",
             set.method
