@@ -476,6 +476,12 @@ impl SecondOrderSystem for CompiledModel {
     }
 }
 
+/// Interpreted instructions (evaluations × program length) from which compiling an
+/// [`Observer`] to native code pays: Cranelift spends about as long per instruction as the
+/// interpreter spends on this many (measured on the pendulum chains' output columns, see
+/// docs/benchmarks.md, issue 28).
+pub const NATIVE_PAYS_FROM: usize = 400_000;
+
 /// A set of expressions of the observation inputs, evaluated together.
 #[derive(Clone)]
 pub struct Observer {
@@ -530,6 +536,26 @@ impl Observer {
                 *self.ws.get_mut() = self.prog.workspace();
             }
         }
+    }
+
+    /// A native copy of this observer when evaluating it `evaluations` times by the
+    /// interpreter would cost more than compiling it ([`NATIVE_PAYS_FROM`]); `None` when it
+    /// is native already or the work is too small.
+    pub fn native_for(&self, evaluations: usize) -> Option<Observer> {
+        let Evaluator::Interpreted(p) = &self.prog else {
+            return None;
+        };
+        if evaluations.saturating_mul(p.len()) < NATIVE_PAYS_FROM || evaluations < 64 {
+            return None;
+        }
+        let mut native = self.clone();
+        native.make_native();
+        Some(native)
+    }
+
+    /// Whether the expressions run as native code.
+    pub fn is_native(&self) -> bool {
+        self.prog.is_native()
     }
 
     /// Evaluates every expression.
