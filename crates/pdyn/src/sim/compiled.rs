@@ -476,11 +476,11 @@ impl SecondOrderSystem for CompiledModel {
     }
 }
 
-/// Interpreted instructions (evaluations × program length) from which compiling an
-/// [`Observer`] to native code pays: Cranelift spends about as long per instruction as the
-/// interpreter spends on this many (measured on the pendulum chains' output columns, see
-/// docs/benchmarks.md, issue 28).
-pub const NATIVE_PAYS_FROM: usize = 400_000;
+/// Evaluations from which compiling an [`Observer`] to native code pays: Cranelift's
+/// compilation costs about as long as the interpreter's evaluations of the same program
+/// 800–1,900 times (measured on the pendulum chains' output columns, n = 3…100: the ratio
+/// hardly depends on the program's length; docs/benchmarks.md, issue 28).
+pub const NATIVE_PAYS_FROM: usize = 2_000;
 
 /// A set of expressions of the observation inputs, evaluated together.
 #[derive(Clone)]
@@ -538,14 +538,11 @@ impl Observer {
         }
     }
 
-    /// A native copy of this observer when evaluating it `evaluations` times by the
-    /// interpreter would cost more than compiling it ([`NATIVE_PAYS_FROM`]); `None` when it
-    /// is native already or the work is too small.
+    /// A native copy of this observer when it is to be evaluated `evaluations` times, from
+    /// [`NATIVE_PAYS_FROM`] on (where the compilation costs less than the interpreter would);
+    /// `None` when it is native already or the work is too small.
     pub fn native_for(&self, evaluations: usize) -> Option<Observer> {
-        let Evaluator::Interpreted(p) = &self.prog else {
-            return None;
-        };
-        if evaluations.saturating_mul(p.len()) < NATIVE_PAYS_FROM || evaluations < 64 {
+        if evaluations < NATIVE_PAYS_FROM || self.prog.is_native() || self.is_empty() {
             return None;
         }
         let mut native = self.clone();

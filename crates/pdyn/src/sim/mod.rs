@@ -1205,6 +1205,16 @@ pub(crate) fn integrate_observed(
 /// output and its median along the run. The median, not the maximum, so that a run that
 /// goes wrong (a satellite spiralling into the planet, where the kinetic energy grows without
 /// bound) cannot enlarge the yardstick its own error is measured with.
+/// `observer` compiled to native code for `evaluations` when that pays
+/// ([`Observer::native_for`]) and the run's equations are native too (not under `--no-jit`).
+fn native_for(prep: &Prepared, observer: &Observer, evaluations: usize) -> Option<Observer> {
+    if prep.system.is_native() {
+        observer.native_for(evaluations)
+    } else {
+        None
+    }
+}
+
 fn conservation_scales(prep: &Prepared, sol: &Solution) -> Vec<f64> {
     let n = prep.scales.len();
     if n == 0 || sol.is_empty() {
@@ -1216,7 +1226,7 @@ fn conservation_scales(prep: &Prepared, sol: &Solution) -> Vec<f64> {
     // As in `tabulate`: no solve when the scales do not read the unknowns, native code for
     // long runs (the same bits either way).
     let solve = !prep.scales.reads_only_first(prep.system.inputs.len());
-    let native = prep.scales.native_for(sol.len());
+    let native = native_for(prep, &prep.scales, sol.len());
     let scales = native.as_ref().unwrap_or(&prep.scales);
     for k in 0..sol.len() {
         let (t, y) = (sol.t[k], sol.y_at(k));
@@ -1262,7 +1272,7 @@ pub(crate) fn tabulate(
         .any(|o| !o.reads_only_first(base));
     // A long table's columns as native code (the same bits), when interpreting them row by
     // row would cost more than compiling them once.
-    let native_observer = prep.observer.native_for(sol.len());
+    let native_observer = native_for(prep, &prep.observer, sol.len());
     let observer = native_observer.as_ref().unwrap_or(&prep.observer);
     for k in 0..sol.len() {
         let t = sol.t[k];
