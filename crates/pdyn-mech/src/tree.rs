@@ -46,7 +46,13 @@ pub struct TreeNode {
 #[derive(Clone, Debug)]
 pub struct TreeForm {
     /// The nodes, each after its parent.
-    pub nodes: Vec<TreeNode>,
+    nodes: Vec<TreeNode>,
+    /// Each node's coordinate, in node order: what the forward pass reads per node, kept
+    /// apart from the nodes' expressions (a cache line per node).
+    coordinates: Vec<usize>,
+    /// Every node is the child of the one before (a chain): [`TreeForm::solve`] then
+    /// carries each link's result to the next in registers.
+    chain: bool,
 }
 
 /// Numbers per node that [`TreeForm::solve`] reads: `m, s'(3), s''q'²(3), F(3)`.
@@ -212,6 +218,25 @@ fn accelerate<T: Scalar>(j: &Joint<T>, ap: [T; 3]) -> (T, [T; 3]) {
 }
 
 impl TreeForm {
+    /// The tree of `nodes` (each after its parent).
+    pub fn new(nodes: Vec<TreeNode>) -> TreeForm {
+        let coordinates = nodes.iter().map(|nd| nd.coordinate).collect();
+        let chain = nodes
+            .iter()
+            .enumerate()
+            .all(|(k, nd)| nd.parent == k.checked_sub(1));
+        TreeForm {
+            nodes,
+            coordinates,
+            chain,
+        }
+    }
+
+    /// The nodes, each after its parent.
+    pub fn nodes(&self) -> &[TreeNode] {
+        &self.nodes
+    }
+
     /// Number of nodes (= free coordinates).
     pub fn len(&self) -> usize {
         self.nodes.len()
@@ -258,12 +283,7 @@ impl TreeForm {
         };
         ws.joint.resize(n, none);
         let node_values = |k: usize| &values[NODE_INPUTS * k..NODE_INPUTS * (k + 1)];
-        let chain = self
-            .nodes
-            .iter()
-            .enumerate()
-            .all(|(k, nd)| nd.parent == k.checked_sub(1));
-        if chain {
+        if self.chain {
             // Leaves to root, then root to leaves, the running contribution and acceleration
             // in registers.
             let mut carried = [zero; 9];
@@ -276,7 +296,7 @@ impl TreeForm {
             let mut ap = [zero; 3];
             for k in 0..n {
                 let (x, a) = accelerate(&ws.joint[k], ap);
-                qdd[self.nodes[k].coordinate] = x;
+                qdd[self.coordinates[k]] = x;
                 ap = a;
             }
             return Ok(());
@@ -303,7 +323,7 @@ impl TreeForm {
                 None => [zero; 3],
             };
             let (x, a) = accelerate(&ws.joint[k], ap);
-            qdd[self.nodes[k].coordinate] = x;
+            qdd[self.coordinates[k]] = x;
             ws.acc[k] = a;
         }
         Ok(())
@@ -436,5 +456,67 @@ pub fn detect(
             force: parts[k].force,
         });
     }
-    Some(TreeForm { nodes })
+    Some(TreeForm::new(nodes))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pdyn_expr::Pool;
+
+    fn node(k: usize, parent: Option<usize>) -> TreeNode {
+        let z = Pool::ZERO;
+        TreeNode {
+            particle: k,
+            parent,
+            coordinate: k,
+            mass: z,
+            direction: [z; 3],
+            centripetal: [z; 3],
+            force: [z; 3],
+        }
+    }
+
+    /// A chain's registers path gives the bits of the general path (per-node accumulators)
+    /// on the same links: spatial directions, unequal masses, forces in every component.
+    #[test]
+    fn a_chain_solves_as_the_general_tree_path_does() {
+        let n = 9;
+        let chain = TreeForm::new((0..n).map(|k| node(k, k.checked_sub(1))).collect());
+        assert!(chain.chain);
+        let general = TreeForm {
+            chain: false,
+            ..chain.clone()
+        };
+        let mut values = Vec::new();
+        for k in 0..n {
+            let a = 0.37 * k as f64 + 0.2;
+            let b = 0.11 * k as f64 - 0.4;
+            let (sa, ca, sb, cb) = (libm::sin(a), libm::cos(a), libm::sin(b), libm::cos(b));
+            values.extend([1.0 + 0.3 * k as f64, ca * cb, ca * sb, sa]);
+            values.extend([-0.2 * sa, 0.1 * ca, 0.05 * sb]);
+            values.extend([0.3 * cb, -9.81 + 0.1 * k as f64, 0.02 * sa]);
+        }
+        let (mut x, mut y) = (vec![0.0; n], vec![0.0; n]);
+        chain
+            .solve(&values, &mut TreeWorkspace::default(), &mut x)
+            .unwrap();
+        general
+            .solve(&values, &mut TreeWorkspace::default(), &mut y)
+            .unwrap();
+        assert!(x.iter().all(|v| v.is_finite() && *v != 0.0));
+        let bits = |v: &[f64]| v.iter().map(|a| a.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&x), bits(&y));
+    }
+
+    /// A link with no inertia along its direction is refused, naming the node.
+    #[test]
+    fn a_massless_end_is_singular() {
+        let tree = TreeForm::new(vec![node(0, None), node(1, Some(0))]);
+        let mut values = vec![1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -9.81, 0.0];
+        values.extend([0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        let mut x = vec![0.0; 2];
+        let e = tree.solve(&values, &mut TreeWorkspace::default(), &mut x);
+        assert_eq!(e, Err(SingularTree { node: 1 }));
+    }
 }
