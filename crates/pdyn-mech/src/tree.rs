@@ -46,7 +46,13 @@ pub struct TreeNode {
 #[derive(Clone, Debug)]
 pub struct TreeForm {
     /// The nodes, each after its parent.
-    pub nodes: Vec<TreeNode>,
+    nodes: Vec<TreeNode>,
+    /// Each node's coordinate, in node order: what the forward pass reads per node, kept
+    /// apart from the nodes' expressions (a cache line per node).
+    coordinates: Vec<usize>,
+    /// Every node is the child of the one before (a chain): [`TreeForm::solve`] then
+    /// carries each link's result to the next in registers.
+    chain: bool,
 }
 
 /// Numbers per node that [`TreeForm::solve`] reads: `m, s'(3), s''q'²(3), F(3)`.
@@ -87,10 +93,25 @@ pub struct TreeWorkspace<T = f64> {
     /// Per node: the children's articulated inertia (symmetric 3×3 as xx, yy, zz, xy, xz,
     /// yz) and bias force, accumulated in the backward pass.
     acc_in: Vec<[T; 9]>,
-    /// Per node, for the forward pass: `Î s` (3), `sᵀ p̂`, `1/(sᵀ Î s)`.
-    joint: Vec<[T; 5]>,
+    /// Per node, what the forward pass needs: the node's acceleration is the affine map
+    /// `A a_parent + b` of its parent's, and `q'' = −wᵀ a_parent − g` (see [`Joint`]).
+    joint: Vec<Joint<T>>,
     /// Each particle's acceleration in the forward pass.
     acc: Vec<[T; 3]>,
+}
+
+/// One link's result of the backward pass, for the forward pass: with `u = Î s`,
+/// `D = sᵀ Î s`, `w = u/D` and `g = (uᵀc + sᵀp̂)/D`, the link's acceleration is
+/// `q'' = −wᵀ a_parent − g` and its particle's `a = A a_parent + b` with `A = 1 − s wᵀ`,
+/// `b = c − s g`. The affine map keeps the forward pass's dependency chain (one particle's
+/// acceleration waiting for its parent's) at one multiply and two adds per link.
+#[derive(Clone, Copy, Debug)]
+struct Joint<T> {
+    w: [T; 3],
+    g: T,
+    /// `A` by rows.
+    a: [[T; 3]; 3],
+    b: [T; 3],
 }
 
 impl<T> Default for TreeWorkspace<T> {
@@ -117,7 +138,105 @@ fn dot<T: Scalar>(a: [T; 3], b: [T; 3]) -> T {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
+/// The backward step of one node: from its per-node numbers `v` ([`NODE_INPUTS`]) and its
+/// children's accumulated contribution `a` (inertia and bias, as in
+/// [`TreeWorkspace::acc_in`]), the contribution it passes to its parent,
+/// `Î − u uᵀ/D` and `Î c + p̂ − u g` (the joint transmits no force along `s`), and its
+/// [`Joint`]. `None` when `D = sᵀ Î s` is not positive (or NaN).
+///
+/// Ordered for a short dependency chain from `a` to the result (a chain's links run one
+/// after another): `D` as a sum of independent products `Î_ij (s_i s_j)` rather than
+/// `sᵀ(Î s)`, the node's mass folded in as `m |s|²`, and `u uᵀ` formed while `1/D` is
+/// computed.
+#[inline(always)]
+fn articulate<T: Scalar>(v: &[T], a: &[T; 9]) -> Option<([T; 9], Joint<T>)> {
+    let zero = T::of(0.0);
+    let one = T::of(1.0);
+    let (m, s, c) = (v[0], [v[1], v[2], v[3]], [v[4], v[5], v[6]]);
+    let ih = [a[0] + m, a[1] + m, a[2] + m, a[3], a[4], a[5]];
+    let ph = [a[6] - v[7], a[7] - v[8], a[8] - v[9]];
+    let (s00, s11, s22) = (s[0] * s[0], s[1] * s[1], s[2] * s[2]);
+    let two = T::of(2.0);
+    let (s01, s02, s12) = (two * s[0] * s[1], two * s[0] * s[2], two * s[1] * s[2]);
+    let d = ((a[0] * s00 + a[1] * s11) + (a[2] * s22 + a[3] * s01))
+        + ((a[4] * s02 + a[5] * s12) + m * ((s00 + s11) + s22));
+    // NaN is refused too (`partial_cmp` is `None` then).
+    if d.partial_cmp(&zero) != Some(std::cmp::Ordering::Greater) {
+        // No inertia along the link's direction (a massless subtree, a zero-length link):
+        // the dense form's M is singular there too.
+        return None;
+    }
+    let r = one / d;
+    let u = sym_mul(&ih, s);
+    let uu = [
+        u[0] * u[0],
+        u[1] * u[1],
+        u[2] * u[2],
+        u[0] * u[1],
+        u[0] * u[2],
+        u[1] * u[2],
+    ];
+    let g = (dot(u, c) + dot(s, ph)) * r;
+    let w = [u[0] * r, u[1] * r, u[2] * r];
+    let ic = sym_mul(&ih, c);
+    let out = [
+        ih[0] - uu[0] * r,
+        ih[1] - uu[1] * r,
+        ih[2] - uu[2] * r,
+        ih[3] - uu[3] * r,
+        ih[4] - uu[4] * r,
+        ih[5] - uu[5] * r,
+        (ic[0] + ph[0]) - u[0] * g,
+        (ic[1] + ph[1]) - u[1] * g,
+        (ic[2] + ph[2]) - u[2] * g,
+    ];
+    let row = |i: usize| {
+        let e = |j: usize| if i == j { one } else { zero };
+        [e(0) - s[i] * w[0], e(1) - s[i] * w[1], e(2) - s[i] * w[2]]
+    };
+    let joint = Joint {
+        w,
+        g,
+        a: [row(0), row(1), row(2)],
+        b: [c[0] - s[0] * g, c[1] - s[1] * g, c[2] - s[2] * g],
+    };
+    Some((out, joint))
+}
+
+/// The forward step of one node: its coordinate's acceleration and its particle's, from the
+/// parent particle's acceleration `ap`.
+#[inline(always)]
+fn accelerate<T: Scalar>(j: &Joint<T>, ap: [T; 3]) -> (T, [T; 3]) {
+    let x = -((j.w[0] * ap[0] + j.w[1] * ap[1]) + j.w[2] * ap[2]) - j.g;
+    let row = |r: [T; 3], b: T| (r[0] * ap[0] + r[1] * ap[1]) + (r[2] * ap[2] + b);
+    let acc = [
+        row(j.a[0], j.b[0]),
+        row(j.a[1], j.b[1]),
+        row(j.a[2], j.b[2]),
+    ];
+    (x, acc)
+}
+
 impl TreeForm {
+    /// The tree of `nodes` (each after its parent).
+    pub fn new(nodes: Vec<TreeNode>) -> TreeForm {
+        let coordinates = nodes.iter().map(|nd| nd.coordinate).collect();
+        let chain = nodes
+            .iter()
+            .enumerate()
+            .all(|(k, nd)| nd.parent == k.checked_sub(1));
+        TreeForm {
+            nodes,
+            coordinates,
+            chain,
+        }
+    }
+
+    /// The nodes, each after its parent.
+    pub fn nodes(&self) -> &[TreeNode] {
+        &self.nodes
+    }
+
     /// Number of nodes (= free coordinates).
     pub fn len(&self) -> usize {
         self.nodes.len()
@@ -142,6 +261,9 @@ impl TreeForm {
 
     /// The accelerations `qdd[coordinate]` from the per-node numbers `values` (laid out as
     /// [`TreeForm::inputs`]), in `O(n)`: the articulated-body recursion.
+    ///
+    /// A chain (every node the child of the one before) carries each link's result to the
+    /// next in registers; other trees accumulate the children's contributions per node.
     pub fn solve<T: Scalar>(
         &self,
         values: &[T],
@@ -150,63 +272,59 @@ impl TreeForm {
     ) -> Result<(), SingularTree> {
         let n = self.nodes.len();
         let zero = T::of(0.0);
-        let one = T::of(1.0);
         if values.len() < NODE_INPUTS * n || qdd.len() < n {
             return Err(SingularTree { node: 0 });
         }
+        let none = Joint {
+            w: [zero; 3],
+            g: zero,
+            a: [[zero; 3]; 3],
+            b: [zero; 3],
+        };
+        ws.joint.resize(n, none);
+        let node_values = |k: usize| &values[NODE_INPUTS * k..NODE_INPUTS * (k + 1)];
+        if self.chain {
+            // Leaves to root, then root to leaves, the running contribution and acceleration
+            // in registers.
+            let mut carried = [zero; 9];
+            for k in (0..n).rev() {
+                let (out, joint) =
+                    articulate(node_values(k), &carried).ok_or(SingularTree { node: k })?;
+                ws.joint[k] = joint;
+                carried = out;
+            }
+            let mut ap = [zero; 3];
+            for k in 0..n {
+                let (x, a) = accelerate(&ws.joint[k], ap);
+                qdd[self.coordinates[k]] = x;
+                ap = a;
+            }
+            return Ok(());
+        }
         ws.acc_in.clear();
         ws.acc_in.resize(n, [zero; 9]);
-        ws.joint.resize(n, [zero; 5]);
         ws.acc.resize(n, [zero; 3]);
-        // Leaves to roots: `acc_in[k]` holds the children's articulated contributions; the
-        // node's own mass and force make Î, p̂; what it passes to its parent is
-        // Î − u uᵀ/D and Î c + p̂ − u (uᵀc + sᵀp̂)/D, with u = Î s and D = sᵀ Î s (the joint
-        // transmits no force along s).
+        // Leaves to roots: each node adds its contribution to its parent's `acc_in`.
         for k in (0..n).rev() {
-            let v = &values[NODE_INPUTS * k..NODE_INPUTS * (k + 1)];
-            let (m, s, c) = (v[0], [v[1], v[2], v[3]], [v[4], v[5], v[6]]);
-            let a = ws.acc_in[k];
-            let ih = [a[0] + m, a[1] + m, a[2] + m, a[3], a[4], a[5]];
-            let ph = [a[6] - v[7], a[7] - v[8], a[8] - v[9]];
-            let u = sym_mul(&ih, s);
-            let d = dot(s, u);
-            // NaN is refused too (`partial_cmp` is `None` then).
-            if d.partial_cmp(&zero) != Some(std::cmp::Ordering::Greater) {
-                // No inertia along the link's direction (a massless subtree, a zero-length
-                // link): the dense form's M is singular there too.
-                return Err(SingularTree { node: k });
-            }
-            let r = one / d;
-            let sp = dot(s, ph);
-            ws.joint[k] = [u[0], u[1], u[2], sp, r];
+            let (out, joint) =
+                articulate(node_values(k), &ws.acc_in[k]).ok_or(SingularTree { node: k })?;
+            ws.joint[k] = joint;
             if let Some(par) = self.nodes[k].parent {
-                let ic = sym_mul(&ih, c);
-                let g = (dot(u, c) + sp) * r;
-                let (w0, w1, w2) = (u[0] * r, u[1] * r, u[2] * r);
                 let pa = &mut ws.acc_in[par];
-                pa[0] = pa[0] + (ih[0] - u[0] * w0);
-                pa[1] = pa[1] + (ih[1] - u[1] * w1);
-                pa[2] = pa[2] + (ih[2] - u[2] * w2);
-                pa[3] = pa[3] + (ih[3] - u[0] * w1);
-                pa[4] = pa[4] + (ih[4] - u[0] * w2);
-                pa[5] = pa[5] + (ih[5] - u[1] * w2);
-                pa[6] = pa[6] + (ic[0] + ph[0] - u[0] * g);
-                pa[7] = pa[7] + (ic[1] + ph[1] - u[1] * g);
-                pa[8] = pa[8] + (ic[2] + ph[2] - u[2] * g);
+                for (x, y) in pa.iter_mut().zip(out) {
+                    *x = *x + y;
+                }
             }
         }
-        // Roots to leaves: q'' = −(uᵀ(a_parent + c) + sᵀp̂)/D, a = a_parent + s q'' + c.
+        // Roots to leaves.
         for k in 0..n {
-            let v = &values[NODE_INPUTS * k..NODE_INPUTS * (k + 1)];
             let ap = match self.nodes[k].parent {
                 Some(par) => ws.acc[par],
                 None => [zero; 3],
             };
-            let base = [ap[0] + v[4], ap[1] + v[5], ap[2] + v[6]];
-            let j = ws.joint[k];
-            let x = -((j[0] * base[0] + j[1] * base[1] + j[2] * base[2]) + j[3]) * j[4];
-            qdd[self.nodes[k].coordinate] = x;
-            ws.acc[k] = [base[0] + v[1] * x, base[1] + v[2] * x, base[2] + v[3] * x];
+            let (x, a) = accelerate(&ws.joint[k], ap);
+            qdd[self.coordinates[k]] = x;
+            ws.acc[k] = a;
         }
         Ok(())
     }
@@ -338,5 +456,67 @@ pub fn detect(
             force: parts[k].force,
         });
     }
-    Some(TreeForm { nodes })
+    Some(TreeForm::new(nodes))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pdyn_expr::Pool;
+
+    fn node(k: usize, parent: Option<usize>) -> TreeNode {
+        let z = Pool::ZERO;
+        TreeNode {
+            particle: k,
+            parent,
+            coordinate: k,
+            mass: z,
+            direction: [z; 3],
+            centripetal: [z; 3],
+            force: [z; 3],
+        }
+    }
+
+    /// A chain's registers path gives the bits of the general path (per-node accumulators)
+    /// on the same links: spatial directions, unequal masses, forces in every component.
+    #[test]
+    fn a_chain_solves_as_the_general_tree_path_does() {
+        let n = 9;
+        let chain = TreeForm::new((0..n).map(|k| node(k, k.checked_sub(1))).collect());
+        assert!(chain.chain);
+        let general = TreeForm {
+            chain: false,
+            ..chain.clone()
+        };
+        let mut values = Vec::new();
+        for k in 0..n {
+            let a = 0.37 * k as f64 + 0.2;
+            let b = 0.11 * k as f64 - 0.4;
+            let (sa, ca, sb, cb) = (libm::sin(a), libm::cos(a), libm::sin(b), libm::cos(b));
+            values.extend([1.0 + 0.3 * k as f64, ca * cb, ca * sb, sa]);
+            values.extend([-0.2 * sa, 0.1 * ca, 0.05 * sb]);
+            values.extend([0.3 * cb, -9.81 + 0.1 * k as f64, 0.02 * sa]);
+        }
+        let (mut x, mut y) = (vec![0.0; n], vec![0.0; n]);
+        chain
+            .solve(&values, &mut TreeWorkspace::default(), &mut x)
+            .unwrap();
+        general
+            .solve(&values, &mut TreeWorkspace::default(), &mut y)
+            .unwrap();
+        assert!(x.iter().all(|v| v.is_finite() && *v != 0.0));
+        let bits = |v: &[f64]| v.iter().map(|a| a.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&x), bits(&y));
+    }
+
+    /// A link with no inertia along its direction is refused, naming the node.
+    #[test]
+    fn a_massless_end_is_singular() {
+        let tree = TreeForm::new(vec![node(0, None), node(1, Some(0))]);
+        let mut values = vec![1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -9.81, 0.0];
+        values.extend([0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        let mut x = vec![0.0; 2];
+        let e = tree.solve(&values, &mut TreeWorkspace::default(), &mut x);
+        assert_eq!(e, Err(SingularTree { node: 1 }));
+    }
 }

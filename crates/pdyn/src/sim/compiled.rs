@@ -476,6 +476,12 @@ impl SecondOrderSystem for CompiledModel {
     }
 }
 
+/// Evaluations from which compiling an [`Observer`] to native code pays: Cranelift's
+/// compilation costs about as long as the interpreter's evaluations of the same program
+/// 800–1,900 times (measured on the pendulum chains' output columns, n = 3…100: the ratio
+/// hardly depends on the program's length; docs/benchmarks.md, issue 28).
+pub const NATIVE_PAYS_FROM: usize = 2_000;
+
 /// A set of expressions of the observation inputs, evaluated together.
 #[derive(Clone)]
 pub struct Observer {
@@ -530,6 +536,23 @@ impl Observer {
                 *self.ws.get_mut() = self.prog.workspace();
             }
         }
+    }
+
+    /// A native copy of this observer when it is to be evaluated `evaluations` times, from
+    /// [`NATIVE_PAYS_FROM`] on (where the compilation costs less than the interpreter would);
+    /// `None` when it is native already or the work is too small.
+    pub fn native_for(&self, evaluations: usize) -> Option<Observer> {
+        if evaluations < NATIVE_PAYS_FROM || self.prog.is_native() || self.is_empty() {
+            return None;
+        }
+        let mut native = self.clone();
+        native.make_native();
+        Some(native)
+    }
+
+    /// Whether the expressions run as native code.
+    pub fn is_native(&self) -> bool {
+        self.prog.is_native()
     }
 
     /// Evaluates every expression.

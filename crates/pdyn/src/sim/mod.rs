@@ -1205,6 +1205,16 @@ pub(crate) fn integrate_observed(
 /// output and its median along the run. The median, not the maximum, so that a run that
 /// goes wrong (a satellite spiralling into the planet, where the kinetic energy grows without
 /// bound) cannot enlarge the yardstick its own error is measured with.
+/// `observer` compiled to native code for `evaluations` when that pays
+/// ([`Observer::native_for`]) and the run's equations are native too (not under `--no-jit`).
+fn native_for(prep: &Prepared, observer: &Observer, evaluations: usize) -> Option<Observer> {
+    if prep.system.is_native() {
+        observer.native_for(evaluations)
+    } else {
+        None
+    }
+}
+
 fn conservation_scales(prep: &Prepared, sol: &Solution) -> Vec<f64> {
     let n = prep.scales.len();
     if n == 0 || sol.is_empty() {
@@ -1213,10 +1223,20 @@ fn conservation_scales(prep: &Prepared, sol: &Solution) -> Vec<f64> {
     let mut per_quantity = vec![Vec::with_capacity(sol.len()); n];
     let mut input = Vec::new();
     let mut out = vec![0.0; n];
+    // As in `tabulate`: no solve when the scales do not read the unknowns, native code for
+    // long runs (the same bits either way).
+    let solve = !prep.scales.reads_only_first(prep.system.inputs.len());
+    let native = native_for(prep, &prep.scales, sol.len());
+    let scales = native.as_ref().unwrap_or(&prep.scales);
     for k in 0..sol.len() {
-        prep.system
-            .observation_input(sol.t[k], sol.y_at(k), &mut input);
-        prep.scales.eval(&input, &mut out);
+        let (t, y) = (sol.t[k], sol.y_at(k));
+        if solve {
+            prep.system.observation_input(t, y, &mut input);
+        } else {
+            prep.system
+                .observation_input_without_unknowns(t, y, &mut input);
+        }
+        scales.eval(&input, &mut out);
         for (series, &v) in per_quantity.iter_mut().zip(&out) {
             series.push(v.abs());
         }
@@ -1244,11 +1264,25 @@ pub(crate) fn tabulate(
     let mut extra = vec![0.0; prep.observer.len()];
     let mut watch = FrictionWatch::default();
     let mut push = PushWatch::default();
+    // Solve for the accelerations and reactions at each row only when a program evaluated
+    // here reads them (as `measured`); the others give the same bits without them.
+    let base = sys.inputs.len();
+    let solve = std::iter::once(&prep.observer)
+        .chain(prep.friction_power.as_ref())
+        .any(|o| !o.reads_only_first(base));
+    // A long table's columns as native code (the same bits), when interpreting them row by
+    // row would cost more than compiling them once.
+    let native_observer = native_for(prep, &prep.observer, sol.len());
+    let observer = native_observer.as_ref().unwrap_or(&prep.observer);
     for k in 0..sol.len() {
         let t = sol.t[k];
         let y = sol.y_at(k);
-        sys.observation_input(t, y, &mut input);
-        prep.observer.eval(&input, &mut extra);
+        if solve {
+            sys.observation_input(t, y, &mut input);
+        } else {
+            sys.observation_input_without_unknowns(t, y, &mut input);
+        }
+        observer.eval(&input, &mut extra);
         watch.check(prep, &input, t);
         push.check(prep, t, &extra);
         let mut row = Vec::with_capacity(columns.len());

@@ -174,3 +174,75 @@ fn tree_evaluation_ops_grow_linearly_in_the_links() {
     );
     assert!(o80 < 80 * 200, "{o80} operations at n = 80");
 }
+
+/// A long run's table, whose output columns and conservation scales run as native code
+/// (from [`super::compiled::NATIVE_PAYS_FROM`] rows) on inputs without the solved unknowns
+/// (they read none), holds the bits the interpreter gives on the solved observation inputs,
+/// row by row, and the same energy scale.
+#[test]
+fn long_tables_give_the_interpreters_bits_without_the_unknowns() {
+    let n = 5;
+    let mut src = String::from("name = \"c\"\ngravity = \"[0, -g, 0]\"\n[parameters]\ng = 9.81\n");
+    src += "[coordinates]\n";
+    for i in 1..=n {
+        src += &format!("q{i} = {{ initial = {}, rate = 0.0 }}\n", 0.3 * i as f64);
+    }
+    for i in 1..=n {
+        let pos: Vec<String> = (1..=i)
+            .map(|j| format!("{}*[sin(q{j}), -cos(q{j}), 0]", 1.0 + 0.1 * j as f64))
+            .collect();
+        src += &format!(
+            "[particles.p{i}]\nmass = \"{}\"\nposition = \"{}\"\n",
+            1.0 + 0.2 * i as f64,
+            pos.join(" + ")
+        );
+    }
+    let mut model = pdyn_mech::load(&src, "c.toml").unwrap();
+    let prep = super::prepare(&mut model).unwrap();
+    assert!(prep.system.is_tree());
+    let base = prep.system.inputs.len();
+    assert!(prep.observer.reads_only_first(base) && prep.scales.reads_only_first(base));
+    assert!(!prep.scales.is_empty(), "the chain's energy is conserved");
+    let rows = super::compiled::NATIVE_PAYS_FROM + 1;
+    // The switch the table relies on, on either side of the threshold.
+    assert!(prep.observer.native_for(rows - 2).is_none());
+    assert!(prep.observer.native_for(rows).is_some());
+    let set = super::RunSettings {
+        method: "dop853".into(),
+        t_end: 3.0,
+        rtol: Some(1e-9),
+        atol: Some(1e-12),
+        dt: None,
+        max_step: None,
+        max_steps: None,
+        points: Some(rows),
+        output_dt: None,
+        t_eval: None,
+        drift_tolerance: super::DEFAULT_DRIFT_TOLERANCE,
+        interrupt: None,
+    };
+    let res = super::run(&prep, &set).unwrap();
+    assert_eq!(res.rows.len(), rows);
+    let (mut input, mut extra) = (Vec::new(), vec![0.0; prep.observer.len()]);
+    let mut scale_series = vec![Vec::new(); prep.scales.len()];
+    let mut scale_out = vec![0.0; prep.scales.len()];
+    for row in &res.rows {
+        let (t, y) = (row[0], &row[1..1 + 2 * n]);
+        prep.system.observation_input(t, y, &mut input);
+        assert!(
+            input[base..].iter().all(|x| x.is_finite()),
+            "solved unknowns"
+        );
+        prep.observer.eval(&input, &mut extra);
+        for (a, b) in row[1 + 2 * n..].iter().zip(&extra) {
+            assert_eq!(a.to_bits(), b.to_bits(), "t = {t}: {a} vs {b}");
+        }
+        prep.scales.eval(&input, &mut scale_out);
+        for (s, v) in scale_series.iter_mut().zip(&scale_out) {
+            s.push(v.abs());
+        }
+    }
+    let expected: Vec<f64> = scale_series.into_iter().map(super::scale_of).collect();
+    let got: Vec<f64> = res.monitors.iter().map(|m| m.scale).collect();
+    assert_eq!(got, expected);
+}
