@@ -29,6 +29,10 @@ struct Kernel {
     /// Per output: per element, the index of the acceleration it adds to (a free coordinate
     /// in state order), or [`NONE`].
     scatter: Vec<Vec<u32>>,
+    /// The outputs that are not identically zero, each with, per element, the index of the
+    /// acceleration it adds to, `n` (a slot past the accelerations, discarded) for a
+    /// component constant in time: the scatter loop without a test.
+    adds: Vec<(usize, Vec<u32>)>,
     /// Per output: which axis of which particle it is, by the particle of each element
     /// (`acts[o / 3][e]`, the particle pushed by the outputs `3 (o / 3) .. 3 (o / 3) + 3`).
     acts: Vec<Vec<u32>>,
@@ -80,6 +84,9 @@ struct Columns {
 #[derive(Clone)]
 pub struct NetKernels {
     kernels: Vec<Kernel>,
+    /// The accelerations being summed, and one slot past them for the components constant in
+    /// time.
+    sums: RefCell<Vec<f64>>,
     /// Free coordinates.
     n: usize,
     /// Whether every kernel that has elements runs native code.
@@ -134,12 +141,24 @@ impl NetKernels {
                         .collect()
                 })
                 .collect();
-            let scatter = (0..outputs.len())
+            let scatter: Vec<Vec<u32>> = (0..outputs.len())
                 .map(|o| {
                     acts[o / 3]
                         .iter()
                         .map(|&p| structure.axes[p as usize][o % 3].unwrap_or(NONE))
                         .collect()
+                })
+                .collect();
+            let adds = scatter
+                .iter()
+                .enumerate()
+                .filter(|&(o, _)| outputs[o] != Pool::ZERO)
+                .map(|(o, rows): (usize, &Vec<u32>)| {
+                    let to = rows
+                        .iter()
+                        .map(|&r| if r == NONE { n as u32 } else { r })
+                        .collect();
+                    (o, to)
                 })
                 .collect();
             // ∂(F/m)/∂(slot input), for the implicit methods.
@@ -168,6 +187,7 @@ impl NetKernels {
                 kernel,
                 gather,
                 scatter,
+                adds,
                 acts,
                 nonzero: outputs.iter().map(|&c| c != Pool::ZERO).collect(),
                 jacobian_entries,
@@ -183,6 +203,7 @@ impl NetKernels {
             .all(|k| k.kernel.is_native() || k.mode == JitMode::Off);
         Ok(Some(NetKernels {
             kernels,
+            sums: RefCell::new(vec![0.0; n + 1]),
             n,
             native: native && jit == JitMode::Auto,
             reads_rates,
@@ -243,21 +264,21 @@ impl NetKernels {
     /// The accelerations `q''` (free coordinates in state order) at `input = [t, q, q',
     /// parameters]`.
     pub fn accelerations(&self, input: &[f64], acc: &mut [f64]) {
-        acc[..self.n].iter_mut().for_each(|a| *a = 0.0);
+        let sums = &mut *self.sums.borrow_mut();
+        sums.iter_mut().for_each(|a| *a = 0.0);
         for k in &self.kernels {
             if k.elements == 0 {
                 continue;
             }
             let cols = &mut *k.columns.borrow_mut();
             run_kernel(k, input, cols);
-            for (rows, out) in k.scatter.iter().zip(&cols.outputs) {
-                for (&to, &v) in rows.iter().zip(out) {
-                    if to != NONE {
-                        acc[to as usize] += v;
-                    }
+            for (o, to) in &k.adds {
+                for (&to, &v) in to.iter().zip(&cols.outputs[*o]) {
+                    sums[to as usize] += v;
                 }
             }
         }
+        acc[..self.n].copy_from_slice(&sums[..self.n]);
     }
 
     /// True when no load acts along a particle's component that is constant in time: the
