@@ -29,10 +29,9 @@ struct Kernel {
     /// Per output: per element, the index of the acceleration it adds to (a free coordinate
     /// in state order), or [`NONE`].
     scatter: Vec<Vec<u32>>,
-    /// The outputs that are not identically zero, each with, per element, the index of the
-    /// acceleration it adds to, `n` (a slot past the accelerations, discarded) for a
-    /// component constant in time: the scatter loop without a test.
-    adds: Vec<(usize, Vec<u32>)>,
+    /// Where its output columns start in [`NetKernels::outputs`] (output `o` of element `e`
+    /// at `at + o * elements + e`).
+    at: usize,
     /// Per output: which axis of which particle it is, by the particle of each element
     /// (`acts[o / 3][e]`, the particle pushed by the outputs `3 (o / 3) .. 3 (o / 3) + 3`).
     acts: Vec<Vec<u32>>,
@@ -76,7 +75,6 @@ struct Columns {
     inputs: Vec<Vec<f64>>,
     /// The value each broadcast input column holds (NaN bits: not filled yet).
     filled: Vec<u64>,
-    outputs: Vec<Vec<f64>>,
     jacobian: Vec<Vec<f64>>,
 }
 
@@ -84,9 +82,14 @@ struct Columns {
 #[derive(Clone)]
 pub struct NetKernels {
     kernels: Vec<Kernel>,
-    /// The accelerations being summed, and one slot past them for the components constant in
-    /// time.
-    sums: RefCell<Vec<f64>>,
+    /// Every kernel's output columns, one after the other.
+    outputs: RefCell<Vec<f64>>,
+    /// The sum forming each acceleration (a free coordinate in state order), as rows of a
+    /// sparse matrix: the terms of acceleration `r` are the outputs at
+    /// `terms[term_start[r]..term_start[r + 1]]`. Summed row by row, each sum in a register,
+    /// instead of adding each output into its acceleration in memory.
+    term_start: Vec<u32>,
+    terms: Vec<u32>,
     /// Free coordinates.
     n: usize,
     /// Whether every kernel that has elements runs native code.
@@ -149,18 +152,6 @@ impl NetKernels {
                         .collect()
                 })
                 .collect();
-            let adds = scatter
-                .iter()
-                .enumerate()
-                .filter(|&(o, _)| outputs[o] != Pool::ZERO)
-                .map(|(o, rows): (usize, &Vec<u32>)| {
-                    let to = rows
-                        .iter()
-                        .map(|&r| if r == NONE { n as u32 } else { r })
-                        .collect();
-                    (o, to)
-                })
-                .collect();
             // ∂(F/m)/∂(slot input), for the implicit methods.
             let mut jacobian_entries = Vec::new();
             let mut derivatives = Vec::new();
@@ -180,14 +171,13 @@ impl NetKernels {
             let columns = Columns {
                 inputs: vec![vec![0.0; elements]; kernel.n_inputs()],
                 filled: vec![f64::NAN.to_bits(); kernel.n_inputs()],
-                outputs: vec![vec![0.0; elements]; outputs.len()],
                 jacobian: Vec::new(),
             };
             kernels.push(Kernel {
                 kernel,
                 gather,
                 scatter,
-                adds,
+                at: 0,
                 acts,
                 nonzero: outputs.iter().map(|&c| c != Pool::ZERO).collect(),
                 jacobian_entries,
@@ -201,9 +191,17 @@ impl NetKernels {
         let native = kernels
             .iter()
             .all(|k| k.kernel.is_native() || k.mode == JitMode::Off);
+        let mut at = 0;
+        for k in &mut kernels {
+            k.at = at;
+            at += k.scatter.len() * k.elements;
+        }
+        let (term_start, terms) = sums(&kernels, n);
         Ok(Some(NetKernels {
             kernels,
-            sums: RefCell::new(vec![0.0; n + 1]),
+            outputs: RefCell::new(vec![0.0; at]),
+            term_start,
+            terms,
             n,
             native: native && jit == JitMode::Auto,
             reads_rates,
@@ -264,21 +262,16 @@ impl NetKernels {
     /// The accelerations `q''` (free coordinates in state order) at `input = [t, q, q',
     /// parameters]`.
     pub fn accelerations(&self, input: &[f64], acc: &mut [f64]) {
-        let sums = &mut *self.sums.borrow_mut();
-        sums.iter_mut().for_each(|a| *a = 0.0);
+        let outputs = &mut *self.outputs.borrow_mut();
         for k in &self.kernels {
-            if k.elements == 0 {
-                continue;
-            }
-            let cols = &mut *k.columns.borrow_mut();
-            run_kernel(k, input, cols);
-            for (o, to) in &k.adds {
-                for (&to, &v) in to.iter().zip(&cols.outputs[*o]) {
-                    sums[to as usize] += v;
-                }
-            }
+            run_kernel(k, input, outputs);
         }
-        acc[..self.n].copy_from_slice(&sums[..self.n]);
+        for (a, w) in acc[..self.n].iter_mut().zip(self.term_start.windows(2)) {
+            *a = self.terms[w[0] as usize..w[1] as usize]
+                .iter()
+                .map(|&i| outputs[i as usize])
+                .sum();
+        }
     }
 
     /// True when no load acts along a particle's component that is constant in time: the
@@ -308,12 +301,13 @@ impl NetKernels {
             if k.elements == 0 {
                 continue;
             }
-            let cols = &mut *k.columns.borrow_mut();
-            run_kernel(k, input, cols);
+            let outputs = &mut *self.outputs.borrow_mut();
+            run_kernel(k, input, outputs);
+            let outs = &outputs[k.at..k.at + k.scatter.len() * k.elements];
             for (a, pushed) in k.acts.iter().enumerate() {
                 for (e, &p) in pushed.iter().enumerate() {
                     let m = mass[p as usize];
-                    let f = [0, 1, 2].map(|c| m * cols.outputs[3 * a + c][e]);
+                    let f = [0, 1, 2].map(|c| m * outs[(3 * a + c) * k.elements + e]);
                     let r = position[p as usize];
                     let terms = [
                         (r[1] * f[2], r[2] * f[1]),
@@ -377,13 +371,51 @@ impl NetKernels {
     }
 }
 
-/// Runs `k` over its elements at `input`: its output columns, one value per element, in
-/// `cols.outputs`.
-fn run_kernel(k: &Kernel, input: &[f64], cols: &mut Columns) {
+/// Runs `k` over its elements at `input`: its output columns, one value per element, in its
+/// part of `outputs`.
+fn run_kernel(k: &Kernel, input: &[f64], outputs: &mut [f64]) {
+    if k.elements == 0 {
+        return;
+    }
+    let cols = &mut *k.columns.borrow_mut();
     gather(k, input, cols);
     let ins: Vec<&[f64]> = cols.inputs.iter().map(|c| c.as_slice()).collect();
-    let mut outs: Vec<&mut [f64]> = cols.outputs.iter_mut().map(|c| c.as_mut_slice()).collect();
+    let mut outs: Vec<&mut [f64]> = outputs[k.at..k.at + k.scatter.len() * k.elements]
+        .chunks_mut(k.elements)
+        .collect();
     k.kernel.run(&ins, &mut outs);
+}
+
+/// The terms of each acceleration (the rows of `NetKernels::terms`): every output not identically
+/// zero of every element, by the acceleration it adds to (kernel by kernel, output by output,
+/// element by element within one acceleration).
+fn sums(kernels: &[Kernel], n: usize) -> (Vec<u32>, Vec<u32>) {
+    let mut count = vec![0u32; n + 1];
+    let each = |f: &mut dyn FnMut(u32, u32)| {
+        for k in kernels {
+            for (o, rows) in k.scatter.iter().enumerate() {
+                if !k.nonzero[o] {
+                    continue;
+                }
+                for (e, &row) in rows.iter().enumerate() {
+                    if row != NONE {
+                        f(row, (k.at + o * k.elements + e) as u32);
+                    }
+                }
+            }
+        }
+    };
+    each(&mut |row, _| count[row as usize + 1] += 1);
+    for r in 0..n {
+        count[r + 1] += count[r];
+    }
+    let mut next = count.clone();
+    let mut terms = vec![0u32; count[n] as usize];
+    each(&mut |row, i| {
+        terms[next[row as usize] as usize] = i;
+        next[row as usize] += 1;
+    });
+    (count, terms)
 }
 
 /// Fills the input columns of kernel `k` from `input`: every element's coordinates, and a
