@@ -1,10 +1,12 @@
 //! The templates compiled once each and evaluated over their elements: gather the inputs of
-//! every element into columns, run the kernel over the columns, scatter-add its outputs into
-//! the accelerations (and its derivatives into the Jacobian).
+//! every element into columns, run the kernel over the columns into one buffer of outputs, and
+//! sum each acceleration from its terms there (and scatter-add the derivatives into the
+//! Jacobian).
 //!
 //! Inputs come from the vector `[t, q, q', parameters]` that [`super::super::compiled`]
 //! keeps, so that setting parameters needs nothing here: each kernel input is, element by
-//! element, an index into that vector (the gather table).
+//! element, an index into that vector (the gather table), or one index for every element (a
+//! parameter, `t`: its column is refilled only when its value changes).
 
 use super::structure::{self, Group, Source, Structure};
 use pdyn_expr::compile::CompileError;
