@@ -288,3 +288,39 @@ fn each_spring_is_one_element_and_parameters_are_not_gathered() {
         );
     }
 }
+
+/// A parameter's column, filled once, is filled again when the parameter changes (a sweep's
+/// `--set`): after new values the right-hand side is still the generic path's, not the one
+/// of the old values.
+#[test]
+fn new_parameter_values_reach_the_kernels() {
+    let src = net_source(4, 3, Some(0.02));
+    let (_, fast) = prepare(&src, NetPath::Always);
+    let (_, generic) = prepare(&src, NetPath::Never);
+    let dim = generic.system.dim();
+    let y = perturbed(&generic.y0);
+    let (mut f1, mut f2) = (vec![0.0; dim], vec![0.0; dim]);
+    fast.system.rhs(0.0, &y, &mut f1);
+    let before = f1.clone();
+    // Every parameter changed: m, k, kd, a, g, c each by its own factor.
+    let values: Vec<f64> = fast
+        .system
+        .parameters()
+        .iter()
+        .enumerate()
+        .map(|(k, v)| v * (1.5 + 0.25 * k as f64))
+        .collect();
+    fast.system.set_parameters(&values);
+    generic.system.set_parameters(&values);
+    fast.system.rhs(0.0, &y, &mut f1);
+    generic.system.rhs(0.0, &y, &mut f2);
+    let d = max_relative_difference(&f2, &f1);
+    assert!(
+        d < 1e-13,
+        "after new parameters, right-hand sides differ by {d:e}"
+    );
+    assert!(
+        max_relative_difference(&before, &f1) > 1e-3,
+        "the parameters changed nothing"
+    );
+}

@@ -408,8 +408,11 @@ fn sums(kernels: &[Kernel], n: usize) -> (Vec<u32>, Vec<u32>) {
         }
     };
     each(&mut |row, _| count[row as usize + 1] += 1);
-    for r in 0..n {
-        count[r + 1] += count[r];
+    // Row `r` starts after every term of the rows before it.
+    let mut total = 0;
+    for c in &mut count {
+        total += *c;
+        *c = total;
     }
     let mut next = count.clone();
     let mut terms = vec![0u32; count[n] as usize];
