@@ -43,6 +43,9 @@ pub enum Source {
     Time,
 }
 
+/// `F / m` of each particle an element pushes, with its slot: `(slot, [x, y, z])`.
+pub type ActsOn = Vec<(u8, [Id; 3])>;
+
 /// The loads that share one template.
 pub struct Group {
     /// Particles per element: the load's own first, then the others by index.
@@ -51,7 +54,7 @@ pub struct Group {
     /// slot of that particle: the load's own (slot 0), and for a two-body force between two
     /// particles (a spring: its second load the first's opposite) the other end (slot 1) as
     /// well, so that the force is evaluated once for both ends.
-    pub acts_on: Vec<(u8, [Id; 3])>,
+    pub acts_on: ActsOn,
     /// The particles of each element, `slots` per element (indices into `Model::particles`).
     pub particles: Vec<u32>,
 }
@@ -140,7 +143,7 @@ pub fn recognise(model: &mut Model) -> Option<Structure> {
     let mut groups: Vec<Group> = Vec::new();
     let mut by_signature: FxHashMap<(usize, [u128; 3], Id, Option<Id>), usize> =
         FxHashMap::default();
-    let mut by_template: FxHashMap<(usize, Vec<(u8, [Id; 3])>), usize> = FxHashMap::default();
+    let mut by_template: FxHashMap<(usize, ActsOn), usize> = FxHashMap::default();
     let mut signer = Signer::default();
     let loads = &model.loads;
     let mut next = 0;
