@@ -10,6 +10,11 @@ use pdyn_ode::OdeSystem;
 /// An `nx × ny` net as `examples/hanging_net.toml` writes it (corners `P[0,0]` and
 /// `P[nx-1,0]` pinned), with drag coefficient `c` (none when `None`).
 fn net_source(nx: i64, ny: i64, c: Option<f64>) -> String {
+    net_source_with_mass(nx, ny, c, "m")
+}
+
+/// [`net_source`] with each particle's mass `mass` (may read `i`, `j`).
+fn net_source_with_mass(nx: i64, ny: i64, c: Option<f64>, mass: &str) -> String {
     let mut s = format!(
         r#"
 name = "net"
@@ -34,7 +39,7 @@ c = {c}
 "P[i,j]" = {{ position = "[i*a, j*a, 0]", where = "j == 0 and (i == 0 or i == nx-1)" }}
 [particles."P[i,j]"]
 where = "not (j == 0 and (i == 0 or i == nx-1))"
-mass = "m"
+mass = "{mass}"
 position = "[x[i,j], y[i,j], z[i,j]]"
 [[forces]]
 kind = "spring"
@@ -112,8 +117,14 @@ fn max_relative_difference(a: &[f64], b: &[f64]) -> f64 {
 /// of 4, 10 and 23 particles, to round-off.
 #[test]
 fn kernels_agree_with_the_generic_derivation() {
-    for (nx, ny) in [(3, 2), (3, 4), (5, 5)] {
-        let src = net_source(nx, ny, Some(0.02));
+    for (nx, ny, mass) in [
+        (3, 2, "m"),
+        (3, 4, "m"),
+        (5, 5, "m"),
+        // Every particle its own mass: a spring's two ends divide by different masses.
+        (4, 3, "m*(1 + i + 2*j)"),
+    ] {
+        let src = net_source_with_mass(nx, ny, Some(0.02), mass);
         let (_, fast) = prepare(&src, NetPath::Always);
         let (_, generic) = prepare(&src, NetPath::Never);
         assert!(fast.system.net_kernels().is_some(), "{nx}x{ny}: not a net");
@@ -248,5 +259,68 @@ fn setup_counts_grow_linearly() {
     assert!(
         (second.1 / first.1 - 1.0).abs() < 0.1,
         "nodes per particle: {increments:?}"
+    );
+}
+
+/// A spring between two particles is one element (its force evaluated once for both ends),
+/// and the kernels gather only coordinates, each parameter's column being filled once: the
+/// counts of an `nx × ny` net with two pinned corners, from its springs (6 of which end at a
+/// corner: 3 loads on one particle each) and its particles (one gravity and one drag load
+/// each; gravity reads nothing, drag the particle's 3 velocities, a spring its ends' 3
+/// positions each).
+#[test]
+fn each_spring_is_one_element_and_parameters_are_not_gathered() {
+    for (nx, ny) in [(3, 3), (5, 4), (10, 10)] {
+        let (_, prep) = prepare(&net_source(nx, ny, Some(0.02)), NetPath::Always);
+        let k = prep.system.net_kernels().expect("a net");
+        let springs = (nx - 1) * ny + nx * (ny - 1) + 2 * (nx - 1) * (ny - 1);
+        let at_corners = 6;
+        let particles = nx * ny - 2;
+        assert_eq!(
+            k.elements() as i64,
+            springs + 2 * particles,
+            "{nx}x{ny}: elements"
+        );
+        assert_eq!(
+            k.gathered() as i64,
+            6 * (springs - at_corners) + 3 * at_corners + 3 * particles,
+            "{nx}x{ny}: gathered values"
+        );
+    }
+}
+
+/// A parameter's column, filled once, is filled again when the parameter changes (a sweep's
+/// `--set`): after new values the right-hand side is still the generic path's, not the one
+/// of the old values.
+#[test]
+fn new_parameter_values_reach_the_kernels() {
+    let src = net_source(4, 3, Some(0.02));
+    let (_, fast) = prepare(&src, NetPath::Always);
+    let (_, generic) = prepare(&src, NetPath::Never);
+    let dim = generic.system.dim();
+    let y = perturbed(&generic.y0);
+    let (mut f1, mut f2) = (vec![0.0; dim], vec![0.0; dim]);
+    fast.system.rhs(0.0, &y, &mut f1);
+    let before = f1.clone();
+    // Every parameter changed: m, k, kd, a, g, c each by its own factor.
+    let values: Vec<f64> = fast
+        .system
+        .parameters()
+        .iter()
+        .enumerate()
+        .map(|(k, v)| v * (1.5 + 0.25 * k as f64))
+        .collect();
+    fast.system.set_parameters(&values);
+    generic.system.set_parameters(&values);
+    fast.system.rhs(0.0, &y, &mut f1);
+    generic.system.rhs(0.0, &y, &mut f2);
+    let d = max_relative_difference(&f2, &f1);
+    assert!(
+        d < 1e-13,
+        "after new parameters, right-hand sides differ by {d:e}"
+    );
+    assert!(
+        max_relative_difference(&before, &f1) > 1e-3,
+        "the parameters changed nothing"
     );
 }

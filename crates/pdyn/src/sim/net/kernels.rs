@@ -1,10 +1,12 @@
 //! The templates compiled once each and evaluated over their elements: gather the inputs of
-//! every element into columns, run the kernel over the columns, scatter-add its outputs into
-//! the accelerations (and its derivatives into the Jacobian).
+//! every element into columns, run the kernel over the columns into one buffer of outputs, and
+//! sum each acceleration from its terms there (and scatter-add the derivatives into the
+//! Jacobian).
 //!
 //! Inputs come from the vector `[t, q, q', parameters]` that [`super::super::compiled`]
 //! keeps, so that setting parameters needs nothing here: each kernel input is, element by
-//! element, an index into that vector (the gather table).
+//! element, an index into that vector (the gather table), or one index for every element (a
+//! parameter, `t`: its column is refilled only when its value changes).
 
 use super::structure::{self, Group, Source, Structure};
 use pdyn_expr::compile::CompileError;
@@ -22,41 +24,76 @@ const NONE: u32 = u32::MAX;
 /// One template compiled, and where its elements read and write.
 #[derive(Clone)]
 struct Kernel {
-    /// `F/m` (x, y, z) of an element over its inputs.
+    /// The accelerations an element gives (x, y, z of each particle it pushes) over its inputs.
     kernel: BatchKernel,
-    /// Per input: per element, the index of its value in `[t, q, q', parameters]`.
-    gather: Vec<Vec<u32>>,
-    /// Per axis: per element, the index of the acceleration it adds to (a free coordinate
+    /// Per input: where each element's value comes from in `[t, q, q', parameters]`.
+    gather: Vec<Gather>,
+    /// Per output: per element, the index of the acceleration it adds to (a free coordinate
     /// in state order), or [`NONE`].
-    scatter: [Vec<u32>; 3],
-    /// Per element, its own particle (the one the load acts on).
-    own: Vec<u32>,
-    /// Which components of the template are not identically zero.
-    nonzero: [bool; 3],
-    /// The derivatives of the outputs by the slot inputs, not identically zero: `(axis,
+    scatter: Vec<Vec<u32>>,
+    /// Where its output columns start in [`NetKernels::outputs`] (output `o` of element `e`
+    /// at `at + o * elements + e`).
+    at: usize,
+    /// Per output: which axis of which particle it is, by the particle of each element
+    /// (`acts[o / 3][e]`, the particle pushed by the outputs `3 (o / 3) .. 3 (o / 3) + 3`).
+    acts: Vec<Vec<u32>>,
+    /// Which outputs are not identically zero.
+    nonzero: Vec<bool>,
+    /// The derivatives of the outputs by the slot inputs, not identically zero: `(output,
     /// input)` of each output of `jacobian_program`.
-    jacobian_entries: Vec<(u8, u32)>,
+    jacobian_entries: Vec<(u32, u32)>,
     jacobian_program: Program,
     /// Compiled on first use: an explicit method never asks for it.
     jacobian_kernel: OnceCell<Option<BatchKernel>>,
     mode: JitMode,
     elements: usize,
+    /// The gathered input columns, kept between evaluations: the columns of parameters are
+    /// refilled only when a parameter's value changed.
+    columns: RefCell<Columns>,
 }
 
-/// Column buffers of one evaluation (per kernel the largest needed).
+/// Where one kernel input comes from, element by element.
+#[derive(Clone)]
+enum Gather {
+    /// Per element, the index of its value in `[t, q, q', parameters]`.
+    Each(Vec<u32>),
+    /// The same entry for every element (a parameter, `t`).
+    Broadcast(u32),
+}
+
+impl Gather {
+    /// The index of element `e`'s value.
+    fn at(&self, e: usize) -> u32 {
+        match self {
+            Gather::Each(from) => from[e],
+            Gather::Broadcast(i) => *i,
+        }
+    }
+}
+
+/// Column buffers of one kernel.
 #[derive(Clone, Default)]
 struct Columns {
     inputs: Vec<Vec<f64>>,
-    outputs: Vec<Vec<f64>>,
+    /// The value each broadcast input column holds (NaN bits: not filled yet).
+    filled: Vec<u64>,
+    jacobian: Vec<Vec<f64>>,
 }
 
 /// The accelerations of a model of free particles, template by template.
 #[derive(Clone)]
 pub struct NetKernels {
     kernels: Vec<Kernel>,
+    /// Every kernel's output columns, one after the other.
+    outputs: RefCell<Vec<f64>>,
+    /// The sum forming each acceleration (a free coordinate in state order), as rows of a
+    /// sparse matrix: the terms of acceleration `r` are the outputs at
+    /// `terms[term_start[r]..term_start[r + 1]]`. Summed row by row, each sum in a register,
+    /// instead of adding each output into its acceleration in memory.
+    term_start: Vec<u32>,
+    terms: Vec<u32>,
     /// Free coordinates.
     n: usize,
-    columns: RefCell<Columns>,
     /// Whether every kernel that has elements runs native code.
     native: bool,
     /// Whether a kernel reads a velocity.
@@ -76,9 +113,10 @@ impl NetKernels {
         let mut kernels = Vec::with_capacity(structure.groups.len());
         let mut reads_rates = false;
         for g in &structure.groups {
+            let outputs = g.outputs();
             let (leaves, sources) = structure::template_inputs(
                 pool,
-                &g.template,
+                &outputs,
                 g.slots,
                 &structure.slot_symbols,
                 parameters,
@@ -86,7 +124,7 @@ impl NetKernels {
             reads_rates |= sources
                 .iter()
                 .any(|s| matches!(s, Source::Slot { order: 1, .. }));
-            let program = Program::compile(pool, &leaves, &g.template)?;
+            let program = Program::compile(pool, &leaves, &outputs)?;
             let elements = g.particles.len() / g.slots;
             let mode = if elements >= NATIVE_FROM {
                 jit
@@ -99,50 +137,74 @@ impl NetKernels {
             let Some(gather) = gather_table(g, &sources, structure, n) else {
                 return Ok(None);
             };
-            let scatter = [0, 1, 2].map(|axis| {
-                (0..elements)
-                    .map(|e| {
-                        let own = g.particles[e * g.slots] as usize;
-                        structure.axes[own][axis].unwrap_or(NONE)
-                    })
-                    .collect()
-            });
+            let acts: Vec<Vec<u32>> = g
+                .acts_on
+                .iter()
+                .map(|&(slot, _)| {
+                    (0..elements)
+                        .map(|e| g.particles[e * g.slots + slot as usize])
+                        .collect()
+                })
+                .collect();
+            let scatter: Vec<Vec<u32>> = (0..outputs.len())
+                .map(|o| {
+                    acts[o / 3]
+                        .iter()
+                        .map(|&p| structure.axes[p as usize][o % 3].unwrap_or(NONE))
+                        .collect()
+                })
+                .collect();
             // ∂(F/m)/∂(slot input), for the implicit methods.
             let mut jacobian_entries = Vec::new();
             let mut derivatives = Vec::new();
-            for (axis, &f) in g.template.iter().enumerate() {
+            for (o, &f) in outputs.iter().enumerate() {
                 for (k, (&leaf, source)) in leaves.iter().zip(&sources).enumerate() {
                     if !matches!(source, Source::Slot { .. }) {
                         continue;
                     }
                     let d = pool.diff(f, leaf);
                     if d != Pool::ZERO {
-                        jacobian_entries.push((axis as u8, k as u32));
+                        jacobian_entries.push((o as u32, k as u32));
                         derivatives.push(d);
                     }
                 }
             }
             let jacobian_program = Program::compile(pool, &leaves, &derivatives)?;
+            let columns = Columns {
+                inputs: vec![vec![0.0; elements]; kernel.n_inputs()],
+                filled: vec![f64::NAN.to_bits(); kernel.n_inputs()],
+                jacobian: Vec::new(),
+            };
             kernels.push(Kernel {
                 kernel,
                 gather,
                 scatter,
-                own: (0..elements).map(|e| g.particles[e * g.slots]).collect(),
-                nonzero: g.template.map(|c| c != Pool::ZERO),
+                at: 0,
+                acts,
+                nonzero: outputs.iter().map(|&c| c != Pool::ZERO).collect(),
                 jacobian_entries,
                 jacobian_program,
                 jacobian_kernel: OnceCell::new(),
                 mode,
                 elements,
+                columns: RefCell::new(columns),
             });
         }
         let native = kernels
             .iter()
             .all(|k| k.kernel.is_native() || k.mode == JitMode::Off);
+        let mut at = 0;
+        for k in &mut kernels {
+            k.at = at;
+            at += k.scatter.len() * k.elements;
+        }
+        let (term_start, terms) = sums(&kernels, n);
         Ok(Some(NetKernels {
             kernels,
+            outputs: RefCell::new(vec![0.0; at]),
+            term_start,
+            terms,
             n,
-            columns: RefCell::new(Columns::default()),
             native: native && jit == JitMode::Auto,
             reads_rates,
         }))
@@ -167,6 +229,28 @@ impl NetKernels {
             .sum()
     }
 
+    /// Elements evaluated per evaluation of the accelerations, every kernel's together (a
+    /// spring between two particles is one element, not one per end).
+    pub fn elements(&self) -> usize {
+        self.kernels.iter().map(|k| k.elements).sum()
+    }
+
+    /// Values gathered per evaluation of the accelerations (the columns of parameters are
+    /// filled once, not counted): a deterministic count.
+    pub fn gathered(&self) -> usize {
+        self.kernels
+            .iter()
+            .map(|k| {
+                let each = k
+                    .gather
+                    .iter()
+                    .filter(|g| matches!(g, Gather::Each(_)))
+                    .count();
+                each * k.elements
+            })
+            .sum()
+    }
+
     /// Whether the large kernels run as native code.
     pub fn is_native(&self) -> bool {
         self.native
@@ -180,20 +264,15 @@ impl NetKernels {
     /// The accelerations `q''` (free coordinates in state order) at `input = [t, q, q',
     /// parameters]`.
     pub fn accelerations(&self, input: &[f64], acc: &mut [f64]) {
-        acc[..self.n].iter_mut().for_each(|a| *a = 0.0);
-        let cols = &mut *self.columns.borrow_mut();
+        let outputs = &mut *self.outputs.borrow_mut();
         for k in &self.kernels {
-            if k.elements == 0 {
-                continue;
-            }
-            let outs = run_kernel(k, input, cols);
-            for (axis, out) in outs.iter().enumerate() {
-                for (&to, &v) in k.scatter[axis].iter().zip(out.iter()) {
-                    if to != NONE {
-                        acc[to as usize] += v;
-                    }
-                }
-            }
+            run_kernel(k, input, outputs);
+        }
+        for (a, w) in acc[..self.n].iter_mut().zip(self.term_start.windows(2)) {
+            *a = self.terms[w[0] as usize..w[1] as usize]
+                .iter()
+                .map(|&i| outputs[i as usize])
+                .sum();
         }
     }
 
@@ -201,9 +280,12 @@ impl NetKernels {
     /// generic derivation then has Newton's equations (one per coordinate) and checks the
     /// momenta; otherwise it projects them, and does not.
     pub fn newton_form(&self) -> bool {
-        self.kernels
-            .iter()
-            .all(|k| (0..3).all(|axis| !k.nonzero[axis] || !k.scatter[axis].contains(&NONE)))
+        self.kernels.iter().all(|k| {
+            k.nonzero
+                .iter()
+                .zip(&k.scatter)
+                .all(|(&nonzero, rows)| !nonzero || !rows.contains(&NONE))
+        })
     }
 
     /// The resultant force `Σ F` and moment about the origin `Σ r × F` of every load at
@@ -217,26 +299,29 @@ impl NetKernels {
         position: &[[f64; 3]],
     ) -> [(f64, f64); 6] {
         let mut out = [(0.0, 0.0); 6];
-        let cols = &mut *self.columns.borrow_mut();
         for k in &self.kernels {
             if k.elements == 0 {
                 continue;
             }
-            let outs = run_kernel(k, input, cols);
-            for (e, &own) in k.own.iter().enumerate() {
-                let m = mass[own as usize];
-                let f = [0, 1, 2].map(|c| m * outs[c][e]);
-                let r = position[own as usize];
-                let terms = [
-                    (r[1] * f[2], r[2] * f[1]),
-                    (r[2] * f[0], r[0] * f[2]),
-                    (r[0] * f[1], r[1] * f[0]),
-                ];
-                for (c, (&fc, (a, b))) in f.iter().zip(terms).enumerate() {
-                    out[c].0 += fc;
-                    out[c].1 += fc.abs();
-                    out[3 + c].0 += a - b;
-                    out[3 + c].1 += a.abs() + b.abs();
+            let outputs = &mut *self.outputs.borrow_mut();
+            run_kernel(k, input, outputs);
+            let outs = &outputs[k.at..k.at + k.scatter.len() * k.elements];
+            for (a, pushed) in k.acts.iter().enumerate() {
+                for (e, &p) in pushed.iter().enumerate() {
+                    let m = mass[p as usize];
+                    let f = [0, 1, 2].map(|c| m * outs[(3 * a + c) * k.elements + e]);
+                    let r = position[p as usize];
+                    let terms = [
+                        (r[1] * f[2], r[2] * f[1]),
+                        (r[2] * f[0], r[0] * f[2]),
+                        (r[0] * f[1], r[1] * f[0]),
+                    ];
+                    for (c, (&fc, (a, b))) in f.iter().zip(terms).enumerate() {
+                        out[c].0 += fc;
+                        out[c].1 += fc.abs();
+                        out[3 + c].0 += a - b;
+                        out[3 + c].1 += a.abs() + b.abs();
+                    }
                 }
             }
         }
@@ -249,7 +334,6 @@ impl NetKernels {
     pub fn add_jacobian(&self, input: &[f64], jac: &mut [f64]) {
         let n = self.n;
         let m = 2 * n;
-        let cols = &mut *self.columns.borrow_mut();
         for k in &self.kernels {
             if k.elements == 0 || k.jacobian_entries.is_empty() {
                 continue;
@@ -262,97 +346,127 @@ impl NetKernels {
                 jac.iter_mut().for_each(|x| *x = f64::NAN);
                 return;
             };
+            let cols = &mut *k.columns.borrow_mut();
+            gather(k, input, cols);
             let outputs = k.jacobian_entries.len();
-            gather(k, input, cols, kernel.n_inputs(), outputs);
-            let ins: Vec<&[f64]> = cols.inputs[..kernel.n_inputs()]
-                .iter()
-                .map(|c| &c[..k.elements])
-                .collect();
-            let mut outs: Vec<&mut [f64]> = cols.outputs[..outputs]
+            if cols.jacobian.len() < outputs {
+                cols.jacobian.resize(outputs, vec![0.0; k.elements]);
+            }
+            let ins: Vec<&[f64]> = cols.inputs.iter().map(|c| c.as_slice()).collect();
+            let mut outs: Vec<&mut [f64]> = cols.jacobian[..outputs]
                 .iter_mut()
-                .map(|c| &mut c[..k.elements])
+                .map(|c| c.as_mut_slice())
                 .collect();
             kernel.run(&ins, &mut outs);
-            for (&(axis, input_k), out) in k.jacobian_entries.iter().zip(&outs) {
-                let rows = &k.scatter[axis as usize];
+            for (&(output, input_k), out) in k.jacobian_entries.iter().zip(&outs) {
+                let rows = &k.scatter[output as usize];
                 let from = &k.gather[input_k as usize];
-                for ((&row, &at), &value) in rows.iter().zip(from).zip(out.iter()) {
+                for (e, (&row, &value)) in rows.iter().zip(out.iter()).enumerate() {
                     if row == NONE {
                         continue;
                     }
                     // The gathered index is 1 + the state index of the input.
-                    jac[(n + row as usize) * m + at as usize - 1] += value;
+                    jac[(n + row as usize) * m + from.at(e) as usize - 1] += value;
                 }
             }
         }
     }
 }
 
-/// Fills the first `inputs` input columns of kernel `k` from `input`, and makes room for
-/// `outputs` output columns.
-/// Runs `k` over its elements at `input`: its three acceleration columns, one value per
-/// element.
-fn run_kernel<'c>(k: &Kernel, input: &[f64], cols: &'c mut Columns) -> Vec<&'c mut [f64]> {
-    gather(k, input, cols, k.kernel.n_inputs(), 3);
-    let ins: Vec<&[f64]> = cols.inputs[..k.kernel.n_inputs()]
-        .iter()
-        .map(|c| &c[..k.elements])
-        .collect();
-    let mut outs: Vec<&mut [f64]> = cols.outputs[..3]
-        .iter_mut()
-        .map(|c| &mut c[..k.elements])
+/// Runs `k` over its elements at `input`: its output columns, one value per element, in its
+/// part of `outputs`.
+fn run_kernel(k: &Kernel, input: &[f64], outputs: &mut [f64]) {
+    if k.elements == 0 {
+        return;
+    }
+    let cols = &mut *k.columns.borrow_mut();
+    gather(k, input, cols);
+    let ins: Vec<&[f64]> = cols.inputs.iter().map(|c| c.as_slice()).collect();
+    let mut outs: Vec<&mut [f64]> = outputs[k.at..k.at + k.scatter.len() * k.elements]
+        .chunks_mut(k.elements)
         .collect();
     k.kernel.run(&ins, &mut outs);
-    outs
 }
 
-fn gather(k: &Kernel, input: &[f64], cols: &mut Columns, inputs: usize, outputs: usize) {
-    let len = k.elements;
-    if cols.inputs.len() < inputs {
-        cols.inputs.resize(inputs, Vec::new());
-    }
-    if cols.outputs.len() < outputs {
-        cols.outputs.resize(outputs, Vec::new());
-    }
-    for c in cols.inputs[..inputs]
-        .iter_mut()
-        .chain(&mut cols.outputs[..outputs])
-    {
-        if c.len() < len {
-            c.resize(len, 0.0);
+/// The terms of each acceleration (the rows of `NetKernels::terms`): every output not identically
+/// zero of every element, by the acceleration it adds to (kernel by kernel, output by output,
+/// element by element within one acceleration).
+fn sums(kernels: &[Kernel], n: usize) -> (Vec<u32>, Vec<u32>) {
+    let mut count = vec![0u32; n + 1];
+    let each = |f: &mut dyn FnMut(u32, u32)| {
+        for k in kernels {
+            for (o, rows) in k.scatter.iter().enumerate() {
+                if !k.nonzero[o] {
+                    continue;
+                }
+                for (e, &row) in rows.iter().enumerate() {
+                    if row != NONE {
+                        f(row, (k.at + o * k.elements + e) as u32);
+                    }
+                }
+            }
         }
+    };
+    each(&mut |row, _| count[row as usize + 1] += 1);
+    // Row `r` starts after every term of the rows before it.
+    let mut total = 0;
+    for c in &mut count {
+        total += *c;
+        *c = total;
     }
-    for (col, from) in cols.inputs.iter_mut().zip(&k.gather[..inputs]) {
-        for (x, &i) in col.iter_mut().zip(from) {
-            *x = input[i as usize];
+    let mut next = count.clone();
+    let mut terms = vec![0u32; count[n] as usize];
+    each(&mut |row, i| {
+        terms[next[row as usize] as usize] = i;
+        next[row as usize] += 1;
+    });
+    (count, terms)
+}
+
+/// Fills the input columns of kernel `k` from `input`: every element's coordinates, and a
+/// parameter's column only when its value changed since it was filled.
+fn gather(k: &Kernel, input: &[f64], cols: &mut Columns) {
+    for ((col, from), filled) in cols.inputs.iter_mut().zip(&k.gather).zip(&mut cols.filled) {
+        match from {
+            Gather::Each(from) => {
+                for (x, &i) in col.iter_mut().zip(from) {
+                    *x = input[i as usize];
+                }
+            }
+            Gather::Broadcast(i) => {
+                let v = input[*i as usize];
+                if v.to_bits() != *filled {
+                    col.iter_mut().for_each(|x| *x = v);
+                    *filled = v.to_bits();
+                }
+            }
         }
     }
 }
 
-/// Per input of group `g`, per element, the index of its value in `[t, q, q', parameters]`
-/// (`n` free coordinates); `None` when an element lacks a coordinate its template reads
-/// (cannot happen: equal templates read the same components).
+/// Per input of group `g`, where each element's value is in `[t, q, q', parameters]` (`n`
+/// free coordinates); `None` when an element lacks a coordinate its template reads (cannot
+/// happen: equal templates read the same components).
 fn gather_table(
     g: &Group,
     sources: &[Source],
     structure: &Structure,
     n: usize,
-) -> Option<Vec<Vec<u32>>> {
+) -> Option<Vec<Gather>> {
     let elements = g.particles.len() / g.slots;
     sources
         .iter()
-        .map(|s| {
-            (0..elements)
-                .map(|e| match *s {
-                    Source::Slot { slot, axis, order } => {
-                        let particle = g.particles[e * g.slots + slot as usize] as usize;
-                        let q = structure.axes[particle][axis as usize]?;
-                        Some(1 + order as u32 * n as u32 + q)
-                    }
-                    Source::Parameter(k) => Some(1 + 2 * n as u32 + k),
-                    Source::Time => Some(0),
+        .map(|s| match *s {
+            Source::Slot { slot, axis, order } => (0..elements)
+                .map(|e| {
+                    let particle = g.particles[e * g.slots + slot as usize] as usize;
+                    let q = structure.axes[particle][axis as usize]?;
+                    Some(1 + order as u32 * n as u32 + q)
                 })
-                .collect()
+                .collect::<Option<Vec<u32>>>()
+                .map(Gather::Each),
+            Source::Parameter(k) => Some(Gather::Broadcast(1 + 2 * n as u32 + k)),
+            Source::Time => Some(Gather::Broadcast(0)),
         })
         .collect()
 }

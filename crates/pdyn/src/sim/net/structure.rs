@@ -13,7 +13,9 @@
 //! for its own particle, `#1.x` for the first other, ...) is its template: the members of a
 //! `[[forces]]` family give the same template up to hash-consing (the canonical
 //! constructors order by name, and the slot names are the same for every member), so a
-//! 10,000-particle net has a dozen templates, each compiled once.
+//! 10,000-particle net has a dozen templates, each compiled once. A two-body force between two
+//! particles (a spring) is two loads, equal and opposite: one element whose template has both
+//! ends' accelerations, so that the force is evaluated once.
 
 use pdyn_expr::{Id, Node, Pool, SymId};
 use pdyn_mech::model::{CoordinateKind, Model, Target};
@@ -41,14 +43,27 @@ pub enum Source {
     Time,
 }
 
+/// `F / m` of each particle an element pushes, with its slot: `(slot, [x, y, z])`.
+pub type ActsOn = Vec<(u8, [Id; 3])>;
+
 /// The loads that share one template.
 pub struct Group {
     /// Particles per element: the load's own first, then the others by index.
     pub slots: usize,
-    /// `F / m` of the load's own particle, x, y, z, over the slot symbols.
-    pub template: [Id; 3],
+    /// `F / m` (x, y, z, over the slot symbols) of each particle the element pushes, with the
+    /// slot of that particle: the load's own (slot 0), and for a two-body force between two
+    /// particles (a spring: its second load the first's opposite) the other end (slot 1) as
+    /// well, so that the force is evaluated once for both ends.
+    pub acts_on: ActsOn,
     /// The particles of each element, `slots` per element (indices into `Model::particles`).
     pub particles: Vec<u32>,
+}
+
+impl Group {
+    /// Every output of the template, `acts_on` in order, x, y, z each.
+    pub fn outputs(&self) -> Vec<Id> {
+        self.acts_on.iter().flat_map(|(_, t)| *t).collect()
+    }
 }
 
 /// A model of free particles in Cartesian coordinates, its loads grouped by template.
@@ -126,9 +141,15 @@ pub fn recognise(model: &mut Model) -> Option<Structure> {
         .map(|s| ["x", "y", "z"].map(|axis| pool.symbol(&format!("#{s}.{axis}"), false)))
         .collect();
     let mut groups: Vec<Group> = Vec::new();
-    let mut by_signature: FxHashMap<(usize, [u128; 3], Id), usize> = FxHashMap::default();
+    let mut by_signature: FxHashMap<(usize, [u128; 3], Id, Option<Id>), usize> =
+        FxHashMap::default();
+    let mut by_template: FxHashMap<(usize, ActsOn), usize> = FxHashMap::default();
     let mut signer = Signer::default();
-    for load in &model.loads {
+    let loads = &model.loads;
+    let mut next = 0;
+    while next < loads.len() {
+        let load = &loads[next];
+        next += 1;
         let Target::Particle(own) = load.target else {
             return None;
         };
@@ -153,6 +174,18 @@ pub fn recognise(model: &mut Model) -> Option<Structure> {
         if others.len() + 1 > MAX_SLOTS {
             return None;
         }
+        // A two-body force between two particles pushes its opposite on the other end as the
+        // next load (`push_pair`): one element acting on both.
+        let partner = match (others.as_slice(), loads.get(next)) {
+            (&[other], Some(second))
+                if second.target == Target::Particle(other as usize)
+                    && (0..3).all(|c| second.force[c] == pool.neg(load.force[c])) =>
+            {
+                next += 1;
+                Some(other as usize)
+            }
+            _ => None,
+        };
         let mut members = vec![own as u32];
         members.extend(others);
         signer.slots.clear();
@@ -169,7 +202,8 @@ pub fn recognise(model: &mut Model) -> Option<Structure> {
         // the slot symbols. Rewriting every member was 80 µs a load.
         let signature = load.force.map(|f| signer.sign(pool, f));
         let mass = model.particles[own].mass;
-        let key = (members.len(), signature, mass);
+        let partner_mass = partner.map(|b| model.particles[b].mass);
+        let key = (members.len(), signature, mass, partner_mass);
         let g = match by_signature.get(&key) {
             Some(&g) => g,
             None => {
@@ -181,17 +215,36 @@ pub fn recognise(model: &mut Model) -> Option<Structure> {
                         map.insert(from, to);
                     }
                 }
-                let template = load.force.map(|f| {
-                    let a = pool.div(f, mass);
-                    pool.subs(a, &map)
-                });
-                groups.push(Group {
-                    slots: members.len(),
-                    template,
-                    particles: Vec::new(),
-                });
-                by_signature.insert(key, groups.len() - 1);
-                groups.len() - 1
+                let mut acts_on = vec![(
+                    0u8,
+                    load.force.map(|f| {
+                        let a = pool.div(f, mass);
+                        pool.subs(a, &map)
+                    }),
+                )];
+                if let Some(m) = partner_mass {
+                    let on_partner = load.force.map(|f| {
+                        let minus = pool.neg(f);
+                        let a = pool.div(minus, m);
+                        pool.subs(a, &map)
+                    });
+                    acts_on.push((1, on_partner));
+                }
+                // Two signatures may give one template: a difference of two coordinates is
+                // ordered by their names (`x[9,0] - x[10,0]` and `x[1,0] - x[2,0]` sign
+                // differently), the slots' names are the same for every member.
+                let g = *by_template
+                    .entry((members.len(), acts_on.clone()))
+                    .or_insert_with(|| {
+                        groups.push(Group {
+                            slots: members.len(),
+                            acts_on,
+                            particles: Vec::new(),
+                        });
+                        groups.len() - 1
+                    });
+                by_signature.insert(key, g);
+                g
             }
         };
         groups[g].particles.extend(members);
