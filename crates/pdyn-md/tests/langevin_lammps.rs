@@ -166,3 +166,61 @@ fn lammps_scheme_samples_the_canonical_temperature() {
         assert!(e < 0.005, "{noise:?}: error {e} too large to test anything");
     }
 }
+
+fn lammps_liquid(cells: usize, seed: u64) -> Simulation<potential::Truncated<LennardJones>> {
+    let th = Langevin::new(LangevinParams {
+        temperature: Some(1.0),
+        damping: 0.5,
+        seed,
+    })
+    .unwrap()
+    .with_scheme(LangevinScheme::Lammps {
+        noise: LangevinNoise::Uniform,
+    });
+    let mut sim = lj_liquid(cells, seed, 0.005);
+    sim.thermostat = Thermostat::Langevin(th);
+    sim
+}
+
+/// 2,048 atoms (the force loop in two segments) on 1, 2 and 3 threads: the same bits.
+#[test]
+fn lammps_scheme_does_not_depend_on_thread_count() {
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut sim = lammps_liquid(8, 11);
+            sim.run(40, &mut |_: &ThermoRecord, _: &System| {}).unwrap();
+            (sim.system.particles.clone(), sim.thermo())
+        })
+    };
+    let (p1, t1) = run(1);
+    for threads in [2, 3] {
+        let (p, t) = run(threads);
+        assert_eq!(p1, p, "{threads} threads");
+        assert_eq!(t1, t, "{threads} threads");
+    }
+}
+
+/// A run stopped after its first step (the energy sums of that step are then made again from
+/// the same positions) and continued is the same bits as one run straight through: the
+/// friction and noise drawn at the step are reused, not drawn again.
+#[test]
+fn lammps_scheme_stopped_and_continued_gives_the_same_bits() {
+    let mut straight = lammps_liquid(4, 7);
+    straight
+        .run(10, &mut |_: &ThermoRecord, _: &System| {})
+        .unwrap();
+    let mut stopped = lammps_liquid(4, 7);
+    let stop = std::sync::atomic::AtomicBool::new(true);
+    let r = stopped
+        .run_interruptible(10, &mut |_: &ThermoRecord, _: &System| {}, Some(&stop))
+        .unwrap();
+    assert_eq!(r.steps, 1);
+    stopped
+        .run(9, &mut |_: &ThermoRecord, _: &System| {})
+        .unwrap();
+    assert_eq!(straight.system.particles, stopped.system.particles);
+}
