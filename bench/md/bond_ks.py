@@ -94,8 +94,10 @@ run             {a.steps - a.equil}
 """)
     lmp.close()
     log = open(os.path.join(work, "log.lammps")).read()
-    thermo = [tuple(float(x) for x in m.groups()) for m in re.finditer(
+    rows = [tuple(float(x) for x in m.groups()) for m in re.finditer(
         r"^\s*(\d+)\s+([-0-9.eE+]+)\s+([-0-9.eE+]+)\s+([-0-9.eE+]+)\s*$", log, re.M)]
+    # the second run repeats the first one's last row
+    thermo = [r for k, r in enumerate(rows) if k == 0 or r[0] != rows[k - 1][0]]
     out, take = [], False
     for line in open(dump):
         if line.startswith("ITEM:"):
