@@ -230,6 +230,30 @@ fn md_langevin_killed_at_random_and_restarted_matches_the_uninterrupted_run() {
     );
 }
 
+/// The same under Langevin's LAMMPS scheme (`scheme = "lammps"`: the friction and noise drawn
+/// at a step live in the saved accelerations).
+#[test]
+fn md_langevin_lammps_scheme_killed_at_random_and_restarted_matches_the_uninterrupted_run() {
+    let models = fresh_dir("langevin-lammps-model");
+    let model = derived_model(
+        &models,
+        "examples/md/argon_melting.toml",
+        &[(
+            "kind = \"langevin\"",
+            "kind = \"langevin\"\nscheme = \"lammps\"",
+        )],
+    );
+    killed_and_restarted_equals_uninterrupted(
+        "langevin-lammps",
+        &model,
+        &["--checkpoint-every", "500steps"],
+        3,
+        1200,
+        2018,
+    );
+    let _ = std::fs::remove_dir_all(&models);
+}
+
 #[test]
 fn md_nose_hoover_killed_at_random_and_restarted_matches_the_uninterrupted_run() {
     let models = fresh_dir("nh-model");

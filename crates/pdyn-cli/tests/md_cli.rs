@@ -376,6 +376,72 @@ fn thermostat_without_temperature_is_located() {
     );
 }
 
+/// `scheme` and `noise` of `[md.thermostat]`: "lammps" selects LAMMPS's fix langevin + fix nve
+/// (uniform noise unless `noise = "gaussian"`), "baoab" is the default; an unknown value, a
+/// noise for BAOAB, or either key on another thermostat is an error at its line.
+#[test]
+fn langevin_scheme_and_noise_parse_and_bad_values_are_located() {
+    use pdyn_md::thermostat::{LangevinNoise, LangevinScheme};
+    let base = lj() + "\n[md.thermostat]\nkind = \"langevin\"\ntemperature = 1.0\n";
+    for (extra, expected) in [
+        ("", LangevinScheme::Baoab),
+        ("scheme = \"baoab\"\n", LangevinScheme::Baoab),
+        (
+            "scheme = \"lammps\"\n",
+            LangevinScheme::Lammps {
+                noise: LangevinNoise::Uniform,
+            },
+        ),
+        (
+            "scheme = \"lammps\"\nnoise = \"gaussian\"\n",
+            LangevinScheme::Lammps {
+                noise: LangevinNoise::Gaussian,
+            },
+        ),
+    ] {
+        let spec = pdyn::md::load(&(base.clone() + extra), "t.toml", &[]).unwrap();
+        match spec.thermostat.ensemble {
+            pdyn::md::spec::Ensemble::Langevin { scheme, .. } => {
+                assert_eq!(scheme, expected, "{extra}")
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+    for (name, extra, needle_line, message) in [
+        (
+            "scheme_unknown",
+            "scheme = \"verlet\"\n",
+            "scheme =",
+            "unknown Langevin scheme `verlet`",
+        ),
+        (
+            "noise_unknown",
+            "scheme = \"lammps\"\nnoise = \"pink\"\n",
+            "noise =",
+            "unknown Langevin noise `pink`",
+        ),
+        (
+            "noise_for_baoab",
+            "noise = \"uniform\"\n",
+            "noise =",
+            "applies to scheme = \"lammps\" only",
+        ),
+    ] {
+        let text = base.clone() + extra;
+        let line = line_of(&text, needle_line);
+        assert_located(name, bad(name, &text, &["--set", "n=5"]), line, message);
+    }
+    let text = lj()
+        + "\n[md.thermostat]\nkind = \"nose-hoover\"\ntemperature = 1.0\nscheme = \"lammps\"\n";
+    let line = line_of(&text, "scheme =");
+    assert_located(
+        "scheme_nh",
+        bad("scheme_nh", &text, &["--set", "n=5"]),
+        line,
+        "applies to the Langevin thermostat only",
+    );
+}
+
 /// Two atoms 0.3σ apart in a file: refused with the pair and the distance and a hint at
 /// `minimize = true`, which then relaxes them and the run succeeds.
 #[test]

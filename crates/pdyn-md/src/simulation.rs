@@ -269,6 +269,10 @@ impl<P: PairPotential> Simulation<P> {
         };
         sim.rebuild();
         sim.check_overlap()?;
+        if let Thermostat::Langevin(l) = &mut sim.thermostat {
+            // LAMMPS's fix langevin adds its forces at set-up too, from v(0)
+            l.draw_post_force(&sim.system.particles, params.dt, params.boltzmann);
+        }
         sim.forces(true).map_err(|e| e.with_step(0))?;
         Ok(sim)
     }
@@ -300,8 +304,9 @@ impl<P: PairPotential> Simulation<P> {
         }
     }
 
-    /// Pair and bond forces into accelerations; potential energy and virial when `energy`
-    /// (else the two keep their last values, see [`ENERGY_CHECK_EVERY`]).
+    /// Pair and bond forces into accelerations (plus the friction and noise of the last draw
+    /// under Langevin's LAMMPS scheme); potential energy and virial when `energy` (else the
+    /// two keep their last values, see [`ENERGY_CHECK_EVERY`]).
     fn forces(&mut self, energy: bool) -> Result<(), MdError> {
         let s = &mut self.system;
         let (u_p, w_p) =
@@ -310,11 +315,25 @@ impl<P: PairPotential> Simulation<P> {
         let (u_s, w_s) = self.special.correct(s, &self.force_field, &mut self.out);
         let (u_b, w_b) = bond_forces(s, &mut self.out, energy)?;
         let p = &mut s.particles;
-        for (i, f) in self.out.iter().enumerate() {
-            let inv_m = if p.m[i] > 0.0 { 1.0 / p.m[i] } else { 0.0 };
-            p.ax[i] = f[0] * inv_m;
-            p.ay[i] = f[1] * inv_m;
-            p.az[i] = f[2] * inv_m;
+        let langevin = match &self.thermostat {
+            Thermostat::Langevin(l) => l.post_force(),
+            _ => None,
+        };
+        if let Some(extra) = langevin {
+            // LAMMPS: f += γ₁ v + f_ran, then v += (h/2) f/m
+            for (i, (f, e)) in self.out.iter().zip(extra).enumerate() {
+                let inv_m = if p.m[i] > 0.0 { 1.0 / p.m[i] } else { 0.0 };
+                p.ax[i] = (f[0] + e[0]) * inv_m;
+                p.ay[i] = (f[1] + e[1]) * inv_m;
+                p.az[i] = (f[2] + e[2]) * inv_m;
+            }
+        } else {
+            for (i, f) in self.out.iter().enumerate() {
+                let inv_m = if p.m[i] > 0.0 { 1.0 / p.m[i] } else { 0.0 };
+                p.ax[i] = f[0] * inv_m;
+                p.ay[i] = f[1] * inv_m;
+                p.az[i] = f[2] * inv_m;
+            }
         }
         if energy {
             self.potential = u_p + u_s + u_b;
@@ -342,9 +361,10 @@ impl<P: PairPotential> Simulation<P> {
     }
 
     /// Which velocities the reported kinetic energy and temperature come from.
+    /// (Langevin's LAMMPS scheme reports the full-step velocities, as LAMMPS does.)
     pub fn kinetic_estimator(&self) -> KineticEstimator {
-        match self.thermostat {
-            Thermostat::Langevin(_) => KineticEstimator::HalfStep,
+        match &self.thermostat {
+            Thermostat::Langevin(l) if l.is_baoab() => KineticEstimator::HalfStep,
             _ => KineticEstimator::FullStep,
         }
     }
@@ -509,10 +529,14 @@ impl<P: PairPotential> Simulation<P> {
             return Err(self.unstable(step, imax, disp));
         }
         if let Thermostat::Langevin(l) = &mut self.thermostat {
-            p.drift(0.5 * h);
-            l.ou_step(p, h, kb);
-            self.half_step_kinetic = Some(p.kinetic_energy());
-            p.drift(0.5 * h);
+            if l.is_baoab() {
+                p.drift(0.5 * h);
+                l.ou_step(p, h, kb);
+                self.half_step_kinetic = Some(p.kinetic_energy());
+                p.drift(0.5 * h);
+            } else {
+                p.drift(h);
+            }
         } else {
             p.drift(h);
         }
@@ -523,6 +547,10 @@ impl<P: PairPotential> Simulation<P> {
             self.rebuild();
         } else {
             self.nl.update_positions(&self.system.particles);
+        }
+        if let Thermostat::Langevin(l) = &mut self.thermostat {
+            // LAMMPS post_force: from the half-step velocities
+            l.draw_post_force(&self.system.particles, h, kb);
         }
         self.forces(energy).map_err(|e| e.with_step(step))?;
         let p = &mut self.system.particles;

@@ -246,8 +246,8 @@ impl<P: PairPotential> Simulation<P> {
 mod tests {
     use crate::potential::{CutoffMode, LennardJones};
     use crate::thermostat::{
-        Berendsen, BerendsenParams, Langevin, LangevinParams, NoseHooverChain, NoseHooverParams,
-        Thermostat,
+        Berendsen, BerendsenParams, Langevin, LangevinNoise, LangevinParams, LangevinScheme,
+        NoseHooverChain, NoseHooverParams, Thermostat,
     };
     use crate::{
         lattice, maxwell_boltzmann, ForceField, Lattice, SimParams, Simulation, System,
@@ -302,6 +302,20 @@ mod tests {
                         tau: 0.1,
                     })
                     .unwrap(),
+                ),
+            ),
+            (
+                "langevin, LAMMPS scheme",
+                Thermostat::Langevin(
+                    Langevin::new(LangevinParams {
+                        temperature: Some(1.2),
+                        damping: 0.5,
+                        seed: 11,
+                    })
+                    .unwrap()
+                    .with_scheme(LangevinScheme::Lammps {
+                        noise: LangevinNoise::Uniform,
+                    }),
                 ),
             ),
         ]

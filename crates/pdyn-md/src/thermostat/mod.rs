@@ -3,14 +3,16 @@
 //! A step is `C(h/2) · B(h/2) · A(h/2) · O(h) · A(h/2) · [forces] · B(h/2) · C(h/2)` where `B`
 //! is a kick, `A` a drift, `O` the Langevin Ornstein–Uhlenbeck step (absent otherwise, and then
 //! the two drifts are one), and `C` the Nosé–Hoover-chain half step (or, at the end only, the
-//! Berendsen rescaling). Each thermostat lives in its own file.
+//! Berendsen rescaling). Langevin's opt-in LAMMPS scheme has no `O` step: its friction and
+//! noise join the forces (see [`LangevinScheme::Lammps`]). Each thermostat lives in its own
+//! file.
 
 mod berendsen;
 mod langevin;
 mod nose_hoover;
 
 pub use berendsen::{Berendsen, BerendsenParams};
-pub use langevin::{Langevin, LangevinParams};
+pub use langevin::{Langevin, LangevinNoise, LangevinParams, LangevinScheme};
 pub use nose_hoover::{NoseHooverChain, NoseHooverParams};
 
 use crate::MdError;
@@ -21,7 +23,7 @@ use crate::MdError;
 pub enum Thermostat {
     /// Constant energy.
     None,
-    /// Langevin dynamics (BAOAB).
+    /// Langevin dynamics (BAOAB, or LAMMPS's scheme: [`LangevinScheme`]).
     Langevin(Langevin),
     /// Nosé–Hoover chain.
     NoseHooverChain(NoseHooverChain),

@@ -423,12 +423,16 @@ pub fn build(spec: &MdSpec, base: &Path, jit: JitMode) -> Result<Prepared, Model
     let t0 = th.temperature.as_ref().map(|t| t.value);
     let thermostat = match &th.ensemble {
         Ensemble::Nve => Ok(Thermostat::None),
-        Ensemble::Langevin { damping, seed } => Langevin::new(LangevinParams {
+        Ensemble::Langevin {
+            damping,
+            seed,
+            scheme,
+        } => Langevin::new(LangevinParams {
             temperature: t0,
             damping: damping.value / u.time,
             seed: *seed,
         })
-        .map(Thermostat::Langevin),
+        .map(|l| Thermostat::Langevin(l.with_scheme(*scheme))),
         Ensemble::NoseHoover { tau, chain } => NoseHooverChain::new(NoseHooverParams {
             temperature: t0,
             tau: tau.value / u.time,

@@ -125,6 +125,8 @@ struct RawThermostat {
     tau: Option<Sv>,
     chain: Option<Sv>,
     seed: Option<Sv>,
+    scheme: Option<Name>,
+    noise: Option<Name>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -286,12 +288,15 @@ pub enum FileFormat {
 pub enum Ensemble {
     /// No thermostat.
     Nve,
-    /// Langevin (BAOAB).
+    /// Langevin (BAOAB, or LAMMPS's `fix langevin` + `fix nve` with `scheme = "lammps"`).
     Langevin {
         /// Damping time 1/γ.
         damping: Num,
         /// Seed of the random forces.
         seed: u64,
+        /// Integration scheme (`scheme = "baoab"` default, or `"lammps"` with
+        /// `noise = "uniform"` default or `"gaussian"`).
+        scheme: pdyn_md::thermostat::LangevinScheme,
     },
     /// Nosé–Hoover chain.
     NoseHoover {
@@ -913,6 +918,7 @@ pub fn parse(
                         Some(if units == Units::Real { 100.0 } else { 1.0 }),
                     )?,
                     seed: r.count_or(&q.seed, "seed", &span, Some(1), u64::MAX)?,
+                    scheme: langevin_scheme(&r, q)?,
                 },
                 "nose-hoover" | "nvt" => Ensemble::NoseHoover {
                     tau: r.positive_or(
@@ -937,6 +943,21 @@ pub fn parse(
                     ))
                 }
             };
+            if !matches!(ensemble, Ensemble::Langevin { .. }) {
+                if let Some(k) = q.scheme.as_ref().or(q.noise.as_ref()) {
+                    let key = if q.scheme.is_some() {
+                        "scheme"
+                    } else {
+                        "noise"
+                    };
+                    return Err(r
+                        .err(
+                            k.span(),
+                            format!("`{key}` applies to the Langevin thermostat only"),
+                        )
+                        .help("set kind = \"langevin\", or remove the key"));
+                }
+            }
             let temperature = q
                 .temperature
                 .as_ref()
@@ -1305,5 +1326,40 @@ impl Resolver<'_> {
             (None, Some(v)) => Ok(v),
             (None, None) => Err(self.err(table.clone(), format!("[md] needs `{what}`"))),
         }
+    }
+}
+
+/// `scheme` and `noise` of a Langevin `[md.thermostat]`.
+fn langevin_scheme(
+    r: &Resolver,
+    q: &RawThermostat,
+) -> Result<pdyn_md::thermostat::LangevinScheme, ModelError> {
+    use pdyn_md::thermostat::{LangevinNoise, LangevinScheme};
+    let noise = match &q.noise {
+        None => LangevinNoise::Uniform,
+        Some(n) => match n.get_ref().as_str() {
+            "uniform" => LangevinNoise::Uniform,
+            "gaussian" => LangevinNoise::Gaussian,
+            other => {
+                return Err(r
+                    .err(n.span(), format!("unknown Langevin noise `{other}`"))
+                    .help("noise: \"uniform\" (LAMMPS's default) or \"gaussian\""))
+            }
+        },
+    };
+    match q.scheme.as_ref().map(|s| (s.get_ref().as_str(), s.span())) {
+        None | Some(("baoab", _)) => match &q.noise {
+            Some(n) => Err(r
+                .err(
+                    n.span(),
+                    "`noise` applies to scheme = \"lammps\" only (BAOAB's noise is Gaussian)",
+                )
+                .help("add scheme = \"lammps\", or remove `noise`")),
+            None => Ok(LangevinScheme::Baoab),
+        },
+        Some(("lammps", _)) => Ok(LangevinScheme::Lammps { noise }),
+        Some((other, span)) => Err(r
+            .err(span, format!("unknown Langevin scheme `{other}`"))
+            .help("schemes: \"baoab\" (default) or \"lammps\" (LAMMPS's fix langevin + fix nve)")),
     }
 }
