@@ -130,6 +130,37 @@ fn kin_data_recovers_the_ellipse() {
     assert_eq!(j["smoothing"][0]["lambda"], 0.01);
     assert_eq!(j["smoothing"][0]["lambda_from"], "given");
     assert_eq!(j["table"]["speed"].as_array().unwrap().len(), 301);
+    // The columns asked for are the full table's, bit for bit (the polar ones, not asked
+    // for, are not computed), and polar alone brings them.
+    let (code, stdout, _) = pdyn(&[
+        "kin",
+        "--data",
+        &example("track.csv"),
+        "--smooth",
+        "0.01",
+        "--json",
+    ]);
+    assert_eq!(code, 0);
+    let all: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    for c in ["speed", "a_n"] {
+        assert_eq!(j["table"][c], all["table"][c], "{c}");
+    }
+    let (code, stdout, _) = pdyn(&[
+        "kin",
+        "--data",
+        &example("track.csv"),
+        "--quantities",
+        "polar",
+        "--smooth",
+        "0.01",
+        "--json",
+    ]);
+    assert_eq!(code, 0);
+    let p: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    for c in ["r", "theta", "v_r", "v_theta", "a_r", "a_theta"] {
+        assert_eq!(p["table"][c].as_array().map(Vec::len), Some(301), "{c}");
+        assert_eq!(p["table"][c], all["table"][c], "{c}");
+    }
 }
 
 /// The lift rises 100·0.6/(2π) m: the integrated record, its bias removed over the quiet

@@ -95,6 +95,17 @@ pub struct KinData {
 
 /// Kinematics of the positions in `series` (2 or 3 value columns: x, y[, z]).
 pub fn kinematics(series: &Series, smoothing: Smoothing) -> Result<KinData, DataError> {
+    kinematics_with(series, smoothing, true)
+}
+
+/// [`kinematics`], with the polar columns (`r`, `theta`, `v_r`, `v_theta`, `a_r`, `a_theta`)
+/// left empty unless `polar`: a table that does not show them (`pdyn kin --data --quantities`
+/// without `polar`) spares their six columns and two transcendental calls per sample.
+pub fn kinematics_with(
+    series: &Series,
+    smoothing: Smoothing,
+    polar: bool,
+) -> Result<KinData, DataError> {
     let dim = series.values.len();
     if !(2..=3).contains(&dim) {
         return Err(DataError::new(
@@ -148,11 +159,11 @@ pub fn kinematics(series: &Series, smoothing: Smoothing) -> Result<KinData, Data
         ..
     } = &k;
     let (frenet, polar) = std::thread::scope(|s| {
-        let polar = s.spawn(|| polar(position, velocity, acceleration));
+        let polar = polar.then(|| s.spawn(|| polar_columns(position, velocity, acceleration)));
         let frenet = frenet(velocity, acceleration, &se_v, &se_a);
-        (frenet, polar.join())
+        (frenet, polar.map(|p| p.join()))
     });
-    let polar = polar.map_err(|_| {
+    let polar = polar.transpose().map_err(|_| {
         DataError::new(
             "",
             "internal error: the thread of the polar components panicked",
@@ -172,7 +183,9 @@ pub fn kinematics(series: &Series, smoothing: Smoothing) -> Result<KinData, Data
         frenet.se_a_n,
         frenet.se_curvature,
     );
-    [k.r, k.theta, k.v_r, k.v_theta, k.a_r, k.a_theta] = polar;
+    if let Some(p) = polar {
+        [k.r, k.theta, k.v_r, k.v_theta, k.a_r, k.a_theta] = p;
+    }
     Ok(k)
 }
 
@@ -254,7 +267,11 @@ fn frenet(velocity: &[Vec<f64>], acceleration: &[Vec<f64>], se_v: &[f64], se_a: 
 }
 
 /// Polar components in the x–y plane: `[r, θ, v_r, v_θ, a_r, a_θ]`, θ continuous (unwrapped).
-fn polar(position: &[Vec<f64>], velocity: &[Vec<f64>], acceleration: &[Vec<f64>]) -> [Vec<f64>; 6] {
+fn polar_columns(
+    position: &[Vec<f64>],
+    velocity: &[Vec<f64>],
+    acceleration: &[Vec<f64>],
+) -> [Vec<f64>; 6] {
     let n = position[0].len();
     let mut out: [Vec<f64>; 6] = std::array::from_fn(|_| vec![0.0; n]);
     let [r_col, theta, v_r, v_theta, a_r, a_theta] = &mut out;

@@ -120,18 +120,6 @@ fn one_step_matches_lammps_update_written_out_by_hand() {
     assert!(noise_scale > 1e-2);
 }
 
-/// Mean and standard error of correlated samples from 10 contiguous block means.
-fn mean_and_error(xs: &[f64]) -> (f64, f64) {
-    const NB: usize = 10;
-    let len = xs.len() / NB;
-    let bm: Vec<f64> = (0..NB)
-        .map(|b| xs[b * len..(b + 1) * len].iter().sum::<f64>() / len as f64)
-        .collect();
-    let m = bm.iter().sum::<f64>() / NB as f64;
-    let var = bm.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (NB * (NB - 1)) as f64;
-    (m, var.sqrt())
-}
-
 /// 256 LJ atoms (ρ = 0.8442) at T = 1 and a small step (dt = 0.002): the reported (full-step)
 /// temperature averages to the target within four standard errors (ten-block errors are
 /// themselves uncertain by a quarter), with either noise. The error is small enough (< 0.005)

@@ -138,18 +138,6 @@ fn velocities_follow_maxwell_boltzmann() {
     assert!(d < 0.015, "KS {d}");
 }
 
-/// Mean and standard error of correlated samples from 10 contiguous block means.
-fn mean_and_error(xs: &[f64]) -> (f64, f64) {
-    const NB: usize = 10;
-    let len = xs.len() / NB;
-    let bm: Vec<f64> = (0..NB)
-        .map(|b| xs[b * len..(b + 1) * len].iter().sum::<f64>() / len as f64)
-        .collect();
-    let m = bm.iter().sum::<f64>() / NB as f64;
-    let var = bm.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (NB * (NB - 1)) as f64;
-    (m, var.sqrt())
-}
-
 /// BAOAB's reported temperature (half-step velocities) is the thermostat's at a large and a
 /// larger time step, where the full-step velocities' temperature is measurably low — the
 /// check has the power to see the bias it guards against. 256 LJ atoms at ρ = 0.8442, T = 1.
