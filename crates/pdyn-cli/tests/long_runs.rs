@@ -8,69 +8,19 @@ use std::process::{Command, Stdio};
 use std::time::Duration;
 
 mod long_run_common;
-use long_run_common::{bin, example, fresh_dir, kill_repeatedly};
+use long_run_common::{
+    assert_whole_csv, bin, example, fresh_dir, kill_repeatedly, run_args,
+    summary_without_bookkeeping,
+};
 
 const CSV: [&str; 3] = ["trajectory.csv", "elements.csv", "conservation.csv"];
 
-/// Every line of every CSV file present is a whole row (the header's columns, numbers that
-/// parse), up to the last newline. After `after_kill` the file may end with one fragment
-/// without a newline: rows are handed to the system whole (one `write` of whole rows), but
-/// Linux checks for a fatal signal between the pages of a `write`, so SIGKILL can cut one
-/// there; a restart truncates the file back to the checkpoint's length. After a clean stop
-/// the file must end with a newline.
+/// Every CSV file present holds whole rows starting with a time ([`assert_whole_csv`];
+/// `elements.csv` has empty cells for bodies without an orbit).
 fn assert_whole_rows(dir: &Path, when: &str, after_kill: bool) {
     for name in CSV {
-        let path = dir.join(name);
-        let Ok(text) = std::fs::read_to_string(&path) else {
-            continue;
-        };
-        if text.is_empty() {
-            continue;
-        }
-        let whole = match text.rfind('\n') {
-            Some(i) => &text[..=i],
-            None => "",
-        };
-        assert!(
-            after_kill || whole.len() == text.len(),
-            "{when}: {name} ends inside a row: {:?}",
-            &text[text.len().saturating_sub(80)..]
-        );
-        let mut lines = whole.lines();
-        let columns = lines.next().map_or(0, |h| h.split(',').count());
-        for (k, line) in lines.enumerate() {
-            let cells: Vec<&str> = line.split(',').collect();
-            assert_eq!(
-                cells.len(),
-                columns,
-                "{when}: {name} row {} has other columns: {line}",
-                k + 2
-            );
-            assert!(
-                cells[0].parse::<f64>().is_ok(),
-                "{when}: {name} row {} does not start with a time: {line}",
-                k + 2
-            );
-        }
+        assert_whole_csv(dir, name, when, after_kill, false);
     }
-}
-
-/// `summary.json` without what only says how the run was carried out (the checkpoint file,
-/// where it restarted from).
-fn summary_without_bookkeeping(dir: &Path) -> serde_json::Value {
-    let text = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json");
-    let mut v: serde_json::Value = serde_json::from_str(&text).expect("summary is JSON");
-    let m = v.as_object_mut().expect("an object");
-    m.remove("checkpoint");
-    m.remove("restarted_from");
-    v
-}
-
-fn run_args(model: &Path, extra: &[&str], out: &Path) -> Vec<String> {
-    let mut a = vec!["run".to_string(), model.display().to_string()];
-    a.extend(extra.iter().map(|s| s.to_string()));
-    a.extend(["--out".to_string(), out.display().to_string()]);
-    a
 }
 
 /// Runs `model` with `extra` options once uninterrupted, then again killed `kills` times at

@@ -11,7 +11,9 @@ use std::process::{Command, Stdio};
 use std::time::Duration;
 
 mod long_run_common;
-use long_run_common::{bin, example, fresh_dir, kill_repeatedly, Rng};
+use long_run_common::{
+    assert_whole_csv, bin, example, fresh_dir, kill_repeatedly, run_args, whole_lines, Rng,
+};
 
 const FILES: [&str; 4] = ["thermo.csv", "traj.xyz", "rdf.csv", "msd.csv"];
 
@@ -29,40 +31,13 @@ fn derived_model(dir: &Path, example_path: &str, edits: &[(&str, &str)]) -> Path
     path
 }
 
-/// The text up to its last newline, and whether something follows it.
-fn whole_lines(text: &str) -> (&str, bool) {
-    match text.rfind('\n') {
-        Some(i) => (&text[..=i], i + 1 < text.len()),
-        None => ("", !text.is_empty()),
-    }
-}
-
 /// `thermo.csv`: every line up to the last newline is a whole row (the header's columns,
 /// numbers); `traj.xyz`: whole frames (count, comment, that many atom lines), but after a
 /// kill the last frame may be cut. A SIGKILL can cut a `write` between pages (see
 /// docs/long-runs.md), leaving part of a row at the end: allowed only `after_kill` (the
 /// restart truncates it); after a clean stop both files end with a whole row or frame.
 fn assert_whole_rows(dir: &Path, when: &str, after_kill: bool) {
-    if let Ok(text) = std::fs::read_to_string(dir.join("thermo.csv")) {
-        let (whole, rest) = whole_lines(&text);
-        assert!(after_kill || !rest, "{when}: thermo.csv ends inside a row");
-        let mut lines = whole.lines();
-        let columns = lines.next().map_or(0, |h| h.split(',').count());
-        for (k, line) in lines.enumerate() {
-            let cells: Vec<&str> = line.split(',').collect();
-            assert_eq!(
-                cells.len(),
-                columns,
-                "{when}: thermo.csv row {}: {line}",
-                k + 2
-            );
-            assert!(
-                cells.iter().all(|c| c.parse::<f64>().is_ok()),
-                "{when}: thermo.csv row {} has a cell that is not a number: {line}",
-                k + 2
-            );
-        }
-    }
+    assert_whole_csv(dir, "thermo.csv", when, after_kill, true);
     if let Ok(text) = std::fs::read_to_string(dir.join("traj.xyz")) {
         let (whole, rest) = whole_lines(&text);
         assert!(after_kill || !rest, "{when}: traj.xyz ends inside a line");
@@ -93,11 +68,8 @@ fn assert_whole_rows(dir: &Path, when: &str, after_kill: bool) {
 /// `summary.json` without what says how the run was carried out: the checkpoint file, where
 /// it restarted from, and the wall-clock time (which differs between any two runs).
 fn summary_without_bookkeeping(dir: &Path) -> serde_json::Value {
-    let text = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json");
-    let mut v: serde_json::Value = serde_json::from_str(&text).expect("summary is JSON");
+    let mut v = long_run_common::summary_without_bookkeeping(dir);
     let m = v.as_object_mut().expect("an object");
-    m.remove("checkpoint");
-    m.remove("restarted_from");
     if let Some(md) = m.get_mut("md").and_then(|x| x.as_object_mut()) {
         md.remove("loop_seconds");
         md.remove("atom_steps_per_second");
@@ -105,13 +77,6 @@ fn summary_without_bookkeeping(dir: &Path) -> serde_json::Value {
     m.remove("loop_seconds");
     m.remove("atom_steps_per_second");
     v
-}
-
-fn run_args(model: &Path, extra: &[&str], out: &Path) -> Vec<String> {
-    let mut a = vec!["run".to_string(), model.display().to_string()];
-    a.extend(extra.iter().map(|s| s.to_string()));
-    a.extend(["--out".to_string(), out.display().to_string()]);
-    a
 }
 
 fn reference_run(tag: &str, model: &Path, extra: &[&str]) -> PathBuf {

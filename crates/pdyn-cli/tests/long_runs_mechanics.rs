@@ -14,61 +14,14 @@ use std::process::{Command, Stdio};
 use std::time::Duration;
 
 mod long_run_common;
-use long_run_common::{bin, example, fresh_dir, kill_repeatedly};
+use long_run_common::{
+    assert_whole_csv, bin, example, fresh_dir, kill_repeatedly, run_args,
+    summary_without_bookkeeping,
+};
 
-/// Every line of `trajectory.csv` up to the last newline is a whole row (the header's number
-/// of cells, numbers that parse). After a SIGKILL the file may end with a fragment without a
-/// newline (Linux checks for a fatal signal between the pages of one `write`); after a clean
-/// stop it must end with a newline.
+/// `trajectory.csv` holds whole rows of numbers ([`assert_whole_csv`]).
 fn assert_whole_rows(dir: &Path, when: &str, after_kill: bool) {
-    let Ok(text) = std::fs::read_to_string(dir.join("trajectory.csv")) else {
-        return;
-    };
-    if text.is_empty() {
-        return;
-    }
-    let whole = match text.rfind('\n') {
-        Some(i) => &text[..=i],
-        None => "",
-    };
-    assert!(
-        after_kill || whole.len() == text.len(),
-        "{when}: trajectory.csv ends inside a row: {:?}",
-        &text[text.len().saturating_sub(80)..]
-    );
-    let mut lines = whole.lines();
-    let columns = lines.next().map_or(0, |h| h.split(',').count());
-    for (k, line) in lines.enumerate() {
-        let cells: Vec<&str> = line.split(',').collect();
-        assert_eq!(
-            cells.len(),
-            columns,
-            "{when}: row {} has other columns",
-            k + 2
-        );
-        assert!(
-            cells.iter().all(|c| c.parse::<f64>().is_ok()),
-            "{when}: row {} holds something that is not a number: {line}",
-            k + 2
-        );
-    }
-}
-
-/// `summary.json` without what only says how the run was carried out.
-fn summary_without_bookkeeping(dir: &Path) -> serde_json::Value {
-    let text = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json");
-    let mut v: serde_json::Value = serde_json::from_str(&text).expect("summary is JSON");
-    let m = v.as_object_mut().expect("an object");
-    m.remove("checkpoint");
-    m.remove("restarted_from");
-    v
-}
-
-fn run_args(model: &Path, extra: &[&str], out: &Path) -> Vec<String> {
-    let mut a = vec!["run".to_string(), model.display().to_string()];
-    a.extend(extra.iter().map(|s| s.to_string()));
-    a.extend(["--out".to_string(), out.display().to_string()]);
-    a
+    assert_whole_csv(dir, "trajectory.csv", when, after_kill, true);
 }
 
 fn assert_same_files(reference: &Path, dir: &Path, tag: &str) {

@@ -80,3 +80,64 @@ pub fn kill_repeatedly(
     let last = with_restart(&mut restarts);
     (last, restarts)
 }
+
+/// `pdyn run MODEL EXTRA… --out OUT`.
+pub fn run_args(model: &Path, extra: &[&str], out: &Path) -> Vec<String> {
+    let mut a = vec!["run".to_string(), model.display().to_string()];
+    a.extend(extra.iter().map(|s| s.to_string()));
+    a.extend(["--out".to_string(), out.display().to_string()]);
+    a
+}
+
+/// `summary.json` of `dir` without what only says how the run was carried out (the
+/// checkpoint file, where it restarted from).
+pub fn summary_without_bookkeeping(dir: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json");
+    let mut v: serde_json::Value = serde_json::from_str(&text).expect("summary is JSON");
+    let m = v.as_object_mut().expect("an object");
+    m.remove("checkpoint");
+    m.remove("restarted_from");
+    v
+}
+
+/// The text up to its last newline, and whether something follows it.
+pub fn whole_lines(text: &str) -> (&str, bool) {
+    match text.rfind('\n') {
+        Some(i) => (&text[..=i], i + 1 < text.len()),
+        None => ("", !text.is_empty()),
+    }
+}
+
+/// The CSV file `name` of `dir`, when present: every line up to the last newline is a whole
+/// row (the header's number of cells; every cell a number when `all_numbers`, else the first,
+/// the time). After a SIGKILL (`after_kill`) the file may end with a fragment without a
+/// newline (Linux checks for a fatal signal between the pages of one `write`); after a clean
+/// stop it must end with a newline.
+pub fn assert_whole_csv(dir: &Path, name: &str, when: &str, after_kill: bool, all_numbers: bool) {
+    let Ok(text) = std::fs::read_to_string(dir.join(name)) else {
+        return;
+    };
+    let (whole, rest) = whole_lines(&text);
+    assert!(
+        after_kill || !rest,
+        "{when}: {name} ends inside a row: {:?}",
+        &text[text.len().saturating_sub(80)..]
+    );
+    let mut lines = whole.lines();
+    let columns = lines.next().map_or(0, |h| h.split(',').count());
+    for (k, line) in lines.enumerate() {
+        let cells: Vec<&str> = line.split(',').collect();
+        assert_eq!(
+            cells.len(),
+            columns,
+            "{when}: {name} row {} has other columns: {line}",
+            k + 2
+        );
+        let checked = if all_numbers { &cells[..] } else { &cells[..1] };
+        assert!(
+            checked.iter().all(|c| c.parse::<f64>().is_ok()),
+            "{when}: {name} row {} holds something that is not a number: {line}",
+            k + 2
+        );
+    }
+}
