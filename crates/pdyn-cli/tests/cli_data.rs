@@ -145,21 +145,41 @@ fn kin_data_recovers_the_ellipse() {
     for c in ["speed", "a_n"] {
         assert_eq!(j["table"][c], all["table"][c], "{c}");
     }
-    let (code, stdout, _) = pdyn(&[
-        "kin",
-        "--data",
-        &example("track.csv"),
-        "--quantities",
-        "polar",
-        "--smooth",
-        "0.01",
-        "--json",
-    ]);
-    assert_eq!(code, 0);
-    let p: serde_json::Value = serde_json::from_str(&stdout).unwrap();
-    for c in ["r", "theta", "v_r", "v_theta", "a_r", "a_theta"] {
-        assert_eq!(p["table"][c].as_array().map(Vec::len), Some(301), "{c}");
-        assert_eq!(p["table"][c], all["table"][c], "{c}");
+    // Each group alone (computed alone, the Frenet columns in two halves of the 301 rows)
+    // gives the full table's columns.
+    for (quantities, columns) in [
+        (
+            "polar",
+            &["r", "theta", "v_r", "v_theta", "a_r", "a_theta"][..],
+        ),
+        (
+            "se,curvature",
+            &["se_speed", "se_a_t", "se_a_n", "se_curvature", "curvature"][..],
+        ),
+        ("tangent", &["T_x", "T_y"][..]),
+        ("normal", &["N_x", "N_y"][..]),
+    ] {
+        let (code, stdout, _) = pdyn(&[
+            "kin",
+            "--data",
+            &example("track.csv"),
+            "--quantities",
+            quantities,
+            "--smooth",
+            "0.01",
+            "--json",
+        ]);
+        assert_eq!(code, 0);
+        let p: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+        assert_eq!(
+            p["columns"].as_array().map(Vec::len),
+            Some(columns.len() + 1),
+            "{quantities}"
+        );
+        for c in columns {
+            assert_eq!(p["table"][c].as_array().map(Vec::len), Some(301), "{c}");
+            assert_eq!(p["table"][c], all["table"][c], "{c}");
+        }
     }
 }
 

@@ -93,18 +93,43 @@ pub struct KinData {
     pub boundary: f64,
 }
 
-/// Kinematics of the positions in `series` (2 or 3 value columns: x, y[, z]).
-pub fn kinematics(series: &Series, smoothing: Smoothing) -> Result<KinData, DataError> {
-    kinematics_with(series, smoothing, true)
+/// Which of the derived columns [`kinematics_with`] computes. Speed, a_t and a_n are always
+/// computed; a table that shows only some of the others spares their memory (8 bytes per
+/// sample each) and time. Columns not wanted are left empty in [`KinData`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Wanted {
+    /// The unit tangent and principal normal (`tangent`, `normal`).
+    pub frame: bool,
+    /// The curvature `a_n/|v|²`.
+    pub curvature: bool,
+    /// The standard errors (`se_speed`, `se_a_t`, `se_a_n`, `se_curvature`).
+    pub se: bool,
+    /// The polar components (`r`, `theta`, `v_r`, `v_theta`, `a_r`, `a_theta`).
+    pub polar: bool,
 }
 
-/// [`kinematics`], with the polar columns (`r`, `theta`, `v_r`, `v_theta`, `a_r`, `a_theta`)
-/// left empty unless `polar`: a table that does not show them (`pdyn kin --data --quantities`
-/// without `polar`) spares their six columns and two transcendental calls per sample.
+impl Wanted {
+    /// Every column.
+    pub const ALL: Wanted = Wanted {
+        frame: true,
+        curvature: true,
+        se: true,
+        polar: true,
+    };
+}
+
+/// Kinematics of the positions in `series` (2 or 3 value columns: x, y[, z]).
+pub fn kinematics(series: &Series, smoothing: Smoothing) -> Result<KinData, DataError> {
+    kinematics_with(series, smoothing, Wanted::ALL)
+}
+
+/// [`kinematics`], computing only the derived columns `wanted` (the others are left empty):
+/// `pdyn kin --data --quantities speed,a_t` spares the frame, curvature, error and polar
+/// columns, their memory and the polar components' two transcendental calls per sample.
 pub fn kinematics_with(
     series: &Series,
     smoothing: Smoothing,
-    polar: bool,
+    wanted: Wanted,
 ) -> Result<KinData, DataError> {
     let dim = series.values.len();
     if !(2..=3).contains(&dim) {
@@ -150,25 +175,33 @@ pub fn kinematics_with(
         k.velocity.push(std::mem::take(&mut f.d1));
         k.acceleration.push(std::mem::take(&mut f.d2));
     }
-    // The Frenet quantities with their errors and the polar components read the same
-    // columns and write different ones: one thread each.
+    // The Frenet quantities are independent from sample to sample: two halves on two
+    // threads, with the polar components (a recurrence: θ is unwrapped from the sample
+    // before) on a third when they are wanted.
     let KinData {
         position,
         velocity,
         acceleration,
         ..
     } = &k;
-    let (frenet, polar) = std::thread::scope(|s| {
-        let polar = polar.then(|| s.spawn(|| polar_columns(position, velocity, acceleration)));
-        let frenet = frenet(velocity, acceleration, &se_v, &se_a);
-        (frenet, polar.map(|p| p.join()))
+    let n = series.t.len();
+    let mut frenet = Frenet::zeros(n, velocity.len(), wanted);
+    let polar = std::thread::scope(|s| {
+        let polar = wanted
+            .polar
+            .then(|| s.spawn(|| polar_columns(position, velocity, acceleration)));
+        let (se_v, se_a) = (&se_v[..], &se_a[..]);
+        let (first, second) = frenet.split_at_mut(n / 2);
+        let other = s.spawn(move || first.fill(velocity, acceleration, se_v, se_a, 0));
+        second.fill(velocity, acceleration, se_v, se_a, n / 2);
+        let joined = other.join();
+        (polar.map(|p| p.join()), joined)
     });
-    let polar = polar.transpose().map_err(|_| {
-        DataError::new(
-            "",
-            "internal error: the thread of the polar components panicked",
-        )
-    })?;
+    let polar = match polar {
+        (polar, Ok(())) => polar.transpose(),
+        (_, Err(e)) => Err(e),
+    }
+    .map_err(|_| DataError::new("", "internal error: a thread of the kinematics panicked"))?;
     (k.speed, k.tangent, k.a_t, k.a_n, k.normal, k.curvature) = (
         frenet.speed,
         frenet.tangent,
@@ -189,7 +222,8 @@ pub fn kinematics_with(
     Ok(k)
 }
 
-/// Speed, tangent, a_t, a_n, normal, curvature and their standard errors at every sample.
+/// Speed, tangent, a_t, a_n, normal, curvature and their standard errors at every sample
+/// (the columns not [`Wanted`] empty).
 struct Frenet {
     speed: Vec<f64>,
     tangent: Vec<Vec<f64>>,
@@ -203,67 +237,173 @@ struct Frenet {
     se_curvature: Vec<f64>,
 }
 
-/// [`Frenet`] from the velocity and acceleration columns (2 or 3) and each coordinate's
-/// standard errors of velocity and acceleration (module documentation).
-fn frenet(velocity: &[Vec<f64>], acceleration: &[Vec<f64>], se_v: &[f64], se_a: &[f64]) -> Frenet {
-    let dim = velocity.len();
-    let n = velocity[0].len();
-    let mut f = Frenet {
-        speed: vec![0.0; n],
-        tangent: vec![vec![0.0; n]; dim],
-        a_t: vec![0.0; n],
-        a_n: vec![0.0; n],
-        normal: vec![vec![0.0; n]; dim],
-        curvature: vec![0.0; n],
-        se_speed: vec![0.0; n],
-        se_a_t: vec![0.0; n],
-        se_a_n: vec![0.0; n],
-        se_curvature: vec![0.0; n],
-    };
-    for i in 0..n {
-        // Fixed-size vectors (a third component of 0 in the plane): no allocation per sample.
-        let mut v = [0.0; 3];
-        let mut a = [0.0; 3];
-        for c in 0..dim {
-            v[c] = velocity[c][i];
-            a[c] = acceleration[c][i];
-        }
-        let s = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        let tan = if s > 0.0 { v.map(|x| x / s) } else { [0.0; 3] };
-        let at = a[0] * tan[0] + a[1] * tan[1] + a[2] * tan[2];
-        let perp = [a[0] - at * tan[0], a[1] - at * tan[1], a[2] - at * tan[2]];
-        let an = (perp[0] * perp[0] + perp[1] * perp[1] + perp[2] * perp[2]).sqrt();
-        let nor = if an > 0.0 {
-            perp.map(|x| x / an)
-        } else {
-            [0.0; 3]
+/// The rows of a [`Frenet`] from some sample on, to be filled (an empty column stays empty).
+struct FrenetRows<'a> {
+    speed: &'a mut [f64],
+    tangent: Vec<&'a mut [f64]>,
+    a_t: &'a mut [f64],
+    a_n: &'a mut [f64],
+    normal: Vec<&'a mut [f64]>,
+    curvature: &'a mut [f64],
+    se_speed: &'a mut [f64],
+    se_a_t: &'a mut [f64],
+    se_a_n: &'a mut [f64],
+    se_curvature: &'a mut [f64],
+}
+
+impl Frenet {
+    /// Zeroed columns of `n` samples in `dim` dimensions, empty where not `wanted`.
+    fn zeros(n: usize, dim: usize, wanted: Wanted) -> Frenet {
+        let col = |on: bool| if on { vec![0.0; n] } else { Vec::new() };
+        let cols = |on: bool| {
+            if on {
+                vec![vec![0.0; n]; dim]
+            } else {
+                Vec::new()
+            }
         };
-        let kappa = if s > 0.0 { an / (s * s) } else { f64::INFINITY };
-        let (mut vs, mut vat, mut van, mut vk) = (0.0, 0.0, 0.0, 0.0);
-        for c in 0..dim {
-            let (sv, sa) = (se_v[c] * se_v[c], se_a[c] * se_a[c]);
-            vs += tan[c] * tan[c] * sv;
-            if s > 0.0 {
-                vat += tan[c] * tan[c] * sa + (an * nor[c] / s).powi(2) * sv;
-                van += nor[c] * nor[c] * sa + (at * nor[c] / s).powi(2) * sv;
-                vk += (nor[c] / (s * s)).powi(2) * sa
-                    + ((at * nor[c] + 2.0 * an * tan[c]) / (s * s * s)).powi(2) * sv;
+        Frenet {
+            speed: col(true),
+            tangent: cols(wanted.frame),
+            a_t: col(true),
+            a_n: col(true),
+            normal: cols(wanted.frame),
+            curvature: col(wanted.curvature),
+            se_speed: col(wanted.se),
+            se_a_t: col(wanted.se),
+            se_a_n: col(wanted.se),
+            se_curvature: col(wanted.se),
+        }
+    }
+
+    /// The rows before sample `at` and those from it on.
+    fn split_at_mut(&mut self, at: usize) -> (FrenetRows<'_>, FrenetRows<'_>) {
+        fn split(c: &mut [f64], at: usize) -> (&mut [f64], &mut [f64]) {
+            c.split_at_mut(at.min(c.len()))
+        }
+        fn splits(cs: &mut [Vec<f64>], at: usize) -> (Vec<&mut [f64]>, Vec<&mut [f64]>) {
+            cs.iter_mut().map(|c| split(c, at)).unzip()
+        }
+        let (speed0, speed1) = split(&mut self.speed, at);
+        let (tangent0, tangent1) = splits(&mut self.tangent, at);
+        let (a_t0, a_t1) = split(&mut self.a_t, at);
+        let (a_n0, a_n1) = split(&mut self.a_n, at);
+        let (normal0, normal1) = splits(&mut self.normal, at);
+        let (curvature0, curvature1) = split(&mut self.curvature, at);
+        let (se_speed0, se_speed1) = split(&mut self.se_speed, at);
+        let (se_a_t0, se_a_t1) = split(&mut self.se_a_t, at);
+        let (se_a_n0, se_a_n1) = split(&mut self.se_a_n, at);
+        let (se_curvature0, se_curvature1) = split(&mut self.se_curvature, at);
+        (
+            FrenetRows {
+                speed: speed0,
+                tangent: tangent0,
+                a_t: a_t0,
+                a_n: a_n0,
+                normal: normal0,
+                curvature: curvature0,
+                se_speed: se_speed0,
+                se_a_t: se_a_t0,
+                se_a_n: se_a_n0,
+                se_curvature: se_curvature0,
+            },
+            FrenetRows {
+                speed: speed1,
+                tangent: tangent1,
+                a_t: a_t1,
+                a_n: a_n1,
+                normal: normal1,
+                curvature: curvature1,
+                se_speed: se_speed1,
+                se_a_t: se_a_t1,
+                se_a_n: se_a_n1,
+                se_curvature: se_curvature1,
+            },
+        )
+    }
+}
+
+impl FrenetRows<'_> {
+    /// Fills the rows from the velocity and acceleration columns (2 or 3; these rows are
+    /// samples `first..`) and each coordinate's standard errors of velocity and acceleration
+    /// (module documentation).
+    fn fill(
+        self,
+        velocity: &[Vec<f64>],
+        acceleration: &[Vec<f64>],
+        se_v: &[f64],
+        se_a: &[f64],
+        first: usize,
+    ) {
+        let dim = velocity.len();
+        let (frame, curvature, se) = (
+            !self.tangent.is_empty(),
+            !self.curvature.is_empty(),
+            !self.se_speed.is_empty(),
+        );
+        let FrenetRows {
+            speed,
+            mut tangent,
+            a_t,
+            a_n,
+            mut normal,
+            curvature: curvature_col,
+            se_speed,
+            se_a_t,
+            se_a_n,
+            se_curvature,
+        } = self;
+        for r in 0..speed.len() {
+            let i = first + r;
+            // Fixed-size vectors (a third component of 0 in the plane): no allocation per
+            // sample.
+            let mut v = [0.0; 3];
+            let mut a = [0.0; 3];
+            for c in 0..dim {
+                v[c] = velocity[c][i];
+                a[c] = acceleration[c][i];
+            }
+            let s = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            let tan = if s > 0.0 { v.map(|x| x / s) } else { [0.0; 3] };
+            let at = a[0] * tan[0] + a[1] * tan[1] + a[2] * tan[2];
+            let perp = [a[0] - at * tan[0], a[1] - at * tan[1], a[2] - at * tan[2]];
+            let an = (perp[0] * perp[0] + perp[1] * perp[1] + perp[2] * perp[2]).sqrt();
+            let nor = if an > 0.0 {
+                perp.map(|x| x / an)
+            } else {
+                [0.0; 3]
+            };
+            speed[r] = s;
+            a_t[r] = at;
+            a_n[r] = an;
+            if curvature {
+                curvature_col[r] = if s > 0.0 { an / (s * s) } else { f64::INFINITY };
+            }
+            if frame {
+                for c in 0..dim {
+                    tangent[c][r] = tan[c];
+                    normal[c][r] = nor[c];
+                }
+            }
+            if se {
+                let (mut vs, mut vat, mut van, mut vk) = (0.0, 0.0, 0.0, 0.0);
+                for c in 0..dim {
+                    let (sv, sa) = (se_v[c] * se_v[c], se_a[c] * se_a[c]);
+                    vs += tan[c] * tan[c] * sv;
+                    if s > 0.0 {
+                        vat += tan[c] * tan[c] * sa + (an * nor[c] / s).powi(2) * sv;
+                        van += nor[c] * nor[c] * sa + (at * nor[c] / s).powi(2) * sv;
+                        vk += (nor[c] / (s * s)).powi(2) * sa
+                            + ((at * nor[c] + 2.0 * an * tan[c]) / (s * s * s)).powi(2) * sv;
+                    }
+                }
+                se_speed[r] = vs.sqrt();
+                se_a_t[r] = if s > 0.0 { vat.sqrt() } else { f64::INFINITY };
+                se_a_n[r] = if s > 0.0 { van.sqrt() } else { f64::INFINITY };
+                se_curvature[r] = if s > 0.0 { vk.sqrt() } else { f64::INFINITY };
             }
         }
-        f.speed[i] = s;
-        f.a_t[i] = at;
-        f.a_n[i] = an;
-        f.curvature[i] = kappa;
-        for c in 0..dim {
-            f.tangent[c][i] = tan[c];
-            f.normal[c][i] = nor[c];
-        }
-        f.se_speed[i] = vs.sqrt();
-        f.se_a_t[i] = if s > 0.0 { vat.sqrt() } else { f64::INFINITY };
-        f.se_a_n[i] = if s > 0.0 { van.sqrt() } else { f64::INFINITY };
-        f.se_curvature[i] = if s > 0.0 { vk.sqrt() } else { f64::INFINITY };
     }
-    f
 }
 
 /// Polar components in the x–y plane: `[r, θ, v_r, v_θ, a_r, a_θ]`, θ continuous (unwrapped).

@@ -174,16 +174,17 @@ fn run_data(a: KinArgs, path: &std::path::Path) -> Result<String, Error> {
                 5,
                 "kinematics from samples",
             )?;
-            let q = &a.d.quantities;
-            let polar = q.is_empty() || q.iter().any(|g| g == "polar");
-            let k = data::lib::kinematics::kinematics_with(&series, smoothing, polar).map_err(
-                |mut error| {
-                    if error.file.is_empty() {
-                        error.file = path.display().to_string();
-                    }
-                    data::data_error(error)
-                },
-            )?;
+            let k = data::lib::kinematics::kinematics_with(
+                &series,
+                smoothing,
+                data::kin_wanted(&a.d.quantities),
+            )
+            .map_err(|mut error| {
+                if error.file.is_empty() {
+                    error.file = path.display().to_string();
+                }
+                data::data_error(error)
+            })?;
             // The summaries first: the table takes the columns (10⁶ samples: no copies).
             let (text, summary) = (data::kin_summary_text(&k), data::kin_summary(&k));
             (text, summary, data::kin_table(k, &a.d.quantities)?)
