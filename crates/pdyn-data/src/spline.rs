@@ -16,7 +16,10 @@
 //! `I − A = λ Q M⁻¹ Qᵀ`, `n − tr A = λ tr(M⁻¹ QᵀQ)` needs only the band of `M⁻¹`
 //! (Hutchinson & de Hoog 1985), so each evaluation is O(n). The minimum is found on a grid of
 //! one point per two decades of λ spanning every cut-off from the sampling (Nyquist) frequency
-//! to the record's length, then refined by Brent's method to 0.005 decade.
+//! to the record's length, then refined by Brent's method to 0.005 decade. On records of
+//! 131,072 samples or more the grid is searched on a subsample (every `s`-th sample, about
+//! 65,536 of them) and the full record is scored only around the minimum it predicts, which
+//! the full record's scores must bracket (else the full grid is searched).
 //!
 //! **Standard errors.** The residual variance is `σ² = RSS / (n − tr A)`. In the interior of
 //! a uniform grid (spacing `h`; the mean spacing is used for uneven samples) the spline is a
