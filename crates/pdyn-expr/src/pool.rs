@@ -497,9 +497,20 @@ impl Pool {
     /// The members of `needles` that occur in `hay`, in one traversal of its DAG (asking
     /// [`Pool::contains`] for each needle costs one traversal per needle: the equations of a
     /// net of N particles against its 3N accelerations made that quadratic).
+    ///
+    /// Subtrees older than every needle are skipped, but only when the set is small: finding
+    /// its oldest member reads the whole set, and callers ask about each of a net's N rows
+    /// against its 2N coordinates and rates (quadratic: 29 % of `pdyn modes` on a chain of
+    /// 10⁴ masses). A small hay is cheaper to walk whole than a large set to scan.
     pub fn occurring(&self, hay: Id, needles: &rustc_hash::FxHashSet<Id>) -> Vec<Id> {
-        let Some(oldest) = needles.iter().min().copied() else {
+        const SCAN_AT_MOST: usize = 64;
+        if needles.is_empty() {
             return Vec::new();
+        }
+        let oldest = if needles.len() <= SCAN_AT_MOST {
+            needles.iter().min().copied().unwrap_or(Id(0))
+        } else {
+            Id(0)
         };
         let mut found = Vec::new();
         let mut seen = rustc_hash::FxHashSet::default();
@@ -772,6 +783,44 @@ mod tests {
                     .iter()
                     .any(|&h| needles.iter().any(|&n| p.contains(h, n)));
                 assert_eq!(p.contains_any(&hays, &needles), pairwise);
+            }
+        }
+    }
+
+    /// `occurring` finds exactly the needles `contains` finds, with few needles (subtrees
+    /// older than all of them skipped) and with many (more than it scans for the oldest).
+    #[test]
+    fn occurring_agrees_with_contains_for_small_and_large_needle_sets() {
+        let mut p = Pool::new();
+        let many: Vec<Id> = (0..200)
+            .map(|k| p.parse_scalar(&format!("v{k}")).unwrap())
+            .collect();
+        let exprs: Vec<Id> = [
+            "a*sin(v3) + v150*b",
+            "cos(v199)^2*c + v0",
+            "a + b + c",
+            "exp(v70*v71) - v72/v73",
+            "3",
+            "v10",
+        ]
+        .iter()
+        .map(|s| p.parse_scalar(s).unwrap())
+        .collect();
+        for size in [1, 5, 64, 65, 200] {
+            for start in [0, 3, 70, 150] {
+                let needles: rustc_hash::FxHashSet<Id> =
+                    many.iter().skip(start).take(size).copied().collect();
+                for &e in &exprs {
+                    let mut found = p.occurring(e, &needles);
+                    found.sort();
+                    let mut expected: Vec<Id> = needles
+                        .iter()
+                        .copied()
+                        .filter(|&n| p.contains(e, n))
+                        .collect();
+                    expected.sort();
+                    assert_eq!(found, expected, "{size} needles from v{start}");
+                }
             }
         }
     }
