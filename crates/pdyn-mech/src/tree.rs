@@ -331,6 +331,12 @@ impl TreeForm {
         &self.nodes
     }
 
+    /// Whether no link direction, centripetal term or force has a `z` component: a chain
+    /// then runs the recursion in the plane.
+    pub fn is_planar(&self) -> bool {
+        self.planar
+    }
+
     /// Number of nodes (= free coordinates).
     pub fn len(&self) -> usize {
         self.nodes.len()
