@@ -12,7 +12,8 @@
 //! then multiplies by it), `x^2 = x*x`, `x^(k/2)` through `sqrt`, a sum that is an already
 //! compiled sum plus one term continues from it (partial sums of a chain's positions). With
 //! invariant inputs ([`crate::hoist`]) products are lowered as variant × invariant part and
-//! sums with a common invariant factor as that factor times the rest.
+//! sums with a common invariant factor as that factor times the rest. A sine and a cosine of
+//! one operand are one `sincos` ([`Op::SinCos`], `crate::sincos`).
 //! Division by zero, `log` of a negative number and the like give `inf`/`NaN`, as IEEE
 //! arithmetic does; they never panic.
 
@@ -57,6 +58,13 @@ pub enum Op {
     /// A tabulated function at `reg[a]`: `b` is the index of the call in
     /// [`Program::tables`] (not a register).
     Table,
+    /// `sin(a)`, whose cosine the next instruction holds ([`Op::CosOfSinCos`], same `a`):
+    /// both from one `libm::sincos`, which gives the bits of `libm::sin` and `libm::cos`
+    /// ([`crate::sincos`]).
+    SinCos,
+    /// `cos(a)`, computed by the [`Op::SinCos`] just before it. An evaluator may also compute
+    /// it alone as `libm::cos(a)`: the same bits.
+    CosOfSinCos,
 }
 
 impl Op {
@@ -72,6 +80,17 @@ impl Op {
     /// call index): renumbering registers leaves it as it is.
     pub fn b_is_immediate(self) -> bool {
         matches!(self, Op::Powi | Op::Table)
+    }
+
+    /// The operation that computes this instruction's value by itself: `Sin` for
+    /// [`Op::SinCos`], `Cos` for [`Op::CosOfSinCos`] (the same bits), the operation itself
+    /// otherwise. For evaluators that do not fuse the pair.
+    pub fn alone(self) -> Op {
+        match self {
+            Op::SinCos => Op::Sin,
+            Op::CosOfSinCos => Op::Cos,
+            op => op,
+        }
     }
 }
 
@@ -617,23 +636,26 @@ impl Program {
                 },
             })
             .collect();
-        Ok(Program {
-            n_inputs: inputs.len(),
-            consts: c.consts,
+        Ok(Program::from_parts(
+            inputs.len(),
+            c.consts,
             instrs,
-            outputs: outs.into_iter().map(remap).collect(),
-            tables: c.table_calls.into_iter().map(|(_, call)| call).collect(),
-        })
+            outs.into_iter().map(remap).collect(),
+            c.table_calls.into_iter().map(|(_, call)| call).collect(),
+        ))
     }
 
-    /// A program from its renumbered parts (registers `[inputs | constants | temporaries]`).
+    /// A program from its renumbered parts (registers `[inputs | constants | temporaries]`),
+    /// each sine and cosine of one operand fused ([`crate::sincos`]).
     pub(crate) fn from_parts(
         n_inputs: usize,
         consts: Vec<f64>,
         instrs: Vec<Instr>,
-        outputs: Vec<u32>,
+        mut outputs: Vec<u32>,
         tables: Arc<[TableCall]>,
     ) -> Program {
+        let first_temp = (n_inputs + consts.len()) as u32;
+        let instrs = crate::sincos::fuse_sin_cos(first_temp, instrs, &mut outputs);
         Program {
             n_inputs,
             consts,
@@ -711,11 +733,13 @@ impl Program {
         );
         ws[..n].copy_from_slice(&inputs[..n]);
         let regs = ws.as_mut_ptr();
+        let len = self.instrs.len();
         for (k, ins) in self.instrs.iter().enumerate() {
             // SAFETY: `compile` only emits operands that are inputs, constants or earlier
             // temporaries, so `ins.a`, `ins.b` < `start + k` <= ws.len() (checked above), and the
-            // destination `start + k` is in bounds. `Powi` stores an exponent, not a register,
-            // in `b`, and never reads it as one.
+            // destination `start + k` is in bounds, as is `SinCos`'s second one `start + k + 1`
+            // (checked: `k + 1 < len`). `Powi` stores an exponent, not a register, in `b`, and
+            // never reads it as one.
             unsafe {
                 let a = *regs.add(ins.a as usize);
                 let reg_b = || *regs.add(ins.b as usize);
@@ -753,6 +777,17 @@ impl Program {
                     Op::Min => a.min(reg_b()),
                     Op::Max => a.max(reg_b()),
                     Op::Table => self.tables[ins.b as usize].eval(a),
+                    Op::SinCos => {
+                        let (sin, cos) = libm::sincos(a);
+                        // The next instruction is this one's `CosOfSinCos` (`fuse_sin_cos`
+                        // emits them so), whose register is the next one.
+                        if k + 1 < len {
+                            *regs.add(start + k + 1) = cos;
+                        }
+                        sin
+                    }
+                    // Written by the `SinCos` just before.
+                    Op::CosOfSinCos => *regs.add(start + k),
                 };
                 *regs.add(start + k) = v;
             }

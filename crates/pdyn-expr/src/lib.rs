@@ -45,6 +45,7 @@ pub mod poly;
 pub mod pool;
 pub mod print;
 pub mod simplify;
+mod sincos;
 pub mod subs;
 pub mod syntax;
 pub mod tabulated;

@@ -168,7 +168,7 @@ impl Steps {
     /// The steps of `prog`, or `None` when it has an operation [`known`] does not list.
     fn new(prog: &Program) -> Option<Steps> {
         let ins = prog.instructions();
-        if !ins.iter().all(|i| known(i.op())) {
+        if !ins.iter().all(|i| known(i.op().alone())) {
             return None;
         }
         let n_in = prog.n_inputs();
@@ -217,7 +217,9 @@ impl Steps {
                 i.b()
             };
             let e = i.b() as i32;
-            match i.op() {
+            // A fused sine and cosine are computed apart here (the same bits): liveness may
+            // have dropped one of them.
+            match i.op().alone() {
                 Op::Div => {
                     let r = c.recip_of(b);
                     if const_of(i.a()) == Some(1.0) {

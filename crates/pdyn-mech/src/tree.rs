@@ -19,7 +19,7 @@
 
 use crate::derive::ParticleKinematics;
 use crate::model::{CoordinateKind, Model};
-use pdyn_expr::{vector, Id};
+use pdyn_expr::{vector, Id, Pool};
 use rustc_hash::{FxHashMap, FxHashSet};
 
 /// One particle of the tree, with the link that carries it.
@@ -53,6 +53,10 @@ pub struct TreeForm {
     /// Every node is the child of the one before (a chain): [`TreeForm::solve`] then
     /// carries each link's result to the next in registers.
     chain: bool,
+    /// Every link direction, centripetal acceleration and force has no `z` component
+    /// (symbolically zero): a chain then runs the recursion in the `xy` plane
+    /// ([`articulate_planar`]), half the arithmetic of the spatial one.
+    planar: bool,
 }
 
 /// Numbers per node that [`TreeForm::solve`] reads: `m, s'(3), s''q'²(3), F(3)`.
@@ -98,6 +102,8 @@ pub struct TreeWorkspace<T = f64> {
     joint: Vec<Joint<T>>,
     /// Each particle's acceleration in the forward pass.
     acc: Vec<[T; 3]>,
+    /// A planar chain's [`PlanarJoint`]s.
+    planar_joint: Vec<PlanarJoint<T>>,
 }
 
 /// One link's result of the backward pass, for the forward pass: with `u = Î s`,
@@ -120,6 +126,7 @@ impl<T> Default for TreeWorkspace<T> {
             acc_in: Vec::new(),
             joint: Vec::new(),
             acc: Vec::new(),
+            planar_joint: Vec::new(),
         }
     }
 }
@@ -203,6 +210,87 @@ fn articulate<T: Scalar>(v: &[T], a: &[T; 9]) -> Option<([T; 9], Joint<T>)> {
     Some((out, joint))
 }
 
+/// [`Joint`] in the `xy` plane: `w`, `b` and `A` without their `z` parts.
+#[derive(Clone, Copy, Debug)]
+struct PlanarJoint<T> {
+    w: [T; 2],
+    g: T,
+    a: [[T; 2]; 2],
+    b: [T; 2],
+}
+
+/// What a planar chain's link passes to its parent besides its contribution `Î − u uᵀ/D`:
+/// its `Î` (`xx, yy, xy`), `u = Î s` and `1/D`, all zero below the last link.
+#[derive(Clone, Copy, Debug)]
+struct Child<T> {
+    ih: [T; 3],
+    u: [T; 2],
+    r: T,
+}
+
+/// [`articulate`] for a link, its particle's load and its subtree in the `xy` plane:
+/// `v` as there (its `z` entries zero and not read), the contribution `a` as the inertia's
+/// `xx, yy, xy` and the bias force's `x, y` (the `zz` inertia never meets a non-zero
+/// direction, the `xz`, `yz` entries and the bias's `z` stay zero); the terms in `z` of
+/// [`articulate`] are exact zeros (`x + 0 = x`, `x·0 = 0`) left out.
+///
+/// `D = sᵀ(Î_c − u_c u_cᵀ/D_c)s + m|s|²` is computed as `A − B²/D_c` with
+/// `A = sᵀ Î_c s + m|s|²` and `B = u_cᵀ s` from the child `c`'s numbers, known before its
+/// `1/D_c`: a chain's dependency from one link's division to the next is then a multiply and
+/// a subtraction, not the contribution's six entries and a quadratic form. Equal to
+/// [`articulate`]'s `D` to round-off (not to the bit).
+#[inline(always)]
+fn articulate_planar<T: Scalar>(
+    v: &[T],
+    a: &[T; 5],
+    child: &Child<T>,
+) -> Option<([T; 5], PlanarJoint<T>, Child<T>)> {
+    let zero = T::of(0.0);
+    let one = T::of(1.0);
+    let (m, s, c) = (v[0], [v[1], v[2]], [v[4], v[5]]);
+    let ih = [a[0] + m, a[1] + m, a[2]];
+    let ph = [a[3] - v[7], a[4] - v[8]];
+    let (s00, s11) = (s[0] * s[0], s[1] * s[1]);
+    let s01 = T::of(2.0) * s[0] * s[1];
+    let along = ((child.ih[0] * s00 + child.ih[1] * s11) + child.ih[2] * s01) + m * (s00 + s11);
+    let across = child.u[0] * s[0] + child.u[1] * s[1];
+    let d = along - (across * across) * child.r;
+    if d.partial_cmp(&zero) != Some(std::cmp::Ordering::Greater) {
+        return None;
+    }
+    let r = one / d;
+    let u = [ih[0] * s[0] + ih[2] * s[1], ih[2] * s[0] + ih[1] * s[1]];
+    let uu = [u[0] * u[0], u[1] * u[1], u[0] * u[1]];
+    let g = ((u[0] * c[0] + u[1] * c[1]) + (s[0] * ph[0] + s[1] * ph[1])) * r;
+    let w = [u[0] * r, u[1] * r];
+    let ic = [ih[0] * c[0] + ih[2] * c[1], ih[2] * c[0] + ih[1] * c[1]];
+    let out = [
+        ih[0] - uu[0] * r,
+        ih[1] - uu[1] * r,
+        ih[2] - uu[2] * r,
+        (ic[0] + ph[0]) - u[0] * g,
+        (ic[1] + ph[1]) - u[1] * g,
+    ];
+    let joint = PlanarJoint {
+        w,
+        g,
+        a: [
+            [one - s[0] * w[0], zero - s[0] * w[1]],
+            [zero - s[1] * w[0], one - s[1] * w[1]],
+        ],
+        b: [c[0] - s[0] * g, c[1] - s[1] * g],
+    };
+    Some((out, joint, Child { ih, u, r }))
+}
+
+/// [`accelerate`] in the `xy` plane (the same bits, as [`articulate_planar`]).
+#[inline(always)]
+fn accelerate_planar<T: Scalar>(j: &PlanarJoint<T>, ap: [T; 2]) -> (T, [T; 2]) {
+    let x = -(j.w[0] * ap[0] + j.w[1] * ap[1]) - j.g;
+    let row = |r: [T; 2], b: T| (r[0] * ap[0] + r[1] * ap[1]) + b;
+    (x, [row(j.a[0], j.b[0]), row(j.a[1], j.b[1])])
+}
+
 /// The forward step of one node: its coordinate's acceleration and its particle's, from the
 /// parent particle's acceleration `ap`.
 #[inline(always)]
@@ -225,16 +313,28 @@ impl TreeForm {
             .iter()
             .enumerate()
             .all(|(k, nd)| nd.parent == k.checked_sub(1));
+        let planar = nodes.iter().all(|nd| {
+            [nd.direction[2], nd.centripetal[2], nd.force[2]]
+                .iter()
+                .all(|&z| z == Pool::ZERO)
+        });
         TreeForm {
             nodes,
             coordinates,
             chain,
+            planar,
         }
     }
 
     /// The nodes, each after its parent.
     pub fn nodes(&self) -> &[TreeNode] {
         &self.nodes
+    }
+
+    /// Whether no link direction, centripetal term or force has a `z` component: a chain
+    /// then runs the recursion in the plane.
+    pub fn is_planar(&self) -> bool {
+        self.planar
     }
 
     /// Number of nodes (= free coordinates).
@@ -283,6 +383,35 @@ impl TreeForm {
         };
         ws.joint.resize(n, none);
         let node_values = |k: usize| &values[NODE_INPUTS * k..NODE_INPUTS * (k + 1)];
+        if self.chain && self.planar {
+            let none = PlanarJoint {
+                w: [zero; 2],
+                g: zero,
+                a: [[zero; 2]; 2],
+                b: [zero; 2],
+            };
+            ws.planar_joint.resize(n, none);
+            let mut carried = [zero; 5];
+            let mut child = Child {
+                ih: [zero; 3],
+                u: [zero; 2],
+                r: zero,
+            };
+            for k in (0..n).rev() {
+                let (out, joint, this) = articulate_planar(node_values(k), &carried, &child)
+                    .ok_or(SingularTree { node: k })?;
+                ws.planar_joint[k] = joint;
+                carried = out;
+                child = this;
+            }
+            let mut ap = [zero; 2];
+            for k in 0..n {
+                let (x, a) = accelerate_planar(&ws.planar_joint[k], ap);
+                qdd[self.coordinates[k]] = x;
+                ap = a;
+            }
+            return Ok(());
+        }
         if self.chain {
             // Leaves to root, then root to leaves, the running contribution and acceleration
             // in registers.
@@ -462,7 +591,6 @@ pub fn detect(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use pdyn_expr::Pool;
 
     fn node(k: usize, parent: Option<usize>) -> TreeNode {
         let z = Pool::ZERO;
@@ -484,6 +612,11 @@ mod tests {
         let n = 9;
         let chain = TreeForm::new((0..n).map(|k| node(k, k.checked_sub(1))).collect());
         assert!(chain.chain);
+        // Spatial values on nodes whose symbols are all zero: not the planar path.
+        let chain = TreeForm {
+            planar: false,
+            ..chain
+        };
         let general = TreeForm {
             chain: false,
             ..chain.clone()
@@ -507,6 +640,54 @@ mod tests {
         assert!(x.iter().all(|v| v.is_finite() && *v != 0.0));
         let bits = |v: &[f64]| v.iter().map(|a| a.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&x), bits(&y));
+    }
+
+    /// A planar chain's recursion in the plane gives the spatial one's accelerations on the
+    /// same links (with zero `z` numbers) to round-off: unequal masses and lengths, forces
+    /// in `x` and `y`.
+    #[test]
+    fn a_planar_chain_solves_in_the_plane_as_in_space() {
+        let n = 12;
+        let planar = TreeForm::new((0..n).map(|k| node(k, k.checked_sub(1))).collect());
+        assert!(planar.chain && planar.planar);
+        let spatial = TreeForm {
+            planar: false,
+            ..planar.clone()
+        };
+        let mut values = Vec::new();
+        for k in 0..n {
+            let (q, l, rate) = (
+                0.3 * k as f64 - 1.1,
+                0.5 + 0.13 * k as f64,
+                0.7 - 0.2 * k as f64,
+            );
+            let (sq, cq) = (libm::sin(q), libm::cos(q));
+            values.extend([1.0 + 0.3 * k as f64, l * cq, l * sq, 0.0]);
+            values.extend([-l * sq * rate * rate, l * cq * rate * rate, 0.0]);
+            values.extend([
+                0.4 * cq - 0.1 * k as f64,
+                -9.81 * (1.0 + 0.3 * k as f64),
+                0.0,
+            ]);
+        }
+        let (mut x, mut y) = (vec![0.0; n], vec![0.0; n]);
+        planar
+            .solve(&values, &mut TreeWorkspace::default(), &mut x)
+            .unwrap();
+        spatial
+            .solve(&values, &mut TreeWorkspace::default(), &mut y)
+            .unwrap();
+        assert!(x.iter().all(|v| v.is_finite() && *v != 0.0));
+        for (k, (a, b)) in x.iter().zip(&y).enumerate() {
+            assert!(
+                (a - b).abs() <= 1e-13 * b.abs().max(1.0),
+                "link {k}: {a} vs {b}"
+            );
+        }
+        // A massless last link is refused on the planar path too.
+        values[NODE_INPUTS * (n - 1)] = 0.0;
+        let e = planar.solve(&values, &mut TreeWorkspace::default(), &mut x);
+        assert_eq!(e, Err(SingularTree { node: n - 1 }));
     }
 
     /// A link with no inertia along its direction is refused, naming the node.

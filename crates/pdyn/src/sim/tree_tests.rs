@@ -128,6 +128,23 @@ fn tree_path_gives_the_dense_paths_accelerations_on_chains_2_to_100() {
     }
 }
 
+/// The chains above run the recursion in the plane, the mobile below in space: the
+/// dense-path comparisons cover both.
+#[test]
+fn chains_in_the_plane_are_planar_trees_and_the_mobile_is_not() {
+    let planar = |source: &str| {
+        let mut model = pdyn_mech::load(source, "t.toml").unwrap();
+        let opts = DeriveOptions {
+            tree_from: Some(1),
+            ..run_options()
+        };
+        let d = pdyn_mech::derive(&mut model, &opts).unwrap();
+        d.tree.map(|t| t.is_planar())
+    };
+    assert_eq!(planar(&chain(5)), Some(true));
+    assert_eq!(planar(MOBILE), Some(false));
+}
+
 #[test]
 fn tree_path_gives_the_dense_paths_accelerations_on_a_branching_spatial_tree() {
     let e = disagreement(MOBILE);
