@@ -464,3 +464,44 @@ fn deferred_loading_keeps_the_errors() {
         assert!(full.message.contains("[i="), "{}", full.message);
     }
 }
+
+/// A deferred model expanded for the generic path keeps the parameter values set before
+/// (`--set`), and the initial state that follows from them: it is then the full load with
+/// the same values, bit for bit.
+#[test]
+fn expanding_keeps_the_parameter_values_set() {
+    let src = net_source(4, 3, Some(0.02));
+    let values = [("k".to_string(), 800.0), ("a".to_string(), 0.2)];
+    let mut deferred = load_deferring(&src);
+    assert!(deferred.has_deferred());
+    pdyn_mech::parameters::set_values(&mut deferred, &values).unwrap();
+    let expanded = sim::prepare_on(
+        &mut deferred,
+        &sim::run_options(),
+        JitMode::Auto,
+        NetPath::Never,
+    )
+    .unwrap();
+    let mut full = load(&src);
+    pdyn_mech::parameters::set_values(&mut full, &values).unwrap();
+    let reference = sim::prepare_on(
+        &mut full,
+        &sim::run_options(),
+        JitMode::Auto,
+        NetPath::Never,
+    )
+    .unwrap();
+    // The new mesh size moved the initial positions (`initial = "i*a"`).
+    assert_eq!(expanded.y0, reference.y0);
+    assert!(
+        expanded.y0.iter().any(|&x| (x - 0.6).abs() < 1e-12),
+        "{:?}",
+        expanded.y0
+    );
+    let dim = reference.system.dim();
+    let y = perturbed(&reference.y0);
+    let (mut f1, mut f2) = (vec![0.0; dim], vec![0.0; dim]);
+    expanded.system.rhs(0.0, &y, &mut f1);
+    reference.system.rhs(0.0, &y, &mut f2);
+    assert_eq!(f1, f2);
+}
