@@ -110,12 +110,18 @@ pub fn of(out: &RunOutput, frames: Frames) -> Value {
                 .model
                 .particles
                 .iter()
-                .map(|p| {
-                    let axis = |a: &str| {
+                .enumerate()
+                .map(|(i, p)| {
+                    // A net's position that is a coordinate is that coordinate's column.
+                    let axis = |k: usize, a: &str| {
                         index(&format!("{}.{a}", p.name))
+                            .or_else(|| {
+                                pdyn::sim::net::position_column(&m.model, i, k)
+                                    .and_then(|c| index(&c))
+                            })
                             .map_or(vec![0.0; t.len()], |j| col(j).collect())
                     };
-                    path(&p.name, axis("x"), axis("y"), axis("z"))
+                    path(&p.name, axis(0, "x"), axis(1, "y"), axis(2, "z"))
                 })
                 .collect();
             json!({"kind": "mechanics", "time": t.iter().copied().map(finite).collect::<Vec<_>>(),

@@ -223,7 +223,7 @@ pub fn run_long(
     // model, an implicit method) it refuses itself, by name.
     Ok(match file.kind {
         Kind::Mechanics => {
-            let mut model = file.mechanics()?;
+            let mut model = file.mechanics_deferring()?;
             crate::params::set_parameter_values(&mut model, &req.params, RunOption::Set.name())?;
             RunOutput::Mechanics(Box::new(run_mechanics_long(model, Some(file), req, long)?))
         }
@@ -248,6 +248,10 @@ fn run_mechanics_long(
     long: &LongRun,
 ) -> Result<MechanicsRun, Error> {
     let mut settings = sim::request::settings(&model, req)?;
+    if settings.method == "exact" {
+        // The closed form derives the model symbolically: every load.
+        sim::net::expand_deferred(&mut model).map_err(|e| sim::request::located(&model, "", e))?;
+    }
     if req.plots
         && settings.points.is_none()
         && settings.output_dt.is_none()

@@ -67,6 +67,20 @@ impl ModelFile {
     /// The mechanics model; an `[nbody]` or `[md]` model is a located error at its table that
     /// says `pdyn run` runs it (they have no symbolic equations to derive or check).
     pub fn mechanics(&self) -> Result<Model, Error> {
+        self.mechanics_with(pdyn_mech::load)
+    }
+
+    /// [`ModelFile::mechanics`] with its force families left unexpanded where they share one
+    /// representative's loads ([`pdyn_mech::model::load_deferring`]): for `pdyn run`, whose
+    /// preparation expands them unless the model runs as free particles.
+    pub fn mechanics_deferring(&self) -> Result<Model, Error> {
+        self.mechanics_with(pdyn_mech::model::load_deferring)
+    }
+
+    fn mechanics_with(
+        &self,
+        load: fn(&str, &str) -> Result<Model, ModelError>,
+    ) -> Result<Model, Error> {
         let refusal = |error: ModelError| Error::Model {
             error,
             source: self.source.as_str().into(),
@@ -93,7 +107,7 @@ impl ModelFile {
                     .help("an [md] model has pair potentials and thermostats, not equations of motion to derive"),
                 ))
             }
-            Kind::Mechanics => pdyn_mech::load(&self.source, &self.origin).map_err(refusal),
+            Kind::Mechanics => load(&self.source, &self.origin).map_err(refusal),
         }
     }
 }

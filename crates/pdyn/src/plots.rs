@@ -78,10 +78,16 @@ pub fn write_run_plots(
     let mut planar = Vec::new();
     let mut spatial = Vec::new();
     let mut axes_used = [false; 3];
-    for p in &model.particles {
+    for (i, p) in model.particles.iter().enumerate() {
+        // A net's position that is a coordinate is that coordinate's column.
         let comps: Vec<Option<Vec<f64>>> = ["x", "y", "z"]
             .iter()
-            .map(|a| column(res, &format!("{}.{a}", p.name)))
+            .enumerate()
+            .map(|(k, a)| {
+                column(res, &format!("{}.{a}", p.name)).or_else(|| {
+                    crate::sim::net::position_column(model, i, k).and_then(|c| column(res, &c))
+                })
+            })
             .collect();
         let varies = |c: &Option<Vec<f64>>| {
             c.as_ref().is_some_and(|v| {

@@ -324,3 +324,184 @@ fn new_parameter_values_reach_the_kernels() {
         "the parameters changed nothing"
     );
 }
+
+fn load_deferring(src: &str) -> Model {
+    pdyn_mech::model::load_deferring(src, "<net>").unwrap_or_else(|e| panic!("{}", e.render(src)))
+}
+
+/// A family's members left unexpanded at load (`load_deferring`: one representative per
+/// family, the others index arrays) run as the fully expanded model does: right-hand side,
+/// Jacobian and a short run against the generic path, to round-off; and a deferred model
+/// sent down the generic path is expanded first (its right-hand side is then the expanded
+/// model's, bit for bit).
+#[test]
+fn deferred_families_agree_with_the_expanded_model() {
+    for (nx, ny, mass, c) in [
+        (3, 2, "m", Some(0.02)),
+        (3, 4, "m", Some(0.02)),
+        (5, 5, "m", None),
+        (4, 3, "m*(1 + i + 2*j)", Some(0.02)),
+    ] {
+        let src = net_source_with_mass(nx, ny, c, mass);
+        let mut deferred = load_deferring(&src);
+        // With masses `m (1 + i + 2 j)` only members whose particles' masses coincide share
+        // a representative.
+        assert!(deferred.has_deferred(), "{nx}x{ny}");
+        let fast = sim::prepare_on(
+            &mut deferred,
+            &sim::run_options(),
+            JitMode::Auto,
+            NetPath::Always,
+        )
+        .unwrap();
+        let mut expanded = load_deferring(&src);
+        let generic = sim::prepare_on(
+            &mut expanded,
+            &sim::run_options(),
+            JitMode::Auto,
+            NetPath::Never,
+        )
+        .unwrap();
+        assert!(!expanded.has_deferred(), "the generic path expands");
+        let (_, reference) = prepare(&src, NetPath::Never);
+        assert!(fast.system.net_kernels().is_some());
+        assert_eq!(fast.state_names, generic.state_names);
+        assert_eq!(fast.observer.names, generic.observer.names);
+        assert_eq!(fast.y0, generic.y0);
+        let dim = generic.system.dim();
+        for y in [generic.y0.clone(), perturbed(&generic.y0)] {
+            let (mut f1, mut f2, mut f3) = (vec![0.0; dim], vec![0.0; dim], vec![0.0; dim]);
+            fast.system.rhs(0.0, &y, &mut f1);
+            generic.system.rhs(0.0, &y, &mut f2);
+            reference.system.rhs(0.0, &y, &mut f3);
+            assert_eq!(f2, f3, "{nx}x{ny}: the expanded model is the full load's");
+            let d = max_relative_difference(&f2, &f1);
+            assert!(d < 1e-13, "{nx}x{ny}: right-hand sides differ by {d:e}");
+            let (mut j1, mut j2) = (vec![0.0; dim * dim], vec![0.0; dim * dim]);
+            fast.system.jacobian(0.0, &y, &mut j1);
+            generic.system.jacobian(0.0, &y, &mut j2);
+            let d = max_relative_difference(&j2, &j1);
+            assert!(d < 1e-12, "{nx}x{ny}: Jacobians differ by {d:e}");
+        }
+        let set = RunSettings::from_spec(&load(&src).run.simulate).unwrap();
+        let r1 = sim::run(&fast, &set).unwrap();
+        let r2 = sim::run(&generic, &set).unwrap();
+        let (a, b) = (r1.rows.last().unwrap(), r2.rows.last().unwrap());
+        let d = max_relative_difference(b, a);
+        assert!(d < 1e-9, "{nx}x{ny}: final rows differ by {d:e}");
+        // Undamped: the energy, formed from every spring's potential (the deferred members'
+        // substituted from their representative's), is monitored and agrees.
+        let energy = |r: &sim::RunResult| {
+            let j = r.columns.iter().position(|c| c == "energy");
+            j.map(|j| (r.rows[0][j], r.rows.last().unwrap()[j]))
+        };
+        assert_eq!(energy(&r1).is_some(), c.is_none(), "{nx}x{ny}");
+        if let (Some(e1), Some(e2)) = (energy(&r1), energy(&r2)) {
+            // The flat net at rest has energy 0 (its springs at rest length, z = 0); its
+            // energies in motion are ~m g a ~ 0.05 J: agreement to 1e-12 J is round-off.
+            assert!((e1.0 - e2.0).abs() <= 1e-12, "{e1:?} {e2:?}");
+            assert!((e1.1 - e2.1).abs() <= 1e-12, "{e1:?} {e2:?}");
+        }
+    }
+}
+
+/// Loading with deferral builds one member per family (and each spring at a pinned corner,
+/// whose pin is a point of its own): the loads and the expression nodes per particle do not
+/// grow with the springs. Fails when members are expanded one by one (the loads then grow
+/// by ~8 per particle: 4 springs × 2 ends).
+#[test]
+fn family_members_are_not_expanded_one_by_one() {
+    let mut rows = Vec::new();
+    for n in [10i64, 20, 40] {
+        let m = load_deferring(&net_source(n, n, Some(0.02)));
+        let particles = (n * n - 2) as usize;
+        let springs = ((n - 1) * n * 2 + 2 * (n - 1) * (n - 1)) as usize;
+        let deferred: usize = m.deferred.iter().map(|d| d.len()).sum();
+        // 4 spring families and the drag: one representative each; 6 springs end at a pin.
+        assert_eq!(m.deferred.len(), 5, "n = {n}");
+        assert_eq!(
+            deferred,
+            springs - 4 - 6 + particles - 1,
+            "n = {n}: deferred members"
+        );
+        // Gravity (one load per particle), the representatives (2 loads per spring, 1 for
+        // the drag), the springs at the pins (1 load each).
+        assert_eq!(m.loads.len(), particles + 4 * 2 + 1 + 6, "n = {n}: loads");
+        rows.push((particles, m.pool.len()));
+    }
+    // Nodes per added particle: the coordinates, positions, gravity and initial values,
+    // not the springs (whose expansion alone made ~100 nodes per particle).
+    let per = |a: (usize, usize), b: (usize, usize)| (b.1 - a.1) as f64 / (b.0 - a.0) as f64;
+    let (first, second) = (per(rows[0], rows[1]), per(rows[1], rows[2]));
+    assert!(second < 40.0, "nodes per particle: {first}, {second}");
+    assert!(
+        (second / first - 1.0).abs() < 0.1,
+        "nodes per particle: {first}, {second}"
+    );
+}
+
+/// A deferred load gives the errors of a full load, located and naming the member.
+#[test]
+fn deferred_loading_keeps_the_errors() {
+    let good = net_source(4, 4, Some(0.02));
+    for (from, to) in [
+        // A spring joining a particle to itself, in one member.
+        (
+            "between = [\"P[i,j]\", \"P[i+1,j]\"]",
+            "between = [\"P[i,j]\", \"P[i,j]\"]",
+        ),
+        // A member outside the family.
+        (
+            "between = [\"P[i,j]\", \"P[i,j+1]\"]",
+            "between = [\"P[i,j]\", \"P[i,j+2]\"]",
+        ),
+    ] {
+        assert!(good.contains(from));
+        let bad = good.replacen(from, to, 1);
+        let full = pdyn_mech::load(&bad, "<net>").unwrap_err();
+        let deferred = pdyn_mech::model::load_deferring(&bad, "<net>").unwrap_err();
+        assert_eq!(full, deferred);
+        assert!(full.message.contains("[i="), "{}", full.message);
+    }
+}
+
+/// A deferred model expanded for the generic path keeps the parameter values set before
+/// (`--set`), and the initial state that follows from them: it is then the full load with
+/// the same values, bit for bit.
+#[test]
+fn expanding_keeps_the_parameter_values_set() {
+    let src = net_source(4, 3, Some(0.02));
+    let values = [("k".to_string(), 800.0), ("a".to_string(), 0.2)];
+    let mut deferred = load_deferring(&src);
+    assert!(deferred.has_deferred());
+    pdyn_mech::parameters::set_values(&mut deferred, &values).unwrap();
+    let expanded = sim::prepare_on(
+        &mut deferred,
+        &sim::run_options(),
+        JitMode::Auto,
+        NetPath::Never,
+    )
+    .unwrap();
+    let mut full = load(&src);
+    pdyn_mech::parameters::set_values(&mut full, &values).unwrap();
+    let reference = sim::prepare_on(
+        &mut full,
+        &sim::run_options(),
+        JitMode::Auto,
+        NetPath::Never,
+    )
+    .unwrap();
+    // The new mesh size moved the initial positions (`initial = "i*a"`).
+    assert_eq!(expanded.y0, reference.y0);
+    assert!(
+        expanded.y0.iter().any(|&x| (x - 0.6).abs() < 1e-12),
+        "{:?}",
+        expanded.y0
+    );
+    let dim = reference.system.dim();
+    let y = perturbed(&reference.y0);
+    let (mut f1, mut f2) = (vec![0.0; dim], vec![0.0; dim]);
+    expanded.system.rhs(0.0, &y, &mut f1);
+    reference.system.rhs(0.0, &y, &mut f2);
+    assert_eq!(f1, f2);
+}

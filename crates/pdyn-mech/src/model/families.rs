@@ -30,7 +30,9 @@ use super::raw::{Name, RawForce, RawModel, RawParticle, Sv};
 use super::ModelError;
 use indexmap::IndexMap;
 use rustc_hash::FxHashMap;
+use std::cell::RefCell;
 use std::ops::Range;
+use std::rc::Rc;
 use toml::Spanned;
 
 /// Most members all families of one model may have together: expansion allocates an entry per
@@ -48,19 +50,25 @@ pub(crate) struct Shape {
 /// Which member of which family an expanded entry is.
 #[derive(Clone, Debug)]
 pub(crate) struct Member {
-    /// `P[i=3, j=4]`, `spring[i=3, j=19]`: prefixed to errors while it is read.
-    pub label: String,
+    /// The family's name (`P`, `spring`): with the bindings, the label `spring[i=3, j=19]`
+    /// prefixed to errors while the member is read (formed only then).
+    pub base: Rc<str>,
     /// The values of its indices.
     pub bindings: Vec<(String, i64)>,
 }
 
 impl Member {
     /// The member of family `base` at `bindings`.
-    fn of(base: &str, bindings: &[(String, i64)]) -> Member {
+    fn of(base: &Rc<str>, bindings: &[(String, i64)]) -> Member {
         Member {
-            label: label(base, bindings),
+            base: Rc::clone(base),
             bindings: bindings.to_vec(),
         }
+    }
+
+    /// `spring[i=3, j=19]`.
+    pub fn label(&self) -> String {
+        label(&self.base, &self.bindings)
     }
 }
 
@@ -72,6 +80,8 @@ pub(crate) struct Members {
     pub points: Vec<Option<Member>>,
     pub particles: Vec<Option<Member>>,
     pub forces: Vec<Option<Member>>,
+    /// The `[[forces]]` entries after expansion (`raw.forces` keeps the file's).
+    pub force_entries: Vec<ForceEntry>,
 }
 
 /// An expanded table and, entry by entry, the member each is.
@@ -96,6 +106,16 @@ pub(crate) struct Indices {
     pub ranges: IndexMap<String, (i64, i64)>,
     /// The shape of each family, by its base name.
     pub shapes: FxHashMap<String, Shape>,
+    /// Subscripted names parsed so far (`P[i+1, j]`): a family's members name the same
+    /// texts with other indices, parsed once.
+    parsed: RefCell<FxHashMap<String, Rc<Subscript>>>,
+}
+
+/// A subscripted name parsed: its base and each index expression with its place in the name.
+#[derive(Debug)]
+struct Subscript {
+    base: String,
+    parts: Vec<(IndexExpr, usize, usize)>,
 }
 
 impl Indices {
@@ -118,27 +138,41 @@ impl Indices {
         name: &str,
         bindings: &[(String, i64)],
     ) -> Result<Option<String>, IndexError> {
-        let Some((base, parts)) = index_expr::split_subscript(name) else {
-            return Ok(None);
-        };
-        let lookup = self.lookup(bindings);
-        let mut values = Vec::with_capacity(parts.len());
-        for (text, offset) in &parts {
-            let shift = |e: IndexError| IndexError {
-                span: e.span.start + offset..e.span.end + offset,
-                message: e.message,
-            };
-            let e = index_expr::parse(text).map_err(shift)?;
-            values.push(e.int(&lookup).map_err(|e| {
-                let e = if e.span == (0..0) {
-                    IndexError {
-                        span: 0..text.len(),
-                        message: e.message,
-                    }
-                } else {
-                    e
+        let cached = self.parsed.borrow().get(name).cloned();
+        let subscript = match cached {
+            Some(s) => s,
+            None => {
+                let Some((base, parts)) = index_expr::split_subscript(name) else {
+                    return Ok(None);
                 };
-                shift(e)
+                let mut parsed = Vec::with_capacity(parts.len());
+                for (text, offset) in &parts {
+                    let e = index_expr::parse(text).map_err(|e| IndexError {
+                        span: e.span.start + offset..e.span.end + offset,
+                        message: e.message,
+                    })?;
+                    parsed.push((e, *offset, text.len()));
+                }
+                let s = Rc::new(Subscript {
+                    base: base.to_string(),
+                    parts: parsed,
+                });
+                self.parsed
+                    .borrow_mut()
+                    .insert(name.to_string(), Rc::clone(&s));
+                s
+            }
+        };
+        let base = subscript.base.as_str();
+        let lookup = self.lookup(bindings);
+        let mut values = Vec::with_capacity(subscript.parts.len());
+        for (e, offset, len) in &subscript.parts {
+            values.push(e.int(&lookup).map_err(|e| {
+                let span = if e.span == (0..0) { 0..*len } else { e.span };
+                IndexError {
+                    span: span.start + offset..span.end + offset,
+                    message: e.message,
+                }
             })?);
         }
         let canonical = member(base, &values);
@@ -538,6 +572,7 @@ impl<'l, 'a> Expander<'l, 'a> {
                         })
                         .collect();
                     self.record_shape(&name, &base, &ranges)?;
+                    let family: Rc<str> = Rc::from(base.as_str());
                     self.each(&name.span(), &base, &domain, |ex, bindings| {
                         let values: Vec<i64> = names
                             .iter()
@@ -545,7 +580,7 @@ impl<'l, 'a> Expander<'l, 'a> {
                             .collect();
                         let key = Spanned::new(name.span(), member(&base, &values));
                         ex.insert(&mut out, key, value.clone())?;
-                        members.push(Some(Member::of(&base, bindings)));
+                        members.push(Some(Member::of(&family, bindings)));
                         Ok(())
                     })?;
                 }
@@ -591,29 +626,32 @@ impl<'l, 'a> Expander<'l, 'a> {
         &self,
         raw: &RawForce,
         bindings: &[(String, i64)],
-    ) -> Result<RawForce, ModelError> {
-        let mut m = raw.clone();
-        m.for_list = None;
-        m.condition = None;
+    ) -> Result<Names, ModelError> {
         let names = |field: &Option<Name>| -> Result<Option<Name>, ModelError> {
             field
                 .as_ref()
                 .map(|n| self.resolve_name(n, bindings))
                 .transpose()
         };
-        m.on = names(&raw.on)?;
-        m.to = names(&raw.to)?;
-        m.normal_force = names(&raw.normal_force)?;
-        m.friction_force = names(&raw.friction_force)?;
-        if let Some(b) = &raw.between {
-            let ends = b
-                .get_ref()
-                .iter()
-                .map(|n| self.resolve_name(n, bindings))
-                .collect::<Result<Vec<_>, _>>()?;
-            m.between = Some(Spanned::new(b.span(), ends));
-        }
-        Ok(m)
+        let between = match &raw.between {
+            Some(b) => {
+                let ends = b
+                    .get_ref()
+                    .iter()
+                    .map(|n| self.resolve_name(n, bindings))
+                    .collect::<Result<Vec<_>, _>>()?;
+                Some(Spanned::new(b.span(), ends))
+            }
+            None => None,
+        };
+        Ok(Names {
+            name: raw.name.clone(),
+            on: names(&raw.on)?,
+            to: names(&raw.to)?,
+            normal_force: names(&raw.normal_force)?,
+            friction_force: names(&raw.friction_force)?,
+            between,
+        })
     }
 
     fn force_member(
@@ -621,7 +659,7 @@ impl<'l, 'a> Expander<'l, 'a> {
         f: &Spanned<RawForce>,
         base: &str,
         bindings: &[(String, i64)],
-    ) -> Result<Spanned<RawForce>, ModelError> {
+    ) -> Result<Names, ModelError> {
         let raw = f.get_ref();
         let mut m = self.resolve_names(raw, bindings)?;
         m.name = Some(match &raw.name {
@@ -629,16 +667,16 @@ impl<'l, 'a> Expander<'l, 'a> {
             Some(n) => Spanned::new(n.span(), label(n.get_ref(), bindings)),
             None => Spanned::new(f.span(), label(base, bindings)),
         });
-        Ok(Spanned::new(f.span(), m))
+        Ok(m)
     }
 
     fn forces(
         &mut self,
-        forces: Vec<Spanned<RawForce>>,
-    ) -> Result<Expanded<Vec<Spanned<RawForce>>>, ModelError> {
+        forces: &[Spanned<RawForce>],
+    ) -> Result<Expanded<Vec<ForceEntry>>, ModelError> {
         let mut out = Vec::with_capacity(forces.len());
         let mut members = Vec::with_capacity(forces.len());
-        for f in forces {
+        for (entry, f) in forces.iter().enumerate() {
             let raw = f.get_ref();
             let Some(for_list) = raw.for_list.clone() else {
                 if let Some(c) = &raw.condition {
@@ -652,8 +690,8 @@ impl<'l, 'a> Expander<'l, 'a> {
                             "add for = \"i in 0..n-2\" (or the indices declared under [indices])",
                         ));
                 }
-                let plain = self.resolve_names(raw, &[])?;
-                out.push(Spanned::new(f.span(), plain));
+                let names = self.resolve_names(raw, &[])?;
+                out.push(ForceEntry { entry, names });
                 members.push(None);
                 continue;
             };
@@ -663,16 +701,56 @@ impl<'l, 'a> Expander<'l, 'a> {
                 (None, None) => "force".to_string(),
             };
             let domain = self.domain(&f.span(), &[], Some(&for_list), raw.condition.as_ref())?;
+            let family: Rc<str> = Rc::from(base.as_str());
             self.each(&for_list.span(), &base, &domain, |ex, bindings| {
-                let m = ex
-                    .force_member(&f, &base, bindings)
+                let names = ex
+                    .force_member(f, &base, bindings)
                     .map_err(|e| in_member(e, &label(&base, bindings)))?;
-                out.push(m);
-                members.push(Some(Member::of(&base, bindings)));
+                out.push(ForceEntry { entry, names });
+                members.push(Some(Member::of(&family, bindings)));
                 Ok(())
             })?;
         }
         Ok((out, members))
+    }
+}
+
+/// The name fields of a `[[forces]]` entry, resolved to the members they name.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Names {
+    pub name: Option<Name>,
+    pub on: Option<Name>,
+    pub to: Option<Name>,
+    pub normal_force: Option<Name>,
+    pub friction_force: Option<Name>,
+    pub between: Option<Spanned<Vec<Name>>>,
+}
+
+/// One `[[forces]]` entry after expansion: the entry of the file it comes from (a family's
+/// members share it: its other fields are not copied per member) and its name fields.
+#[derive(Clone, Debug)]
+pub(crate) struct ForceEntry {
+    /// Index into the file's `[[forces]]`.
+    pub entry: usize,
+    /// Its name fields, resolved.
+    pub names: Names,
+}
+
+impl ForceEntry {
+    /// The entry as an ordinary `[[forces]]` entry (`forces`: the file's).
+    pub fn raw(&self, forces: &[Spanned<RawForce>]) -> Spanned<RawForce> {
+        let f = &forces[self.entry];
+        let mut m = f.get_ref().clone();
+        m.for_list = None;
+        m.condition = None;
+        let n = self.names.clone();
+        m.name = n.name;
+        m.on = n.on;
+        m.to = n.to;
+        m.normal_force = n.normal_force;
+        m.friction_force = n.friction_force;
+        m.between = n.between;
+        Spanned::new(f.span(), m)
     }
 }
 
@@ -731,6 +809,25 @@ pub(crate) fn expand(
             points: vec![None; raw.points.len()],
             particles: vec![None; raw.particles.len()],
             forces: vec![None; raw.forces.len()],
+            force_entries: raw
+                .forces
+                .iter()
+                .enumerate()
+                .map(|(entry, f)| {
+                    let r = f.get_ref();
+                    ForceEntry {
+                        entry,
+                        names: Names {
+                            name: r.name.clone(),
+                            on: r.on.clone(),
+                            to: r.to.clone(),
+                            normal_force: r.normal_force.clone(),
+                            friction_force: r.friction_force.clone(),
+                            between: r.between.clone(),
+                        },
+                    }
+                })
+                .collect(),
         };
         return Ok((raw, members));
     }
@@ -759,12 +856,11 @@ pub(crate) fn expand(
             Ok((Spanned::new(p.span(), q), for_list, condition))
         },
     )?;
-    let (forces, mf) = ex.forces(std::mem::take(&mut raw.forces))?;
+    let (force_entries, mf) = ex.forces(&raw.forces)?;
     raw.coordinates = coordinates;
     raw.points = points;
     raw.definitions = definitions;
     raw.particles = particles;
-    raw.forces = forces;
     let indices = ex.indices;
     ld.scope.indices = indices;
     Ok((
@@ -775,6 +871,7 @@ pub(crate) fn expand(
             points: mp,
             particles: mq,
             forces: mf,
+            force_entries,
         },
     ))
 }

@@ -12,6 +12,7 @@ use pdyn_expr::syntax::Ast;
 use pdyn_expr::{ExprError, Id, Number, Pool, Program, Value};
 use rustc_hash::FxHashMap;
 use std::ops::Range;
+use std::rc::Rc;
 
 /// Name resolution for expressions in a model file.
 #[derive(Default)]
@@ -105,8 +106,16 @@ pub(crate) struct Loader<'a> {
     pub unknown_initials: Vec<super::UnknownInitial>,
     /// Which family member each expanded entry is ([`super::families`]).
     pub members: Members,
-    /// The label of the member being read (`spring[i=3, j=19]`), prefixed to its errors.
-    pub member: Option<String>,
+    /// The family of the member being read (with [`ModelScope::bindings`], its label
+    /// `spring[i=3, j=19]`, prefixed to its errors).
+    pub member: Option<Rc<str>>,
+    /// Whether force families may be left unexpanded ([`super::load_deferring`]).
+    pub defer: bool,
+    /// The force families left unexpanded.
+    pub deferred: Vec<super::deferred::DeferredForces>,
+    /// The values [`Loader::constant`] found, by expression: a family's members repeat a
+    /// few (`initial = "i*a"` over 10^4 members has 100), each evaluated once.
+    constants: FxHashMap<Id, f64>,
 }
 
 impl<'a> Loader<'a> {
@@ -128,6 +137,9 @@ impl<'a> Loader<'a> {
             unknown_initials: Vec::new(),
             members: Members::default(),
             member: None,
+            defer: false,
+            deferred: Vec::new(),
+            constants: FxHashMap::default(),
         }
     }
 
@@ -140,10 +152,10 @@ impl<'a> Loader<'a> {
             Table::Particles => &self.members.particles,
             Table::Forces => &self.members.forces,
         };
-        match list.get(k).cloned().flatten() {
-            Some(Member { label, bindings }) => {
-                self.scope.bindings = bindings;
-                self.member = Some(label);
+        match list.get(k).and_then(Option::as_ref) {
+            Some(Member { base, bindings }) => {
+                self.scope.bindings.clone_from(bindings);
+                self.member = Some(Rc::clone(base));
             }
             None => self.leave(),
         }
@@ -158,7 +170,14 @@ impl<'a> Loader<'a> {
     /// `err` with the label of the member being read, if any.
     pub(super) fn in_member(&self, err: ModelError) -> ModelError {
         match &self.member {
-            Some(label) => in_member(err, label),
+            Some(base) => in_member(
+                err,
+                &Member {
+                    base: Rc::clone(base),
+                    bindings: self.scope.bindings.clone(),
+                }
+                .label(),
+            ),
             None => err,
         }
     }
@@ -411,6 +430,10 @@ impl<'a> Loader<'a> {
 
     /// Evaluates an expression that may only involve parameters.
     pub fn constant(&mut self, e: Id, span: Range<usize>, what: &str) -> Result<f64, ModelError> {
+        // Parameters' values do not change while a file is read.
+        if let Some(&v) = self.constants.get(&e) {
+            return Ok(v);
+        }
         let inputs: Vec<Id> = self.params.iter().map(|p| p.id).collect();
         let values: Vec<f64> = self.params.iter().map(|p| p.value).collect();
         let prog = Program::compile(&mut self.pool, &inputs, &[e]).map_err(|err| {
@@ -423,6 +446,7 @@ impl<'a> Loader<'a> {
         if !out[0].is_finite() {
             return Err(self.err(span, format!("{what} evaluates to {}", out[0])));
         }
+        self.constants.insert(e, out[0]);
         Ok(out[0])
     }
 }

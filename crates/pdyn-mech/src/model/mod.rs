@@ -10,6 +10,7 @@
 pub mod constants;
 mod contacts;
 pub mod data;
+pub mod deferred;
 pub mod families;
 mod forces;
 pub mod index_expr;
@@ -297,18 +298,33 @@ pub struct Model {
     /// Initial values and rates written in `[unknowns]` (`rate = "omega"`): `pdyn forces`
     /// solves for them; their numeric copies in [`CoordinateKind::Free`] are NaN.
     pub unknown_initials: Vec<UnknownInitial>,
+    /// Force families left unexpanded by [`load_deferring`] (empty from [`load`]): their
+    /// members' loads, potentials and tensions are not in `loads`, `potentials`, `axial`.
+    pub deferred: Vec<deferred::DeferredForces>,
 }
 
 /// Reads a model from TOML text. `origin` names it in error messages.
 ///
 /// The tables are read in dependency order — each may use the names the earlier ones declared.
 pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
+    load_with(source, origin, false)
+}
+
+/// [`load`], leaving the members of force families that share one representative's loads
+/// unexpanded ([`deferred`]): for a consumer that reads [`Model::deferred`] (a run of free
+/// particles), or calls [`Model::expand_deferred`] first. The same errors as [`load`].
+pub fn load_deferring(source: &str, origin: &str) -> Result<Model, ModelError> {
+    load_with(source, origin, true)
+}
+
+fn load_with(source: &str, origin: &str, defer: bool) -> Result<Model, ModelError> {
     let raw: RawModel = toml::from_str(source).map_err(|e| {
         let span = e.span().unwrap_or(0..0);
         ModelError::new(origin, span, e.message().trim().to_string())
             .help("see docs/model-format.md for the tables a model file may contain")
     })?;
     let mut ld = Loader::new(origin, source);
+    ld.defer = defer;
     let (raw, members) = families::expand(&mut ld, raw)?;
     ld.members = members;
     // An error met inside a family member names the member (`spring[i=3, j=19]: ...`).
@@ -362,6 +378,7 @@ fn read(ld: &mut Loader, raw: &RawModel) -> Result<Model, ModelError> {
         run,
         initial_exprs,
         unknown_initials: std::mem::take(&mut ld.unknown_initials),
+        deferred: std::mem::take(&mut ld.deferred),
         unknowns,
         known_accelerations,
         checks,

@@ -1,6 +1,7 @@
 //! One method per table of a model file, in the order [`super::load`] reads them: each
 //! declares the names it introduces (so later tables can use them) and returns what it built.
 
+use super::deferred::Decision;
 use super::families::Table;
 use super::forces;
 use super::loader::Loader;
@@ -551,11 +552,63 @@ impl Loader<'_> {
         if let Some(g) = gravity {
             fb.gravity(self, g);
         }
-        for (k, f) in raw.forces.iter().enumerate() {
+        let mut deferrer = super::deferred::Deferrer::default();
+        let index_names: Vec<String> = self.scope.indices.ranges.keys().cloned().collect();
+        let entries = std::mem::take(&mut self.members.force_entries);
+        for (k, fe) in entries.iter().enumerate() {
             self.enter(Table::Forces, k);
-            fb.force(self, f)?;
+            let original = &raw.forces[fe.entry];
+            let decision = if self.defer && !self.scope.bindings.is_empty() {
+                let mut names: Vec<&str> = index_names.iter().map(String::as_str).collect();
+                names.extend(self.scope.bindings.iter().map(|b| b.0.as_str()));
+                deferrer.decide(
+                    &self.pool,
+                    particles,
+                    |n| fb.particle_named(n),
+                    original,
+                    &fe.names,
+                    &names,
+                )
+            } else {
+                Decision::Build
+            };
+            match decision {
+                Decision::Deferred => {}
+                Decision::Build => fb.force(self, &fe.raw(&raw.forces))?,
+                Decision::Representative(key, ends) => {
+                    let before = fb.counts();
+                    fb.force(self, &fe.raw(&raw.forces))?;
+                    let after = fb.counts();
+                    let f = original.get_ref();
+                    let family = fe.names.name.as_ref().map_or_else(
+                        || {
+                            f.kind
+                                .as_ref()
+                                .map_or(String::new(), |k| k.get_ref().clone())
+                        },
+                        |n| {
+                            n.get_ref()
+                                .split('[')
+                                .next()
+                                .unwrap_or_default()
+                                .to_string()
+                        },
+                    );
+                    let one = |a: usize, b: usize| (b == a + 1).then_some(a);
+                    deferrer.represent(
+                        key,
+                        ends,
+                        family,
+                        before.0,
+                        after.0 - before.0,
+                        one(before.1, after.1),
+                        one(before.2, after.2),
+                    );
+                }
+            }
         }
         self.leave();
+        self.deferred = deferrer.families;
         let built = fb.finish();
         let friction_names = built.contacts.iter().flat_map(|c| {
             let (n, ids) = &c.friction_force;

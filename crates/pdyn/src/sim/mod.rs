@@ -581,6 +581,15 @@ pub fn prepare_on(
     // open); the run derives the other modes as it meets them.
     let mut hybrid = None;
     let mut reference_model;
+    // Force families left unexpanded (`pdyn_mech::model::load_deferring`) serve the path of
+    // free particles below; every other path reads each load.
+    if model.has_deferred()
+        && (pdyn_mech::hybrid::is_hybrid(model)
+            || opts.form != pdyn_mech::derive::Form::Auto
+            || matches!(path, NetPath::Never))
+    {
+        net::expand_deferred(model)?;
+    }
     let model = if pdyn_mech::hybrid::is_hybrid(model) {
         let h = hybrid::Hybrid::new(model, jit)?;
         reference_model = pdyn_mech::hybrid::reference_model(model).0;
@@ -619,6 +628,7 @@ pub fn prepare_on(
             (d, system)
         }
         None => {
+            net::expand_deferred(model)?;
             // The chapter's steps: equations of motion, solved for the accelerations...
             let d = derive(model, opts).map_err(SimError::Derive)?;
             // ... as a first-order system the integrators can step...
@@ -742,9 +752,12 @@ fn observations(
     let mut names = Vec::new();
     let mut exprs = Vec::new();
     let mut conserved = Vec::new();
+    // A net's positions that are coordinates are the coordinates' columns already.
+    let net = net::positions_are_coordinates(model);
     for (pk, part) in d.particles.iter().zip(&model.particles) {
         for (axis, &c) in ["x", "y", "z"].iter().zip(&part.position) {
-            if c != Pool::ZERO {
+            let repeated = net && matches!(model.pool.node(c), pdyn_expr::Node::Coord(_, 0));
+            if c != Pool::ZERO && !repeated {
                 names.push(format!("{}.{axis}", pk.name));
                 exprs.push(c);
                 conserved.push(false);
@@ -1034,7 +1047,7 @@ pub fn run(prep: &Prepared, set: &RunSettings) -> Result<RunResult, SimError> {
         return hybrid::run(prep, h, set);
     }
     let (sol, failure) = integrate(prep, set)?;
-    Ok(tabulate(prep, &sol, set, failure))
+    Ok(tabulate_owned(prep, sol, set, failure))
 }
 
 /// The integration of [`run`], before tabulation: the solver's output points and why it
@@ -1257,9 +1270,75 @@ pub(crate) fn tabulate(
     set: &RunSettings,
     failure: Option<RunFailure>,
 ) -> RunResult {
-    let sys = &prep.system;
-    let columns = prep.columns();
+    let scales = conservation_scales(prep, sol);
+    let extras = observed_columns(prep, sol);
+    let rows = (0..sol.len())
+        .zip(extras.outputs)
+        .map(|(k, extra)| row(sol.t[k], sol.y_at(k), &extra))
+        .collect();
+    finish_table(
+        prep,
+        sol,
+        set,
+        failure,
+        rows,
+        scales,
+        extras.watch,
+        extras.push,
+    )
+}
+
+/// [`tabulate`] of a solution no longer needed: its states are released as the rows that
+/// copy them are made (last first), so that a long table of many particles is held once,
+/// not twice (201 rows of a 10^4-particle net's 6·10^4 states are 97 MB). The same rows.
+pub(crate) fn tabulate_owned(
+    prep: &Prepared,
+    mut sol: Solution,
+    set: &RunSettings,
+    failure: Option<RunFailure>,
+) -> RunResult {
+    let scales = conservation_scales(prep, &sol);
+    let extras = observed_columns(prep, &sol);
+    let width = sol.n;
     let mut rows = Vec::with_capacity(sol.len());
+    for (k, extra) in extras.outputs.into_iter().enumerate().rev() {
+        rows.push(row(sol.t[k], sol.y_at(k), &extra));
+        sol.y.truncate(k * width);
+        sol.y.shrink_to_fit();
+    }
+    rows.reverse();
+    finish_table(
+        prep,
+        &sol,
+        set,
+        failure,
+        rows,
+        scales,
+        extras.watch,
+        extras.push,
+    )
+}
+
+/// `[t, y..., extra...]`.
+fn row(t: f64, y: &[f64], extra: &[f64]) -> Vec<f64> {
+    let mut row = Vec::with_capacity(1 + y.len() + extra.len());
+    row.push(t);
+    row.extend_from_slice(y);
+    row.extend_from_slice(extra);
+    row
+}
+
+/// The observer's columns at each output point, and what the friction and push watches saw
+/// along them (in time order).
+struct Observed {
+    outputs: Vec<Vec<f64>>,
+    watch: FrictionWatch,
+    push: PushWatch,
+}
+
+fn observed_columns(prep: &Prepared, sol: &Solution) -> Observed {
+    let sys = &prep.system;
+    let mut outputs = Vec::with_capacity(sol.len());
     let mut input = Vec::new();
     let mut extra = vec![0.0; prep.observer.len()];
     let mut watch = FrictionWatch::default();
@@ -1285,12 +1364,29 @@ pub(crate) fn tabulate(
         observer.eval(&input, &mut extra);
         watch.check(prep, &input, t);
         push.check(prep, t, &extra);
-        let mut row = Vec::with_capacity(columns.len());
-        row.push(t);
-        row.extend_from_slice(y);
-        row.extend_from_slice(&extra);
-        rows.push(row);
+        outputs.push(extra.clone());
     }
+    Observed {
+        outputs,
+        watch,
+        push,
+    }
+}
+
+/// The run's result from its rows: drifts of the conserved quantities, events, monitors,
+/// warnings, status.
+#[allow(clippy::too_many_arguments)]
+fn finish_table(
+    prep: &Prepared,
+    sol: &Solution,
+    set: &RunSettings,
+    failure: Option<RunFailure>,
+    rows: Vec<Vec<f64>>,
+    scales: Vec<f64>,
+    watch: FrictionWatch,
+    push: PushWatch,
+) -> RunResult {
+    let columns = prep.columns();
     let offset = 1 + prep.state_names.len();
     let drifts: Vec<(f64, f64)> = match rows.first() {
         None => Vec::new(),
@@ -1315,7 +1411,6 @@ pub(crate) fn tabulate(
     };
     let non_finite = rows.iter().any(|r| r.iter().any(|x| !x.is_finite()));
     let t_last = rows.last().map_or(0.0, |r| r[0]);
-    let scales = conservation_scales(prep, sol);
     let (events, monitors, mut warnings, status) = report(
         prep, sol, set, &failure, &drifts, &scales, t_last, non_finite,
     );

@@ -216,6 +216,16 @@ impl<'a> ForceBuilder<'a> {
         }
     }
 
+    /// The particle named `name`.
+    pub fn particle_named(&self, name: &str) -> Option<usize> {
+        self.particle_index.get(name).copied()
+    }
+
+    /// How many loads, potentials and tensions are pushed so far.
+    pub fn counts(&self) -> (usize, usize, usize) {
+        (self.loads.len(), self.potentials.len(), self.axial.len())
+    }
+
     pub fn finish(self) -> Built {
         Built {
             friction_forces: self.friction_forces,

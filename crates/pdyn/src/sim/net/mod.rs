@@ -19,6 +19,7 @@ pub mod kernels;
 pub mod structure;
 
 use super::compiled::CompiledModel;
+use super::SimError;
 use kernels::NetKernels;
 use pdyn_expr::linsolve::LinearSystem;
 use pdyn_expr::{Id, Node, Pool, Program};
@@ -27,6 +28,39 @@ use pdyn_mech::conservation::{self, Conserved};
 use pdyn_mech::derive::{Form, ParticleKinematics, Unknown, UnknownKind};
 use pdyn_mech::model::Target;
 use pdyn_mech::{Derivation, Model};
+
+/// Whether the model is a net for its output table: from [`NET_FROM`] particles, every
+/// component of every particle's position a coordinate or constant in time. Its position
+/// columns `P.x` are then not written for the components that are coordinates (they are the
+/// coordinate's own column: a 10^4-particle net's table would hold each of its 3·10^4
+/// positions twice), whichever path derives it; smaller models keep every position column.
+pub fn positions_are_coordinates(model: &Model) -> bool {
+    let p = &model.pool;
+    model.particles.len() >= NET_FROM
+        && model.particles.iter().all(|pt| {
+            pt.position.iter().all(|&c| match p.node(c) {
+                Node::Coord(_, 0) => true,
+                _ => !p.any_node(c, &|n| matches!(n, Node::Coord(..) | Node::Time)),
+            })
+        })
+}
+
+/// The coordinate that is component `axis` of particle `particle`'s position, by name: the
+/// column that holds it when [`positions_are_coordinates`] left out `P.x`.
+pub fn position_column(model: &Model, particle: usize, axis: usize) -> Option<String> {
+    let c = *model.particles.get(particle)?.position.get(axis)?;
+    let Node::Coord(s, 0) = *model.pool.node(c) else {
+        return None;
+    };
+    let coordinate = model.coordinates.iter().find(|q| q.sym == s)?;
+    Some(coordinate.name.clone())
+}
+
+/// The model with its deferred force families expanded ([`Model::expand_deferred`]), for a
+/// path that reads every load.
+pub fn expand_deferred(model: &mut Model) -> Result<(), SimError> {
+    model.expand_deferred().map_err(SimError::Derive)
+}
 
 /// From how many particles a model of free particles in Cartesian coordinates takes this
 /// path. Below, the generic derivation is cheap and keeps the exact forms of small models
@@ -166,6 +200,11 @@ pub fn conserved_quantities(
     let Some(kernels) = system.net_kernels() else {
         return conservation::conserved_quantities(model, d);
     };
+    // The energy sums every potential: deferred members' are formed from their
+    // representative's (only when the energy may be conserved).
+    if model.conservative {
+        model.materialize_deferred();
+    }
     if !kernels.newton_form() {
         return conservation::conserved_energy(model, d)
             .into_iter()
@@ -180,6 +219,7 @@ pub fn conserved_quantities(
             .into_iter()
             .collect();
     }
+    model.materialize_deferred();
     let d = with_forces(model, d);
     conservation::conserved_quantities(model, &d)
 }

@@ -145,9 +145,14 @@ pub fn recognise(model: &mut Model) -> Option<Structure> {
         FxHashMap::default();
     let mut by_template: FxHashMap<(usize, ActsOn), usize> = FxHashMap::default();
     let mut signer = Signer::default();
+    // The first loads of the representatives of deferred families: the group and the
+    // particles of their elements.
+    let representatives: FxHashSet<usize> = model.deferred.iter().map(|d| d.first_load).collect();
+    let mut represented: FxHashMap<usize, (usize, usize, Vec<u32>)> = FxHashMap::default();
     let loads = &model.loads;
     let mut next = 0;
     while next < loads.len() {
+        let first = next;
         let load = &loads[next];
         next += 1;
         let Target::Particle(own) = load.target else {
@@ -247,7 +252,19 @@ pub fn recognise(model: &mut Model) -> Option<Structure> {
                 g
             }
         };
+        if representatives.contains(&first) {
+            represented.insert(first, (g, next - first, members.clone()));
+        }
         groups[g].particles.extend(members);
+    }
+    // The members of a deferred family are its representative's element with other
+    // particles, in the same slots: their index arrays join its group as they are.
+    for d in &model.deferred {
+        let (g, loads, particles) = represented.get(&d.first_load)?;
+        if *loads != d.loads || *particles != d.ends || groups[*g].slots != d.ends.len() {
+            return None;
+        }
+        groups[*g].particles.extend(&d.members);
     }
     Some(Structure {
         axes,
