@@ -53,7 +53,9 @@ impl Table {
             .step_by(ROWS_PER_BLOCK)
             .map(|a| (a, (a + ROWS_PER_BLOCK).min(rows)))
             .collect();
-        let at_once = 4 * rayon::current_num_threads().max(1);
+        // Two blocks per thread in a group: with one group written while the next is
+        // formatted, twice the memory of one group is in flight.
+        let at_once = 2 * rayon::current_num_threads().max(1);
         std::thread::scope(|s| {
             // A rendezvous channel: one group written while the next is formatted.
             let (send, receive) = std::sync::mpsc::sync_channel::<Vec<Vec<u8>>>(0);
