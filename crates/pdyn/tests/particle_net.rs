@@ -112,6 +112,25 @@ fn max_relative_difference(a: &[f64], b: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The right-hand sides (to 1e-13) and Jacobians (to 1e-12) of `fast` and `generic` agree
+/// at the initial state and at a perturbed one.
+fn assert_same_derivatives(fast: &sim::Prepared, generic: &sim::Prepared, label: &str) {
+    let dim = generic.system.dim();
+    assert!(fast.system.has_jacobian() && generic.system.has_jacobian());
+    for y in [generic.y0.clone(), perturbed(&generic.y0)] {
+        let (mut f1, mut f2) = (vec![0.0; dim], vec![0.0; dim]);
+        fast.system.rhs(0.0, &y, &mut f1);
+        generic.system.rhs(0.0, &y, &mut f2);
+        let d = max_relative_difference(&f2, &f1);
+        assert!(d < 1e-13, "{label}: right-hand sides differ by {d:e}");
+        let (mut j1, mut j2) = (vec![0.0; dim * dim], vec![0.0; dim * dim]);
+        fast.system.jacobian(0.0, &y, &mut j1);
+        generic.system.jacobian(0.0, &y, &mut j2);
+        let d = max_relative_difference(&j2, &j1);
+        assert!(d < 1e-12, "{label}: Jacobians differ by {d:e}");
+    }
+}
+
 /// The right-hand side, its Jacobian and a short run agree with the generic symbolic path
 /// (A x = b solved by the diagonal rule, the Jacobian differentiated entry by entry) on nets
 /// of 4, 10 and 23 particles, to round-off.
@@ -132,20 +151,7 @@ fn kernels_agree_with_the_generic_derivation() {
         assert_eq!(fast.state_names, generic.state_names);
         assert_eq!(fast.y0, generic.y0);
         assert_eq!(fast.observer.names, generic.observer.names);
-        let dim = generic.system.dim();
-        for y in [generic.y0.clone(), perturbed(&generic.y0)] {
-            let (mut f1, mut f2) = (vec![0.0; dim], vec![0.0; dim]);
-            fast.system.rhs(0.0, &y, &mut f1);
-            generic.system.rhs(0.0, &y, &mut f2);
-            let d = max_relative_difference(&f2, &f1);
-            assert!(d < 1e-13, "{nx}x{ny}: right-hand sides differ by {d:e}");
-            assert!(fast.system.has_jacobian() && generic.system.has_jacobian());
-            let (mut j1, mut j2) = (vec![0.0; dim * dim], vec![0.0; dim * dim]);
-            fast.system.jacobian(0.0, &y, &mut j1);
-            generic.system.jacobian(0.0, &y, &mut j2);
-            let d = max_relative_difference(&j2, &j1);
-            assert!(d < 1e-12, "{nx}x{ny}: Jacobians differ by {d:e}");
-        }
+        assert_same_derivatives(&fast, &generic, &format!("{nx}x{ny}"));
         let set = RunSettings::from_spec(&load(&src).run.simulate).unwrap();
         let r1 = sim::run(&fast, &set).unwrap();
         let r2 = sim::run(&generic, &set).unwrap();
@@ -368,21 +374,21 @@ fn deferred_families_agree_with_the_expanded_model() {
         assert_eq!(fast.state_names, generic.state_names);
         assert_eq!(fast.observer.names, generic.observer.names);
         assert_eq!(fast.y0, generic.y0);
+        // The fully loaded model on the fast path: the deferred members join their group
+        // where the expanded members stand, so the same terms in the same order.
+        let (_, full_fast) = prepare(&src, NetPath::Always);
         let dim = generic.system.dim();
         for y in [generic.y0.clone(), perturbed(&generic.y0)] {
-            let (mut f1, mut f2, mut f3) = (vec![0.0; dim], vec![0.0; dim], vec![0.0; dim]);
-            fast.system.rhs(0.0, &y, &mut f1);
+            let (mut f2, mut f3) = (vec![0.0; dim], vec![0.0; dim]);
             generic.system.rhs(0.0, &y, &mut f2);
             reference.system.rhs(0.0, &y, &mut f3);
             assert_eq!(f2, f3, "{nx}x{ny}: the expanded model is the full load's");
-            let d = max_relative_difference(&f2, &f1);
-            assert!(d < 1e-13, "{nx}x{ny}: right-hand sides differ by {d:e}");
-            let (mut j1, mut j2) = (vec![0.0; dim * dim], vec![0.0; dim * dim]);
-            fast.system.jacobian(0.0, &y, &mut j1);
-            generic.system.jacobian(0.0, &y, &mut j2);
-            let d = max_relative_difference(&j2, &j1);
-            assert!(d < 1e-12, "{nx}x{ny}: Jacobians differ by {d:e}");
+            let (mut f1, mut f4) = (vec![0.0; dim], vec![0.0; dim]);
+            fast.system.rhs(0.0, &y, &mut f1);
+            full_fast.system.rhs(0.0, &y, &mut f4);
+            assert_eq!(f1, f4, "{nx}x{ny}: deferred and full loads on the fast path");
         }
+        assert_same_derivatives(&fast, &generic, &format!("{nx}x{ny}"));
         let set = RunSettings::from_spec(&load(&src).run.simulate).unwrap();
         let r1 = sim::run(&fast, &set).unwrap();
         let r2 = sim::run(&generic, &set).unwrap();

@@ -147,8 +147,13 @@ pub fn recognise(model: &mut Model) -> Option<Structure> {
     let mut signer = Signer::default();
     // The first loads of the representatives of deferred families: the group and the
     // particles of their elements.
-    let representatives: FxHashSet<usize> = model.deferred.iter().map(|d| d.first_load).collect();
-    let mut represented: FxHashMap<usize, (usize, usize, Vec<u32>)> = FxHashMap::default();
+    let representatives: FxHashMap<usize, usize> = model
+        .deferred
+        .iter()
+        .enumerate()
+        .map(|(k, d)| (d.first_load, k))
+        .collect();
+    let mut joined = 0;
     let loads = &model.loads;
     let mut next = 0;
     while next < loads.len() {
@@ -252,19 +257,22 @@ pub fn recognise(model: &mut Model) -> Option<Structure> {
                 g
             }
         };
-        if representatives.contains(&first) {
-            represented.insert(first, (g, next - first, members.clone()));
+        groups[g].particles.extend(&members);
+        // The members of a deferred family are its representative's element with other
+        // particles, in the same slots: their index arrays join its group as they are,
+        // right after it, where the expanded model's members stand (the same order of
+        // terms, hence the same bits, as the full load).
+        if let Some(&k) = representatives.get(&first) {
+            let d = &model.deferred[k];
+            if next - first != d.loads || members != d.ends || groups[g].slots != d.ends.len() {
+                return None;
+            }
+            groups[g].particles.extend(&d.members);
+            joined += 1;
         }
-        groups[g].particles.extend(members);
     }
-    // The members of a deferred family are its representative's element with other
-    // particles, in the same slots: their index arrays join its group as they are.
-    for d in &model.deferred {
-        let (g, loads, particles) = represented.get(&d.first_load)?;
-        if *loads != d.loads || *particles != d.ends || groups[*g].slots != d.ends.len() {
-            return None;
-        }
-        groups[*g].particles.extend(&d.members);
+    if joined != model.deferred.len() {
+        return None;
     }
     Some(Structure {
         axes,
