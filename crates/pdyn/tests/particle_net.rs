@@ -386,7 +386,10 @@ fn deferred_families_agree_with_the_expanded_model() {
             let (mut f1, mut f4) = (vec![0.0; dim], vec![0.0; dim]);
             fast.system.rhs(0.0, &y, &mut f1);
             full_fast.system.rhs(0.0, &y, &mut f4);
-            assert_eq!(f1, f4, "{nx}x{ny}: deferred and full loads on the fast path");
+            assert_eq!(
+                f1, f4,
+                "{nx}x{ny}: deferred and full loads on the fast path"
+            );
         }
         assert_same_derivatives(&fast, &generic, &format!("{nx}x{ny}"));
         let set = RunSettings::from_spec(&load(&src).run.simulate).unwrap();
