@@ -165,11 +165,7 @@ fn neighbour_list_survives_many_rebuilds() {
 #[test]
 fn results_do_not_depend_on_thread_count() {
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        common::on_threads(threads, || {
             let mut sim = lj_liquid(4, 5, 0.005);
             sim.run(100, &mut |_: &ThermoRecord, _: &System| {})
                 .unwrap();
@@ -186,11 +182,7 @@ fn results_do_not_depend_on_thread_count() {
 fn results_do_not_depend_on_thread_count_with_several_segments() {
     // 2,048 atoms: the force loop is cut into two segments, each with its own Newton buffer
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        common::on_threads(threads, || {
             let mut sim = lj_liquid(8, 11, 0.005);
             sim.run(40, &mut |_: &ThermoRecord, _: &System| {}).unwrap();
             (sim.system.particles.clone(), sim.thermo())

@@ -174,11 +174,7 @@ fn lammps_liquid(cells: usize, seed: u64) -> Simulation<potential::Truncated<Len
 #[test]
 fn lammps_scheme_does_not_depend_on_thread_count() {
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        common::on_threads(threads, || {
             let mut sim = lammps_liquid(8, 11);
             sim.run(40, &mut |_: &ThermoRecord, _: &System| {}).unwrap();
             (sim.system.particles.clone(), sim.thermo())

@@ -1,7 +1,9 @@
-//! Post-processing: radial distribution function and mean-squared displacement.
+//! Post-processing: radial distribution function, mean-squared displacement, block averages.
 
+mod blocks;
 mod msd;
 mod rdf;
 
+pub use blocks::block_means;
 pub use msd::Msd;
 pub use rdf::{BlockRdf, Rdf};

@@ -87,12 +87,14 @@ pub fn detrended_std(x: &[f64], y: &[f64]) -> f64 {
 
 /// Mean and standard error of correlated samples from 10 contiguous block means.
 pub fn mean_and_error(xs: &[f64]) -> (f64, f64) {
-    const NB: usize = 10;
-    let len = xs.len() / NB;
-    let bm: Vec<f64> = (0..NB)
-        .map(|b| xs[b * len..(b + 1) * len].iter().sum::<f64>() / len as f64)
-        .collect();
-    let m = bm.iter().sum::<f64>() / NB as f64;
-    let var = bm.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (NB * (NB - 1)) as f64;
-    (m, var.sqrt())
+    pdyn_md::analysis::block_means(xs, 10).expect("at least 20 samples")
+}
+
+/// `f` run on a rayon pool of `threads` threads (results must not depend on the count).
+pub fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("a thread pool")
+        .install(f)
 }

@@ -212,15 +212,9 @@ pub fn block_average(xs: &[f64]) -> Option<Average> {
             blocks: 0,
         });
     }
-    let len = xs.len() / NB;
-    let bm: Vec<f64> = (0..NB)
-        .map(|b| xs[b * len..(b + 1) * len].iter().sum::<f64>() / len as f64)
-        .collect();
-    let m = bm.iter().sum::<f64>() / NB as f64;
-    let var = bm.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (NB * (NB - 1)) as f64;
     Some(Average {
         mean,
-        error: Some(var.sqrt()),
+        error: pdyn_md::analysis::block_means(xs, NB).map(|(_, error)| error),
         blocks: NB,
     })
 }
