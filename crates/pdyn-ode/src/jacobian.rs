@@ -9,6 +9,7 @@
 //! grouping SciPy's `num_jac` uses), so a banded or block system costs as many evaluations as
 //! it has groups, and entries outside the pattern are zero.
 
+use crate::error::{invalid, OdeError};
 use crate::problem::OdeSystem;
 use crate::solution::Stats;
 
@@ -33,24 +34,77 @@ impl Sparsity {
         let rows: Vec<Vec<usize>> = (0..n)
             .map(|j| (0..n).filter(|&i| nonzero(i, j)).collect())
             .collect();
+        Sparsity::grouped(n, rows)
+    }
+
+    /// The pattern from the rows where each column may be nonzero (`rows[j]`, any order,
+    /// repetitions allowed), in time and memory linear in the entries (a many-particle
+    /// model's pattern, which [`Sparsity::new`]'s `n²` questions would take too long to
+    /// ask). Columns are grouped as by [`Sparsity::new`].
+    pub fn from_columns(n: usize, mut rows: Vec<Vec<usize>>) -> Result<Sparsity, OdeError> {
+        if rows.len() != n {
+            return Err(invalid(format!(
+                "the sparsity pattern has {} columns, the system {n} components",
+                rows.len()
+            )));
+        }
+        for (j, r) in rows.iter_mut().enumerate() {
+            r.sort_unstable();
+            r.dedup();
+            if let Some(&i) = r.last().filter(|&&i| i >= n) {
+                return Err(invalid(format!(
+                    "the sparsity pattern names row {i} in column {j}; rows are 0..{n}"
+                )));
+            }
+        }
+        Ok(Sparsity::grouped(n, rows))
+    }
+
+    /// Groups the columns greedily in order: column `j` joins the first group none of whose
+    /// columns shares a row with it (Curtis, Powell & Reid's grouping).
+    fn grouped(n: usize, rows: Vec<Vec<usize>>) -> Sparsity {
+        // The columns of each row, to find a column's neighbours without scanning groups.
+        let mut row_cols: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for (j, r) in rows.iter().enumerate() {
+            for &i in r {
+                row_cols[i].push(j);
+            }
+        }
+        let mut group_of = vec![usize::MAX; n];
+        // `blocked[g] == j + 1`: group g has a column sharing a row with column j.
+        let mut blocked: Vec<usize> = Vec::new();
         let mut groups: Vec<Vec<usize>> = Vec::new();
-        let mut used: Vec<Vec<bool>> = Vec::new();
-        for (j, rj) in rows.iter().enumerate() {
-            let slot = used.iter().position(|u| rj.iter().all(|&i| !u[i]));
-            let g = match slot {
+        for (j, r) in rows.iter().enumerate() {
+            for &i in r {
+                for &other in &row_cols[i] {
+                    if other < j {
+                        blocked[group_of[other]] = j + 1;
+                    }
+                }
+            }
+            let g = match blocked.iter().position(|&b| b != j + 1) {
                 Some(g) => g,
                 None => {
                     groups.push(Vec::new());
-                    used.push(vec![false; n]);
+                    blocked.push(0);
                     groups.len() - 1
                 }
             };
             groups[g].push(j);
-            for &i in rj {
-                used[g][i] = true;
-            }
+            group_of[j] = g;
         }
         Sparsity { n, rows, groups }
+    }
+
+    /// Entries of the pattern.
+    pub fn nnz(&self) -> usize {
+        self.rows.iter().map(Vec::len).sum()
+    }
+
+    /// The rows where column `j` may be nonzero, ascending: the order of column `j`'s values
+    /// in [`crate::OdeSystem::sparse_jacobian`] (columns one after the other).
+    pub fn column(&self, j: usize) -> &[usize] {
+        &self.rows[j]
     }
 
     /// A band: `∂f_i/∂y_j` may be nonzero when `i − lower ≤ j ≤ i + upper` (LSODA's `lband`,
@@ -136,6 +190,50 @@ impl FdJacobian {
                             jac[i * n + j] = (out[i] - f0[i]) / delt;
                         }
                     }
+                }
+            }
+        }
+        stats.fevals += k;
+        stats.jac_fevals += k;
+    }
+
+    /// Writes `∂f/∂y` at `(t, y)` into `values`, the entries of `s` column after column (as
+    /// [`OdeSystem::sparse_jacobian`] does), one evaluation of `f` per group of columns.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn eval_sparse<S: OdeSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        s: &Sparsity,
+        t: f64,
+        y: &[f64],
+        f0: &[f64],
+        values: &mut [f64],
+        stats: &mut Stats,
+    ) {
+        let n = y.len();
+        let k = s.groups.len();
+        if self.states.len() != k * n {
+            self.states = vec![0.0; k * n];
+            self.out = vec![0.0; k * n];
+        }
+        for (g, cols) in s.groups.iter().enumerate() {
+            let row = &mut self.states[g * n..(g + 1) * n];
+            row.copy_from_slice(y);
+            for &j in cols {
+                row[j] = y[j] + increment(y[j]);
+            }
+        }
+        sys.rhs_batch(t, &self.states, &mut self.out);
+        let mut start = vec![0usize; n + 1];
+        for j in 0..n {
+            start[j + 1] = start[j] + s.rows[j].len();
+        }
+        for (g, cols) in s.groups.iter().enumerate() {
+            let out = &self.out[g * n..(g + 1) * n];
+            for &j in cols {
+                let delt = increment(y[j]);
+                for (v, &i) in values[start[j]..start[j + 1]].iter_mut().zip(&s.rows[j]) {
+                    *v = (out[i] - f0[i]) / delt;
                 }
             }
         }

@@ -33,6 +33,7 @@
 //! | `resume.rs` | [`solve_observed`]: an explicit pair watched step by step (outputs taken as they come) and resumed bit for bit from a saved [`ResumeState`] |
 //! | `tableau.rs` | Butcher tableaus as data; order-condition checker over rooted trees |
 //! | `linalg.rs` | dense real/complex LU with partial pivoting (decsol.f), allocation-free |
+//! | `sparse_lu.rs`, `ordering.rs` | sparse real/complex LU on a known pattern (up-looking, no pivoting) in nested-dissection order, for Radau5's iteration matrices ([`LinearSolver`]) |
 //! | `methods/dopri5.rs` | **DOPRI5**, Dormand & Prince 1980: 5(4), FSAL, 4th-order dense output, stiffness detection (MATLAB `ode45`) |
 //! | `methods/rk23.rs` | **RK23**, Bogacki & Shampine 1989: 3(2), FSAL, cubic Hermite dense output (MATLAB `ode23`) |
 //! | `methods/tsit5.rs` | **Tsit5**, Tsitouras 2011: 5(4), FSAL, 4th-order dense output |
@@ -41,7 +42,7 @@
 //! | `methods/rk4.rs` | **RK4**, Kutta 1901: classical order 4, fixed step |
 //! | `jacobian.rs` | finite-difference Jacobians of the implicit methods, columns grouped by a [`Sparsity`] pattern (SciPy's `jac_sparsity`) |
 //! | `methods/bdf.rs` | **BDF**, Shampine & Reichelt 1997: variable order 1–5, quasi-constant step size, NDF coefficients (MATLAB `ode15s`, SciPy's `BDF`), its own interpolating polynomial as dense output |
-//! | `methods/radau5.rs` | **Radau5**, Hairer & Wanner 1996: Radau IIA order 5, stiff, mass matrices / index-1 DAEs |
+//! | `methods/radau5.rs` | **Radau5**, Hairer & Wanner 1996: Radau IIA order 5, stiff, mass matrices / index-1 DAEs; `methods/radau5_linear.rs` its Jacobian and iteration matrices, dense or sparse |
 //! | `methods/symplectic.rs` | **Velocity Verlet** (Verlet 1967), **Yoshida 4** (Yoshida 1990), **Kahan–Li 6 / 8** (Kahan & Li 1997): explicit symplectic, fixed step |
 //! | `methods/gauss.rs` | **Gauss–Legendre 4 / 6** (Butcher 1964): implicit symplectic for any Hamiltonian, fixed step |
 //!
@@ -78,10 +79,12 @@ pub mod jacobian;
 pub mod linalg;
 pub mod methods;
 mod options;
+mod ordering;
 pub mod problem;
 pub mod problems;
 pub mod resume;
 mod solution;
+pub mod sparse_lu;
 pub mod tableau;
 
 pub use controller::Controller;
@@ -89,7 +92,7 @@ pub use dense::{DenseSolution, Interpolant};
 pub use error::{FailurePoint, OdeError};
 pub use events::{DenseOutput, Event};
 pub use jacobian::Sparsity;
-pub use options::{Interrupt, Options, StiffnessAction, Tolerance};
+pub use options::{Interrupt, LinearSolver, Options, StiffnessAction, Tolerance};
 pub use problem::{
     FirstOrderForm, FnSecondOrder, FnSystem, FnSystemWithJacobian, MassInverse, MassKind,
     OdeSystem, SecondOrderSystem,

@@ -133,6 +133,25 @@ pub struct Options {
     /// one evaluation of `f` per group of columns ([`crate::jacobian`]). Unused when the system
     /// has an analytic Jacobian. Default `None` (dense).
     pub jac_sparsity: Option<std::sync::Arc<crate::jacobian::Sparsity>>,
+    /// How Radau5 solves its linear systems: dense LU, or sparse LU when the Jacobian's
+    /// pattern is known ([`Options::jac_sparsity`] or [`crate::OdeSystem::jacobian_sparsity`]).
+    /// Default [`LinearSolver::Auto`].
+    pub linear_solver: LinearSolver,
+}
+
+/// How the implicit method Radau5 factors its iteration matrices `c·M − J`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LinearSolver {
+    /// Sparse when the Jacobian's pattern is known, the mass matrix is the identity, the
+    /// system has at least 200 components and no analytic Jacobian given only dense; dense
+    /// otherwise.
+    #[default]
+    Auto,
+    /// Dense LU with partial pivoting (radau5.f's DECSOL): `n²` memory, `n³/3` operations.
+    Dense,
+    /// Sparse LU on the pattern ([`crate::sparse_lu`]): nested-dissection order, no
+    /// pivoting. Needs the pattern and the identity mass matrix.
+    Sparse,
 }
 
 /// A stop request shared with the thread that may set it.
@@ -164,6 +183,7 @@ impl Default for Options {
             output_terminal_event: true,
             interrupt: None,
             jac_sparsity: None,
+            linear_solver: LinearSolver::Auto,
         }
     }
 }

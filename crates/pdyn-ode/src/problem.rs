@@ -58,6 +58,28 @@ pub trait OdeSystem {
         let _ = (t, y, jac);
     }
 
+    /// The pattern of `∂f/∂y` when the system knows it (a many-particle model knows which
+    /// particles each force joins). Radau5 then factors its iteration matrices as sparse
+    /// matrices ([`crate::LinearSolver`]) and, without [`sparse_jacobian`]
+    /// (OdeSystem::sparse_jacobian), groups the columns of its finite differences. Default
+    /// `None`; [`crate::Options::jac_sparsity`] takes precedence.
+    fn jacobian_sparsity(&self) -> Option<std::sync::Arc<crate::Sparsity>> {
+        None
+    }
+
+    /// Whether [`sparse_jacobian`](OdeSystem::sparse_jacobian) is implemented.
+    fn has_sparse_jacobian(&self) -> bool {
+        false
+    }
+
+    /// Writes the entries of `∂f/∂y` at `(t, y)` that
+    /// [`jacobian_sparsity`](OdeSystem::jacobian_sparsity) names, column after column, each
+    /// column's rows ascending ([`crate::Sparsity::column`]). Called only when
+    /// [`has_sparse_jacobian`](OdeSystem::has_sparse_jacobian) returns `true`.
+    fn sparse_jacobian(&self, t: f64, y: &[f64], values: &mut [f64]) {
+        let _ = (t, y, values);
+    }
+
     /// Kind of mass matrix (default: identity).
     fn mass_kind(&self) -> MassKind {
         MassKind::Identity
@@ -85,6 +107,15 @@ impl<S: OdeSystem + ?Sized> OdeSystem for &S {
     }
     fn jacobian(&self, t: f64, y: &[f64], jac: &mut [f64]) {
         (**self).jacobian(t, y, jac)
+    }
+    fn jacobian_sparsity(&self) -> Option<std::sync::Arc<crate::Sparsity>> {
+        (**self).jacobian_sparsity()
+    }
+    fn has_sparse_jacobian(&self) -> bool {
+        (**self).has_sparse_jacobian()
+    }
+    fn sparse_jacobian(&self, t: f64, y: &[f64], values: &mut [f64]) {
+        (**self).sparse_jacobian(t, y, values)
     }
     fn mass_kind(&self) -> MassKind {
         (**self).mass_kind()

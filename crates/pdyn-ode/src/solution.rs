@@ -26,6 +26,9 @@ pub struct Stats {
     pub linear_solves: usize,
     /// Accepted step at which the explicit method's stiffness detector fired, if it did.
     pub stiffness_detected_at: Option<f64>,
+    /// Whether the implicit method factored its iteration matrices as sparse matrices
+    /// ([`crate::LinearSolver`]).
+    pub sparse_lu: bool,
 }
 
 impl Stats {
@@ -40,6 +43,7 @@ impl Stats {
         self.jacobians += other.jacobians;
         self.lu_decompositions += other.lu_decompositions;
         self.linear_solves += other.linear_solves;
+        self.sparse_lu |= other.sparse_lu;
         if self.stiffness_detected_at.is_none() {
             self.stiffness_detected_at = other.stiffness_detected_at;
         }

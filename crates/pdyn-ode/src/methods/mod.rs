@@ -5,6 +5,7 @@ pub mod dop853;
 pub mod dopri5;
 pub mod gauss;
 pub mod radau5;
+pub(crate) mod radau5_linear;
 pub mod rk23;
 pub mod rk4;
 pub mod symplectic;

@@ -32,11 +32,11 @@
 //! real + complex system, the error-estimate solves not counted); `lu_decompositions` is NDEC
 //! (one per real + complex pair).
 
+use super::radau5_linear::Systems;
 use crate::controller::Controller;
 use crate::error::{invalid, point, OdeError};
 use crate::events::{DenseOutput, Event, EventState, Output};
 use crate::explicit::setup;
-use crate::linalg::{Lu, LuComplex};
 use crate::options::Options;
 use crate::problem::{MassKind, OdeSystem};
 use crate::solution::{Solution, Status};
@@ -195,14 +195,6 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
 ) -> Result<Solution, OdeError> {
     let su = setup(sys, t0, tf, y_init, opts)?;
     let n = su.n;
-    if let Some(s) = &opts.jac_sparsity {
-        if s.dim() != n {
-            return Err(invalid(format!(
-                "jac_sparsity is {0} × {0}, the system has {n} components",
-                s.dim()
-            )));
-        }
-    }
     let mass = match sys.mass_kind() {
         MassKind::Identity => None,
         MassKind::Constant => {
@@ -272,10 +264,9 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
     let (mut f1, mut f2, mut f3) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let mut tmp = vec![0.0; n];
     let mut ytmp = vec![0.0; n];
-    let mut fjac = vec![0.0; n * n]; // row-major ∂f_i/∂y_j
     let mut fd = crate::jacobian::FdJacobian::default();
-    let mut e1 = Lu::new(n);
-    let mut e2 = LuComplex::new(n);
+    let mut systems = Systems::new(sys, opts, n, mass)?;
+    sol.stats.sparse_lu = systems.is_sparse();
     let mut dense = Radau5Dense {
         n,
         cont: vec![0.0; 4 * n],
@@ -302,22 +293,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
         match next {
             Next::Jacobian => {
                 sol.stats.jacobians += 1;
-                if sys.has_jacobian() {
-                    sys.jacobian(x, &y, &mut fjac);
-                } else {
-                    // The n perturbed states (or one per group of columns of
-                    // `jac_sparsity`), evaluated in one batch (one call of a vectorized
-                    // right-hand side).
-                    fd.eval(
-                        sys,
-                        opts.jac_sparsity.as_deref(),
-                        x,
-                        &y,
-                        &y0f,
-                        &mut fjac,
-                        &mut sol.stats,
-                    );
-                }
+                systems.jacobian(sys, opts, &mut fd, x, &y, &y0f, &mut sol.stats);
                 caljac = true;
                 next = Next::Decompose;
                 continue;
@@ -336,33 +312,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                 fac1 = k.u1 / h;
                 alphn = k.alph / h;
                 betan = k.beta / h;
-                {
-                    let a = e1.matrix_mut();
-                    for j in 0..n {
-                        for i in 0..n {
-                            let m = match &mass {
-                                None => f64::from(u8::from(i == j)),
-                                Some(m) => m[i * n + j],
-                            };
-                            a[i + j * n] = fac1 * m - fjac[i * n + j];
-                        }
-                    }
-                }
-                let ok1 = e1.factor().is_ok();
-                let ok2 = ok1 && {
-                    let (ar, ai) = e2.matrix_mut();
-                    for j in 0..n {
-                        for i in 0..n {
-                            let m = match &mass {
-                                None => f64::from(u8::from(i == j)),
-                                Some(m) => m[i * n + j],
-                            };
-                            ar[i + j * n] = alphn * m - fjac[i * n + j];
-                            ai[i + j * n] = betan * m;
-                        }
-                    }
-                    e2.factor().is_ok()
-                };
+                let ok2 = systems.decompose(fac1, alphn, betan);
                 if !ok2 {
                     unexpected = Some(true);
                 } else {
@@ -452,7 +402,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                     z3[i] = TI31 * a1 + TI32 * a2 + TI33 * a3;
                 }
                 // SLVRAD
-                match &mass {
+                match systems.mass() {
                     None => {
                         for i in 0..n {
                             let s2 = -f2[i];
@@ -477,8 +427,8 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                         }
                     }
                 }
-                e1.solve_in_place(&mut z1);
-                e2.solve_in_place(&mut z2, &mut z3);
+                systems.solve1(&mut z1);
+                systems.solve2(&mut z2, &mut z3);
                 sol.stats.linear_solves += 1;
                 newt += 1;
                 let mut dyno = 0.0;
@@ -541,7 +491,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                 for i in 0..n {
                     f1[i] = hee1 * z1[i] + hee2 * z2[i] + hee3 * z3[i];
                 }
-                match &mass {
+                match systems.mass() {
                     None => f2.copy_from_slice(&f1),
                     Some(m) => {
                         for i in 0..n {
@@ -556,7 +506,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                 for i in 0..n {
                     tmp[i] = f2[i] + y0f[i];
                 }
-                e1.solve_in_place(&mut tmp);
+                systems.solve1(&mut tmp);
                 let mut err = norm(&tmp, &scal);
                 if err >= 1.0 && (first || reject) {
                     for i in 0..n {
@@ -567,7 +517,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                     for i in 0..n {
                         tmp[i] = f1[i] + f2[i];
                     }
-                    e1.solve_in_place(&mut tmp);
+                    systems.solve1(&mut tmp);
                     err = norm(&tmp, &scal);
                 }
                 // ---- new step size

@@ -605,6 +605,8 @@ fn stats_of(v: &Value) -> Option<Stats> {
             Value::Null => None,
             x => Some(unbit(x)?),
         },
+        // Long runs resume explicit pairs only (see `resume.rs`): no linear systems.
+        sparse_lu: false,
     })
 }
 
