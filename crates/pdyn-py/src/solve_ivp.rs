@@ -476,7 +476,7 @@ pub(crate) fn _solve_ivp(
     jit: bool,
     jac: Option<Bound<'_, PyAny>>,
     vectorized: bool,
-    jac_sparsity: Option<Vec<bool>>,
+    jac_sparsity: Option<(Vec<usize>, Vec<usize>)>,
 ) -> PyResult<PyObject> {
     guarded(py, || {
         let y0 = y0.as_slice()?.to_vec();
@@ -595,13 +595,20 @@ pub(crate) fn _solve_ivp(
         if let Some(te) = t_eval {
             opts.t_eval = Some(te.as_slice()?.to_vec());
         }
-        if let Some(pattern) = jac_sparsity {
-            if pattern.len() != n * n {
-                return Err(PyValueError::new_err("`jac_sparsity` has wrong shape."));
+        if let Some((rows, cols)) = jac_sparsity {
+            // The entries (row, column) where the Jacobian may be nonzero.
+            let mut by_column: Vec<Vec<usize>> = vec![Vec::new(); n];
+            for (&i, &j) in rows.iter().zip(&cols) {
+                if i >= n || j >= n {
+                    return Err(PyValueError::new_err(format!(
+                        "`jac_sparsity` has an entry ({i}, {j}) outside the {n} × {n} Jacobian."
+                    )));
+                }
+                by_column[j].push(i);
             }
-            opts.jac_sparsity = Some(Arc::new(pdyn_ode::Sparsity::new(n, |i, j| {
-                pattern[i * n + j]
-            })));
+            let sparsity = pdyn_ode::Sparsity::from_columns(n, by_column)
+                .map_err(|e| PyValueError::new_err(e.to_string()))?;
+            opts.jac_sparsity = Some(Arc::new(sparsity));
         }
         if m == Method::Auto {
             // LSODA: the stiffness test at every step (as LSODA weighs a switch at every

@@ -380,6 +380,32 @@ def test_jac_sparsity_groups_the_finite_differences(method):
             pdyn.solve_ivp(heat, (0, 0.01), y0, method=method, jac_sparsity=np.eye(n + 1))
 
 
+def test_radau_with_a_sparse_pattern_solves_a_system_too_large_for_dense_matrices():
+    # The 2-D heat equation on 100 x 100 interior points: 10^4 states, whose three dense
+    # n x n matrices of Radau5 would take 2.4 GB. With jac_sparsity (a scipy.sparse matrix,
+    # as SciPy takes it) Radau5 factors them sparsely. sin(pi x) sin(pi y) on the grid is an
+    # eigenvector of the discrete Laplacian: the exact solution decays as
+    # exp(-8/h^2 sin^2(pi h / 2) t).
+    from scipy import sparse as sp
+    m = 100
+    h = 1.0 / (m + 1)
+    x = np.arange(1, m + 1) * h
+    u0 = np.outer(np.sin(np.pi * x), np.sin(np.pi * x)).ravel()
+    rate = 8.0 / h ** 2 * np.sin(np.pi * h / 2) ** 2
+    lap1 = sp.diags([1.0, -2.0, 1.0], [-1, 0, 1], shape=(m, m))
+    lap = (sp.kron(sp.eye(m), lap1) + sp.kron(lap1, sp.eye(m))).tocsr() / h ** 2
+
+    def fun(t, u):
+        return lap @ u
+    r = pdyn.solve_ivp(fun, (0, 0.02), u0, method="Radau", rtol=1e-8, atol=1e-10,
+                       jac_sparsity=lap != 0)
+    assert r.success, r.message
+    np.testing.assert_allclose(r.y[:, -1], np.exp(-rate * 0.02) * u0, rtol=0, atol=1e-7)
+    # The finite-difference Jacobian took one call of fun per group of columns (5-point
+    # stencil: a handful), not 10^4.
+    assert r.njev >= 1 and r.nfev < 2000, (r.nfev, r.njev)
+
+
 def test_structure_hints_of_other_methods_warn():
     # SciPy's explicit methods ignore jac_sparsity, and every method but LSODA lband/uband,
     # with a warning: so does pdyn (no silently ignored option).

@@ -247,18 +247,30 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
         r, a = r.tolist(), a.tolist()
     pattern = None
     if sparsity is not None and jac is None:
-        if hasattr(sparsity, "toarray"):
-            sparsity = sparsity.toarray()
-        sp = np.asarray(sparsity)
-        if sp.shape != (n, n):
-            raise ValueError("`jac_sparsity` has wrong shape.")
-        pattern = [bool(v) for v in (sp != 0).ravel()]
+        # As (rows, columns) of the entries: a sparse matrix is never made dense (a 10^5
+        # state's n × n array would not fit), and the pattern reaches Radau5's sparse LU.
+        if hasattr(sparsity, "tocoo"):
+            coo = sparsity.tocoo()
+            if coo.shape != (n, n):
+                raise ValueError("`jac_sparsity` has wrong shape.")
+            nz = np.asarray(coo.data) != 0
+            rows, cols = np.asarray(coo.row)[nz], np.asarray(coo.col)[nz]
+        else:
+            sp = np.asarray(sparsity)
+            if sp.shape != (n, n):
+                raise ValueError("`jac_sparsity` has wrong shape.")
+            rows, cols = np.nonzero(sp)
+        pattern = (rows.astype(np.int64).tolist(), cols.astype(np.int64).tolist())
     elif (lband is not None or uband is not None) and jac is None:
         lo, up = int(lband or 0), int(uband or 0)
         if lo < 0 or up < 0:
             raise ValueError("`lband` and `uband` must be non-negative")
-        i, j = np.indices((n, n))
-        pattern = [bool(v) for v in ((j - i <= up) & (i - j <= lo)).ravel()]
+        rows, cols = [], []
+        for offset in range(-min(lo, n - 1), min(up, n - 1) + 1):
+            i = np.arange(max(0, -offset), min(n, n - offset))
+            rows.append(i)
+            cols.append(i + offset)
+        pattern = (np.concatenate(rows).tolist(), np.concatenate(cols).tolist())
     if max_steps is not None and int(max_steps) < 1:
         raise ValueError("`max_steps` must be a positive integer")
     raw = _pdyn._solve_ivp(fun, t0, tf, y0a, key, te, r, a,
