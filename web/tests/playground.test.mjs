@@ -20,7 +20,7 @@ const bin = process.env.PDYN_BIN ?? path.join(root, "target", "debug", "pdyn");
 // which call glibc natively and a libm port in WebAssembly). Chaotic and stochastic runs too:
 // the same seeds, the same arithmetic in the same order.
 // Files the browser cannot read (the model names another file on disk).
-const NEEDS_FILES = new Set(["examples/nbody/outer_solar_system_csv.toml", "examples/data/earthquake.toml"]);
+const NEEDS_FILES = new Set(["examples/nbody/outer_solar_system_csv.toml", "examples/data/earthquake.toml", "examples/hanging_net_tables.toml", "examples/truss_tables.toml"]);
 
 const examples = (function list(dir) {
   return fs
@@ -70,7 +70,7 @@ for (const ex of examples) {
       const r = await command(page, "run");
       assert.equal(r, null);
       const box = page.locator("#error");
-      assert.match(await box.textContent(), /cannot read the (bodies|data) file .* not supported on this platform/);
+      assert.match(await box.textContent(), /cannot read the (bodies|data|table) file .* not supported on this platform/);
       assert.ok(Number(await box.getAttribute("data-line")) > 0, "the error is located");
       assert.equal(await page.locator(".cm-error-line").count(), 1);
       await page.close();

@@ -245,7 +245,7 @@ impl Loader<'_> {
 }
 
 /// A data error as one line: `file:line:column: message (column `a`, text `x`)`.
-fn located(e: &pdyn_data::DataError) -> String {
+pub(super) fn located(e: &pdyn_data::DataError) -> String {
     let mut out = e.file.clone();
     if let Some(line) = e.line {
         out.push_str(&format!(":{line}"));
@@ -265,7 +265,7 @@ fn located(e: &pdyn_data::DataError) -> String {
 
 /// The data file's path: relative to the model file's directory (the working directory for a
 /// model given as text).
-fn data_path(origin: &str, file: &str) -> std::path::PathBuf {
+pub(super) fn data_path(origin: &str, file: &str) -> std::path::PathBuf {
     let file = std::path::Path::new(file);
     if file.is_absolute() {
         return file.to_path_buf();
@@ -276,7 +276,7 @@ fn data_path(origin: &str, file: &str) -> std::path::PathBuf {
     }
 }
 
-fn is_function_name(s: &str) -> bool {
+pub(super) fn is_function_name(s: &str) -> bool {
     let mut chars = s.chars();
     chars.next().is_some_and(|c| c.is_alphabetic() || c == '_')
         && chars.all(|c| c.is_alphanumeric() || c == '_')

@@ -27,9 +27,10 @@
 use super::index_expr::{self, ForClause, IndexError, IndexExpr};
 use super::loader::Loader;
 use super::raw::{Name, RawForce, RawModel, RawParticle, Sv};
+use super::row_tables::RowTable;
 use super::ModelError;
 use indexmap::IndexMap;
-use rustc_hash::FxHashMap;
+use rustc_hash::{FxHashMap, FxHashSet};
 use std::cell::RefCell;
 use std::ops::Range;
 use std::rc::Rc;
@@ -45,7 +46,14 @@ pub const MAX_MEMBERS: u64 = 2_000_000;
 pub(crate) struct Shape {
     /// Inclusive range of each index.
     pub ranges: Vec<(i64, i64)>,
+    /// For a family declared over the rows of tables only: the subscripts its rows give
+    /// (node ids need not fill their range). `None` when a declaration covers whole ranges.
+    pub rows: Option<FxHashSet<Vec<i64>>>,
 }
+
+/// The rows of tables a member stands for: `(table, row)`, indices into [`Indices::tables`]
+/// and the table's rows.
+pub(crate) type Rows = Vec<(usize, usize)>;
 
 /// Which member of which family an expanded entry is.
 #[derive(Clone, Debug)]
@@ -55,20 +63,18 @@ pub(crate) struct Member {
     pub base: Rc<str>,
     /// The values of its indices.
     pub bindings: Vec<(String, i64)>,
+    /// The table rows it stands for (empty outside families over tables).
+    pub rows: Rows,
 }
 
 impl Member {
-    /// The member of family `base` at `bindings`.
-    fn of(base: &Rc<str>, bindings: &[(String, i64)]) -> Member {
+    /// The member of family `base` at `bindings` (and table rows `rows`).
+    fn of(base: &Rc<str>, bindings: &[(String, i64)], rows: &[(usize, usize)]) -> Member {
         Member {
             base: Rc::clone(base),
             bindings: bindings.to_vec(),
+            rows: rows.to_vec(),
         }
-    }
-
-    /// `spring[i=3, j=19]`.
-    pub fn label(&self) -> String {
-        label(&self.base, &self.bindings)
     }
 }
 
@@ -109,6 +115,10 @@ pub(crate) struct Indices {
     /// Subscripted names parsed so far (`P[i+1, j]`): a family's members name the same
     /// texts with other indices, parsed once.
     parsed: RefCell<FxHashMap<String, Rc<Subscript>>>,
+    /// `[tables.NAME]`, in file order.
+    pub tables: Vec<Rc<RowTable>>,
+    /// `NAME_c`: the table and column it names.
+    pub columns: FxHashMap<String, (usize, usize)>,
 }
 
 /// A subscripted name parsed: its base and each index expression with its place in the name.
@@ -118,15 +128,145 @@ struct Subscript {
     parts: Vec<(IndexExpr, usize, usize)>,
 }
 
+/// A table's cell that a name (`bars_a`) stands for in a member.
+pub(crate) struct Cell<'a> {
+    pub table: &'a RowTable,
+    pub row: usize,
+    pub column: usize,
+}
+
+impl Cell<'_> {
+    pub fn value(&self) -> f64 {
+        self.table.value(self.row, self.column)
+    }
+}
+
 impl Indices {
-    /// The value of a size or a bound index.
-    fn lookup<'a>(&'a self, bindings: &'a [(String, i64)]) -> impl Fn(&str) -> Option<i64> + 'a {
+    /// The value of a size, a bound index, or a table's cell in the bound row.
+    fn lookup<'a>(
+        &'a self,
+        bindings: &'a [(String, i64)],
+        rows: &'a [(usize, usize)],
+    ) -> impl Fn(&str) -> Result<Option<i64>, String> + 'a {
         move |name| {
-            bindings
-                .iter()
-                .find(|(n, _)| n == name)
-                .map(|b| b.1)
-                .or_else(|| self.sizes.get(name).copied())
+            if let Some(b) = bindings.iter().find(|(n, _)| n == name) {
+                return Ok(Some(b.1));
+            }
+            if let Some(&v) = self.sizes.get(name) {
+                return Ok(Some(v));
+            }
+            match self.cell(name, rows)? {
+                Some(c) => c.table.integer(c.row, c.column, name).map(Some),
+                None => Ok(None),
+            }
+        }
+    }
+
+    /// The cell that column `name` (`bars_a`) stands for in the row of its table in `rows`:
+    /// `Ok(None)` when `name` is no column, an error when no row of its table is bound.
+    pub fn cell(&self, name: &str, rows: &[(usize, usize)]) -> Result<Option<Cell<'_>>, String> {
+        let Some(&(t, column)) = self.columns.get(name) else {
+            return Ok(None);
+        };
+        let table = &self.tables[t];
+        match rows.iter().find(|(rt, _)| *rt == t) {
+            Some(&(_, row)) => Ok(Some(Cell { table, row, column })),
+            None => Err(format!(
+                "`{name}` is a column of table `{}`: it has a value in a family over its rows (for = \"r in {}\"), or with the row named: {name}[k]",
+                table.name, table.name
+            )),
+        }
+    }
+
+    /// The cell that `name` names when it is a column with a subscript, `nodes_x[bars_a]`: the
+    /// row whose key (or number) the subscript gives. `Ok(None)` when `name` is not that.
+    pub fn subscripted_cell(
+        &self,
+        name: &str,
+        bindings: &[(String, i64)],
+        rows: &[(usize, usize)],
+    ) -> Result<Option<Cell<'_>>, IndexError> {
+        let Some((base, parts)) = index_expr::split_subscript(name) else {
+            return Ok(None);
+        };
+        let Some(&(t, column)) = self.columns.get(base) else {
+            return Ok(None);
+        };
+        let table = &self.tables[t];
+        let [(text, offset)] = parts.as_slice() else {
+            return Err(IndexError {
+                span: 0..name.len(),
+                message: format!("`{base}` is a column: it takes one subscript, the row's key"),
+            });
+        };
+        let at = |e: IndexError| IndexError {
+            span: e.span.start + offset..e.span.end + offset,
+            message: e.message,
+        };
+        let e = index_expr::parse(text).map_err(at)?;
+        let key = e.int(&self.lookup(bindings, rows)).map_err(|e| {
+            let span = if e.span == (0..0) {
+                0..text.len()
+            } else {
+                e.span
+            };
+            at(IndexError {
+                span,
+                message: e.message,
+            })
+        })?;
+        match table.row_of(key) {
+            Some(row) => Ok(Some(Cell { table, row, column })),
+            None => Err(IndexError {
+                span: 0..name.len(),
+                message: format!(
+                    "`{name}`: table `{}` has no row {key} (its rows are named by {}){}",
+                    table.name,
+                    table.naming(),
+                    self.cells_text(&e, rows)
+                ),
+            }),
+        }
+    }
+
+    /// `spring[i=3, j=19]`, with the table rows the member stands for.
+    pub fn label(&self, base: &str, bindings: &[(String, i64)], rows: &[(usize, usize)]) -> String {
+        let mut out = label(base, bindings);
+        for &(t, row) in rows {
+            let table = &self.tables[t];
+            out.push_str(&format!(
+                " (table `{}`, {} line {})",
+                table.name,
+                table.file,
+                table.line(row)
+            ));
+        }
+        out
+    }
+
+    /// ` (`bars_b` = 9 at bars.csv:4:5)`: where the table cells an index expression uses
+    /// come from, for a message about the member they name.
+    fn cells_text(&self, e: &IndexExpr, rows: &[(usize, usize)]) -> String {
+        let mut parts = Vec::new();
+        for name in e.names() {
+            if let Ok(Some(c)) = self.cell(name, rows) {
+                let text = c
+                    .table
+                    .cell_message(c.row, c.column, "")
+                    .split(": ")
+                    .next()
+                    .unwrap_or_default()
+                    .to_string();
+                let part = format!("`{name}` = {} at {text}", c.value());
+                if !parts.contains(&part) {
+                    parts.push(part);
+                }
+            }
+        }
+        if parts.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", parts.join(", "))
         }
     }
 
@@ -137,6 +277,7 @@ impl Indices {
         &self,
         name: &str,
         bindings: &[(String, i64)],
+        rows: &[(usize, usize)],
     ) -> Result<Option<String>, IndexError> {
         let cached = self.parsed.borrow().get(name).cloned();
         let subscript = match cached {
@@ -164,7 +305,7 @@ impl Indices {
             }
         };
         let base = subscript.base.as_str();
-        let lookup = self.lookup(bindings);
+        let lookup = self.lookup(bindings, rows);
         let mut values = Vec::with_capacity(subscript.parts.len());
         for (e, offset, len) in &subscript.parts {
             values.push(e.int(&lookup).map_err(|e| {
@@ -186,11 +327,36 @@ impl Indices {
             if !inside {
                 return Err(IndexError {
                     span: 0..name.len(),
-                    message: format!("{canonical} is outside {}", shape_text(base, shape)),
+                    message: format!(
+                        "{canonical} is outside {}{}",
+                        shape_text(base, shape),
+                        self.subscript_cells(&subscript, rows)
+                    ),
                 });
+            }
+            if let Some(declared) = &shape.rows {
+                if !declared.contains(&values) {
+                    return Err(IndexError {
+                        span: 0..name.len(),
+                        message: format!(
+                            "{canonical} is not declared: `{base}` is declared over the rows of tables, and no row names {canonical}{}",
+                            self.subscript_cells(&subscript, rows)
+                        ),
+                    });
+                }
             }
         }
         Ok(Some(canonical))
+    }
+}
+
+impl Indices {
+    fn subscript_cells(&self, s: &Subscript, rows: &[(usize, usize)]) -> String {
+        let mut out = String::new();
+        for (e, _, _) in &s.parts {
+            out.push_str(&self.cells_text(e, rows));
+        }
+        out
     }
 }
 
@@ -217,10 +383,19 @@ fn label(base: &str, bindings: &[(String, i64)]) -> String {
 }
 
 /// A family declaration's head: `P[i,j]` is `P` over `i`, `j`; `P[3,4]` (all numbers) is an
-/// ordinary name, `P` too.
+/// ordinary name, `P` too. A family over the rows of tables may be named by its columns,
+/// `P[nodes_i, nodes_j]`: each part is kept with its offset in the name.
 enum Head<'a> {
     Plain,
-    Family(&'a str, Vec<String>),
+    Family(&'a str, Vec<(String, usize)>),
+}
+
+/// Whether `p` is a plain index name.
+fn is_index_name(p: &str) -> bool {
+    p.chars()
+        .next()
+        .is_some_and(|c| c.is_alphabetic() || c == '_')
+        && p.chars().all(|c| c.is_alphanumeric() || c == '_')
 }
 
 /// The byte offset at which the text of a string value or key starts (after its quote).
@@ -241,6 +416,9 @@ fn located(ld: &Loader, span: &Range<usize>, e: IndexError) -> ModelError {
 struct Domain {
     names: Vec<String>,
     ranges: Vec<(i64, i64)>,
+    /// Per name, the table whose rows it runs over (its range is then the rows' numbers and
+    /// its value each row's key).
+    tables: Vec<Option<usize>>,
     condition: Option<(IndexExpr, Sv)>,
 }
 
@@ -276,27 +454,16 @@ impl<'l, 'a> Expander<'l, 'a> {
         if trimmed.iter().all(|p| p.parse::<i64>().is_ok()) {
             return Ok(Head::Plain);
         }
-        let mut names = Vec::new();
-        for (p, (_, off)) in trimmed.iter().zip(&parts) {
-            let is_name = p
-                .chars()
-                .next()
-                .is_some_and(|c| c.is_alphabetic() || c == '_')
-                && p.chars().all(|c| c.is_alphanumeric() || c == '_');
-            if !is_name {
-                let e = IndexError {
-                    span: *off..off + p.len().max(1),
-                    message: format!("a family is declared over index names (`{base}[i,j]`), not `{p}`: index arithmetic belongs where members are used"),
-                };
-                return Err(located(self.ld, &name.span(), e));
-            }
-            if names.contains(&p.to_string()) {
+        let mut names: Vec<(String, usize)> = Vec::new();
+        for (p, (raw, off)) in trimmed.iter().zip(&parts) {
+            if is_index_name(p) && names.iter().any(|(n, _)| n == p) {
                 return Err(self.ld.err(
                     name.span(),
                     format!("index `{p}` appears twice in `{text}`"),
                 ));
             }
-            names.push(p.to_string());
+            let lead = raw.len() - raw.trim_start().len();
+            names.push((p.to_string(), off + lead));
         }
         if names.len() > 2 {
             return Err(self.ld.err(
@@ -333,17 +500,48 @@ impl<'l, 'a> Expander<'l, 'a> {
                     name: n.clone(),
                     span: 0..0,
                     range: None,
+                    table: None,
                 })
                 .collect(),
         };
         let mut out = Domain {
             names: Vec::new(),
             ranges: Vec::new(),
+            tables: Vec::new(),
             condition: None,
         };
-        let lookup = self.indices.lookup(&[]);
+        let lookup = self.indices.lookup(&[], &[]);
         for c in &clauses {
+            let mut table = None;
             let range = match &c.range {
+                _ if c.table.is_some() => {
+                    let (t, at) = c.table.clone().unwrap_or_default();
+                    let Some(k) = self.indices.tables.iter().position(|x| x.name == t) else {
+                        let span = match for_list {
+                            Some(sv) => {
+                                let s = text_start(self.ld, &sv.span());
+                                s + at.start..s + at.end
+                            }
+                            None => at.clone(),
+                        };
+                        let declared: Vec<String> =
+                            self.indices.tables.iter().map(|x| x.name.clone()).collect();
+                        let help = if declared.is_empty() {
+                            "declare it as [tables.NAME] with file = \"NAME.csv\", or give a range: i in 0..n-1".to_string()
+                        } else {
+                            format!(
+                                "the tables are {}; a range is written i in 0..n-1",
+                                super::row_tables::quoted_list(&declared)
+                            )
+                        };
+                        return Err(self
+                            .ld
+                            .err(span, format!("`{t}` is not a table: `{} in {t}` runs over the rows of a [tables.{t}]", c.name))
+                            .help(help));
+                    };
+                    table = Some(k);
+                    (0, self.indices.tables[k].len() as i64 - 1)
+                }
                 Some(r) => {
                     // A range is written in a `for` list; its clause's own span otherwise.
                     let span = for_list.map_or(c.span.clone(), |sv| sv.span());
@@ -383,6 +581,7 @@ impl<'l, 'a> Expander<'l, 'a> {
             }
             out.names.push(c.name.clone());
             out.ranges.push(range);
+            out.tables.push(table);
         }
         for n in names {
             if !out.names.contains(n) {
@@ -412,7 +611,7 @@ impl<'l, 'a> Expander<'l, 'a> {
         at: &Range<usize>,
         base: &str,
         domain: &Domain,
-        mut make: impl FnMut(&mut Self, &[(String, i64)]) -> Result<(), ModelError>,
+        mut make: impl FnMut(&mut Self, &[(String, i64)], &[(usize, usize)]) -> Result<(), ModelError>,
     ) -> Result<(), ModelError> {
         let count = domain.count();
         self.members = self.members.saturating_add(count);
@@ -430,30 +629,41 @@ impl<'l, 'a> Expander<'l, 'a> {
         let mut any = false;
         let mut values: Vec<i64> = domain.ranges.iter().map(|r| r.0).collect();
         'all: loop {
+            // A table's index takes each row's key; the row itself is kept for its cells.
+            let mut rows: Rows = Vec::new();
             let bindings: Vec<(String, i64)> = domain
                 .names
                 .iter()
-                .cloned()
-                .zip(values.iter().copied())
+                .zip(&values)
+                .zip(&domain.tables)
+                .map(|((n, &v), t)| match t {
+                    Some(t) => {
+                        rows.push((*t, v as usize));
+                        (n.clone(), self.indices.tables[*t].keys[v as usize])
+                    }
+                    None => (n.clone(), v),
+                })
                 .collect();
             let keep = match &domain.condition {
                 None => true,
-                Some((e, sv)) => e.condition(&self.indices.lookup(&bindings)).map_err(|e| {
-                    let e = if e.span == (0..0) {
-                        IndexError {
-                            span: 0..self.ld.source[sv.span()].len().saturating_sub(2),
-                            message: e.message,
-                        }
-                    } else {
-                        e
-                    };
-                    let err = located(self.ld, &sv.span(), e);
-                    in_member(err, &label(base, &bindings))
-                })?,
+                Some((e, sv)) => e
+                    .condition(&self.indices.lookup(&bindings, &rows))
+                    .map_err(|e| {
+                        let e = if e.span == (0..0) {
+                            IndexError {
+                                span: 0..self.ld.source[sv.span()].len().saturating_sub(2),
+                                message: e.message,
+                            }
+                        } else {
+                            e
+                        };
+                        let err = located(self.ld, &sv.span(), e);
+                        in_member(err, &self.indices.label(base, &bindings, &rows))
+                    })?,
             };
             if keep {
                 any = true;
-                make(self, &bindings)?;
+                make(self, &bindings, &rows)?;
             }
             for k in (0..values.len()).rev() {
                 if values[k] < domain.ranges[k].1 {
@@ -483,6 +693,7 @@ impl<'l, 'a> Expander<'l, 'a> {
         name: &Name,
         base: &str,
         ranges: &[(i64, i64)],
+        rows: Option<FxHashSet<Vec<i64>>>,
     ) -> Result<(), ModelError> {
         match self.indices.shapes.get_mut(base) {
             None => {
@@ -490,12 +701,18 @@ impl<'l, 'a> Expander<'l, 'a> {
                     base.to_string(),
                     Shape {
                         ranges: ranges.to_vec(),
+                        rows,
                     },
                 );
             }
             Some(shape) if shape.ranges.len() == ranges.len() => {
                 for (s, r) in shape.ranges.iter_mut().zip(ranges) {
                     *s = (s.0.min(r.0), s.1.max(r.1));
+                }
+                match (&mut shape.rows, rows) {
+                    (Some(a), Some(b)) => a.extend(b),
+                    // A declaration over whole ranges: every member inside them may exist.
+                    (a, _) => *a = None,
                 }
             }
             Some(shape) => {
@@ -546,7 +763,7 @@ impl<'l, 'a> Expander<'l, 'a> {
                         Some(_) => Spanned::new(
                             name.span(),
                             self.indices
-                                .member_name(name.get_ref(), &[])
+                                .member_name(name.get_ref(), &[], &[])
                                 .map_err(|e| located(self.ld, &name.span(), e))?
                                 .unwrap_or_else(|| name.get_ref().clone()),
                         ),
@@ -555,15 +772,59 @@ impl<'l, 'a> Expander<'l, 'a> {
                     self.insert(&mut out, key, value)?;
                     members.push(None);
                 }
-                Head::Family(base, names) => {
+                Head::Family(base, parts) => {
                     let base = base.to_string();
                     let (value, for_list, condition) = split(self, &value)?;
+                    let index_names: Vec<String> = parts
+                        .iter()
+                        .filter(|(p, _)| is_index_name(p))
+                        .map(|(p, _)| p.clone())
+                        .collect();
+                    // Without `for`, the head's names take their [indices] ranges; with it, the
+                    // names are checked below (a family over table rows has none to check).
+                    let implied: &[String] = if for_list.is_some() {
+                        &[]
+                    } else {
+                        &index_names
+                    };
                     let domain = self.domain(
                         &span_of(&value),
-                        &names,
+                        implied,
                         for_list.as_ref(),
                         condition.as_ref(),
                     )?;
+                    if domain.tables.iter().any(Option::is_some) {
+                        // Over table rows: each part of the name an index expression of the
+                        // row (`N[r]`, `P[nodes_i, nodes_j]`).
+                        self.table_family(
+                            &name,
+                            &base,
+                            &parts,
+                            &domain,
+                            &value,
+                            &mut out,
+                            &mut members,
+                        )?;
+                        continue;
+                    }
+                    for (p, off) in &parts {
+                        if !is_index_name(p) {
+                            let e = IndexError {
+                                span: *off..off + p.len().max(1),
+                                message: format!("a family is declared over index names (`{base}[i,j]`), not `{p}`: index arithmetic belongs where members are used"),
+                            };
+                            return Err(located(self.ld, &name.span(), e));
+                        }
+                    }
+                    let names = index_names;
+                    for n in &names {
+                        if !domain.names.contains(n) {
+                            let span = for_list.as_ref().map_or(span_of(&value), |sv| sv.span());
+                            return Err(self
+                                .ld
+                                .err(span, format!("`for` gives no range to index `{n}`")));
+                        }
+                    }
                     // The shape is the ranges declared, whatever `where` leaves out.
                     let ranges: Vec<(i64, i64)> = names
                         .iter()
@@ -571,22 +832,79 @@ impl<'l, 'a> Expander<'l, 'a> {
                             domain.ranges[domain.names.iter().position(|d| d == n).unwrap_or(0)]
                         })
                         .collect();
-                    self.record_shape(&name, &base, &ranges)?;
+                    self.record_shape(&name, &base, &ranges, None)?;
                     let family: Rc<str> = Rc::from(base.as_str());
-                    self.each(&name.span(), &base, &domain, |ex, bindings| {
+                    self.each(&name.span(), &base, &domain, |ex, bindings, rows| {
                         let values: Vec<i64> = names
                             .iter()
                             .map(|n| bindings.iter().find(|b| &b.0 == n).map_or(0, |b| b.1))
                             .collect();
                         let key = Spanned::new(name.span(), member(&base, &values));
                         ex.insert(&mut out, key, value.clone())?;
-                        members.push(Some(Member::of(&family, bindings)));
+                        members.push(Some(Member::of(&family, bindings, rows)));
                         Ok(())
                     })?;
                 }
             }
         }
         Ok((out, members))
+    }
+
+    /// The members of a family over table rows, named by index expressions of each row
+    /// (`N[r]`, `P[nodes_i, nodes_j]`); its shape is the names its rows give.
+    #[allow(clippy::too_many_arguments)]
+    fn table_family<V: Clone>(
+        &mut self,
+        name: &Name,
+        base: &str,
+        parts: &[(String, usize)],
+        domain: &Domain,
+        value: &V,
+        out: &mut IndexMap<Name, V>,
+        members: &mut Vec<Option<Member>>,
+    ) -> Result<(), ModelError> {
+        let mut exprs = Vec::with_capacity(parts.len());
+        for (p, off) in parts {
+            let e = index_expr::parse(p).map_err(|e| {
+                let e = IndexError {
+                    span: e.span.start + off..e.span.end + off,
+                    message: e.message,
+                };
+                located(self.ld, &name.span(), e)
+            })?;
+            exprs.push((e, *off, p.len()));
+        }
+        let family: Rc<str> = Rc::from(base);
+        let mut declared: FxHashSet<Vec<i64>> = FxHashSet::default();
+        let mut ranges = vec![(i64::MAX, i64::MIN); parts.len()];
+        self.each(&name.span(), base, domain, |ex, bindings, rows| {
+            let label = || ex.indices.label(base, bindings, rows);
+            let mut values = Vec::with_capacity(exprs.len());
+            {
+                let lookup = ex.indices.lookup(bindings, rows);
+                for (e, off, len) in &exprs {
+                    let v = e.int(&lookup).map_err(|e| {
+                        let span = if e.span == (0..0) { 0..*len } else { e.span };
+                        let e = IndexError {
+                            span: span.start + off..span.end + off,
+                            message: e.message,
+                        };
+                        in_member(located(ex.ld, &name.span(), e), &label())
+                    })?;
+                    values.push(v);
+                }
+            }
+            for (r, &v) in ranges.iter_mut().zip(&values) {
+                *r = (r.0.min(v), r.1.max(v));
+            }
+            let key = Spanned::new(name.span(), member(base, &values));
+            ex.insert(out, key, value.clone())
+                .map_err(|e| in_member(e, &label()))?;
+            declared.insert(values);
+            members.push(Some(Member::of(&family, bindings, rows)));
+            Ok(())
+        })?;
+        self.record_shape(name, base, &ranges, Some(declared))
     }
 
     fn insert<V>(
@@ -609,10 +927,15 @@ impl<'l, 'a> Expander<'l, 'a> {
     }
 
     /// A name field of a force member: `P[i+1, j]` → `P[4,3]`.
-    fn resolve_name(&self, name: &Name, bindings: &[(String, i64)]) -> Result<Name, ModelError> {
+    fn resolve_name(
+        &self,
+        name: &Name,
+        bindings: &[(String, i64)],
+        rows: &[(usize, usize)],
+    ) -> Result<Name, ModelError> {
         match self
             .indices
-            .member_name(name.get_ref(), bindings)
+            .member_name(name.get_ref(), bindings, rows)
             .map_err(|e| located(self.ld, &name.span(), e))?
         {
             Some(n) => Ok(Spanned::new(name.span(), n)),
@@ -626,11 +949,12 @@ impl<'l, 'a> Expander<'l, 'a> {
         &self,
         raw: &RawForce,
         bindings: &[(String, i64)],
+        rows: &[(usize, usize)],
     ) -> Result<Names, ModelError> {
         let names = |field: &Option<Name>| -> Result<Option<Name>, ModelError> {
             field
                 .as_ref()
-                .map(|n| self.resolve_name(n, bindings))
+                .map(|n| self.resolve_name(n, bindings, rows))
                 .transpose()
         };
         let between = match &raw.between {
@@ -638,7 +962,7 @@ impl<'l, 'a> Expander<'l, 'a> {
                 let ends = b
                     .get_ref()
                     .iter()
-                    .map(|n| self.resolve_name(n, bindings))
+                    .map(|n| self.resolve_name(n, bindings, rows))
                     .collect::<Result<Vec<_>, _>>()?;
                 Some(Spanned::new(b.span(), ends))
             }
@@ -659,11 +983,12 @@ impl<'l, 'a> Expander<'l, 'a> {
         f: &Spanned<RawForce>,
         base: &str,
         bindings: &[(String, i64)],
+        rows: &[(usize, usize)],
     ) -> Result<Names, ModelError> {
         let raw = f.get_ref();
-        let mut m = self.resolve_names(raw, bindings)?;
+        let mut m = self.resolve_names(raw, bindings, rows)?;
         m.name = Some(match &raw.name {
-            Some(n) if n.get_ref().contains('[') => self.resolve_name(n, bindings)?,
+            Some(n) if n.get_ref().contains('[') => self.resolve_name(n, bindings, rows)?,
             Some(n) => Spanned::new(n.span(), label(n.get_ref(), bindings)),
             None => Spanned::new(f.span(), label(base, bindings)),
         });
@@ -690,7 +1015,7 @@ impl<'l, 'a> Expander<'l, 'a> {
                             "add for = \"i in 0..n-2\" (or the indices declared under [indices])",
                         ));
                 }
-                let names = self.resolve_names(raw, &[])?;
+                let names = self.resolve_names(raw, &[], &[])?;
                 out.push(ForceEntry { entry, names });
                 members.push(None);
                 continue;
@@ -702,12 +1027,12 @@ impl<'l, 'a> Expander<'l, 'a> {
             };
             let domain = self.domain(&f.span(), &[], Some(&for_list), raw.condition.as_ref())?;
             let family: Rc<str> = Rc::from(base.as_str());
-            self.each(&for_list.span(), &base, &domain, |ex, bindings| {
+            self.each(&for_list.span(), &base, &domain, |ex, bindings, rows| {
                 let names = ex
-                    .force_member(f, &base, bindings)
-                    .map_err(|e| in_member(e, &label(&base, bindings)))?;
+                    .force_member(f, &base, bindings, rows)
+                    .map_err(|e| in_member(e, &ex.indices.label(&base, bindings, rows)))?;
                 out.push(ForceEntry { entry, names });
-                members.push(Some(Member::of(&family, bindings)));
+                members.push(Some(Member::of(&family, bindings, rows)));
                 Ok(())
             })?;
         }
@@ -801,7 +1126,17 @@ pub(crate) fn expand(
     ld: &mut Loader,
     mut raw: RawModel,
 ) -> Result<(RawModel, Members), ModelError> {
-    let indices = read_indices(ld, &raw)?;
+    let tables = ld.read_row_tables(&raw)?;
+    let mut indices = read_indices(ld, &raw)?;
+    for (k, t) in tables.into_iter().enumerate() {
+        for (c, column) in t.column_names().iter().enumerate() {
+            indices
+                .columns
+                .insert(format!("{}_{column}", t.name), (k, c));
+        }
+        indices.sizes.insert(t.name.clone(), t.len() as i64);
+        indices.tables.push(Rc::new(t));
+    }
     if indices.ranges.is_empty() && indices.sizes.is_empty() && !mentions_families(&raw) {
         let members = Members {
             coordinates: vec![None; raw.coordinates.len()],
@@ -910,7 +1245,7 @@ fn read_indices(ld: &mut Loader, raw: &RawModel) -> Result<Indices, ModelError> 
             toml::Value::String(text) => {
                 let r = index_expr::parse_range(text).map_err(|e| located(ld, &sv.span(), e))?;
                 let (lo, hi) = {
-                    let lookup = indices.lookup(&[]);
+                    let lookup = indices.lookup(&[], &[]);
                     let lo = r.lo.int(&lookup).map_err(|e| located(ld, &sv.span(), e))?;
                     let hi = r.hi.int(&lookup).map_err(|e| located(ld, &sv.span(), e))?;
                     (lo, hi)

@@ -1,7 +1,7 @@
 //! The small language of indices in a model file's families: integer arithmetic on index
 //! names and sizes (`i+1`, `n-1`, `2*k`, `j % 2`), conditions (`j == 0 and (i == 0 or i ==
 //! n-1)`), ranges (`0..n-1`, both ends included as in "i = 0, …, n−1") and the `for` list of
-//! a force family (`i in 0..n-2, j`). It is separate from the expression language because
+//! a force family (`i in 0..n-2, j`, or `e in bars` over the rows of a table). It is separate from the expression language because
 //! indices are exact integers known while the file loads, never symbols.
 //!
 //! Errors carry a byte range in the text they were parsed from; the caller places it in the
@@ -79,7 +79,7 @@ pub struct RangeExpr {
 }
 
 /// One clause of a `for` list: an index name and, unless it takes its `[indices]` range, a
-/// range of its own.
+/// range of its own or the table whose rows it runs over.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ForClause {
     /// The index name.
@@ -88,7 +88,14 @@ pub struct ForClause {
     pub span: Range<usize>,
     /// `in lo..hi`, if written.
     pub range: Option<RangeExpr>,
+    /// `in TABLE` (a `[tables.TABLE]`), if written: the table's name and where it is written.
+    pub table: Option<(String, Range<usize>)>,
 }
+
+/// What a name stands for while an index expression is evaluated: its value, nothing
+/// (`Ok(None)`: an unknown name), or why it has no integer value (a table's cell that is not
+/// an integer).
+pub type Lookup<'a> = dyn Fn(&str) -> Result<Option<i64>, String> + 'a;
 
 #[derive(Clone, Debug, PartialEq, Eq)]
 enum Tok {
@@ -372,16 +379,33 @@ pub fn parse_for(text: &str) -> Result<Vec<ForClause>, IndexError> {
             );
         };
         p.bump();
-        let range = if p.is_word("in") {
+        let (range, table) = if p.is_word("in") {
             p.bump();
-            Some(p.range()?)
+            // `e in bars`: a name alone (up to `,` or the end) is a table, not a range.
+            let alone = matches!(
+                p.toks.get(p.at + 1).map(|t| &t.0),
+                Some(Tok::End) | Some(Tok::Sym(","))
+            );
+            match p.peek().clone() {
+                Tok::Name(t) if alone => {
+                    let at = p.span();
+                    p.bump();
+                    (None, Some((t, at)))
+                }
+                _ => (Some(p.range()?), None),
+            }
         } else {
-            None
+            (None, None)
         };
         if out.iter().any(|c: &ForClause| c.name == name) {
             return fail(span, format!("index `{name}` is listed twice"));
         }
-        out.push(ForClause { name, span, range });
+        out.push(ForClause {
+            name,
+            span,
+            range,
+            table,
+        });
         if p.is_sym(",") {
             p.bump();
             continue;
@@ -407,15 +431,16 @@ pub fn split_subscript(name: &str) -> Option<(&str, Vec<(&str, usize)>)> {
 
 impl IndexExpr {
     /// The value, with `lookup` giving the value of a name.
-    pub fn eval(&self, lookup: &dyn Fn(&str) -> Option<i64>) -> Result<IndexValue, IndexError> {
+    pub fn eval(&self, lookup: &Lookup) -> Result<IndexValue, IndexError> {
         match self {
             IndexExpr::Int(n) => Ok(IndexValue::Int(*n)),
             IndexExpr::Name(n, span) => match lookup(n) {
-                Some(v) => Ok(IndexValue::Int(v)),
-                None => fail(
+                Ok(Some(v)) => Ok(IndexValue::Int(v)),
+                Ok(None) => fail(
                     span.clone(),
                     format!("`{n}` is not an index here, nor a size declared in [indices]"),
                 ),
+                Err(message) => fail(span.clone(), message),
             },
             IndexExpr::Neg(e) => match e.eval(lookup)? {
                 IndexValue::Int(v) => v
@@ -436,8 +461,26 @@ impl IndexExpr {
         }
     }
 
+    /// The names the expression uses, in order (with repeats).
+    pub fn names(&self) -> Vec<&str> {
+        let mut out = Vec::new();
+        let mut stack = vec![self];
+        while let Some(e) = stack.pop() {
+            match e {
+                IndexExpr::Int(_) => {}
+                IndexExpr::Name(n, _) => out.push(n.as_str()),
+                IndexExpr::Neg(a) | IndexExpr::Not(a) => stack.push(a),
+                IndexExpr::Binary(_, a, b, _) => {
+                    stack.push(b);
+                    stack.push(a);
+                }
+            }
+        }
+        out
+    }
+
     /// The value as an integer.
-    pub fn int(&self, lookup: &dyn Fn(&str) -> Option<i64>) -> Result<i64, IndexError> {
+    pub fn int(&self, lookup: &Lookup) -> Result<i64, IndexError> {
         match self.eval(lookup)? {
             IndexValue::Int(v) => Ok(v),
             IndexValue::Bool(_) => fail(0..0, "expected a number, found a condition"),
@@ -445,7 +488,7 @@ impl IndexExpr {
     }
 
     /// The value as a condition.
-    pub fn condition(&self, lookup: &dyn Fn(&str) -> Option<i64>) -> Result<bool, IndexError> {
+    pub fn condition(&self, lookup: &Lookup) -> Result<bool, IndexError> {
         match self.eval(lookup)? {
             IndexValue::Bool(b) => Ok(b),
             IndexValue::Int(_) => fail(
@@ -501,13 +544,13 @@ fn binary(
 mod tests {
     use super::*;
 
-    fn lookup(name: &str) -> Option<i64> {
-        match name {
+    fn lookup(name: &str) -> Result<Option<i64>, String> {
+        Ok(match name {
             "i" => Some(3),
             "j" => Some(0),
             "n" => Some(5),
             _ => None,
-        }
+        })
     }
 
     #[test]
@@ -532,6 +575,11 @@ mod tests {
         assert_eq!(f.len(), 2);
         assert!(f[0].range.is_some() && f[1].range.is_none());
         assert!(parse_for("i, i").unwrap_err().message.contains("twice"));
+        // A name alone after `in` is a table; a range may still start with a size.
+        let f = parse_for("e in bars, j in n..n+1").unwrap();
+        assert_eq!(f[0].table, Some(("bars".to_string(), 5..9)));
+        assert!(f[0].range.is_none() && f[1].table.is_none() && f[1].range.is_some());
+        assert!(parse_for("e in bars j").is_err());
     }
 
     #[test]

@@ -24,6 +24,8 @@ pub(crate) struct ModelScope {
     pub(super) indices: Indices,
     /// The indices of the family member being read (`i = 3, j = 4`), empty elsewhere.
     pub(super) bindings: Vec<(String, i64)>,
+    /// The table rows that member stands for (`[tables.NAME]`), empty elsewhere.
+    pub(super) rows: Vec<(usize, usize)>,
     /// The names `[indices]` declares as indices: no other entry may take them.
     pub(super) index_names: Vec<String>,
 }
@@ -42,9 +44,31 @@ impl Scope for ModelScope {
         if let Some((_, v)) = self.bindings.iter().find(|(n, _)| n == name) {
             return Some(Binding::Value(Value::Scalar(pool.int(*v))));
         }
+        // A table's column: the value in the member's row (`nodes_x`) or in the row named
+        // (`nodes_x[bars_a]`); a column without a row is no value (`undefined` says why).
+        if self.indices.columns.contains_key(name) {
+            let cell = self.indices.cell(name, &self.rows).ok()??;
+            return Some(Binding::Value(Value::Scalar(cell_number(
+                pool,
+                cell.value(),
+            ))));
+        }
         if name.ends_with(']') {
+            if let Some(cell) = self
+                .indices
+                .subscripted_cell(name, &self.bindings, &self.rows)
+                .ok()?
+            {
+                return Some(Binding::Value(Value::Scalar(cell_number(
+                    pool,
+                    cell.value(),
+                ))));
+            }
             // `x[i+1, j]`: the member the subscript names with the current indices.
-            let member = self.indices.member_name(name, &self.bindings).ok()??;
+            let member = self
+                .indices
+                .member_name(name, &self.bindings, &self.rows)
+                .ok()??;
             return self.lookup(&member);
         }
         self.lookup(name)
@@ -55,11 +79,23 @@ impl Scope for ModelScope {
         v
     }
     fn undefined(&self, name: &str) -> Option<(String, Option<String>)> {
+        if let Err(message) = self.indices.cell(name, &self.rows) {
+            return Some((message, None));
+        }
+        if let Err(e) = self
+            .indices
+            .subscripted_cell(name, &self.bindings, &self.rows)
+        {
+            return Some((e.message, None));
+        }
+        if let Some(m) = self.missing_column(name) {
+            return Some(m);
+        }
         if !name.ends_with(']') {
             return None;
         }
         let help = "a member is written NAME[i] or NAME[i,j] with indices in its family's ranges";
-        match self.indices.member_name(name, &self.bindings) {
+        match self.indices.member_name(name, &self.bindings, &self.rows) {
             Err(e) => Some((e.message, Some(help.to_string()))),
             Ok(Some(member)) => {
                 let base = member.split('[').next().unwrap_or_default();
@@ -74,6 +110,43 @@ impl Scope for ModelScope {
             }
             Ok(None) => None,
         }
+    }
+}
+
+impl ModelScope {
+    /// `bars_EA` when table `bars` has no column `EA`: the message and the columns it has.
+    fn missing_column(&self, name: &str) -> Option<(String, Option<String>)> {
+        let base = name.split('[').next().unwrap_or(name);
+        if self.indices.columns.contains_key(base) {
+            return None;
+        }
+        let table = self.indices.tables.iter().find(|t| {
+            base.strip_prefix(t.name.as_str())
+                .and_then(|rest| rest.strip_prefix('_'))
+                .is_some_and(|c| !c.is_empty())
+        })?;
+        let column = &base[table.name.len() + 1..];
+        Some((
+            format!(
+                "table `{}` ({}) has no column `{column}`",
+                table.name, table.file
+            ),
+            Some(format!(
+                "its columns are {} (written {}_COLUMN)",
+                super::row_tables::quoted_list(table.column_names()),
+                table.name
+            )),
+        ))
+    }
+}
+
+/// A table's value in an expression: an integer as an integer (so `nodes_i*a` is the same
+/// expression as `i*a` over an index), anything else as the number it is.
+fn cell_number(pool: &mut Pool, x: f64) -> Id {
+    if x.fract() == 0.0 && x.abs() < 9_007_199_254_740_992.0 {
+        pool.int(x as i64)
+    } else {
+        pool.num(Number::Float(x))
     }
 }
 
@@ -153,8 +226,13 @@ impl<'a> Loader<'a> {
             Table::Forces => &self.members.forces,
         };
         match list.get(k).and_then(Option::as_ref) {
-            Some(Member { base, bindings }) => {
+            Some(Member {
+                base,
+                bindings,
+                rows,
+            }) => {
                 self.scope.bindings.clone_from(bindings);
+                self.scope.rows.clone_from(rows);
                 self.member = Some(Rc::clone(base));
             }
             None => self.leave(),
@@ -164,6 +242,7 @@ impl<'a> Loader<'a> {
     /// Done with the entries of families.
     pub(super) fn leave(&mut self) {
         self.scope.bindings.clear();
+        self.scope.rows.clear();
         self.member = None;
     }
 
@@ -172,11 +251,10 @@ impl<'a> Loader<'a> {
         match &self.member {
             Some(base) => in_member(
                 err,
-                &Member {
-                    base: Rc::clone(base),
-                    bindings: self.scope.bindings.clone(),
-                }
-                .label(),
+                &self
+                    .scope
+                    .indices
+                    .label(base, &self.scope.bindings, &self.scope.rows),
             ),
             None => err,
         }

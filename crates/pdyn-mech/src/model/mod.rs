@@ -16,6 +16,7 @@ mod forces;
 pub mod index_expr;
 mod loader;
 pub(crate) mod raw;
+mod row_tables;
 pub mod spec;
 mod tables;
 mod unknown_initials;

@@ -53,6 +53,23 @@ pub struct RawModel {
     /// `[data.NAME]`: measured time series ([`super::data`]).
     #[serde(default)]
     pub data: IndexMap<Name, Spanned<RawData>>,
+    /// `[tables.NAME]`: node and element tables that families run over
+    /// ([`super::row_tables`]).
+    #[serde(default)]
+    pub tables: IndexMap<Name, Spanned<RawTable>>,
+}
+
+/// `[tables.NAME]`: a CSV (or Parquet) file of rows, one family member per row.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawTable {
+    /// The file, relative to the model file.
+    pub file: Option<Spanned<String>>,
+    /// The integer column that names the rows (`id`); without it a row is named by its
+    /// 0-based number.
+    pub key: Option<Name>,
+    /// The columns read (default: every column; each must hold numbers).
+    pub columns: Option<Spanned<Vec<Name>>>,
 }
 
 /// `[data.NAME]`: a CSV time series whose columns become functions of time.

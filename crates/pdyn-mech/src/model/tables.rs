@@ -553,7 +553,10 @@ impl Loader<'_> {
             fb.gravity(self, g);
         }
         let mut deferrer = super::deferred::Deferrer::default();
-        let index_names: Vec<String> = self.scope.indices.ranges.keys().cloned().collect();
+        // A field naming an index or a table's column differs from member to member: such
+        // a family is built in full, never deferred to its representative.
+        let mut index_names: Vec<String> = self.scope.indices.ranges.keys().cloned().collect();
+        index_names.extend(self.scope.indices.columns.keys().cloned());
         let entries = std::mem::take(&mut self.members.force_entries);
         for (k, fe) in entries.iter().enumerate() {
             self.enter(Table::Forces, k);
