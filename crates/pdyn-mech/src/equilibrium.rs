@@ -10,7 +10,7 @@
 //! does not. Where `μ` must grow past any bound, no state balances the forces: the stiffness is
 //! singular along the directions the forces push (a mechanism), which are named.
 
-use crate::linearization::{Linearization, Linearizer};
+use crate::linearization::{Linearization, Linearize};
 use nalgebra::{DMatrix, DVector};
 
 /// Knobs of [`solve`].
@@ -21,6 +21,10 @@ pub struct EquilibriumOptions {
     pub tolerance: f64,
     /// Most steps. Default 200.
     pub max_steps: usize,
+    /// Whether to look for the directions along which the equilibrium found is neutral
+    /// ([`Equilibrium::neutral`]; an eigenproblem of its own). Default true; the modes skip it,
+    /// since they show such directions as zero frequencies.
+    pub neutral: bool,
 }
 
 impl Default for EquilibriumOptions {
@@ -28,6 +32,7 @@ impl Default for EquilibriumOptions {
         EquilibriumOptions {
             tolerance: 1e-12,
             max_steps: 200,
+            neutral: true,
         }
     }
 }
@@ -158,13 +163,13 @@ fn max_abs(v: &DVector<f64>) -> f64 {
 }
 
 /// The equilibrium nearest `start` (default: the initial values).
-pub fn solve(
-    lin: &Linearizer,
+pub fn solve<L: Linearize + ?Sized>(
+    lin: &L,
     start: Option<&[f64]>,
     opts: &EquilibriumOptions,
 ) -> Result<Equilibrium, EquilibriumError> {
     let n = lin.len();
-    let q = DVector::from_column_slice(start.unwrap_or(&lin.initial));
+    let q = DVector::from_column_slice(start.unwrap_or(lin.initial()));
     let at = lin.at(q.as_slice());
     let stiff = (0..n).fold(0.0f64, |m, i| m.max(at.stiffness[(i, i)].abs()));
     let length = max_abs(&q).max(1.0);
@@ -187,7 +192,11 @@ pub fn solve(
         opts,
     )?;
     let (q, at, residual, steps) = (end.q, end.at, end.residual, end.steps);
-    let neutral = free_directions(&lin.names, &at.stiffness);
+    let neutral = if opts.neutral {
+        free_directions(lin.names(), &at.stiffness)
+    } else {
+        Vec::new()
+    };
     Ok(Equilibrium {
         q,
         residual,
@@ -199,9 +208,9 @@ pub fn solve(
 }
 
 /// The dense path of damped Newton: `K` as it is, solved by LU.
-struct Dense<'a>(&'a Linearizer);
+struct Dense<'a, L: ?Sized>(&'a L);
 
-impl crate::damped_newton::NewtonSystem for Dense<'_> {
+impl<L: Linearize + ?Sized> crate::damped_newton::NewtonSystem for Dense<'_, L> {
     type At = Linearization;
 
     fn at(&self, q: &[f64]) -> Linearization {
@@ -223,7 +232,7 @@ impl crate::damped_newton::NewtonSystem for Dense<'_> {
     }
 
     fn free_directions(&self, at: &Linearization) -> Vec<FreeDirection> {
-        free_directions(&self.0.names, &at.stiffness)
+        free_directions(self.0.names(), &at.stiffness)
     }
 }
 
@@ -246,10 +255,11 @@ pub fn free_directions(names: &[String], stiffness: &DMatrix<f64>) -> Vec<FreeDi
 
 /// The reactions of the supports holding the model's points (pins): minus the sum of the
 /// forces the two-body forces put on each point, at rest at `q` (t = 0). Points no force
-/// touches are left out.
+/// touches are left out. `state` is the state's symbols, coordinates then rates
+/// ([`crate::Derivation::state`]).
 pub fn support_reactions(
     model: &mut crate::Model,
-    d: &crate::Derivation,
+    state: &[pdyn_expr::Id],
     q: &[f64],
 ) -> Result<Vec<(String, [f64; 3])>, crate::linearization::LinearizationError> {
     let mut names: Vec<String> = Vec::new();
@@ -273,7 +283,7 @@ pub fn support_reactions(
         sums.push(total.map(|c| model.pool.neg(c)));
     }
     let outputs: Vec<pdyn_expr::Id> = sums.iter().flatten().copied().collect();
-    let out = at_rest(model, d, q, &outputs)?;
+    let out = at_rest(model, state, q, &outputs)?;
     Ok(names
         .into_iter()
         .enumerate()
@@ -282,14 +292,14 @@ pub fn support_reactions(
 }
 
 /// The tension of every spring and damper ([`crate::model::AxialForce`]) at rest at `q`
-/// (t = 0): a truss's bar forces, positive in tension.
+/// (t = 0): a truss's bar forces, positive in tension. `state` as for [`support_reactions`].
 pub fn axial_forces(
     model: &mut crate::Model,
-    d: &crate::Derivation,
+    state: &[pdyn_expr::Id],
     q: &[f64],
 ) -> Result<Vec<(String, f64)>, crate::linearization::LinearizationError> {
     let outputs: Vec<pdyn_expr::Id> = model.axial.iter().map(|a| a.tension).collect();
-    let out = at_rest(model, d, q, &outputs)?;
+    let out = at_rest(model, state, q, &outputs)?;
     Ok(model
         .axial
         .iter()
@@ -301,17 +311,17 @@ pub fn axial_forces(
 /// `outputs` evaluated at rest at `q` (t = 0, rates zero), the parameters at their values.
 fn at_rest(
     model: &mut crate::Model,
-    d: &crate::Derivation,
+    state: &[pdyn_expr::Id],
     q: &[f64],
     outputs: &[pdyn_expr::Id],
 ) -> Result<Vec<f64>, crate::linearization::LinearizationError> {
     let p = &mut model.pool;
     let mut inputs = vec![p.time()];
-    inputs.extend(&d.state);
+    inputs.extend(state);
     inputs.extend(model.parameters.iter().map(|par| par.id));
     let prog = pdyn_expr::Program::compile(p, &inputs, outputs)
         .map_err(|e| crate::linearization::LinearizationError::Compile(e.to_string()))?;
-    let n = d.free.len();
+    let n = state.len() / 2;
     let mut input = vec![0.0; inputs.len()];
     input[1..1 + n].copy_from_slice(q);
     for (k, par) in model.parameters.iter().enumerate() {

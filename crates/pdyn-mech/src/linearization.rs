@@ -98,6 +98,51 @@ impl SparseLinearization {
     }
 }
 
+/// What the statics ([`crate::equilibrium`], [`crate::sparse_statics`],
+/// [`crate::statics::modes_of`]) read of a model linearized at rest: the symbolic
+/// [`Linearizer`] of any model, or a numeric one built from compiled per-element kernels
+/// (`pdyn`'s path for many free particles), which never forms the equations symbolically.
+pub trait Linearize {
+    /// Names of the free coordinates, in state order.
+    fn names(&self) -> &[String];
+    /// Initial values of the free coordinates.
+    fn initial(&self) -> &[f64];
+    /// Number of free coordinates.
+    fn len(&self) -> usize {
+        self.names().len()
+    }
+    /// True when there is no coordinate.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// `M`, `K`, `C` and `f` at rest at `q` (t = 0), sparse.
+    fn at_sparse(&self, q: &[f64]) -> SparseLinearization;
+    /// The same, dense (for small systems).
+    fn at(&self, q: &[f64]) -> Linearization {
+        self.at_sparse(q).to_dense()
+    }
+    /// `M r_d` at rest at `q`, for d = x, y, z ([`Linearizer::inertia_at`]).
+    fn inertia_at(&self, q: &[f64]) -> [Vec<f64>; 3];
+}
+
+impl Linearize for Linearizer {
+    fn names(&self) -> &[String] {
+        &self.names
+    }
+    fn initial(&self) -> &[f64] {
+        &self.initial
+    }
+    fn at_sparse(&self, q: &[f64]) -> SparseLinearization {
+        Linearizer::at_sparse(self, q)
+    }
+    fn at(&self, q: &[f64]) -> Linearization {
+        Linearizer::at(self, q)
+    }
+    fn inertia_at(&self, q: &[f64]) -> [Vec<f64>; 3] {
+        Linearizer::inertia_at(self, q)
+    }
+}
+
 /// Where each compiled output goes.
 #[derive(Clone, Debug)]
 enum Slot {

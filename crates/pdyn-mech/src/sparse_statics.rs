@@ -15,7 +15,7 @@
 
 use crate::equilibrium::{EquilibriumError, EquilibriumOptions, FreeDirection};
 use crate::lanczos::{nearest, LanczosError, LanczosOptions};
-use crate::linearization::{Linearizer, SparseLinearization};
+use crate::linearization::{Linearize, SparseLinearization};
 use crate::modes::{Mode, Modes, ModesError};
 use crate::sparse::{rcm, Csr, EnvelopeLdlt, SparseError};
 
@@ -48,12 +48,12 @@ fn norm(v: &[f64]) -> f64 {
 }
 
 /// The equilibrium nearest `start` (default: the initial values), sparse.
-pub fn solve(
-    lin: &Linearizer,
+pub fn solve<L: Linearize + ?Sized>(
+    lin: &L,
     start: Option<&[f64]>,
     opts: &EquilibriumOptions,
 ) -> Result<SparseEquilibrium, EquilibriumError> {
-    let q: Vec<f64> = start.unwrap_or(&lin.initial).to_vec();
+    let q: Vec<f64> = start.unwrap_or(lin.initial()).to_vec();
     let at = lin.at_sparse(&q);
     let kd = at.stiffness.diag();
     let stiff = kd.iter().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -79,7 +79,11 @@ pub fn solve(
     let end =
         crate::damped_newton::solve(&sparse, q, SparseAt { at, ks }, &diag, ratio, target, opts)?;
     let (q, SparseAt { at, ks }, residual, steps) = (end.q, end.at, end.residual, end.steps);
-    let neutral = free_directions(&lin.names, &ks, &diag);
+    let neutral = if opts.neutral {
+        free_directions(lin.names(), &ks, &diag)
+    } else {
+        Vec::new()
+    };
     Ok(SparseEquilibrium {
         q,
         residual,
@@ -92,8 +96,8 @@ pub fn solve(
 
 /// The sparse path of damped Newton: the symmetric part of `K`, by envelope `L D Lᵀ` in one
 /// reverse Cuthill–McKee order.
-struct Sparse<'a> {
-    lin: &'a Linearizer,
+struct Sparse<'a, L: ?Sized> {
+    lin: &'a L,
     order: Vec<usize>,
     diag: &'a [f64],
 }
@@ -104,7 +108,7 @@ struct SparseAt {
     ks: Csr,
 }
 
-impl crate::damped_newton::NewtonSystem for Sparse<'_> {
+impl<L: Linearize + ?Sized> crate::damped_newton::NewtonSystem for Sparse<'_, L> {
     type At = SparseAt;
 
     fn at(&self, q: &[f64]) -> SparseAt {
@@ -124,7 +128,7 @@ impl crate::damped_newton::NewtonSystem for Sparse<'_> {
     }
 
     fn free_directions(&self, at: &SparseAt) -> Vec<FreeDirection> {
-        free_directions(&self.lin.names, &at.ks, self.diag)
+        free_directions(self.lin.names(), &at.ks, self.diag)
     }
 }
 

@@ -156,25 +156,39 @@ pub fn modes_about(
     model: &mut crate::Model,
     request: &ModesRequest,
 ) -> Result<ModesReport, StaticsError> {
+    let (_, lin) = linearize(model)?;
+    modes_of(&lin, request)
+}
+
+/// The modes of a linearized model as `request` asks ([`modes_about`] after the
+/// linearization): the state, the dense or the sparse eigenproblem, the damped modes.
+pub fn modes_of<L: crate::linearization::Linearize + ?Sized>(
+    lin: &L,
+    request: &ModesRequest,
+) -> Result<ModesReport, StaticsError> {
     use crate::equilibrium::EquilibriumOptions;
     use crate::sparse_statics::{DEFAULT_SPARSE_COUNT, SPARSE_FROM};
-    let (_, lin) = linearize(model)?;
     let n = lin.len();
     let sparse = match request.solver {
         Solver::Auto => n >= SPARSE_FROM,
         Solver::Dense => false,
         Solver::Sparse => true,
     };
+    // The modes show neutral directions as zero frequencies: no separate search for them.
+    let balance = EquilibriumOptions {
+        neutral: false,
+        ..EquilibriumOptions::default()
+    };
     let (q, residual) = match request.about {
         About::Equilibrium if sparse => {
-            let eq = crate::sparse_statics::solve(&lin, None, &EquilibriumOptions::default())?;
+            let eq = crate::sparse_statics::solve(lin, None, &balance)?;
             (eq.q, eq.residual)
         }
         About::Equilibrium => {
-            let eq = crate::equilibrium::solve(&lin, None, &EquilibriumOptions::default())?;
+            let eq = crate::equilibrium::solve(lin, None, &balance)?;
             (eq.q, eq.residual)
         }
-        About::Initial => (lin.initial.clone(), f64::NAN),
+        About::Initial => (lin.initial().to_vec(), f64::NAN),
     };
     let matrices = lin.at_sparse(&q);
     let residual = if residual.is_nan() {
@@ -220,7 +234,7 @@ pub fn modes_about(
         _ => None,
     };
     Ok(ModesReport {
-        names: lin.names.clone(),
+        names: lin.names().to_vec(),
         about: request.about,
         q,
         residual,

@@ -1,11 +1,12 @@
-//! `Model.modes`: the library's `pdyn_mech::statics::modes_about` (what `pdyn modes` computes)
+//! `Model.modes`: the library's `pdyn::sim::net::statics::modes_about` (what `pdyn modes` computes)
 //! with its arrays as NumPy.
 
 use crate::convert::{f64_array, f64_matrix};
 use crate::errors::to_py;
 use crate::model::PyModel;
+use pdyn::sim::net::statics::modes_about;
 use pdyn::Error;
-use pdyn_mech::statics::{modes_about, About, ModesRequest, Solver};
+use pdyn_mech::statics::{About, ModesRequest, Solver};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;

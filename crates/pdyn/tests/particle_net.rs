@@ -1,9 +1,15 @@
 //! Many free particles in Cartesian coordinates (`pdyn::sim::net`, issue 33): the per-template
 //! kernels against the generic symbolic derivation on small nets, energy conservation on an
-//! undamped net, and set-up that grows linearly (counted, not timed).
+//! undamped net, set-up that grows linearly (counted, not timed), and the statics (`pdyn modes`,
+//! `pdyn equilibrium`) by the kernels against the symbolic linearization and closed forms.
 
+use pdyn::sim::net::linearization::NetLinearization;
+use pdyn::sim::net::statics::{equilibrium_from, EquilibriumReport};
 use pdyn::sim::{self, NetPath, RunSettings};
 use pdyn_jit::JitMode;
+use pdyn_mech::equilibrium::{EquilibriumError, EquilibriumOptions};
+use pdyn_mech::linearization::Linearize;
+use pdyn_mech::statics::{modes_of, About, ModesRequest, Solver, StaticsError};
 use pdyn_mech::Model;
 use pdyn_ode::OdeSystem;
 
@@ -513,4 +519,215 @@ fn expanding_keeps_the_parameter_values_set() {
     expanded.system.rhs(0.0, &y, &mut f1);
     reference.system.rhs(0.0, &y, &mut f2);
     assert_eq!(f1, f2);
+}
+
+// ---- Statics of a net by its kernels (`pdyn modes`, `pdyn equilibrium`) ----
+
+/// `examples/chain_modes.toml` with `n` masses.
+fn chain_source(n: usize) -> String {
+    let src = include_str!("../../../examples/chain_modes.toml");
+    assert!(src.contains("\nn = 30\n"));
+    src.replace("\nn = 30\n", &format!("\nn = {n}\n"))
+}
+
+/// The net's linearization by its kernels (taken whatever the number of particles).
+fn net_linearization(model: &mut Model) -> NetLinearization {
+    NetLinearization::new(model, JitMode::Auto, 0).expect("a net of free particles")
+}
+
+/// `max |a - b| / max |b|` over two matrices' entries (column-major, as nalgebra iterates).
+fn matrix_difference<'a>(
+    a: impl Iterator<Item = &'a f64>,
+    b: impl Iterator<Item = &'a f64>,
+) -> f64 {
+    let (a, b): (Vec<f64>, Vec<f64>) = (a.copied().collect(), b.copied().collect());
+    assert_eq!(a.len(), b.len());
+    max_relative_difference(&b, &a)
+}
+
+/// `M`, `K`, `C`, `f` and `M r_d` of the net's kernels agree with the symbolic linearizer's
+/// (the model derived, each row's sum of loads differentiated) to 1e-12 of each matrix's
+/// largest entry, at the initial state and at a perturbed one: the chain of
+/// examples/chain_modes.toml, nets of 4, 10 and 23 particles with and without drag (`C ≠ 0`),
+/// loaded in full and with deferred families (as `pdyn modes` loads).
+#[test]
+fn a_nets_linearization_by_kernels_agrees_with_the_symbolic_one() {
+    let sources = [
+        ("chain of 30", chain_source(30)),
+        ("3x2 net with drag", net_source(3, 2, Some(0.5))),
+        ("4x3 net with drag", net_source(4, 3, Some(0.02))),
+        ("5x5 net", net_source(5, 5, None)),
+        ("5x5 net with drag", net_source(5, 5, Some(0.02))),
+    ];
+    for (label, src) in &sources {
+        let mut symbolic_model = load(src);
+        let (_, symbolic) = pdyn_mech::statics::linearize(&mut symbolic_model).unwrap();
+        for deferred in [false, true] {
+            let mut model = if deferred {
+                load_deferring(src)
+            } else {
+                load(src)
+            };
+            let net = net_linearization(&mut model);
+            assert_eq!(net.names(), &symbolic.names[..], "{label}");
+            assert_eq!(net.initial(), &symbolic.initial[..], "{label}");
+            for q in [symbolic.initial.clone(), perturbed(&symbolic.initial)] {
+                let (a, b) = (net.at(&q), symbolic.at(&q));
+                let label = format!("{label} (deferred: {deferred})");
+                for (what, x, y) in [
+                    ("M", &a.mass, &b.mass),
+                    ("K", &a.stiffness, &b.stiffness),
+                    ("C", &a.damping, &b.damping),
+                ] {
+                    let d = matrix_difference(x.iter(), y.iter());
+                    assert!(d <= 1e-12, "{label}: {what} differs by {d:e}");
+                }
+                let d = matrix_difference(a.force.iter(), b.force.iter());
+                assert!(d <= 1e-12, "{label}: f differs by {d:e}");
+                let has_drag = label.contains("drag");
+                assert_eq!(b.damping.iter().any(|&c| c != 0.0), has_drag, "{label}: C");
+                assert!(b.stiffness.iter().any(|&k| k != 0.0), "{label}: K = 0");
+                for (x, y) in net.inertia_at(&q).iter().zip(symbolic.inertia_at(&q)) {
+                    assert_eq!(x, &y, "{label}: M r_d");
+                }
+                // The sparse form holds the dense one's entries.
+                let s = net.at_sparse(&q);
+                let d = matrix_difference(s.stiffness.to_dense().iter(), a.stiffness.iter());
+                assert_eq!(d, 0.0, "{label}");
+            }
+        }
+    }
+}
+
+/// ω_j = 2 sqrt(k/m) sin(j π / (2 (n + 1))) of the uniform chain fixed at both ends.
+fn chain_omega(j: usize, n: usize) -> f64 {
+    let (k, m) = (100.0f64, 1.0f64); // examples/chain_modes.toml's parameters
+    2.0 * (k / m).sqrt() * libm::sin(j as f64 * std::f64::consts::PI / (2.0 * (n + 1) as f64))
+}
+
+/// The chain's modes on the net path about its equilibrium: all 30 by the dense solver, and
+/// the lowest 10 of 1,000 masses by the sparse one, against the closed form to 1e-12.
+#[test]
+fn the_chains_modes_by_kernels_match_the_closed_form() {
+    for (n, solver, count) in [(30, Solver::Dense, None), (1000, Solver::Sparse, Some(10))] {
+        let mut model = load_deferring(&chain_source(n));
+        let lin = net_linearization(&mut model);
+        let request = ModesRequest {
+            about: About::Equilibrium,
+            solver,
+            count,
+        };
+        let report = modes_of(&lin, &request).unwrap();
+        assert_eq!(report.sparse, solver == Solver::Sparse);
+        assert_eq!(report.modes.modes.len(), count.unwrap_or(n));
+        for (j, mode) in report.modes.modes.iter().enumerate() {
+            let exact = chain_omega(j + 1, n);
+            let e = (mode.omega - exact).abs() / exact;
+            assert!(
+                e <= 1e-12,
+                "n = {n}, mode {}: {} vs {exact} ({e:e})",
+                j + 1,
+                mode.omega
+            );
+        }
+        assert!(!report.has_damping);
+    }
+}
+
+/// `pdyn equilibrium` of the hanging net with drag on the net path equals the symbolic
+/// path's: coordinates to 1e-10 m, reactions and tensions to 1e-10 of the weight.
+#[test]
+fn the_nets_equilibrium_by_kernels_equals_the_symbolic_one() {
+    let src = net_source(5, 5, Some(0.02));
+    let opts = EquilibriumOptions::default();
+    let solve = |from: usize| -> EquilibriumReport {
+        equilibrium_from(&mut load_deferring(&src), &opts, from).unwrap()
+    };
+    let (fast, generic) = (solve(0), solve(usize::MAX));
+    assert!(fast.net && !generic.net);
+    assert_eq!(fast.names, generic.names);
+    for ((name, a), b) in fast.names.iter().zip(&fast.q).zip(&generic.q) {
+        assert!((a - b).abs() <= 1e-10, "{name}: {a} vs {b}");
+    }
+    // The net hangs: it moved from its flat start.
+    let sag = fast
+        .q
+        .iter()
+        .zip(&load(&src).coordinates)
+        .fold(0.0f64, |s, (q, c)| match c.kind {
+            pdyn_mech::model::CoordinateKind::Free { initial, .. } => s.max((q - initial).abs()),
+            _ => s,
+        });
+    assert!(sag > 0.05, "sag {sag}");
+    let weight = 23.0 * 0.05 * 9.81;
+    assert_eq!(fast.reactions.len(), 2);
+    for ((na, ra), (nb, rb)) in fast.reactions.iter().zip(&generic.reactions) {
+        assert_eq!(na, nb);
+        for (x, y) in ra.iter().zip(rb) {
+            assert!((x - y).abs() <= 1e-10 * weight, "{na}: {ra:?} vs {rb:?}");
+        }
+    }
+    assert_eq!(fast.axial.len(), generic.axial.len());
+    for ((na, ta), (nb, tb)) in fast.axial.iter().zip(&generic.axial) {
+        assert_eq!(na, nb);
+        assert!((ta - tb).abs() <= 1e-10 * weight, "{na}: {ta} vs {tb}");
+    }
+}
+
+/// A chain of `n` masses with no walls under gravity along it: a mechanism whose free
+/// direction, the rigid translation, the load pushes along.
+fn free_chain(n: usize) -> String {
+    format!(
+        r#"
+name = "free chain"
+gravity = "[g, 0, 0]"
+[indices]
+n = {n}
+i = "1..n"
+[parameters]
+m = 1.0
+k = 100.0
+L = 0.1
+g = 9.81
+[coordinates]
+"x[i]" = {{ initial = "i*L", rate = 0 }}
+[particles."P[i]"]
+mass = "m"
+position = "[x[i], 0, 0]"
+[[forces]]
+kind = "spring"
+name = "spring"
+for = "i in 1..n-1"
+between = ["P[i+1]", "P[i]"]
+k = "k"
+l0 = "L"
+"#
+    )
+}
+
+/// A free chain under a load along it has no equilibrium: on the net path, by the dense and
+/// the sparse solver, the error names the free direction, every mass moving alike, as the
+/// symbolic path does.
+#[test]
+fn a_free_net_under_load_is_a_mechanism_on_the_net_path() {
+    for n in [12, 400] {
+        for from in [0, usize::MAX] {
+            let mut model = load_deferring(&free_chain(n));
+            let e = equilibrium_from(&mut model, &EquilibriumOptions::default(), from);
+            let Err(StaticsError::Equilibrium(EquilibriumError::Mechanism { directions, .. })) = e
+            else {
+                panic!("n = {n}, from {from}: {e:?}");
+            };
+            assert_eq!(directions.len(), 1, "n = {n}");
+            let d = &directions[0];
+            assert_eq!(d.moved, n, "n = {n}: {d}");
+            let first = d.components[0].1;
+            assert!(
+                d.components
+                    .iter()
+                    .all(|(_, c)| (c - first).abs() < 1e-9 * first),
+                "n = {n}: {d}"
+            );
+        }
+    }
 }

@@ -4,12 +4,10 @@
 use super::{load_model, set_parameters};
 use clap::Args;
 use pdyn::output::json_num;
+use pdyn::sim::net::statics::equilibrium;
 use pdyn::Error;
-use pdyn_mech::equilibrium::{
-    axial_forces, solve, support_reactions, EquilibriumOptions, FreeDirection,
-};
-use pdyn_mech::sparse_statics::{self, SPARSE_FROM};
-use pdyn_mech::statics::{linearize, StaticsError};
+use pdyn_mech::equilibrium::{EquilibriumOptions, FreeDirection};
+use pdyn_mech::statics::StaticsError;
 use serde_json::json;
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -40,19 +38,10 @@ fn direction_json(d: &FreeDirection) -> serde_json::Value {
     })
 }
 
-/// What either path found.
-struct Found {
-    q: Vec<f64>,
-    residual: f64,
-    scale: f64,
-    steps: usize,
-    neutral: Vec<FreeDirection>,
-}
-
-/// `pdyn equilibrium MODEL`.
 /// Spring and damper forces printed (a net has thousands; `--json` has them all).
 const AXIAL_SHOWN: usize = 40;
 
+/// `pdyn equilibrium MODEL`.
 pub fn run(a: EquilibriumArgs) -> Result<String, Error> {
     let mut model = load_model(&a.model)?;
     set_parameters(&mut model, &a.set)?;
@@ -67,41 +56,23 @@ pub fn run(a: EquilibriumArgs) -> Result<String, Error> {
         origin: origin.clone(),
         error,
     };
-    let (d, lin) = linearize(&mut model).map_err(fail)?;
     let opts = EquilibriumOptions {
         tolerance: a.tolerance,
         max_steps: a.max_steps,
+        ..EquilibriumOptions::default()
     };
-    // Sparse matrices from `SPARSE_FROM` coordinates on (the same Newton steps, solved by an
-    // envelope L D Lᵀ instead of a dense LU).
-    let eq = if lin.len() >= SPARSE_FROM {
-        let e = sparse_statics::solve(&lin, None, &opts).map_err(|e| fail(e.into()))?;
-        Found {
-            q: e.q,
-            residual: e.residual,
-            scale: e.scale,
-            steps: e.steps,
-            neutral: e.neutral,
-        }
-    } else {
-        let e = solve(&lin, None, &opts).map_err(|e| fail(e.into()))?;
-        Found {
-            q: e.q,
-            residual: e.residual,
-            scale: e.scale,
-            steps: e.steps,
-            neutral: e.neutral,
-        }
-    };
-    let reactions = support_reactions(&mut model, &d, &eq.q).map_err(|e| fail(e.into()))?;
-    let axial = axial_forces(&mut model, &d, &eq.q).map_err(|e| fail(e.into()))?;
+    // A net by its kernels, any other model by its symbolic linearization; sparse matrices
+    // from `SPARSE_FROM` coordinates on (the same Newton steps, solved by an envelope L D Lᵀ
+    // instead of a dense LU).
+    let eq = equilibrium(&mut model, &opts).map_err(fail)?;
+    let (reactions, axial) = (&eq.reactions, &eq.axial);
     if a.json {
         let v = json!({
             "model": model.name,
             "steps": eq.steps,
             "residual": json_num(eq.residual),
             "force_scale": json_num(eq.scale),
-            "coordinates": lin.names.iter().zip(&eq.q).map(|(n, q)| json!({"name": n, "value": json_num(*q)})).collect::<Vec<_>>(),
+            "coordinates": eq.names.iter().zip(&eq.q).map(|(n, q)| json!({"name": n, "value": json_num(*q)})).collect::<Vec<_>>(),
             "reactions": reactions.iter().map(|(n, r)| json!({"point": n, "force": r.iter().map(|x| json_num(*x)).collect::<Vec<_>>()})).collect::<Vec<_>>(),
             "axial_forces": axial.iter().map(|(n, t)| json!({"element": n, "tension": json_num(*t)})).collect::<Vec<_>>(),
             "neutral_directions": eq.neutral.iter().map(direction_json).collect::<Vec<_>>(),
@@ -115,9 +86,9 @@ pub fn run(a: EquilibriumArgs) -> Result<String, Error> {
         "  Newton steps: {}; out-of-balance force |f| = {:.3e} (force scale {:.3e})",
         eq.steps, eq.residual, eq.scale
     );
-    let width = lin.names.iter().map(|n| n.len()).max().unwrap_or(0);
+    let width = eq.names.iter().map(|n| n.len()).max().unwrap_or(0);
     let _ = writeln!(s, "\nCoordinates:");
-    for (n, q) in lin.names.iter().zip(&eq.q) {
+    for (n, q) in eq.names.iter().zip(&eq.q) {
         let _ = writeln!(s, "  {n:width$}  {q:.12e}");
     }
     if !reactions.is_empty() {
@@ -125,7 +96,7 @@ pub fn run(a: EquilibriumArgs) -> Result<String, Error> {
             s,
             "\nReactions at the points (force of the support on the point):"
         );
-        for (n, r) in &reactions {
+        for (n, r) in reactions {
             let _ = writeln!(s, "  {n}: [{:.6e}, {:.6e}, {:.6e}]", r[0], r[1], r[2]);
         }
     }

@@ -3,13 +3,14 @@
 //! systems, the lowest few by sparse shift-invert Lanczos for large ones; with damping, the
 //! damped modes of `s² M + s C + K` too (natural frequency and damping ratio).
 
-use super::{load_model, set_parameters};
+use super::set_parameters;
 use clap::{Args, ValueEnum};
 use pdyn::output::json_num;
+use pdyn::sim::net::statics::modes_about;
 use pdyn::Error;
 use pdyn_mech::damped::{DampedMode, DAMPED_LIMIT};
 use pdyn_mech::sparse::Csr;
-use pdyn_mech::statics::{self, modes_about, ModesRequest, StaticsError};
+use pdyn_mech::statics::{self, ModesRequest, StaticsError};
 use serde_json::json;
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -76,7 +77,9 @@ fn write_matrices(dir: &std::path::Path, k: &Csr, m: &Csr, c: &Csr) -> Result<()
 
 /// `pdyn modes MODEL`.
 pub fn run(a: ModesArgs) -> Result<String, Error> {
-    let mut model = load_model(&a.model)?;
+    // Force families compact (one representative and index arrays): a net is linearized by
+    // its kernels, any other model expanded first.
+    let mut model = pdyn::model_file::ModelFile::read(&a.model)?.mechanics_deferring()?;
     set_parameters(&mut model, &a.set)?;
     let origin = model.origin.clone();
     let fail = |error: StaticsError| Error::Statics {

@@ -334,6 +334,22 @@ impl NetKernels {
     pub fn add_jacobian(&self, input: &[f64], jac: &mut [f64]) {
         let n = self.n;
         let m = 2 * n;
+        let compiled = self.jacobian_terms(input, &mut |row, column, value| {
+            jac[(n + row) * m + column] += value;
+        });
+        if !compiled {
+            // Cannot happen: the same operations as the kernels', which compiled.
+            jac.iter_mut().for_each(|x| *x = f64::NAN);
+        }
+    }
+
+    /// Every term of `∂q''/∂w` (`w = [q, q']`) at `input = [t, q, q', parameters]`, element
+    /// by element: `term(row, column, value)` with `row` the acceleration (a free coordinate
+    /// in state order) and `column` the index in `w` (`< n`: a coordinate, `≥ n`: a rate).
+    /// An entry of the Jacobian is the sum of its terms (a particle's springs each give one).
+    /// False when a kernel of derivatives could not be compiled (cannot happen: the same
+    /// operations as the kernels', which compiled).
+    pub fn jacobian_terms(&self, input: &[f64], term: &mut dyn FnMut(usize, usize, f64)) -> bool {
         for k in &self.kernels {
             if k.elements == 0 || k.jacobian_entries.is_empty() {
                 continue;
@@ -342,9 +358,7 @@ impl NetKernels {
                 .jacobian_kernel
                 .get_or_init(|| BatchKernel::new(&k.jacobian_program, k.mode));
             let Some(kernel) = kernel else {
-                // Cannot happen: the same operations as the kernel's, which compiled.
-                jac.iter_mut().for_each(|x| *x = f64::NAN);
-                return;
+                return false;
             };
             let cols = &mut *k.columns.borrow_mut();
             gather(k, input, cols);
@@ -366,10 +380,16 @@ impl NetKernels {
                         continue;
                     }
                     // The gathered index is 1 + the state index of the input.
-                    jac[(n + row as usize) * m + from.at(e) as usize - 1] += value;
+                    term(row as usize, from.at(e) as usize - 1, value);
                 }
             }
         }
+        true
+    }
+
+    /// Free coordinates (accelerations) the kernels form.
+    pub fn coordinates(&self) -> usize {
+        self.n
     }
 }
 

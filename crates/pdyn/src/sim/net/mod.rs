@@ -14,8 +14,13 @@
 //! The accelerations are those of the generic path to round-off (the sum of the loads is
 //! formed in another order, each divided by the mass before summing; a kernel shares
 //! reciprocals): checked on nets of 4, 9 and 23 particles by `tests/particle_net.rs`.
+//!
+//! The same kernels, with their derivatives, linearize a net at rest for `pdyn modes` and
+//! `pdyn equilibrium` ([`linearization`], entered by [`statics`]).
 
 pub mod kernels;
+pub mod linearization;
+pub mod statics;
 pub mod structure;
 
 use super::compiled::CompiledModel;
