@@ -92,6 +92,7 @@ pub use dense::{DenseSolution, Interpolant};
 pub use error::{FailurePoint, OdeError};
 pub use events::{DenseOutput, Event};
 pub use jacobian::Sparsity;
+pub use methods::radau5_linear::SPARSE_FROM as RADAU_SPARSE_FROM;
 pub use options::{Interrupt, LinearSolver, Options, StiffnessAction, Tolerance};
 pub use problem::{
     FirstOrderForm, FnSecondOrder, FnSystem, FnSystemWithJacobian, MassInverse, MassKind,

@@ -21,8 +21,9 @@ use pdyn_jit::{Evaluator, JitLinearSystem, JitMode};
 use pdyn_mech::derive::{Derivation, UnknownKind};
 use pdyn_mech::tree::{TreeForm, TreeWorkspace};
 use pdyn_mech::Model;
-use pdyn_ode::{OdeSystem, SecondOrderSystem};
-use std::cell::RefCell;
+use pdyn_ode::{OdeSystem, SecondOrderSystem, Sparsity};
+use std::cell::{OnceCell, RefCell};
+use std::sync::Arc;
 
 #[derive(Clone)]
 enum Engine {
@@ -78,6 +79,54 @@ pub struct CompiledModel {
     pub inputs: Vec<Id>,
     /// The observation inputs: `inputs` followed by `[q'', reactions]`.
     pub observation_inputs: Vec<Id>,
+    /// The Jacobian's pattern, formed when an implicit method first asks for it.
+    sparse_jacobian: OnceCell<Option<SparseJacobian>>,
+}
+
+/// The pattern of the first-order system's Jacobian `∂(q', q'')/∂(q, q')` and where each
+/// computed term goes in its values (issue 33: Radau5 factors a many-particle model's
+/// iteration matrices sparsely, [`pdyn_ode::LinearSolver`]).
+#[derive(Clone)]
+struct SparseJacobian {
+    sparsity: Arc<Sparsity>,
+    /// The value index of `∂q'_i/∂q'_i = 1`, for each `i`.
+    identity: Vec<usize>,
+    /// The value index of each term, in the order they are computed: the net kernels'
+    /// `jacobian_terms`, or the Jacobian program's outputs.
+    terms: Vec<usize>,
+}
+
+impl SparseJacobian {
+    /// From the `(row, column)` of each term of `∂q''/∂w` (rows of `q''`, columns of `w`).
+    fn new(n: usize, terms: &[(usize, usize)]) -> Option<SparseJacobian> {
+        let m = 2 * n;
+        let mut by_column: Vec<Vec<usize>> = vec![Vec::new(); m];
+        for i in 0..n {
+            by_column[n + i].push(i);
+        }
+        for &(row, col) in terms {
+            by_column[col].push(n + row);
+        }
+        let sparsity = Sparsity::from_columns(m, by_column).ok()?;
+        let mut start = vec![0usize; m + 1];
+        for j in 0..m {
+            start[j + 1] = start[j] + sparsity.column(j).len();
+        }
+        let slot = |row: usize, col: usize| -> Option<usize> {
+            let at = sparsity.column(col).binary_search(&row).ok()?;
+            Some(start[col] + at)
+        };
+        let identity = (0..n).map(|i| slot(i, n + i)).collect::<Option<Vec<_>>>()?;
+        let terms = terms
+            .iter()
+            .map(|&(row, col)| slot(n + row, col))
+            .collect::<Option<Vec<_>>>()?;
+        Some(SparseJacobian {
+            sparsity: Arc::new(sparsity),
+            identity,
+            terms,
+        })
+    }
 }
 
 /// `dst.copy_from_slice(src)`, with the copy inlined for the lengths of small models: the
@@ -218,6 +267,7 @@ impl CompiledModel {
             }),
             inputs,
             observation_inputs,
+            sparse_jacobian: OnceCell::new(),
         })
     }
 
@@ -251,6 +301,7 @@ impl CompiledModel {
             }),
             inputs,
             observation_inputs,
+            sparse_jacobian: OnceCell::new(),
         }
     }
 
@@ -418,6 +469,46 @@ impl OdeSystem for CompiledModel {
         self.jacobian.is_some() || matches!(self.engine, Engine::Net(_))
     }
 
+    fn jacobian_sparsity(&self) -> Option<Arc<Sparsity>> {
+        self.sparse_form().map(|f| f.sparsity.clone())
+    }
+
+    fn has_sparse_jacobian(&self) -> bool {
+        self.has_jacobian() && self.sparse_form().is_some()
+    }
+
+    fn sparse_jacobian(&self, t: f64, y: &[f64], values: &mut [f64]) {
+        let Some(form) = self.sparse_form() else {
+            values.fill(f64::NAN);
+            return;
+        };
+        let n = self.n;
+        values.fill(0.0);
+        for &p in &form.identity {
+            values[p] = 1.0;
+        }
+        let s = &mut *self.scratch.borrow_mut();
+        s.input[0] = t;
+        s.input[1..1 + 2 * n].copy_from_slice(y);
+        let mut next = form.terms.iter();
+        if let Engine::Net(kernels) = &self.engine {
+            let ok = kernels.jacobian_terms(&s.input, &mut |_, _, value| {
+                if let Some(&p) = next.next() {
+                    values[p] += value;
+                }
+            });
+            if !ok {
+                values.fill(f64::NAN);
+            }
+            return;
+        }
+        let Some(prog) = &self.jacobian else { return };
+        prog.eval(&s.input, &mut s.jac_ws, &mut s.jac_out);
+        for (&p, &value) in next.zip(&s.jac_out) {
+            values[p] += value;
+        }
+    }
+
     fn jacobian(&self, t: f64, y: &[f64], jac: &mut [f64]) {
         let n = self.n;
         let s = &mut *self.scratch.borrow_mut();
@@ -445,6 +536,40 @@ impl OdeSystem for CompiledModel {
         for (&k, &value) in self.jacobian_entries.iter().zip(&s.jac_out) {
             jac[n * m + k] = value;
         }
+    }
+}
+
+impl CompiledModel {
+    /// The Jacobian's pattern, for models large enough that Radau5 factors sparsely
+    /// ([`pdyn_ode::LinearSolver::Auto`]): the net kernels' terms, or the Jacobian
+    /// program's entries.
+    fn sparse_form(&self) -> Option<&SparseJacobian> {
+        self.sparse_jacobian
+            .get_or_init(|| {
+                let n = self.n;
+                if 2 * n < pdyn_ode::RADAU_SPARSE_FROM {
+                    return None;
+                }
+                let mut terms = Vec::new();
+                match &self.engine {
+                    Engine::Net(kernels) => {
+                        let s = self.scratch.borrow();
+                        let ok = kernels.jacobian_terms(&s.input, &mut |row, col, _| {
+                            terms.push((row, col));
+                        });
+                        if !ok {
+                            return None;
+                        }
+                    }
+                    _ => {
+                        self.jacobian.as_ref()?;
+                        let m = 2 * n;
+                        terms.extend(self.jacobian_entries.iter().map(|&k| (k / m, k % m)));
+                    }
+                }
+                SparseJacobian::new(n, &terms)
+            })
+            .as_ref()
     }
 }
 
