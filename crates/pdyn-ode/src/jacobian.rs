@@ -152,49 +152,30 @@ impl FdJacobian {
         stats: &mut Stats,
     ) {
         let n = y.len();
-        let k = sparsity.map_or(n, |s| s.groups.len());
-        if self.states.len() != k * n {
-            self.states = vec![0.0; k * n];
-            self.out = vec![0.0; k * n];
-        }
-        match sparsity {
-            None => {
-                for i in 0..n {
-                    let row = &mut self.states[i * n..(i + 1) * n];
-                    row.copy_from_slice(y);
-                    row[i] = y[i] + increment(y[i]);
-                }
-                sys.rhs_batch(t, &self.states, &mut self.out);
-                for i in 0..n {
-                    let delt = increment(y[i]);
-                    for j in 0..n {
-                        jac[j * n + i] = (self.out[i * n + j] - f0[j]) / delt;
-                    }
+        let Some(s) = sparsity else {
+            if self.states.len() != n * n {
+                self.states = vec![0.0; n * n];
+                self.out = vec![0.0; n * n];
+            }
+            for i in 0..n {
+                let row = &mut self.states[i * n..(i + 1) * n];
+                row.copy_from_slice(y);
+                row[i] = y[i] + increment(y[i]);
+            }
+            sys.rhs_batch(t, &self.states, &mut self.out);
+            for i in 0..n {
+                let delt = increment(y[i]);
+                for j in 0..n {
+                    jac[j * n + i] = (self.out[i * n + j] - f0[j]) / delt;
                 }
             }
-            Some(s) => {
-                for (g, cols) in s.groups.iter().enumerate() {
-                    let row = &mut self.states[g * n..(g + 1) * n];
-                    row.copy_from_slice(y);
-                    for &j in cols {
-                        row[j] = y[j] + increment(y[j]);
-                    }
-                }
-                sys.rhs_batch(t, &self.states, &mut self.out);
-                jac.fill(0.0);
-                for (g, cols) in s.groups.iter().enumerate() {
-                    let out = &self.out[g * n..(g + 1) * n];
-                    for &j in cols {
-                        let delt = increment(y[j]);
-                        for &i in &s.rows[j] {
-                            jac[i * n + j] = (out[i] - f0[i]) / delt;
-                        }
-                    }
-                }
-            }
-        }
-        stats.fevals += k;
-        stats.jac_fevals += k;
+            stats.fevals += n;
+            stats.jac_fevals += n;
+            return;
+        };
+        self.perturb_groups(sys, s, t, y, stats);
+        jac.fill(0.0);
+        self.differences(s, y, f0, |i, j, _, d| jac[i * n + j] = d);
     }
 
     /// Writes `∂f/∂y` at `(t, y)` into `values`, the entries of `s` column after column (as
@@ -211,6 +192,25 @@ impl FdJacobian {
         stats: &mut Stats,
     ) {
         let n = y.len();
+        let mut start = vec![0usize; n + 1];
+        for j in 0..n {
+            start[j + 1] = start[j] + s.rows[j].len();
+        }
+        self.perturb_groups(sys, s, t, y, stats);
+        self.differences(s, y, f0, |_, j, r, d| values[start[j] + r] = d);
+    }
+
+    /// Evaluates `f` at `y` with each group's columns perturbed together (one state per group,
+    /// one batch), into `self.out`; counts the evaluations.
+    fn perturb_groups<S: OdeSystem + ?Sized>(
+        &mut self,
+        sys: &S,
+        s: &Sparsity,
+        t: f64,
+        y: &[f64],
+        stats: &mut Stats,
+    ) {
+        let n = y.len();
         let k = s.groups.len();
         if self.states.len() != k * n {
             self.states = vec![0.0; k * n];
@@ -224,21 +224,29 @@ impl FdJacobian {
             }
         }
         sys.rhs_batch(t, &self.states, &mut self.out);
-        let mut start = vec![0usize; n + 1];
-        for j in 0..n {
-            start[j + 1] = start[j] + s.rows[j].len();
-        }
+        stats.fevals += k;
+        stats.jac_fevals += k;
+    }
+
+    /// The difference quotient of every entry of the pattern from [`Self::perturb_groups`]'s
+    /// evaluations: `put(i, j, r, ∂f_i/∂y_j)` with `r` the entry's place in column `j`.
+    fn differences(
+        &self,
+        s: &Sparsity,
+        y: &[f64],
+        f0: &[f64],
+        mut put: impl FnMut(usize, usize, usize, f64),
+    ) {
+        let n = y.len();
         for (g, cols) in s.groups.iter().enumerate() {
             let out = &self.out[g * n..(g + 1) * n];
             for &j in cols {
                 let delt = increment(y[j]);
-                for (v, &i) in values[start[j]..start[j + 1]].iter_mut().zip(&s.rows[j]) {
-                    *v = (out[i] - f0[i]) / delt;
+                for (r, &i) in s.rows[j].iter().enumerate() {
+                    put(i, j, r, (out[i] - f0[i]) / delt);
                 }
             }
         }
-        stats.fevals += k;
-        stats.jac_fevals += k;
     }
 }
 

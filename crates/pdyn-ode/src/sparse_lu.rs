@@ -21,10 +21,11 @@
 use crate::ordering::{nested_dissection, Graph};
 use std::ops::{Add, Div, Mul, Sub};
 
-/// Most entries the factors `L` and `U` may have together (each side): ~3 GB of values and
-/// indices for a real and a complex factorization. A pattern that would fill more is refused
-/// before the numeric arrays are allocated.
-pub const MAX_FACTOR_ENTRIES: usize = 120_000_000;
+/// Most entries `L` may have below its diagonal (as many in `U` above): each costs 72 bytes
+/// (three indices of the analysis, `L` and `U` in real and in complex numbers), ~2.9 GB at
+/// this bound. A pattern that would fill more is refused while it is analysed, before the
+/// numeric arrays are allocated.
+pub const MAX_FACTOR_ENTRIES: usize = 40_000_000;
 
 /// A pivot smaller than this fraction of its row's largest entry makes the factorization
 /// unreliable without pivoting: reported as singular.
@@ -191,6 +192,11 @@ pub struct Symbolic {
 impl Symbolic {
     /// Analyses `pattern` (made symmetric for the ordering and the elimination tree).
     pub fn new(pattern: &Pattern) -> Result<Symbolic, SparseLuError> {
+        Symbolic::bounded(pattern, MAX_FACTOR_ENTRIES)
+    }
+
+    /// [`Symbolic::new`] refusing factors of more than `limit` entries below the diagonal.
+    fn bounded(pattern: &Pattern, limit: usize) -> Result<Symbolic, SparseLuError> {
         let n = pattern.dim();
         // The symmetric graph, without the diagonal.
         let mut degree = vec![0usize; n];
@@ -305,7 +311,7 @@ impl Symbolic {
                     i = parent[i];
                 }
             }
-            if reach.len() > MAX_FACTOR_ENTRIES {
+            if reach.len() > limit {
                 return Err(SparseLuError::TooMuchFill {
                     entries: reach.len(),
                 });
@@ -685,6 +691,21 @@ mod tests {
         let mut b = [3.0, 4.0];
         lu.solve_in_place(&s, &mut b);
         assert!((b[0] - 1.0).abs() < 1e-15 && (b[1] - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn too_much_fill_is_refused_while_analysing() {
+        // A full 30 × 30 pattern fills 435 entries below the diagonal.
+        let n = 30;
+        let p = Pattern {
+            start: (0..=n).map(|i| i * n).collect(),
+            cols: (0..n * n).map(|k| k % n).collect(),
+        };
+        assert_eq!(Symbolic::bounded(&p, 435).unwrap().factor_entries(), 435);
+        match Symbolic::bounded(&p, 400) {
+            Err(SparseLuError::TooMuchFill { entries }) => assert!(entries > 400),
+            other => panic!("{other:?}"),
+        }
     }
 
     #[test]

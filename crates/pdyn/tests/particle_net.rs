@@ -13,6 +13,9 @@ use pdyn_mech::statics::{modes_of, About, ModesRequest, Solver, StaticsError};
 use pdyn_mech::Model;
 use pdyn_ode::OdeSystem;
 
+mod common;
+use common::max_relative_difference;
+
 /// An `nx × ny` net as `examples/hanging_net.toml` writes it (corners `P[0,0]` and
 /// `P[nx-1,0]` pinned), with drag coefficient `c` (none when `None`).
 fn net_source(nx: i64, ny: i64, c: Option<f64>) -> String {
@@ -108,14 +111,6 @@ fn perturbed(y0: &[f64]) -> Vec<f64> {
         .enumerate()
         .map(|(k, &v)| v + 0.01 * libm::sin(1.7 * k as f64 + 0.3))
         .collect()
-}
-
-fn max_relative_difference(a: &[f64], b: &[f64]) -> f64 {
-    let scale = a.iter().fold(0.0f64, |s, x| s.max(x.abs())).max(1e-300);
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs() / scale)
-        .fold(0.0, f64::max)
 }
 
 /// The right-hand sides (to 1e-13) and Jacobians (to 1e-12) of `fast` and `generic` agree

@@ -9,6 +9,9 @@ use pdyn_mech::Model;
 use pdyn_ode::OdeSystem;
 use std::path::{Path, PathBuf};
 
+mod common;
+use common::max_relative_difference;
+
 fn examples() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples")
 }
@@ -40,14 +43,6 @@ fn rhs(p: &sim::Prepared, y: &[f64]) -> Vec<f64> {
     let mut f = vec![0.0; p.system.dim()];
     p.system.rhs(0.0, y, &mut f);
     f
-}
-
-fn max_relative_difference(a: &[f64], b: &[f64]) -> f64 {
-    let scale = a.iter().fold(0.0f64, |s, x| s.max(x.abs())).max(1e-300);
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs() / scale)
-        .fold(0.0, f64::max)
 }
 
 #[test]
