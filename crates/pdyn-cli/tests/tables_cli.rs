@@ -91,3 +91,52 @@ fn the_table_net_runs_as_the_index_range_net_bit_for_bit() {
     assert!(ranges == tables, "the trajectories differ");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The fields of one CSV line as RFC 4180 reads them: a quoted field may hold commas, `""` is
+/// a quote. Written here from the RFC, not taken from pdyn's reader.
+fn rfc4180_fields(line: &str) -> Vec<String> {
+    let (mut out, mut field, mut quoted, mut chars) =
+        (Vec::new(), String::new(), false, line.chars().peekable());
+    while let Some(c) = chars.next() {
+        match (c, quoted) {
+            ('"', true) if chars.peek() == Some(&'"') => {
+                field.push('"');
+                chars.next();
+            }
+            ('"', _) => quoted = !quoted,
+            (',', false) => out.push(std::mem::take(&mut field)),
+            _ => field.push(c),
+        }
+    }
+    out.push(field);
+    out
+}
+
+/// A family's members are named `x[1,2]`: the trajectory's header must quote them, or every
+/// CSV reader splits one name into two columns and shifts every column after it.
+#[test]
+fn family_columns_are_one_csv_field_each() {
+    let dir = std::env::temp_dir().join(format!("pdyn-family-csv-{}", std::process::id()));
+    let (ok, _, err) = pdyn(&[
+        "run",
+        &example("hanging_net.toml"),
+        "--t-end",
+        "0.01",
+        "--points",
+        "3",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(dir.join("trajectory.csv")).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+    let mut lines = text.lines();
+    let names = rfc4180_fields(lines.next().unwrap());
+    let row = rfc4180_fields(lines.next().unwrap());
+    assert_eq!(names.len(), row.len(), "header {names:?}");
+    // 23 free particles, 3 coordinates and 3 rates each, after `t`.
+    assert_eq!(names[0], "t");
+    assert!(names.iter().any(|n| n == "x[1,2]"), "{names:?}");
+    assert!(names.iter().any(|n| n == "z[4,4]'"), "{names:?}");
+    assert_eq!(names.iter().filter(|n| n.starts_with("x[")).count(), 2 * 23);
+}

@@ -3,7 +3,9 @@
 //! The format: an optional UTF-8 byte-order mark; lines that are blank or start with `#` are
 //! skipped anywhere; the first other line is a header naming the columns; then one row per
 //! sample. The delimiter is the header's: `,` (default), `;` or a tab. Fields may be quoted
-//! with `"` (no embedded delimiters in numeric fields, which is all this reader needs).
+//! with `"`; a quoted header name may hold the delimiter (`"x[0,1]"`, as pdyn writes it) and
+//! `""` for a quote. Data fields are split at every delimiter: a text column of the rows may
+//! be quoted but must not hold the delimiter.
 //!
 //! Only the columns asked for are parsed, so a file may carry text columns (labels, flags)
 //! beside its numbers. Every value must be a finite number: an empty field, `NaN`, `inf` or
@@ -11,6 +13,7 @@
 //! requires strictly increasing times and a minimum number of samples.
 
 use crate::error::DataError;
+use std::borrow::Cow;
 
 /// Columns of numbers read from a CSV file, with where each value came from.
 #[derive(Clone, Debug)]
@@ -107,23 +110,38 @@ impl Columns {
     }
 }
 
-/// The delimiter of a header line.
+/// The delimiter of a header line: the first of `,`, `;`, tab outside quotes.
 fn delimiter(header: &str) -> char {
-    for d in [',', ';', '\t'] {
-        if header.contains(d) {
-            return d;
+    let mut quoted = false;
+    let mut seen = [false; 3];
+    for c in header.chars() {
+        match c {
+            '"' => quoted = !quoted,
+            ',' if !quoted => seen[0] = true,
+            ';' if !quoted => seen[1] = true,
+            '\t' if !quoted => seen[2] = true,
+            _ => {}
         }
     }
-    ','
+    [',', ';', '\t']
+        .into_iter()
+        .zip(seen)
+        .find_map(|(d, s)| s.then_some(d))
+        .unwrap_or(',')
 }
 
 /// The fields of a line with their 1-based character columns, quotes removed, spaces trimmed.
-fn fields(line: &str, delim: char) -> Vec<(usize, &str)> {
+/// A quoted field (RFC 4180) may hold the delimiter, and `""` stands for one quote inside it:
+/// pdyn writes a column named `x[0,1]` as `"x[0,1]"`.
+fn fields(line: &str, delim: char) -> Vec<(usize, Cow<'_, str>)> {
     let mut out = Vec::new();
     let mut start_byte = 0;
     let mut start_char = 1;
+    let mut quoted = false;
     for (chars, (i, c)) in line.char_indices().enumerate() {
-        if c == delim {
+        if c == '"' {
+            quoted = !quoted;
+        } else if c == delim && !quoted {
             out.push((start_char, &line[start_byte..i]));
             start_byte = i + c.len_utf8();
             start_char = chars + 2;
@@ -135,10 +153,11 @@ fn fields(line: &str, delim: char) -> Vec<(usize, &str)> {
             // The column reported is that of the first non-blank character of the field.
             let lead = f.chars().take_while(|c| c.is_whitespace()).count();
             let t = f.trim();
-            let t = t
-                .strip_prefix('"')
-                .and_then(|s| s.strip_suffix('"'))
-                .unwrap_or(t);
+            let t = match t.strip_prefix('"').and_then(|s| s.strip_suffix('"')) {
+                Some(inner) if inner.contains("\"\"") => Cow::Owned(inner.replace("\"\"", "\"")),
+                Some(inner) => Cow::Borrowed(inner),
+                None => Cow::Borrowed(t),
+            };
             (col + lead, t)
         })
         .collect()
@@ -183,7 +202,7 @@ pub fn header(text: &str) -> (usize, Vec<String>) {
         }
         let names = fields(l, delimiter(l))
             .into_iter()
-            .map(|(_, n)| n.to_string())
+            .map(|(_, n)| n.into_owned())
             .collect();
         return (i + 1, names);
     }
@@ -221,7 +240,7 @@ pub fn read_columns(file: &str, text: &str, wanted: &[&str]) -> Result<Columns, 
         return Err(
             DataError::new(file, "the first line must be a header naming the columns")
                 .at(header_line, Some(*col))
-                .text(n)
+                .text(n.as_ref())
                 .help(format!(
                     "add a line such as `{}` before the data",
                     default_names(head.len()).join(&delim.to_string())

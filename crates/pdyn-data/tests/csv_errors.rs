@@ -176,3 +176,23 @@ fn a_large_file_parsed_in_parts_keeps_its_lines() {
         assert_eq!(e.column, Some(t_len + 2), "{e}");
     }
 }
+
+#[test]
+fn quoted_header_names_may_hold_the_delimiter() {
+    // pdyn writes a family member's column `x[0,1]` quoted; a reader must take it whole.
+    let text = "t,\"x[0,1]\",\"y[0,1]\",\"say \"\"hi\"\"\"\n0,1,2,3\n1,4,5,6\n2,7,8,9\n";
+    let (_, names) = pdyn_data::csv::header(text);
+    assert_eq!(names, ["t", "x[0,1]", "y[0,1]", "say \"hi\""]);
+    let c = read_columns("net.csv", text, &["t", "y[0,1]", "say \"hi\""]).unwrap();
+    assert_eq!(
+        c.values,
+        vec![
+            vec![0.0, 1.0, 2.0],
+            vec![2.0, 5.0, 8.0],
+            vec![3.0, 6.0, 9.0]
+        ]
+    );
+    // A `;` file whose quoted names hold commas is still read as `;`-delimited.
+    let c = read_columns("net.csv", "t;\"x[0,1]\"\n0;1\n1;2\n", &["x[0,1]"]).unwrap();
+    assert_eq!(c.values, vec![vec![1.0, 2.0]]);
+}

@@ -46,8 +46,7 @@ impl Table {
     /// formatting instead of leaving the other cores idle.
     pub fn write_csv<W: std::io::Write + Send>(&self, out: &mut W) -> std::io::Result<()> {
         use rayon::prelude::*;
-        out.write_all(self.names.join(",").as_bytes())?;
-        out.write_all(b"\n")?;
+        out.write_all(crate::output::csv_header(&self.names).as_bytes())?;
         let rows = self.rows();
         let blocks: Vec<(usize, usize)> = (0..rows)
             .step_by(ROWS_PER_BLOCK)

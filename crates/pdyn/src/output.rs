@@ -10,10 +10,33 @@ use serde_json::json;
 use std::io::Write;
 use std::path::Path;
 
+/// The header line of a CSV table (with its newline): the names joined by commas, a name
+/// that holds a comma, a quote or a line break quoted as RFC 4180 says (`"x[0,1]"`, a quote
+/// doubled), so that every CSV reader (pandas, Excel, `pdyn kin --data`) sees one column per
+/// name. A family's members are named `x[0,1]`: unquoted, a reader split them in two.
+pub fn csv_header<S: AsRef<str>>(names: &[S]) -> String {
+    let mut line = String::new();
+    for (i, name) in names.iter().enumerate() {
+        let name = name.as_ref();
+        if i > 0 {
+            line.push(',');
+        }
+        if name.contains([',', '"', '\n', '\r']) {
+            line.push('"');
+            line.push_str(&name.replace('"', "\"\""));
+            line.push('"');
+        } else {
+            line.push_str(name);
+        }
+    }
+    line.push('\n');
+    line
+}
+
 /// Writes the trajectory table.
 pub fn write_csv(res: &RunResult, path: &Path) -> std::io::Result<()> {
     let mut f = std::fs::File::create(path)?;
-    writeln!(f, "{}", res.columns.join(","))?;
+    f.write_all(csv_header(&res.columns).as_bytes())?;
     // Rows are formatted into one buffer, written every 256 KiB: a run of 1,000 stick-slip
     // cycles writes 1.6 million numbers, and the formatting is half of its time.
     let mut out: Vec<u8> = Vec::with_capacity(CSV_CHUNK + 4096);

@@ -75,16 +75,13 @@ pub fn report(
         .collect();
     if let Some(dir) = &req.out {
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, "create", e))?;
-        let mut csv = res.parameter.clone();
+        // Measures are named by the user (`max(x[0,1])`): the header quotes what needs it.
+        let mut names = vec![res.parameter.as_str()];
         if let Some(sl) = res.slices.first() {
-            for (n, _) in &sl.fixed {
-                csv += &format!(",{n}");
-            }
+            names.extend(sl.fixed.iter().map(|(n, _)| n.as_str()));
         }
-        for m in &res.measures {
-            csv += &format!(",{m}");
-        }
-        csv.push('\n');
+        names.extend(res.measures.iter().map(String::as_str));
+        let mut csv = crate::output::csv_header(&names);
         for sl in &res.slices {
             for (v, row) in res.values.iter().zip(&sl.table) {
                 crate::output::push_number(&mut csv, *v);

@@ -152,7 +152,7 @@ pub fn execute(
     let csv = plan.dir.join("trajectory.csv");
     let (mut file, mut tally, before, resume) = match &plan.restart {
         None => {
-            let header = format!("{}\n", prep.columns().join(","));
+            let header = crate::output::csv_header(&prep.columns());
             (
                 RowFile::create(&csv, &header)?,
                 Tally::new(prep),
