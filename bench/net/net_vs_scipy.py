@@ -5,8 +5,8 @@ that builds and integrates the same net").
 
 Both write the 201-row table as CSV; both use Dormand–Prince 5(4) with rtol 1e-6, atol 1e-9.
 The two are first checked to be the same model: their states at t = 0.5 s must agree to
-1e-6 (tolerance-level; the falling net folds and later the two runs part exponentially, as
-any two integrations of it with different round-off do). Then each is timed `--repeat` times,
+1e-5 (tolerance-level; the falling net folds and later the two runs part exponentially, as
+any two integrations of it with different round-off do: 3e-6 at t = 2 s, 2e-2 at t = 4 s). Then each is timed `--repeat` times,
 alternating, and the fastest kept; CPU time (user + system) from /usr/bin/time too.
 
     python3 -m venv /tmp/venv-bench && /tmp/venv-bench/bin/pip install numpy scipy
@@ -51,8 +51,8 @@ def main():
     ap.add_argument("--t-end", default="8")
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
-    print("| particles | states | pdyn wall | pdyn CPU | pdyn memory | SciPy wall | SciPy CPU | SciPy memory | SciPy / pdyn (wall) | max difference at t = 0.5 |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("| particles | states | pdyn wall | pdyn CPU | pdyn memory | SciPy wall | SciPy CPU | SciPy memory | SciPy / pdyn (wall) | SciPy / pdyn (CPU) | max difference at t = 0.5 |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
         for n in map(int, args.sizes.split(",")):
             model = Path(tmp) / f"net{n}.toml"
@@ -73,7 +73,7 @@ def main():
                         best[side] = r
             (pw, pc, pm), (sw, sc, sm) = best["pdyn"], best["scipy"]
             particles = n * n - 2
-            print(f"| {particles} | {6 * particles} | {pw:.2f} s | {pc:.2f} s | {pm:.0f} MB | {sw:.2f} s | {sc:.2f} s | {sm:.0f} MB | {sw / pw:.1f}× | {diff:.1e} |")
+            print(f"| {particles} | {6 * particles} | {pw:.2f} s | {pc:.2f} s | {pm:.0f} MB | {sw:.2f} s | {sc:.2f} s | {sm:.0f} MB | {sw / pw:.1f}× | {sc / pc:.1f}× | {diff:.1e} |")
 
 
 if __name__ == "__main__":
