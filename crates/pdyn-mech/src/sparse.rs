@@ -714,7 +714,7 @@ mod tests {
     /// Random triplets, with repeated entries and rows left empty.
     fn random_triplets(n: usize, count: usize, seed: u64) -> Vec<(usize, usize, f64)> {
         let mut r = rng(seed);
-        let mut index = |r: &mut dyn FnMut() -> f64| ((r() + 1.0) * 0.5 * n as f64) as usize % n;
+        let index = |r: &mut dyn FnMut() -> f64| ((r() + 1.0) * 0.5 * n as f64) as usize % n;
         (0..count)
             .map(|_| {
                 let i = index(&mut r);
