@@ -6,9 +6,11 @@
 //! length), so the plain Newton step is undefined there. Each step solves
 //! `(K + μ D) δq = f` with `D` the mass matrix's diagonal (Levenberg–Marquardt: for large `μ`
 //! a short step along the forces, as damped dynamics would take; for `μ → 0` Newton's step),
-//! `μ` shrinking tenfold after a step that lowers `|f|` and growing tenfold after one that
-//! does not. Where `μ` must grow past any bound, no state balances the forces: the stiffness is
-//! singular along the directions the forces push (a mechanism), which are named.
+//! `μ` shrinking tenfold after a step taken and growing tenfold after one refused; a step is
+//! taken where it lowers `|f|` or, for conservative forces, the potential energy
+//! (`damped_newton.rs`). Where `μ` must grow past any bound, no state balances the
+//! forces: the stiffness is singular along the directions the forces push (a mechanism),
+//! which are named.
 
 use crate::linearization::{Linearization, Linearize};
 use nalgebra::{DMatrix, DVector};

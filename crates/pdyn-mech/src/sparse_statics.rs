@@ -6,8 +6,8 @@
 //!
 //! - **Equilibrium**: Newton–Levenberg–Marquardt as in [`crate::equilibrium::solve`], each step
 //!   `(K_s + μ D) δq = f` with `K_s = (K + Kᵀ)/2` (Newton's exact step for conservative forces,
-//!   whose `K` is symmetric; for others a quasi-Newton step, accepted only where it lowers
-//!   `|f|`, like every step).
+//!   whose `K` is symmetric, taken where it lowers `|f|` or the energy; for others a
+//!   quasi-Newton step, taken only where it lowers `|f|`: `damped_newton.rs`).
 //! - **Modes**: the `count` lowest of `K_s φ = ω² M φ` by shift-invert Lanczos
 //!   ([`crate::lanczos::nearest`], shift 0, or just below 0 when `K` is singular).
 //! - **Free directions** (a mechanism, a neutral equilibrium): the eigenvectors of
