@@ -6,9 +6,11 @@
 //! length), so the plain Newton step is undefined there. Each step solves
 //! `(K + μ D) δq = f` with `D` the mass matrix's diagonal (Levenberg–Marquardt: for large `μ`
 //! a short step along the forces, as damped dynamics would take; for `μ → 0` Newton's step),
-//! `μ` shrinking tenfold after a step that lowers `|f|` and growing tenfold after one that
-//! does not. Where `μ` must grow past any bound, no state balances the forces: the stiffness is
-//! singular along the directions the forces push (a mechanism), which are named.
+//! `μ` shrinking tenfold after a step taken and growing tenfold after one refused; a step is
+//! taken where it lowers `|f|` or, for conservative forces, the potential energy
+//! (`damped_newton.rs`). Where `μ` must grow past any bound, no state balances the
+//! forces: the stiffness is singular along the directions the forces push (a mechanism),
+//! which are named.
 
 use crate::linearization::{Linearization, Linearize};
 use nalgebra::{DMatrix, DVector};
@@ -234,7 +236,24 @@ impl<L: Linearize + ?Sized> crate::damped_newton::NewtonSystem for Dense<'_, L> 
     fn free_directions(&self, at: &Linearization) -> Vec<FreeDirection> {
         free_directions(self.0.names(), &at.stiffness)
     }
+
+    fn force(&self, q: &[f64]) -> Vec<f64> {
+        self.0.force(q)
+    }
+
+    fn conservative(&self, at: &Linearization) -> bool {
+        let k = &at.stiffness;
+        let big = k.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let worst = (0..k.nrows())
+            .flat_map(|i| (0..i).map(move |j| (i, j)))
+            .fold(0.0f64, |m, (i, j)| m.max((k[(i, j)] - k[(j, i)]).abs()));
+        worst <= SYMMETRIC * big
+    }
 }
+
+/// Asymmetry of `K` (relative to its largest entry) below which the forces are taken to derive
+/// from a potential: round-off in entries computed from different expressions.
+pub(crate) const SYMMETRIC: f64 = 1e-9;
 
 /// The null space of the stiffness's symmetric part: eigenvectors whose eigenvalue is below
 /// 1e-9 of the largest in magnitude.

@@ -117,6 +117,11 @@ pub trait Linearize {
     }
     /// `M`, `K`, `C` and `f` at rest at `q` (t = 0), sparse.
     fn at_sparse(&self, q: &[f64]) -> SparseLinearization;
+    /// `f` alone at rest at `q` (t = 0): what damped Newton's work along a step reads (a
+    /// linearization that can compute it without the matrices says so).
+    fn force(&self, q: &[f64]) -> Vec<f64> {
+        self.at_sparse(q).force
+    }
     /// The same, dense (for small systems).
     fn at(&self, q: &[f64]) -> Linearization {
         self.at_sparse(q).to_dense()

@@ -169,23 +169,66 @@ impl Csr {
             .sum()
     }
 
-    /// `Aᵀ`.
+    /// `Aᵀ`: the entries counted into their columns' rows, which come out sorted since the
+    /// rows are visited in order (no sort: damped Newton forms `(K + Kᵀ)/2` at every step).
     pub fn transpose(&self) -> Csr {
-        let mut t = Vec::with_capacity(self.nnz());
-        for i in 0..self.n {
-            t.extend(self.row(i).map(|(j, v)| (j, i, v)));
+        let n = self.n;
+        let mut ptr = vec![0usize; n + 1];
+        for &j in &self.col {
+            ptr[j + 1] += 1;
         }
-        Csr::from_triplets(self.n, &t).expect("indices of a valid matrix")
+        for j in 0..n {
+            ptr[j + 1] += ptr[j];
+        }
+        let mut next = ptr.clone();
+        let mut col = vec![0usize; self.nnz()];
+        let mut val = vec![0.0f64; self.nnz()];
+        for i in 0..n {
+            for (j, v) in self.row(i) {
+                col[next[j]] = i;
+                val[next[j]] = v;
+                next[j] += 1;
+            }
+        }
+        Csr { n, ptr, col, val }
     }
 
-    /// `a A + b B` (the union of the patterns).
+    /// `a A + b B` (the union of the patterns): each row the merge of the two sorted rows, an
+    /// entry in both `a A_ij + b B_ij` (as [`Csr::from_triplets`] sums them, in that order).
     pub fn add(&self, a: f64, other: &Csr, b: f64) -> Csr {
-        let mut t = Vec::with_capacity(self.nnz() + other.nnz());
-        for i in 0..self.n {
-            t.extend(self.row(i).map(|(j, v)| (i, j, a * v)));
-            t.extend(other.row(i).map(|(j, v)| (i, j, b * v)));
+        let n = self.n;
+        let mut ptr = Vec::with_capacity(n + 1);
+        let mut col = Vec::with_capacity(self.nnz() + other.nnz());
+        let mut val = Vec::with_capacity(self.nnz() + other.nnz());
+        ptr.push(0);
+        for i in 0..n {
+            let (ra, rb) = (self.ptr[i]..self.ptr[i + 1], other.ptr[i]..other.ptr[i + 1]);
+            let (ca, va) = (&self.col[ra.clone()], &self.val[ra]);
+            let (cb, vb) = (&other.col[rb.clone()], &other.val[rb]);
+            let (mut x, mut y) = (0, 0);
+            while x < ca.len() || y < cb.len() {
+                let (ja, jb) = (
+                    ca.get(x).copied().unwrap_or(usize::MAX),
+                    cb.get(y).copied().unwrap_or(usize::MAX),
+                );
+                if ja < jb {
+                    col.push(ja);
+                    val.push(a * va[x]);
+                    x += 1;
+                } else if jb < ja {
+                    col.push(jb);
+                    val.push(b * vb[y]);
+                    y += 1;
+                } else {
+                    col.push(ja);
+                    val.push(a * va[x] + b * vb[y]);
+                    x += 1;
+                    y += 1;
+                }
+            }
+            ptr.push(col.len());
         }
-        Csr::from_triplets(self.n, &t).expect("indices of a valid matrix")
+        Csr { n, ptr, col, val }
     }
 
     /// `max |A_ij − A_ji| / max |A_ij|` (zero for a symmetric or a zero matrix).
@@ -234,6 +277,127 @@ impl Csr {
         }
         d
     }
+}
+
+/// How a fixed sequence of `(row, column)` triplets lands in a [`Csr`]: the pattern and each
+/// triplet's entry, found once (sorting each row), then refilled with new values in `O(nnz)`.
+/// A linearization whose pattern never changes (a net's elements) assembles `K` at every
+/// Newton step: the sort was a third of the time.
+#[derive(Clone, Debug)]
+pub struct Assembly {
+    n: usize,
+    /// `(row, column)` of each triplet, in order.
+    at: Vec<(usize, usize)>,
+    /// The index in `col`/`val` each triplet adds into.
+    slot: Vec<usize>,
+    /// Whether the triplet is its entry's first (it sets the value, the others add to it, as
+    /// [`Csr::from_triplets`] sums them: the same additions in the same order).
+    first: Vec<bool>,
+    ptr: Vec<usize>,
+    col: Vec<usize>,
+}
+
+impl Assembly {
+    /// The assembly of `entries`' pattern, and their matrix (what [`Csr::from_triplets`] gives).
+    pub fn new(n: usize, entries: &[(usize, usize, f64)]) -> Result<(Assembly, Csr), SparseError> {
+        let mut count = vec![0usize; n + 1];
+        for &(r, c, _) in entries {
+            if r >= n || c >= n {
+                return Err(SparseError::OutOfBounds { row: r, col: c, n });
+            }
+            count[r + 1] += 1;
+        }
+        for i in 0..n {
+            count[i + 1] += count[i];
+        }
+        let mut next = count.clone();
+        let mut ck = vec![(0usize, 0usize); entries.len()];
+        for (k, &(r, c, _)) in entries.iter().enumerate() {
+            ck[next[r]] = (c, k);
+            next[r] += 1;
+        }
+        let mut slot = vec![0usize; entries.len()];
+        let mut first = vec![false; entries.len()];
+        let mut ptr = Vec::with_capacity(n + 1);
+        let mut col: Vec<usize> = Vec::with_capacity(entries.len());
+        ptr.push(0);
+        for i in 0..n {
+            let row = &mut ck[count[i]..count[i + 1]];
+            // Stable: the triplets of one entry stay in their order.
+            row.sort_by_key(|e| e.0);
+            for &(c, k) in row.iter() {
+                if !(col.len() > ptr[i] && col.last() == Some(&c)) {
+                    col.push(c);
+                    first[k] = true;
+                }
+                slot[k] = col.len() - 1;
+            }
+            ptr.push(col.len());
+        }
+        let assembly = Assembly {
+            n,
+            at: entries.iter().map(|&(r, c, _)| (r, c)).collect(),
+            slot,
+            first,
+            ptr,
+            col,
+        };
+        let matrix = assembly.values(entries);
+        Ok((assembly, matrix))
+    }
+
+    /// The matrix of `entries`, the same as [`Csr::from_triplets`] gives, or `None` when their
+    /// `(row, column)` sequence is not this assembly's.
+    pub fn fill(&self, entries: &[(usize, usize, f64)]) -> Option<Csr> {
+        if entries.len() != self.at.len()
+            || entries
+                .iter()
+                .zip(&self.at)
+                .any(|(&(r, c, _), &(ar, ac))| r != ar || c != ac)
+        {
+            return None;
+        }
+        Some(self.values(entries))
+    }
+
+    /// The matrix of `entries`, known to be this assembly's sequence.
+    fn values(&self, entries: &[(usize, usize, f64)]) -> Csr {
+        let mut val = vec![0.0f64; self.col.len()];
+        for (k, &(_, _, v)) in entries.iter().enumerate() {
+            let s = self.slot[k];
+            if self.first[k] {
+                val[s] = v;
+            } else {
+                val[s] += v;
+            }
+        }
+        Csr {
+            n: self.n,
+            ptr: self.ptr.clone(),
+            col: self.col.clone(),
+            val,
+        }
+    }
+}
+
+/// `Σ a_k b_k` in four interleaved sums (the compiler vectorizes them; one running sum it may
+/// not reorder): the inner loop of the envelope factorization and its solves.
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut s = [0.0f64; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for ((s, x), y) in s.iter_mut().zip(x).zip(y) {
+            *s += x * y;
+        }
+    }
+    let mut tail = 0.0;
+    for (x, y) in ra.iter().zip(rb) {
+        tail += x * y;
+    }
+    (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
 /// Reverse Cuthill–McKee order of the symmetric pattern of `a` (of `A + Aᵀ`): `perm[new] = old`.
@@ -400,7 +564,7 @@ impl EnvelopeLdlt {
                 let k0 = fi.max(fj);
                 let lj = &done[start[j] + k0 - fj..start[j] + j - fj];
                 let ui = &row[k0 - fi..j - fi];
-                let s: f64 = ui.iter().zip(lj).map(|(u, l)| u * l).sum();
+                let s = dot(ui, lj);
                 row[j - fi] -= s;
             }
             let mut di = d[i];
@@ -458,7 +622,7 @@ impl EnvelopeLdlt {
         for i in 0..n {
             let fi = self.first[i];
             let row = &self.l[self.start[i]..self.start[i + 1]];
-            let s: f64 = row.iter().zip(&work[fi..i]).map(|(l, y)| l * y).sum();
+            let s = dot(row, &work[fi..i]);
             work[i] -= s;
         }
         for (w, d) in work.iter_mut().zip(&self.d) {
@@ -545,6 +709,82 @@ mod tests {
             let neg = eig.eigenvalues.iter().filter(|&&l| l < 0.0).count();
             assert_eq!(f.negative_pivots(), neg, "seed {seed}");
         }
+    }
+
+    /// Random triplets, with repeated entries and rows left empty.
+    fn random_triplets(n: usize, count: usize, seed: u64) -> Vec<(usize, usize, f64)> {
+        let mut r = rng(seed);
+        let index = |r: &mut dyn FnMut() -> f64| ((r() + 1.0) * 0.5 * n as f64) as usize % n;
+        (0..count)
+            .map(|_| {
+                let i = index(&mut r);
+                // Rows below n/2 only, so that the upper half is empty.
+                (i / 2, index(&mut r), r())
+            })
+            .collect()
+    }
+
+    /// Whether two matrices are the same, pattern and values bit for bit.
+    fn same_bits(a: &Csr, b: &Csr) -> bool {
+        a.n == b.n
+            && a.ptr == b.ptr
+            && a.col == b.col
+            && a.val
+                .iter()
+                .zip(&b.val)
+                .all(|(x, y)| x.to_bits() == y.to_bits())
+    }
+
+    #[test]
+    fn an_assembly_refills_the_matrix_from_triplets_gives() {
+        let n = 40;
+        let t = random_triplets(n, 400, 11);
+        let (assembly, first) = Assembly::new(n, &t).unwrap();
+        assert!(same_bits(&first, &Csr::from_triplets(n, &t).unwrap()));
+        // New values on the same pattern: the same bits as a fresh assembly.
+        let mut r = rng(12);
+        let u: Vec<(usize, usize, f64)> = t.iter().map(|&(i, j, _)| (i, j, r())).collect();
+        let refilled = assembly.fill(&u).unwrap();
+        assert!(same_bits(&refilled, &Csr::from_triplets(n, &u).unwrap()));
+        // Each entry is the sum of its terms.
+        let dense = refilled.to_dense();
+        let mut sums = nalgebra::DMatrix::<f64>::zeros(n, n);
+        for &(i, j, v) in &u {
+            sums[(i, j)] += v;
+        }
+        assert!((dense - sums).amax() <= 1e-15);
+        // Another pattern is refused, not misfilled.
+        let mut other = u.clone();
+        other[3].1 = (other[3].1 + 1) % n;
+        assert!(assembly.fill(&other).is_none());
+        assert!(assembly.fill(&u[1..]).is_none());
+    }
+
+    #[test]
+    fn transpose_and_add_merge_as_triplets_would() {
+        let n = 30;
+        let a = Csr::from_triplets(n, &random_triplets(n, 200, 21)).unwrap();
+        let b = Csr::from_triplets(n, &random_triplets(n, 150, 22)).unwrap();
+        // Aᵀ through triplets, as it was formed before.
+        let mut t = Vec::new();
+        for i in 0..n {
+            t.extend(a.row(i).map(|(j, v)| (j, i, v)));
+        }
+        assert!(same_bits(
+            &a.transpose(),
+            &Csr::from_triplets(n, &t).unwrap()
+        ));
+        let mut t = Vec::new();
+        for i in 0..n {
+            t.extend(a.row(i).map(|(j, v)| (i, j, 0.5 * v)));
+            t.extend(b.row(i).map(|(j, v)| (i, j, -2.0 * v)));
+        }
+        assert!(same_bits(
+            &a.add(0.5, &b, -2.0),
+            &Csr::from_triplets(n, &t).unwrap()
+        ));
+        let dense = a.add(0.5, &b, -2.0).to_dense();
+        assert!((dense - (a.to_dense() * 0.5 - b.to_dense() * 2.0)).amax() <= 1e-15);
     }
 
     #[test]

@@ -6,8 +6,8 @@
 //!
 //! - **Equilibrium**: Newton–Levenberg–Marquardt as in [`crate::equilibrium::solve`], each step
 //!   `(K_s + μ D) δq = f` with `K_s = (K + Kᵀ)/2` (Newton's exact step for conservative forces,
-//!   whose `K` is symmetric; for others a quasi-Newton step, accepted only where it lowers
-//!   `|f|`, like every step).
+//!   whose `K` is symmetric, taken where it lowers `|f|` or the energy; for others a
+//!   quasi-Newton step, taken only where it lowers `|f|`: `damped_newton.rs`).
 //! - **Modes**: the `count` lowest of `K_s φ = ω² M φ` by shift-invert Lanczos
 //!   ([`crate::lanczos::nearest`], shift 0, or just below 0 when `K` is singular).
 //! - **Free directions** (a mechanism, a neutral equilibrium): the eigenvectors of
@@ -68,7 +68,8 @@ pub fn solve<L: Linearize + ?Sized>(
         .collect();
     let dmax = diag.iter().fold(0.0f64, |m, x| m.max(*x));
     let ratio = stiff.max(f64::MIN_POSITIVE) / dmax;
-    let ks = symmetric_part(&at.stiffness);
+    let at = SparseAt::new(at);
+    let ks = &at.ks;
     // One ordering for every step: the pattern of K + D does not change.
     let order = rcm(&ks.add(1.0, &Csr::diagonal(&diag), 1.0));
     let sparse = Sparse {
@@ -76,8 +77,7 @@ pub fn solve<L: Linearize + ?Sized>(
         order,
         diag: &diag,
     };
-    let end =
-        crate::damped_newton::solve(&sparse, q, SparseAt { at, ks }, &diag, ratio, target, opts)?;
+    let end = crate::damped_newton::solve(&sparse, q, at, &diag, ratio, target, opts)?;
     let (q, SparseAt { at, ks }, residual, steps) = (end.q, end.at, end.residual, end.steps);
     let neutral = if opts.neutral {
         free_directions(lin.names(), &ks, &diag)
@@ -108,13 +108,18 @@ struct SparseAt {
     ks: Csr,
 }
 
+impl SparseAt {
+    fn new(at: SparseLinearization) -> SparseAt {
+        let ks = symmetric_part(&at.stiffness);
+        SparseAt { at, ks }
+    }
+}
+
 impl<L: Linearize + ?Sized> crate::damped_newton::NewtonSystem for Sparse<'_, L> {
     type At = SparseAt;
 
     fn at(&self, q: &[f64]) -> SparseAt {
-        let at = self.lin.at_sparse(q);
-        let ks = symmetric_part(&at.stiffness);
-        SparseAt { at, ks }
+        SparseAt::new(self.lin.at_sparse(q))
     }
 
     fn residual(&self, at: &SparseAt) -> f64 {
@@ -129,6 +134,14 @@ impl<L: Linearize + ?Sized> crate::damped_newton::NewtonSystem for Sparse<'_, L>
 
     fn free_directions(&self, at: &SparseAt) -> Vec<FreeDirection> {
         free_directions(self.lin.names(), &at.ks, self.diag)
+    }
+
+    fn force(&self, q: &[f64]) -> Vec<f64> {
+        self.lin.force(q)
+    }
+
+    fn conservative(&self, at: &SparseAt) -> bool {
+        at.at.stiffness.asymmetry() <= crate::equilibrium::SYMMETRIC
     }
 }
 

@@ -150,6 +150,9 @@ impl Loader<'_> {
 
     /// Whether the coordinate table's `key` names a definition not declared yet.
     fn names_pending_definition(&self, t: &toml::Table, key: &str) -> bool {
+        if self.definition_names.is_empty() {
+            return false;
+        }
         let Some(v) = t.get(key) else { return false };
         let Ok(text) = number_text(v) else {
             return false;
@@ -315,7 +318,8 @@ impl Loader<'_> {
             self.dims.require(&dim.into(), &want, sv.span(), &what, "");
             return Ok((q, self.pool.num(Number::Float(q))));
         }
-        let ast = pdyn_expr::syntax::parse(&text)
+        let ast = self
+            .parse(&text, sv.span().start)
             .map_err(|e| self.err(sv.span(), format!("in `{key}`: {}", e.message)))?;
         let v = lower(&mut self.pool, &ast, &mut self.scope).map_err(|e| {
             self.err(sv.span(), format!("in `{key}` of `{n}`: {}", e.message))
@@ -371,7 +375,7 @@ impl Loader<'_> {
         }
         // The table's values carry no spans of their own: errors inside point at the table.
         let before = self.dims.errors.len();
-        let got = self.dims.infer(
+        let got = self.infer(
             ast,
             Source {
                 text,

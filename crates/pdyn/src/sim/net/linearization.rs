@@ -22,8 +22,9 @@ use pdyn_expr::{Id, Program};
 use pdyn_jit::JitMode;
 use pdyn_mech::linearization::{Linearize, SparseLinearization};
 use pdyn_mech::model::CoordinateKind;
-use pdyn_mech::sparse::Csr;
+use pdyn_mech::sparse::{Assembly, Csr, SparseError};
 use pdyn_mech::Model;
+use std::cell::RefCell;
 
 /// The linearization of a model of free particles in Cartesian coordinates, numeric.
 pub struct NetLinearization {
@@ -36,6 +37,9 @@ pub struct NetLinearization {
     kernels: NetKernels,
     /// `[t, q, q', parameters]` at rest at t = 0, the parameters' values set.
     input: Vec<f64>,
+    /// How the terms of `K` and of `C` land in their matrices: the elements' pattern, found at
+    /// the first linearization and refilled at the next (damped Newton's steps).
+    assembly: RefCell<[Option<Assembly>; 2]>,
 }
 
 impl NetLinearization {
@@ -85,7 +89,38 @@ impl NetLinearization {
             inertia,
             kernels,
             input,
+            assembly: RefCell::new([None, None]),
         })
+    }
+
+    /// `[t, q, q', parameters]` at rest at `q`.
+    fn input_at(&self, q: &[f64]) -> Vec<f64> {
+        let mut input = self.input.clone();
+        input[1..1 + q.len()].copy_from_slice(q);
+        input
+    }
+
+    /// The loads at `input`: each acceleration times its particle's mass.
+    fn force_with(&self, input: &[f64]) -> Vec<f64> {
+        let mut force = vec![0.0; self.names.len()];
+        self.kernels.accelerations(input, &mut force);
+        for (f, m) in force.iter_mut().zip(&self.mass) {
+            *f *= m;
+        }
+        force
+    }
+
+    /// The matrix of the terms `t` (`which`: 0 for `K`, 1 for `C`), through the assembly kept
+    /// from the last call when the terms are the same `(row, column)` sequence (always, for
+    /// one net), else a new one.
+    fn assemble(&self, t: &[(usize, usize, f64)], which: usize) -> Result<Csr, SparseError> {
+        let mut kept = self.assembly.borrow_mut();
+        if let Some(a) = kept[which].as_ref().and_then(|a| a.fill(t)) {
+            return Ok(a);
+        }
+        let (assembly, a) = Assembly::new(self.names.len(), t)?;
+        kept[which] = Some(assembly);
+        Ok(a)
     }
 
     /// Operations per evaluation of the loads (every kernel over its elements): a
@@ -104,15 +139,14 @@ impl Linearize for NetLinearization {
         &self.initial
     }
 
+    fn force(&self, q: &[f64]) -> Vec<f64> {
+        self.force_with(&self.input_at(q))
+    }
+
     fn at_sparse(&self, q: &[f64]) -> SparseLinearization {
         let n = self.names.len();
-        let mut input = self.input.clone();
-        input[1..1 + n].copy_from_slice(q);
-        let mut force = vec![0.0; n];
-        self.kernels.accelerations(&input, &mut force);
-        for (f, m) in force.iter_mut().zip(&self.mass) {
-            *f *= m;
-        }
+        let input = self.input_at(q);
+        let force = self.force_with(&input);
         let (mut k, mut c) = (Vec::new(), Vec::new());
         let compiled = self
             .kernels
@@ -127,14 +161,14 @@ impl Linearize for NetLinearization {
         // Rows and columns are free coordinates of this model, hence in bounds; a kernel of
         // derivatives that would not compile (it cannot: the same operations as the loads')
         // gives NaN matrices, which the solvers refuse.
-        let csr = |t: &[(usize, usize, f64)]| match Csr::from_triplets(n, t) {
+        let csr = |t: &[(usize, usize, f64)], which: usize| match self.assemble(t, which) {
             Ok(a) if compiled => a,
             _ => Csr::diagonal(&vec![f64::NAN; n]),
         };
         SparseLinearization {
             mass: Csr::diagonal(&self.mass),
-            stiffness: csr(&k),
-            damping: csr(&c),
+            stiffness: csr(&k, 0),
+            damping: csr(&c, 1),
             force,
         }
     }
