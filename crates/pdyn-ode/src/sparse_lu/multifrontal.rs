@@ -64,7 +64,6 @@ impl<T: Scalar> Numeric<T> {
                 self.stack.truncate(base);
             }
             partial_lu(front, m, ns, &self.row_max[f..f + ns], floor).map_err(|k| f + k)?;
-            schur(front, m, ns);
             let off = sn.lu_start[s];
             self.lu[off..off + m * ns].copy_from_slice(&front[..m * ns]);
             let u12 = &mut self.lu[off + m * ns..off + m * ns + ns * r];
@@ -79,51 +78,66 @@ impl<T: Scalar> Numeric<T> {
         Ok(())
     }
 
-    /// Solves `A z = b` in place, `z` in the permuted order.
-    pub(crate) fn solve_permuted(&self, sn: &Supernodes, z: &mut [T]) {
+    /// Solves `A z = b` in place, `z` in the permuted order; `t` is scratch of at least the
+    /// largest front's side.
+    pub(crate) fn solve_permuted(&self, sn: &Supernodes, z: &mut [T], t: &mut [T]) {
         for s in 0..sn.len() {
             let (f, ns) = (sn.first[s], sn.first[s + 1] - sn.first[s]);
             let rows = &sn.rows[sn.row_start[s]..sn.row_start[s + 1]];
-            let m = ns + rows.len();
+            let (r, m) = (rows.len(), ns + rows.len());
             let l = &self.lu[sn.lu_start[s]..sn.lu_start[s] + m * ns];
+            let zs = &mut z[f..f + ns];
+            let t = &mut t[..r];
+            t.fill(T::ZERO);
             for k in 0..ns {
-                let zk = z[f + k];
+                let zk = zs[k];
                 let col = &l[k * m..k * m + m];
                 for i in k + 1..ns {
-                    z[f + i] = z[f + i] - col[i] * zk;
+                    zs[i] = zs[i] - col[i] * zk;
                 }
-                for (&i, &v) in rows.iter().zip(&col[ns..]) {
-                    z[i] = z[i] - v * zk;
+                for (x, &v) in t.iter_mut().zip(&col[ns..]) {
+                    *x = *x + v * zk;
                 }
+            }
+            for (&i, &v) in rows.iter().zip(t.iter()) {
+                z[i] = z[i] - v;
             }
         }
         for s in (0..sn.len()).rev() {
             let (f, ns) = (sn.first[s], sn.first[s + 1] - sn.first[s]);
             let rows = &sn.rows[sn.row_start[s]..sn.row_start[s + 1]];
-            let m = ns + rows.len();
+            let (r, m) = (rows.len(), ns + rows.len());
             let off = sn.lu_start[s];
             let u = &self.lu[off..off + m * ns];
-            let u12 = &self.lu[off + m * ns..off + m * ns + ns * rows.len()];
-            for (a, &i) in rows.iter().enumerate() {
-                let zi = z[i];
-                for (k, &v) in u12[a * ns..a * ns + ns].iter().enumerate() {
-                    z[f + k] = z[f + k] - v * zi;
+            let u12 = &self.lu[off + m * ns..off + m * ns + ns * r];
+            let t = &mut t[..r];
+            for (x, &i) in t.iter_mut().zip(rows) {
+                *x = z[i];
+            }
+            let zs = &mut z[f..f + ns];
+            for (a, &za) in t.iter().enumerate() {
+                for (x, &v) in zs.iter_mut().zip(&u12[a * ns..a * ns + ns]) {
+                    *x = *x - v * za;
                 }
             }
             for k in (0..ns).rev() {
-                let zk = z[f + k] / u[k + k * m];
-                z[f + k] = zk;
+                let zk = zs[k] / u[k + k * m];
+                zs[k] = zk;
                 for i in 0..k {
-                    z[f + i] = z[f + i] - u[i + k * m] * zk;
+                    zs[i] = zs[i] - u[i + k * m] * zk;
                 }
             }
         }
     }
 }
 
-/// Eliminates the first `ns` pivots of the `m × m` front (column-major): `L11`, `U11` in
-/// place of the diagonal block, `L21` below it, `U12 = L11⁻¹ F12` right of it. `Err(k)` for
-/// a negligible pivot `k`.
+/// Columns eliminated together by [`partial_lu`] before the rest of the front is updated.
+const BLOCK: usize = 32;
+
+/// Eliminates the first `ns` pivots of the `m × m` front (column-major), `BLOCK` columns at a
+/// time (right-looking, blocked): `L11`, `U11` in place of the diagonal block, `L21` below
+/// it, `U12 = L11⁻¹ F12` right of it and the Schur complement `F22 − L21 U12` in place of
+/// `F22`. `Err(k)` for a negligible pivot `k`.
 fn partial_lu<T: Scalar>(
     front: &mut [T],
     m: usize,
@@ -131,48 +145,65 @@ fn partial_lu<T: Scalar>(
     row_max: &[f64],
     floor: f64,
 ) -> Result<(), usize> {
-    for k in 0..ns {
-        let (left, right) = front.split_at_mut((k + 1) * m);
-        let colk = &mut left[k * m..];
-        let d = colk[k];
-        let mag = d.magnitude();
-        if !(mag.is_finite() && mag > floor * row_max[k]) {
-            return Err(k);
-        }
-        let inv = T::ONE / d;
-        for x in &mut colk[k + 1..] {
-            *x = *x * inv;
-        }
-        let colk = &colk[..];
-        // Columns of the panel: every row below k; columns right of it: the rows of U12.
-        for (jj, col) in right.chunks_exact_mut(m).enumerate() {
-            let u = col[k];
-            let end = if k + 1 + jj < ns { m } else { ns };
-            for (x, &l) in col[k + 1..end].iter_mut().zip(&colk[k + 1..end]) {
-                *x = *x - l * u;
+    let mut k0 = 0;
+    while k0 < ns {
+        let k1 = (k0 + BLOCK).min(ns);
+        // The block's columns, unblocked, on every row below the diagonal.
+        for k in k0..k1 {
+            let (left, right) = front.split_at_mut((k + 1) * m);
+            let colk = &mut left[k * m..];
+            let d = colk[k];
+            let mag = d.magnitude();
+            if !(mag.is_finite() && mag > floor * row_max[k]) {
+                return Err(k);
+            }
+            let inv = T::ONE / d;
+            for x in &mut colk[k + 1..] {
+                *x = *x * inv;
+            }
+            let colk = &colk[..];
+            for col in right.chunks_exact_mut(m).take(k1 - k - 1) {
+                let u = col[k];
+                for (x, &l) in col[k + 1..].iter_mut().zip(&colk[k + 1..]) {
+                    *x = *x - l * u;
+                }
             }
         }
+        // The block's rows of U right of it: L(k0..k1, k0..k1)⁻¹ F(k0..k1, k1..).
+        let (left, right) = front.split_at_mut(k1 * m);
+        for col in right.chunks_exact_mut(m) {
+            for k in k0..k1 {
+                let u = col[k];
+                let l = &left[k * m..];
+                for i in k + 1..k1 {
+                    col[i] = col[i] - l[i] * u;
+                }
+            }
+        }
+        // The rest of the front: F(k1.., k1..) −= L(k1.., k0..k1) U(k0..k1, k1..).
+        update(front, m, k0, k1);
+        k0 = k1;
     }
     Ok(())
 }
 
-/// The Schur complement `F22 −= L21 U12` of the front, four columns at a time (each entry
-/// of `L21` loaded once for four multiply–adds).
-fn schur<T: Scalar>(front: &mut [T], m: usize, ns: usize) {
-    let (left, right) = front.split_at_mut(ns * m);
-    let r = m - ns;
+/// `F(k1.., k1..) −= F(k1.., k0..k1) F(k0..k1, k1..)` on the `m × m` front, four columns at a
+/// time (each entry of `L` loaded once for four multiply–adds).
+fn update<T: Scalar>(front: &mut [T], m: usize, k0: usize, k1: usize) {
+    let (left, right) = front.split_at_mut(k1 * m);
+    let r = m - k1;
     let full = right.len() / (4 * m) * (4 * m);
     let (quads, rest) = right.split_at_mut(full);
     for quad in quads.chunks_exact_mut(4 * m) {
         let (c0, quad) = quad.split_at_mut(m);
         let (c1, quad) = quad.split_at_mut(m);
         let (c2, c3) = quad.split_at_mut(m);
-        let (u0, c0) = c0.split_at_mut(ns);
-        let (u1, c1) = c1.split_at_mut(ns);
-        let (u2, c2) = c2.split_at_mut(ns);
-        let (u3, c3) = c3.split_at_mut(ns);
-        for k in 0..ns {
-            let a = &left[k * m + ns..k * m + ns + r];
+        let (u0, c0) = c0.split_at_mut(k1);
+        let (u1, c1) = c1.split_at_mut(k1);
+        let (u2, c2) = c2.split_at_mut(k1);
+        let (u3, c3) = c3.split_at_mut(k1);
+        for k in k0..k1 {
+            let a = &left[k * m + k1..k * m + k1 + r];
             let (b0, b1, b2, b3) = (u0[k], u1[k], u2[k], u3[k]);
             let (c0, c1, c2, c3) = (&mut c0[..r], &mut c1[..r], &mut c2[..r], &mut c3[..r]);
             for i in 0..r {
@@ -185,9 +216,9 @@ fn schur<T: Scalar>(front: &mut [T], m: usize, ns: usize) {
         }
     }
     for c in rest.chunks_exact_mut(m) {
-        let (u, c) = c.split_at_mut(ns);
-        for k in 0..ns {
-            let a = &left[k * m + ns..(k + 1) * m];
+        let (u, c) = c.split_at_mut(k1);
+        for k in k0..k1 {
+            let a = &left[k * m + k1..(k + 1) * m];
             let b = u[k];
             for (x, &ai) in c.iter_mut().zip(a) {
                 *x = *x - ai * b;
