@@ -63,7 +63,7 @@ impl<T: Scalar> Numeric<T> {
                 }
                 self.stack.truncate(base);
             }
-            partial_lu(front, m, ns, &self.row_max[f..f + ns], floor).map_err(|k| f + k)?;
+            eliminate(front, m, ns, &self.row_max[f..f + ns], floor).map_err(|k| f + k)?;
             let off = sn.lu_start[s];
             self.lu[off..off + m * ns].copy_from_slice(&front[..m * ns]);
             let u12 = &mut self.lu[off + m * ns..off + m * ns + ns * r];
@@ -134,6 +134,36 @@ impl<T: Scalar> Numeric<T> {
 /// Columns eliminated together by [`partial_lu`] before the rest of the front is updated.
 const BLOCK: usize = 32;
 
+/// [`partial_lu`], compiled for AVX when the processor has it: four lanes per instruction in
+/// the kernels' columns, the same operations in the same order (no fused multiply–add), so
+/// the same bits on every processor (as `pdyn_expr::lu`'s Cholesky).
+fn eliminate<T: Scalar>(
+    front: &mut [T],
+    m: usize,
+    ns: usize,
+    row_max: &[f64],
+    floor: f64,
+) -> Result<(), usize> {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx") {
+        // SAFETY: the processor has AVX (checked just above).
+        return unsafe { partial_lu_avx(front, m, ns, row_max, floor) };
+    }
+    partial_lu(front, m, ns, row_max, floor)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+unsafe fn partial_lu_avx<T: Scalar>(
+    front: &mut [T],
+    m: usize,
+    ns: usize,
+    row_max: &[f64],
+    floor: f64,
+) -> Result<(), usize> {
+    partial_lu(front, m, ns, row_max, floor)
+}
+
 /// Eliminates the first `ns` pivots of the `m × m` front (column-major), `BLOCK` columns at a
 /// time (right-looking, blocked): `L11`, `U11` in place of the diagonal block, `L21` below
 /// it, `U12 = L11⁻¹ F12` right of it and the Schur complement `F22 − L21 U12` in place of
@@ -189,6 +219,7 @@ fn partial_lu<T: Scalar>(
 
 /// `F(k1.., k1..) −= F(k1.., k0..k1) F(k0..k1, k1..)` on the `m × m` front, four columns at a
 /// time (each entry of `L` loaded once for four multiply–adds).
+#[inline(always)]
 fn update<T: Scalar>(front: &mut [T], m: usize, k0: usize, k1: usize) {
     let (left, right) = front.split_at_mut(k1 * m);
     let r = m - k1;
