@@ -711,4 +711,19 @@ mod tests {
             Err(SparseLuError::Singular { row: 3 })
         );
     }
+
+    #[test]
+    fn an_empty_matrix_factors_and_solves_nothing() {
+        let p = Pattern {
+            start: vec![0],
+            cols: vec![],
+        };
+        let s = Symbolic::new(&p).unwrap();
+        let mut lu = SparseLu::new(&s);
+        lu.factor(&s, &[]).unwrap();
+        lu.solve_in_place(&s, &mut []);
+        let mut lc = SparseLuComplex::new(&s);
+        lc.factor(&s, &[], |_| 0.0).unwrap();
+        lc.solve_in_place(&s, &mut [], &mut []);
+    }
 }

@@ -131,9 +131,9 @@ impl Supernodes {
             }
         }
         // Fundamental supernodes.
-        let mut fund_first = vec![0usize];
-        for j in 1..n {
-            if !(parent[j - 1] == j && count[j - 1] == count[j] + 1) {
+        let mut fund_first = Vec::new();
+        for j in 0..n {
+            if j == 0 || !(parent[j - 1] == j && count[j - 1] == count[j] + 1) {
                 fund_first.push(j);
             }
         }
