@@ -33,7 +33,7 @@
 //! | `resume.rs` | [`solve_observed`]: an explicit pair watched step by step (outputs taken as they come) and resumed bit for bit from a saved [`ResumeState`] |
 //! | `tableau.rs` | Butcher tableaus as data; order-condition checker over rooted trees |
 //! | `linalg.rs` | dense real/complex LU with partial pivoting (decsol.f), allocation-free |
-//! | `sparse_lu.rs`, `ordering.rs` | sparse real/complex LU on a known pattern (up-looking, no pivoting) in nested-dissection order, for Radau5's iteration matrices ([`LinearSolver`]) |
+//! | `sparse_lu.rs`, `ordering.rs` | sparse real/complex LU on a known pattern (kinematic rows `q' = v` eliminated first, then supernodal multifrontal with dense kernels, no pivoting) in nested-dissection order, for Radau5's iteration matrices ([`LinearSolver`]) |
 //! | `methods/dopri5.rs` | **DOPRI5**, Dormand & Prince 1980: 5(4), FSAL, 4th-order dense output, stiffness detection (MATLAB `ode45`) |
 //! | `methods/rk23.rs` | **RK23**, Bogacki & Shampine 1989: 3(2), FSAL, cubic Hermite dense output (MATLAB `ode23`) |
 //! | `methods/tsit5.rs` | **Tsit5**, Tsitouras 2011: 5(4), FSAL, 4th-order dense output |

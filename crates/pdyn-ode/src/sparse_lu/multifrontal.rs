@@ -1,0 +1,259 @@
+//! The numeric phase of the supernodal multifrontal LU ([`super::supernodal`]): for each
+//! supernode in postorder, its front (a dense `m × m` block, column-major) is assembled from
+//! the matrix's entries and its children's update matrices, its `ns` pivots are eliminated
+//! with dense kernels (no pivoting), the `L` and `U` blocks are kept and the Schur
+//! complement goes on the stack for the parent. Real and complex alike (`T`).
+
+use super::scalar::Scalar;
+use super::supernodal::Supernodes;
+
+/// The numeric factors of one matrix on a [`Supernodes`] structure.
+#[derive(Debug)]
+pub(crate) struct Numeric<T> {
+    lu: Vec<T>,
+    front: Vec<T>,
+    stack: Vec<T>,
+    row_max: Vec<f64>,
+}
+
+impl<T: Scalar> Numeric<T> {
+    pub(crate) fn new(sn: &Supernodes) -> Self {
+        Numeric {
+            lu: vec![T::ZERO; sn.lu_start[sn.len()]],
+            front: vec![T::ZERO; sn.max_front * sn.max_front],
+            stack: Vec::with_capacity(sn.max_stack),
+            row_max: vec![0.0; sn.n],
+        }
+    }
+
+    /// Factors the matrix with values `vals` (the analysed pattern's order); `Err(k)` when
+    /// pivot `k` (permuted) is zero, not finite, or below `floor` times its row's largest
+    /// entry.
+    pub(crate) fn factor(&mut self, sn: &Supernodes, vals: &[T], floor: f64) -> Result<(), usize> {
+        self.row_max.fill(0.0);
+        for (q, v) in vals.iter().enumerate() {
+            let r = sn.value_row[q];
+            self.row_max[r] = self.row_max[r].max(v.magnitude());
+        }
+        self.stack.clear();
+        for s in 0..sn.len() {
+            let (f, ns) = (sn.first[s], sn.first[s + 1] - sn.first[s]);
+            let r = sn.row_start[s + 1] - sn.row_start[s];
+            let m = ns + r;
+            let front = &mut self.front[..m * m];
+            front.fill(T::ZERO);
+            for &(at, q) in &sn.assembly[sn.asm_start[s]..sn.asm_start[s + 1]] {
+                front[at] = front[at] + vals[q];
+            }
+            // Extend-add the children's update matrices, last child on top of the stack.
+            for &c in sn.children[sn.child_start[s]..sn.child_start[s + 1]]
+                .iter()
+                .rev()
+            {
+                let rel = &sn.rel[sn.row_start[c]..sn.row_start[c + 1]];
+                let rc = rel.len();
+                let base = self.stack.len() - rc * rc;
+                let upd = &self.stack[base..];
+                for (b, &cb) in rel.iter().enumerate() {
+                    let col = &mut front[cb * m..cb * m + m];
+                    let src = &upd[b * rc..b * rc + rc];
+                    for (&ra, &v) in rel.iter().zip(src) {
+                        col[ra] = col[ra] + v;
+                    }
+                }
+                self.stack.truncate(base);
+            }
+            eliminate(front, m, ns, &self.row_max[f..f + ns], floor).map_err(|k| f + k)?;
+            let off = sn.lu_start[s];
+            self.lu[off..off + m * ns].copy_from_slice(&front[..m * ns]);
+            let u12 = &mut self.lu[off + m * ns..off + m * ns + ns * r];
+            for j in 0..r {
+                u12[j * ns..j * ns + ns].copy_from_slice(&front[(ns + j) * m..(ns + j) * m + ns]);
+            }
+            for j in 0..r {
+                self.stack
+                    .extend_from_slice(&front[(ns + j) * m + ns..(ns + j + 1) * m]);
+            }
+        }
+        Ok(())
+    }
+
+    /// Solves `A z = b` in place, `z` in the permuted order; `t` is scratch of at least the
+    /// largest front's side.
+    pub(crate) fn solve_permuted(&self, sn: &Supernodes, z: &mut [T], t: &mut [T]) {
+        for s in 0..sn.len() {
+            let (f, ns) = (sn.first[s], sn.first[s + 1] - sn.first[s]);
+            let rows = &sn.rows[sn.row_start[s]..sn.row_start[s + 1]];
+            let (r, m) = (rows.len(), ns + rows.len());
+            let l = &self.lu[sn.lu_start[s]..sn.lu_start[s] + m * ns];
+            let zs = &mut z[f..f + ns];
+            let t = &mut t[..r];
+            t.fill(T::ZERO);
+            for k in 0..ns {
+                let zk = zs[k];
+                let col = &l[k * m..k * m + m];
+                for i in k + 1..ns {
+                    zs[i] = zs[i] - col[i] * zk;
+                }
+                for (x, &v) in t.iter_mut().zip(&col[ns..]) {
+                    *x = *x + v * zk;
+                }
+            }
+            for (&i, &v) in rows.iter().zip(t.iter()) {
+                z[i] = z[i] - v;
+            }
+        }
+        for s in (0..sn.len()).rev() {
+            let (f, ns) = (sn.first[s], sn.first[s + 1] - sn.first[s]);
+            let rows = &sn.rows[sn.row_start[s]..sn.row_start[s + 1]];
+            let (r, m) = (rows.len(), ns + rows.len());
+            let off = sn.lu_start[s];
+            let u = &self.lu[off..off + m * ns];
+            let u12 = &self.lu[off + m * ns..off + m * ns + ns * r];
+            let t = &mut t[..r];
+            for (x, &i) in t.iter_mut().zip(rows) {
+                *x = z[i];
+            }
+            let zs = &mut z[f..f + ns];
+            for (a, &za) in t.iter().enumerate() {
+                for (x, &v) in zs.iter_mut().zip(&u12[a * ns..a * ns + ns]) {
+                    *x = *x - v * za;
+                }
+            }
+            for k in (0..ns).rev() {
+                let zk = zs[k] / u[k + k * m];
+                zs[k] = zk;
+                for i in 0..k {
+                    zs[i] = zs[i] - u[i + k * m] * zk;
+                }
+            }
+        }
+    }
+}
+
+/// Columns eliminated together by [`partial_lu`] before the rest of the front is updated.
+const BLOCK: usize = 32;
+
+/// [`partial_lu`], compiled for AVX when the processor has it: four lanes per instruction in
+/// the kernels' columns, the same operations in the same order (no fused multiply–add), so
+/// the same bits on every processor (as `pdyn_expr::lu`'s Cholesky).
+fn eliminate<T: Scalar>(
+    front: &mut [T],
+    m: usize,
+    ns: usize,
+    row_max: &[f64],
+    floor: f64,
+) -> Result<(), usize> {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx") {
+        // SAFETY: the processor has AVX (checked just above).
+        return unsafe { partial_lu_avx(front, m, ns, row_max, floor) };
+    }
+    partial_lu(front, m, ns, row_max, floor)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+unsafe fn partial_lu_avx<T: Scalar>(
+    front: &mut [T],
+    m: usize,
+    ns: usize,
+    row_max: &[f64],
+    floor: f64,
+) -> Result<(), usize> {
+    partial_lu(front, m, ns, row_max, floor)
+}
+
+/// Eliminates the first `ns` pivots of the `m × m` front (column-major), `BLOCK` columns at a
+/// time (right-looking, blocked): `L11`, `U11` in place of the diagonal block, `L21` below
+/// it, `U12 = L11⁻¹ F12` right of it and the Schur complement `F22 − L21 U12` in place of
+/// `F22`. `Err(k)` for a negligible pivot `k`.
+fn partial_lu<T: Scalar>(
+    front: &mut [T],
+    m: usize,
+    ns: usize,
+    row_max: &[f64],
+    floor: f64,
+) -> Result<(), usize> {
+    let mut k0 = 0;
+    while k0 < ns {
+        let k1 = (k0 + BLOCK).min(ns);
+        // The block's columns, unblocked, on every row below the diagonal.
+        for k in k0..k1 {
+            let (left, right) = front.split_at_mut((k + 1) * m);
+            let colk = &mut left[k * m..];
+            let d = colk[k];
+            let mag = d.magnitude();
+            if !(mag.is_finite() && mag > floor * row_max[k]) {
+                return Err(k);
+            }
+            let inv = T::ONE / d;
+            for x in &mut colk[k + 1..] {
+                *x = *x * inv;
+            }
+            let colk = &colk[..];
+            for col in right.chunks_exact_mut(m).take(k1 - k - 1) {
+                let u = col[k];
+                for (x, &l) in col[k + 1..].iter_mut().zip(&colk[k + 1..]) {
+                    *x = *x - l * u;
+                }
+            }
+        }
+        // The block's rows of U right of it: L(k0..k1, k0..k1)⁻¹ F(k0..k1, k1..).
+        let (left, right) = front.split_at_mut(k1 * m);
+        for col in right.chunks_exact_mut(m) {
+            for k in k0..k1 {
+                let u = col[k];
+                let l = &left[k * m..];
+                for i in k + 1..k1 {
+                    col[i] = col[i] - l[i] * u;
+                }
+            }
+        }
+        // The rest of the front: F(k1.., k1..) −= L(k1.., k0..k1) U(k0..k1, k1..).
+        update(front, m, k0, k1);
+        k0 = k1;
+    }
+    Ok(())
+}
+
+/// `F(k1.., k1..) −= F(k1.., k0..k1) F(k0..k1, k1..)` on the `m × m` front, four columns at a
+/// time (each entry of `L` loaded once for four multiply–adds).
+#[inline(always)]
+fn update<T: Scalar>(front: &mut [T], m: usize, k0: usize, k1: usize) {
+    let (left, right) = front.split_at_mut(k1 * m);
+    let r = m - k1;
+    let full = right.len() / (4 * m) * (4 * m);
+    let (quads, rest) = right.split_at_mut(full);
+    for quad in quads.chunks_exact_mut(4 * m) {
+        let (c0, quad) = quad.split_at_mut(m);
+        let (c1, quad) = quad.split_at_mut(m);
+        let (c2, c3) = quad.split_at_mut(m);
+        let (u0, c0) = c0.split_at_mut(k1);
+        let (u1, c1) = c1.split_at_mut(k1);
+        let (u2, c2) = c2.split_at_mut(k1);
+        let (u3, c3) = c3.split_at_mut(k1);
+        for k in k0..k1 {
+            let a = &left[k * m + k1..k * m + k1 + r];
+            let (b0, b1, b2, b3) = (u0[k], u1[k], u2[k], u3[k]);
+            let (c0, c1, c2, c3) = (&mut c0[..r], &mut c1[..r], &mut c2[..r], &mut c3[..r]);
+            for i in 0..r {
+                let ai = a[i];
+                c0[i] = c0[i] - ai * b0;
+                c1[i] = c1[i] - ai * b1;
+                c2[i] = c2[i] - ai * b2;
+                c3[i] = c3[i] - ai * b3;
+            }
+        }
+    }
+    for c in rest.chunks_exact_mut(m) {
+        let (u, c) = c.split_at_mut(k1);
+        for k in k0..k1 {
+            let a = &left[k * m + k1..(k + 1) * m];
+            let b = u[k];
+            for (x, &ai) in c.iter_mut().zip(a) {
+                *x = *x - ai * b;
+            }
+        }
+    }
+}
