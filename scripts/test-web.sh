@@ -8,7 +8,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ -z "${SKIP_BUILD:-}" ]; then
     scripts/build-web.sh
-    cargo build --quiet -p pdyn-cli
+    # The binary `cargo test --workspace` builds (see scripts/test-all.sh).
+    cargo test --workspace --no-run --quiet
 fi
 cd web
 PDYN_BIN="${PDYN_BIN:-$(pwd)/../target/debug/pdyn}" node --test --test-reporter=spec tests/
