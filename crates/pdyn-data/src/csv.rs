@@ -130,6 +130,17 @@ fn delimiter(header: &str) -> char {
         .unwrap_or(',')
 }
 
+/// The 1-based character column of a quote that opens a name and is never closed.
+fn unclosed_quote(line: &str) -> Option<usize> {
+    let mut open = None;
+    for (col, c) in line.chars().enumerate() {
+        if c == '"' {
+            open = if open.is_some() { None } else { Some(col + 1) };
+        }
+    }
+    open
+}
+
 /// The fields of a line with their 1-based character columns, quotes removed, spaces trimmed.
 /// A quoted field (RFC 4180) may hold the delimiter, and `""` stands for one quote inside it:
 /// pdyn writes a column named `x[0,1]` as `"x[0,1]"`.
@@ -233,6 +244,14 @@ pub fn read_columns(file: &str, text: &str, wanted: &[&str]) -> Result<Columns, 
             ),
         );
     };
+    if let Some(col) = unclosed_quote(header) {
+        return Err(
+            DataError::new(file, "a quoted name of the header is not closed")
+                .at(header_line, Some(col))
+                .text(header)
+                .help("close the name with `\"` (a quote inside a name is written `\"\"`)"),
+        );
+    }
     let delim = delimiter(header);
     let head = fields(header, delim);
     let names: Vec<String> = head.iter().map(|(_, n)| n.to_string()).collect();

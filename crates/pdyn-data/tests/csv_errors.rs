@@ -196,3 +196,10 @@ fn quoted_header_names_may_hold_the_delimiter() {
     let c = read_columns("net.csv", "t;\"x[0,1]\"\n0;1\n1;2\n", &["x[0,1]"]).unwrap();
     assert_eq!(c.values, vec![vec![1.0, 2.0]]);
 }
+
+#[test]
+fn an_unclosed_quote_in_the_header_is_located() {
+    let e = read_columns("net.csv", "t,\"x[0,1],y\n0,1,2\n", &["t"]).unwrap_err();
+    assert_eq!((e.line, e.column), (Some(1), Some(3)), "{e}");
+    assert!(e.message.contains("not closed"), "{e}");
+}

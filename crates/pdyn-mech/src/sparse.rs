@@ -83,43 +83,8 @@ impl Csr {
     /// The `n × n` matrix with these `(row, column, value)` entries (duplicates added; explicit
     /// zeros kept, so that the pattern is the symbolic one).
     pub fn from_triplets(n: usize, entries: &[(usize, usize, f64)]) -> Result<Csr, SparseError> {
-        let mut count = vec![0usize; n + 1];
-        for &(r, c, _) in entries {
-            if r >= n || c >= n {
-                return Err(SparseError::OutOfBounds { row: r, col: c, n });
-            }
-            count[r + 1] += 1;
-        }
-        for i in 0..n {
-            count[i + 1] += count[i];
-        }
-        let mut next = count.clone();
-        let mut cv = vec![(0usize, 0.0f64); entries.len()];
-        for &(r, c, v) in entries {
-            cv[next[r]] = (c, v);
-            next[r] += 1;
-        }
-        let mut ptr = Vec::with_capacity(n + 1);
-        let mut col = Vec::with_capacity(entries.len());
-        let mut val = Vec::with_capacity(entries.len());
-        ptr.push(0);
-        for i in 0..n {
-            let row = &mut cv[count[i]..count[i + 1]];
-            row.sort_by_key(|e| e.0);
-            for &(c, v) in row.iter() {
-                // A repeated (row, column) adds to the entry just pushed for this row.
-                let same = col.len() > ptr[i] && col.last() == Some(&c);
-                match val.last_mut() {
-                    Some(last) if same => *last += v,
-                    _ => {
-                        col.push(c);
-                        val.push(v);
-                    }
-                }
-            }
-            ptr.push(col.len());
-        }
-        Ok(Csr { n, ptr, col, val })
+        // One way of sorting triplets into rows: an assembly's, used once.
+        Assembly::new(n, entries).map(|(_, matrix)| matrix)
     }
 
     /// The diagonal matrix `diag(d)`.
@@ -735,29 +700,47 @@ mod tests {
                 .all(|(x, y)| x.to_bits() == y.to_bits())
     }
 
+    /// Each entry is its triplets' values summed in their order (the first sets it), bit for
+    /// bit, and each row's columns increase strictly: written from the definition, not from
+    /// the assembly.
+    fn is_the_sum_in_order(m: &Csr, t: &[(usize, usize, f64)]) -> bool {
+        let mut sums: std::collections::HashMap<(usize, usize), f64> = Default::default();
+        for &(i, j, v) in t {
+            sums.entry((i, j)).and_modify(|s| *s += v).or_insert(v);
+        }
+        let rows_sorted = (0..m.n).all(|i| {
+            m.col[m.ptr[i]..m.ptr[i + 1]]
+                .windows(2)
+                .all(|w| w[0] < w[1])
+        });
+        rows_sorted
+            && m.nnz() == sums.len()
+            && sums
+                .iter()
+                .all(|(&(i, j), s)| m.get(i, j).to_bits() == s.to_bits())
+    }
+
     #[test]
     fn an_assembly_refills_the_matrix_from_triplets_gives() {
         let n = 40;
-        let t = random_triplets(n, 400, 11);
+        // ~5 triplets per entry: sums of several terms, whose order shows in their bits.
+        let t = random_triplets(n, 4000, 11);
         let (assembly, first) = Assembly::new(n, &t).unwrap();
+        assert!(is_the_sum_in_order(&first, &t));
         assert!(same_bits(&first, &Csr::from_triplets(n, &t).unwrap()));
         // New values on the same pattern: the same bits as a fresh assembly.
         let mut r = rng(12);
         let u: Vec<(usize, usize, f64)> = t.iter().map(|&(i, j, _)| (i, j, r())).collect();
         let refilled = assembly.fill(&u).unwrap();
+        assert!(is_the_sum_in_order(&refilled, &u));
         assert!(same_bits(&refilled, &Csr::from_triplets(n, &u).unwrap()));
-        // Each entry is the sum of its terms.
-        let dense = refilled.to_dense();
-        let mut sums = nalgebra::DMatrix::<f64>::zeros(n, n);
-        for &(i, j, v) in &u {
-            sums[(i, j)] += v;
-        }
-        assert!((dense - sums).amax() <= 1e-15);
         // Another pattern is refused, not misfilled.
         let mut other = u.clone();
         other[3].1 = (other[3].1 + 1) % n;
         assert!(assembly.fill(&other).is_none());
         assert!(assembly.fill(&u[1..]).is_none());
+        // An index outside the matrix is an error.
+        assert!(Csr::from_triplets(n, &[(0, n, 1.0)]).is_err());
     }
 
     #[test]
