@@ -33,11 +33,24 @@ enum Engine {
     /// writes its buffers).
     Numeric,
     /// A tree of links: the program gives each link's numbers
-    /// ([`TreeForm::inputs`]), [`TreeForm::solve`] the accelerations.
-    Tree(Evaluator, Box<TreeForm>),
+    /// ([`TreeForm::inputs`]), [`TreeForm::solve`] the accelerations. The sines and cosines
+    /// of inputs (a chain's link angles) are computed all at once before the program runs
+    /// ([`TreeTrig`]).
+    Tree(Evaluator, Box<TreeForm>, TreeTrig),
     /// Free particles in Cartesian coordinates: one kernel per load template
     /// ([`super::net`]), its Jacobian too.
     Net(Box<NetKernels>),
+}
+
+/// The inputs whose sine and cosine a tree program reads, computed together by
+/// [`pdyn_expr::sincos_many`] (four at a time, `libm::sincos`'s bits) into the input slots
+/// after `[t, q, q', parameters]`: at 100 links, one `sincos` call per link from the program
+/// was a fifth of the run. The program was compiled with them as inputs
+/// ([`pdyn_expr::sincos_many::hoist_input_sincos`]).
+#[derive(Clone, Default)]
+struct TreeTrig {
+    /// The input slots of the angles, in the order of the hoisted inputs.
+    angles: Vec<usize>,
 }
 
 #[derive(Clone)]
@@ -51,6 +64,8 @@ struct Scratch {
     /// The tree engine's per-link numbers and its recursion's buffers.
     tree_values: Vec<f64>,
     tree_ws: TreeWorkspace,
+    /// The tree's angles gathered for [`pdyn_expr::sincos_many`].
+    tree_angles: Vec<f64>,
 }
 
 /// The equations of motion of a model as an [`OdeSystem`] (and a [`SecondOrderSystem`]).
@@ -193,8 +208,12 @@ impl CompiledModel {
             (Some(tree), _) => {
                 let exprs = tree.inputs();
                 let prog = Program::compile(p, &inputs, &exprs)?;
+                let (prog, angles) = pdyn_expr::sincos_many::hoist_input_sincos(prog);
+                let trig = TreeTrig {
+                    angles: angles.into_iter().map(|r| r as usize).collect(),
+                };
                 let separable = !p.contains_any(&exprs, &rates);
-                let engine = Engine::Tree(Evaluator::new(prog, jit), Box::new(tree.clone()));
+                let engine = Engine::Tree(Evaluator::new(prog, jit), Box::new(tree.clone()), trig);
                 (engine, None, None, separable)
             }
             (None, Some(sol)) => {
@@ -228,12 +247,17 @@ impl CompiledModel {
                 (Engine::Numeric, None, Some(sys), !depends_on_rates)
             }
         };
-        let mut input = vec![0.0; inputs.len()];
+        // The tree's hoisted sines and cosines follow the inputs.
+        let hoisted = match &engine {
+            Engine::Tree(_, _, trig) => 2 * trig.angles.len(),
+            _ => 0,
+        };
+        let mut input = vec![0.0; inputs.len() + hoisted];
         for (k, par) in model.parameters.iter().enumerate() {
             input[1 + 2 * n + k] = par.value;
         }
         let (ws, native) = match (&engine, &numeric) {
-            (Engine::Exact(e), _) | (Engine::Tree(e, _), _) => (e.workspace(), e.is_native()),
+            (Engine::Exact(e), _) | (Engine::Tree(e, _, _), _) => (e.workspace(), e.is_native()),
             (Engine::Numeric, Some(sys)) => (Vec::new(), sys.is_native()),
             (Engine::Numeric, None) => (Vec::new(), false),
             (Engine::Net(k), _) => (Vec::new(), k.is_native()),
@@ -242,9 +266,9 @@ impl CompiledModel {
             Some(j) => (j.workspace(), vec![0.0; j.n_outputs()]),
             None => (Vec::new(), Vec::new()),
         };
-        let tree_values = match &engine {
-            Engine::Tree(e, _) => vec![0.0; e.n_outputs()],
-            _ => Vec::new(),
+        let (tree_values, tree_angles) = match &engine {
+            Engine::Tree(e, _, trig) => (vec![0.0; e.n_outputs()], vec![0.0; trig.angles.len()]),
+            _ => (Vec::new(), Vec::new()),
         };
         Ok(CompiledModel {
             n,
@@ -264,6 +288,7 @@ impl CompiledModel {
                 jac_out,
                 tree_values,
                 tree_ws: TreeWorkspace::default(),
+                tree_angles,
             }),
             inputs,
             observation_inputs,
@@ -298,6 +323,7 @@ impl CompiledModel {
                 jac_out: Vec::new(),
                 tree_values: Vec::new(),
                 tree_ws: TreeWorkspace::default(),
+                tree_angles: Vec::new(),
             }),
             inputs,
             observation_inputs,
@@ -330,7 +356,7 @@ impl CompiledModel {
     /// The current parameter values.
     pub fn parameters(&self) -> Vec<f64> {
         let s = self.scratch.borrow();
-        s.input[1 + 2 * self.n..].to_vec()
+        s.input[1 + 2 * self.n..self.inputs.len()].to_vec()
     }
 
     /// Solves for the unknowns at `(t, y)`: writes `q''` into `acc` and the reactions into
@@ -365,7 +391,8 @@ impl CompiledModel {
                 }
             }
             Engine::Net(kernels) => kernels.accelerations(&s.input, &mut s.out),
-            Engine::Tree(prog, tree) => {
+            Engine::Tree(prog, tree, trig) => {
+                fill_tree_trig(s, trig, self.inputs.len());
                 prog.eval(&s.input, &mut s.ws, &mut s.tree_values);
                 // The unknowns are the accelerations in state order, as the tree's
                 // coordinates are numbered.
@@ -390,12 +417,13 @@ impl CompiledModel {
     /// runs at `(t, y)` ([`pdyn_mech::tree::TreeForm::solve`] on a counting scalar). `None`
     /// on the dense paths.
     pub fn tree_evaluation_ops(&self, t: f64, y: &[f64]) -> Option<usize> {
-        let Engine::Tree(prog, tree) = &self.engine else {
+        let Engine::Tree(prog, tree, trig) = &self.engine else {
             return None;
         };
         let s = &mut *self.scratch.borrow_mut();
         s.input[0] = t;
         s.input[1..1 + 2 * self.n].copy_from_slice(&y[..2 * self.n]);
+        fill_tree_trig(s, trig, self.inputs.len());
         prog.eval(&s.input, &mut s.ws, &mut s.tree_values);
         let counted: Vec<Counted> = s.tree_values.iter().map(|&x| Counted(x)).collect();
         let mut out = vec![Counted(0.0); self.n];
@@ -406,7 +434,8 @@ impl CompiledModel {
             Evaluator::Native(j) => j.len(),
             _ => 0,
         };
-        Some(program + OPS.with(|c| c.get()))
+        // The hoisted sines and cosines, counted as the two instructions they were.
+        Some(program + 2 * trig.angles.len() + OPS.with(|c| c.get()))
     }
 
     /// Fills the observation input vector `[t, q, q', parameters, q'', reactions]` at `(t, y)`.
@@ -415,9 +444,9 @@ impl CompiledModel {
     pub fn observation_input(&self, t: f64, y: &[f64], out: &mut Vec<f64>) {
         let s = &mut *self.scratch.borrow_mut();
         self.solve_into(s, t, &y[..2 * self.n]);
-        let base = s.input.len();
+        let base = self.inputs.len();
         out.resize(base + self.n + self.n_reactions, 0.0);
-        out[..base].copy_from_slice(&s.input);
+        out[..base].copy_from_slice(&s.input[..base]);
         let (acc, reac) = out[base..].split_at_mut(self.n);
         for (k, slot) in self.slots.iter().enumerate() {
             match slot {
@@ -439,13 +468,27 @@ impl CompiledModel {
     /// of a right-hand side evaluation.
     pub fn observation_input_without_unknowns(&self, t: f64, y: &[f64], out: &mut Vec<f64>) {
         let s = self.scratch.borrow();
-        let base = s.input.len();
+        let base = self.inputs.len();
         out.resize(base + self.n + self.n_reactions, 0.0);
         out[0] = t;
         copy_small(&mut out[1..1 + 2 * self.n], &y[..2 * self.n]);
-        out[1 + 2 * self.n..base].copy_from_slice(&s.input[1 + 2 * self.n..]);
+        out[1 + 2 * self.n..base].copy_from_slice(&s.input[1 + 2 * self.n..base]);
         out[base..].fill(f64::NAN);
     }
+}
+
+/// Writes the sines and cosines of the tree's angles into the input slots after the first
+/// `n_inputs` (sines, then cosines), as the hoisted program reads them.
+fn fill_tree_trig(s: &mut Scratch, trig: &TreeTrig, n_inputs: usize) {
+    let m = trig.angles.len();
+    if m == 0 {
+        return;
+    }
+    for (a, &slot) in s.tree_angles.iter_mut().zip(&trig.angles) {
+        *a = s.input[slot];
+    }
+    let (sines, cosines) = s.input[n_inputs..n_inputs + 2 * m].split_at_mut(m);
+    pdyn_expr::sincos_many(&s.tree_angles, sines, cosines);
 }
 
 impl OdeSystem for CompiledModel {
