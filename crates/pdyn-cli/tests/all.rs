@@ -33,6 +33,8 @@ mod derived_parameters;
 mod examples_snapshot;
 #[path = "exit_codes.rs"]
 mod exit_codes;
+#[path = "large_examples.rs"]
+mod large_examples;
 #[path = "long_runs.rs"]
 mod long_runs;
 #[path = "long_runs_md.rs"]
