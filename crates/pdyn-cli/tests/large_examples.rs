@@ -31,7 +31,10 @@ fn the_100_by_100_cloth_sets_up_and_falls_freely_far_from_its_pins() {
     assert_eq!(states, 2 * 3 * (100 * 100 - 2));
     let z = fin["far_corner_z"].as_f64().unwrap();
     let want = -drag_fall(9.81, 0.05, 0.02, 0.01);
-    assert!((z - want).abs() <= 1e-6 * want.abs(), "z = {z}, closed form {want}");
+    assert!(
+        (z - want).abs() <= 1e-6 * want.abs(),
+        "z = {z}, closed form {want}"
+    );
 }
 
 /// Every model here is run by a test of this file (a new one needs its own).

@@ -90,20 +90,20 @@ pub(crate) fn fuse_sin_cos(first_temp: u32, instrs: Vec<Instr>, outputs: &mut [u
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use crate::compile::{Op, Program};
     use crate::hoist::{HoistedInputs, HoistedProgram};
     use crate::{Id, Pool};
 
     /// xorshift64: a seeded stream of 64-bit words.
-    fn next(state: &mut u64) -> u64 {
+    pub(crate) fn next(state: &mut u64) -> u64 {
         *state ^= *state << 13;
         *state ^= *state >> 7;
         *state ^= *state << 17;
         *state
     }
 
-    fn same(a: f64, b: f64) -> bool {
+    pub(crate) fn same(a: f64, b: f64) -> bool {
         a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
     }
 

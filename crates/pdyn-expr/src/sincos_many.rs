@@ -356,17 +356,7 @@ mod avx {
 mod tests {
     use super::sincos_many;
 
-    /// xorshift64: a seeded stream of 64-bit words.
-    fn next(state: &mut u64) -> u64 {
-        *state ^= *state << 13;
-        *state ^= *state >> 7;
-        *state ^= *state << 17;
-        *state
-    }
-
-    fn same(a: f64, b: f64) -> bool {
-        a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
-    }
+    use crate::sincos::tests::{next, same};
 
     fn check(args: &[f64]) {
         let mut s = vec![0.0; args.len()];
