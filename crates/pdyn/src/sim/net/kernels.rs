@@ -50,6 +50,9 @@ struct Kernel {
     /// The gathered input columns, kept between evaluations: the columns of parameters are
     /// refilled only when a parameter's value changed.
     columns: RefCell<Columns>,
+    /// One more than the largest index the gather table reads: an input vector at least this
+    /// long is checked once per gather, not once per value.
+    input_len: usize,
 }
 
 /// Where one kernel input comes from, element by element.
@@ -170,6 +173,14 @@ impl NetKernels {
                 }
             }
             let jacobian_program = Program::compile(pool, &leaves, &derivatives)?;
+            let input_len = gather
+                .iter()
+                .map(|g| match g {
+                    Gather::Each(from) => from.iter().max().map_or(0, |&i| i as usize + 1),
+                    Gather::Broadcast(i) => *i as usize + 1,
+                })
+                .max()
+                .unwrap_or(0);
             let columns = Columns {
                 inputs: vec![vec![0.0; elements]; kernel.n_inputs()],
                 filled: vec![f64::NAN.to_bits(); kernel.n_inputs()],
@@ -188,6 +199,7 @@ impl NetKernels {
                 mode,
                 elements,
                 columns: RefCell::new(columns),
+                input_len,
             });
         }
         let native = kernels
@@ -199,6 +211,11 @@ impl NetKernels {
             at += k.scatter.len() * k.elements;
         }
         let (term_start, terms) = sums(&kernels, n);
+        // Every term is an output (the sums index the outputs they were built from): checked
+        // here once, so that the sums read them unchecked.
+        if terms.iter().any(|&t| t as usize >= at) || term_start.len() != n + 1 {
+            return Ok(None);
+        }
         Ok(Some(NetKernels {
             kernels,
             outputs: RefCell::new(vec![0.0; at]),
@@ -271,7 +288,9 @@ impl NetKernels {
         for (a, w) in acc[..self.n].iter_mut().zip(self.term_start.windows(2)) {
             *a = self.terms[w[0] as usize..w[1] as usize]
                 .iter()
-                .map(|&i| outputs[i as usize])
+                // SAFETY: every term indexes the outputs (checked in `compile`, which sized
+                // them; they are never resized).
+                .map(|&i| unsafe { *outputs.get_unchecked(i as usize) })
                 .sum();
         }
     }
@@ -446,11 +465,18 @@ fn sums(kernels: &[Kernel], n: usize) -> (Vec<u32>, Vec<u32>) {
 /// Fills the input columns of kernel `k` from `input`: every element's coordinates, and a
 /// parameter's column only when its value changed since it was filled.
 fn gather(k: &Kernel, input: &[f64], cols: &mut Columns) {
+    assert!(
+        input.len() >= k.input_len,
+        "net kernel inputs: {} values, the gather table reads {}",
+        input.len(),
+        k.input_len
+    );
     for ((col, from), filled) in cols.inputs.iter_mut().zip(&k.gather).zip(&mut cols.filled) {
         match from {
             Gather::Each(from) => {
                 for (x, &i) in col.iter_mut().zip(from) {
-                    *x = input[i as usize];
+                    // SAFETY: `i < k.input_len <= input.len()` (asserted above).
+                    *x = unsafe { *input.get_unchecked(i as usize) };
                 }
             }
             Gather::Broadcast(i) => {
