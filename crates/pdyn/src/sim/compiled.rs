@@ -78,6 +78,9 @@ pub struct CompiledModel {
     /// For each unknown: its slot (`Ok(i)`: acceleration of free coordinate `i`; `Err(r)`:
     /// reaction `r`).
     slots: Vec<Result<usize, usize>>,
+    /// The unknowns are the `n` accelerations in state order (no reactions): they are copied
+    /// as one block (a net's thousands of them, at every evaluation).
+    accelerations_in_order: bool,
     engine: Engine,
     /// The entries of `∂q''/∂w` that are not identically zero, as one program...
     jacobian: Option<Evaluator>,
@@ -273,6 +276,7 @@ impl CompiledModel {
         Ok(CompiledModel {
             n,
             n_reactions: model.reactions.len(),
+            accelerations_in_order: in_order(&slots, n),
             slots: slots.clone(),
             engine,
             jacobian,
@@ -309,6 +313,7 @@ impl CompiledModel {
             n,
             n_reactions: 0,
             slots: (0..n).map(Ok).collect(),
+            accelerations_in_order: true,
             native: kernels.is_native(),
             separable: !kernels.reads_rates(),
             engine: Engine::Net(Box::new(kernels)),
@@ -477,6 +482,11 @@ impl CompiledModel {
     }
 }
 
+/// Whether `slots` are the `n` accelerations in state order, and nothing else.
+fn in_order(slots: &[Result<usize, usize>], n: usize) -> bool {
+    slots.len() == n && slots.iter().enumerate().all(|(k, s)| *s == Ok(k))
+}
+
 /// Writes the sines and cosines of the tree's angles into the input slots after the first
 /// `n_inputs` (sines, then cosines), as the hoisted program reads them.
 fn fill_tree_trig(s: &mut Scratch, trig: &TreeTrig, n_inputs: usize) {
@@ -501,6 +511,10 @@ impl OdeSystem for CompiledModel {
         let s = &mut *self.scratch.borrow_mut();
         self.solve_into(s, t, y);
         copy_small(&mut dydt[..n], &y[n..]);
+        if self.accelerations_in_order {
+            copy_small(&mut dydt[n..2 * n], &s.out[..n]);
+            return;
+        }
         for (k, slot) in self.slots.iter().enumerate() {
             if let Ok(i) = slot {
                 dydt[n + i] = s.out[k];
