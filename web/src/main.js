@@ -10,8 +10,9 @@ import { showCommands, commandLine } from "./commands.js";
 import { Scene } from "./scene.js";
 import { encodeModel, readHash } from "./share.js";
 
-// Every model file of examples/, and the kin/dsolve scripts, bundled as text (~45 kB).
-const files = import.meta.glob(["../../examples/**/*.toml", "../../examples/kin/*.sh", "../../examples/dsolve/*.sh"], { query: "?raw", import: "default", eager: true });
+// Every model file of examples/, and the kin/dsolve scripts, bundled as text (~45 kB); not
+// examples/large/ (thousands of particles: their derivation does not fit a browser tab).
+const files = import.meta.glob(["../../examples/**/*.toml", "!../../examples/large/**", "../../examples/kin/*.sh", "../../examples/dsolve/*.sh"], { query: "?raw", import: "default", eager: true });
 const EXAMPLES = Object.fromEntries(
   Object.entries(files)
     .map(([path, text]) => [path.replace("../../", ""), text])

@@ -26,6 +26,7 @@ const examples = (function list(dir) {
   return fs
     .readdirSync(path.join(root, dir), { withFileTypes: true })
     .flatMap((e) => (e.isDirectory() ? list(path.join(dir, e.name)) : e.name.endsWith(".toml") ? [path.join(dir, e.name)] : []))
+    .filter((f) => !f.startsWith(path.join("examples", "large")))
     .sort();
 })("examples");
 

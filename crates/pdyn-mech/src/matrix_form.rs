@@ -105,9 +105,19 @@ impl StateTest {
     }
 }
 
+/// Largest number of unknowns whose `M` is laid out entry by entry: 1,200 (the 398-particle
+/// net's 1,194 coordinates), 1.4·10⁶ entries. A 10⁴-particle cloth's 29,994 would ask for
+/// 9·10⁸ entries (29 GB) to print a matrix nobody reads; its equations are printed as
+/// Newton's.
+pub const MATRIX_FORM_MAX_UNKNOWNS: usize = 1_200;
+
 /// The matrix form of `d`, or `None` when some unknown is a reaction (then `A x = b` mixes
-/// accelerations and forces: Newton's equations are printed as they are).
+/// accelerations and forces: Newton's equations are printed as they are) or when there are
+/// more than [`MATRIX_FORM_MAX_UNKNOWNS`] unknowns.
 pub fn matrix_form(p: &mut Pool, d: &Derivation) -> Option<MatrixForm> {
+    if d.system.cols() > MATRIX_FORM_MAX_UNKNOWNS {
+        return None;
+    }
     if d.unknowns.is_empty()
         || d.unknowns
             .iter()
