@@ -195,3 +195,56 @@ t_end = 1
     let want = expected(&[(c / m, k / m), (0.0, k / m)]);
     assert_roots(r.damped.as_ref().unwrap(), &want, 1e-12);
 }
+
+#[test]
+fn a_free_chain_with_drag_keeps_its_rigid_mode_as_a_still_root_and_a_decay() {
+    // No walls: ω_j = 2 √(k/m) sin(jπ/(2n)), j = 0..n-1, ω_0 = 0 the rigid translation. With
+    // drag b on each mass its roots are s = 0 (it stays where it is pushed) and s = −b/m.
+    let (n, b) = (6, 0.5);
+    let src = format!(
+        r#"name = "free chain"
+[indices]
+n = {n}
+i = "1..n"
+[parameters]
+m = 1.0
+k = 100.0
+L = 0.1
+[coordinates]
+"x[i]" = {{ initial = "i*L", rate = 0 }}
+[particles."P[i]"]
+mass = "m"
+position = "[x[i], 0, 0]"
+[[forces]]
+kind = "spring"
+name = "spring"
+for = "i in 1..n-1"
+between = ["P[i+1]", "P[i]"]
+k = "k"
+l0 = "L"
+{}
+[simulate]
+t_end = 1
+"#,
+        drag(b)
+    );
+    let mut m = load(&src, "model.toml").unwrap_or_else(|e| panic!("{}", e.render(&src)));
+    let request = ModesRequest {
+        about: About::Initial,
+        solver: Solver::Dense,
+        count: None,
+    };
+    let r = modes_about(&mut m, &request).unwrap();
+    assert_eq!(r.damped_path, Some(DampedPath::Classical));
+    let pairs: Vec<(f64, f64)> = (0..n)
+        .map(|j| {
+            let w = 20.0 * libm::sin(j as f64 * std::f64::consts::PI / (2.0 * n as f64));
+            (b, w * w)
+        })
+        .collect();
+    let want = expected(&pairs);
+    let found = r.damped.as_ref().unwrap();
+    assert_eq!(found.len(), n);
+    assert_roots(found, &want[..n], 1e-10);
+    assert!(found[0].re.abs() < 1e-10 && !found[0].oscillatory);
+}
