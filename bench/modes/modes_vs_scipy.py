@@ -14,7 +14,11 @@ changed), and the hanging net of bench/net (n x n nodes) where `--nets` lists si
 3. a Python process (timed whole: interpreter start, `import scipy`, reading the matrices,
    `eigsh`) computes the same K lowest modes;
 4. both sets of frequencies are compared with each other and, for the chain, with the closed
-   form w_j = 2 sqrt(k/m) sin(j pi / (2 (n + 1))).
+   form w_j = 2 sqrt(k/m) sin(j pi / (2 (n + 1)));
+5. with damping (the net's drag: C.mtx not zero), SciPy's side also gives the damped roots
+   the way one would for classical damping, c_j = phi_j' C phi_j / phi_j' M phi_j and
+   s^2 + c_j s + w_j^2 = 0, and pdyn's damped roots (its `damped_path` is printed) are
+   compared with them.
 
 Each timing is the fastest of `--repeat` runs (default 3). Prints a Markdown table.
 """
@@ -39,9 +43,18 @@ import scipy.io, scipy.sparse.linalg as sla
 K = scipy.io.mmread(sys.argv[1]).tocsc()
 M = scipy.io.mmread(sys.argv[2]).tocsc()
 t1 = time.perf_counter()
+C = scipy.io.mmread(sys.argv[4]).tocsc() if len(sys.argv) > 4 else None
 w2, phi = sla.eigsh(K, k=int(sys.argv[3]), M=M, sigma=0, which="LM")
+damped = []
+if C is not None and C.nnz and abs(C).max() > 0:
+    c = np.einsum("ij,ij->j", phi, C @ phi) / np.einsum("ij,ij->j", phi, M @ phi)
+    for cj, wj2 in zip(c, w2):
+        r = np.roots([1.0, cj, wj2])
+        damped += [[z.real, abs(z.imag)] for z in r if z.imag >= 0] if r.imag.any() else [[z.real, 0.0] for z in r]
+    damped.sort(key=lambda z: (abs(complex(*z)), z[0]))
+    damped = damped[: int(sys.argv[3])]
 t2 = time.perf_counter()
-print(json.dumps({"omega": sorted(np.sqrt(w2).tolist()), "read": t1 - t0, "eigsh": t2 - t1}))
+print(json.dumps({"omega": sorted(np.sqrt(w2).tolist()), "damped": damped, "read": t1 - t0, "eigsh": t2 - t1}))
 """
 
 
@@ -78,12 +91,17 @@ def main():
             t_pdyn = min(r[0] for r in runs)
             out = json.loads(runs[0][1])
             w_pdyn = [m["omega"] for m in out["modes"]]
-            srun = [timed([args.python, "-c", SCIPY, f"{tmp}/K.mtx", f"{tmp}/M.mtx", str(args.count)]) for _ in range(args.repeat)]
+            srun = [timed([args.python, "-c", SCIPY, f"{tmp}/K.mtx", f"{tmp}/M.mtx", str(args.count), f"{tmp}/C.mtx"]) for _ in range(args.repeat)]
             t_scipy = min(r[0] for r in srun)
             s = json.loads(srun[0][1])
             eig = min(json.loads(r[1])["eigsh"] for r in srun)
             w_scipy = s["omega"]
             diff = max(abs(a - b) / b for a, b in zip(w_pdyn, w_scipy))
+            if s["damped"]:
+                d_pdyn = [complex(*d["eigenvalue"]) for d in out.get("damped_modes", [])]
+                d_scipy = [complex(*z) for z in s["damped"]]
+                dd = max(abs(a - b) / abs(b) for a, b in zip(d_pdyn, d_scipy)) if d_pdyn else float("nan")
+                print(f"<!-- {name}: damped roots by {out.get('damped_path')}, {len(d_pdyn)} vs SciPy's {len(d_scipy)}, max rel. difference {dd:.1e} -->", flush=True)
             if n is not None:
                 exact = [20 * math.sin(j * math.pi / (2 * (n + 1))) for j in range(1, args.count + 1)]
                 e_p = max(abs(a - b) / b for a, b in zip(w_pdyn, exact))

@@ -162,6 +162,9 @@ fn the_damped_modes_of_the_net_follow_from_mass_proportional_drag() {
     let undamped = v["modes"].as_array().unwrap();
     let damped = v["damped_modes"].as_array().unwrap();
     assert_eq!(damped.len(), 8);
+    // Classical damping: from the undamped modes, no companion form (issue 33).
+    assert_eq!(v["damped_path"], "classical");
+    assert!(v["damping_commutation_defect"].as_f64().unwrap() < 1e-12);
     for (d, u) in damped.iter().zip(undamped) {
         let wn = d["natural_frequency"].as_f64().unwrap();
         let zeta = d["damping_ratio"].as_f64().unwrap();

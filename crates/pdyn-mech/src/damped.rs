@@ -11,6 +11,10 @@
 //! `s = −ζ ωₙ ± i ωₙ √(1 − ζ²)`: natural frequency `ωₙ = |s|`, damping ratio `ζ = −Re s / |s|`,
 //! damped frequency `ω_d = Im s`; one of each pair (`Im s > 0`) is reported. A real `s` is a
 //! motion that decays (or grows, `s > 0`) without oscillating: `e^{s t}`.
+//!
+//! When the damping is classical the companion form is not needed: the undamped modes give
+//! the damped ones ([`crate::classical_damping`]); [`DampedPath`] says which way they were
+//! found.
 
 use crate::linearization::Linearization;
 use nalgebra::DMatrix;
@@ -61,6 +65,68 @@ pub struct DampedMode {
     pub oscillatory: bool,
 }
 
+impl DampedMode {
+    /// The mode of the root `s = re + i im` (`im ≥ 0`): `im` within 1e-10 of `|s|` of zero is
+    /// a real root, a motion that does not oscillate.
+    pub fn of_root(re: f64, im: f64) -> DampedMode {
+        let omega_n = libm::hypot(re, im);
+        let oscillatory = im > 1e-10 * omega_n.max(f64::MIN_POSITIVE);
+        DampedMode {
+            re,
+            im: if oscillatory { im } else { 0.0 },
+            omega_n,
+            damping_ratio: if omega_n > 0.0 {
+                -re / omega_n
+            } else {
+                f64::NAN
+            },
+            oscillatory,
+        }
+    }
+}
+
+/// How the damped modes were found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DampedPath {
+    /// Classical damping (`C M⁻¹ K = K M⁻¹ C`): from the undamped modes computed, one
+    /// single-degree-of-freedom oscillator each ([`crate::classical_damping`]).
+    Classical,
+    /// Every root of the dense `2n × 2n` companion form ([`damped_modes`]).
+    Companion,
+    /// Not computed: the damping is not classical and there are more than [`DAMPED_LIMIT`]
+    /// coordinates.
+    NotComputed,
+}
+
+impl DampedPath {
+    /// The name `--json` and Python give it.
+    pub fn name(self) -> &'static str {
+        match self {
+            DampedPath::Classical => "classical",
+            DampedPath::Companion => "companion",
+            DampedPath::NotComputed => "not_computed",
+        }
+    }
+
+    /// One line saying how the damped modes were found.
+    pub fn describe(self) -> String {
+        match self {
+            DampedPath::Classical => format!(
+                "classical damping (C M⁻¹K = K M⁻¹C to {:.0e}): each undamped mode computed is a \
+                 damped mode, s² + (φᵀCφ/φᵀMφ) s + ω² = 0",
+                crate::classical_damping::COMMUTATION_TOLERANCE
+            ),
+            DampedPath::Companion => {
+                "non-classical damping: every root of the dense 2n × 2n companion form".to_string()
+            }
+            DampedPath::NotComputed => format!(
+                "not computed: the damping is not classical (C M⁻¹K ≠ K M⁻¹C) and the companion \
+                 form is dense, for at most {DAMPED_LIMIT} coordinates"
+            ),
+        }
+    }
+}
+
 /// The damped modes of `lin`, by increasing `ωₙ`.
 pub fn damped_modes(lin: &Linearization) -> Result<Vec<DampedMode>, DampedError> {
     let n = lin.mass.nrows();
@@ -82,24 +148,15 @@ pub fn damped_modes(lin: &Linearization) -> Result<Vec<DampedMode>, DampedError>
         .complex_eigenvalues()
         .iter()
         .filter(|s| s.im >= 0.0)
-        .map(|s| {
-            let omega_n = libm::hypot(s.re, s.im);
-            let oscillatory = s.im > 1e-10 * omega_n.max(f64::MIN_POSITIVE);
-            DampedMode {
-                re: s.re,
-                im: if oscillatory { s.im } else { 0.0 },
-                omega_n,
-                damping_ratio: if omega_n > 0.0 {
-                    -s.re / omega_n
-                } else {
-                    f64::NAN
-                },
-                oscillatory,
-            }
-        })
+        .map(|s| DampedMode::of_root(s.re, s.im))
         .collect();
-    out.sort_by(|x, y| x.omega_n.total_cmp(&y.omega_n).then(x.re.total_cmp(&y.re)));
+    sort(&mut out);
     Ok(out)
+}
+
+/// By increasing `ωₙ`, then `Re s`.
+pub fn sort(modes: &mut [DampedMode]) {
+    modes.sort_by(|x, y| x.omega_n.total_cmp(&y.omega_n).then(x.re.total_cmp(&y.re)));
 }
 
 #[cfg(test)]

@@ -14,6 +14,7 @@
 #![warn(missing_docs)]
 
 pub mod algebra;
+pub mod classical_damping;
 pub mod conservation;
 mod constraint_rank;
 pub mod damped;

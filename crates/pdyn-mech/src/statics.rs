@@ -140,9 +140,15 @@ pub struct ModesReport {
     pub sparse: bool,
     /// The modes, lowest first (`count` of them when asked).
     pub modes: crate::modes::Modes,
-    /// The damped modes (as many), when there is damping and the system is small enough for
-    /// the dense companion form ([`crate::damped::DAMPED_LIMIT`]).
+    /// The damped modes (as many, lowest `ωₙ` first), when there is damping: from the
+    /// undamped modes when it is classical, else from the dense companion form for up to
+    /// [`crate::damped::DAMPED_LIMIT`] coordinates.
     pub damped: Option<Vec<crate::damped::DampedMode>>,
+    /// How the damped modes were found (`None` without damping).
+    pub damped_path: Option<crate::damped::DampedPath>,
+    /// `‖C M⁻¹ K x − K M⁻¹ C x‖ / (‖C M⁻¹ K x‖ + ‖K M⁻¹ C x‖)` on fixed probes
+    /// ([`crate::classical_damping::commutation_defect`]); NaN without damping.
+    pub commutation_defect: f64,
     /// True when `C ≠ 0`.
     pub has_damping: bool,
     /// `M`, `K`, `C` at the state.
@@ -200,16 +206,14 @@ pub fn modes_of<L: crate::linearization::Linearize + ?Sized>(
     let count = request.count.map(|c| c.max(1));
     let (mut modes, dense) = if sparse {
         let count = count.unwrap_or(DEFAULT_SPARSE_COUNT).min(n);
-        let modes = crate::sparse_statics::lowest_modes(&matrices, count)?;
-        let dense = (has_damping && n <= crate::damped::DAMPED_LIMIT).then(|| matrices.to_dense());
-        (modes, dense)
+        (crate::sparse_statics::lowest_modes(&matrices, count)?, None)
     } else {
         let dense = lin.at(&q);
         (crate::modes::modes(&dense)?, Some(dense))
     };
     let inertia = lin.inertia_at(&q);
     match &dense {
-        Some(d) if !sparse => {
+        Some(d) => {
             let chol = d.mass.clone().cholesky();
             modes.add_participation(&inertia, |b| {
                 let x = chol
@@ -218,21 +222,18 @@ pub fn modes_of<L: crate::linearization::Linearize + ?Sized>(
                 Some(x.iter().copied().collect())
             });
         }
-        _ => {
+        None => {
             let ldl = crate::sparse::EnvelopeLdlt::new(&matrices.mass).ok();
             modes.add_participation(&inertia, |b| Some(ldl.as_ref()?.solve(b)));
         }
     }
     let shown = count.unwrap_or(modes.modes.len()).min(modes.modes.len());
-    modes.modes.truncate(shown);
-    let damped = match &dense {
-        Some(d) if has_damping => {
-            let mut all = crate::damped::damped_modes(d)?;
-            all.truncate(shown);
-            Some(all)
-        }
-        _ => None,
+    let (damped, damped_path, commutation_defect) = if has_damping {
+        damped_of(&matrices, &modes.modes, dense.as_ref(), shown)?
+    } else {
+        (None, None, f64::NAN)
     };
+    modes.modes.truncate(shown);
     Ok(ModesReport {
         names: lin.names().to_vec(),
         about: request.about,
@@ -241,7 +242,51 @@ pub fn modes_of<L: crate::linearization::Linearize + ?Sized>(
         sparse,
         modes,
         damped,
+        damped_path,
+        commutation_defect,
         has_damping,
         matrices,
     })
+}
+
+/// The damped modes (the `shown` lowest by `ωₙ`), how they were found and the damping's
+/// relative commutator ([`crate::classical_damping::commutation_defect`]): from the undamped
+/// `modes` when the damping is classical, else by the dense companion form up to
+/// [`crate::damped::DAMPED_LIMIT`] coordinates, else none.
+type DampedOf = (
+    Option<Vec<crate::damped::DampedMode>>,
+    Option<crate::damped::DampedPath>,
+    f64,
+);
+
+fn damped_of(
+    matrices: &crate::linearization::SparseLinearization,
+    modes: &[crate::modes::Mode],
+    dense: Option<&crate::linearization::Linearization>,
+    shown: usize,
+) -> Result<DampedOf, StaticsError> {
+    use crate::classical_damping::{commutation_defect, from_undamped, is_classical};
+    use crate::damped::{damped_modes, sort, DampedPath, DAMPED_LIMIT};
+    let defect = commutation_defect(matrices);
+    let classical = if is_classical(defect) {
+        from_undamped(matrices, modes)
+    } else {
+        None
+    };
+    let (mut all, path) = match classical {
+        Some(mut all) => {
+            sort(&mut all);
+            (all, DampedPath::Classical)
+        }
+        None if matrices.mass.n <= DAMPED_LIMIT => {
+            let all = match dense {
+                Some(d) => damped_modes(d)?,
+                None => damped_modes(&matrices.to_dense())?,
+            };
+            (all, DampedPath::Companion)
+        }
+        None => return Ok((None, Some(DampedPath::NotComputed), defect)),
+    };
+    all.truncate(shown);
+    Ok((Some(all), Some(path), defect))
 }

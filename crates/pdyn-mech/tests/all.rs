@@ -9,6 +9,8 @@
 
 #[path = "budgets.rs"]
 mod budgets;
+#[path = "classical_damping.rs"]
+mod classical_damping;
 #[path = "complexity.rs"]
 mod complexity;
 #[path = "derive_chapter.rs"]

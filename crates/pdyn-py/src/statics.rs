@@ -107,9 +107,11 @@ pub(crate) fn modes(
             dd.set_item("damping_ratio", f64_array(py, c(&|x| x.damping_ratio)))?;
             dd.set_item("damped_frequency", f64_array(py, c(&|x| x.im)))?;
             dd.set_item("real", f64_array(py, c(&|x| x.re)))?;
+            dd.set_item("path", report.damped_path.map(|p| p.name()))?;
             d.set_item("damped", dd)?;
         }
         None => d.set_item("damped", py.None())?,
     }
+    d.set_item("damped_path", report.damped_path.map(|p| p.name()))?;
     Ok(d.into_any().unbind())
 }

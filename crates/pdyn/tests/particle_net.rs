@@ -662,11 +662,64 @@ fn the_nets_equilibrium_by_kernels_equals_the_symbolic_one() {
             assert!((x - y).abs() <= 1e-10 * weight, "{na}: {ra:?} vs {rb:?}");
         }
     }
-    assert_eq!(fast.axial.len(), generic.axial.len());
-    for ((na, ta), (nb, tb)) in fast.axial.iter().zip(&generic.axial) {
-        assert_eq!(na, nb);
-        assert!((ta - tb).abs() <= 1e-10 * weight, "{na}: {ta} vs {tb}");
+    assert_same_tensions(&fast.axial, &generic.axial, 1e-10 * weight);
+}
+
+/// Tensions by element: the family (a member's indices dropped: a deferred member is labelled
+/// `horizontal (A, B)`, an expanded one `horizontal[i=0, j=1] (A, B)`) and its ends.
+fn by_element(axial: &[(String, f64)]) -> std::collections::BTreeMap<(String, String), f64> {
+    let mut out = std::collections::BTreeMap::new();
+    for (label, t) in axial {
+        let cut = label.rfind(" (").unwrap_or(label.len());
+        let family = label[..cut].split('[').next().unwrap().to_string();
+        let ends = label[cut..].to_string();
+        assert!(out.insert((family, ends), *t).is_none(), "{label} twice");
     }
+    out
+}
+
+fn assert_same_tensions(a: &[(String, f64)], b: &[(String, f64)], tol: f64) {
+    assert_eq!(a.len(), b.len());
+    let (a, b) = (by_element(a), by_element(b));
+    assert_eq!(a.len(), b.len());
+    for ((key, ta), (kb, tb)) in a.iter().zip(&b) {
+        assert_eq!(key, kb);
+        assert!((ta - tb).abs() <= tol, "{key:?}: {ta} vs {tb}");
+    }
+}
+
+/// `pdyn equilibrium` on a net loaded with its families deferred (one representative per
+/// family, index arrays: issue 33) equals the same net loaded in full: the same Newton steps,
+/// coordinates, reactions and every spring's tension (the deferred members' computed from
+/// their representative's expression) to round-off.
+#[test]
+fn the_equilibrium_of_a_deferred_net_equals_the_expanded_nets() {
+    let src = net_source(6, 5, Some(0.02));
+    let opts = EquilibriumOptions::default();
+    let mut compact = load_deferring(&src);
+    assert!(compact.has_deferred());
+    let springs = 5 * 5 + 6 * 4 + 2 * 5 * 4;
+    let a = equilibrium_from(&mut compact, &opts, 0).unwrap();
+    // Still compact afterwards: nothing was expanded.
+    assert!(compact.has_deferred());
+    assert!(compact.axial.len() < springs / 2, "{}", compact.axial.len());
+    let b = equilibrium_from(&mut load(&src), &opts, 0).unwrap();
+    assert!(a.net && b.net);
+    assert_eq!(a.names, b.names);
+    assert_eq!(a.steps, b.steps);
+    for ((name, x), y) in a.names.iter().zip(&a.q).zip(&b.q) {
+        assert!((x - y).abs() <= 1e-13, "{name}: {x} vs {y}");
+    }
+    let weight = 28.0 * 0.05 * 9.81;
+    assert_eq!(a.reactions.len(), 2);
+    for ((na, ra), (nb, rb)) in a.reactions.iter().zip(&b.reactions) {
+        assert_eq!(na, nb);
+        for (x, y) in ra.iter().zip(rb) {
+            assert!((x - y).abs() <= 1e-12 * weight, "{na}: {ra:?} vs {rb:?}");
+        }
+    }
+    assert_eq!(a.axial.len(), springs);
+    assert_same_tensions(&a.axial, &b.axial, 1e-12 * weight);
 }
 
 /// A chain of `n` masses with no walls under gravity along it: a mechanism whose free

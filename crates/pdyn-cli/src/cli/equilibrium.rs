@@ -1,7 +1,7 @@
 //! `pdyn equilibrium MODEL`: the state at rest where the forces balance, by Newton's method
 //! with the exact Jacobian; the reactions at the points (pins); the residual; mechanisms named.
 
-use super::{load_model, set_parameters};
+use super::set_parameters;
 use clap::Args;
 use pdyn::output::json_num;
 use pdyn::sim::net::statics::equilibrium;
@@ -43,7 +43,9 @@ const AXIAL_SHOWN: usize = 40;
 
 /// `pdyn equilibrium MODEL`.
 pub fn run(a: EquilibriumArgs) -> Result<String, Error> {
-    let mut model = load_model(&a.model)?;
+    // Force families compact (one representative and index arrays): a net is solved by its
+    // kernels without expanding them, any other model is expanded first.
+    let mut model = pdyn::model_file::ModelFile::read(&a.model)?.mechanics_deferring()?;
     set_parameters(&mut model, &a.set)?;
     if !(a.tolerance > 0.0 && a.tolerance.is_finite()) {
         return Err(Error::argument(

@@ -1,14 +1,16 @@
 //! `pdyn modes MODEL`: natural frequencies and mode shapes of the model linearized about its
 //! static equilibrium (or its initial state), `K φ = ω² M φ`: dense (every mode) for small
 //! systems, the lowest few by sparse shift-invert Lanczos for large ones; with damping, the
-//! damped modes of `s² M + s C + K` too (natural frequency and damping ratio).
+//! damped modes of `s² M + s C + K` too (natural frequency and damping ratio): from the
+//! undamped modes when the damping is classical (`C M⁻¹ K = K M⁻¹ C`), else from the dense
+//! companion form (at most 1,000 coordinates); the output says which.
 
 use super::set_parameters;
 use clap::{Args, ValueEnum};
 use pdyn::output::json_num;
 use pdyn::sim::net::statics::modes_about;
 use pdyn::Error;
-use pdyn_mech::damped::{DampedMode, DAMPED_LIMIT};
+use pdyn_mech::damped::DampedMode;
 use pdyn_mech::sparse::Csr;
 use pdyn_mech::statics::{self, ModesRequest, StaticsError};
 use serde_json::json;
@@ -157,6 +159,10 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
         v["total_mass"] = by_axis(&result.total_mass);
         v["solver"] = json!(if sparse { "sparse" } else { "dense" });
         v["coordinate_count"] = json!(n);
+        if let Some(path) = report.damped_path {
+            v["damped_path"] = json!(path.name());
+            v["damping_commutation_defect"] = json_num(report.commutation_defect);
+        }
         if damped.is_some() {
             v["damped_modes"] = json!(damped_shown
                 .iter()
@@ -260,10 +266,11 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
             captured.join(", ")
         );
     }
+    let path = report.damped_path.map(|p| p.describe()).unwrap_or_default();
     if damped.is_some() {
         let _ = writeln!(
             s,
-            "\n  damped modes (roots s of det(s² M + s C + K) = 0, lowest natural frequency first)\n  mode      omega_n (rad/s)     damping ratio     omega_d (rad/s)"
+            "\n  damped modes (roots s of det(s² M + s C + K) = 0, lowest natural frequency first)\n  path: {path}\n  mode      omega_n (rad/s)     damping ratio     omega_d (rad/s)"
         );
         for (k, d) in damped_shown.iter().enumerate() {
             if d.oscillatory {
@@ -280,10 +287,7 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
             }
         }
     } else if has_damping {
-        let _ = writeln!(
-            s,
-            "\n  (damped modes are computed densely, for at most {DAMPED_LIMIT} coordinates)"
-        );
+        let _ = writeln!(s, "\n  damped modes {path}");
     }
     if a.shapes {
         for (k, m) in shown.iter().enumerate() {

@@ -100,6 +100,7 @@ class Modes:
     natural_frequency: Optional[npt.NDArray[np.float64]]
     damping_ratio: Optional[npt.NDArray[np.float64]]
     damped_frequency: Optional[npt.NDArray[np.float64]]
+    damped_path: Optional[str]
     def __len__(self) -> int: ...
 
 class Linearization:

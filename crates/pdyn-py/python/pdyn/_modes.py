@@ -19,9 +19,13 @@ class Modes:
     (``k × 3``: per mode, along x, y, z) are ``Γ = φᵀ M r / φᵀ M φ`` and ``(φᵀ M r)² / φᵀ M φ``,
     with ``M r`` the inertia load of a unit ground acceleration along the axis; ``total_mass``
     (3) is what all modes' effective masses add up to, so ``effective_mass.sum(axis=0) /
-    total_mass`` is the share the modes found carry. With damping (``C ≠ 0``) and up to 1,000
-    coordinates, ``natural_frequency``, ``damping_ratio`` and ``damped_frequency`` of the roots
-    of ``det(s² M + s C + K) = 0``; else ``None``."""
+    total_mass`` is the share the modes found carry. With damping (``C ≠ 0``),
+    ``natural_frequency``, ``damping_ratio`` and ``damped_frequency`` of the roots of
+    ``det(s² M + s C + K) = 0``, and ``damped_path`` says how they were found:
+    ``"classical"`` (``C M⁻¹ K = K M⁻¹ C``: from the undamped modes computed, one oscillator
+    each, any size), ``"companion"`` (every root of the dense companion form, up to 1,000
+    coordinates) or ``"not_computed"`` (non-classical damping on more coordinates: the
+    arrays are ``None``); without damping all four are ``None``."""
 
     def __init__(self, raw: Dict[str, Any]):
         import numpy as np
@@ -46,6 +50,7 @@ class Modes:
         self.natural_frequency = damped["natural_frequency"] if damped else None
         self.damping_ratio = damped["damping_ratio"] if damped else None
         self.damped_frequency = damped["damped_frequency"] if damped else None
+        self.damped_path: Optional[str] = raw.get("damped_path")
 
     def __len__(self) -> int:
         return len(self.omega)

@@ -16,8 +16,10 @@
 //! reciprocals): checked on nets of 4, 9 and 23 particles by `tests/particle_net.rs`.
 //!
 //! The same kernels, with their derivatives, linearize a net at rest for `pdyn modes` and
-//! `pdyn equilibrium` ([`linearization`], entered by [`statics`]).
+//! `pdyn equilibrium` ([`linearization`], entered by [`statics`]; the tensions of deferred
+//! families' members from their representative's, [`axial`]).
 
+pub mod axial;
 pub mod kernels;
 pub mod linearization;
 pub mod statics;

@@ -61,8 +61,10 @@ pub struct EquilibriumReport {
 
 /// The static equilibrium of `model` nearest its initial values, by damped Newton: dense below
 /// [`SPARSE_FROM`] coordinates, sparse from there on; linearized by the kernels of a net of at
-/// least [`NET_FROM`] particles, symbolically otherwise. The reactions and tensions read every
-/// load: a model loaded with deferred families is expanded first.
+/// least [`NET_FROM`] particles, symbolically otherwise. A net loaded with deferred families
+/// stays compact (its reactions read the loads on points, which are never deferred, and its
+/// tensions come from each family's representative: [`super::axial::axial_forces`]); any
+/// other model is expanded first.
 pub fn equilibrium(
     model: &mut Model,
     opts: &EquilibriumOptions,
@@ -76,31 +78,39 @@ pub fn equilibrium_from(
     opts: &EquilibriumOptions,
     from: usize,
 ) -> Result<EquilibriumReport, StaticsError> {
+    if let Some(lin) = NetLinearization::new(model, JitMode::Auto, from) {
+        let p = &mut model.pool;
+        let mut state: Vec<Id> = model
+            .coordinates
+            .iter()
+            .map(|c| p.coord(c.sym, 0))
+            .collect();
+        let rates: Vec<Id> = model
+            .coordinates
+            .iter()
+            .map(|c| p.coord(c.sym, 1))
+            .collect();
+        state.extend(rates);
+        let found = solve(&lin, opts)?;
+        let reactions = equilibrium::support_reactions(model, &state, &found.q)?;
+        let axial = super::axial::axial_forces(model, &state, &found.q)?;
+        return Ok(report(found, reactions, axial, true));
+    }
     model.expand_deferred()?;
-    let (found, state, net) = match NetLinearization::new(model, JitMode::Auto, from) {
-        Some(lin) => {
-            let p = &mut model.pool;
-            let mut state: Vec<Id> = model
-                .coordinates
-                .iter()
-                .map(|c| p.coord(c.sym, 0))
-                .collect();
-            let rates: Vec<Id> = model
-                .coordinates
-                .iter()
-                .map(|c| p.coord(c.sym, 1))
-                .collect();
-            state.extend(rates);
-            (solve(&lin, opts)?, state, true)
-        }
-        None => {
-            let (d, lin) = statics::linearize(model)?;
-            (solve(&lin, opts)?, d.state, false)
-        }
-    };
-    let reactions = equilibrium::support_reactions(model, &state, &found.q)?;
-    let axial = equilibrium::axial_forces(model, &state, &found.q)?;
-    Ok(EquilibriumReport {
+    let (d, lin) = statics::linearize(model)?;
+    let found = solve(&lin, opts)?;
+    let reactions = equilibrium::support_reactions(model, &d.state, &found.q)?;
+    let axial = equilibrium::axial_forces(model, &d.state, &found.q)?;
+    Ok(report(found, reactions, axial, false))
+}
+
+fn report(
+    found: Found,
+    reactions: Vec<(String, [f64; 3])>,
+    axial: Vec<(String, f64)>,
+    net: bool,
+) -> EquilibriumReport {
+    EquilibriumReport {
         names: found.names,
         q: found.q,
         residual: found.residual,
@@ -110,7 +120,7 @@ pub fn equilibrium_from(
         reactions,
         axial,
         net,
-    })
+    }
 }
 
 /// What either Newton path found.
