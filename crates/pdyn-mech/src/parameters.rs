@@ -123,6 +123,7 @@ impl DerivedParameters {
 /// Recomputes every coordinate's numeric initial value and rate from its expression with the
 /// current parameter values. An expression that cannot be evaluated keeps its old value.
 pub fn refresh_initial_values(model: &mut Model) {
+    model.refresh_family_initials();
     let params: Vec<Id> = model.parameters.iter().map(|p| p.id).collect();
     let values: Vec<f64> = model.parameters.iter().map(|p| p.value).collect();
     for &(ci, initial, rate) in &model.initial_exprs {

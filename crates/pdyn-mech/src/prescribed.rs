@@ -257,6 +257,7 @@ pub fn solve_forces(model: &mut Model, opts: &ForcesOptions) -> Result<ForcesRes
         .filter_map(|c| c.over.as_ref().map(|o| o.0))
         .collect();
     let (_, newton, constraints) = newton_equations(model);
+    model.materialize_initials();
     let p = &mut model.pool;
 
     // The instant: exact values of t and the free coordinates (value, rate, known acceleration).

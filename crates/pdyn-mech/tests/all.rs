@@ -29,6 +29,8 @@ mod dsolve_rules;
 mod dsolve_rules_symbolic;
 #[path = "families.rs"]
 mod families;
+#[path = "family_initials.rs"]
+mod family_initials;
 #[path = "forces_chapter.rs"]
 mod forces_chapter;
 #[path = "kin_chapter.rs"]

@@ -196,6 +196,14 @@ pub(crate) struct Loader<'a> {
     /// equations between dimensions (and the same errors, at the same place), member after
     /// member. Inferring them again for each of 10^4 members was a sixth of loading a chain.
     inferred: FxHashMap<(usize, String), Form>,
+    /// Coordinate families whose initial values are read as numbers
+    /// ([`super::family_initials`]): each table's texts compiled once, by its offset.
+    pub(super) family_initials: super::family_initials::Cache,
+    /// Their members, with the family's expressions.
+    pub initial_families: Vec<super::InitialFamily>,
+    /// The last forms [`Loader::want`] required equal at each place of the file, for the
+    /// members of families.
+    wanted: FxHashMap<usize, (Form, Form)>,
 }
 
 impl<'a> Loader<'a> {
@@ -222,6 +230,9 @@ impl<'a> Loader<'a> {
             constants: FxHashMap::default(),
             parsed: FxHashMap::default(),
             inferred: FxHashMap::default(),
+            family_initials: FxHashMap::default(),
+            initial_families: Vec::new(),
+            wanted: FxHashMap::default(),
         }
     }
 
@@ -456,9 +467,22 @@ impl<'a> Loader<'a> {
     /// of loading, and reported only in a model that uses units).
     pub fn want(&mut self, sv: &Sv, want: impl Into<Form>, what: &str) {
         let got = self.last.clone();
+        let want = want.into();
+        if self.member.is_some() {
+            // The members of a family read one text at one place: the same two forms
+            // required equal again change nothing (they are equal once unified; a failure
+            // was recorded by the first member, and only the first error is reported).
+            let key = sv.span().start;
+            if let Some((g, w)) = self.wanted.get(&key) {
+                if *g == got && *w == want {
+                    return;
+                }
+            }
+            self.wanted.insert(key, (got.clone(), want.clone()));
+        }
         self.dims.require(
             &got,
-            &want.into(),
+            &want,
             sv.span(),
             what,
             "write the quantity with its units (\"2 kg\", \"0.5 m\", \"100 N/m\"), or check \

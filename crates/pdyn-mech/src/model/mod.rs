@@ -12,6 +12,7 @@ mod contacts;
 pub mod data;
 pub mod deferred;
 pub mod families;
+mod family_initials;
 mod forces;
 pub mod index_expr;
 mod loader;
@@ -22,6 +23,7 @@ mod tables;
 mod unknown_initials;
 
 pub use contacts::Contact;
+pub use family_initials::InitialFamily;
 pub(crate) use loader::Loader;
 use pdyn_expr::error::render_diagnostic;
 use pdyn_expr::{Id, Pool, SymId, Value};
@@ -295,7 +297,12 @@ pub struct Model {
     pub one_sided: Vec<String>,
     /// `(coordinate index, initial value, initial rate)` as expressions of the parameters, so
     /// that a sweep over a parameter recomputes the initial conditions that depend on it.
+    /// Family members leave this list to [`Model::initial_families`] in a model from
+    /// [`load_deferring`]: [`Model::materialize_initials`] writes them in.
     pub initial_exprs: Vec<(usize, Id, Id)>,
+    /// The coordinate families whose members' initial values and rates are one expression
+    /// in the parameters and the indices ([`InitialFamily`]); empty from [`load`].
+    pub initial_families: Vec<InitialFamily>,
     /// Initial values and rates written in `[unknowns]` (`rate = "omega"`): `pdyn forces`
     /// solves for them; their numeric copies in [`CoordinateKind::Free`] are NaN.
     pub unknown_initials: Vec<UnknownInitial>,
@@ -308,12 +315,17 @@ pub struct Model {
 ///
 /// The tables are read in dependency order — each may use the names the earlier ones declared.
 pub fn load(source: &str, origin: &str) -> Result<Model, ModelError> {
-    load_with(source, origin, false)
+    let mut model = load_with(source, origin, false)?;
+    model.materialize_initials();
+    Ok(model)
 }
 
 /// [`load`], leaving the members of force families that share one representative's loads
 /// unexpanded ([`deferred`]): for a consumer that reads [`Model::deferred`] (a run of free
-/// particles), or calls [`Model::expand_deferred`] first. The same errors as [`load`].
+/// particles), or calls [`Model::expand_deferred`] first. The same errors as [`load`]. The
+/// initial values of coordinate families are left as [`Model::initial_families`] (numbers in
+/// the coordinates, one expression per family): [`Model::materialize_initials`] writes each
+/// member's into [`Model::initial_exprs`] for a consumer that reads those.
 pub fn load_deferring(source: &str, origin: &str) -> Result<Model, ModelError> {
     load_with(source, origin, true)
 }
@@ -378,6 +390,7 @@ fn read(ld: &mut Loader, raw: &RawModel) -> Result<Model, ModelError> {
     Ok(Model {
         run,
         initial_exprs,
+        initial_families: std::mem::take(&mut ld.initial_families),
         unknown_initials: std::mem::take(&mut ld.unknown_initials),
         deferred: std::mem::take(&mut ld.deferred),
         unknowns,

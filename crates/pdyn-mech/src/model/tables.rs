@@ -245,6 +245,24 @@ impl Loader<'_> {
                 Value::Vector(_) => Err(self.err(sv.span(), "a coordinate is a scalar")),
             };
         }
+        // A family member whose texts its family compiled once: numbers, no expressions.
+        if let Some((initial, rate)) = self.family_initial(sv, t, index)? {
+            // The same texts give every member the same dimension: inferred and checked for
+            // the first, whose own unknown dimension the check solved, or equated with the
+            // texts' (an error is the first member's, as when each was checked; only the
+            // first error is reported). Numbers alone check nothing: each member keeps its own.
+            match self.family_form(sv) {
+                Some(form) => self.dims.bind(n, form),
+                None => {
+                    if self.coordinate_dimensions_of(n, sv, t) {
+                        let form = self.dims.of(n).unwrap_or_default();
+                        self.set_family_form(sv, form);
+                    }
+                }
+            }
+            self.known_acceleration(n, sv, t, index, out)?;
+            return Ok(CoordinateKind::Free { initial, rate });
+        }
         let read = |ld: &mut Self, key: &'static str| {
             if ld.names_pending_definition(t, key) {
                 ld.deferred_initials
@@ -256,6 +274,19 @@ impl Loader<'_> {
         let (initial, initial_expr) = read(self, "initial")?;
         let (rate, rate_expr) = read(self, "rate")?;
         out.initial_exprs.push((index, initial_expr, rate_expr));
+        self.known_acceleration(n, sv, t, index, out)?;
+        Ok(CoordinateKind::Free { initial, rate })
+    }
+
+    /// A free coordinate's `acceleration = ...`, if given.
+    fn known_acceleration(
+        &mut self,
+        n: &str,
+        sv: &Sv,
+        t: &toml::Table,
+        index: usize,
+        out: &mut Coordinates,
+    ) -> Result<(), ModelError> {
         if let Some(acc) = t.get("acceleration") {
             let text = number_text(acc).map_err(|found| {
                 self.err(
@@ -278,7 +309,24 @@ impl Loader<'_> {
             self.coordinate_dimension(n, sv, &ast, &text, 2, "acceleration");
             out.known_accelerations.push((index, id));
         }
-        Ok(CoordinateKind::Free { initial, rate })
+        Ok(())
+    }
+
+    /// The dimension checks [`Loader::initial_condition`] makes of `initial` and `rate`, for
+    /// values read by their family's compiled texts (parsed, inferred once per family).
+    /// Whether either was more than a number (and so checked).
+    fn coordinate_dimensions_of(&mut self, n: &str, sv: &Sv, t: &toml::Table) -> bool {
+        let mut checked = false;
+        for (key, order) in [("initial", 0), ("rate", 1)] {
+            let Some(Ok(text)) = t.get(key).map(number_text) else {
+                continue;
+            };
+            if let Ok(ast) = self.parse(&text, sv.span().start) {
+                checked |= !ast_is_number(&ast);
+                self.coordinate_dimension(n, sv, &ast, &text, order, key);
+            }
+        }
+        checked
     }
 
     /// A coordinate's `initial` or `rate`: its value now and its expression in the parameters.
@@ -439,6 +487,7 @@ impl Loader<'_> {
     /// `v_NAME`. A model needs at least one.
     pub(super) fn read_particles(&mut self, raw: &RawModel) -> Result<Vec<Particle>, ModelError> {
         let mut particles = Vec::new();
+        let mut bound: Option<std::rc::Rc<str>> = None;
         for (k, (name, sp)) in raw.particles.iter().enumerate() {
             self.enter(Table::Particles, k);
             let n = name.get_ref();
@@ -466,12 +515,17 @@ impl Loader<'_> {
             }
             let position = self.vector(psv, &format!("the position of `{n}`"))?;
             self.want(psv, Dimension::LENGTH, &format!("the position of `{n}`"));
-            for (prefix, d) in [
-                ("", Dimension::LENGTH),
-                ("r_", Dimension::LENGTH),
-                ("v_", Dimension::VELOCITY),
-            ] {
-                self.dims.bind(&format!("{prefix}{n}"), d.into());
+            // The members of a family share their dimensions (`P[]`): bound once.
+            let family = self.member.clone();
+            if family.is_none() || family != bound {
+                for (prefix, d) in [
+                    ("", Dimension::LENGTH),
+                    ("r_", Dimension::LENGTH),
+                    ("v_", Dimension::VELOCITY),
+                ] {
+                    self.dims.bind(&format!("{prefix}{n}"), d.into());
+                }
+                bound = family;
             }
             let vel = position.map(|c| self.pool.dt(c));
             for (prefix, v) in [("r_", position), ("v_", vel)] {

@@ -94,6 +94,7 @@ impl Sensitivities {
         f.extend(acc);
         let param_ids: Vec<Id> = model.parameters.iter().map(|p| p.id).collect();
         // Initial values as expressions of the parameters (numbers when not given by any).
+        model.materialize_initials();
         let mut y0 = vec![Pool::ZERO; dim];
         for (j, &ci) in d.free.iter().enumerate() {
             if let Some(&(_, e, r)) = model.initial_exprs.iter().find(|(k, _, _)| *k == ci) {

@@ -113,6 +113,7 @@ fn solve_equations(
     stable: bool,
 ) -> Result<ExactSolution, ClosedFormError> {
     let n = d.free.len();
+    model.materialize_initials();
     let values: Vec<f64> = model.parameters.iter().map(|q| q.value).collect();
     let p = &mut model.pool;
     let mut coords = Vec::with_capacity(n);

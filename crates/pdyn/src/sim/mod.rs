@@ -957,6 +957,8 @@ fn compile_initial_conditions(
     model: &mut Model,
     d: &pdyn_mech::Derivation,
 ) -> Result<Observer, SimError> {
+    // Each member of a coordinate family its own expression (sweeps compute them all).
+    model.materialize_initials();
     let param_ids: Vec<Id> = model.parameters.iter().map(|q| q.id).collect();
     let mut ic_exprs = Vec::new();
     let mut ic_rates = Vec::new();
