@@ -37,6 +37,26 @@ fn the_100_by_100_cloth_sets_up_and_falls_freely_far_from_its_pins() {
     );
 }
 
+/// `pdyn derive` of the cloth is refused at once (it would lay out a 29,994² system and print
+/// 105 MB), saying why and what to do, in text and in JSON.
+#[test]
+fn deriving_the_cloth_is_refused_at_once_with_what_to_do() {
+    let (code, out, err) = pdyn(&["derive", "examples/large/cloth_100x100.toml"]);
+    assert_eq!(code, 2, "{out:.500}");
+    assert!(
+        err.contains("29994 coordinates") && err.contains("smaller instance"),
+        "{err}"
+    );
+    let (code, out, _) = pdyn(&["derive", "examples/large/cloth_100x100.toml", "--json"]);
+    assert_eq!(code, 2);
+    let v = json(&out);
+    assert_eq!(v["error"]["kind"], "derivation");
+    assert_eq!(
+        v["error"]["location"]["file"],
+        "examples/large/cloth_100x100.toml"
+    );
+}
+
 /// Every model here is run by a test of this file (a new one needs its own).
 #[test]
 fn every_large_example_has_a_test() {

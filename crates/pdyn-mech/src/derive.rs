@@ -111,6 +111,17 @@ impl std::fmt::Display for DeriveError {
 
 impl std::error::Error for DeriveError {}
 
+impl DeriveError {
+    /// An error about the model as a whole (no declaration at fault), with what to do.
+    pub fn new(message: impl Into<String>, help: impl Into<String>) -> DeriveError {
+        DeriveError {
+            message: message.into(),
+            help: Some(help.into()),
+            location: None,
+        }
+    }
+}
+
 fn derr(message: impl Into<String>, help: impl Into<String>) -> DeriveError {
     DeriveError {
         message: message.into(),

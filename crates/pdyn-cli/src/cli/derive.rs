@@ -1,7 +1,6 @@
 //! `pdyn derive MODEL`: the equations of motion of a model file, as the chapter writes them
 //! (the text is `pdyn::report::derive::report`'s).
 
-use super::load_model;
 use clap::{Args, ValueEnum};
 use pdyn::report::derive::DeriveRequest;
 use pdyn::Error;
@@ -46,7 +45,8 @@ pub struct DeriveArgs {
 
 /// `pdyn derive MODEL`.
 pub fn run(a: DeriveArgs) -> Result<String, Error> {
-    let model = load_model(&a.model)?;
+    // Loaded compact: a model too large to print is refused before its families are expanded.
+    let model = pdyn::model_file::ModelFile::read(&a.model)?.mechanics_deferring()?;
     let req = DeriveRequest {
         latex: a.latex,
         json: a.json,

@@ -48,8 +48,37 @@ impl Default for DeriveRequest {
 /// printed on request (`--solve`), up to [`PRINT_CHARS`].
 pub const EXPLICIT_CHARS: usize = 600;
 
-/// The derivation of `model` printed as `a` asks (what `pdyn derive MODEL` prints).
+/// Most coordinates whose equations `pdyn derive` writes out one by one. The derivation lays
+/// out `A x = b` densely (n² entries) and prints every equation: at the 398-particle net's
+/// 1,194 coordinates that is seconds, at the 10⁴-particle cloth's 29,994 it was 3.6 GB and
+/// minutes for 105 MB of text nobody reads. Larger models are refused at once, saying what
+/// to do instead.
+pub const DERIVE_MAX_COORDINATES: usize = 3_000;
+
+/// The derivation of `model` printed as `a` asks (what `pdyn derive MODEL` prints). A model
+/// loaded with deferred families ([`pdyn_mech::model::load_deferring`]) is expanded here,
+/// after the size check.
 pub fn report(mut model: pdyn_mech::Model, a: &DeriveRequest) -> Result<String, Error> {
+    let n = model.coordinates.len();
+    if n > DERIVE_MAX_COORDINATES {
+        return Err(Error::Derive {
+            origin: model.origin.clone(),
+            error: pdyn_mech::DeriveError::new(
+                format!(
+                    "this model has {n} coordinates ({} particles): `pdyn derive` writes out the \
+                     equations of models of at most {DERIVE_MAX_COORDINATES} coordinates",
+                    model.particles.len()
+                ),
+                "derive a smaller instance of the same families (a smaller index range, e.g. \
+                 `n = 5` under [indices]) to read its equations; `pdyn run`, `pdyn modes` and \
+                 `pdyn equilibrium` handle this size",
+            ),
+        });
+    }
+    model.expand_deferred().map_err(|error| Error::Derive {
+        origin: model.origin.clone(),
+        error,
+    })?;
     // A model with contacts is printed in one mode of its contacts, named in a note.
     let mut hybrid_note = None;
     if pdyn_mech::hybrid::is_hybrid(&model) && !model.contacts.is_empty() {
