@@ -85,19 +85,13 @@ impl Table {
 
     /// Rows `a..b` as CSV lines.
     fn format_rows(&self, a: usize, b: usize) -> Vec<u8> {
-        let mut buf = ryu::Buffer::new();
         let mut text = Vec::with_capacity((b - a) * self.names.len() * 20);
         for i in a..b {
             for (k, c) in self.columns.iter().enumerate() {
                 if k > 0 {
                     text.push(b',');
                 }
-                let x = c[i];
-                if x.is_finite() {
-                    text.extend_from_slice(buf.format_finite(x).as_bytes());
-                } else {
-                    text.extend_from_slice(x.to_string().as_bytes());
-                }
+                crate::output::append_number(&mut text, c[i]);
             }
             text.push(b'\n');
         }

@@ -22,6 +22,7 @@
 //! closed form, the stiff and the fixed-step methods are written at the end as before, and
 //! refuse `--restart` and `--checkpoint-every` by name.
 
+use super::compiled::NATIVE_PAYS_FROM;
 use super::measured::{report, NonFinite, NonFiniteScan};
 use super::{
     integrate_observed, method_by_name, request::located, scale_of, FrictionWatch, Prepared,
@@ -179,6 +180,7 @@ pub fn execute(
             (RowFile::resume(&csv, len)?, tally, before, Some(resume))
         }
     };
+    tally.t_end = set.t_end;
     let n = prep.system.n * 2;
     let interrupt = set.interrupt.clone();
     let mut io_error: Option<Error> = None;
@@ -278,6 +280,7 @@ fn take_rows(
             tally.point(prep, t, &ys[k * n..(k + 1) * n], out);
         }
     });
+    tally.consider_native(prep);
     sol.t.clear();
     sol.y.clear();
     written
@@ -337,6 +340,20 @@ pub(crate) struct Tally {
     extra: Vec<f64>,
     scale_out: Vec<f64>,
     row: Vec<f64>,
+    /// Whether a program evaluated at each output point reads the solved unknowns
+    /// (accelerations, reactions): only then is the right-hand side solved there, as
+    /// `tabulate` does; the other programs give the same bits without them.
+    solve: bool,
+    /// The observer and the scales as native code (the same bits), made once the rows still
+    /// to come are enough to pay for their compilation ([`Tally::consider_native`]).
+    native_observer: Option<super::Observer>,
+    native_scales: Option<super::Observer>,
+    native_decided: bool,
+    /// This process's first output point: its time and the outputs before it (a restart
+    /// continues a count), where the projection of the rows to come starts.
+    since: Option<(f64, usize)>,
+    /// The run's end time, for that projection (NaN: none is made).
+    t_end: f64,
 }
 
 impl Tally {
@@ -356,14 +373,58 @@ impl Tally {
             extra: vec![0.0; prep.observer.len()],
             scale_out: vec![0.0; prep.scales.len()],
             row: Vec::new(),
+            solve: reads_unknowns(prep),
+            native_observer: None,
+            native_scales: None,
+            native_decided: false,
+            since: None,
+            t_end: f64::NAN,
+        }
+    }
+
+    /// Compiles the observer and the scales to native code when the run's rows still to
+    /// come, projected from this process's rows so far at their rate per unit of time, reach
+    /// [`NATIVE_FOR_ROWS_TO_COME`]: a streamed run does not know its number of rows in
+    /// advance. The 100-link chain's 4,286 rows interpreted cost about a seventh of its run.
+    /// At most once; only where the right-hand side is native too (not under `--no-jit`).
+    fn consider_native(&mut self, prep: &Prepared) {
+        if self.native_decided {
+            return;
+        }
+        let (Some((t0, before)), Some(last)) = (self.since, self.last.as_ref()) else {
+            return;
+        };
+        let rows = self.outputs - before;
+        let t = last[0];
+        let (done, left) = ((t - t0).abs(), (self.t_end - t).abs());
+        // A few rows first: the first steps of an adaptive run are its smallest.
+        if rows < PROJECT_FROM_ROWS || done <= 0.0 || !left.is_finite() {
+            return;
+        }
+        let to_come = rows as f64 * (left / done);
+        if to_come >= NATIVE_FOR_ROWS_TO_COME as f64 {
+            self.native_observer = super::native_for(prep, &prep.observer, NATIVE_PAYS_FROM);
+            if !self.scale_out.is_empty() {
+                self.native_scales = super::native_for(prep, &prep.scales, NATIVE_PAYS_FROM);
+            }
+            self.native_decided = true;
         }
     }
 
     /// One output point: its row appended to `out` (as `output::write_csv` formats it), the
     /// aggregates updated.
     fn point(&mut self, prep: &Prepared, t: f64, y: &[f64], out: &mut Vec<u8>) {
-        prep.system.observation_input(t, y, &mut self.input);
-        prep.observer.eval(&self.input, &mut self.extra);
+        if self.solve {
+            prep.system.observation_input(t, y, &mut self.input);
+        } else {
+            prep.system
+                .observation_input_without_unknowns(t, y, &mut self.input);
+        }
+        if self.since.is_none() {
+            self.since = Some((t, self.outputs));
+        }
+        let observer = self.native_observer.as_ref().unwrap_or(&prep.observer);
+        observer.eval(&self.input, &mut self.extra);
         self.watch.check(prep, &self.input, t);
         self.push.check(prep, t, &self.extra);
         self.row.clear();
@@ -395,7 +456,8 @@ impl Tally {
             };
         }
         if !self.scale_out.is_empty() {
-            prep.scales.eval(&self.input, &mut self.scale_out);
+            let scales = self.native_scales.as_ref().unwrap_or(&prep.scales);
+            scales.eval(&self.input, &mut self.scale_out);
             for (s, &v) in self.scale_series.iter_mut().zip(&self.scale_out) {
                 s.push(v.abs());
             }
@@ -536,6 +598,27 @@ impl Tally {
     }
 }
 
+/// Rows of this process seen before [`Tally::consider_native`] projects the rows to come.
+const PROJECT_FROM_ROWS: usize = 32;
+
+/// Rows still to come from which [`Tally::consider_native`] compiles: half of
+/// [`NATIVE_PAYS_FROM`], about what the compilation costs in interpreted rows (800–1,900).
+/// The projection from the rate so far underestimates a run whose steps shorten as it goes
+/// (a chain released from rest: the 100-link chain's projection grows from 258 rows at 32
+/// rows to 1,800 at 1,632 of its 4,286 and never reaches 2,000), and overestimates one whose
+/// steps lengthen; at half, the chain compiles after 432 rows.
+const NATIVE_FOR_ROWS_TO_COME: usize = NATIVE_PAYS_FROM / 2;
+
+/// Whether the observer, the friction watch or the scales read the solved unknowns (inputs
+/// past [`super::CompiledModel::inputs`]).
+fn reads_unknowns(prep: &Prepared) -> bool {
+    let base = prep.system.inputs.len();
+    std::iter::once(&prep.observer)
+        .chain(prep.friction_power.as_ref())
+        .chain((!prep.scales.is_empty()).then_some(&prep.scales))
+        .any(|o| !o.reads_only_first(base))
+}
+
 fn event_json(e: &EventHit) -> Value {
     json!({
         "index": e.index,
@@ -666,5 +749,79 @@ impl Plan {
     /// Where the files go.
     pub fn dir(&self) -> &Path {
         &self.dir
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Tally, NATIVE_FOR_ROWS_TO_COME, PROJECT_FROM_ROWS};
+
+    /// A 4-link chain with its energy monitored: an observer (positions, energy) and scales.
+    fn chain() -> String {
+        let mut s =
+            String::from("name = \"c\"\ngravity = \"[0, -g, 0]\"\n[parameters]\ng = 9.81\n");
+        s += "[coordinates]\n";
+        for i in 1..=4 {
+            s += &format!("q{i} = {{ initial = {}, rate = 0.0 }}\n", 0.3 * i as f64);
+        }
+        for i in 1..=4 {
+            let pos: Vec<String> = (1..=i)
+                .map(|j| format!("{}*[sin(q{j}), -cos(q{j}), 0]", 1.0 + 0.1 * j as f64))
+                .collect();
+            s += &format!(
+                "[particles.p{i}]\nmass = \"{}\"\nposition = \"{}\"\n",
+                1.0 + 0.2 * i as f64,
+                pos.join(" + ")
+            );
+        }
+        s
+    }
+
+    /// Feeds `rows` output points at times `k·dt` (states varied along) to a fresh tally of a
+    /// run ending at `t_end`, as `take_rows` does (a projection after each chunk of 8); the
+    /// rows' text and whether the tally went native.
+    fn stream(prep: &super::Prepared, rows: usize, dt: f64, t_end: f64) -> (Vec<u8>, bool) {
+        let mut tally = Tally::new(prep);
+        tally.t_end = t_end;
+        let mut out = Vec::new();
+        for k in 0..rows {
+            let t = k as f64 * dt;
+            let y: Vec<f64> = (0..8)
+                .map(|i| 0.3 * (i % 4) as f64 + libm::sin(t * (i + 1) as f64))
+                .collect();
+            tally.point(prep, t, &y, &mut out);
+            if k % 8 == 7 {
+                tally.consider_native(prep);
+            }
+        }
+        (out, tally.native_observer.is_some())
+    }
+
+    /// A streamed run compiles its output columns once the rows still to come, projected from
+    /// those so far, reach [`NATIVE_FOR_ROWS_TO_COME`]; not for a short run nor before
+    /// [`PROJECT_FROM_ROWS`] rows; and the native rows are the interpreter's, byte for byte.
+    #[test]
+    fn a_long_stream_goes_native_with_the_interpreters_bytes() {
+        let mut model = pdyn_mech::load(&chain(), "c.toml").unwrap();
+        let prep = super::super::prepare(&mut model).unwrap();
+        assert!(prep.system.is_native(), "the JIT is available in tests");
+        assert!(!prep.scales.is_empty(), "the chain's energy is monitored");
+        let dt = 1e-3;
+        let rows = 300;
+        // The projection at `m` rows (t = (m - 1) dt) is m (t_end - t) / t: about
+        // (t_end - t) / dt more rows, the most at the first projection (m = 32).
+        let long_end = (rows + NATIVE_FOR_ROWS_TO_COME + 20) as f64 * dt;
+        let short_end = (NATIVE_FOR_ROWS_TO_COME - 100) as f64 * dt;
+        let (native, went) = stream(&prep, rows, dt, long_end);
+        assert!(went, "enough rows to come: compiled");
+        let (interpreted, stayed) = stream(&prep, rows, dt, short_end);
+        assert!(!stayed, "too few rows to come: interpreted");
+        assert_eq!(
+            native, interpreted,
+            "the native rows are the interpreter's bytes"
+        );
+        // Too few rows to project from: nothing compiled however far the end.
+        let (_, early) = stream(&prep, PROJECT_FROM_ROWS - 8, dt, 1e9);
+        assert!(!early);
     }
 }

@@ -1222,7 +1222,11 @@ pub(crate) fn integrate_observed(
 /// bound) cannot enlarge the yardstick its own error is measured with.
 /// `observer` compiled to native code for `evaluations` when that pays
 /// ([`Observer::native_for`]) and the run's equations are native too (not under `--no-jit`).
-fn native_for(prep: &Prepared, observer: &Observer, evaluations: usize) -> Option<Observer> {
+pub(crate) fn native_for(
+    prep: &Prepared,
+    observer: &Observer,
+    evaluations: usize,
+) -> Option<Observer> {
     if prep.system.is_native() {
         observer.native_for(evaluations)
     } else {
