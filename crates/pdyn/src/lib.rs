@@ -20,6 +20,7 @@ pub mod kin;
 pub mod md;
 pub mod model_file;
 pub mod nbody;
+pub mod number_rows;
 pub mod optimize;
 pub mod output;
 pub mod params;

@@ -30,6 +30,7 @@ use super::{
 };
 use crate::checkpoint::{bits, unbit, unbits, Checkpointer, Every, LongRun, Restart};
 use crate::model_file::ModelFile;
+use crate::number_rows::NumberRows;
 use crate::stream::RowFile;
 use crate::{Error, Request};
 use pdyn_mech::Model;
@@ -151,11 +152,12 @@ pub fn execute(
     crate::data::reset_data_range(model);
     set.validate().map_err(|e| located(model, "", e))?;
     let csv = plan.dir.join("trajectory.csv");
+    let width = prep.columns().len();
     let (mut file, mut tally, before, resume) = match &plan.restart {
         None => {
             let header = crate::output::csv_header(&prep.columns());
             (
-                RowFile::create(&csv, &header)?,
+                NumberRows::new(RowFile::create(&csv, &header)?, width),
                 Tally::new(prep),
                 Before::default(),
                 None,
@@ -177,7 +179,12 @@ pub fn execute(
             let resume = ode_state(&s["ode"]).ok_or_else(|| damaged("integrator"))?;
             let tally = Tally::from_json(prep, &s["tally"]).ok_or_else(|| damaged("monitors"))?;
             let before = before_from_json(s).ok_or_else(|| damaged("events"))?;
-            (RowFile::resume(&csv, len)?, tally, before, Some(resume))
+            (
+                NumberRows::new(RowFile::resume(&csv, len)?, width),
+                tally,
+                before,
+                Some(resume),
+            )
         }
     };
     tally.t_end = set.t_end;
@@ -265,7 +272,7 @@ pub fn execute(
 
 /// Moves the solution's output points into the file as rows.
 fn take_rows(
-    file: &mut RowFile,
+    file: &mut NumberRows,
     tally: &mut Tally,
     prep: &Prepared,
     sol: &mut pdyn_ode::Solution,
@@ -275,11 +282,14 @@ fn take_rows(
         return Ok(());
     }
     let (ts, ys) = (&sol.t, &sol.y);
-    let written = file.rows(|out| {
-        for (k, &t) in ts.iter().enumerate() {
-            tally.point(prep, t, &ys[k * n..(k + 1) * n], out);
+    let mut written = Ok(());
+    for (k, &t) in ts.iter().enumerate() {
+        tally.point(prep, t, &ys[k * n..(k + 1) * n]);
+        written = file.row(&tally.row);
+        if written.is_err() {
+            break;
         }
-    });
+    }
     tally.consider_native(prep);
     sol.t.clear();
     sol.y.clear();
@@ -290,12 +300,12 @@ fn take_rows(
 /// recorded.
 fn checkpoint(
     cp: &mut Checkpointer,
-    file: &mut RowFile,
+    file: &mut NumberRows,
     step: &Accepted<'_>,
     tally: &Tally,
     before: &Before,
 ) -> Result<(), Error> {
-    file.sync()?;
+    let len = file.sync()?;
     let state = step.state();
     let events: Vec<Value> = before
         .events
@@ -315,12 +325,7 @@ fn checkpoint(
         "events": events,
         "misses": misses,
     });
-    cp.write(
-        state.t,
-        state.stats.accepted as u64,
-        json!([file.len()]),
-        body,
-    )
+    cp.write(state.t, state.stats.accepted as u64, json!([len]), body)
 }
 
 /// The running aggregates of a table that is not kept: what `tabulate` computes from the
@@ -411,9 +416,8 @@ impl Tally {
         }
     }
 
-    /// One output point: its row appended to `out` (as `output::write_csv` formats it), the
-    /// aggregates updated.
-    fn point(&mut self, prep: &Prepared, t: f64, y: &[f64], out: &mut Vec<u8>) {
+    /// One output point: its row in `self.row` (for the table), the aggregates updated.
+    fn point(&mut self, prep: &Prepared, t: f64, y: &[f64]) {
         if self.solve {
             prep.system.observation_input(t, y, &mut self.input);
         } else {
@@ -431,13 +435,6 @@ impl Tally {
         self.row.push(t);
         self.row.extend_from_slice(y);
         self.row.extend_from_slice(&self.extra);
-        for (i, &x) in self.row.iter().enumerate() {
-            if i > 0 {
-                out.push(b',');
-            }
-            crate::output::append_number(out, x);
-        }
-        out.push(b'\n');
         self.non_finite.row(t, self.row.iter().copied());
         if self.outputs == 0 {
             self.drifts = self
@@ -789,7 +786,11 @@ mod tests {
             let y: Vec<f64> = (0..8)
                 .map(|i| 0.3 * (i % 4) as f64 + libm::sin(t * (i + 1) as f64))
                 .collect();
-            tally.point(prep, t, &y, &mut out);
+            tally.point(prep, t, &y);
+            for &x in &tally.row {
+                crate::output::append_number(&mut out, x);
+                out.push(b',');
+            }
             if k % 8 == 7 {
                 tally.consider_native(prep);
             }
