@@ -290,8 +290,8 @@ pub(crate) struct Deferrer {
     /// Per `[[forces]]` entry (its span's start): whether its members may be deferred.
     entry_ok: FxHashMap<usize, bool>,
     /// Each particle's [`shape`], found once: a chain's particle ends two springs, a net's
-    /// eight (looking through its position's expressions each time was a tenth of reading
-    /// the forces).
+    /// eight (looking through its position's expressions each time was 23 of the 53 million
+    /// instructions of reading a 10^4-mass chain's forces).
     shapes: FxHashMap<usize, Option<Shape>>,
 }
 

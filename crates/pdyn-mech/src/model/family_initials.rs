@@ -247,7 +247,7 @@ impl Loader<'_> {
 /// A text's value as written, in floating point, nothing simplified, prepared once for a
 /// family: numbers read, each name an index slot or a number. Evaluated per member: walking
 /// the syntax tree, reading each literal and looking up each name for each of 10^4 members
-/// was a tenth of loading a chain.
+/// was 44 of the 548 million instructions of loading a chain.
 #[derive(Debug)]
 enum Written {
     Num(f64),

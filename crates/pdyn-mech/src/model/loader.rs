@@ -516,7 +516,7 @@ impl<'a> Loader<'a> {
 
     /// [`Loader::want`] with the description made only when the forms are compared: a
     /// family's members repeat one requirement, checked once (formatting `the position of
-    /// P[3]` for each of 10^4 members was a tenth of reading them).
+    /// P[3]` for each of 10^4 members was 25 of the 188 million instructions of reading them).
     pub fn want_with(&mut self, sv: &Sv, want: impl Into<Form>, what: impl FnOnce() -> String) {
         if let Some((got, want)) = self.still_wanted(sv, want.into()) {
             self.require(sv, &got, &want, &what());
