@@ -27,7 +27,7 @@
 use crate::damped::DampedMode;
 use crate::linearization::SparseLinearization;
 use crate::modes::Mode;
-use crate::sparse::{Csr, EnvelopeLdlt};
+use crate::sparse::Csr;
 use nalgebra::DMatrix;
 
 /// Largest relative commutator `‖C M⁻¹ K x − K M⁻¹ C x‖ / (‖C M⁻¹ K x‖ + ‖K M⁻¹ C x‖)` of
@@ -53,7 +53,7 @@ pub fn commutation_defect(lin: &SparseLinearization) -> f64 {
     {
         return f64::INFINITY;
     }
-    let Ok(mf) = EnvelopeLdlt::new(m) else {
+    let Ok(mf) = crate::modes::factor_mass(m) else {
         return f64::INFINITY;
     };
     let n = m.n;

@@ -223,7 +223,7 @@ pub fn modes_of<L: crate::linearization::Linearize + ?Sized>(
             });
         }
         None => {
-            let ldl = crate::sparse::EnvelopeLdlt::new(&matrices.mass).ok();
+            let ldl = crate::modes::factor_mass(&matrices.mass).ok();
             modes.add_participation(&inertia, |b| Some(ldl.as_ref()?.solve(b)));
         }
     }

@@ -273,3 +273,62 @@ fn members_are_named_like_the_chapter_and_usable_everywhere() {
     let m = loaded(&NET.replace("[x[i,j], j, 0]", "[x[ i , j ], j, 0]"));
     assert_eq!(m.particles.len(), 16);
 }
+
+/// A member's field that names nothing of its own is lowered once for the family
+/// (`mass = "m"`); one that names an index, a subscripted member or a table column is lowered
+/// for each member: each particle's mass and position must be its own.
+#[test]
+fn index_free_fields_are_shared_and_indexed_ones_are_each_members() {
+    let src = r#"
+[indices]
+n = 4
+i = "1..n"
+
+[parameters]
+m = 2.0
+L = 0.5
+
+[coordinates]
+"x[i]" = { initial = "i*L", rate = 0 }
+
+[particles."P[i]"]
+mass = "m"
+position = "[x[i], 0, 0]"
+
+[particles."Q[i]"]
+mass = "m*i"
+position = "[x[i], L*i, 0]"
+
+[particles."R[i]"]
+mass = "m + n"
+position = "r_P[i] + [0, 0, 1]"
+"#;
+    let model = loaded(src);
+    let p = &model.pool;
+    let text = |name: &str| {
+        let q = model.particles.iter().find(|q| q.name == name).unwrap();
+        (p.to_text(q.mass), q.position.map(|c| p.to_text(c)))
+    };
+    for i in 1..=4 {
+        let x = format!("x[{i}]");
+        let (mass, position) = text(&format!("P[{i}]"));
+        assert_eq!(mass, "m");
+        assert_eq!(position, [x.clone(), "0".into(), "0".into()]);
+        let (mass, position) = text(&format!("Q[{i}]"));
+        let m_i = if i == 1 {
+            "m".to_string()
+        } else {
+            format!("{i}*m")
+        };
+        assert_eq!(mass, m_i, "Q[{i}]");
+        let y = if i == 1 {
+            "L".to_string()
+        } else {
+            format!("{i}*L")
+        };
+        assert_eq!(position, [x.clone(), y, "0".into()], "Q[{i}]");
+        let (mass, position) = text(&format!("R[{i}]"));
+        assert_eq!(mass, "4 + m");
+        assert_eq!(position, [x, "0".into(), "1".into()], "R[{i}]");
+    }
+}

@@ -15,6 +15,7 @@ pub mod fuse;
 pub mod interrupt;
 pub mod kin;
 pub mod modes;
+pub mod modes_json;
 pub mod optimize;
 pub mod roots;
 pub mod run;

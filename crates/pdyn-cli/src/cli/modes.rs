@@ -7,13 +7,11 @@
 
 use super::set_parameters;
 use clap::{Args, ValueEnum};
-use pdyn::output::json_num;
 use pdyn::sim::net::statics::modes_about;
 use pdyn::Error;
 use pdyn_mech::damped::DampedMode;
 use pdyn_mech::sparse::Csr;
 use pdyn_mech::statics::{self, ModesRequest, StaticsError};
-use serde_json::json;
 use std::fmt::Write;
 use std::path::PathBuf;
 
@@ -133,49 +131,19 @@ pub fn run(a: ModesArgs) -> Result<String, Error> {
         .filter(|&d| result.total_mass[d].is_finite() && result.total_mass[d] > 1e-12 * biggest)
         .collect();
     const AXES: [&str; 3] = ["x", "y", "z"];
-    let by_axis =
-        |v: &[f64; 3]| json!({"x": json_num(v[0]), "y": json_num(v[1]), "z": json_num(v[2])});
     if a.json {
-        let v = json!({
-            "model": model.name,
-            "about": about,
-            "out_of_balance_force": json_num(residual),
-            "stiffness_asymmetry": json_num(result.stiffness_asymmetry),
-            "coordinates": lin_names,
-            "modes": shown.iter().enumerate().map(|(k, m)| json!({
-                "mode": k + 1,
-                "omega_squared": json_num(m.omega_squared),
-                "omega": json_num(m.omega),
-                "frequency_hz": json_num(m.omega / tau),
-                "period": json_num(tau / m.omega),
-                "modal_mass": json_num(m.modal_mass),
-                "modal_stiffness": json_num(m.modal_stiffness),
-                "participation": by_axis(&m.participation),
-                "effective_mass": by_axis(&m.effective_mass),
-                "shape": m.shape.iter().map(|x| json_num(*x)).collect::<Vec<_>>(),
-            })).collect::<Vec<_>>(),
-        });
-        let mut v = v;
-        v["total_mass"] = by_axis(&result.total_mass);
-        v["solver"] = json!(if sparse { "sparse" } else { "dense" });
-        v["coordinate_count"] = json!(n);
-        if let Some(path) = report.damped_path {
-            v["damped_path"] = json!(path.name());
-            v["damping_commutation_defect"] = json_num(report.commutation_defect);
-        }
-        if damped.is_some() {
-            v["damped_modes"] = json!(damped_shown
-                .iter()
-                .map(|d| json!({
-                    "eigenvalue": [json_num(d.re), json_num(d.im)],
-                    "natural_frequency": json_num(d.omega_n),
-                    "damping_ratio": json_num(d.damping_ratio),
-                    "damped_frequency": json_num(d.im),
-                    "oscillatory": d.oscillatory,
-                }))
-                .collect::<Vec<_>>());
-        }
-        return Ok(format!("{v:#}"));
+        let header = super::modes_json::Header {
+            model: &model.name,
+            about,
+            residual,
+            names: lin_names,
+            sparse,
+            damped_path: report
+                .damped_path
+                .map(|path| (path, report.commutation_defect)),
+            damped: damped.as_deref(),
+        };
+        return Ok(super::modes_json::modes_json(&header, result, shown.len()));
     }
     let mut s = String::new();
     if sparse {

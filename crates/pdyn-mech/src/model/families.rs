@@ -61,18 +61,27 @@ pub(crate) struct Member {
     /// The family's name (`P`, `spring`): with the bindings, the label `spring[i=3, j=19]`
     /// prefixed to errors while the member is read (formed only then).
     pub base: Rc<str>,
-    /// The values of its indices.
-    pub bindings: Vec<(String, i64)>,
+    /// The names of its indices, shared by the family's members.
+    pub names: Rc<[String]>,
+    /// Their values for this member.
+    pub values: Vec<i64>,
     /// The table rows it stands for (empty outside families over tables).
     pub rows: Rows,
 }
 
 impl Member {
-    /// The member of family `base` at `bindings` (and table rows `rows`).
-    fn of(base: &Rc<str>, bindings: &[(String, i64)], rows: &[(usize, usize)]) -> Member {
+    /// The member of family `base` over the indices `names` at `bindings` (the same names,
+    /// with values) and table rows `rows`.
+    fn of(
+        base: &Rc<str>,
+        names: &Rc<[String]>,
+        bindings: &[(String, i64)],
+        rows: &[(usize, usize)],
+    ) -> Member {
         Member {
             base: Rc::clone(base),
-            bindings: bindings.to_vec(),
+            names: Rc::clone(names),
+            values: bindings.iter().map(|b| b.1).collect(),
             rows: rows.to_vec(),
         }
     }
@@ -362,19 +371,41 @@ impl Indices {
 
 /// `P[3,4]`.
 pub(crate) fn member(base: &str, values: &[i64]) -> String {
-    use std::fmt::Write;
     // Written into one string: a net's 10^5 names were a Vec of strings each.
     let mut out = String::with_capacity(base.len() + 2 + 6 * values.len());
     out.push_str(base);
     out.push('[');
-    for (k, v) in values.iter().enumerate() {
+    for (k, &v) in values.iter().enumerate() {
         if k > 0 {
             out.push(',');
         }
-        let _ = write!(out, "{v}");
+        push_int(&mut out, v);
     }
     out.push(']');
     out
+}
+
+/// `v` in decimal appended to `out`, as `{v}` writes it: a family's names are made per
+/// member and per reference (`P[i+1]` of each spring), and the formatting machinery was most
+/// of making them.
+fn push_int(out: &mut String, v: i64) {
+    let mut digits = [0u8; 20];
+    let mut k = digits.len();
+    let mut m = v.unsigned_abs();
+    loop {
+        k -= 1;
+        digits[k] = b'0' + (m % 10) as u8;
+        m /= 10;
+        if m == 0 {
+            break;
+        }
+    }
+    if v < 0 {
+        out.push('-');
+    }
+    for &d in &digits[k..] {
+        out.push(char::from(d));
+    }
 }
 
 /// `P[0..19, 0..19]`.
@@ -389,7 +420,6 @@ pub(crate) fn shape_text(base: &str, shape: &Shape) -> String {
 
 /// `spring[i=3, j=19]`.
 fn label(base: &str, bindings: &[(String, i64)]) -> String {
-    use std::fmt::Write;
     let mut out = String::with_capacity(base.len() + 2 + 8 * bindings.len());
     out.push_str(base);
     out.push('[');
@@ -397,7 +427,9 @@ fn label(base: &str, bindings: &[(String, i64)]) -> String {
         if k > 0 {
             out.push_str(", ");
         }
-        let _ = write!(out, "{n}={v}");
+        out.push_str(n);
+        out.push('=');
+        push_int(&mut out, *v);
     }
     out.push(']');
     out
@@ -649,22 +681,22 @@ impl<'l, 'a> Expander<'l, 'a> {
         }
         let mut any = false;
         let mut values: Vec<i64> = domain.ranges.iter().map(|r| r.0).collect();
+        // The names once, the values set for each member (not a string per index per member).
+        let mut bindings: Vec<(String, i64)> =
+            domain.names.iter().map(|n| (n.clone(), 0)).collect();
+        let mut rows: Rows = Vec::new();
         'all: loop {
             // A table's index takes each row's key; the row itself is kept for its cells.
-            let mut rows: Rows = Vec::new();
-            let bindings: Vec<(String, i64)> = domain
-                .names
-                .iter()
-                .zip(&values)
-                .zip(&domain.tables)
-                .map(|((n, &v), t)| match t {
+            rows.clear();
+            for ((b, &v), t) in bindings.iter_mut().zip(&values).zip(&domain.tables) {
+                b.1 = match t {
                     Some(t) => {
                         rows.push((*t, v as usize));
-                        (n.clone(), self.indices.tables[*t].keys[v as usize])
+                        self.indices.tables[*t].keys[v as usize]
                     }
-                    None => (n.clone(), v),
-                })
-                .collect();
+                    None => v,
+                };
+            }
             let keep = match &domain.condition {
                 None => true,
                 Some((e, sv)) => e
@@ -855,6 +887,7 @@ impl<'l, 'a> Expander<'l, 'a> {
                         .collect();
                     self.record_shape(&name, &base, &ranges, None)?;
                     let family: Rc<str> = Rc::from(base.as_str());
+                    let index_names: Rc<[String]> = domain.names.clone().into();
                     self.each(&name.span(), &base, &domain, |ex, bindings, rows| {
                         let values: Vec<i64> = names
                             .iter()
@@ -862,7 +895,7 @@ impl<'l, 'a> Expander<'l, 'a> {
                             .collect();
                         let key = Spanned::new(name.span(), member(&base, &values));
                         ex.insert(&mut out, key, value.clone())?;
-                        members.push(Some(Member::of(&family, bindings, rows)));
+                        members.push(Some(Member::of(&family, &index_names, bindings, rows)));
                         Ok(())
                     })?;
                 }
@@ -896,6 +929,7 @@ impl<'l, 'a> Expander<'l, 'a> {
             exprs.push((e, *off, p.len()));
         }
         let family: Rc<str> = Rc::from(base);
+        let index_names: Rc<[String]> = domain.names.clone().into();
         let mut declared: FxHashSet<Vec<i64>> = FxHashSet::default();
         let mut ranges = vec![(i64::MAX, i64::MIN); parts.len()];
         self.each(&name.span(), base, domain, |ex, bindings, rows| {
@@ -922,7 +956,7 @@ impl<'l, 'a> Expander<'l, 'a> {
             ex.insert(out, key, value.clone())
                 .map_err(|e| in_member(e, &label()))?;
             declared.insert(values);
-            members.push(Some(Member::of(&family, bindings, rows)));
+            members.push(Some(Member::of(&family, &index_names, bindings, rows)));
             Ok(())
         })?;
         self.record_shape(name, base, &ranges, Some(declared))
@@ -1048,12 +1082,13 @@ impl<'l, 'a> Expander<'l, 'a> {
             };
             let domain = self.domain(&f.span(), &[], Some(&for_list), raw.condition.as_ref())?;
             let family: Rc<str> = Rc::from(base.as_str());
+            let index_names: Rc<[String]> = domain.names.clone().into();
             self.each(&for_list.span(), &base, &domain, |ex, bindings, rows| {
                 let names = ex
                     .force_member(f, &base, bindings, rows)
                     .map_err(|e| in_member(e, &ex.indices.label(&base, bindings, rows)))?;
                 out.push(ForceEntry { entry, names });
-                members.push(Some(Member::of(&family, bindings, rows)));
+                members.push(Some(Member::of(&family, &index_names, bindings, rows)));
                 Ok(())
             })?;
         }
@@ -1290,4 +1325,18 @@ fn read_indices(ld: &mut Loader, raw: &RawModel) -> Result<Indices, ModelError> 
         }
     }
     Ok(indices)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn names_print_their_indices_as_format_does() {
+        for v in [0, 7, -7, 10, 99, -100, 123_456, i64::MAX, i64::MIN] {
+            assert_eq!(super::member("P", &[v, 3]), format!("P[{v},3]"));
+        }
+        assert_eq!(
+            super::label("spring", &[("i".into(), -3), ("j".into(), 19)]),
+            "spring[i=-3, j=19]"
+        );
+    }
 }

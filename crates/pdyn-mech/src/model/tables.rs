@@ -121,7 +121,11 @@ impl Loader<'_> {
                     CoordinateKind::Prescribed { expr }
                 }
                 toml::Value::Table(t) => {
-                    self.dims.bind_unknown(n);
+                    // A member of a family whose dimension is known shares it (the members'
+                    // key, `x[]`, holds it since the first member): no unknown of its own.
+                    if self.member.is_none() || self.family_form(sv).is_none() {
+                        self.dims.bind_unknown(n);
+                    }
                     self.coordinate_table(n, sv, t, index, &mut out)?
                 }
                 other => {
@@ -252,7 +256,8 @@ impl Loader<'_> {
             // texts' (an error is the first member's, as when each was checked; only the
             // first error is reported). Numbers alone check nothing: each member keeps its own.
             match self.family_form(sv) {
-                Some(form) => self.dims.bind(n, form),
+                // Bound by the first member (`read_coordinates`): the key is the family's.
+                Some(_) => {}
                 None => {
                     if self.coordinate_dimensions_of(n, sv, t) {
                         let form = self.dims.of(n).unwrap_or_default();
@@ -503,7 +508,7 @@ impl Loader<'_> {
                     .help("add position = \"[x, y, z]\" in terms of the coordinates"));
             };
             let mass = self.scalar(msv, "a mass")?;
-            self.want(msv, Dimension::MASS, &format!("the mass of `{n}`"));
+            self.want_with(msv, Dimension::MASS, || format!("the mass of `{n}`"));
             let mv = self.constant(mass, msv.span(), "a mass")?;
             if mv <= 0.0 {
                 return Err(self
@@ -513,8 +518,8 @@ impl Loader<'_> {
                     )
                     .help("a massless body is a frame: declare it under [frames]"));
             }
-            let position = self.vector(psv, &format!("the position of `{n}`"))?;
-            self.want(psv, Dimension::LENGTH, &format!("the position of `{n}`"));
+            let position = self.vector_with(psv, || format!("the position of `{n}`"))?;
+            self.want_with(psv, Dimension::LENGTH, || format!("the position of `{n}`"));
             // The members of a family share their dimensions (`P[]`): bound once.
             let family = self.member.clone();
             if family.is_none() || family != bound {
@@ -529,7 +534,10 @@ impl Loader<'_> {
             }
             let vel = position.map(|c| self.pool.dt(c));
             for (prefix, v) in [("r_", position), ("v_", vel)] {
-                let key = format!("{prefix}{n}");
+                // Concatenated, not `format!`: once per particle.
+                let mut key = String::with_capacity(prefix.len() + n.len());
+                key.push_str(prefix);
+                key.push_str(n);
                 if !self.scope.names.contains_key(&key) {
                     self.scope
                         .local
