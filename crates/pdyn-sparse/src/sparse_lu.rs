@@ -244,7 +244,7 @@ impl SparseLu {
 }
 
 /// A complex sparse LU of `A = Ar + i·Ai` (real and imaginary parts given separately, as
-/// [`crate::linalg::LuComplex`] takes them).
+/// pdyn-ode's dense `LuComplex` takes them).
 #[derive(Debug)]
 pub struct SparseLuComplex {
     factors: Factors<C64>,
@@ -299,6 +299,37 @@ mod tests {
             self.0 ^= self.0 << 17;
             (self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
         }
+    }
+
+    /// `A⁻¹ b` for the dense `n × n` matrix `a` (column-major) by Gaussian elimination with
+    /// partial pivoting: the reference the sparse LU (no pivoting) is checked against.
+    fn dense_solve<T: Scalar>(mut a: Vec<T>, mut b: Vec<T>) -> Vec<T> {
+        let n = b.len();
+        for k in 0..n {
+            let p = (k..n)
+                .max_by(|&i, &j| a[i + k * n].magnitude().total_cmp(&a[j + k * n].magnitude()))
+                .unwrap();
+            for j in 0..n {
+                a.swap(k + j * n, p + j * n);
+            }
+            b.swap(k, p);
+            let d = a[k + k * n];
+            for i in k + 1..n {
+                let l = a[i + k * n] / d;
+                for j in k..n {
+                    a[i + j * n] = a[i + j * n] - l * a[k + j * n];
+                }
+                b[i] = b[i] - l * b[k];
+            }
+        }
+        for k in (0..n).rev() {
+            let mut s = b[k];
+            for j in k + 1..n {
+                s = s - a[k + j * n] * b[j];
+            }
+            b[k] = s / a[k + k * n];
+        }
+        b
     }
 
     /// A random matrix on the pattern of an m × m grid with 3 unknowns per node, coupled to
@@ -385,25 +416,28 @@ mod tests {
         let s = Symbolic::new(&p).unwrap();
         let mut lu = SparseLuComplex::new(&s);
         lu.factor(&s, &re, im).unwrap();
-        let mut dense = crate::linalg::LuComplex::new(n);
-        {
-            let (ar, ai) = dense.matrix_mut();
-            for i in 0..n {
-                for q in p.start[i]..p.start[i + 1] {
-                    ar[i + p.cols[q] * n] = re[q];
-                    ai[i + p.cols[q] * n] = im(q);
-                }
+        let mut a = vec![C64::ZERO; n * n];
+        for i in 0..n {
+            for q in p.start[i]..p.start[i + 1] {
+                a[i + p.cols[q] * n] = C64 {
+                    re: re[q],
+                    im: im(q),
+                };
             }
         }
-        dense.factor().unwrap();
         let (mut br, mut bi): (Vec<f64>, Vec<f64>) =
             (0..n).map(|_| (rng.next(), rng.next())).unzip();
-        let (mut dr, mut di) = (br.clone(), bi.clone());
+        let d = dense_solve(
+            a,
+            br.iter()
+                .zip(&bi)
+                .map(|(&re, &im)| C64 { re, im })
+                .collect(),
+        );
         lu.solve_in_place(&s, &mut br, &mut bi);
-        dense.solve_in_place(&mut dr, &mut di);
         for i in 0..n {
             assert!(
-                (br[i] - dr[i]).abs() < 1e-12 && (bi[i] - di[i]).abs() < 1e-12,
+                (br[i] - d[i].re).abs() < 1e-12 && (bi[i] - d[i].im).abs() < 1e-12,
                 "{i}"
             );
         }
@@ -468,7 +502,7 @@ mod tests {
     }
 
     /// Solves with the sparse LU (real, and complex with `im` on the diagonal when given) and
-    /// with the dense LU of [`crate::linalg`] (partial pivoting, an independent code), and
+    /// with [`dense_solve`] (partial pivoting, an independent code), and
     /// returns the largest difference of the solutions relative to their size.
     fn against_dense(p: &Pattern, re: &[f64], im_diag: Option<f64>, rng: &mut Rng) -> f64 {
         let n = p.dim();
@@ -479,17 +513,15 @@ mod tests {
             None => {
                 let mut lu = SparseLu::new(&s);
                 lu.factor(&s, re).unwrap();
-                let mut dense = crate::linalg::Lu::new(n);
-                let a = dense.matrix_mut();
+                let mut a = vec![0.0; n * n];
                 for i in 0..n {
                     for q in p.start[i]..p.start[i + 1] {
                         a[i + p.cols[q] * n] += re[q];
                     }
                 }
-                dense.factor().unwrap();
-                let (mut x, mut y) = (b.clone(), b.clone());
+                let mut x = b.clone();
                 lu.solve_in_place(&s, &mut x);
-                dense.solve_in_place(&mut y);
+                let y = dense_solve(a, b.clone());
                 let scale = y.iter().fold(0f64, |m, v| m.max(v.abs()));
                 for i in 0..n {
                     worst = worst.max((x[i] - y[i]).abs() / scale);
@@ -506,20 +538,27 @@ mod tests {
                 };
                 let mut lu = SparseLuComplex::new(&s);
                 lu.factor(&s, re, im).unwrap();
-                let mut dense = crate::linalg::LuComplex::new(n);
-                let (ar, ai) = dense.matrix_mut();
+                let mut a = vec![C64::ZERO; n * n];
                 for i in 0..n {
                     for q in p.start[i]..p.start[i + 1] {
-                        ar[i + p.cols[q] * n] += re[q];
-                        ai[i + p.cols[q] * n] += im(q);
+                        let x = &mut a[i + p.cols[q] * n];
+                        *x = *x + C64 {
+                            re: re[q],
+                            im: im(q),
+                        };
                     }
                 }
-                dense.factor().unwrap();
                 let bi: Vec<f64> = (0..n).map(|_| rng.next()).collect();
                 let (mut xr, mut xi) = (b.clone(), bi.clone());
-                let (mut yr, mut yi) = (b.clone(), bi);
                 lu.solve_in_place(&s, &mut xr, &mut xi);
-                dense.solve_in_place(&mut yr, &mut yi);
+                let y = dense_solve(
+                    a,
+                    b.iter()
+                        .zip(&bi)
+                        .map(|(&re, &im)| C64 { re, im })
+                        .collect(),
+                );
+                let (yr, yi): (Vec<f64>, Vec<f64>) = y.iter().map(|c| (c.re, c.im)).unzip();
                 let scale = yr.iter().chain(&yi).fold(0f64, |m, v| m.max(v.abs()));
                 for i in 0..n {
                     worst = worst.max(libm::hypot(xr[i] - yr[i], xi[i] - yi[i]) / scale);
