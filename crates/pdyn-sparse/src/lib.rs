@@ -6,7 +6,7 @@
 //! | file | what |
 //! |---|---|
 //! | `ordering.rs` | nested dissection by breadth-first level structures: the fill-reducing order |
-//! | `sparse_lu.rs` | sparse real/complex LU on a known pattern: rows of the shape `q' = v` eliminated first (`sparse_lu/reduce.rs`), the rest supernodal multifrontal with dense kernels (`sparse_lu/{supernodal,multifrontal,scalar}.rs`), no pivoting |
+//! | `sparse_lu.rs` | sparse real/complex LU on a known pattern, with a symmetric mode (`SparseLu::factor_symmetric`: half the work): rows of the shape `q' = v` eliminated first (`sparse_lu/reduce.rs`), the rest supernodal multifrontal with dense kernels (`sparse_lu/{supernodal,multifrontal,scalar}.rs`), no pivoting |
 
 pub mod ordering;
 pub mod sparse_lu;
