@@ -116,8 +116,9 @@ enum StepSolver {
         pattern: Pattern,
         /// Where each diagonal entry is in the pattern's values.
         diagonal: Vec<usize>,
-        symbolic: Symbolic,
-        lu: SparseLu,
+        /// Boxed: the analysis and the factors are large beside the envelope's order.
+        symbolic: Box<Symbolic>,
+        lu: Box<SparseLu>,
     },
     /// The envelope `L D Lᵀ` in one reverse Cuthill–McKee order: for a pattern whose LU
     /// factors the analysis refused as too large (the envelope has its own limit).
@@ -139,11 +140,11 @@ impl StepSolver {
             .collect();
         match (Symbolic::new(&pattern), diagonal) {
             (Ok(symbolic), Some(diagonal)) => {
-                let lu = SparseLu::new(&symbolic);
+                let lu = Box::new(SparseLu::new(&symbolic));
                 StepSolver::Lu {
                     pattern,
                     diagonal,
-                    symbolic,
+                    symbolic: Box::new(symbolic),
                     lu,
                 }
             }

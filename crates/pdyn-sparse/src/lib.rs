@@ -8,5 +8,9 @@
 //! | `ordering.rs` | nested dissection by breadth-first level structures: the fill-reducing order |
 //! | `sparse_lu.rs` | sparse real/complex LU on a known pattern, with a symmetric mode (`SparseLu::factor_symmetric`: half the work): rows of the shape `q' = v` eliminated first (`sparse_lu/reduce.rs`), the rest supernodal multifrontal with dense kernels (`sparse_lu/{supernodal,multifrontal,scalar}.rs`), no pivoting |
 
+// As in pdyn-ode, where this code came from: index loops over several parallel arrays read
+// as the algorithms are written (Davis, George & Liu).
+#![allow(clippy::needless_range_loop)]
+
 pub mod ordering;
 pub mod sparse_lu;
