@@ -1,13 +1,17 @@
 //! Equilibrium and modes of large systems with sparse matrices: the same mathematics as
 //! [`crate::equilibrium`] and [`crate::modes`], with `M`, `K`, `C` kept sparse
-//! ([`crate::linearization::Linearizer::at_sparse`]) and every solve an envelope `L D Lᵀ`
-//! ([`crate::sparse::EnvelopeLdlt`]): memory and work in proportion to `n b²` (`b` the
-//! bandwidth after reverse Cuthill–McKee), where the dense path needs `n²` memory and `n³` work.
+//! ([`crate::linearization::Linearizer::at_sparse`]), where the dense path needs `n²` memory
+//! and `n³` work.
 //!
 //! - **Equilibrium**: Newton–Levenberg–Marquardt as in [`crate::equilibrium::solve`], each step
 //!   `(K_s + μ D) δq = f` with `K_s = (K + Kᵀ)/2` (Newton's exact step for conservative forces,
 //!   whose `K` is symmetric, taken where it lowers `|f|` or the energy; for others a
-//!   quasi-Newton step, taken only where it lowers `|f|`: `damped_newton.rs`).
+//!   quasi-Newton step, taken only where it lowers `|f|`: `damped_newton.rs`). Each step is
+//!   solved by the supernodal multifrontal LU of pdyn-sparse in nested-dissection order,
+//!   analysed once (the pattern of `K_s + D` does not change from step to step): on a 2-D mesh
+//!   `O(n^{3/2})` work per step where the envelope `L D Lᵀ` of reverse Cuthill–McKee
+//!   ([`crate::sparse::EnvelopeLdlt`]) takes `O(n b²)`, `b ~ √n` (the 100 × 100 cloth: ~300);
+//!   the envelope remains for a pattern the LU refuses as too large.
 //! - **Modes**: the `count` lowest of `K_s φ = ω² M φ` by shift-invert Lanczos
 //!   ([`crate::lanczos::nearest`], shift 0, or just below 0 when `K` is singular).
 //! - **Free directions** (a mechanism, a neutral equilibrium): the eigenvectors of
@@ -18,6 +22,8 @@ use crate::lanczos::{nearest, LanczosError, LanczosOptions};
 use crate::linearization::{Linearize, SparseLinearization};
 use crate::modes::{Mode, Modes, ModesError};
 use crate::sparse::{rcm, Csr, EnvelopeLdlt, SparseError};
+use pdyn_sparse::sparse_lu::{Pattern, SparseLu, Symbolic};
+use std::cell::RefCell;
 
 /// Coordinates from which the front ends choose the sparse path by default: below it the
 /// dense one (all modes, `O(n³)`) takes under half a second.
@@ -69,16 +75,13 @@ pub fn solve<L: Linearize + ?Sized>(
     let dmax = diag.iter().fold(0.0f64, |m, x| m.max(*x));
     let ratio = stiff.max(f64::MIN_POSITIVE) / dmax;
     let at = SparseAt::new(at);
-    let ks = &at.ks;
-    // One ordering for every step: the pattern of K + D does not change.
-    let order = rcm(&ks.add(1.0, &Csr::diagonal(&diag), 1.0));
     let sparse = Sparse {
         lin,
-        order,
+        solver: RefCell::new(StepSolver::new(&at.ks.add(1.0, &Csr::diagonal(&diag), 1.0))),
         diag: &diag,
     };
     let end = crate::damped_newton::solve(&sparse, q, at, &diag, ratio, target, opts)?;
-    let (q, SparseAt { at, ks }, residual, steps) = (end.q, end.at, end.residual, end.steps);
+    let (q, SparseAt { at, ks, .. }, residual, steps) = (end.q, end.at, end.residual, end.steps);
     let neutral = if opts.neutral {
         free_directions(lin.names(), &ks, &diag)
     } else {
@@ -94,24 +97,149 @@ pub fn solve<L: Linearize + ?Sized>(
     })
 }
 
-/// The sparse path of damped Newton: the symmetric part of `K`, by envelope `L D Lᵀ` in one
-/// reverse Cuthill–McKee order.
+/// The sparse path of damped Newton: the symmetric part of `K`, by the solver of its
+/// pattern.
 struct Sparse<'a, L: ?Sized> {
     lin: &'a L,
-    order: Vec<usize>,
+    /// Mutable behind `&self` ([`crate::damped_newton::NewtonSystem::step`]): the LU's
+    /// storage is reused by every step.
+    solver: RefCell<StepSolver>,
     diag: &'a [f64],
+}
+
+/// How the steps `(K_s + diag(damping)) δq = f` are solved: the analysis of their pattern,
+/// done once.
+enum StepSolver {
+    /// The supernodal LU of pdyn-sparse in nested-dissection order, symmetric (no pivoting:
+    /// `K_s + μD` is symmetric, its elimination without pivoting is its `L D Lᵀ`).
+    Lu {
+        pattern: Pattern,
+        /// Where each diagonal entry is in the pattern's values.
+        diagonal: Vec<usize>,
+        /// Boxed: the analysis and the factors are large beside the envelope's order.
+        symbolic: Box<Symbolic>,
+        lu: Box<SparseLu>,
+    },
+    /// The envelope `L D Lᵀ` in one reverse Cuthill–McKee order: for a pattern whose LU
+    /// factors the analysis refused as too large (the envelope has its own limit).
+    Envelope { order: Vec<usize> },
+}
+
+impl StepSolver {
+    /// The solver for matrices with the pattern of `a` (every diagonal present).
+    fn new(a: &Csr) -> StepSolver {
+        let pattern = Pattern {
+            start: a.ptr.clone(),
+            cols: a.col.clone(),
+        };
+        let diagonal: Option<Vec<usize>> = (0..a.n)
+            .map(|i| {
+                let row = &a.col[a.ptr[i]..a.ptr[i + 1]];
+                row.binary_search(&i).ok().map(|k| a.ptr[i] + k)
+            })
+            .collect();
+        match (Symbolic::new(&pattern), diagonal) {
+            (Ok(symbolic), Some(diagonal)) => {
+                let lu = Box::new(SparseLu::new(&symbolic));
+                StepSolver::Lu {
+                    pattern,
+                    diagonal,
+                    symbolic: Box::new(symbolic),
+                    lu,
+                }
+            }
+            _ => StepSolver::Envelope { order: rcm(a) },
+        }
+    }
+
+    /// `(ks + diag(damping))⁻¹ b`: the damping added on the diagonal of a copy of `ks`'s
+    /// values when `ks` has this solver's pattern (no merge of two matrices per trial step),
+    /// by [`StepSolver::solve`] otherwise. The same values either way (`x + d`).
+    fn solve_damped(&mut self, ks: &Csr, damping: &[f64], b: &[f64]) -> Option<Vec<f64>> {
+        if let StepSolver::Lu {
+            pattern,
+            diagonal,
+            symbolic,
+            lu,
+        } = self
+        {
+            if ks.ptr == pattern.start && ks.col == pattern.cols {
+                let mut values = ks.val.clone();
+                for (&k, d) in diagonal.iter().zip(damping) {
+                    values[k] += d;
+                }
+                lu.factor_symmetric(symbolic, &values).ok()?;
+                let mut x = b.to_vec();
+                lu.solve_in_place(symbolic, &mut x);
+                return Some(x);
+            }
+        }
+        self.solve(&ks.add(1.0, &Csr::diagonal(damping), 1.0), b)
+    }
+
+    /// `A⁻¹ b`, or `None` when `A` cannot be factored (a zero or negligible pivot).
+    fn solve(&mut self, a: &Csr, b: &[f64]) -> Option<Vec<f64>> {
+        match self {
+            StepSolver::Lu {
+                pattern,
+                symbolic,
+                lu,
+                ..
+            } if a.ptr == pattern.start && a.col == pattern.cols => {
+                // `a` is symmetric (`K_s + diag`) on a symmetric pattern.
+                lu.factor_symmetric(symbolic, &a.val).ok()?;
+                let mut x = b.to_vec();
+                lu.solve_in_place(symbolic, &mut x);
+                Some(x)
+            }
+            StepSolver::Lu { .. } => {
+                // A linearization whose pattern changed (not one of the kernels' or the
+                // symbolic path's, whose patterns are fixed): analysed again.
+                *self = StepSolver::new(a);
+                self.solve(a, b)
+            }
+            StepSolver::Envelope { order } => {
+                let f = EnvelopeLdlt::with_order(a, order.clone()).ok()?;
+                Some(f.solve(b))
+            }
+        }
+    }
 }
 
 /// A sparse linearization with the symmetric part of its stiffness.
 struct SparseAt {
     at: SparseLinearization,
     ks: Csr,
+    /// Whether `K` is symmetric to round-off ([`crate::equilibrium::SYMMETRIC`]), found with
+    /// `K_s` from the one transpose (damped Newton asks at every trial step).
+    conservative: bool,
 }
 
 impl SparseAt {
     fn new(at: SparseLinearization) -> SparseAt {
-        let ks = symmetric_part(&at.stiffness);
-        SparseAt { at, ks }
+        let k = &at.stiffness;
+        let kt = k.transpose();
+        let ks = k.add(0.5, &kt, 0.5);
+        // max |K_ij − K_ji| / max |K_ij|, as `Csr::asymmetry` (without a search per entry;
+        // entry by entry where the pattern is symmetric, as a net's and a truss's are).
+        let big = k.val.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let worst = if k.ptr == kt.ptr && k.col == kt.col {
+            k.val
+                .iter()
+                .zip(&kt.val)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
+        } else {
+            k.add(1.0, &kt, -1.0)
+                .val
+                .iter()
+                .fold(0.0f64, |m, v| m.max(v.abs()))
+        };
+        let conservative = big == 0.0 || worst <= crate::equilibrium::SYMMETRIC * big;
+        SparseAt {
+            at,
+            ks,
+            conservative,
+        }
     }
 }
 
@@ -127,9 +255,9 @@ impl<L: Linearize + ?Sized> crate::damped_newton::NewtonSystem for Sparse<'_, L>
     }
 
     fn step(&self, at: &SparseAt, damping: &[f64]) -> Option<Vec<f64>> {
-        let a = at.ks.add(1.0, &Csr::diagonal(damping), 1.0);
-        let f = EnvelopeLdlt::with_order(&a, self.order.clone()).ok()?;
-        Some(f.solve(&at.at.force))
+        self.solver
+            .borrow_mut()
+            .solve_damped(&at.ks, damping, &at.at.force)
     }
 
     fn free_directions(&self, at: &SparseAt) -> Vec<FreeDirection> {
@@ -141,7 +269,7 @@ impl<L: Linearize + ?Sized> crate::damped_newton::NewtonSystem for Sparse<'_, L>
     }
 
     fn conservative(&self, at: &SparseAt) -> bool {
-        at.at.stiffness.asymmetry() <= crate::equilibrium::SYMMETRIC
+        at.conservative
     }
 }
 
@@ -243,4 +371,125 @@ pub fn lowest_modes(lin: &SparseLinearization, count: usize) -> Result<Modes, Mo
         stiffness_asymmetry,
         total_mass: [f64::NAN; 3],
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A symmetric `K + diag(d)` on the pattern of an `m × m` grid of nodes with three
+    /// coordinates each (a net's), random values from a seeded generator.
+    fn grid(m: usize, shift: f64, seed: u64) -> Csr {
+        let mut s = seed;
+        let mut next = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut t = Vec::new();
+        for node in 0..m * m {
+            let (r, c) = (node / m, node % m);
+            for a in 0..3 {
+                t.push((3 * node + a, 3 * node + a, shift));
+            }
+            let mut near = vec![node];
+            if c + 1 < m {
+                near.push(node + 1);
+            }
+            if r + 1 < m {
+                near.push(node + m);
+            }
+            for &other in &near {
+                for a in 0..3 {
+                    for b in 0..3 {
+                        let (i, j) = (3 * node + a, 3 * other + b);
+                        if i < j || (other != node && i != j) {
+                            let v = next();
+                            t.push((i, j, v));
+                            t.push((j, i, v));
+                        }
+                    }
+                }
+            }
+        }
+        Csr::from_triplets(3 * m * m, &t).unwrap()
+    }
+
+    #[test]
+    fn steps_solve_as_the_dense_lu_definite_or_not_and_after_a_change_of_pattern() {
+        for (m, shift, seed) in [(4, 9.0, 1u64), (11, 6.0, 2), (11, -2.5, 3)] {
+            let a = grid(m, shift, seed);
+            let n = a.n;
+            let mut solver = StepSolver::new(&a);
+            assert!(matches!(solver, StepSolver::Lu { .. }));
+            let b: Vec<f64> = (0..n).map(|i| ((i * 7) % 13) as f64 - 6.0).collect();
+            let x = solver.solve(&a, &b).unwrap();
+            let dense = a
+                .to_dense()
+                .lu()
+                .solve(&nalgebra::DVector::from_vec(b.clone()))
+                .unwrap();
+            let big = dense.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+            for (u, v) in x.iter().zip(dense.iter()) {
+                assert!((u - v).abs() <= 1e-10 * big, "m = {m}: {u} vs {v}");
+            }
+            // Another pattern (the grid one node smaller) is analysed again, not misread.
+            let small = grid(m - 1, shift, seed);
+            let y = solver.solve(&small, &b[..small.n]).unwrap();
+            let dense = small
+                .to_dense()
+                .lu()
+                .solve(&nalgebra::DVector::from_vec(b[..small.n].to_vec()))
+                .unwrap();
+            let big = dense.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+            for (u, v) in y.iter().zip(dense.iter()) {
+                assert!((u - v).abs() <= 1e-10 * big, "m = {m} − 1: {u} vs {v}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_damped_step_is_the_step_of_the_sum() {
+        // `ks + diag(d)` by the copy of `ks`'s values and by the merge: the same bits.
+        let ks = grid(6, 0.0, 9);
+        let d: Vec<f64> = (0..ks.n).map(|i| 3.0 + (i % 5) as f64).collect();
+        let b: Vec<f64> = (0..ks.n).map(|i| (i % 4) as f64 - 1.5).collect();
+        let sum = ks.add(1.0, &Csr::diagonal(&d), 1.0);
+        let mut solver = StepSolver::new(&sum);
+        let x = solver.solve_damped(&ks, &d, &b).unwrap();
+        let y = solver.solve(&sum, &b).unwrap();
+        assert!(x.iter().zip(&y).all(|(u, v)| u.to_bits() == v.to_bits()));
+        // A `ks` missing a diagonal entry goes through the merge.
+        let t: Vec<(usize, usize, f64)> = (1..ks.n)
+            .flat_map(|i| [(i, i, 1.0), (i, i - 1, 0.5), (i - 1, i, 0.5)])
+            .collect();
+        let sparse = Csr::from_triplets(ks.n, &t).unwrap();
+        let z = solver.solve_damped(&sparse, &d, &b).unwrap();
+        let dense = sparse
+            .add(1.0, &Csr::diagonal(&d), 1.0)
+            .to_dense()
+            .lu()
+            .solve(&nalgebra::DVector::from_vec(b.clone()))
+            .unwrap();
+        for (u, v) in z.iter().zip(dense.iter()) {
+            assert!((u - v).abs() <= 1e-12, "{u} vs {v}");
+        }
+    }
+
+    #[test]
+    fn a_singular_step_matrix_is_no_step() {
+        // Two coordinates joined by a spring and held by nothing: singular.
+        let a =
+            Csr::from_triplets(2, &[(0, 0, 1.0), (0, 1, -1.0), (1, 0, -1.0), (1, 1, 1.0)]).unwrap();
+        let mut solver = StepSolver::new(&a);
+        assert_eq!(solver.solve(&a, &[1.0, 0.0]), None);
+        let held = a.add(1.0, &Csr::diagonal(&[1.0, 0.0]), 1.0);
+        let x = solver.solve(&held, &[1.0, 0.0]).unwrap();
+        // [[2, −1], [−1, 1]] x = [1, 0]: x = [1, 1].
+        assert!(
+            (x[0] - 1.0).abs() < 1e-15 && (x[1] - 1.0).abs() < 1e-15,
+            "{x:?}"
+        );
+    }
 }

@@ -2,7 +2,7 @@
 //! stiff implicit solver, symplectic and geometric methods; events, dense output, typed errors.
 //!
 //! pdyn-ode integrates any Rust function: it knows nothing of symbols and depends on no other
-//! pdyn crate.
+//! pdyn crate but pdyn-sparse (the sparse factorization it shares with the statics).
 //!
 //! # Quick start
 //! ```
@@ -33,7 +33,7 @@
 //! | `resume.rs` | [`solve_observed`]: an explicit pair watched step by step (outputs taken as they come) and resumed bit for bit from a saved [`ResumeState`] |
 //! | `tableau.rs` | Butcher tableaus as data; order-condition checker over rooted trees |
 //! | `linalg.rs` | dense real/complex LU with partial pivoting (decsol.f), allocation-free |
-//! | `sparse_lu.rs`, `ordering.rs` | sparse real/complex LU on a known pattern (kinematic rows `q' = v` eliminated first, then supernodal multifrontal with dense kernels, no pivoting) in nested-dissection order, for Radau5's iteration matrices ([`LinearSolver`]) |
+//! | [`sparse_lu`] | re-exported from pdyn-sparse (shared with pdyn-mech's statics): sparse real/complex LU on a known pattern (kinematic rows `q' = v` eliminated first, then supernodal multifrontal with dense kernels, no pivoting) in nested-dissection order, for Radau5's iteration matrices ([`LinearSolver`]) |
 //! | `methods/dopri5.rs` | **DOPRI5**, Dormand & Prince 1980: 5(4), FSAL, 4th-order dense output, stiffness detection (MATLAB `ode45`) |
 //! | `methods/rk23.rs` | **RK23**, Bogacki & Shampine 1989: 3(2), FSAL, cubic Hermite dense output (MATLAB `ode23`) |
 //! | `methods/tsit5.rs` | **Tsit5**, Tsitouras 2011: 5(4), FSAL, 4th-order dense output |
@@ -79,12 +79,12 @@ pub mod jacobian;
 pub mod linalg;
 pub mod methods;
 mod options;
-mod ordering;
 pub mod problem;
 pub mod problems;
 pub mod resume;
 mod solution;
-pub mod sparse_lu;
+/// The sparse LU of Radau5's iteration matrices, from pdyn-sparse (shared with the statics).
+pub use pdyn_sparse::sparse_lu;
 pub mod tableau;
 
 pub use controller::Controller;

@@ -185,6 +185,7 @@ impl<T: Scalar> Factors<T> {
         &mut self,
         s: &Symbolic,
         value: impl Fn(usize) -> T,
+        symmetric: bool,
     ) -> Result<(), SparseLuError> {
         s.red
             .values(
@@ -197,7 +198,7 @@ impl<T: Scalar> Factors<T> {
             )
             .map_err(|row| SparseLuError::Singular { row })?;
         self.num
-            .factor(&s.sn, &self.svals, PIVOT_FLOOR)
+            .factor(&s.sn, &self.svals, PIVOT_FLOOR, symmetric)
             .map_err(|k| SparseLuError::Singular {
                 row: s.red.orig[s.sn.perm[k]],
             })
@@ -234,7 +235,14 @@ impl SparseLu {
 
     /// Factors the matrix with entries `values` (in the pattern's order).
     pub fn factor(&mut self, s: &Symbolic, values: &[f64]) -> Result<(), SparseLuError> {
-        self.factors.factor(s, |p| values[p])
+        self.factors.factor(s, |p| values[p], false)
+    }
+
+    /// [`SparseLu::factor`] for a symmetric matrix (on a symmetric pattern), in about half the
+    /// work: its elimination without pivoting is `L D Lᵀ`, and only the lower triangles of the
+    /// fronts are computed. Values off that symmetry give a wrong factorization, not an error.
+    pub fn factor_symmetric(&mut self, s: &Symbolic, values: &[f64]) -> Result<(), SparseLuError> {
+        self.factors.factor(s, |p| values[p], true)
     }
 
     /// Overwrites `b` with the solution of `A x = b`.
@@ -244,7 +252,7 @@ impl SparseLu {
 }
 
 /// A complex sparse LU of `A = Ar + i·Ai` (real and imaginary parts given separately, as
-/// [`crate::linalg::LuComplex`] takes them).
+/// pdyn-ode's dense `LuComplex` takes them).
 #[derive(Debug)]
 pub struct SparseLuComplex {
     factors: Factors<C64>,
@@ -267,10 +275,14 @@ impl SparseLuComplex {
         re: &[f64],
         im: impl Fn(usize) -> f64,
     ) -> Result<(), SparseLuError> {
-        self.factors.factor(s, |p| C64 {
-            re: re[p],
-            im: im(p),
-        })
+        self.factors.factor(
+            s,
+            |p| C64 {
+                re: re[p],
+                im: im(p),
+            },
+            false,
+        )
     }
 
     /// Overwrites `(br, bi)` with the solution of `A x = b`, `b = br + i·bi`.
@@ -299,6 +311,41 @@ mod tests {
             self.0 ^= self.0 << 17;
             (self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
         }
+    }
+
+    /// `A⁻¹ b` for the dense `n × n` matrix `a` (column-major) by Gaussian elimination with
+    /// partial pivoting: the reference the sparse LU (no pivoting) is checked against.
+    fn dense_solve<T: Scalar>(mut a: Vec<T>, mut b: Vec<T>) -> Vec<T> {
+        let n = b.len();
+        for k in 0..n {
+            let p = (k..n)
+                .max_by(|&i, &j| {
+                    a[i + k * n]
+                        .magnitude()
+                        .total_cmp(&a[j + k * n].magnitude())
+                })
+                .unwrap();
+            for j in 0..n {
+                a.swap(k + j * n, p + j * n);
+            }
+            b.swap(k, p);
+            let d = a[k + k * n];
+            for i in k + 1..n {
+                let l = a[i + k * n] / d;
+                for j in k..n {
+                    a[i + j * n] = a[i + j * n] - l * a[k + j * n];
+                }
+                b[i] = b[i] - l * b[k];
+            }
+        }
+        for k in (0..n).rev() {
+            let mut s = b[k];
+            for j in k + 1..n {
+                s = s - a[k + j * n] * b[j];
+            }
+            b[k] = s / a[k + k * n];
+        }
+        b
     }
 
     /// A random matrix on the pattern of an m × m grid with 3 unknowns per node, coupled to
@@ -385,25 +432,28 @@ mod tests {
         let s = Symbolic::new(&p).unwrap();
         let mut lu = SparseLuComplex::new(&s);
         lu.factor(&s, &re, im).unwrap();
-        let mut dense = crate::linalg::LuComplex::new(n);
-        {
-            let (ar, ai) = dense.matrix_mut();
-            for i in 0..n {
-                for q in p.start[i]..p.start[i + 1] {
-                    ar[i + p.cols[q] * n] = re[q];
-                    ai[i + p.cols[q] * n] = im(q);
-                }
+        let mut a = vec![C64::ZERO; n * n];
+        for i in 0..n {
+            for q in p.start[i]..p.start[i + 1] {
+                a[i + p.cols[q] * n] = C64 {
+                    re: re[q],
+                    im: im(q),
+                };
             }
         }
-        dense.factor().unwrap();
         let (mut br, mut bi): (Vec<f64>, Vec<f64>) =
             (0..n).map(|_| (rng.next(), rng.next())).unzip();
-        let (mut dr, mut di) = (br.clone(), bi.clone());
+        let d = dense_solve(
+            a,
+            br.iter()
+                .zip(&bi)
+                .map(|(&re, &im)| C64 { re, im })
+                .collect(),
+        );
         lu.solve_in_place(&s, &mut br, &mut bi);
-        dense.solve_in_place(&mut dr, &mut di);
         for i in 0..n {
             assert!(
-                (br[i] - dr[i]).abs() < 1e-12 && (bi[i] - di[i]).abs() < 1e-12,
+                (br[i] - d[i].re).abs() < 1e-12 && (bi[i] - d[i].im).abs() < 1e-12,
                 "{i}"
             );
         }
@@ -468,7 +518,7 @@ mod tests {
     }
 
     /// Solves with the sparse LU (real, and complex with `im` on the diagonal when given) and
-    /// with the dense LU of [`crate::linalg`] (partial pivoting, an independent code), and
+    /// with [`dense_solve`] (partial pivoting, an independent code), and
     /// returns the largest difference of the solutions relative to their size.
     fn against_dense(p: &Pattern, re: &[f64], im_diag: Option<f64>, rng: &mut Rng) -> f64 {
         let n = p.dim();
@@ -479,17 +529,15 @@ mod tests {
             None => {
                 let mut lu = SparseLu::new(&s);
                 lu.factor(&s, re).unwrap();
-                let mut dense = crate::linalg::Lu::new(n);
-                let a = dense.matrix_mut();
+                let mut a = vec![0.0; n * n];
                 for i in 0..n {
                     for q in p.start[i]..p.start[i + 1] {
                         a[i + p.cols[q] * n] += re[q];
                     }
                 }
-                dense.factor().unwrap();
-                let (mut x, mut y) = (b.clone(), b.clone());
+                let mut x = b.clone();
                 lu.solve_in_place(&s, &mut x);
-                dense.solve_in_place(&mut y);
+                let y = dense_solve(a, b.clone());
                 let scale = y.iter().fold(0f64, |m, v| m.max(v.abs()));
                 for i in 0..n {
                     worst = worst.max((x[i] - y[i]).abs() / scale);
@@ -506,20 +554,25 @@ mod tests {
                 };
                 let mut lu = SparseLuComplex::new(&s);
                 lu.factor(&s, re, im).unwrap();
-                let mut dense = crate::linalg::LuComplex::new(n);
-                let (ar, ai) = dense.matrix_mut();
+                let mut a = vec![C64::ZERO; n * n];
                 for i in 0..n {
                     for q in p.start[i]..p.start[i + 1] {
-                        ar[i + p.cols[q] * n] += re[q];
-                        ai[i + p.cols[q] * n] += im(q);
+                        let x = &mut a[i + p.cols[q] * n];
+                        *x = *x
+                            + C64 {
+                                re: re[q],
+                                im: im(q),
+                            };
                     }
                 }
-                dense.factor().unwrap();
                 let bi: Vec<f64> = (0..n).map(|_| rng.next()).collect();
                 let (mut xr, mut xi) = (b.clone(), bi.clone());
-                let (mut yr, mut yi) = (b.clone(), bi);
                 lu.solve_in_place(&s, &mut xr, &mut xi);
-                dense.solve_in_place(&mut yr, &mut yi);
+                let y = dense_solve(
+                    a,
+                    b.iter().zip(&bi).map(|(&re, &im)| C64 { re, im }).collect(),
+                );
+                let (yr, yi): (Vec<f64>, Vec<f64>) = y.iter().map(|c| (c.re, c.im)).unzip();
                 let scale = yr.iter().chain(&yi).fold(0f64, |m, v| m.max(v.abs()));
                 for i in 0..n {
                     worst = worst.max(libm::hypot(xr[i] - yr[i], xi[i] - yi[i]) / scale);
@@ -710,6 +763,84 @@ mod tests {
             lu.factor(&s, &vals, |_| 0.0),
             Err(SparseLuError::Singular { row: 3 })
         );
+    }
+
+    /// `(A + Aᵀ)/2` of a matrix on a pattern (values in the pattern's order), on the pattern
+    /// made symmetric.
+    fn symmetric_part(p: &Pattern, vals: &[f64]) -> (Pattern, Vec<f64>) {
+        let n = p.dim();
+        let mut rows: Vec<std::collections::BTreeMap<usize, f64>> = vec![Default::default(); n];
+        for i in 0..n {
+            for q in p.start[i]..p.start[i + 1] {
+                let j = p.cols[q];
+                *rows[i].entry(j).or_insert(0.0) += 0.5 * vals[q];
+                *rows[j].entry(i).or_insert(0.0) += 0.5 * vals[q];
+            }
+        }
+        let (mut start, mut cols, mut out) = (vec![0], Vec::new(), Vec::new());
+        for r in rows {
+            for (j, v) in r {
+                cols.push(j);
+                out.push(v);
+            }
+            start.push(cols.len());
+        }
+        (Pattern { start, cols }, out)
+    }
+
+    #[test]
+    fn symmetric_matrices_factor_in_half_the_work_and_solve_as_the_dense_elimination() {
+        // Definite and indefinite symmetric matrices on grids (one large separator: fronts
+        // of several of `partial_lu`'s blocks) and on random blocks (supernodes of every
+        // size), each solved by `factor_symmetric`, by `factor`, and by dense elimination
+        // with partial pivoting.
+        let mut rng = Rng(0x5eed);
+        let mut cases = Vec::new();
+        for (m, shift) in [(3, 20.0), (12, 8.0), (20, -3.0), (25, 0.7)] {
+            cases.push(grid_matrix(m, shift, &mut rng));
+        }
+        for nodes in [1, 9, 120, 300] {
+            let (p, mut vals) = random_blocks(nodes, &mut rng);
+            // Some negative pivots: the diagonal of every third unknown made −12.
+            for i in (0..p.dim()).step_by(3) {
+                let q = p.find(i, i).unwrap();
+                vals[q] = -vals[q];
+            }
+            cases.push((p, vals));
+        }
+        for (k, (p, vals)) in cases.iter().enumerate() {
+            let (p, a) = symmetric_part(p, vals);
+            let n = p.dim();
+            let s = Symbolic::new(&p).unwrap();
+            let mut dense = vec![0.0; n * n];
+            for i in 0..n {
+                for q in p.start[i]..p.start[i + 1] {
+                    dense[i + p.cols[q] * n] = a[q];
+                }
+            }
+            let b: Vec<f64> = (0..n).map(|_| rng.next()).collect();
+            let y = dense_solve(dense, b.clone());
+            let scale = y.iter().fold(0f64, |m, v| m.max(v.abs()));
+            let mut lu = SparseLu::new(&s);
+            lu.factor_symmetric(&s, &a).unwrap();
+            let mut x = b.clone();
+            lu.solve_in_place(&s, &mut x);
+            lu.factor(&s, &a).unwrap();
+            let mut z = b.clone();
+            lu.solve_in_place(&s, &mut z);
+            for i in 0..n {
+                assert!(
+                    (x[i] - y[i]).abs() <= 1e-11 * scale,
+                    "case {k}, unknown {i}: {} vs {}",
+                    x[i],
+                    y[i]
+                );
+                assert!(
+                    (x[i] - z[i]).abs() <= 1e-11 * scale,
+                    "case {k}, unknown {i}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -22,7 +22,7 @@ const MAX_DEPTH: usize = 64;
 
 /// An undirected graph in compressed rows: the neighbours of `v` are
 /// `adj[start[v]..start[v + 1]]` (no self-loops needed; any present are ignored).
-pub(crate) struct Graph<'a> {
+pub struct Graph<'a> {
     /// Row starts, `n + 1` of them.
     pub start: &'a [usize],
     /// Neighbours, row after row.
@@ -39,7 +39,7 @@ impl Graph<'_> {
 }
 
 /// The elimination order: `order[k]` is the vertex eliminated `k`-th.
-pub(crate) fn nested_dissection(g: &Graph) -> Vec<usize> {
+pub fn nested_dissection(g: &Graph) -> Vec<usize> {
     let n = g.len();
     let mut w = Work {
         part: vec![0; n],

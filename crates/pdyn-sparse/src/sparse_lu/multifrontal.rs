@@ -3,6 +3,13 @@
 //! the matrix's entries and its children's update matrices, its `ns` pivots are eliminated
 //! with dense kernels (no pivoting), the `L` and `U` blocks are kept and the Schur
 //! complement goes on the stack for the parent. Real and complex alike (`T`).
+//!
+//! A symmetric matrix (damped Newton's `K + μD` in the statics) needs only half of the work:
+//! its elimination without pivoting has `U = D Lᵀ`, so each row of `U` is its pivot's column
+//! of the front as it stands when that pivot is reached (copied, not solved for), and only the
+//! lower triangle of each Schur complement is updated (the dominant cost). The upper triangles
+//! of the fronts and update matrices are then never read: they hold whatever the assembly
+//! put there.
 
 use super::scalar::Scalar;
 use super::supernodal::Supernodes;
@@ -28,8 +35,14 @@ impl<T: Scalar> Numeric<T> {
 
     /// Factors the matrix with values `vals` (the analysed pattern's order); `Err(k)` when
     /// pivot `k` (permuted) is zero, not finite, or below `floor` times its row's largest
-    /// entry.
-    pub(crate) fn factor(&mut self, sn: &Supernodes, vals: &[T], floor: f64) -> Result<(), usize> {
+    /// entry. `symmetric`: the matrix is symmetric (its upper triangle is then not read).
+    pub(crate) fn factor(
+        &mut self,
+        sn: &Supernodes,
+        vals: &[T],
+        floor: f64,
+        symmetric: bool,
+    ) -> Result<(), usize> {
         self.row_max.fill(0.0);
         for (q, v) in vals.iter().enumerate() {
             let r = sn.value_row[q];
@@ -63,7 +76,8 @@ impl<T: Scalar> Numeric<T> {
                 }
                 self.stack.truncate(base);
             }
-            eliminate(front, m, ns, &self.row_max[f..f + ns], floor).map_err(|k| f + k)?;
+            eliminate(front, m, ns, &self.row_max[f..f + ns], floor, symmetric)
+                .map_err(|k| f + k)?;
             let off = sn.lu_start[s];
             self.lu[off..off + m * ns].copy_from_slice(&front[..m * ns]);
             let u12 = &mut self.lu[off + m * ns..off + m * ns + ns * r];
@@ -143,13 +157,14 @@ fn eliminate<T: Scalar>(
     ns: usize,
     row_max: &[f64],
     floor: f64,
+    symmetric: bool,
 ) -> Result<(), usize> {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx") {
         // SAFETY: the processor has AVX (checked just above).
-        return unsafe { partial_lu_avx(front, m, ns, row_max, floor) };
+        return unsafe { partial_lu_avx(front, m, ns, row_max, floor, symmetric) };
     }
-    partial_lu(front, m, ns, row_max, floor)
+    partial_lu(front, m, ns, row_max, floor, symmetric)
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -160,26 +175,36 @@ unsafe fn partial_lu_avx<T: Scalar>(
     ns: usize,
     row_max: &[f64],
     floor: f64,
+    symmetric: bool,
 ) -> Result<(), usize> {
-    partial_lu(front, m, ns, row_max, floor)
+    partial_lu(front, m, ns, row_max, floor, symmetric)
 }
 
 /// Eliminates the first `ns` pivots of the `m × m` front (column-major), `BLOCK` columns at a
 /// time (right-looking, blocked): `L11`, `U11` in place of the diagonal block, `L21` below
 /// it, `U12 = L11⁻¹ F12` right of it and the Schur complement `F22 − L21 U12` in place of
-/// `F22`. `Err(k)` for a negligible pivot `k`.
+/// `F22`. `Err(k)` for a negligible pivot `k`. `symmetric`: row `k` of `U` is copied from
+/// column `k` when pivot `k` is reached (`U = D Lᵀ`), and only the lower triangle of `F22` is
+/// updated.
 fn partial_lu<T: Scalar>(
     front: &mut [T],
     m: usize,
     ns: usize,
     row_max: &[f64],
     floor: f64,
+    symmetric: bool,
 ) -> Result<(), usize> {
     let mut k0 = 0;
     while k0 < ns {
         let k1 = (k0 + BLOCK).min(ns);
         // The block's columns, unblocked, on every row below the diagonal.
         for k in k0..k1 {
+            if symmetric {
+                // Column k below the pivot is final: it is row k of U right of the pivot.
+                for j in k + 1..m {
+                    front[k + j * m] = front[j + k * m];
+                }
+            }
             let (left, right) = front.split_at_mut((k + 1) * m);
             let colk = &mut left[k * m..];
             let d = colk[k];
@@ -199,9 +224,10 @@ fn partial_lu<T: Scalar>(
                 }
             }
         }
-        // The block's rows of U right of it: L(k0..k1, k0..k1)⁻¹ F(k0..k1, k1..).
+        // The block's rows of U right of it: L(k0..k1, k0..k1)⁻¹ F(k0..k1, k1..) (copied
+        // already when symmetric).
         let (left, right) = front.split_at_mut(k1 * m);
-        for col in right.chunks_exact_mut(m) {
+        for col in right.chunks_exact_mut(m).filter(|_| !symmetric) {
             for k in k0..k1 {
                 let u = col[k];
                 let l = &left[k * m..];
@@ -211,21 +237,24 @@ fn partial_lu<T: Scalar>(
             }
         }
         // The rest of the front: F(k1.., k1..) −= L(k1.., k0..k1) U(k0..k1, k1..).
-        update(front, m, k0, k1);
+        update(front, m, k0, k1, symmetric);
         k0 = k1;
     }
     Ok(())
 }
 
 /// `F(k1.., k1..) −= F(k1.., k0..k1) F(k0..k1, k1..)` on the `m × m` front, four columns at a
-/// time (each entry of `L` loaded once for four multiply–adds).
+/// time (each entry of `L` loaded once for four multiply–adds); `lower`: only the rows from
+/// each group's first column down (the lower triangle, and a few entries above it).
 #[inline(always)]
-fn update<T: Scalar>(front: &mut [T], m: usize, k0: usize, k1: usize) {
+fn update<T: Scalar>(front: &mut [T], m: usize, k0: usize, k1: usize, lower: bool) {
     let (left, right) = front.split_at_mut(k1 * m);
     let r = m - k1;
     let full = right.len() / (4 * m) * (4 * m);
     let (quads, rest) = right.split_at_mut(full);
-    for quad in quads.chunks_exact_mut(4 * m) {
+    for (g, quad) in quads.chunks_exact_mut(4 * m).enumerate() {
+        // The first row updated (relative to k1).
+        let top = if lower { 4 * g } else { 0 };
         let (c0, quad) = quad.split_at_mut(m);
         let (c1, quad) = quad.split_at_mut(m);
         let (c2, c3) = quad.split_at_mut(m);
@@ -237,7 +266,7 @@ fn update<T: Scalar>(front: &mut [T], m: usize, k0: usize, k1: usize) {
             let a = &left[k * m + k1..k * m + k1 + r];
             let (b0, b1, b2, b3) = (u0[k], u1[k], u2[k], u3[k]);
             let (c0, c1, c2, c3) = (&mut c0[..r], &mut c1[..r], &mut c2[..r], &mut c3[..r]);
-            for i in 0..r {
+            for i in top..r {
                 let ai = a[i];
                 c0[i] = c0[i] - ai * b0;
                 c1[i] = c1[i] - ai * b1;
@@ -246,12 +275,13 @@ fn update<T: Scalar>(front: &mut [T], m: usize, k0: usize, k1: usize) {
             }
         }
     }
-    for c in rest.chunks_exact_mut(m) {
+    for (g, c) in rest.chunks_exact_mut(m).enumerate() {
+        let top = if lower { full / m + g } else { 0 };
         let (u, c) = c.split_at_mut(k1);
         for k in k0..k1 {
             let a = &left[k * m + k1..(k + 1) * m];
             let b = u[k];
-            for (x, &ai) in c.iter_mut().zip(a) {
+            for (x, &ai) in c[top..].iter_mut().zip(&a[top..]) {
                 *x = *x - ai * b;
             }
         }
