@@ -753,27 +753,6 @@ impl Plan {
 mod tests {
     use super::{Tally, NATIVE_FOR_ROWS_TO_COME, PROJECT_FROM_ROWS};
 
-    /// A 4-link chain with its energy monitored: an observer (positions, energy) and scales.
-    fn chain() -> String {
-        let mut s =
-            String::from("name = \"c\"\ngravity = \"[0, -g, 0]\"\n[parameters]\ng = 9.81\n");
-        s += "[coordinates]\n";
-        for i in 1..=4 {
-            s += &format!("q{i} = {{ initial = {}, rate = 0.0 }}\n", 0.3 * i as f64);
-        }
-        for i in 1..=4 {
-            let pos: Vec<String> = (1..=i)
-                .map(|j| format!("{}*[sin(q{j}), -cos(q{j}), 0]", 1.0 + 0.1 * j as f64))
-                .collect();
-            s += &format!(
-                "[particles.p{i}]\nmass = \"{}\"\nposition = \"{}\"\n",
-                1.0 + 0.2 * i as f64,
-                pos.join(" + ")
-            );
-        }
-        s
-    }
-
     /// Feeds `rows` output points at times `k·dt` (states varied along) to a fresh tally of a
     /// run ending at `t_end`, as `take_rows` does (a projection after each chunk of 8); the
     /// rows' text and whether the tally went native.
@@ -803,7 +782,8 @@ mod tests {
     /// [`PROJECT_FROM_ROWS`] rows; and the native rows are the interpreter's, byte for byte.
     #[test]
     fn a_long_stream_goes_native_with_the_interpreters_bytes() {
-        let mut model = pdyn_mech::load(&chain(), "c.toml").unwrap();
+        let mut model =
+            pdyn_mech::load(&super::super::tree_tests::released_chain(4), "c.toml").unwrap();
         let prep = super::super::prepare(&mut model).unwrap();
         assert!(prep.system.is_native(), "the JIT is available in tests");
         assert!(!prep.scales.is_empty(), "the chain's energy is monitored");

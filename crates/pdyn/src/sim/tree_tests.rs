@@ -192,13 +192,9 @@ fn tree_evaluation_ops_grow_linearly_in_the_links() {
     assert!(o80 < 80 * 200, "{o80} operations at n = 80");
 }
 
-/// A long run's table, whose output columns and conservation scales run as native code
-/// (from [`super::compiled::NATIVE_PAYS_FROM`] rows) on inputs without the solved unknowns
-/// (they read none), holds the bits the interpreter gives on the solved observation inputs,
-/// row by row, and the same energy scale.
-#[test]
-fn long_tables_give_the_interpreters_bits_without_the_unknowns() {
-    let n = 5;
+/// An n-link chain under gravity alone, with unequal masses and lengths, released from rest
+/// at `0.3·i`: its energy is monitored (output columns and scales).
+pub(super) fn released_chain(n: usize) -> String {
     let mut src = String::from("name = \"c\"\ngravity = \"[0, -g, 0]\"\n[parameters]\ng = 9.81\n");
     src += "[coordinates]\n";
     for i in 1..=n {
@@ -214,6 +210,17 @@ fn long_tables_give_the_interpreters_bits_without_the_unknowns() {
             pos.join(" + ")
         );
     }
+    src
+}
+
+/// A long run's table, whose output columns and conservation scales run as native code
+/// (from [`super::compiled::NATIVE_PAYS_FROM`] rows) on inputs without the solved unknowns
+/// (they read none), holds the bits the interpreter gives on the solved observation inputs,
+/// row by row, and the same energy scale.
+#[test]
+fn long_tables_give_the_interpreters_bits_without_the_unknowns() {
+    let n = 5;
+    let src = released_chain(n);
     let mut model = pdyn_mech::load(&src, "c.toml").unwrap();
     let prep = super::prepare(&mut model).unwrap();
     assert!(prep.system.is_tree());
