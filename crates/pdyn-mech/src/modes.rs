@@ -40,7 +40,8 @@ pub struct Mode {
     pub omega_squared: f64,
     /// `ω` in rad/s (NaN when `ω² < 0`).
     pub omega: f64,
-    /// The shape, scaled so that its largest component is +1.
+    /// The shape, scaled so that its largest component is ±1, and +1 for the first (lowest
+    /// index) of the components within 1e-9 of the largest in magnitude ([`unit_largest`]).
     pub shape: Vec<f64>,
     /// `φᵀ M φ` with that scaling.
     pub modal_mass: f64,
@@ -90,6 +91,27 @@ impl Modes {
                 m.effective_mass[d] = l * l / m.modal_mass;
             }
         }
+    }
+}
+
+/// Scales a mode shape so that its largest component in magnitude is ±1, with the sign that
+/// makes the first component within 1e-9 (relative) of that magnitude +1. An eigenvector's
+/// sign is arbitrary; taking the largest component's would let round-off decide it whenever
+/// two components tie in magnitude, as in every antisymmetric mode of a symmetric structure
+/// (the uniform chain's even modes: `φ_i = −φ_{n+1−i}`), so that the same model printed
+/// opposite shapes from two builds. Ties go to the lowest index instead. A zero vector is left
+/// as it is.
+pub fn unit_largest(phi: &mut [f64]) {
+    let big = phi.iter().fold(0.0f64, |b, x| b.max(x.abs()));
+    if big == 0.0 || !big.is_finite() {
+        return;
+    }
+    let tie = big * (1.0 - 1e-9);
+    let first = phi.iter().copied().find(|x| x.abs() >= tie).unwrap_or(big);
+    // Without a tie, `first` is the largest component itself and this divides by it.
+    let scale = if first < 0.0 { -big } else { big };
+    for x in phi.iter_mut() {
+        *x /= scale;
     }
 }
 
@@ -152,13 +174,7 @@ pub fn modes(lin: &Linearization) -> Result<Modes, ModesError> {
         let mut phi = lt
             .solve_upper_triangular(&psi)
             .ok_or(ModesError::MassNotPositiveDefinite)?;
-        let big = phi
-            .iter()
-            .copied()
-            .fold(0.0f64, |b, x| if x.abs() > b.abs() { x } else { b });
-        if big != 0.0 {
-            phi /= big;
-        }
+        unit_largest(phi.as_mut_slice());
         let modal_mass = (phi.transpose() * &ms * &phi)[(0, 0)];
         let modal_stiffness = (phi.transpose() * &ks * &phi)[(0, 0)];
         let w2 = eig.eigenvalues[j];

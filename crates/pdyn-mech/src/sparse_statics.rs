@@ -346,15 +346,8 @@ pub fn lowest_modes(lin: &SparseLinearization, count: usize) -> Result<Modes, Mo
     let mut modes = Vec::with_capacity(pairs.values.len());
     let mut kphi = vec![0.0; n];
     for (&w2, phi) in pairs.values.iter().zip(&pairs.vectors) {
-        let big = phi
-            .iter()
-            .copied()
-            .fold(0.0f64, |b, x| if x.abs() > b.abs() { x } else { b });
-        let phi: Vec<f64> = if big != 0.0 {
-            phi.iter().map(|x| x / big).collect()
-        } else {
-            phi.clone()
-        };
+        let mut phi = phi.clone();
+        crate::modes::unit_largest(&mut phi);
         ks.mul_vec(&phi, &mut kphi);
         modes.push(Mode {
             omega_squared: w2,

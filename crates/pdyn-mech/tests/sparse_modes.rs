@@ -146,3 +146,76 @@ fn a_damped_chain_has_the_damping_ratios_of_mass_proportional_damping() {
         );
     }
 }
+
+/// The uniform chain is symmetric: its even modes are antisymmetric (`φ_i = −φ_{n+1−i}`), so
+/// their largest components tie in magnitude and round-off alone chose the sign of the shape
+/// (the sparse and dense paths, or two builds, printed opposite shapes). The shape's sign is
+/// now set by the first of the tied components: +1 on both paths, which then agree component
+/// by component; the closed form `sin(j i π/(n+1))` fixes which component that is.
+#[test]
+fn tied_largest_components_give_the_shape_the_sign_of_the_first() {
+    let n = 30;
+    let lin = linearizer(&chain(n));
+    let eq = solve(&lin, None, &EquilibriumOptions::default()).unwrap();
+    let sparse = lowest_modes(&eq.linearization, 10).unwrap();
+    let dense_eq =
+        pdyn_mech::equilibrium::solve(&lin, None, &EquilibriumOptions::default()).unwrap();
+    let dense = pdyn_mech::modes::modes(&dense_eq.linearization).unwrap();
+    for (j, (s, d)) in sparse.modes.iter().zip(&dense.modes).enumerate() {
+        let shape: Vec<f64> = (1..=n)
+            .map(|i| libm::sin((j + 1) as f64 * i as f64 * std::f64::consts::PI / (n as f64 + 1.0)))
+            .collect();
+        let top = shape.iter().fold(0.0f64, |t, x| t.max(x.abs()));
+        let first = shape
+            .iter()
+            .position(|x| x.abs() >= top * (1.0 - 1e-9))
+            .unwrap();
+        for mode in [s, d] {
+            let big = mode.shape.iter().fold(0.0f64, |t, x| t.max(x.abs()));
+            assert!((big - 1.0).abs() < 1e-12, "mode {}: largest {big}", j + 1);
+            assert!(
+                (mode.shape[first] - 1.0).abs() < 1e-9,
+                "mode {}: component {} is {}",
+                j + 1,
+                first + 1,
+                mode.shape[first]
+            );
+            // The closed form, scaled the same way.
+            let scale = shape[first];
+            for (a, b) in mode.shape.iter().zip(&shape) {
+                assert!(
+                    (a - b / scale).abs() < 1e-9,
+                    "mode {}: {a} vs {}",
+                    j + 1,
+                    b / scale
+                );
+            }
+        }
+        for (a, b) in s.shape.iter().zip(&d.shape) {
+            assert!(
+                (a - b).abs() < 1e-9,
+                "mode {}: sparse {a}, dense {b}",
+                j + 1
+            );
+        }
+    }
+}
+
+/// `unit_largest` on its own: a tie goes to the lowest index, a clear maximum divides by
+/// itself (bits as before), a zero vector is left alone.
+#[test]
+fn unit_largest_breaks_ties_by_index() {
+    use pdyn_mech::modes::unit_largest;
+    let mut v = vec![0.5, -2.0, 2.0 * (1.0 + 1e-12), 1.0];
+    unit_largest(&mut v);
+    assert!(
+        (v[1] - 1.0).abs() < 1e-11 && (v[2] + 1.0).abs() < 1e-11,
+        "{v:?}"
+    );
+    let mut w = vec![0.3, -0.7, 0.2];
+    unit_largest(&mut w);
+    assert_eq!(w, vec![0.3 / -0.7, 1.0, 0.2 / -0.7]);
+    let mut z = vec![0.0; 3];
+    unit_largest(&mut z);
+    assert_eq!(z, vec![0.0; 3]);
+}
