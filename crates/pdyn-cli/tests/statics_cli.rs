@@ -285,3 +285,41 @@ fn assert_at_rest_where_a_damped_run_ends(net: &str, eq: &serde_json::Value, cou
         assert!((at_rest - q).abs() < 1e-9, "{name}: {at_rest} vs {q}");
     }
 }
+
+/// `pdyn modes --json` is written token by token (`cli/modes_json.rs`), not through a
+/// `serde_json::Value`: its text must be exactly what serde_json's pretty printer gives for
+/// the same document (keys sorted, numbers, NaN as null, escapes), with and without damped
+/// modes and on both solvers.
+#[test]
+fn modes_json_is_serde_jsons_pretty_text() {
+    let net = example("hanging_net.toml");
+    let chain = example("chain_modes.toml");
+    for args in [
+        vec!["modes", chain.as_str(), "--json"],
+        vec![
+            "modes",
+            chain.as_str(),
+            "--json",
+            "--solver",
+            "sparse",
+            "--count",
+            "4",
+        ],
+        vec!["modes", net.as_str(), "--json"],
+        vec![
+            "modes",
+            net.as_str(),
+            "--json",
+            "--solver",
+            "sparse",
+            "--count",
+            "6",
+        ],
+    ] {
+        let (ok, out, err) = pdyn(&args);
+        assert!(ok, "{args:?}: {err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        let again = serde_json::to_string_pretty(&v).unwrap();
+        assert_eq!(out.trim_end(), again, "{args:?}");
+    }
+}

@@ -31,6 +31,8 @@ const IN_FLIGHT: usize = 4;
 /// Whole rows of numbers into a [`RowFile`], formatted on a writer thread once the table
 /// outgrows one batch.
 pub struct NumberRows {
+    /// The file's path, for an error when the writer thread is lost.
+    path: std::path::PathBuf,
     pending: Vec<f64>,
     width: usize,
     state: State,
@@ -52,6 +54,8 @@ struct Writer {
 }
 
 enum Job {
+    /// The file, the writer's first job.
+    File(RowFile),
     Rows(Vec<f64>),
     /// Flush (and with `true`, sync) and reply with the file's length or the error.
     Flush(bool),
@@ -61,6 +65,7 @@ impl NumberRows {
     /// Rows of `width` numbers into `file`.
     pub fn new(file: RowFile, width: usize) -> NumberRows {
         NumberRows {
+            path: file.path().to_path_buf(),
             pending: Vec::with_capacity(BATCH + width),
             width: width.max(1),
             state: State::Inline(file),
@@ -110,7 +115,7 @@ impl NumberRows {
         }
         self.hand_over()?;
         let State::Writer(w) = &self.state else {
-            return Err(lost());
+            return Err(lost(&self.path));
         };
         if w.jobs.send(Job::Flush(sync)).is_err() {
             return Err(self.writer_ended());
@@ -129,7 +134,7 @@ impl NumberRows {
         if let State::Inline(_) = self.state {
             if !self.start_writer() {
                 let State::Inline(file) = &mut self.state else {
-                    return Err(lost());
+                    return Err(lost(&self.path));
                 };
                 let done = format_rows(file, &self.pending, self.width);
                 self.pending.clear();
@@ -144,7 +149,7 @@ impl NumberRows {
                 }
                 Ok(())
             }
-            _ => Err(lost()),
+            _ => Err(lost(&self.path)),
         }
     }
 
@@ -156,43 +161,42 @@ impl NumberRows {
         {
             return false;
         }
-        let State::Inline(file) = std::mem::replace(&mut self.state, State::Lost) else {
-            return false;
-        };
         let (jobs, job_rx) = sync_channel::<Job>(IN_FLIGHT);
         let (reply_tx, replies) = sync_channel::<Result<u64, Error>>(1);
         let failed = Arc::new(AtomicBool::new(false));
         let flag = failed.clone();
         let width = self.width;
-        // The file travels to the thread and back: a spawn that fails returns it unused.
-        let slot = Arc::new(std::sync::Mutex::new(Some(file)));
-        let theirs = slot.clone();
+        // The thread is started before the file is handed over (its first job): a spawn
+        // that fails leaves the file here, formatted in place.
         let spawned = std::thread::Builder::new()
             .name("pdyn-table-writer".into())
             .spawn(move || {
-                // Always there: the file is put in before the spawn.
-                let mut file = theirs.lock().ok().and_then(|mut f| f.take())?;
-                drop(theirs);
+                let Ok(Job::File(mut file)) = job_rx.recv() else {
+                    return None;
+                };
                 write_batches(&mut file, job_rx, &reply_tx, &flag, width);
                 Some(file)
             });
-        match spawned {
-            Ok(thread) => {
-                self.state = State::Writer(Writer {
-                    jobs,
-                    replies,
-                    failed,
-                    thread,
-                });
-                true
+        let Ok(thread) = spawned else {
+            return false;
+        };
+        let State::Inline(file) = std::mem::replace(&mut self.state, State::Lost) else {
+            return false;
+        };
+        if let Err(returned) = jobs.send(Job::File(file)) {
+            // The thread ended before its first job (cannot happen): the file stays here.
+            if let Job::File(file) = returned.0 {
+                self.state = State::Inline(file);
             }
-            Err(_) => {
-                if let Some(file) = slot.lock().ok().and_then(|mut f| f.take()) {
-                    self.state = State::Inline(file);
-                }
-                matches!(self.state, State::Writer(_))
-            }
+            return false;
         }
+        self.state = State::Writer(Writer {
+            jobs,
+            replies,
+            failed,
+            thread,
+        });
+        true
     }
 
     /// The writer stopped taking jobs: its thread ended. Joins it for the file back (so that
@@ -204,7 +208,7 @@ impl NumberRows {
                 self.state = State::Inline(file);
             }
         }
-        lost()
+        lost(&self.path)
     }
 }
 
@@ -218,9 +222,9 @@ impl Drop for NumberRows {
     }
 }
 
-fn lost() -> Error {
+fn lost(path: &std::path::Path) -> Error {
     Error::io(
-        std::path::Path::new("trajectory.csv"),
+        path,
         "write",
         std::io::Error::other("the table's writer thread ended unexpectedly"),
     )
@@ -254,6 +258,8 @@ fn write_batches(
     let mut error: Option<Error> = None;
     for job in jobs {
         match job {
+            // Only ever the first job, taken before this loop.
+            Job::File(_) => {}
             Job::Rows(batch) => {
                 if error.is_none() {
                     if let Err(e) = format_rows(file, &batch, width) {
