@@ -141,6 +141,64 @@ impl PiState {
     }
 }
 
+/// SciPy's initial step (`scipy.integrate._ivp.common.select_initial_step`), for the methods
+/// that follow SciPy's algorithms (BDF): Hairer's estimate with root-mean-square norms
+/// (`‖x‖ = sqrt(Σ (x_i/sk_i)² / n)`, where Hairer sums without dividing by `n`) and the
+/// exponent `1/(order + 1)` of the error estimator's `order`, clamped to the interval `span`
+/// and `hmax`. Uses one evaluation of `f` (none for an empty system or interval). Positive;
+/// the caller applies the direction.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn scipy_initial_step<S: OdeSystem + ?Sized>(
+    sys: &S,
+    t0: f64,
+    y0: &[f64],
+    f0: &[f64],
+    dir: f64,
+    order: i32,
+    span: f64,
+    hmax: f64,
+    atol: &[f64],
+    rtol: &[f64],
+    y1: &mut [f64],
+    f1: &mut [f64],
+) -> f64 {
+    let n = y0.len();
+    if n == 0 {
+        return hmax.min(span);
+    }
+    if span == 0.0 {
+        return 0.0;
+    }
+    let rms = |x: &dyn Fn(usize) -> f64| {
+        let s: f64 = (0..n).map(|i| x(i) * x(i)).sum();
+        (s / n as f64).sqrt()
+    };
+    let sk = |i: usize| atol[i] + rtol[i] * y0[i].abs();
+    let d0 = rms(&|i| y0[i] / sk(i));
+    let d1 = rms(&|i| f0[i] / sk(i));
+    let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    };
+    let h0 = h0.min(span);
+    for i in 0..n {
+        y1[i] = y0[i] + h0 * dir * f0[i];
+    }
+    sys.rhs(t0 + h0 * dir, y1, f1);
+    let d2 = rms(&|i| (f1[i] - f0[i]) / sk(i)) / h0;
+    let h1 = if d1 <= 1e-15 && d2 <= 1e-15 {
+        1e-6_f64.max(h0 * 1e-3)
+    } else {
+        libm::pow(0.01 / d1.max(d2), 1.0 / (order + 1) as f64)
+    };
+    let h = (100.0 * h0).min(h1).min(span).min(hmax);
+    if !h.is_finite() || h <= 0.0 {
+        return 1e-6_f64.min(span);
+    }
+    h
+}
+
 /// Hairer's initial step estimate (see the module docs). Uses one evaluation of `f`.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn initial_step<S: OdeSystem + ?Sized>(
@@ -192,4 +250,57 @@ pub(crate) fn initial_step<S: OdeSystem + ?Sized>(
         return 1e-6 * dir;
     }
     h * dir
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::FnSystem;
+
+    /// SciPy's estimate on `y' = −λ y` (two equal components), worked by hand: `sk = atol +
+    /// rtol`, `d0 = 1/sk`, `d1 = λ/sk`, `h0 = 0.01/λ`, one Euler step gives `f1 = −(1 − 0.01) λ`
+    /// so `d2 = 0.01 λ / sk / h0 = λ²/sk`, and `h = min(100 h0, (0.01/d2)^(1/2))`. Root mean
+    /// squares: two equal components give what one does (Hairer's sums would be √2 larger).
+    #[test]
+    fn scipy_s_first_step_on_a_decay_is_the_hand_computed_one() {
+        let lambda = 100.0;
+        let sys = FnSystem::new(2, move |_t, y: &[f64], f: &mut [f64]| {
+            f[0] = -lambda * y[0];
+            f[1] = -lambda * y[1];
+        });
+        let (atol, rtol) = (1e-10, 1e-8);
+        let sk = atol + rtol;
+        let d2 = lambda * lambda / sk;
+        let expected = (100.0 * 0.01 / lambda).min((0.01 / d2).sqrt());
+        let y0 = [1.0, 1.0];
+        let f0 = [-lambda, -lambda];
+        let (mut y1, mut f1) = ([0.0; 2], [0.0; 2]);
+        let h = scipy_initial_step(
+            &sys,
+            0.0,
+            &y0,
+            &f0,
+            1.0,
+            1,
+            10.0,
+            f64::INFINITY,
+            &[atol; 2],
+            &[rtol; 2],
+            &mut y1,
+            &mut f1,
+        );
+        assert!(
+            (h - expected).abs() < 1e-12 * expected,
+            "{h:e} against {expected:e}"
+        );
+        // Clamped to the interval and to the largest step.
+        let short = scipy_initial_step(
+            &sys, 0.0, &y0, &f0, 1.0, 1, 1e-9, 1.0, &[atol; 2], &[rtol; 2], &mut y1, &mut f1,
+        );
+        assert_eq!(short, 1e-9);
+        let capped = scipy_initial_step(
+            &sys, 0.0, &y0, &f0, 1.0, 1, 10.0, 1e-8, &[atol; 2], &[rtol; 2], &mut y1, &mut f1,
+        );
+        assert_eq!(capped, 1e-8);
+    }
 }

@@ -41,8 +41,8 @@
 //! | `methods/vern9.rs` | **Vern9**, Verner 2010: 9(8), for very tight tolerances (cubic Hermite dense output) |
 //! | `methods/rk4.rs` | **RK4**, Kutta 1901: classical order 4, fixed step |
 //! | `jacobian.rs` | finite-difference Jacobians of the implicit methods, columns grouped by a [`Sparsity`] pattern (SciPy's `jac_sparsity`) |
-//! | `methods/bdf.rs` | **BDF**, Shampine & Reichelt 1997: variable order 1–5, quasi-constant step size, NDF coefficients (MATLAB `ode15s`, SciPy's `BDF`), its own interpolating polynomial as dense output |
-//! | `methods/radau5.rs` | **Radau5**, Hairer & Wanner 1996: Radau IIA order 5, stiff, mass matrices / index-1 DAEs; `methods/radau5_linear.rs` its Jacobian and iteration matrices, dense or sparse |
+//! | `methods/bdf.rs` | **BDF**, Shampine & Reichelt 1997: variable order 1–5, quasi-constant step size, NDF coefficients (MATLAB `ode15s`, SciPy's `BDF`), its own interpolating polynomial as dense output; `methods/bdf_linear.rs` its Jacobian and iteration matrix `I − c·J`, dense or sparse |
+//! | `methods/radau5.rs` | **Radau5**, Hairer & Wanner 1996: Radau IIA order 5, stiff, mass matrices / index-1 DAEs; `methods/radau5_linear.rs` its Jacobian and iteration matrices, dense or sparse; `methods/iteration_pattern.rs` the sparse pattern both implicit methods share |
 //! | `methods/symplectic.rs` | **Velocity Verlet** (Verlet 1967), **Yoshida 4** (Yoshida 1990), **Kahan–Li 6 / 8** (Kahan & Li 1997): explicit symplectic, fixed step |
 //! | `methods/gauss.rs` | **Gauss–Legendre 4 / 6** (Butcher 1964): implicit symplectic for any Hamiltonian, fixed step |
 //!
@@ -92,7 +92,7 @@ pub use dense::{DenseSolution, Interpolant};
 pub use error::{FailurePoint, OdeError};
 pub use events::{DenseOutput, Event};
 pub use jacobian::Sparsity;
-pub use methods::radau5_linear::SPARSE_FROM as RADAU_SPARSE_FROM;
+pub use methods::iteration_pattern::SPARSE_FROM as IMPLICIT_SPARSE_FROM;
 pub use options::{Interrupt, LinearSolver, Options, StiffnessAction, Tolerance};
 pub use problem::{
     FirstOrderForm, FnSecondOrder, FnSystem, FnSystemWithJacobian, MassInverse, MassKind,

@@ -133,13 +133,15 @@ pub struct Options {
     /// one evaluation of `f` per group of columns ([`crate::jacobian`]). Unused when the system
     /// has an analytic Jacobian. Default `None` (dense).
     pub jac_sparsity: Option<std::sync::Arc<crate::jacobian::Sparsity>>,
-    /// How Radau5 solves its linear systems: dense LU, or sparse LU when the Jacobian's
-    /// pattern is known ([`Options::jac_sparsity`] or [`crate::OdeSystem::jacobian_sparsity`]).
+    /// How Radau5 and BDF solve their linear systems: dense LU, or sparse LU when the
+    /// Jacobian's pattern is known ([`Options::jac_sparsity`] or
+    /// [`crate::OdeSystem::jacobian_sparsity`]).
     /// Default [`LinearSolver::Auto`].
     pub linear_solver: LinearSolver,
 }
 
-/// How the implicit method Radau5 factors its iteration matrices `c·M − J`.
+/// How the implicit methods factor their iteration matrices (Radau5's `c·M − J`, BDF's
+/// `I − c·J`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum LinearSolver {
     /// Sparse when the Jacobian's pattern is known, the mass matrix is the identity, the

@@ -17,12 +17,12 @@ mod convergence;
 mod dense_solution;
 #[path = "events.rs"]
 mod events;
+#[path = "implicit_sparse.rs"]
+mod implicit_sparse;
 #[path = "kepler_energy.rs"]
 mod kepler_energy;
 #[path = "published_stats.rs"]
 mod published_stats;
-#[path = "radau5_sparse.rs"]
-mod radau5_sparse;
 #[path = "reference_solutions.rs"]
 mod reference_solutions;
 #[path = "resume.rs"]

@@ -343,6 +343,28 @@ def test_bdf_takes_scipys_bdf_steps_on_stiff_van_der_pol(tol):
     np.testing.assert_allclose(d.sol(d.t), d.y, rtol=1e-12, atol=1e-12)
 
 
+@pytest.mark.parametrize("m", [10, 20])
+def test_bdf_starts_and_steps_as_scipys_bdf_on_a_stiff_decay(m):
+    # The 2-D heat equation from its lowest mode (m x m points: 100 states, the dense LU;
+    # 400, the sparse one). The first step is SciPy's select_initial_step (RMS norms,
+    # exponent 1/2): with Hairer's HINIT (sums, exponent 1) pdyn's BDF started at 2.7e-14
+    # against SciPy's 5.2e-7 and took 48 steps to SciPy's 33. The step sequences are SciPy's,
+    # to round-off (the LU differs: LAPACK's against pdyn's).
+    from scipy import sparse as sp
+    h = 1.0 / (m + 1)
+    x = np.arange(1, m + 1) * h
+    u0 = np.outer(np.sin(np.pi * x), np.sin(np.pi * x)).ravel()
+    lap1 = sp.diags([1.0, -2.0, 1.0], [-1, 0, 1], shape=(m, m))
+    lap = (sp.kron(sp.eye(m), lap1) + sp.kron(lap1, sp.eye(m))).tocsr() / h ** 2
+    kw = dict(method="BDF", rtol=1e-8, atol=1e-10, jac_sparsity=lap != 0)
+    s = scipy_integrate.solve_ivp(lambda t, u: lap @ u, (0, 0.02), u0, **kw)
+    p = pdyn.solve_ivp(lambda t, u: lap @ u, (0, 0.02), u0, **kw)
+    assert p.success and p.method == "bdf"
+    assert len(p.t) == len(s.t), (len(p.t), len(s.t))
+    np.testing.assert_allclose(p.t, s.t, rtol=1e-7, atol=0)
+    assert p.nlu == s.nlu, (p.nlu, s.nlu)
+
+
 def heat(t, y):
     # The 1-D heat equation on 30 interior points: a tridiagonal Jacobian.
     dx = 1.0 / (len(y) + 1)
@@ -380,12 +402,13 @@ def test_jac_sparsity_groups_the_finite_differences(method):
             pdyn.solve_ivp(heat, (0, 0.01), y0, method=method, jac_sparsity=np.eye(n + 1))
 
 
-def test_radau_with_a_sparse_pattern_solves_a_system_too_large_for_dense_matrices():
-    # The 2-D heat equation on 100 x 100 interior points: 10^4 states, whose three dense
-    # n x n matrices of Radau5 would take 2.4 GB. With jac_sparsity (a scipy.sparse matrix,
-    # as SciPy takes it) Radau5 factors them sparsely. sin(pi x) sin(pi y) on the grid is an
-    # eigenvector of the discrete Laplacian: the exact solution decays as
-    # exp(-8/h^2 sin^2(pi h / 2) t).
+@pytest.mark.parametrize("method", ["Radau", "BDF"])
+def test_a_sparse_pattern_solves_a_system_too_large_for_dense_matrices(method):
+    # The 2-D heat equation on 100 x 100 interior points: 10^4 states, whose dense n x n
+    # matrices would take 2.4 GB (Radau5's three) or 1.6 GB (BDF's Jacobian and LU). With
+    # jac_sparsity (a scipy.sparse matrix, as SciPy takes it) both factor sparsely, as
+    # SciPy's do with splu. sin(pi x) sin(pi y) on the grid is an eigenvector of the discrete
+    # Laplacian: the exact solution decays as exp(-8/h^2 sin^2(pi h / 2) t).
     from scipy import sparse as sp
     m = 100
     h = 1.0 / (m + 1)
@@ -397,7 +420,7 @@ def test_radau_with_a_sparse_pattern_solves_a_system_too_large_for_dense_matrice
 
     def fun(t, u):
         return lap @ u
-    r = pdyn.solve_ivp(fun, (0, 0.02), u0, method="Radau", rtol=1e-8, atol=1e-10,
+    r = pdyn.solve_ivp(fun, (0, 0.02), u0, method=method, rtol=1e-8, atol=1e-10,
                        jac_sparsity=lap != 0)
     assert r.success, r.message
     np.testing.assert_allclose(r.y[:, -1], np.exp(-rate * 0.02) * u0, rtol=0, atol=1e-7)

@@ -794,7 +794,7 @@ fn radau_gets_the_dense_jacobian_as_a_sparse_one() {
         let (_, prep) = prepare(&src, path);
         let sys = &prep.system;
         let dim = sys.dim();
-        assert!(dim >= pdyn_ode::RADAU_SPARSE_FROM, "{dim} states");
+        assert!(dim >= pdyn_ode::IMPLICIT_SPARSE_FROM, "{dim} states");
         let pattern = sys.jacobian_sparsity().expect("a pattern for Radau5");
         assert!(sys.has_sparse_jacobian());
         let y = perturbed(&prep.y0);
@@ -847,6 +847,36 @@ fn radau_gets_the_dense_jacobian_as_a_sparse_one() {
     let (_, b) = sparse.last().unwrap();
     let d = max_relative_difference(a, b);
     assert!(d < 1e-6, "sparse and dense runs differ by {d:e}");
+}
+
+/// BDF (MATLAB's `ode15s`, SciPy's `BDF`) factors `I − c·J` of a stiff net on the model's
+/// sparse pattern too, and follows the dense LU's run to the Newton tolerance.
+#[test]
+fn bdf_factors_a_stiff_net_sparsely() {
+    use pdyn_ode::{solve, LinearSolver, Method, Options};
+    let stiff = net_source(6, 6, Some(0.5)).replace("k = 400.0", "k = 4.0e5");
+    let (_, prep) = prepare(&stiff, NetPath::Auto);
+    let run = |solver: LinearSolver| {
+        let opts = Options {
+            rtol: 1e-6.into(),
+            atol: 1e-9.into(),
+            linear_solver: solver,
+            ..Default::default()
+        };
+        solve(Method::Bdf, &prep.system, (0.0, 0.05), &prep.y0, &opts).unwrap()
+    };
+    let (sparse, dense) = (run(LinearSolver::Auto), run(LinearSolver::Dense));
+    assert!(sparse.stats.sparse_lu && !dense.stats.sparse_lu);
+    let (na, nb) = (dense.stats.accepted, sparse.stats.accepted);
+    assert!(na > 20, "{na} steps: not exercised");
+    assert!(
+        na.abs_diff(nb) * 50 <= na,
+        "accepted steps: dense {na}, sparse {nb}"
+    );
+    let (_, a) = dense.last().unwrap();
+    let (_, b) = sparse.last().unwrap();
+    let d = max_relative_difference(a, b);
+    assert!(d < 1e-5, "sparse and dense runs differ by {d:e}");
 }
 
 /// Damped Newton on the 20 × 20 hanging net released flat (issue 33): steps that lower the

@@ -18,7 +18,9 @@
 //!   converge with a `J` that is not current; the LU of `I − cJ` is kept while `c` is
 //!   unchanged (a step-size or order change refactors). `J` is analytic when
 //!   [`OdeSystem::has_jacobian`], else forward differences ([`crate::jacobian`], grouped by
-//!   [`Options::jac_sparsity`] when given).
+//!   [`Options::jac_sparsity`] when given). `I − cJ` is factored densely, or by the sparse
+//!   LU when the pattern is known and the system large ([`crate::LinearSolver`], as Radau5
+//!   and SciPy's `BDF` with `jac_sparsity`): `methods/bdf_linear.rs`.
 //! * A change of step size by `ρ` rescales the differences (`D ← (R(ρ) U)ᵀ D`, with
 //!   `R(ρ)_{ij} = Π_{m≤i} (m − 1 − ρ j)/m`, `U = R(1)`): the same interpolating polynomial on
 //!   the new grid. Newton failure halves the step.
@@ -27,6 +29,9 @@
 //!   `max(0.2, safety · err^{−1/(k+1)})`, `safety = 0.9 (2·4 + 1)/(2·4 + iterations)`.
 //!   After `k + 1` steps of equal size, orders `k − 1`, `k`, `k + 1` are compared by their
 //!   estimated errors and the step grows by at most 10.
+//! * The first step is SciPy's `select_initial_step` (RMS norms, exponent 1/2), not Hairer's
+//!   `HINIT` (sums, exponent 1 at order 1): on a smooth stiff decay Hairer's started 10⁷ times
+//!   smaller and took 15 more steps than SciPy to grow back.
 //! * Dense output: the method's own interpolating polynomial through the last `k + 1`
 //!   solution values (`D` after the step), evaluated as SciPy's `BdfDenseOutput`.
 //!
@@ -36,13 +41,13 @@
 //! factorizations, `linear_solves` the Newton iterations, `fevals` every evaluation of `f`
 //! (the first-step estimate's and the finite-difference Jacobians' included).
 
-use crate::controller::initial_step;
+use super::bdf_linear::BdfMatrix;
+use crate::controller::scipy_initial_step;
 use crate::dense::{DenseSolution, Interpolant};
 use crate::error::{point, OdeError};
 use crate::events::{DenseOutput, Event, EventState, Output};
 use crate::explicit::setup;
 use crate::jacobian::FdJacobian;
-use crate::linalg::Lu;
 use crate::options::Options;
 use crate::problem::OdeSystem;
 use crate::solution::{Solution, Status};
@@ -220,7 +225,8 @@ fn norm(v: &[f64], scale: &[f64]) -> f64 {
 
 /// The iteration matrix's factors, valid for one `c = h/α_k`.
 struct IterationMatrix {
-    lu: Lu,
+    /// `J` and the factors of `I − c·J`, dense or sparse.
+    matrix: BdfMatrix,
     valid: bool,
 }
 
@@ -241,14 +247,8 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
 ) -> Result<Solution, OdeError> {
     let su = setup(sys, t0, tf, y_init, opts)?;
     let n = su.n;
-    if let Some(s) = &opts.jac_sparsity {
-        if s.dim() != n {
-            return Err(crate::error::invalid(format!(
-                "jac_sparsity is {0} × {0}, the system has {n} components",
-                s.dim()
-            )));
-        }
-    }
+    // Checks the pattern against the system before anything is evaluated.
+    let matrix = BdfMatrix::new(sys, opts, n)?;
     let dir = su.dir;
     let (atol, rtol) = (&su.atol, &su.rtol);
     let co = Coefficients::new();
@@ -257,6 +257,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
     let hmax = su.hmax;
 
     let mut sol = Solution::new(Method::Bdf, n);
+    sol.stats.sparse_lu = matrix.is_sparse();
     if opts.dense_output {
         sol.dense = Some(DenseSolution::new(n));
     }
@@ -277,20 +278,21 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
         None => {
             let (mut y1, mut f1) = (vec![0.0; n], vec![0.0; n]);
             sol.stats.fevals += 1;
-            let h = initial_step(
+            // SciPy's estimate, as SciPy's BDF takes it (error estimator of order 1).
+            scipy_initial_step(
                 sys,
                 t0,
                 &y,
                 &f,
                 dir,
                 1,
-                hmax.min((tf - t0).abs()),
+                (tf - t0).abs(),
+                hmax,
                 atol,
                 rtol,
                 &mut y1,
                 &mut f1,
-            );
-            h.abs()
+            )
         }
     };
     let mut d = Differences::new(n);
@@ -301,22 +303,16 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
     let mut order = 1usize;
     let mut n_equal_steps = 0usize;
 
-    let mut jac = vec![0.0; n * n]; // row-major ∂f_i/∂y_j
     let mut fd = FdJacobian::default();
-    let sparsity = opts.jac_sparsity.as_deref();
-    let mut jacobian = |t: f64, y: &[f64], f0: &[f64], jac: &mut [f64], sol: &mut Solution| {
+    let mut jacobian = |m: &mut BdfMatrix, t: f64, y: &[f64], f0: &[f64], sol: &mut Solution| {
         sol.stats.jacobians += 1;
-        if sys.has_jacobian() {
-            sys.jacobian(t, y, jac);
-        } else {
-            fd.eval(sys, sparsity, t, y, f0, jac, &mut sol.stats);
-        }
+        m.jacobian(sys, opts, &mut fd, t, y, f0, &mut sol.stats);
     };
-    jacobian(t, &y, &f, &mut jac, &mut sol);
     let mut itm = IterationMatrix {
-        lu: Lu::new(n),
+        matrix,
         valid: false,
     };
+    jacobian(&mut itm.matrix, t, &y, &f, &mut sol);
 
     let mut y_predict = vec![0.0; n];
     let mut y_new = vec![0.0; n];
@@ -412,15 +408,8 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
             let c = h / alpha;
             let newton = loop {
                 if !itm.valid {
-                    let a = itm.lu.matrix_mut();
-                    for j in 0..n {
-                        for i in 0..n {
-                            let id = f64::from(u8::from(i == j));
-                            a[i + j * n] = id - c * jac[i * n + j];
-                        }
-                    }
                     sol.stats.lu_decompositions += 1;
-                    if itm.lu.factor().is_err() {
+                    if !itm.matrix.factor(c) {
                         singular_in_row += 1;
                         if singular_in_row >= MAX_SINGULAR {
                             return Err(OdeError::SingularMatrix {
@@ -441,7 +430,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                     &y_predict,
                     c,
                     &psi,
-                    &itm.lu,
+                    &mut itm.matrix,
                     &scale,
                     newton_tol,
                     (&mut y_new, &mut corr, &mut f, &mut dy),
@@ -455,7 +444,7 @@ pub(crate) fn integrate<S: OdeSystem + ?Sized>(
                     sys.rhs(t_new, &y_predict, &mut ytmp);
                     sol.stats.fevals += 1;
                 }
-                jacobian(t_new, &y_predict, &ytmp, &mut jac, &mut sol);
+                jacobian(&mut itm.matrix, t_new, &y_predict, &ytmp, &mut sol);
                 itm.valid = false;
                 current_jac = true;
             };
@@ -631,7 +620,7 @@ fn solve_corrector<S: OdeSystem + ?Sized>(
     y_predict: &[f64],
     c: f64,
     psi: &[f64],
-    lu: &Lu,
+    matrix: &mut BdfMatrix,
     scale: &[f64],
     tol: f64,
     (y_new, corr, f, dy): (&mut [f64], &mut [f64], &mut [f64], &mut [f64]),
@@ -650,7 +639,7 @@ fn solve_corrector<S: OdeSystem + ?Sized>(
         for i in 0..dy.len() {
             dy[i] = c * f[i] - psi[i] - corr[i];
         }
-        lu.solve_in_place(dy);
+        matrix.solve_in_place(dy);
         sol.stats.linear_solves += 1;
         let dy_norm = norm(dy, scale);
         let rate = dy_norm_old.map(|old| dy_norm / old);

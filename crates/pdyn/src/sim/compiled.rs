@@ -597,14 +597,14 @@ impl OdeSystem for CompiledModel {
 }
 
 impl CompiledModel {
-    /// The Jacobian's pattern, for models large enough that Radau5 factors sparsely
+    /// The Jacobian's pattern, for models large enough that Radau5 and BDF factor sparsely
     /// ([`pdyn_ode::LinearSolver::Auto`]): the net kernels' terms, or the Jacobian
     /// program's entries.
     fn sparse_form(&self) -> Option<&SparseJacobian> {
         self.sparse_jacobian
             .get_or_init(|| {
                 let n = self.n;
-                if 2 * n < pdyn_ode::RADAU_SPARSE_FROM {
+                if 2 * n < pdyn_ode::IMPLICIT_SPARSE_FROM {
                     return None;
                 }
                 let mut terms = Vec::new();

@@ -1,6 +1,6 @@
-//! Radau5 with sparse iteration matrices (`LinearSolver::Sparse`, `pdyn_ode::sparse_lu`):
-//! against closed forms of stiff linear systems, and against the dense LU on a stiff
-//! nonlinear lattice of springs.
+//! Radau5 and BDF with sparse iteration matrices (`LinearSolver::Sparse`,
+//! `pdyn_ode::sparse_lu`): against closed forms of stiff linear systems, and against the dense
+//! LU on a stiff nonlinear lattice of springs.
 
 use pdyn_ode::{solve, LinearSolver, Method, OdeSystem, Options, Sparsity};
 use std::sync::Arc;
@@ -303,4 +303,122 @@ fn columns_are_grouped_as_the_quadratic_constructor_groups_them() {
     let n = 81;
     let dense = Sparsity::new(n, |i, j| Heat2d::neighbours(9, j).contains(&i));
     assert_eq!(*sys.sparsity, dense);
+}
+
+#[test]
+fn bdf_decays_the_2d_heat_equation_as_its_closed_form_with_the_sparse_lu() {
+    let (m, d) = (40, 1.0); // 1,600 unknowns, as above
+    for analytic in [true, false] {
+        let sys = Heat2d::new(m, d, analytic);
+        let (u0, rate) = heat_mode(m);
+        let (rtol, atol) = (1e-8, 1e-12);
+        let opts = Options {
+            rtol: rtol.into(),
+            atol: atol.into(),
+            ..Default::default()
+        };
+        let t_end = 0.05;
+        let sol = solve(Method::Bdf, &sys, (0.0, t_end), &u0, &opts).unwrap();
+        // `LinearSolver::Auto` with a known pattern and n ≥ 200.
+        assert!(sol.stats.sparse_lu, "n = {} should factor sparsely", m * m);
+        // Linear, factored exactly: Newton converges with the first Jacobian, which is
+        // therefore never evaluated again (an inexact factorization would fail Newton's
+        // contraction test and fetch a fresh one).
+        assert_eq!(sol.stats.jacobians, 1, "{:?}", sol.stats);
+        assert!(sol.stats.accepted > 20, "{:?}", sol.stats);
+        let (_, u) = sol.last().unwrap();
+        let decay = libm::exp(-d * rate * t_end);
+        let err = u
+            .iter()
+            .zip(&u0)
+            .map(|(a, b)| (a - b * decay).abs())
+            .fold(0.0, f64::max);
+        // The global error of a variable-order BDF at rtol 1e-8 over ~1.3 decay times.
+        assert!(
+            err < 1e-7 * decay,
+            "analytic = {analytic}: max error {err:e} against {decay:e}"
+        );
+    }
+}
+
+#[test]
+fn bdf_on_a_stiff_lattice_gives_the_dense_lu_s_steps_and_solution() {
+    let m = 8; // 256 unknowns
+    let sys = Lattice::new(m, 1e4, 1e5, 2.0);
+    let nodes = m * m;
+    let mut y0 = vec![0.0; 4 * nodes];
+    for node in 0..nodes {
+        let (i, j) = (node / m, node % m);
+        y0[2 * node] = j as f64 + 0.05 * ((i * 7 + j * 3) % 5) as f64 / 5.0;
+        y0[2 * node + 1] = i as f64 - 0.03 * ((i * 2 + j * 5) % 7) as f64 / 7.0;
+    }
+    let run = |solver: LinearSolver| {
+        let opts = Options {
+            rtol: 1e-8.into(),
+            atol: 1e-10.into(),
+            linear_solver: solver,
+            ..Default::default()
+        };
+        solve(Method::Bdf, &sys, (0.0, 0.1), &y0, &opts).unwrap()
+    };
+    let (dense, sparse) = (run(LinearSolver::Dense), run(LinearSolver::Sparse));
+    assert!(!dense.stats.sparse_lu && sparse.stats.sparse_lu);
+    // The linear solves differ in round-off, BDF's Newton stops at a tolerance on the
+    // correction (not at round-off) and its order choice turns such differences into a few
+    // steps more or less: the sequences part by a few percent at most.
+    let (na, nb) = (dense.stats.accepted, sparse.stats.accepted);
+    assert!(
+        na.abs_diff(nb) * 30 <= na,
+        "accepted steps: dense {na}, sparse {nb}"
+    );
+    assert!(na > 20, "{na} steps: not exercised");
+    assert!(dense.stats.lu_decompositions > 5, "{:?}", dense.stats);
+    let (_, a) = dense.last().unwrap();
+    let (_, b) = sparse.last().unwrap();
+    let err = a
+        .iter()
+        .zip(b)
+        .map(|(p, q)| (p - q).abs())
+        .fold(0.0, f64::max);
+    // BDF's Newton stops at a tolerance on the correction (a fraction of rtol), not at
+    // round-off, so the two differ by what that stop leaves: within rtol of the largest
+    // component (8 here), far below the global error.
+    let size = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    assert!(
+        err < 1e-8 * size,
+        "dense and sparse differ by {err:e} (largest component {size})"
+    );
+}
+
+#[test]
+fn bdf_s_sparse_solver_refuses_what_it_cannot_do() {
+    let decay = pdyn_ode::FnSystem::new(300, |_t, y: &[f64], f: &mut [f64]| {
+        for (fi, yi) in f.iter_mut().zip(y) {
+            *fi = -yi;
+        }
+    });
+    let opts = Options {
+        linear_solver: LinearSolver::Sparse,
+        ..Default::default()
+    };
+    let e = solve(Method::Bdf, &decay, (0.0, 1.0), &[1.0; 300], &opts).unwrap_err();
+    assert!(e.to_string().contains("jac_sparsity"), "{e}");
+    let opts = Options {
+        jac_sparsity: Some(Arc::new(Sparsity::banded(10, 1, 1))),
+        ..Default::default()
+    };
+    let e = solve(Method::Bdf, &decay, (0.0, 1.0), &[1.0; 300], &opts).unwrap_err();
+    assert!(e.to_string().contains("300 components"), "{e}");
+    // Below 200 components `Auto` stays dense, pattern or not.
+    let opts = Options {
+        jac_sparsity: Some(Arc::new(Sparsity::banded(100, 0, 0))),
+        ..Default::default()
+    };
+    let small = pdyn_ode::FnSystem::new(100, |_t, y: &[f64], f: &mut [f64]| {
+        for (fi, yi) in f.iter_mut().zip(y) {
+            *fi = -yi;
+        }
+    });
+    let sol = solve(Method::Bdf, &small, (0.0, 1.0), &[1.0; 100], &opts).unwrap();
+    assert!(!sol.stats.sparse_lu);
 }
