@@ -2,7 +2,8 @@
 //! symmetric positive definite): shift-invert Lanczos with full reorthogonalization, as SciPy's
 //! `eigsh(K, k, M, sigma)` (ARPACK mode 3) does it.
 //!
-//! With `K − σ M = L D Lᵀ` ([`crate::sparse::EnvelopeLdlt`]) the operator
+//! With `K − σ M = L D Lᵀ` ([`crate::shifted_factor::ShiftedFactor`]: the envelope or the
+//! supernodal LU, whichever is smaller) the operator
 //! `OP = (K − σ M)⁻¹ M` is self-adjoint in the `M`-inner product `⟨x, y⟩ = xᵀ M y`, and has the
 //! eigenvectors of the pencil with eigenvalues `θ = 1 / (λ − σ)`: the `λ` nearest `σ` become the
 //! largest `|θ|`, well separated, found first by Lanczos. The Lanczos basis `Q` (`M`-orthonormal,
@@ -16,7 +17,8 @@
 //! search is run again from a new start vector orthogonal to them: a pair it finds nearer `σ`
 //! than the farthest wanted one is taken in, and the search repeated, until a run finds none.
 
-use crate::sparse::{Csr, EnvelopeLdlt, SparseError};
+use crate::shifted_factor::ShiftedFactor;
+use crate::sparse::{Csr, SparseError};
 
 /// Knobs of [`nearest`].
 #[derive(Clone, Debug)]
@@ -114,7 +116,7 @@ pub struct EigenPairs {
     pub residuals: Vec<f64>,
     /// Lanczos steps taken in all (each one solve with `K − σ M`).
     pub steps: usize,
-    /// Entries of the envelope factor of `K − σ M`.
+    /// Entries of the factor of `K − σ M` below its diagonal.
     pub factor_entries: usize,
 }
 
@@ -169,7 +171,7 @@ struct Problem<'a> {
     mass_diagonal: Option<Vec<f64>>,
     /// Passes of [`Problem::project_out`] made (the tests check that a Lanczos step takes one).
     passes: std::cell::Cell<usize>,
-    factor: EnvelopeLdlt,
+    factor: ShiftedFactor,
     /// Converged vectors and their `M` products.
     locked: Vec<(Vec<f64>, Vec<f64>)>,
 }
@@ -408,8 +410,8 @@ pub fn nearest(k: &Csr, m: &Csr, opts: &LanczosOptions) -> Result<EigenPairs, La
         });
     }
     let shifted = k.add(1.0, m, -opts.shift);
-    let factor = EnvelopeLdlt::new(&shifted).map_err(LanczosError::Factor)?;
-    let factor_entries = factor.envelope();
+    let factor = ShiftedFactor::new(&shifted).map_err(LanczosError::Factor)?;
+    let factor_entries = factor.entries();
     // One entry per row, on the diagonal (a repeated entry would be a sum: left to mul_vec).
     let diagonal = (0..n).all(|i| m.ptr[i + 1] == m.ptr[i] + 1 && m.col[m.ptr[i]] == i);
     let mut p = Problem {
@@ -543,7 +545,7 @@ mod tests {
         let (kk, mm) = chain(n, k, m);
         let p = Problem {
             m: &mm,
-            factor: EnvelopeLdlt::new(&kk).unwrap(),
+            factor: ShiftedFactor::new(&kk).unwrap(),
             locked: Vec::new(),
             mass_diagonal: Some(mm.val.clone()),
             passes: std::cell::Cell::new(0),

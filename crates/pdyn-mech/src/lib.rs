@@ -35,6 +35,7 @@ pub mod options;
 pub mod parameters;
 pub mod prescribed;
 mod projection;
+pub mod shifted_factor;
 pub mod sparse;
 pub mod sparse_statics;
 pub mod statics;

@@ -120,10 +120,10 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// `M = L D Lᵀ` for the participation factors and the damping's commutator: a diagonal `M`
-/// (free particles in Cartesian coordinates) in its own order. Reverse Cuthill–McKee would
-/// visit each of its `n` one-vertex components with a fresh `n`-entry mark array (`n²` work:
-/// 0.3 × 10⁹ instructions for a 10⁴-mass chain), and any order gives a diagonal matrix the
-/// same pivots, so the factor is the one [`EnvelopeLdlt::new`] would make.
+/// (free particles in Cartesian coordinates) in its own order, without the reverse
+/// Cuthill–McKee pass (linear in `n` since issue 33's third session, but still a search per
+/// one-vertex component); any order gives a diagonal matrix the same pivots, so the factor is
+/// the one [`EnvelopeLdlt::new`] would make.
 pub(crate) fn factor_mass(
     m: &crate::sparse::Csr,
 ) -> Result<crate::sparse::EnvelopeLdlt, crate::sparse::SparseError> {

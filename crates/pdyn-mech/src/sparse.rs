@@ -145,14 +145,16 @@ impl Csr {
         for j in 0..n {
             ptr[j + 1] += ptr[j];
         }
-        let mut next = ptr.clone();
+        let mut next = ptr[..n].to_vec();
         let mut col = vec![0usize; self.nnz()];
         let mut val = vec![0.0f64; self.nnz()];
         for i in 0..n {
-            for (j, v) in self.row(i) {
-                col[next[j]] = i;
-                val[next[j]] = v;
-                next[j] += 1;
+            let r = self.ptr[i]..self.ptr[i + 1];
+            for (&j, &v) in self.col[r.clone()].iter().zip(&self.val[r]) {
+                let slot = next[j];
+                col[slot] = i;
+                val[slot] = v;
+                next[j] = slot + 1;
             }
         }
         Csr { n, ptr, col, val }
@@ -162,6 +164,22 @@ impl Csr {
     /// entry in both `a A_ij + b B_ij` (as [`Csr::from_triplets`] sums them, in that order).
     pub fn add(&self, a: f64, other: &Csr, b: f64) -> Csr {
         let n = self.n;
+        if self.ptr == other.ptr && self.col == other.col {
+            // One pattern (`K` and `Kᵀ` of a net, `K` and its refill): entry by entry, the
+            // same sums as the merge makes, without it (damped Newton adds at every step).
+            let val = self
+                .val
+                .iter()
+                .zip(&other.val)
+                .map(|(x, y)| a * x + b * y)
+                .collect();
+            return Csr {
+                n,
+                ptr: self.ptr.clone(),
+                col: self.col.clone(),
+                val,
+            };
+        }
         let mut ptr = Vec::with_capacity(n + 1);
         let mut col = Vec::with_capacity(self.nnz() + other.nnz());
         let mut val = Vec::with_capacity(self.nnz() + other.nnz());
@@ -202,12 +220,22 @@ impl Csr {
         if big == 0.0 {
             return 0.0;
         }
-        let mut worst = 0.0f64;
-        for i in 0..self.n {
-            for (j, v) in self.row(i) {
-                worst = worst.max((v - self.get(j, i)).abs());
+        let t = self.transpose();
+        let worst = if t.ptr == self.ptr && t.col == self.col {
+            // A symmetric pattern: `Aᵀ`'s entry at each position is `A_ji`, no search.
+            self.val
+                .iter()
+                .zip(&t.val)
+                .fold(0.0f64, |m, (v, w)| m.max((v - w).abs()))
+        } else {
+            let mut worst = 0.0f64;
+            for i in 0..self.n {
+                for (j, v) in self.row(i) {
+                    worst = worst.max((v - self.get(j, i)).abs());
+                }
             }
-        }
+            worst
+        };
         worst / big
     }
 
@@ -365,32 +393,86 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
-/// Reverse Cuthill–McKee order of the symmetric pattern of `a` (of `A + Aᵀ`): `perm[new] = old`.
-pub fn rcm(a: &Csr) -> Vec<usize> {
+/// The pattern of `A + Aᵀ` without the diagonal, each vertex's neighbours sorted, in
+/// compressed rows (one array for all: a vector per vertex was an allocation per coordinate).
+struct Adjacency {
+    start: Vec<usize>,
+    to: Vec<usize>,
+}
+
+impl Adjacency {
+    fn of(&self, v: usize) -> &[usize] {
+        &self.to[self.start[v]..self.start[v + 1]]
+    }
+
+    fn degree(&self, v: usize) -> usize {
+        self.start[v + 1] - self.start[v]
+    }
+}
+
+fn symmetric_adjacency(a: &Csr) -> Adjacency {
     let n = a.n;
-    // Symmetric adjacency without the diagonal.
-    let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
+    let mut count = vec![0usize; n + 1];
     for i in 0..n {
         for (j, _) in a.row(i) {
             if i != j {
-                adj[i].push(j);
-                adj[j].push(i);
+                count[i + 1] += 1;
+                count[j + 1] += 1;
             }
         }
     }
-    for l in &mut adj {
-        l.sort_unstable();
-        l.dedup();
+    for i in 0..n {
+        count[i + 1] += count[i];
     }
-    let degree = |i: usize| adj[i].len();
+    let mut fill = count.clone();
+    let mut all = vec![0usize; count[n]];
+    for i in 0..n {
+        for (j, _) in a.row(i) {
+            if i != j {
+                all[fill[i]] = j;
+                fill[i] += 1;
+                all[fill[j]] = i;
+                fill[j] += 1;
+            }
+        }
+    }
+    // Sorted, and each neighbour once (an entry and its transpose both list it).
+    let mut start = Vec::with_capacity(n + 1);
+    let mut to = Vec::with_capacity(all.len());
+    start.push(0);
+    for i in 0..n {
+        let row = &mut all[count[i]..count[i + 1]];
+        row.sort_unstable();
+        let from = to.len();
+        for &j in row.iter() {
+            if to.len() == from || to.last() != Some(&j) {
+                to.push(j);
+            }
+        }
+        start.push(to.len());
+    }
+    Adjacency { start, to }
+}
+
+/// Reverse Cuthill–McKee order of the symmetric pattern of `a` (of `A + Aᵀ`): `perm[new] = old`.
+pub fn rcm(a: &Csr) -> Vec<usize> {
+    let n = a.n;
+    let adj = symmetric_adjacency(a);
+    let degree = |i: usize| adj.degree(i);
     let mut placed = vec![false; n];
     let mut order = Vec::with_capacity(n);
+    // `mark[v] == pass` says `v` was reached by the current breadth-first pass: one array for
+    // every pass (a fresh copy of `placed` per pass cost `n` per pass, `n²` over a matrix of
+    // many components, such as a diagonal one).
+    let mut mark = vec![0usize; n];
+    let mut pass = 0usize;
+    let mut next: Vec<usize> = Vec::new();
     // Breadth-first levels from `s` within the unplaced vertices: (order, last level's vertex of
     // least degree, depth).
-    let bfs = |s: usize, placed: &[bool]| -> (Vec<usize>, usize, usize) {
-        let mut seen = placed.to_vec();
+    let mut bfs = |s: usize, placed: &[bool]| -> (Vec<usize>, usize, usize) {
+        pass += 1;
         let mut out = vec![s];
-        seen[s] = true;
+        mark[s] = pass;
         let mut start = 0;
         let mut depth = 0;
         let mut last = s;
@@ -402,11 +484,17 @@ pub fn rcm(a: &Csr) -> Vec<usize> {
                 if best == usize::MAX || degree(v) < degree(best) {
                     best = v;
                 }
-                let mut next: Vec<usize> = adj[v].iter().copied().filter(|&w| !seen[w]).collect();
+                next.clear();
+                next.extend(
+                    adj.of(v)
+                        .iter()
+                        .copied()
+                        .filter(|&w| !placed[w] && mark[w] != pass),
+                );
                 next.sort_by_key(|&w| (degree(w), w));
-                for w in next {
-                    if !seen[w] {
-                        seen[w] = true;
+                for &w in &next {
+                    if mark[w] != pass {
+                        mark[w] = pass;
                         out.push(w);
                     }
                 }
@@ -451,6 +539,37 @@ pub fn rcm(a: &Csr) -> Vec<usize> {
     order
 }
 
+/// The inverse of `perm` (`perm[new] = old`) and, for each row of the reordered symmetric
+/// pattern of `a`, its first column: the envelope.
+fn envelope_rows(a: &Csr, perm: &[usize]) -> (Vec<usize>, Vec<usize>) {
+    let n = a.n;
+    let mut inv = vec![0usize; n];
+    for (new, &old) in perm.iter().enumerate() {
+        inv[old] = new;
+    }
+    let mut first: Vec<usize> = (0..n).collect();
+    for i in 0..n {
+        for (j, _) in a.row(i) {
+            let (r, c) = (inv[i], inv[j]);
+            let (r, c) = if r >= c { (r, c) } else { (c, r) };
+            if c < first[r] {
+                first[r] = c;
+            }
+        }
+    }
+    (inv, first)
+}
+
+/// Entries below the diagonal that the envelope factor of `a` in the order `perm` would hold
+/// ([`EnvelopeLdlt::envelope`]), without factorizing.
+pub fn envelope_size(a: &Csr, perm: &[usize]) -> usize {
+    let (_, first) = envelope_rows(a, perm);
+    first
+        .iter()
+        .enumerate()
+        .fold(0usize, |t, (i, &f)| t.saturating_add(i - f))
+}
+
 /// `P A Pᵀ = L D Lᵀ` of a symmetric sparse matrix, `L` unit lower triangular kept by rows over
 /// their envelopes. The lower triangle of `(A + Aᵀ)/2` is the matrix factorized.
 #[derive(Clone, Debug)]
@@ -476,21 +595,7 @@ impl EnvelopeLdlt {
     /// Factorizes `a` in the order `perm` (`perm[new] = old`).
     pub fn with_order(a: &Csr, perm: Vec<usize>) -> Result<EnvelopeLdlt, SparseError> {
         let n = a.n;
-        let mut inv = vec![0usize; n];
-        for (new, &old) in perm.iter().enumerate() {
-            inv[old] = new;
-        }
-        // The envelope: each row's first column of the symmetric pattern.
-        let mut first: Vec<usize> = (0..n).collect();
-        for i in 0..n {
-            for (j, _) in a.row(i) {
-                let (r, c) = (inv[i], inv[j]);
-                let (r, c) = if r >= c { (r, c) } else { (c, r) };
-                if c < first[r] {
-                    first[r] = c;
-                }
-            }
-        }
+        let (inv, first) = envelope_rows(a, &perm);
         let mut start = Vec::with_capacity(n + 1);
         let mut total = 0usize;
         for (i, &fi) in first.iter().enumerate() {
@@ -768,6 +873,37 @@ mod tests {
         ));
         let dense = a.add(0.5, &b, -2.0).to_dense();
         assert!((dense - (a.to_dense() * 0.5 - b.to_dense() * 2.0)).amax() <= 1e-15);
+        // One pattern (entry by entry, no merge): the same bits as the triplets' sums.
+        let mut r = rng(23);
+        let c = Csr {
+            val: a.val.iter().map(|_| r()).collect(),
+            ..a.clone()
+        };
+        let mut t = Vec::new();
+        for i in 0..n {
+            t.extend(a.row(i).map(|(j, v)| (i, j, 0.5 * v)));
+            t.extend(c.row(i).map(|(j, v)| (i, j, -2.0 * v)));
+        }
+        assert!(same_bits(
+            &a.add(0.5, &c, -2.0),
+            &Csr::from_triplets(n, &t).unwrap()
+        ));
+        // The asymmetry of a symmetric pattern (the fast path) and of another, by definition.
+        let s = a.add(1.0, &a.transpose(), 1.0);
+        let big = s.val.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let mut skew = s.clone();
+        let k = (skew.ptr[3]..skew.ptr[4])
+            .find(|&k| skew.col[k] != 3)
+            .unwrap();
+        skew.val[k] += 0.25 * big;
+        let expected = |m: &Csr| {
+            let d = m.to_dense();
+            (&d - d.transpose()).amax() / d.amax()
+        };
+        assert_eq!(s.asymmetry(), 0.0);
+        assert!(expected(&skew) > 0.1);
+        assert_eq!(skew.asymmetry(), expected(&skew));
+        assert_eq!(a.asymmetry(), expected(&a));
     }
 
     #[test]
@@ -792,6 +928,51 @@ mod tests {
         let a = Csr::from_triplets(n, &t).unwrap();
         let f = EnvelopeLdlt::new(&a).unwrap();
         assert_eq!(f.envelope(), n - 1);
+    }
+
+    /// `perm` holds each of `0..n` once.
+    fn is_permutation(perm: &[usize], n: usize) -> bool {
+        let mut seen = vec![false; n];
+        perm.len() == n
+            && perm
+                .iter()
+                .all(|&v| v < n && !std::mem::replace(&mut seen[v], true))
+    }
+
+    #[test]
+    fn rcm_orders_a_matrix_of_many_components_in_linear_time() {
+        // 200,000 coordinates, nearly all on their own (a diagonal), with a 3-path and a
+        // 4-clique among them: every component is numbered together, so the envelope holds
+        // the path's 2 entries (band 1) and the clique's 3 + 2 + 1, and nothing else. A copy
+        // of an n-entry mark array per component (the old breadth-first search) took
+        // 200,000² = 4·10^10 bytes of copying here, tens of seconds; linear work takes
+        // milliseconds, so the time bound below separates the two by a wide margin.
+        let n = 200_000;
+        let mut t: Vec<(usize, usize, f64)> = (0..n).map(|i| (i, i, 4.0)).collect();
+        let path = [17, 150_001, 99];
+        for w in path.windows(2) {
+            t.push((w[0], w[1], -1.0));
+            t.push((w[1], w[0], -1.0));
+        }
+        let clique = [5, 70_000, 123_456, 199_999];
+        for &i in &clique {
+            for &j in &clique {
+                if i != j {
+                    t.push((i, j, 0.5));
+                }
+            }
+        }
+        let a = Csr::from_triplets(n, &t).unwrap();
+        let clock = std::time::Instant::now();
+        let order = rcm(&a);
+        let took = clock.elapsed();
+        assert!(is_permutation(&order, n));
+        assert!(
+            took < std::time::Duration::from_secs(2),
+            "rcm of {n} components took {took:?}"
+        );
+        let f = EnvelopeLdlt::with_order(&a, order).unwrap();
+        assert_eq!(f.envelope(), 2 + 6);
     }
 
     #[test]
