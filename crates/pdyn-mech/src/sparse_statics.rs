@@ -81,6 +81,9 @@ pub fn solve<L: Linearize + ?Sized>(
         diag: &diag,
     };
     let end = crate::damped_newton::solve(&sparse, q, at, &diag, ratio, target, opts)?;
+    // The steps' factors freed before the free directions' Lanczos factors its own matrix:
+    // the peak memory is the larger of the two, not their sum.
+    drop(sparse);
     let (q, SparseAt { at, ks, .. }, residual, steps) = (end.q, end.at, end.residual, end.steps);
     let neutral = if opts.neutral {
         free_directions(lin.names(), &ks, &diag)

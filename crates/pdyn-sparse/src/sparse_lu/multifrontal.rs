@@ -10,6 +10,12 @@
 //! lower triangle of each Schur complement is updated (the dominant cost). The upper triangles
 //! of the fronts and update matrices are then never read: they hold whatever the assembly
 //! put there.
+//!
+//! A symmetric factorization also keeps only half of the factors: the `ns` rows of each
+//! supernode's pivots (`U11`, `U12`, unscaled, and `L11` below the diagonal block's
+//! diagonal), not `L21`, whose entries are `U12`'s transposed times the pivots' inverses.
+//! The solve forms each of them as the elimination did (`x · (1/d)`), so the solutions are
+//! the same bits as from the full factors.
 
 use super::scalar::Scalar;
 use super::supernodal::Supernodes;
@@ -17,7 +23,12 @@ use super::supernodal::Supernodes;
 /// The numeric factors of one matrix on a [`Supernodes`] structure.
 #[derive(Debug)]
 pub(crate) struct Numeric<T> {
+    /// The factors: of every supernode its `m × ns` columns and `ns × r` rows of `U` right
+    /// of them ([`Supernodes::lu_start`]), or, when `symmetric`, its `ns × m` rows of `U`
+    /// ([`Supernodes::sym_start`]). Allocated by the first factorization, for its layout.
     lu: Vec<T>,
+    /// The layout of `lu`: the last factorization's.
+    symmetric: bool,
     front: Vec<T>,
     stack: Vec<T>,
     row_max: Vec<f64>,
@@ -26,11 +37,18 @@ pub(crate) struct Numeric<T> {
 impl<T: Scalar> Numeric<T> {
     pub(crate) fn new(sn: &Supernodes) -> Self {
         Numeric {
-            lu: vec![T::ZERO; sn.lu_start[sn.len()]],
+            lu: Vec::new(),
+            symmetric: false,
             front: vec![T::ZERO; sn.max_front * sn.max_front],
             stack: Vec::with_capacity(sn.max_stack),
             row_max: vec![0.0; sn.n],
         }
+    }
+
+    /// Entries the factors hold (as last allocated).
+    #[cfg(test)]
+    pub(crate) fn stored(&self) -> usize {
+        self.lu.len()
     }
 
     /// Factors the matrix with values `vals` (the analysed pattern's order); `Err(k)` when
@@ -43,6 +61,17 @@ impl<T: Scalar> Numeric<T> {
         floor: f64,
         symmetric: bool,
     ) -> Result<(), usize> {
+        let len = if symmetric {
+            sn.sym_start[sn.len()]
+        } else {
+            sn.lu_start[sn.len()]
+        };
+        if self.lu.len() != len {
+            // The old layout freed before the new one is allocated (the peak is one of them).
+            self.lu = Vec::new();
+            self.lu = vec![T::ZERO; len];
+        }
+        self.symmetric = symmetric;
         self.row_max.fill(0.0);
         for (q, v) in vals.iter().enumerate() {
             let r = sn.value_row[q];
@@ -78,11 +107,21 @@ impl<T: Scalar> Numeric<T> {
             }
             eliminate(front, m, ns, &self.row_max[f..f + ns], floor, symmetric)
                 .map_err(|k| f + k)?;
-            let off = sn.lu_start[s];
-            self.lu[off..off + m * ns].copy_from_slice(&front[..m * ns]);
-            let u12 = &mut self.lu[off + m * ns..off + m * ns + ns * r];
-            for j in 0..r {
-                u12[j * ns..j * ns + ns].copy_from_slice(&front[(ns + j) * m..(ns + j) * m + ns]);
+            if symmetric {
+                // The pivots' rows, column by column (leading dimension `ns`).
+                let off = sn.sym_start[s];
+                let rows = &mut self.lu[off..off + ns * m];
+                for (j, dst) in rows.chunks_exact_mut(ns).enumerate() {
+                    dst.copy_from_slice(&front[j * m..j * m + ns]);
+                }
+            } else {
+                let off = sn.lu_start[s];
+                self.lu[off..off + m * ns].copy_from_slice(&front[..m * ns]);
+                let u12 = &mut self.lu[off + m * ns..off + m * ns + ns * r];
+                for j in 0..r {
+                    u12[j * ns..j * ns + ns]
+                        .copy_from_slice(&front[(ns + j) * m..(ns + j) * m + ns]);
+                }
             }
             for j in 0..r {
                 self.stack
@@ -92,9 +131,12 @@ impl<T: Scalar> Numeric<T> {
         Ok(())
     }
 
-    /// Solves `A z = b` in place, `z` in the permuted order; `t` is scratch of at least the
-    /// largest front's side.
+    /// Solves `A z = b` in place, `z` in the permuted order; `t` is scratch of at least twice
+    /// the largest front's side.
     pub(crate) fn solve_permuted(&self, sn: &Supernodes, z: &mut [T], t: &mut [T]) {
+        if self.symmetric {
+            return self.solve_symmetric(sn, z, t);
+        }
         for s in 0..sn.len() {
             let (f, ns) = (sn.first[s], sn.first[s + 1] - sn.first[s]);
             let rows = &sn.rows[sn.row_start[s]..sn.row_start[s + 1]];
@@ -139,6 +181,63 @@ impl<T: Scalar> Numeric<T> {
                 zs[k] = zk;
                 for i in 0..k {
                     zs[i] = zs[i] - u[i + k * m] * zk;
+                }
+            }
+        }
+    }
+
+    /// [`Numeric::solve_permuted`] from the pivots' rows of a symmetric factorization: the
+    /// same operations in the same order as from the full factors, each entry of `L21`
+    /// formed as the elimination formed it (its row of `U` times the pivot's inverse).
+    fn solve_symmetric(&self, sn: &Supernodes, z: &mut [T], scratch: &mut [T]) {
+        let (t, inv) = scratch.split_at_mut(sn.max_front);
+        for s in 0..sn.len() {
+            let (f, ns) = (sn.first[s], sn.first[s + 1] - sn.first[s]);
+            let rows = &sn.rows[sn.row_start[s]..sn.row_start[s + 1]];
+            let (r, m) = (rows.len(), ns + rows.len());
+            // Entry (i, j) at `j * ns + i`: `L11` below the diagonal, `U` on and above it.
+            let u = &self.lu[sn.sym_start[s]..sn.sym_start[s] + ns * m];
+            let zs = &mut z[f..f + ns];
+            for k in 0..ns {
+                let zk = zs[k];
+                let col = &u[k * ns..k * ns + ns];
+                for i in k + 1..ns {
+                    zs[i] = zs[i] - col[i] * zk;
+                }
+                inv[k] = T::ONE / col[k];
+            }
+            let t = &mut t[..r];
+            for (x, row) in t.iter_mut().zip(u[ns * ns..].chunks_exact(ns)) {
+                let mut sum = T::ZERO;
+                for ((&v, &d), &zk) in row.iter().zip(&inv[..ns]).zip(zs.iter()) {
+                    sum = sum + v * d * zk;
+                }
+                *x = sum;
+            }
+            for (&i, &v) in rows.iter().zip(t.iter()) {
+                z[i] = z[i] - v;
+            }
+        }
+        for s in (0..sn.len()).rev() {
+            let (f, ns) = (sn.first[s], sn.first[s + 1] - sn.first[s]);
+            let rows = &sn.rows[sn.row_start[s]..sn.row_start[s + 1]];
+            let (r, m) = (rows.len(), ns + rows.len());
+            let u = &self.lu[sn.sym_start[s]..sn.sym_start[s] + ns * m];
+            let t = &mut t[..r];
+            for (x, &i) in t.iter_mut().zip(rows) {
+                *x = z[i];
+            }
+            let zs = &mut z[f..f + ns];
+            for (&za, row) in t.iter().zip(u[ns * ns..].chunks_exact(ns)) {
+                for (x, &v) in zs.iter_mut().zip(row) {
+                    *x = *x - v * za;
+                }
+            }
+            for k in (0..ns).rev() {
+                let zk = zs[k] / u[k + k * ns];
+                zs[k] = zk;
+                for i in 0..k {
+                    zs[i] = zs[i] - u[i + k * ns] * zk;
                 }
             }
         }

@@ -34,6 +34,9 @@ pub(crate) struct Supernodes {
     /// Where its factors start in the numeric array: the `m × ns` block of its columns
     /// (column-major; `m = ns + r`), then the `ns × r` block of `U` right of it.
     pub lu_start: Vec<usize>,
+    /// Where its factors start in the numeric array of a symmetric factorization, which keeps
+    /// only the `ns × m` rows of its pivots (`U`, and `L` in the diagonal block).
+    pub sym_start: Vec<usize>,
     /// Each of the pattern's values assembled into supernode `s`'s front:
     /// `assembly[asm_start[s]..asm_start[s + 1]]` = (position in the front, value index).
     pub asm_start: Vec<usize>,
@@ -207,6 +210,7 @@ impl Supernodes {
         let mut rows = Vec::new();
         let mut entries = 0usize;
         let mut lu_start = vec![0usize];
+        let mut sym_start = vec![0usize];
         let mut sn_of = vec![0usize; n];
         for (s, node) in nodes.iter().enumerate() {
             first.push(node.first);
@@ -215,6 +219,7 @@ impl Supernodes {
             let (ns, r) = (node.end - node.first, node.rows.len());
             entries += stored(ns, r);
             lu_start.push(lu_start[s] + (ns + r) * ns + ns * r);
+            sym_start.push(sym_start[s] + ns * (ns + r));
             for j in node.first..node.end {
                 sn_of[j] = s;
             }
@@ -310,6 +315,7 @@ impl Supernodes {
             row_start,
             rows,
             lu_start,
+            sym_start,
             asm_start,
             assembly,
             child_start,
