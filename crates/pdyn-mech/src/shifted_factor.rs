@@ -25,13 +25,8 @@ use pdyn_sparse::sparse_lu::{Pattern, SparseLu, Symbolic};
 use std::cell::RefCell;
 
 /// Mean entries per row of the envelope (its bandwidth, roughly) from which the LU is analysed:
-/// below it, the envelope is at most about the LU's size. At 100 the 40 × 40 hanging net
-/// (diagonal springs too: eight neighbours, rows of ~120) took the LU and its `pdyn modes`
-/// was 8 % slower (2,556 → 2,753 ms); at 150 it keeps the envelope, while the 100 × 100 cloth
-/// (rows of ~300: 31 → 18 s with the LU) and the 4-neighbour test net of 60 × 60 nodes take
-/// the LU. Where between 40 and 100 nodes a side the LU starts to pay on 8-neighbour nets was
-/// not measured.
-pub const ANALYSE_FROM: usize = 150;
+/// below it, the envelope is at most about the LU's size (a net of up to ~35 × 35 nodes).
+pub const ANALYSE_FROM: usize = 100;
 
 /// A factorization of a symmetric `A` (the lower triangle of `(A + Aᵀ)/2`, as the envelope
 /// takes it), to solve `A x = b` many times.
