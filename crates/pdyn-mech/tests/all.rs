@@ -31,6 +31,8 @@ mod dsolve_rules_symbolic;
 mod families;
 #[path = "family_initials.rs"]
 mod family_initials;
+#[path = "family_templates.rs"]
+mod family_templates;
 #[path = "forces_chapter.rs"]
 mod forces_chapter;
 #[path = "kin_chapter.rs"]

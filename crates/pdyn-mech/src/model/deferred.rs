@@ -22,7 +22,7 @@
 //! conservation laws of a run that already holds ids of this pool).
 
 use super::families::Names;
-use super::raw::{RawForce, Sv};
+use super::raw::{Name, RawForce, Sv};
 use super::{AxialForce, Load, Model, ModelError, Particle, PotentialTerm, Target};
 use crate::derive::DeriveError;
 use pdyn_expr::{Id, Node, Pool, SymId};
@@ -83,6 +83,9 @@ pub(crate) fn shape(pool: &Pool, mass: Id, position: &[Id; 3]) -> Option<Shape> 
     for (o, &c) in out.iter_mut().zip(position) {
         match pool.node(c) {
             Node::Coord(_, 0) => {}
+            // A leaf that is no coordinate nor `t` is constant (a family's `0` components:
+            // walking them with `any_node` was a quarter of reading a chain's forces).
+            Node::Num(_) | Node::Const(_) | Node::Sym(_) => *o = Some(c),
             _ if pool.any_node(c, &|n| matches!(n, Node::Coord(..) | Node::Time)) => return None,
             _ => *o = Some(c),
         }
@@ -286,7 +289,9 @@ fn identifiers(text: &str) -> impl Iterator<Item = &str> {
 pub(crate) struct Deferrer {
     /// The families, in order of their representatives.
     pub families: Vec<DeferredForces>,
-    by_key: FxHashMap<Key, usize>,
+    /// Per entry (its span's start), the shapes of each of its representatives and the
+    /// family it leads (one in a uniform net).
+    by_key: FxHashMap<usize, Vec<(Vec<Shape>, usize)>>,
     /// Per `[[forces]]` entry (its span's start): whether its members may be deferred.
     entry_ok: FxHashMap<usize, bool>,
     /// Each particle's [`shape`], found once: a chain's particle ends two springs, a net's
@@ -297,43 +302,55 @@ pub(crate) struct Deferrer {
 
 impl Deferrer {
     /// Decides for a member of the family `f` (the file's entry) whose name fields are
-    /// `names`; `indices` are the names of its indices and of every index (none: not a
-    /// member). `particle` finds a particle by name.
-    pub fn decide(
+    /// `names`; `indices` gives the names of its indices and of every index (none: not a
+    /// member), asked for at the entry's first member only. `particle` finds a particle by
+    /// name.
+    pub fn decide<'n>(
         &mut self,
         pool: &Pool,
         particles: &[Particle],
         particle: impl Fn(&str) -> Option<usize>,
         f: &Spanned<RawForce>,
         names: &Names,
-        indices: &[&str],
+        indices: impl FnOnce() -> Vec<&'n str>,
     ) -> Decision {
-        if indices.is_empty() {
-            return Decision::Build;
-        }
         let raw = f.get_ref();
         let entry = f.span().start;
-        let ok = *self.entry_ok.entry(entry).or_insert_with(|| {
-            deferrable_fields(raw).is_some()
-                && [&raw.k, &raw.l0, &raw.c]
-                    .iter()
-                    .all(|field| same_for_every_member(field, indices))
-        });
+        let ok = match self.entry_ok.get(&entry) {
+            Some(&ok) => ok,
+            None => {
+                let indices = indices();
+                if indices.is_empty() {
+                    return Decision::Build;
+                }
+                let ok = deferrable_fields(raw).is_some()
+                    && [&raw.k, &raw.l0, &raw.c]
+                        .iter()
+                        .all(|field| same_for_every_member(field, &indices));
+                self.entry_ok.insert(entry, ok);
+                ok
+            }
+        };
         if !ok {
             return Decision::Build;
         }
-        let names: Vec<&str> = match (&names.between, &names.on) {
-            (Some(b), None) => b.get_ref().iter().map(|n| n.get_ref().as_str()).collect(),
-            (None, Some(on)) => vec![on.get_ref().as_str()],
+        // One or two ends (the deferrable kinds have no more): on the stack, nothing
+        // allocated for a member that joins its family's representative.
+        let names: &[Name] = match (&names.between, &names.on) {
+            (Some(b), None) => b.get_ref(),
+            (None, Some(on)) => std::slice::from_ref(on),
             _ => return Decision::Build,
         };
-        let mut ends = Vec::with_capacity(names.len());
-        let mut shapes = Vec::with_capacity(names.len());
-        for name in &names {
-            let Some(i) = particle(name) else {
+        if names.len() > 2 {
+            return Decision::Build;
+        }
+        let mut ends = [0u32; 2];
+        let mut shapes: [Shape; 2] = [(Pool::ZERO, [None; 3]); 2];
+        for (k, name) in names.iter().enumerate() {
+            let Some(i) = particle(name.get_ref()) else {
                 return Decision::Build;
             };
-            if ends.contains(&(i as u32)) {
+            if ends[..k].contains(&(i as u32)) {
                 // `between` joins a particle to itself: the build says so.
                 return Decision::Build;
             }
@@ -344,19 +361,26 @@ impl Deferrer {
             let Some(s) = *s else {
                 return Decision::Build;
             };
-            ends.push(i as u32);
-            shapes.push(s);
+            ends[k] = i as u32;
+            shapes[k] = s;
         }
-        if ends.len() != 2 && raw.between.is_some() {
+        let n = names.len();
+        if n != 2 && raw.between.is_some() {
             return Decision::Build;
         }
-        let key = (entry, shapes);
-        match self.by_key.get(&key) {
-            Some(&k) => {
-                self.families[k].members.extend(&ends);
+        let shapes = &shapes[..n];
+        let known = self.by_key.get(&entry).and_then(|families| {
+            families
+                .iter()
+                .find(|(s, _)| s.as_slice() == shapes)
+                .map(|&(_, family)| family)
+        });
+        match known {
+            Some(k) => {
+                self.families[k].members.extend(&ends[..n]);
                 Decision::Deferred
             }
-            None => Decision::Representative(key, ends),
+            None => Decision::Representative((entry, shapes.to_vec()), ends[..n].to_vec()),
         }
     }
 
@@ -377,7 +401,11 @@ impl Deferrer {
         if loads != ends.len() {
             return;
         }
-        self.by_key.insert(key, self.families.len());
+        let (entry, shapes) = key;
+        self.by_key
+            .entry(entry)
+            .or_default()
+            .push((shapes, self.families.len()));
         self.families.push(DeferredForces {
             family,
             first_load,

@@ -102,6 +102,63 @@ pub(crate) struct Members {
 /// An expanded table and, entry by entry, the member each is.
 type Expanded<T> = (T, Vec<Option<Member>>);
 
+/// The values the members of a keyed table's families share: each family's value once, and
+/// for each entry of the expanded table the index of its family's value. A member's own
+/// value in the table is then a placeholder (copying a coordinate's `{ initial, rate }` table
+/// or a particle's fields for each of 10^4 members, and freeing them, was a third of
+/// expanding a chain); readers take the value through [`Shared::get`].
+#[derive(Debug)]
+pub(crate) struct Shared<V> {
+    values: Vec<V>,
+    of_entry: Vec<Option<u32>>,
+}
+
+impl<V> Default for Shared<V> {
+    fn default() -> Self {
+        Shared {
+            values: Vec::new(),
+            of_entry: Vec::new(),
+        }
+    }
+}
+
+impl<V> Shared<V> {
+    /// The value of entry `k` of the expanded table, whose value in the table is `own`.
+    pub fn get<'a>(&'a self, k: usize, own: &'a V) -> &'a V {
+        match self.of_entry.get(k).copied().flatten() {
+            Some(v) => &self.values[v as usize],
+            None => own,
+        }
+    }
+}
+
+/// [`Shared`] for each keyed table.
+#[derive(Debug, Default)]
+pub(crate) struct SharedValues {
+    pub coordinates: Shared<Sv>,
+    pub points: Shared<Sv>,
+    pub definitions: Shared<Sv>,
+    pub particles: Shared<Spanned<RawParticle>>,
+}
+
+/// A value that stands in the expanded table for a member's (its family's is in [`Shared`]):
+/// nothing allocated.
+fn placeholder_value(v: &Sv) -> Sv {
+    Spanned::new(v.span(), toml::Value::Boolean(false))
+}
+
+fn placeholder_particle(p: &Spanned<RawParticle>) -> Spanned<RawParticle> {
+    Spanned::new(
+        p.span(),
+        RawParticle {
+            mass: None,
+            position: None,
+            for_list: None,
+            condition: None,
+        },
+    )
+}
+
 /// Which table an entry is in.
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Table {
@@ -195,6 +252,11 @@ impl Indices {
         bindings: &[(String, i64)],
         rows: &[(usize, usize)],
     ) -> Result<Option<Cell<'_>>, IndexError> {
+        if self.columns.is_empty() {
+            // No table: no column, with or without a subscript (a family's members name
+            // their neighbours 10^4 times: nothing is split for them).
+            return Ok(None);
+        }
         let Some((base, parts)) = index_expr::split_subscript(name) else {
             return Ok(None);
         };
@@ -315,23 +377,33 @@ impl Indices {
         };
         let base = subscript.base.as_str();
         let lookup = self.lookup(bindings, rows);
-        let mut values = Vec::with_capacity(subscript.parts.len());
-        for (e, offset, len) in &subscript.parts {
-            values.push(e.int(&lookup).map_err(|e| {
+        // One or two indices in practice: kept on the stack (this is once per reference per
+        // member).
+        let mut inline = [0i64; 4];
+        let mut spilled = Vec::new();
+        let n = subscript.parts.len();
+        let fits = n <= inline.len();
+        for (k, (e, offset, len)) in subscript.parts.iter().enumerate() {
+            let v = e.int(&lookup).map_err(|e| {
                 let span = if e.span == (0..0) { 0..*len } else { e.span };
                 IndexError {
                     span: span.start + offset..span.end + offset,
                     message: e.message,
                 }
-            })?);
+            })?;
+            match inline.get_mut(k) {
+                Some(slot) if fits => *slot = v,
+                _ => spilled.push(v),
+            }
         }
-        let canonical = member(base, &values);
+        let values: &[i64] = if fits { &inline[..n] } else { &spilled };
+        let canonical = member(base, values);
         if let Some(shape) = self.shapes.get(base) {
             let inside = shape.ranges.len() == values.len()
                 && shape
                     .ranges
                     .iter()
-                    .zip(&values)
+                    .zip(values)
                     .all(|((lo, hi), v)| lo <= v && v <= hi);
             if !inside {
                 return Err(IndexError {
@@ -344,7 +416,7 @@ impl Indices {
                 });
             }
             if let Some(declared) = &shape.rows {
-                if !declared.contains(&values) {
+                if !declared.contains(values) {
                     return Err(IndexError {
                         span: 0..name.len(),
                         message: format!(
@@ -403,9 +475,8 @@ fn push_int(out: &mut String, v: i64) {
     if v < 0 {
         out.push('-');
     }
-    for &d in &digits[k..] {
-        out.push(char::from(d));
-    }
+    // ASCII digits: one copy, not a `char` each.
+    out.push_str(std::str::from_utf8(&digits[k..]).unwrap_or_default());
 }
 
 /// `P[0..19, 0..19]`.
@@ -788,8 +859,10 @@ impl<'l, 'a> Expander<'l, 'a> {
     fn keyed<V: Clone>(
         &mut self,
         table: IndexMap<Name, V>,
+        shared: &mut Shared<V>,
         span_of: impl Fn(&V) -> Range<usize>,
         split: impl Fn(&Self, &V) -> Result<(V, Option<Sv>, Option<Sv>), ModelError>,
+        placeholder: impl Fn(&V) -> V,
     ) -> Result<Expanded<IndexMap<Name, V>>, ModelError> {
         let mut out = IndexMap::with_capacity(table.len());
         let mut members = Vec::with_capacity(table.len());
@@ -824,6 +897,7 @@ impl<'l, 'a> Expander<'l, 'a> {
                     };
                     self.insert(&mut out, key, value)?;
                     members.push(None);
+                    shared.of_entry.push(None);
                 }
                 Head::Family(base, parts) => {
                     let base = base.to_string();
@@ -858,6 +932,7 @@ impl<'l, 'a> Expander<'l, 'a> {
                             &mut out,
                             &mut members,
                         )?;
+                        shared.of_entry.resize(members.len(), None);
                         continue;
                     }
                     for (p, off) in &parts {
@@ -888,14 +963,18 @@ impl<'l, 'a> Expander<'l, 'a> {
                     self.record_shape(&name, &base, &ranges, None)?;
                     let family: Rc<str> = Rc::from(base.as_str());
                     let index_names: Rc<[String]> = domain.names.clone().into();
+                    let stand_in = placeholder(&value);
+                    let which = Some(shared.values.len() as u32);
+                    shared.values.push(value);
                     self.each(&name.span(), &base, &domain, |ex, bindings, rows| {
                         let values: Vec<i64> = names
                             .iter()
                             .map(|n| bindings.iter().find(|b| &b.0 == n).map_or(0, |b| b.1))
                             .collect();
                         let key = Spanned::new(name.span(), member(&base, &values));
-                        ex.insert(&mut out, key, value.clone())?;
+                        ex.insert(&mut out, key, stand_in.clone())?;
                         members.push(Some(Member::of(&family, &index_names, bindings, rows)));
+                        shared.of_entry.push(which);
                         Ok(())
                     })?;
                 }
@@ -1228,17 +1307,31 @@ pub(crate) fn expand(
         members: 0,
     };
     let sv_span = |v: &Sv| v.span();
-    let (coordinates, mc) = ex.keyed(std::mem::take(&mut raw.coordinates), sv_span, |ex, v| {
-        split_table(ex.ld, v, None)
-    })?;
-    let (points, mp) = ex.keyed(std::mem::take(&mut raw.points), sv_span, |ex, v| {
-        split_table(ex.ld, v, Some("position"))
-    })?;
-    let (definitions, md) = ex.keyed(std::mem::take(&mut raw.definitions), sv_span, |ex, v| {
-        split_table(ex.ld, v, Some("value"))
-    })?;
+    let mut shared = SharedValues::default();
+    let (coordinates, mc) = ex.keyed(
+        std::mem::take(&mut raw.coordinates),
+        &mut shared.coordinates,
+        sv_span,
+        |ex, v| split_table(ex.ld, v, None),
+        placeholder_value,
+    )?;
+    let (points, mp) = ex.keyed(
+        std::mem::take(&mut raw.points),
+        &mut shared.points,
+        sv_span,
+        |ex, v| split_table(ex.ld, v, Some("position")),
+        placeholder_value,
+    )?;
+    let (definitions, md) = ex.keyed(
+        std::mem::take(&mut raw.definitions),
+        &mut shared.definitions,
+        sv_span,
+        |ex, v| split_table(ex.ld, v, Some("value")),
+        placeholder_value,
+    )?;
     let (particles, mq) = ex.keyed(
         std::mem::take(&mut raw.particles),
+        &mut shared.particles,
         |p: &Spanned<RawParticle>| p.span(),
         |_, p| {
             let mut q = p.get_ref().clone();
@@ -1246,7 +1339,9 @@ pub(crate) fn expand(
             let condition = q.condition.take();
             Ok((Spanned::new(p.span(), q), for_list, condition))
         },
+        placeholder_particle,
     )?;
+    raw.shared = shared;
     let (force_entries, mf) = ex.forces(&raw.forces)?;
     raw.coordinates = coordinates;
     raw.points = points;

@@ -3,6 +3,7 @@
 //! expression (located errors, unit literals, shape checks, constant evaluation).
 
 use super::families::{in_member, Indices, Member, Members, Table};
+use super::member_template::MemberTemplate;
 use super::raw::Sv;
 use super::{ModelError, Parameter};
 use crate::dimensions::{Form, Inference, Source};
@@ -197,6 +198,9 @@ pub(crate) struct Loader<'a> {
     /// equations between dimensions (and the same errors, at the same place), member after
     /// member. Inferring them again for each of 10^4 members was a sixth of loading a chain.
     inferred: FxHashMap<usize, (String, Form)>,
+    /// And its template ([`super::member_template`]), when it has one, by offset (with the
+    /// text).
+    templates: FxHashMap<usize, (String, Option<Rc<MemberTemplate>>)>,
     /// And its expression, when it names nothing of the member's own
     /// ([`Loader::same_for_every_member`]): lowered once, by offset (with the text).
     lowered: FxHashMap<usize, (String, Value)>,
@@ -235,6 +239,7 @@ impl<'a> Loader<'a> {
             parsed: FxHashMap::default(),
             inferred: FxHashMap::default(),
             lowered: FxHashMap::default(),
+            templates: FxHashMap::default(),
             family_initials: FxHashMap::default(),
             initial_families: Vec::new(),
             wanted: FxHashMap::default(),
@@ -473,9 +478,13 @@ impl<'a> Loader<'a> {
             return Ok(Value::Scalar(self.pool.num(Number::Float(x))));
         }
         let ast = self.parse(text, off).map_err(|e| self.located(e, off))?;
-        let v = match self.lowered.get(&off) {
-            Some((t, v)) if self.member.is_some() && t == text => *v,
-            _ => {
+        let same = match self.lowered.get(&off) {
+            Some((t, v)) if self.member.is_some() && t == text => Some(*v),
+            _ => None,
+        };
+        let v = match same.or_else(|| self.templated_value(text, off, &ast)) {
+            Some(v) => v,
+            None => {
                 let v = lower(&mut self.pool, &ast, &mut self.scope)
                     .map_err(|e| self.located(e, off))?;
                 if self.member.is_some() && self.same_for_every_member(&ast) {
@@ -491,6 +500,35 @@ impl<'a> Loader<'a> {
             self.infer(&ast, Source { text, offset: off })
         };
         Ok(v)
+    }
+
+    /// The value of a family member's field from its family's template
+    /// ([`super::member_template`]), made at the first member that reads `text` at `off`.
+    /// `None` outside families, for a text of another shape, or for a member whose names do
+    /// not resolve as the template needs (it is then lowered in full, with its error).
+    fn templated_value(&mut self, text: &str, off: usize, ast: &Ast) -> Option<Value> {
+        self.member.as_ref()?;
+        let template = match self.templates.get(&off) {
+            Some((t, template)) if t == text => template.clone()?,
+            _ => {
+                // What differs from member to member, named once (the scope is lowered
+                // through while the template is made).
+                let own: Vec<String> = (self.scope.bindings.iter().map(|(b, _)| b))
+                    .chain(self.scope.indices.ranges.keys())
+                    .chain(self.scope.indices.columns.keys())
+                    .cloned()
+                    .collect();
+                let varies = |a: &Ast| {
+                    a.any_name(&|name| name.contains('[') || own.iter().any(|o| o == name))
+                };
+                let template =
+                    MemberTemplate::of(&mut self.pool, ast, &mut self.scope, &varies).map(Rc::new);
+                self.templates
+                    .insert(off, (text.to_string(), template.clone()));
+                template?
+            }
+        };
+        template.member(&mut self.pool, &mut self.scope)
     }
 
     /// Whether `ast` names nothing that differs from member to member of a family: no index,

@@ -16,6 +16,7 @@ mod family_initials;
 mod forces;
 pub mod index_expr;
 mod loader;
+mod member_template;
 pub(crate) mod raw;
 mod row_tables;
 pub mod spec;

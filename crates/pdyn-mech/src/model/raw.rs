@@ -57,6 +57,10 @@ pub struct RawModel {
     /// ([`super::row_tables`]).
     #[serde(default)]
     pub tables: IndexMap<Name, Spanned<RawTable>>,
+    /// After expansion ([`super::families::expand`]): the values the members of each family
+    /// share (a member's own value in its table is a placeholder).
+    #[serde(skip)]
+    pub(crate) shared: super::families::SharedValues,
 }
 
 /// `[tables.NAME]`: a CSV (or Parquet) file of rows, one family member per row.

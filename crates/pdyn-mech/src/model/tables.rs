@@ -110,6 +110,7 @@ impl Loader<'_> {
             known_accelerations: Vec::new(),
         };
         for (k, (name, sv)) in raw.coordinates.iter().enumerate() {
+            let sv = raw.shared.coordinates.get(k, sv);
             self.enter(Table::Coordinates, k);
             let n = name.get_ref();
             let index = out.coordinates.len();
@@ -450,6 +451,7 @@ impl Loader<'_> {
     ) -> Result<Vec<(String, Value)>, ModelError> {
         let mut definitions = Vec::new();
         for (k, (name, sv)) in raw.definitions.iter().enumerate() {
+            let sv = raw.shared.definitions.get(k, sv);
             self.enter(Table::Definitions, k);
             let v = self.value(sv)?;
             let form = self.last_for(name.get_ref());
@@ -468,6 +470,7 @@ impl Loader<'_> {
     ) -> Result<Vec<(String, [Id; 3])>, ModelError> {
         let mut points = Vec::new();
         for (k, (name, sv)) in raw.points.iter().enumerate() {
+            let sv = raw.shared.points.get(k, sv);
             self.enter(Table::Points, k);
             let v = self.vector(sv, &format!("point `{}`", name.get_ref()))?;
             self.want(
@@ -494,6 +497,7 @@ impl Loader<'_> {
         let mut particles = Vec::new();
         let mut bound: Option<std::rc::Rc<str>> = None;
         for (k, (name, sp)) in raw.particles.iter().enumerate() {
+            let sp = raw.shared.particles.get(k, sp);
             self.enter(Table::Particles, k);
             let n = name.get_ref();
             let p = sp.get_ref();
@@ -532,7 +536,7 @@ impl Loader<'_> {
                 }
                 bound = family;
             }
-            let vel = position.map(|c| self.pool.dt(c));
+            let vel = position.map(|c| super::member_template::dt(&mut self.pool, c));
             for (prefix, v) in [("r_", position), ("v_", vel)] {
                 // Concatenated, not `format!`: once per particle.
                 let mut key = String::with_capacity(prefix.len() + n.len());
@@ -628,15 +632,21 @@ impl Loader<'_> {
             self.enter(Table::Forces, k);
             let original = &raw.forces[fe.entry];
             let decision = if self.defer && !self.scope.bindings.is_empty() {
-                let mut names: Vec<&str> = index_names.iter().map(String::as_str).collect();
-                names.extend(self.scope.bindings.iter().map(|b| b.0.as_str()));
+                // The names of the indices, made only for the first member of an entry (the
+                // others' decision about the entry is the first's).
+                let bindings = &self.scope.bindings;
+                let names = || {
+                    let mut names: Vec<&str> = index_names.iter().map(String::as_str).collect();
+                    names.extend(bindings.iter().map(|b| b.0.as_str()));
+                    names
+                };
                 deferrer.decide(
                     &self.pool,
                     particles,
                     |n| fb.particle_named(n),
                     original,
                     &fe.names,
-                    &names,
+                    names,
                 )
             } else {
                 Decision::Build
