@@ -231,10 +231,8 @@ impl OdeSystem for Lattice {
     }
 }
 
-#[test]
-fn a_stiff_lattice_gives_the_dense_lu_s_steps_and_solution() {
-    let m = 8; // 256 unknowns
-    let sys = Lattice::new(m, 1e4, 1e5, 2.0);
+/// The lattice at rest positions displaced by a few per cent, at rest.
+fn lattice_start(m: usize) -> Vec<f64> {
     let nodes = m * m;
     let mut y0 = vec![0.0; 4 * nodes];
     for node in 0..nodes {
@@ -242,6 +240,14 @@ fn a_stiff_lattice_gives_the_dense_lu_s_steps_and_solution() {
         y0[2 * node] = j as f64 + 0.05 * ((i * 7 + j * 3) % 5) as f64 / 5.0;
         y0[2 * node + 1] = i as f64 - 0.03 * ((i * 2 + j * 5) % 7) as f64 / 7.0;
     }
+    y0
+}
+
+#[test]
+fn a_stiff_lattice_gives_the_dense_lu_s_steps_and_solution() {
+    let m = 8; // 256 unknowns
+    let sys = Lattice::new(m, 1e4, 1e5, 2.0);
+    let y0 = lattice_start(m);
     let run = |solver: LinearSolver| {
         let opts = Options {
             rtol: 1e-8.into(),
@@ -345,13 +351,7 @@ fn bdf_decays_the_2d_heat_equation_as_its_closed_form_with_the_sparse_lu() {
 fn bdf_on_a_stiff_lattice_gives_the_dense_lu_s_steps_and_solution() {
     let m = 8; // 256 unknowns
     let sys = Lattice::new(m, 1e4, 1e5, 2.0);
-    let nodes = m * m;
-    let mut y0 = vec![0.0; 4 * nodes];
-    for node in 0..nodes {
-        let (i, j) = (node / m, node % m);
-        y0[2 * node] = j as f64 + 0.05 * ((i * 7 + j * 3) % 5) as f64 / 5.0;
-        y0[2 * node + 1] = i as f64 - 0.03 * ((i * 2 + j * 5) % 7) as f64 / 7.0;
-    }
+    let y0 = lattice_start(m);
     let run = |solver: LinearSolver| {
         let opts = Options {
             rtol: 1e-8.into(),

@@ -787,7 +787,6 @@ fn a_free_net_under_load_is_a_mechanism_on_the_net_path() {
 /// and follows the dense LU's run to round-off.
 #[test]
 fn radau_gets_the_dense_jacobian_as_a_sparse_one() {
-    use pdyn_ode::{solve, LinearSolver, Method, Options};
     // 6 × 6 with two pins: 34 particles, 204 states (Radau5 factors sparsely from 200).
     let src = net_source(6, 6, Some(0.5));
     for path in [NetPath::Always, NetPath::Never] {
@@ -824,19 +823,7 @@ fn radau_gets_the_dense_jacobian_as_a_sparse_one() {
         // A net is sparse: each particle meets its neighbours only.
         assert!(pattern.nnz() * 10 < dim * dim, "{} entries", pattern.nnz());
     }
-    // Stiff springs (k = 4e5 against m = 0.05: ω ≈ 2,800 rad/s) over 0.05 s.
-    let stiff = src.replace("k = 400.0", "k = 4.0e5");
-    let (_, prep) = prepare(&stiff, NetPath::Auto);
-    let run = |solver: LinearSolver| {
-        let opts = Options {
-            rtol: 1e-6.into(),
-            atol: 1e-9.into(),
-            linear_solver: solver,
-            ..Default::default()
-        };
-        solve(Method::Radau5, &prep.system, (0.0, 0.05), &prep.y0, &opts).unwrap()
-    };
-    let (sparse, dense) = (run(LinearSolver::Auto), run(LinearSolver::Dense));
+    let (sparse, dense) = stiff_net_runs(pdyn_ode::Method::Radau5);
     assert!(sparse.stats.sparse_lu && !dense.stats.sparse_lu);
     let (na, nb) = (dense.stats.accepted, sparse.stats.accepted);
     assert!(
@@ -849,11 +836,11 @@ fn radau_gets_the_dense_jacobian_as_a_sparse_one() {
     assert!(d < 1e-6, "sparse and dense runs differ by {d:e}");
 }
 
-/// BDF (MATLAB's `ode15s`, SciPy's `BDF`) factors `I − c·J` of a stiff net on the model's
-/// sparse pattern too, and follows the dense LU's run to the Newton tolerance.
-#[test]
-fn bdf_factors_a_stiff_net_sparsely() {
-    use pdyn_ode::{solve, LinearSolver, Method, Options};
+/// The 6 × 6 net with stiff springs (k = 4e5 against m = 0.05: ω ≈ 2,800 rad/s; 204 states)
+/// over 0.05 s by `method`, its iteration matrices factored as `LinearSolver::Auto` decides
+/// (sparse) and densely: `(auto, dense)`.
+fn stiff_net_runs(method: pdyn_ode::Method) -> (pdyn_ode::Solution, pdyn_ode::Solution) {
+    use pdyn_ode::{solve, LinearSolver, Options};
     let stiff = net_source(6, 6, Some(0.5)).replace("k = 400.0", "k = 4.0e5");
     let (_, prep) = prepare(&stiff, NetPath::Auto);
     let run = |solver: LinearSolver| {
@@ -863,9 +850,16 @@ fn bdf_factors_a_stiff_net_sparsely() {
             linear_solver: solver,
             ..Default::default()
         };
-        solve(Method::Bdf, &prep.system, (0.0, 0.05), &prep.y0, &opts).unwrap()
+        solve(method, &prep.system, (0.0, 0.05), &prep.y0, &opts).unwrap()
     };
-    let (sparse, dense) = (run(LinearSolver::Auto), run(LinearSolver::Dense));
+    (run(LinearSolver::Auto), run(LinearSolver::Dense))
+}
+
+/// BDF (MATLAB's `ode15s`, SciPy's `BDF`) factors `I − c·J` of a stiff net on the model's
+/// sparse pattern too, and follows the dense LU's run to the Newton tolerance.
+#[test]
+fn bdf_factors_a_stiff_net_sparsely() {
+    let (sparse, dense) = stiff_net_runs(pdyn_ode::Method::Bdf);
     assert!(sparse.stats.sparse_lu && !dense.stats.sparse_lu);
     let (na, nb) = (dense.stats.accepted, sparse.stats.accepted);
     assert!(na > 20, "{na} steps: not exercised");

@@ -4,7 +4,7 @@
 //! `splu` when given `jac_sparsity`). The integrator calls the same three operations either
 //! way.
 
-use super::iteration_pattern::{sparse_pattern, IterationPattern};
+use super::iteration_pattern::{evaluate_jacobian, sparse_pattern, IterationPattern};
 use crate::error::OdeError;
 use crate::jacobian::{FdJacobian, Sparsity};
 use crate::linalg::Lu;
@@ -82,26 +82,11 @@ impl BdfMatrix {
     ) {
         match self {
             BdfMatrix::Dense(d) => {
-                if sys.has_jacobian() {
-                    sys.jacobian(t, y, &mut d.jac);
-                } else {
-                    fd.eval(
-                        sys,
-                        opts.jac_sparsity.as_deref(),
-                        t,
-                        y,
-                        f0,
-                        &mut d.jac,
-                        stats,
-                    );
-                }
+                evaluate_jacobian(sys, opts, fd, None, t, y, f0, &mut d.jac, stats)
             }
             BdfMatrix::Sparse(s) => {
-                if sys.has_sparse_jacobian() {
-                    sys.sparse_jacobian(t, y, &mut s.jac);
-                } else {
-                    fd.eval_sparse(sys, &s.sparsity, t, y, f0, &mut s.jac, stats);
-                }
+                let pattern = Some(&*s.sparsity);
+                evaluate_jacobian(sys, opts, fd, pattern, t, y, f0, &mut s.jac, stats)
             }
         }
     }

@@ -1,11 +1,13 @@
-//! The sparse form shared by the implicit methods: whether to factor sparsely, and the
-//! pattern of an iteration matrix `c·I − J` (Radau5) or `I − c·J` (BDF) — `J`'s entries and
-//! the whole diagonal — analysed once for every factorization of the run.
+//! The sparse form shared by the implicit methods: whether to factor sparsely, the pattern of
+//! an iteration matrix `c·I − J` (Radau5) or `I − c·J` (BDF) — `J`'s entries and the whole
+//! diagonal — analysed once for every factorization of the run, and `J` evaluated dense or
+//! on that pattern.
 
 use crate::error::{invalid, OdeError};
-use crate::jacobian::Sparsity;
+use crate::jacobian::{FdJacobian, Sparsity};
 use crate::options::{LinearSolver, Options};
 use crate::problem::{MassKind, OdeSystem};
+use crate::solution::Stats;
 use crate::sparse_lu::{Pattern, Symbolic};
 use std::sync::Arc;
 
@@ -62,6 +64,32 @@ pub(crate) fn sparse_pattern<S: OdeSystem + ?Sized>(
         LinearSolver::Auto => !mass && n >= SPARSE_FROM && !analytic_dense_only,
     };
     Ok(sparsity.filter(|_| sparse))
+}
+
+/// Evaluates `J` at `(t, y)`, `f0 = f(t, y)`, into `jac`: analytic when the system has it,
+/// else by finite differences. Dense (`sparse` `None`: row-major `n × n`, the differences
+/// grouped by [`Options::jac_sparsity`] when given) or on the pattern `sparse` (its entries
+/// column after column, the differences grouped by it).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn evaluate_jacobian<S: OdeSystem + ?Sized>(
+    sys: &S,
+    opts: &Options,
+    fd: &mut FdJacobian,
+    sparse: Option<&Sparsity>,
+    t: f64,
+    y: &[f64],
+    f0: &[f64],
+    jac: &mut [f64],
+    stats: &mut Stats,
+) {
+    match sparse {
+        None if sys.has_jacobian() => sys.jacobian(t, y, jac),
+        // The n perturbed states (or one per group of columns of `jac_sparsity`), evaluated
+        // in one batch (one call of a vectorized right-hand side).
+        None => fd.eval(sys, opts.jac_sparsity.as_deref(), t, y, f0, jac, stats),
+        Some(_) if sys.has_sparse_jacobian() => sys.sparse_jacobian(t, y, jac),
+        Some(pattern) => fd.eval_sparse(sys, pattern, t, y, f0, jac, stats),
+    }
 }
 
 /// The pattern of `J` plus the diagonal, analysed for the sparse LU, and where `J`'s entries

@@ -3,7 +3,7 @@
 //! DECSOL), or sparse, factored by [`crate::sparse_lu`] when the Jacobian's pattern is known
 //! ([`crate::LinearSolver`]). The integrator calls the same four operations either way.
 
-use super::iteration_pattern::{sparse_pattern, IterationPattern};
+use super::iteration_pattern::{evaluate_jacobian, sparse_pattern, IterationPattern};
 use crate::error::OdeError;
 use crate::jacobian::{FdJacobian, Sparsity};
 use crate::linalg::{Lu, LuComplex};
@@ -90,29 +90,11 @@ impl Systems {
     ) {
         match self {
             Systems::Dense(d) => {
-                if sys.has_jacobian() {
-                    sys.jacobian(t, y, &mut d.fjac);
-                } else {
-                    // The n perturbed states (or one per group of columns of
-                    // `jac_sparsity`), evaluated in one batch (one call of a vectorized
-                    // right-hand side).
-                    fd.eval(
-                        sys,
-                        opts.jac_sparsity.as_deref(),
-                        t,
-                        y,
-                        f0,
-                        &mut d.fjac,
-                        stats,
-                    );
-                }
+                evaluate_jacobian(sys, opts, fd, None, t, y, f0, &mut d.fjac, stats)
             }
             Systems::Sparse(s) => {
-                if sys.has_sparse_jacobian() {
-                    sys.sparse_jacobian(t, y, &mut s.jac);
-                } else {
-                    fd.eval_sparse(sys, &s.sparsity, t, y, f0, &mut s.jac, stats);
-                }
+                let pattern = Some(&*s.sparsity);
+                evaluate_jacobian(sys, opts, fd, pattern, t, y, f0, &mut s.jac, stats)
             }
         }
     }
