@@ -120,11 +120,12 @@ pub struct EigenPairs {
     pub factor_entries: usize,
 }
 
-/// splitmix64 numbers in [-1, 1): the start vectors (fixed seeds, the results reproducible).
-struct Start(u64);
+/// splitmix64 numbers in [-1, 1): the start vectors (fixed seeds, the results reproducible);
+/// also the tests' seeded matrices.
+pub(crate) struct Start(pub(crate) u64);
 
 impl Start {
-    fn next(&mut self) -> f64 {
+    pub(crate) fn next(&mut self) -> f64 {
         self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);

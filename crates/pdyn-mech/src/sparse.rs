@@ -726,15 +726,8 @@ mod tests {
 
     /// A seeded generator of numbers in [-1, 1) (splitmix64).
     fn rng(seed: u64) -> impl FnMut() -> f64 {
-        let mut s = seed;
-        move || {
-            s = s.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = s;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            z ^= z >> 31;
-            (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-        }
+        let mut s = crate::lanczos::Start(seed);
+        move || s.next()
     }
 
     /// A random symmetric matrix with a random sparse pattern, diagonally shifted by `shift`.

@@ -424,6 +424,19 @@ mod tests {
         Csr::from_triplets(3 * m * m, &t).unwrap()
     }
 
+    /// `x` is `a⁻¹ b` as nalgebra's dense LU gives it, to `tol` of its largest component.
+    fn assert_solves_as_dense(a: &Csr, b: &[f64], x: &[f64], tol: f64, what: &str) {
+        let dense = a
+            .to_dense()
+            .lu()
+            .solve(&nalgebra::DVector::from_vec(b.to_vec()))
+            .unwrap();
+        let big = dense.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+        for (u, v) in x.iter().zip(dense.iter()) {
+            assert!((u - v).abs() <= tol * big, "{what}: {u} vs {v}");
+        }
+    }
+
     #[test]
     fn steps_solve_as_the_dense_lu_definite_or_not_and_after_a_change_of_pattern() {
         for (m, shift, seed) in [(4, 9.0, 1u64), (11, 6.0, 2), (11, -2.5, 3)] {
@@ -433,27 +446,11 @@ mod tests {
             assert!(matches!(solver, StepSolver::Lu { .. }));
             let b: Vec<f64> = (0..n).map(|i| ((i * 7) % 13) as f64 - 6.0).collect();
             let x = solver.solve(&a, &b).unwrap();
-            let dense = a
-                .to_dense()
-                .lu()
-                .solve(&nalgebra::DVector::from_vec(b.clone()))
-                .unwrap();
-            let big = dense.iter().fold(0.0f64, |s, v| s.max(v.abs()));
-            for (u, v) in x.iter().zip(dense.iter()) {
-                assert!((u - v).abs() <= 1e-10 * big, "m = {m}: {u} vs {v}");
-            }
+            assert_solves_as_dense(&a, &b, &x, 1e-10, &format!("m = {m}"));
             // Another pattern (the grid one node smaller) is analysed again, not misread.
             let small = grid(m - 1, shift, seed);
             let y = solver.solve(&small, &b[..small.n]).unwrap();
-            let dense = small
-                .to_dense()
-                .lu()
-                .solve(&nalgebra::DVector::from_vec(b[..small.n].to_vec()))
-                .unwrap();
-            let big = dense.iter().fold(0.0f64, |s, v| s.max(v.abs()));
-            for (u, v) in y.iter().zip(dense.iter()) {
-                assert!((u - v).abs() <= 1e-10 * big, "m = {m} − 1: {u} vs {v}");
-            }
+            assert_solves_as_dense(&small, &b[..small.n], &y, 1e-10, &format!("m = {m} − 1"));
         }
     }
 
@@ -476,15 +473,7 @@ mod tests {
         assert!(matches!(solver, StepSolver::Envelope { .. }));
         let b: Vec<f64> = (0..n).map(|i| ((i * 5) % 11) as f64 - 5.0).collect();
         let x = solver.solve(&a, &b).unwrap();
-        let dense = a
-            .to_dense()
-            .lu()
-            .solve(&nalgebra::DVector::from_vec(b.clone()))
-            .unwrap();
-        let big = dense.iter().fold(0.0f64, |s, v| s.max(v.abs()));
-        for (u, v) in x.iter().zip(dense.iter()) {
-            assert!((u - v).abs() <= 1e-12 * big, "{u} vs {v}");
-        }
+        assert_solves_as_dense(&a, &b, &x, 1e-12, "chain");
     }
 
     #[test]
