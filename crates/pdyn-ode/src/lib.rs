@@ -335,8 +335,9 @@ impl Method {
     }
 
     /// The explicit pair [`Method::Auto`] integrates with (until stiffness is detected) at
-    /// this `rtol` ([`Options::rtol`]): DOPRI5 when every component's `rtol` is ≥ [`AUTO_DOP853_BELOW`], DOP853
-    /// otherwise. The tightest component decides, since it sets the step size.
+    /// this `rtol` ([`Options::rtol`]): DOPRI5 when every component's `rtol` is above
+    /// [`AUTO_DOP853_FROM`], DOP853 otherwise. The tightest component decides, since it sets the
+    /// step size.
     ///
     /// Why these two and this threshold: f-evaluations measured with `pdyn run --method M
     /// --rtol R --atol 1e-14` (release build) on examples/satellite.toml,
@@ -352,16 +353,21 @@ impl Method {
     /// | 1e-11 | 30986 / 3278 / 15674 / 61592 | 7094 / 1062 / 4014 / 21725 | 8312 / 895 / 3948 / 18602 |
     /// | 1e-13 | 70982 / 6464 / 34910 / 136742 | 12374 / 1539 / 6264 / 33929 | 12498 / 1201 / 5762 / 27263 |
     ///
-    /// DOP853 overtakes DOPRI5 between rtol 1e-5 and 1e-6 (at 1e-6 it saves 0–44 %, at 1e-7
-    /// 18–53 %); the threshold keeps DOPRI5 at the default rtol 1e-6, where the two are close
-    /// and DOPRI5's smaller steps give more output rows for free. Vern9 saves at most ~22 % over
-    /// DOP853 even at 1e-13 (and costs more on the satellite), while it has neither a
-    /// stiffness detector (the switch to Radau5 would be lost) nor more than a cubic Hermite
-    /// dense output (outputs at `t_eval` and events would be third-order only), so `auto`
-    /// never picks it.
+    /// DOP853 overtakes DOPRI5 between rtol 1e-5 and 1e-6: at 1e-6 it saves 0–44 % on these
+    /// four, and at the default tolerances of the model files (rtol 1e-6, `atol` theirs) it
+    /// saves 36 % on examples/hanging_net.toml (6,620 → 4,254), 28 % on examples/truss.toml
+    /// (2,120 → 1,535), 6 % on the 100 × 100 cloth and **52 % on the 8 s run of the 20 × 20 net**
+    /// (35,294 → 17,026: issue 33's case); at 1e-7 18–53 %. So the default rtol 1e-6 takes
+    /// DOP853 (until 2026-11-28 it kept DOPRI5 there, for its smaller steps' extra output rows;
+    /// rows at given times, `points`, cost nothing extra with either). Only runs of a few steps
+    /// pay DOP853's twelve stages for nothing (examples/pulley.toml: 32 → 86). Vern9 saves at
+    /// most ~22 % over DOP853 even at 1e-13 (and costs more on the satellite), while it has
+    /// neither a stiffness detector (the switch to Radau5 would be lost) nor more than a cubic
+    /// Hermite dense output (outputs at `t_eval` and events would be third-order only), so
+    /// `auto` never picks it.
     pub fn auto_explicit(rtol: &Tolerance) -> Method {
         // NaN (refused later by the options' check) keeps DOPRI5.
-        if rtol.tightest() < AUTO_DOP853_BELOW {
+        if rtol.tightest() <= AUTO_DOP853_FROM {
             Method::Dop853
         } else {
             Method::Dopri5
@@ -492,11 +498,12 @@ fn dispatch<S: OdeSystem + ?Sized>(
     }
 }
 
-/// [`Method::Auto`] integrates with DOP853 rather than DOPRI5 when `rtol` is below this
+/// [`Method::Auto`] integrates with DOP853 rather than DOPRI5 when `rtol` is this or tighter
 /// (measurements in [`Method::auto_explicit`]).
-pub const AUTO_DOP853_BELOW: f64 = 1e-6;
+pub const AUTO_DOP853_FROM: f64 = 1e-6;
 
-const AUTO_DOC: &str = "DOPRI5 (rtol ≥ 1e-6) or DOP853 (tighter), with Hairer's stiffness \
+const AUTO_DOC: &str =
+    "DOPRI5 (rtol above 1e-6) or DOP853 (1e-6 and tighter), with Hairer's stiffness \
 detection; switches to Radau5 for the rest of the interval when the problem becomes stiff.";
 
 /// `Method::Auto`: the explicit pair of [`Method::auto_explicit`] until its stiffness detector

@@ -16,8 +16,9 @@ from ._result import OdeResult, _from_ivp
 
 # SciPy's names of methods pdyn runs with another of its own methods, and what it says.
 _MAPPED = {
-    "lsoda": ("auto", "LSODA ran as pdyn's auto (DOPRI5, switching to Radau when it detects "
-                      "stiffness, as LSODA switches from Adams to BDF)"),
+    "lsoda": ("auto", "LSODA ran as pdyn's auto (DOPRI5, or DOP853 at rtol <= 1e-6, "
+                      "switching to Radau when it detects stiffness, as LSODA switches "
+                      "from Adams to BDF)"),
 }
 _IMPLICIT = {"radau", "radau5", "bdf", "ode15s", "lsoda", "auto"}
 _EXPLICIT = {"rk45", "rk23", "dop853", "dopri5", "tsit5", "vern9", "ode45", "ode23", "rk4"}
@@ -67,8 +68,9 @@ def solve_ivp(fun: Union[Callable[..., Any], Sequence[str]], t_span: Tuple[float
 
     ``method``: ``"RK45"`` (default; DOPRI5), ``"RK23"`` (Bogacki-Shampine), ``"DOP853"``,
     ``"Radau"``, ``"BDF"`` (variable order 1-5 with the NDF coefficients, as SciPy's);
-    ``"LSODA"`` runs as pdyn's ``auto`` (DOPRI5 switching to Radau when stiff) -- the
-    ``message`` says so; or pdyn's own (``"Tsit5"``, ``"Vern9"``, ...; :func:`pdyn.methods`).
+    ``"LSODA"`` runs as pdyn's ``auto`` (DOPRI5, or DOP853 at ``rtol <= 1e-6``, switching to
+    Radau when stiff) -- the ``message`` says so; or pdyn's own (``"Tsit5"``, ``"Vern9"``,
+    ...; :func:`pdyn.methods`).
 
     ``jac_sparsity`` (an ``(n, n)`` array or sparse matrix, nonzero where the Jacobian may be)
     groups the columns of the finite-difference Jacobian of Radau, BDF and LSODA, one
