@@ -293,7 +293,61 @@ fn each_spring_is_one_element_and_parameters_are_not_gathered() {
             6 * (springs - at_corners) + 3 * at_corners + 3 * particles,
             "{nx}x{ny}: gathered values"
         );
+        // Terms of the accelerations: a spring's force on each free end (three components),
+        // the drag on each particle (three), gravity (along z). All but gravity's are summed
+        // three at a time, a particle's x, y and z together.
+        let together = 6 * (springs - at_corners) + 3 * at_corners + 3 * particles;
+        assert_eq!(
+            k.terms_summed(),
+            (together as usize, (together + particles) as usize),
+            "{nx}x{ny}: terms summed together, in all"
+        );
     }
+}
+
+/// The right-hand side reads the state where the integrator keeps it and writes the
+/// accelerations where they go (`NetKernels::accelerations_of_state`): the same bits as the
+/// accelerations from the input vector `[t, q, q', parameters]`, whatever stale state that
+/// vector holds.
+#[test]
+fn the_state_read_in_place_gives_the_accelerations_of_the_input_vector() {
+    let (_, prep) = prepare(&net_source(5, 4, Some(0.02)), NetPath::Always);
+    let k = prep.system.net_kernels().expect("a net");
+    let y = perturbed(&prep.y0);
+    let n = y.len() / 2;
+    let parameters = prep.system.parameters();
+    let input: Vec<f64> = [0.25]
+        .iter()
+        .chain(&y)
+        .chain(&parameters)
+        .copied()
+        .collect();
+    let mut from_input = vec![0.0; n];
+    k.accelerations(&input, &mut from_input);
+    // A stale state in the vector: only t and the parameters are read from it.
+    let stale: Vec<f64> = [0.25]
+        .iter()
+        .chain(&prep.y0)
+        .chain(&parameters)
+        .copied()
+        .collect();
+    let mut in_place = vec![f64::NAN; n];
+    k.accelerations_of_state(&y, &stale, &mut in_place);
+    for (r, (a, b)) in in_place.iter().zip(&from_input).enumerate() {
+        assert_eq!(
+            a.to_bits(),
+            b.to_bits(),
+            "acceleration {r}: {a:e} against {b:e}"
+        );
+    }
+    // And the system's right-hand side is that: the rates, then the accelerations.
+    let mut dydt = vec![f64::NAN; 2 * n];
+    prep.system.rhs(0.25, &y, &mut dydt);
+    assert_eq!(&dydt[..n], &y[n..]);
+    assert!(dydt[n..]
+        .iter()
+        .zip(&from_input)
+        .all(|(a, b)| a.to_bits() == b.to_bits()));
 }
 
 /// A parameter's column, filled once, is filled again when the parameter changes (a sweep's

@@ -9,6 +9,7 @@
 //! parameter, `t`: its column is refilled only when its value changes).
 
 use super::structure::{self, Group, Source, Structure};
+use super::sums::Sums;
 use pdyn_expr::compile::CompileError;
 use pdyn_expr::{Id, Pool, Program};
 use pdyn_jit::{BatchKernel, JitMode};
@@ -50,26 +51,28 @@ struct Kernel {
     /// The gathered input columns, kept between evaluations: the columns of parameters are
     /// refilled only when a parameter's value changed.
     columns: RefCell<Columns>,
-    /// One more than the largest index the gather table reads: an input vector at least this
-    /// long is checked once per gather, not once per value.
+    /// One more than the largest index of `[t, q, q', parameters]` a broadcast input reads,
+    /// and of `[q, q']` a per-element input reads: vectors at least this long are checked
+    /// once per gather, not once per value.
     input_len: usize,
+    state_len: usize,
 }
 
 /// Where one kernel input comes from, element by element.
 #[derive(Clone)]
 enum Gather {
-    /// Per element, the index of its value in `[t, q, q', parameters]`.
+    /// Per element, the index of its value in the state `[q, q']` (a coordinate or a rate).
     Each(Vec<u32>),
     /// The same entry for every element (a parameter, `t`).
     Broadcast(u32),
 }
 
 impl Gather {
-    /// The index of element `e`'s value.
-    fn at(&self, e: usize) -> u32 {
+    /// The index in the state `[q, q']` of element `e`'s value, if it is a state's.
+    fn state_index(&self, e: usize) -> Option<u32> {
         match self {
-            Gather::Each(from) => from[e],
-            Gather::Broadcast(i) => *i,
+            Gather::Each(from) => Some(from[e]),
+            Gather::Broadcast(_) => None,
         }
     }
 }
@@ -89,12 +92,10 @@ pub struct NetKernels {
     kernels: Vec<Kernel>,
     /// Every kernel's output columns, one after the other.
     outputs: RefCell<Vec<f64>>,
-    /// The sum forming each acceleration (a free coordinate in state order), as rows of a
-    /// sparse matrix: the terms of acceleration `r` are the outputs at
-    /// `terms[term_start[r]..term_start[r + 1]]`. Summed row by row, each sum in a register,
-    /// instead of adding each output into its acceleration in memory.
-    term_start: Vec<u32>,
-    terms: Vec<u32>,
+    /// The sum forming each acceleration (a free coordinate in state order) from the
+    /// outputs, each sum in a register instead of adding each output into its acceleration in
+    /// memory; a particle's three sums together ([`Sums`]).
+    sums: Sums,
     /// Free coordinates.
     n: usize,
     /// Whether every kernel that has elements runs native code.
@@ -173,14 +174,18 @@ impl NetKernels {
                 }
             }
             let jacobian_program = Program::compile(pool, &leaves, &derivatives)?;
-            let input_len = gather
-                .iter()
-                .map(|g| match g {
-                    Gather::Each(from) => from.iter().max().map_or(0, |&i| i as usize + 1),
-                    Gather::Broadcast(i) => *i as usize + 1,
-                })
-                .max()
-                .unwrap_or(0);
+            let len = |each: bool| {
+                gather
+                    .iter()
+                    .filter_map(|g| match g {
+                        Gather::Each(from) if each => from.iter().max().map(|&i| i as usize + 1),
+                        Gather::Broadcast(i) if !each => Some(*i as usize + 1),
+                        _ => None,
+                    })
+                    .max()
+                    .unwrap_or(0)
+            };
+            let (input_len, state_len) = (len(false), len(true));
             let columns = Columns {
                 inputs: vec![vec![0.0; elements]; kernel.n_inputs()],
                 filled: vec![f64::NAN.to_bits(); kernel.n_inputs()],
@@ -200,6 +205,7 @@ impl NetKernels {
                 elements,
                 columns: RefCell::new(columns),
                 input_len,
+                state_len,
             });
         }
         let native = kernels
@@ -212,15 +218,17 @@ impl NetKernels {
         }
         let (term_start, terms) = sums(&kernels, n);
         // Every term is an output (the sums index the outputs they were built from): checked
-        // here once, so that the sums read them unchecked.
-        if terms.iter().any(|&t| t as usize >= at) || term_start.len() != n + 1 {
+        // here once (`Sums::new`), so that the sums read them unchecked.
+        if term_start.len() != n + 1 {
             return Ok(None);
         }
+        let Some(sums) = Sums::new(&term_start, &terms, &structure.axes, at) else {
+            return Ok(None);
+        };
         Ok(Some(NetKernels {
             kernels,
             outputs: RefCell::new(vec![0.0; at]),
-            term_start,
-            terms,
+            sums,
             n,
             native: native && jit == JitMode::Auto,
             reads_rates,
@@ -268,6 +276,12 @@ impl NetKernels {
             .sum()
     }
 
+    /// Terms summed into the accelerations per evaluation: three at a time (a particle's x,
+    /// y and z together, [`Sums`]) and in all (deterministic counts).
+    pub fn terms_summed(&self) -> (usize, usize) {
+        (self.sums.together(), self.sums.terms())
+    }
+
     /// Whether the large kernels run as native code.
     pub fn is_native(&self) -> bool {
         self.native
@@ -283,16 +297,20 @@ impl NetKernels {
     pub fn accelerations(&self, input: &[f64], acc: &mut [f64]) {
         let outputs = &mut *self.outputs.borrow_mut();
         for k in &self.kernels {
-            run_kernel(k, input, outputs);
+            run_kernel(k, Values::Input(input), outputs);
         }
-        for (a, w) in acc[..self.n].iter_mut().zip(self.term_start.windows(2)) {
-            *a = self.terms[w[0] as usize..w[1] as usize]
-                .iter()
-                // SAFETY: every term indexes the outputs (checked in `compile`, which sized
-                // them; they are never resized).
-                .map(|&i| unsafe { *outputs.get_unchecked(i as usize) })
-                .sum();
+        self.sums.sum_into(outputs, &mut acc[..self.n]);
+    }
+
+    /// The same accelerations at the state `y = [q, q']`, read where it is: `input = [t, q,
+    /// q', parameters]` gives `t` and the parameters only (its `q`, `q'` are not read, so the
+    /// caller need not copy the state there at every evaluation).
+    pub fn accelerations_of_state(&self, y: &[f64], input: &[f64], acc: &mut [f64]) {
+        let outputs = &mut *self.outputs.borrow_mut();
+        for k in &self.kernels {
+            run_kernel(k, Values::State { y, input }, outputs);
         }
+        self.sums.sum_into(outputs, &mut acc[..self.n]);
     }
 
     /// True when no load acts along a particle's component that is constant in time: the
@@ -323,7 +341,7 @@ impl NetKernels {
                 continue;
             }
             let outputs = &mut *self.outputs.borrow_mut();
-            run_kernel(k, input, outputs);
+            run_kernel(k, Values::Input(input), outputs);
             let outs = &outputs[k.at..k.at + k.scatter.len() * k.elements];
             for (a, pushed) in k.acts.iter().enumerate() {
                 for (e, &p) in pushed.iter().enumerate() {
@@ -380,7 +398,7 @@ impl NetKernels {
                 return false;
             };
             let cols = &mut *k.columns.borrow_mut();
-            gather(k, input, cols);
+            gather(k, Values::Input(input), cols);
             let outputs = k.jacobian_entries.len();
             if cols.jacobian.len() < outputs {
                 cols.jacobian.resize(outputs, vec![0.0; k.elements]);
@@ -398,8 +416,9 @@ impl NetKernels {
                     if row == NONE {
                         continue;
                     }
-                    // The gathered index is 1 + the state index of the input.
-                    term(row as usize, from.at(e) as usize - 1, value);
+                    if let Some(column) = from.state_index(e) {
+                        term(row as usize, column as usize, value);
+                    }
                 }
             }
         }
@@ -414,7 +433,7 @@ impl NetKernels {
 
 /// Runs `k` over its elements at `input`: its output columns, one value per element, in its
 /// part of `outputs`.
-fn run_kernel(k: &Kernel, input: &[f64], outputs: &mut [f64]) {
+fn run_kernel(k: &Kernel, input: Values, outputs: &mut [f64]) {
     if k.elements == 0 {
         return;
     }
@@ -427,7 +446,7 @@ fn run_kernel(k: &Kernel, input: &[f64], outputs: &mut [f64]) {
     k.kernel.run(&ins, &mut outs);
 }
 
-/// The terms of each acceleration (the rows of `NetKernels::terms`): every output not identically
+/// The terms of each acceleration (the rows [`Sums`] is built from): every output not identically
 /// zero of every element, by the acceleration it adds to (kernel by kernel, output by output,
 /// element by element within one acceleration).
 fn sums(kernels: &[Kernel], n: usize) -> (Vec<u32>, Vec<u32>) {
@@ -462,21 +481,37 @@ fn sums(kernels: &[Kernel], n: usize) -> (Vec<u32>, Vec<u32>) {
     (count, terms)
 }
 
-/// Fills the input columns of kernel `k` from `input`: every element's coordinates, and a
+/// Where a kernel's inputs are read.
+#[derive(Clone, Copy)]
+enum Values<'a> {
+    /// Everything from `[t, q, q', parameters]`.
+    Input(&'a [f64]),
+    /// The per-element values (coordinates, rates) from the state `y = [q, q']`, `t` and the
+    /// parameters from `input` (whose `q`, `q'` are not read).
+    State { y: &'a [f64], input: &'a [f64] },
+}
+
+/// Fills the input columns of kernel `k` from `values`: every element's coordinates, and a
 /// parameter's column only when its value changed since it was filled.
-fn gather(k: &Kernel, input: &[f64], cols: &mut Columns) {
+fn gather(k: &Kernel, values: Values, cols: &mut Columns) {
+    let (state, input) = match values {
+        Values::Input(input) => (input.get(1..).unwrap_or_default(), input),
+        Values::State { y, input } => (y, input),
+    };
     assert!(
-        input.len() >= k.input_len,
-        "net kernel inputs: {} values, the gather table reads {}",
+        input.len() >= k.input_len && state.len() >= k.state_len,
+        "net kernel inputs: {} values, {} of state; the gather table reads {}, {}",
         input.len(),
-        k.input_len
+        state.len(),
+        k.input_len,
+        k.state_len
     );
     for ((col, from), filled) in cols.inputs.iter_mut().zip(&k.gather).zip(&mut cols.filled) {
         match from {
             Gather::Each(from) => {
                 for (x, &i) in col.iter_mut().zip(from) {
-                    // SAFETY: `i < k.input_len <= input.len()` (asserted above).
-                    *x = unsafe { *input.get_unchecked(i as usize) };
+                    // SAFETY: `i < k.state_len <= state.len()` (asserted above).
+                    *x = unsafe { *state.get_unchecked(i as usize) };
                 }
             }
             Gather::Broadcast(i) => {
@@ -507,7 +542,7 @@ fn gather_table(
                 .map(|e| {
                     let particle = g.particles[e * g.slots + slot as usize] as usize;
                     let q = structure.axes[particle][axis as usize]?;
-                    Some(1 + order as u32 * n as u32 + q)
+                    Some(order as u32 * n as u32 + q)
                 })
                 .collect::<Option<Vec<u32>>>()
                 .map(Gather::Each),

@@ -24,6 +24,7 @@ pub mod kernels;
 pub mod linearization;
 pub mod statics;
 pub mod structure;
+mod sums;
 
 use super::compiled::CompiledModel;
 use super::SimError;
