@@ -332,3 +332,66 @@ position = "r_P[i] + [0, 0, 1]"
         assert_eq!(position, [x, "0".into(), "1".into()], "R[{i}]");
     }
 }
+
+/// `examples/chain_modes.toml` with `n` masses.
+fn chain(n: usize) -> String {
+    include_str!("../../../examples/chain_modes.toml").replacen(
+        "n = 30\n",
+        &format!("n = {n}\n"),
+        1,
+    )
+}
+
+/// The names of members a load makes, on this thread.
+fn names_made_loading(src: &str) -> u64 {
+    let before = pdyn_mech::model::families::names_made();
+    pdyn_mech::model::load_deferring(src, "chain.toml")
+        .unwrap_or_else(|e| panic!("{}", e.render(src)));
+    pdyn_mech::model::families::names_made() - before
+}
+
+/// The springs of a chain find their ends `P[i+1]`, `P[i]` by index: loading `n` more masses
+/// makes exactly `3 n` more names, the keys of `n` coordinates `x[i]` and `n` particles `P[i]`
+/// and the `n` references `x[i]` of the particles' positions, and none for the `n` springs'
+/// `2 n` ends (by name they were `5 n`).
+#[test]
+fn a_chain_s_springs_find_their_ends_without_names() {
+    let (a, b) = (
+        names_made_loading(&chain(100)),
+        names_made_loading(&chain(300)),
+    );
+    assert_eq!(b - a, 3 * 200, "{a} names for 100 masses, {b} for 300");
+}
+
+/// The same ends found by index or by name: a chain loaded with deferral has one spring family
+/// whose members join `P[i+1]` to `P[i]` (the walls' springs, to points, are built), and
+/// loaded in full the springs pull on the particles the names give.
+#[test]
+fn springs_found_by_index_join_the_neighbours() {
+    let n = 7;
+    let m = pdyn_mech::model::load_deferring(&chain(n), "chain.toml").unwrap();
+    let names: Vec<&str> = m.particles.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(
+        names,
+        ["P[1]", "P[2]", "P[3]", "P[4]", "P[5]", "P[6]", "P[7]"]
+    );
+    assert_eq!(m.deferred.len(), 1);
+    let d = &m.deferred[0];
+    // The representative joins P[2] (particle 1) to P[1] (particle 0): spring i = 1.
+    assert_eq!(d.ends, [1, 0]);
+    // Springs i = 2..6 join P[i+1] (particle i) to P[i] (particle i - 1).
+    let members: Vec<Vec<u32>> = d.each().map(|e| e.to_vec()).collect();
+    let expected: Vec<Vec<u32>> = (2..n as u32).map(|i| vec![i, i - 1]).collect();
+    assert_eq!(members, expected);
+}
+
+/// A reference outside its family by index arithmetic is the same located error as before.
+#[test]
+fn a_spring_beyond_the_chain_names_its_member_and_the_family() {
+    let src = chain(30).replace("for = \"i in 0..n\"", "for = \"i in 0..n+1\"");
+    let e = match pdyn_mech::model::load_deferring(&src, "chain.toml") {
+        Ok(_) => panic!("expected an error"),
+        Err(e) => e.render(&src),
+    };
+    assert!(e.contains("spring[i=31]: P[32] is outside P[0..31]"), "{e}");
+}

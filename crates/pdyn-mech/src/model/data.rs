@@ -284,14 +284,15 @@ pub(super) fn is_function_name(s: &str) -> bool {
 
 /// The kind of entry declared under `name` elsewhere in the file, if any.
 fn declared_elsewhere(raw: &RawModel, name: &str) -> Option<&'static str> {
-    let has = |m: &indexmap::IndexMap<Name, super::raw::Sv>| m.keys().any(|k| k.get_ref() == name);
-    if has(&raw.parameters) {
+    let has =
+        |mut keys: indexmap::map::Keys<'_, Name, super::raw::Sv>| keys.any(|k| k.get_ref() == name);
+    if has(raw.parameters.keys()) {
         Some("parameter")
-    } else if has(&raw.coordinates) {
+    } else if has(raw.coordinates.keys()) {
         Some("coordinate")
-    } else if has(&raw.definitions) {
+    } else if has(raw.definitions.keys()) {
         Some("definition")
-    } else if has(&raw.points) {
+    } else if has(raw.points.keys()) {
         Some("point")
     } else if raw.particles.keys().any(|k| k.get_ref() == name) {
         Some("particle")

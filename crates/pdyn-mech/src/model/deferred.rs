@@ -21,8 +21,8 @@
 //! substituted from the representative's into the same pool: the same values, for the
 //! conservation laws of a run that already holds ids of this pool).
 
-use super::families::Names;
-use super::raw::{Name, RawForce, Sv};
+use super::families::End;
+use super::raw::{RawForce, Sv};
 use super::{AxialForce, Load, Model, ModelError, Particle, PotentialTerm, Target};
 use crate::derive::DeriveError;
 use pdyn_expr::{Id, Node, Pool, SymId};
@@ -301,17 +301,17 @@ pub(crate) struct Deferrer {
 }
 
 impl Deferrer {
-    /// Decides for a member of the family `f` (the file's entry) whose name fields are
-    /// `names`; `indices` gives the names of its indices and of every index (none: not a
-    /// member), asked for at the entry's first member only. `particle` finds a particle by
-    /// name.
-    pub fn decide<'n>(
+    /// Decides for a member of the family `f` (the file's entry) whose ends (`between`'s or
+    /// `on`'s, [`ForceEntry::ends`]) are `ends`; `indices` gives the names of its indices and
+    /// of every index (none: not a member), asked for at the entry's first member only.
+    /// `particle` finds the particle an end names.
+    pub fn decide<'n, 'e>(
         &mut self,
         pool: &Pool,
         particles: &[Particle],
-        particle: impl Fn(&str) -> Option<usize>,
+        particle: impl Fn(End<'e>) -> Option<usize>,
         f: &Spanned<RawForce>,
-        names: &Names,
+        ends: Option<([End<'e>; 2], usize)>,
         indices: impl FnOnce() -> Vec<&'n str>,
     ) -> Decision {
         let raw = f.get_ref();
@@ -336,18 +336,13 @@ impl Deferrer {
         }
         // One or two ends (the deferrable kinds have no more): on the stack, nothing
         // allocated for a member that joins its family's representative.
-        let names: &[Name] = match (&names.between, &names.on) {
-            (Some(b), None) => b.get_ref(),
-            (None, Some(on)) => std::slice::from_ref(on),
-            _ => return Decision::Build,
-        };
-        if names.len() > 2 {
+        let Some((names, n)) = ends else {
             return Decision::Build;
-        }
+        };
         let mut ends = [0u32; 2];
         let mut shapes: [Shape; 2] = [(Pool::ZERO, [None; 3]); 2];
-        for (k, name) in names.iter().enumerate() {
-            let Some(i) = particle(name.get_ref()) else {
+        for (k, &name) in names[..n].iter().enumerate() {
+            let Some(i) = particle(name) else {
                 return Decision::Build;
             };
             if ends[..k].contains(&(i as u32)) {
@@ -364,7 +359,6 @@ impl Deferrer {
             ends[k] = i as u32;
             shapes[k] = s;
         }
-        let n = names.len();
         if n != 2 && raw.between.is_some() {
             return Decision::Build;
         }

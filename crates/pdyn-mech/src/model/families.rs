@@ -25,8 +25,9 @@
 //! P[0..19, 0..19]`). Sizes are checked before anything is allocated.
 
 use super::index_expr::{self, ForClause, IndexError, IndexExpr};
+use super::index_program::{IndexProgram, Operand};
 use super::loader::Loader;
-use super::raw::{Name, RawForce, RawModel, RawParticle, Sv};
+use super::raw::{Keyed, Name, RawForce, RawModel, RawParticle, Sv};
 use super::row_tables::RowTable;
 use super::ModelError;
 use indexmap::IndexMap;
@@ -64,7 +65,7 @@ pub(crate) struct Member {
     /// The names of its indices, shared by the family's members.
     pub names: Rc<[String]>,
     /// Their values for this member.
-    pub values: Vec<i64>,
+    pub values: IndexValues,
     /// The table rows it stands for (empty outside families over tables).
     pub rows: Rows,
 }
@@ -81,8 +82,36 @@ impl Member {
         Member {
             base: Rc::clone(base),
             names: Rc::clone(names),
-            values: bindings.iter().map(|b| b.1).collect(),
+            values: IndexValues::of(bindings),
             rows: rows.to_vec(),
+        }
+    }
+}
+
+/// A member's index values: one or two kept inline (nothing allocated, nor freed, for each
+/// of 10^4 members), more on the heap.
+#[derive(Clone, Debug)]
+pub(crate) enum IndexValues {
+    Inline([i64; 2], u8),
+    Heap(Vec<i64>),
+}
+
+impl IndexValues {
+    fn of(bindings: &[(String, i64)]) -> IndexValues {
+        match bindings {
+            [a] => IndexValues::Inline([a.1, 0], 1),
+            [a, b] => IndexValues::Inline([a.1, b.1], 2),
+            more => IndexValues::Heap(more.iter().map(|b| b.1).collect()),
+        }
+    }
+}
+
+impl std::ops::Deref for IndexValues {
+    type Target = [i64];
+    fn deref(&self) -> &[i64] {
+        match self {
+            IndexValues::Inline(v, n) => &v[..*n as usize],
+            IndexValues::Heap(v) => v,
         }
     }
 }
@@ -185,14 +214,77 @@ pub(crate) struct Indices {
     pub tables: Vec<Rc<RowTable>>,
     /// `NAME_c`: the table and column it names.
     pub columns: FxHashMap<String, (usize, usize)>,
+    /// Each particle family's members by their indices (`None`: the family is declared more
+    /// than once, or over tables' rows; its members are then found by name).
+    pub particles: FxHashMap<String, Option<EntriesByIndex>>,
+}
+
+/// The entries of an expanded table that one declaration's members are, by their indices:
+/// row-major over the declared ranges (a force's `between = ["P[i+1]", "P[i]"]` finds its
+/// particles by arithmetic, not by making and hashing `P[4]`).
+#[derive(Clone, Debug)]
+pub(crate) struct EntriesByIndex {
+    ranges: Vec<(i64, i64)>,
+    entries: Vec<u32>,
+}
+
+impl EntriesByIndex {
+    const NONE: u32 = u32::MAX;
+
+    /// No entry yet over `ranges` (their product at most [`MAX_MEMBERS`]: checked before the
+    /// first member is made).
+    fn new(ranges: &[(i64, i64)]) -> EntriesByIndex {
+        let len = ranges
+            .iter()
+            .map(|(lo, hi)| (hi - lo + 1) as usize)
+            .product::<usize>()
+            .min(MAX_MEMBERS as usize);
+        EntriesByIndex {
+            ranges: ranges.to_vec(),
+            entries: vec![Self::NONE; len],
+        }
+    }
+
+    /// Where the member at `values` is kept, `None` outside the ranges.
+    fn slot(&self, values: &[i64]) -> Option<usize> {
+        if values.len() != self.ranges.len() {
+            return None;
+        }
+        let mut at = 0usize;
+        for (&v, &(lo, hi)) in values.iter().zip(&self.ranges) {
+            if v < lo || v > hi {
+                return None;
+            }
+            at = at * (hi - lo + 1) as usize + (v - lo) as usize;
+        }
+        (at < self.entries.len()).then_some(at)
+    }
+
+    fn set(&mut self, values: &[i64], entry: usize) {
+        if let (Some(at), Ok(entry)) = (self.slot(values), u32::try_from(entry)) {
+            self.entries[at] = entry;
+        }
+    }
+
+    /// The entry of the member at `values`, if it is one.
+    pub fn get(&self, values: &[i64]) -> Option<usize> {
+        let e = self.entries[self.slot(values)?];
+        (e != Self::NONE).then_some(e as usize)
+    }
 }
 
 /// A subscripted name parsed: its base and each index expression with its place in the name.
 #[derive(Debug)]
 struct Subscript {
-    base: String,
+    base: Rc<str>,
     parts: Vec<(IndexExpr, usize, usize)>,
+    /// Its parts as [`IndexProgram`]s, for the index names they were compiled with (`None`
+    /// inside: a part names something a program cannot hold).
+    programs: RefCell<Option<ProgramsFor>>,
 }
+
+/// Index names and the programs compiled for them.
+type ProgramsFor = (Vec<String>, Option<Vec<IndexProgram>>);
 
 /// A table's cell that a name (`bars_a`) stands for in a member.
 pub(crate) struct Cell<'a> {
@@ -226,6 +318,16 @@ impl Indices {
                 None => Ok(None),
             }
         }
+    }
+
+    /// `e` with its names resolved once: `names[k]` (a member's indices, in the order its
+    /// values are given) before the sizes, as [`Indices::lookup`] finds them. `None` when `e`
+    /// names anything else (a table's column, an unknown name).
+    pub(crate) fn program(&self, e: &IndexExpr, names: &[String]) -> Option<IndexProgram> {
+        IndexProgram::compile(e, &|n: &str| match names.iter().position(|m| m == n) {
+            Some(k) => Some(Operand::Index(k)),
+            None => self.sizes.get(n).map(|&v| Operand::Constant(v)),
+        })
     }
 
     /// The cell that column `name` (`bars_a`) stands for in the row of its table in `rows`:
@@ -350,54 +452,187 @@ impl Indices {
         bindings: &[(String, i64)],
         rows: &[(usize, usize)],
     ) -> Result<Option<String>, IndexError> {
-        let cached = self.parsed.borrow().get(name).cloned();
-        let subscript = match cached {
-            Some(s) => s,
-            None => {
-                let Some((base, parts)) = index_expr::split_subscript(name) else {
-                    return Ok(None);
-                };
-                let mut parsed = Vec::with_capacity(parts.len());
-                for (text, offset) in &parts {
-                    let e = index_expr::parse(text).map_err(|e| IndexError {
-                        span: e.span.start + offset..e.span.end + offset,
-                        message: e.message,
-                    })?;
-                    parsed.push((e, *offset, text.len()));
-                }
-                let s = Rc::new(Subscript {
-                    base: base.to_string(),
-                    parts: parsed,
-                });
-                self.parsed
-                    .borrow_mut()
-                    .insert(name.to_string(), Rc::clone(&s));
-                s
-            }
+        let Some(subscript) = self.subscript(name)? else {
+            return Ok(None);
         };
-        let base = subscript.base.as_str();
-        let lookup = self.lookup(bindings, rows);
         // One or two indices in practice: kept on the stack (this is once per reference per
         // member).
         let mut inline = [0i64; 4];
         let mut spilled = Vec::new();
         let n = subscript.parts.len();
-        let fits = n <= inline.len();
-        for (k, (e, offset, len)) in subscript.parts.iter().enumerate() {
-            let v = e.int(&lookup).map_err(|e| {
+        let values: &[i64] = if n <= inline.len() {
+            self.subscript_values(&subscript, bindings, rows, &mut inline[..n])?;
+            &inline[..n]
+        } else {
+            spilled.resize(n, 0);
+            self.subscript_values(&subscript, bindings, rows, &mut spilled)?;
+            &spilled
+        };
+        self.check_member(&subscript, values, name, rows)?;
+        Ok(Some(member(&subscript.base, values)))
+    }
+
+    /// [`Indices::member_name`] written into `buf` (cleared first) instead of a new string:
+    /// `Ok(false)` when `name` has no subscript. For a lookup by name that keeps nothing (a
+    /// family's template names `x[i]` for each of 10^4 members).
+    pub fn member_name_into(
+        &self,
+        name: &str,
+        bindings: &[(String, i64)],
+        rows: &[(usize, usize)],
+        buf: &mut String,
+    ) -> Result<bool, IndexError> {
+        let Some(subscript) = self.subscript(name)? else {
+            return Ok(false);
+        };
+        let n = subscript.parts.len();
+        let mut inline = [0i64; 4];
+        let mut spilled = Vec::new();
+        let values: &[i64] = if n <= inline.len() {
+            self.subscript_values(&subscript, bindings, rows, &mut inline[..n])?;
+            &inline[..n]
+        } else {
+            spilled.resize(n, 0);
+            self.subscript_values(&subscript, bindings, rows, &mut spilled)?;
+            &spilled
+        };
+        self.check_member(&subscript, values, name, rows)?;
+        buf.clear();
+        push_member(buf, &subscript.base, values);
+        Ok(true)
+    }
+
+    /// [`Indices::member_name`] without the name: the member's family and indices, checked
+    /// as that checks them. `Ok(None)` when `name` has no subscript or more than two (the
+    /// name then says what it is).
+    pub fn member_ref(
+        &self,
+        name: &str,
+        bindings: &[(String, i64)],
+        rows: &[(usize, usize)],
+    ) -> Result<Option<MemberRef>, IndexError> {
+        let Some(subscript) = self.subscript(name)? else {
+            return Ok(None);
+        };
+        let n = subscript.parts.len();
+        if n > 2 {
+            return Ok(None);
+        }
+        let mut values = [0i64; 2];
+        self.subscript_values(&subscript, bindings, rows, &mut values[..n])?;
+        self.check_member(&subscript, &values[..n], name, rows)?;
+        Ok(Some(MemberRef {
+            base: Rc::clone(&subscript.base),
+            values,
+            len: n as u8,
+        }))
+    }
+
+    /// The entry of `[particles]` (after expansion: the particle's index) that `r` names, when
+    /// its family's members are known by index; `None` otherwise (found by name then).
+    pub fn particle_of(&self, r: &MemberRef) -> Option<usize> {
+        self.particles.get(&*r.base)?.as_ref()?.get(r.values())
+    }
+
+    /// The subscripted name `name` parsed (once per text), or `None` when it has no subscript.
+    fn subscript(&self, name: &str) -> Result<Option<Rc<Subscript>>, IndexError> {
+        if let Some(s) = self.parsed.borrow().get(name) {
+            return Ok(Some(Rc::clone(s)));
+        }
+        let Some((base, parts)) = index_expr::split_subscript(name) else {
+            return Ok(None);
+        };
+        let mut parsed = Vec::with_capacity(parts.len());
+        for (text, offset) in &parts {
+            let e = index_expr::parse(text).map_err(|e| IndexError {
+                span: e.span.start + offset..e.span.end + offset,
+                message: e.message,
+            })?;
+            parsed.push((e, *offset, text.len()));
+        }
+        let s = Rc::new(Subscript {
+            base: Rc::from(base),
+            parts: parsed,
+            programs: RefCell::new(None),
+        });
+        self.parsed
+            .borrow_mut()
+            .insert(name.to_string(), Rc::clone(&s));
+        Ok(Some(s))
+    }
+
+    /// The values of `subscript`'s indices with `bindings`, into `out` (one per part): by its
+    /// programs when they compute them, else (and for the error) by the general evaluation.
+    fn subscript_values(
+        &self,
+        subscript: &Subscript,
+        bindings: &[(String, i64)],
+        rows: &[(usize, usize)],
+        out: &mut [i64],
+    ) -> Result<(), IndexError> {
+        {
+            let mut programs = subscript.programs.borrow_mut();
+            // Compiled for the names of the indices bound: a family's members bind the same
+            // names, so this is once per text and family.
+            let same_names = programs.as_ref().is_some_and(|(names, _)| {
+                names.len() == bindings.len() && names.iter().zip(bindings).all(|(n, b)| *n == b.0)
+            });
+            if !same_names {
+                let names: Vec<String> = bindings.iter().map(|b| b.0.clone()).collect();
+                let compiled: Option<Vec<IndexProgram>> = subscript
+                    .parts
+                    .iter()
+                    .map(|(e, _, _)| self.program(e, &names))
+                    .collect();
+                *programs = Some((names, compiled));
+            }
+            if let Some((_, Some(compiled))) = programs.as_ref() {
+                let mut bound = [0i64; 4];
+                if bindings.len() <= bound.len() {
+                    for (slot, b) in bound.iter_mut().zip(bindings) {
+                        *slot = b.1;
+                    }
+                    let bound = &bound[..bindings.len()];
+                    let mut all = true;
+                    for (o, p) in out.iter_mut().zip(compiled) {
+                        match p.int(bound) {
+                            Some(v) => *o = v,
+                            None => {
+                                all = false;
+                                break;
+                            }
+                        }
+                    }
+                    if all {
+                        return Ok(());
+                    }
+                }
+            }
+        }
+        let lookup = self.lookup(bindings, rows);
+        for (o, (e, offset, len)) in out.iter_mut().zip(&subscript.parts) {
+            *o = e.int(&lookup).map_err(|e| {
                 let span = if e.span == (0..0) { 0..*len } else { e.span };
                 IndexError {
                     span: span.start + offset..span.end + offset,
                     message: e.message,
                 }
             })?;
-            match inline.get_mut(k) {
-                Some(slot) if fits => *slot = v,
-                _ => spilled.push(v),
-            }
         }
-        let values: &[i64] = if fits { &inline[..n] } else { &spilled };
-        let canonical = member(base, values);
+        Ok(())
+    }
+
+    /// Whether the member of `subscript`'s family at `values` is inside its family's shape
+    /// (and among the rows of a family over tables); the error names it (`name` is the text
+    /// referring to it, for the span).
+    fn check_member(
+        &self,
+        subscript: &Subscript,
+        values: &[i64],
+        name: &str,
+        rows: &[(usize, usize)],
+    ) -> Result<(), IndexError> {
+        let base: &str = &subscript.base;
         if let Some(shape) = self.shapes.get(base) {
             let inside = shape.ranges.len() == values.len()
                 && shape
@@ -409,25 +644,49 @@ impl Indices {
                 return Err(IndexError {
                     span: 0..name.len(),
                     message: format!(
-                        "{canonical} is outside {}{}",
+                        "{} is outside {}{}",
+                        member(base, values),
                         shape_text(base, shape),
-                        self.subscript_cells(&subscript, rows)
+                        self.subscript_cells(subscript, rows)
                     ),
                 });
             }
             if let Some(declared) = &shape.rows {
                 if !declared.contains(values) {
+                    let canonical = member(base, values);
                     return Err(IndexError {
                         span: 0..name.len(),
                         message: format!(
                             "{canonical} is not declared: `{base}` is declared over the rows of tables, and no row names {canonical}{}",
-                            self.subscript_cells(&subscript, rows)
+                            self.subscript_cells(subscript, rows)
                         ),
                     });
                 }
             }
         }
-        Ok(Some(canonical))
+        Ok(())
+    }
+}
+
+/// A member of a family named by its indices (`P[i+1]` read for `i = 3`: `P` at `[4]`), its
+/// name `P[4]` made only when something needs it.
+#[derive(Clone, Debug)]
+pub(crate) struct MemberRef {
+    /// The family.
+    pub base: Rc<str>,
+    values: [i64; 2],
+    len: u8,
+}
+
+impl MemberRef {
+    /// The member's indices.
+    pub fn values(&self) -> &[i64] {
+        &self.values[..self.len as usize]
+    }
+
+    /// Its canonical name, `P[4]`.
+    pub fn name(&self) -> String {
+        member(&self.base, self.values())
     }
 }
 
@@ -441,20 +700,38 @@ impl Indices {
     }
 }
 
+thread_local! {
+    /// How many members' names this thread has made ([`names_made`]).
+    static NAMES_MADE: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// How many members' names (`P[3,4]`) this thread has made so far: a test counts those a
+/// load makes (a reference found by index makes none). One increment per name.
+#[doc(hidden)]
+pub fn names_made() -> u64 {
+    NAMES_MADE.with(|c| c.get())
+}
+
 /// `P[3,4]`.
 pub(crate) fn member(base: &str, values: &[i64]) -> String {
     // Written into one string: a net's 10^5 names were a Vec of strings each.
     let mut out = String::with_capacity(base.len() + 2 + 6 * values.len());
+    push_member(&mut out, base, values);
+    out
+}
+
+/// `P[3,4]` appended to `out`.
+fn push_member(out: &mut String, base: &str, values: &[i64]) {
+    NAMES_MADE.with(|c| c.set(c.get() + 1));
     out.push_str(base);
     out.push('[');
     for (k, &v) in values.iter().enumerate() {
         if k > 0 {
             out.push(',');
         }
-        push_int(&mut out, v);
+        push_int(out, v);
     }
     out.push(']');
-    out
 }
 
 /// `v` in decimal appended to `out`, as `{v}` writes it: a family's names are made per
@@ -475,8 +752,12 @@ fn push_int(out: &mut String, v: i64) {
     if v < 0 {
         out.push('-');
     }
-    // ASCII digits: one copy, not a `char` each.
-    out.push_str(std::str::from_utf8(&digits[k..]).unwrap_or_default());
+    // ASCII digits pushed one by one: checking them as UTF-8 (`from_utf8`) cost more than
+    // pushing a name's few digits.
+    out.reserve(digits.len() - k);
+    for &d in &digits[k..] {
+        out.push(char::from(d));
+    }
 }
 
 /// `P[0..19, 0..19]`.
@@ -756,10 +1037,22 @@ impl<'l, 'a> Expander<'l, 'a> {
         let mut bindings: Vec<(String, i64)> =
             domain.names.iter().map(|n| (n.clone(), 0)).collect();
         let mut rows: Rows = Vec::new();
+        // The `where` with its names resolved once (`None`: it names a table's column, or
+        // something that is an error; the general path then evaluates it, and says so).
+        let program = domain
+            .condition
+            .as_ref()
+            .and_then(|(e, _)| self.indices.program(e, &domain.names));
+        let mut bound: Vec<i64> = vec![0; bindings.len()];
         'all: loop {
             // A table's index takes each row's key; the row itself is kept for its cells.
             rows.clear();
-            for ((b, &v), t) in bindings.iter_mut().zip(&values).zip(&domain.tables) {
+            for (((b, slot), &v), t) in bindings
+                .iter_mut()
+                .zip(bound.iter_mut())
+                .zip(&values)
+                .zip(&domain.tables)
+            {
                 b.1 = match t {
                     Some(t) => {
                         rows.push((*t, v as usize));
@@ -767,10 +1060,13 @@ impl<'l, 'a> Expander<'l, 'a> {
                     }
                     None => v,
                 };
+                *slot = b.1;
             }
-            let keep = match &domain.condition {
-                None => true,
-                Some((e, sv)) => e
+            let fast = program.as_ref().and_then(|p| p.condition(&bound));
+            let keep = match (&domain.condition, fast) {
+                (None, _) => true,
+                (Some(_), Some(keep)) => keep,
+                (Some((e, sv)), None) => e
                     .condition(&self.indices.lookup(&bindings, &rows))
                     .map_err(|e| {
                         let e = if e.span == (0..0) {
@@ -858,13 +1154,14 @@ impl<'l, 'a> Expander<'l, 'a> {
     /// `split` takes the `for` and `where` out of an entry's value and returns the value left.
     fn keyed<V: Clone>(
         &mut self,
-        table: IndexMap<Name, V>,
+        table: Keyed<V>,
         shared: &mut Shared<V>,
         span_of: impl Fn(&V) -> Range<usize>,
         split: impl Fn(&Self, &V) -> Result<(V, Option<Sv>, Option<Sv>), ModelError>,
         placeholder: impl Fn(&V) -> V,
-    ) -> Result<Expanded<IndexMap<Name, V>>, ModelError> {
-        let mut out = IndexMap::with_capacity(table.len());
+        by_index: &mut FxHashMap<String, Option<EntriesByIndex>>,
+    ) -> Result<Expanded<Keyed<V>>, ModelError> {
+        let mut out = Keyed::with_capacity_and_hasher(table.len(), Default::default());
         let mut members = Vec::with_capacity(table.len());
         for (name, value) in table {
             match self.head(&name)? {
@@ -933,6 +1230,7 @@ impl<'l, 'a> Expander<'l, 'a> {
                             &mut members,
                         )?;
                         shared.of_entry.resize(members.len(), None);
+                        by_index.insert(base, None);
                         continue;
                     }
                     for (p, off) in &parts {
@@ -966,17 +1264,42 @@ impl<'l, 'a> Expander<'l, 'a> {
                     let stand_in = placeholder(&value);
                     let which = Some(shared.values.len() as u32);
                     shared.values.push(value);
+                    let count = usize::try_from(domain.count()).unwrap_or(0);
+                    let count = count.min(MAX_MEMBERS as usize);
+                    out.reserve(count);
+                    members.reserve(count);
+                    shared.of_entry.reserve(count);
+                    // Where each head name's value is among the bindings, found once.
+                    let slots: Vec<usize> = names
+                        .iter()
+                        .map(|n| domain.names.iter().position(|d| d == n).unwrap_or(0))
+                        .collect();
+                    let mut entries: Option<EntriesByIndex> = None;
                     self.each(&name.span(), &base, &domain, |ex, bindings, rows| {
-                        let values: Vec<i64> = names
-                            .iter()
-                            .map(|n| bindings.iter().find(|b| &b.0 == n).map_or(0, |b| b.1))
-                            .collect();
-                        let key = Spanned::new(name.span(), member(&base, &values));
+                        let mut inline = [0i64; 2];
+                        let mut spilled = Vec::new();
+                        let values: &mut [i64] = if slots.len() <= inline.len() {
+                            &mut inline[..slots.len()]
+                        } else {
+                            spilled.resize(slots.len(), 0);
+                            &mut spilled
+                        };
+                        for (v, &k) in values.iter_mut().zip(&slots) {
+                            *v = bindings.get(k).map_or(0, |b| b.1);
+                        }
+                        // Made at the first member: `each` has checked the family's size.
+                        entries
+                            .get_or_insert_with(|| EntriesByIndex::new(&ranges))
+                            .set(values, out.len());
+                        let key = Spanned::new(name.span(), member(&base, values));
                         ex.insert(&mut out, key, stand_in.clone())?;
                         members.push(Some(Member::of(&family, &index_names, bindings, rows)));
                         shared.of_entry.push(which);
                         Ok(())
                     })?;
+                    // A second declaration of the same family in this table: found by name.
+                    let known = by_index.contains_key(&base);
+                    by_index.insert(base, if known { None } else { entries });
                 }
             }
         }
@@ -993,7 +1316,7 @@ impl<'l, 'a> Expander<'l, 'a> {
         parts: &[(String, usize)],
         domain: &Domain,
         value: &V,
-        out: &mut IndexMap<Name, V>,
+        out: &mut Keyed<V>,
         members: &mut Vec<Option<Member>>,
     ) -> Result<(), ModelError> {
         let mut exprs = Vec::with_capacity(parts.len());
@@ -1041,22 +1364,17 @@ impl<'l, 'a> Expander<'l, 'a> {
         self.record_shape(name, base, &ranges, Some(declared))
     }
 
-    fn insert<V>(
-        &self,
-        out: &mut IndexMap<Name, V>,
-        key: Name,
-        value: V,
-    ) -> Result<(), ModelError> {
-        if out.contains_key(&key) {
+    fn insert<V>(&self, out: &mut Keyed<V>, key: Name, value: V) -> Result<(), ModelError> {
+        // Hashed once: inserted, and refused if it was there (the table is then dropped).
+        let span = key.span();
+        let (at, previous) = out.insert_full(key, value);
+        if previous.is_some() {
+            let name = out.get_index(at).map_or("", |(k, _)| k.get_ref().as_str());
             return Err(self
                 .ld
-                .err(
-                    key.span(),
-                    format!("`{}` is declared twice in this table", key.get_ref()),
-                )
+                .err(span, format!("`{name}` is declared twice in this table"))
                 .help("a family's members and the table's other entries need distinct names"));
         }
-        out.insert(key, value);
         Ok(())
     }
 
@@ -1112,21 +1430,71 @@ impl<'l, 'a> Expander<'l, 'a> {
         })
     }
 
-    fn force_member(
+    /// A force member's `between` (two names) or `on` as members by index, when that is
+    /// all it names and each is a subscripted name: no name made (`Ok(None)` otherwise: its
+    /// names are then resolved as text). The errors are [`Expander::resolve_name`]'s.
+    fn member_ends(
         &self,
-        f: &Spanned<RawForce>,
-        base: &str,
+        raw: &RawForce,
         bindings: &[(String, i64)],
         rows: &[(usize, usize)],
-    ) -> Result<Names, ModelError> {
+    ) -> Result<Option<MemberEnds>, ModelError> {
+        if raw.to.is_some() || raw.normal_force.is_some() || raw.friction_force.is_some() {
+            return Ok(None);
+        }
+        let end = |name: &Name| -> Result<Option<(MemberRef, Range<usize>)>, ModelError> {
+            let r = self
+                .indices
+                .member_ref(name.get_ref(), bindings, rows)
+                .map_err(|e| located(self.ld, &name.span(), e))?;
+            Ok(r.map(|r| (r, name.span())))
+        };
+        match (&raw.between, &raw.on) {
+            (Some(b), None) => {
+                let [first, second] = b.get_ref().as_slice() else {
+                    return Ok(None);
+                };
+                let (Some(first), Some(second)) = (end(first)?, end(second)?) else {
+                    return Ok(None);
+                };
+                Ok(Some(MemberEnds::Between(b.span(), [first, second])))
+            }
+            (None, Some(on)) => Ok(end(on)?.map(|(r, span)| MemberEnds::On(r, span))),
+            _ => Ok(None),
+        }
+    }
+
+    /// A member of the force family `f` whose name (without `name`: its kind) is `base`, read
+    /// with `bindings`: its name fields resolved, `between` or `on` by index when they can be
+    /// ([`Expander::member_ends`]), its own name made when it is built ([`ForceEntry::raw`]).
+    fn force_member(
+        &self,
+        entry: usize,
+        f: &Spanned<RawForce>,
+        base: &Rc<str>,
+        bindings: &[(String, i64)],
+        rows: &[(usize, usize)],
+    ) -> Result<ForceEntry, ModelError> {
         let raw = f.get_ref();
-        let mut m = self.resolve_names(raw, bindings, rows)?;
-        m.name = Some(match &raw.name {
-            Some(n) if n.get_ref().contains('[') => self.resolve_name(n, bindings, rows)?,
-            Some(n) => Spanned::new(n.span(), label(n.get_ref(), bindings)),
-            None => Spanned::new(f.span(), label(base, bindings)),
-        });
-        Ok(m)
+        let (mut names, ends) = match self.member_ends(raw, bindings, rows)? {
+            Some(ends) => (Names::default(), Some(ends)),
+            None => (self.resolve_names(raw, bindings, rows)?, None),
+        };
+        let mut label_of = None;
+        match &raw.name {
+            Some(n) if n.get_ref().contains('[') => {
+                names.name = Some(self.resolve_name(n, bindings, rows)?)
+            }
+            // `spring[i=3]`: made from the bindings when the member is built.
+            Some(n) => label_of = Some((Rc::clone(base), n.span())),
+            None => label_of = Some((Rc::clone(base), f.span())),
+        }
+        Ok(ForceEntry {
+            entry,
+            names,
+            ends,
+            label_of,
+        })
     }
 
     fn forces(
@@ -1150,7 +1518,7 @@ impl<'l, 'a> Expander<'l, 'a> {
                         ));
                 }
                 let names = self.resolve_names(raw, &[], &[])?;
-                out.push(ForceEntry { entry, names });
+                out.push(ForceEntry::written(entry, names));
                 members.push(None);
                 continue;
             };
@@ -1162,11 +1530,16 @@ impl<'l, 'a> Expander<'l, 'a> {
             let domain = self.domain(&f.span(), &[], Some(&for_list), raw.condition.as_ref())?;
             let family: Rc<str> = Rc::from(base.as_str());
             let index_names: Rc<[String]> = domain.names.clone().into();
+            let count = usize::try_from(domain.count())
+                .unwrap_or(0)
+                .min(MAX_MEMBERS as usize);
+            out.reserve(count);
+            members.reserve(count);
             self.each(&for_list.span(), &base, &domain, |ex, bindings, rows| {
-                let names = ex
-                    .force_member(f, &base, bindings, rows)
+                let member = ex
+                    .force_member(entry, f, &family, bindings, rows)
                     .map_err(|e| in_member(e, &ex.indices.label(&base, bindings, rows)))?;
-                out.push(ForceEntry { entry, names });
+                out.push(member);
                 members.push(Some(Member::of(&family, &index_names, bindings, rows)));
                 Ok(())
             })?;
@@ -1192,18 +1565,98 @@ pub(crate) struct Names {
 pub(crate) struct ForceEntry {
     /// Index into the file's `[[forces]]`.
     pub entry: usize,
-    /// Its name fields, resolved.
-    pub names: Names,
+    /// Its name fields, resolved (without what `ends` and `label_of` hold).
+    names: Names,
+    /// A family member's `between` or `on` by index ([`Expander::member_ends`]): the names
+    /// `P[4]` are made only for a member that is built (a deferred member needs its
+    /// particles, found by index: [`Indices::particle_of`]).
+    ends: Option<MemberEnds>,
+    /// A family member named by its family and indices, `spring[i=3]`: the family and the
+    /// span of the name (or of the entry), the label made when the member is built.
+    label_of: Option<(Rc<str>, Range<usize>)>,
+}
+
+/// A force member's ends by index, with the spans of the names that name them.
+#[derive(Clone, Debug)]
+pub(crate) enum MemberEnds {
+    /// `between = ["P[i+1]", "P[i]"]`: the list's span and each end.
+    Between(Range<usize>, [(MemberRef, Range<usize>); 2]),
+    /// `on = "P[i]"`.
+    On(MemberRef, Range<usize>),
+}
+
+/// One end of a force as its entry names it: by name, or a member by index.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum End<'a> {
+    Name(&'a str),
+    Member(&'a MemberRef),
 }
 
 impl ForceEntry {
-    /// The entry as an ordinary `[[forces]]` entry (`forces`: the file's).
-    pub fn raw(&self, forces: &[Spanned<RawForce>]) -> Spanned<RawForce> {
+    /// An entry whose name fields are all resolved to text.
+    fn written(entry: usize, names: Names) -> ForceEntry {
+        ForceEntry {
+            entry,
+            names,
+            ends: None,
+            label_of: None,
+        }
+    }
+
+    /// The name fields resolved to text: a member's with its `bindings` (the indices it was
+    /// expanded with, in its family's order).
+    pub fn names(&self, bindings: &[(String, i64)]) -> Names {
+        let mut n = self.names.clone();
+        if let Some((base, span)) = &self.label_of {
+            n.name = Some(Spanned::new(span.clone(), label(base, bindings)));
+        }
+        match &self.ends {
+            None => {}
+            Some(MemberEnds::Between(span, ends)) => {
+                let names = ends
+                    .iter()
+                    .map(|(r, s)| Spanned::new(s.clone(), r.name()))
+                    .collect();
+                n.between = Some(Spanned::new(span.clone(), names));
+            }
+            Some(MemberEnds::On(r, s)) => n.on = Some(Spanned::new(s.clone(), r.name())),
+        }
+        n
+    }
+
+    /// The ends its `between` (when it has no `on`) or its `on` (when it has no `between`)
+    /// names, at most two; `None` for any other entry. Nothing is made for a member's ends.
+    pub fn ends(&self) -> Option<([End<'_>; 2], usize)> {
+        let none = End::Name("");
+        match &self.ends {
+            Some(MemberEnds::Between(_, [a, b])) => {
+                Some(([End::Member(&a.0), End::Member(&b.0)], 2))
+            }
+            Some(MemberEnds::On(r, _)) => Some(([End::Member(r), none], 1)),
+            None => match (&self.names.between, &self.names.on) {
+                (Some(b), None) => match b.get_ref().as_slice() {
+                    [a] => Some(([End::Name(a.get_ref()), none], 1)),
+                    [a, c] => Some(([End::Name(a.get_ref()), End::Name(c.get_ref())], 2)),
+                    _ => None,
+                },
+                (None, Some(on)) => Some(([End::Name(on.get_ref()), none], 1)),
+                _ => None,
+            },
+        }
+    }
+
+    /// The entry as an ordinary `[[forces]]` entry (`forces`: the file's; `bindings`: the
+    /// member's indices, as for [`ForceEntry::names`]).
+    pub fn raw(
+        &self,
+        forces: &[Spanned<RawForce>],
+        bindings: &[(String, i64)],
+    ) -> Spanned<RawForce> {
         let f = &forces[self.entry];
         let mut m = f.get_ref().clone();
         m.for_list = None;
         m.condition = None;
-        let n = self.names.clone();
+        let n = self.names(bindings);
         m.name = n.name;
         m.on = n.on;
         m.to = n.to;
@@ -1285,9 +1738,9 @@ pub(crate) fn expand(
                 .enumerate()
                 .map(|(entry, f)| {
                     let r = f.get_ref();
-                    ForceEntry {
+                    ForceEntry::written(
                         entry,
-                        names: Names {
+                        Names {
                             name: r.name.clone(),
                             on: r.on.clone(),
                             to: r.to.clone(),
@@ -1295,7 +1748,7 @@ pub(crate) fn expand(
                             friction_force: r.friction_force.clone(),
                             between: r.between.clone(),
                         },
-                    }
+                    )
                 })
                 .collect(),
         };
@@ -1308,12 +1761,14 @@ pub(crate) fn expand(
     };
     let sv_span = |v: &Sv| v.span();
     let mut shared = SharedValues::default();
+    let mut particles_by_index = FxHashMap::default();
     let (coordinates, mc) = ex.keyed(
         std::mem::take(&mut raw.coordinates),
         &mut shared.coordinates,
         sv_span,
         |ex, v| split_table(ex.ld, v, None),
         placeholder_value,
+        &mut FxHashMap::default(),
     )?;
     let (points, mp) = ex.keyed(
         std::mem::take(&mut raw.points),
@@ -1321,6 +1776,7 @@ pub(crate) fn expand(
         sv_span,
         |ex, v| split_table(ex.ld, v, Some("position")),
         placeholder_value,
+        &mut FxHashMap::default(),
     )?;
     let (definitions, md) = ex.keyed(
         std::mem::take(&mut raw.definitions),
@@ -1328,6 +1784,7 @@ pub(crate) fn expand(
         sv_span,
         |ex, v| split_table(ex.ld, v, Some("value")),
         placeholder_value,
+        &mut FxHashMap::default(),
     )?;
     let (particles, mq) = ex.keyed(
         std::mem::take(&mut raw.particles),
@@ -1340,7 +1797,9 @@ pub(crate) fn expand(
             Ok((Spanned::new(p.span(), q), for_list, condition))
         },
         placeholder_particle,
+        &mut particles_by_index,
     )?;
+    ex.indices.particles = particles_by_index;
     raw.shared = shared;
     let (force_entries, mf) = ex.forces(&raw.forces)?;
     raw.coordinates = coordinates;

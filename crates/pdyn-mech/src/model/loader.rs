@@ -19,8 +19,10 @@ use std::rc::Rc;
 /// Name resolution for expressions in a model file.
 #[derive(Default)]
 pub(crate) struct ModelScope {
-    pub(super) names: FxHashMap<String, (Binding, Range<usize>, &'static str)>,
-    pub(super) order: Vec<String>,
+    /// Every name declared, with where and as what. Its text is shared with `order` (one
+    /// allocation per name: a family declares 10^4).
+    pub(super) names: FxHashMap<Rc<str>, (Binding, Range<usize>, &'static str)>,
+    pub(super) order: Vec<Rc<str>>,
     pub(super) local: FxHashMap<String, Binding>,
     /// Sizes, index ranges and family shapes ([`super::families`]).
     pub(super) indices: Indices,
@@ -30,9 +32,18 @@ pub(crate) struct ModelScope {
     pub(super) rows: Vec<(usize, usize)>,
     /// The names `[indices]` declares as indices: no other entry may take them.
     pub(super) index_names: Vec<String>,
+    /// Where a member's name is written to be looked up ([`Scope::resolve`]).
+    scratch: String,
 }
 
 impl ModelScope {
+    /// Room for `names` more declared names and `local` more local ones.
+    pub(super) fn reserve(&mut self, names: usize, local: usize) {
+        self.names.reserve(names);
+        self.order.reserve(names);
+        self.local.reserve(local);
+    }
+
     fn lookup(&self, name: &str) -> Option<Binding> {
         if let Some((b, _, _)) = self.names.get(name) {
             return Some(*b);
@@ -66,17 +77,24 @@ impl Scope for ModelScope {
                     cell.value(),
                 ))));
             }
-            // `x[i+1, j]`: the member the subscript names with the current indices.
-            let member = self
-                .indices
-                .member_name(name, &self.bindings, &self.rows)
-                .ok()??;
-            return self.lookup(&member);
+            // `x[i+1, j]`: the member the subscript names with the current indices, its
+            // name written into a buffer kept for this (nothing allocated per member).
+            let mut buf = std::mem::take(&mut self.scratch);
+            let found =
+                match self
+                    .indices
+                    .member_name_into(name, &self.bindings, &self.rows, &mut buf)
+                {
+                    Ok(true) => self.lookup(&buf),
+                    Ok(false) | Err(_) => None,
+                };
+            self.scratch = buf;
+            return found;
         }
         self.lookup(name)
     }
     fn names(&self) -> Vec<String> {
-        let mut v = self.order.clone();
+        let mut v: Vec<String> = self.order.iter().map(|n| n.to_string()).collect();
         v.extend(self.local.keys().cloned());
         v
     }
@@ -304,7 +322,7 @@ impl<'a> Loader<'a> {
                 {
                     *bound = names.iter().map(|n| (n.clone(), 0)).collect();
                 }
-                for (b, &v) in bound.iter_mut().zip(values) {
+                for (b, &v) in bound.iter_mut().zip(values.iter()) {
                     b.1 = v;
                 }
                 self.scope.rows.clone_from(rows);
@@ -410,8 +428,9 @@ impl<'a> Loader<'a> {
                 .err(span, format!("`{name}` cannot be used as a {what} name"))
                 .help("names are letters, digits and `_`, not starting with a digit, and not t, pi or a function name"));
         }
-        self.scope.names.insert(name.to_string(), (b, span, what));
-        self.scope.order.push(name.to_string());
+        let name: Rc<str> = Rc::from(name);
+        self.scope.names.insert(Rc::clone(&name), (b, span, what));
+        self.scope.order.push(name);
         Ok(())
     }
 
@@ -719,18 +738,89 @@ fn is_identifier(name: &str) -> bool {
 
 /// `P[3,4]`: a member of a family, as the expansion names it.
 fn is_member_name(name: &str) -> bool {
-    // Scanned in place (no list of parts): every member of a family is declared by name.
+    // Scanned byte by byte, once (every member of a family is declared by name: splitting
+    // and trimming its parts was a quarter of declaring one).
     let Some(open) = name.find('[') else {
         return false;
     };
     let Some(inner) = name[open + 1..].strip_suffix(']') else {
         return false;
     };
-    is_identifier(&name[..open])
-        && inner.split(',').all(|p| {
-            !p.is_empty()
-                && p.trim_start_matches('-')
-                    .bytes()
-                    .all(|b| b.is_ascii_digit())
-        })
+    if !is_identifier(&name[..open]) {
+        return false;
+    }
+    // Each part is not empty: `-`s, then digits (as `trim_start_matches('-')` then all
+    // digits read it).
+    let mut length = 0usize;
+    let mut in_digits = false;
+    for b in inner.bytes() {
+        match b {
+            b',' => {
+                if length == 0 {
+                    return false;
+                }
+                length = 0;
+                in_digits = false;
+            }
+            b'-' if !in_digits => length += 1,
+            b'0'..=b'9' => {
+                length += 1;
+                in_digits = true;
+            }
+            _ => return false,
+        }
+    }
+    length > 0
+}
+
+#[cfg(test)]
+mod tests {
+    /// The byte scan accepts what splitting at `,` and trimming leading `-`s accepted.
+    #[test]
+    fn member_names_as_the_parts_read_them() {
+        let by_parts = |name: &str| {
+            let Some(open) = name.find('[') else {
+                return false;
+            };
+            let Some(inner) = name[open + 1..].strip_suffix(']') else {
+                return false;
+            };
+            super::is_identifier(&name[..open])
+                && inner.split(',').all(|p| {
+                    !p.is_empty()
+                        && p.trim_start_matches('-')
+                            .bytes()
+                            .all(|b| b.is_ascii_digit())
+                })
+        };
+        let names = [
+            "P[3]",
+            "P[3,4]",
+            "P[-3,4]",
+            "P[--3]",
+            "P[-]",
+            "P[]",
+            "P[,]",
+            "P[3,]",
+            "P[,3]",
+            "P[3-]",
+            "P[3-4]",
+            "P[ 3]",
+            "P[3",
+            "P3]",
+            "[3]",
+            "1P[3]",
+            "P[a]",
+            "P[3,4,5]",
+            "P[-,-]",
+            "x_2[10000]",
+            "P[3]]",
+            "P[[3]",
+        ];
+        for n in names {
+            assert_eq!(super::is_member_name(n), by_parts(n), "{n}");
+        }
+        assert!(super::is_member_name("P[10000]"));
+        assert!(!super::is_member_name("P[3-4]"));
+    }
 }

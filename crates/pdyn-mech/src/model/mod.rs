@@ -15,6 +15,7 @@ pub mod families;
 mod family_initials;
 mod forces;
 pub mod index_expr;
+mod index_program;
 mod loader;
 mod member_template;
 pub(crate) mod raw;

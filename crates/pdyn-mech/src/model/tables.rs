@@ -2,7 +2,7 @@
 //! declares the names it introduces (so later tables can use them) and returns what it built.
 
 use super::deferred::Decision;
-use super::families::Table;
+use super::families::{End, Table};
 use super::forces;
 use super::loader::Loader;
 use super::raw::{RawModel, Sv};
@@ -105,10 +105,12 @@ impl Loader<'_> {
     /// `[coordinates]`: free ones with initial conditions, prescribed ones as functions of t.
     pub(super) fn read_coordinates(&mut self, raw: &RawModel) -> Result<Coordinates, ModelError> {
         let mut out = Coordinates {
-            coordinates: Vec::new(),
+            coordinates: Vec::with_capacity(raw.coordinates.len()),
             initial_exprs: Vec::new(),
             known_accelerations: Vec::new(),
         };
+        self.scope.reserve(raw.coordinates.len(), 0);
+        self.coordinate_names.reserve(raw.coordinates.len());
         for (k, (name, sv)) in raw.coordinates.iter().enumerate() {
             let sv = raw.shared.coordinates.get(k, sv);
             self.enter(Table::Coordinates, k);
@@ -494,8 +496,12 @@ impl Loader<'_> {
     /// `[particles.NAME]`: mass and position; declares `NAME` (the position), `r_NAME` and
     /// `v_NAME`. A model needs at least one.
     pub(super) fn read_particles(&mut self, raw: &RawModel) -> Result<Vec<Particle>, ModelError> {
-        let mut particles = Vec::new();
+        let mut particles = Vec::with_capacity(raw.particles.len());
         let mut bound: Option<std::rc::Rc<str>> = None;
+        // Each particle declares its name, `r_NAME` and `v_NAME`: the tables sized once (a
+        // family's 10^4 members grew them step by step, each step rehashing every name).
+        self.scope
+            .reserve(raw.particles.len(), 2 * raw.particles.len());
         for (k, (name, sp)) in raw.particles.iter().enumerate() {
             let sp = raw.shared.particles.get(k, sp);
             self.enter(Table::Particles, k);
@@ -542,7 +548,7 @@ impl Loader<'_> {
                 let mut key = String::with_capacity(prefix.len() + n.len());
                 key.push_str(prefix);
                 key.push_str(n);
-                if !self.scope.names.contains_key(&key) {
+                if !self.scope.names.contains_key(key.as_str()) {
                     self.scope
                         .local
                         .insert(key, Binding::Value(Value::Vector(v)));
@@ -640,26 +646,32 @@ impl Loader<'_> {
                     names.extend(bindings.iter().map(|b| b.0.as_str()));
                     names
                 };
-                deferrer.decide(
-                    &self.pool,
-                    particles,
-                    |n| fb.particle_named(n),
-                    original,
-                    &fe.names,
-                    names,
-                )
+                // A member by index is found by index when its family's particles are
+                // known that way (no name made), else by its name, as any other end.
+                let indices = &self.scope.indices;
+                let particle = |end: End| match end {
+                    End::Name(n) => fb.particle_named(n),
+                    End::Member(r) => indices
+                        .particle_of(r)
+                        .or_else(|| fb.particle_named(&r.name())),
+                };
+                deferrer.decide(&self.pool, particles, particle, original, fe.ends(), names)
             } else {
                 Decision::Build
             };
             match decision {
                 Decision::Deferred => {}
-                Decision::Build => fb.force(self, &fe.raw(&raw.forces))?,
+                Decision::Build => {
+                    let force = fe.raw(&raw.forces, &self.scope.bindings);
+                    fb.force(self, &force)?
+                }
                 Decision::Representative(key, ends) => {
                     let before = fb.counts();
-                    fb.force(self, &fe.raw(&raw.forces))?;
+                    let force = fe.raw(&raw.forces, &self.scope.bindings);
+                    fb.force(self, &force)?;
                     let after = fb.counts();
                     let f = original.get_ref();
-                    let family = fe.names.name.as_ref().map_or_else(
+                    let family = force.get_ref().name.as_ref().map_or_else(
                         || {
                             f.kind
                                 .as_ref()
@@ -695,19 +707,20 @@ impl Loader<'_> {
         });
         let friction_names: Vec<(String, Id)> = friction_names.collect();
         for (name, id) in friction_names {
-            if !self.scope.names.contains_key(&name) {
-                self.scope.order.push(name.clone());
-                self.scope.names.insert(
-                    name.clone(),
-                    (Binding::Value(Value::Scalar(id)), 0..0, "reaction"),
-                );
+            if !self.scope.names.contains_key(name.as_str()) {
+                let name: std::rc::Rc<str> = std::rc::Rc::from(name.as_str());
+                self.scope.order.push(std::rc::Rc::clone(&name));
+                self.scope
+                    .names
+                    .insert(name, (Binding::Value(Value::Scalar(id)), 0..0, "reaction"));
             }
         }
         for r in &built.reactions {
-            if !self.scope.names.contains_key(&r.name) {
-                self.scope.order.push(r.name.clone());
+            if !self.scope.names.contains_key(r.name.as_str()) {
+                let name: std::rc::Rc<str> = std::rc::Rc::from(r.name.as_str());
+                self.scope.order.push(std::rc::Rc::clone(&name));
                 self.scope.names.insert(
-                    r.name.clone(),
+                    name,
                     (Binding::Value(Value::Scalar(r.id)), 0..0, "reaction"),
                 );
             }
