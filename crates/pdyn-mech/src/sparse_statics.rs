@@ -17,6 +17,7 @@
 //! - **Free directions** (a mechanism, a neutral equilibrium): the eigenvectors of
 //!   `K_s φ = λ D φ` with `|λ| ≤ 10⁻⁹ max_i |K_ii| / D_ii`, the lowest six looked at.
 
+use crate::damped_newton::TrialEnd;
 use crate::equilibrium::{EquilibriumError, EquilibriumOptions, FreeDirection};
 use crate::lanczos::{nearest, LanczosError, LanczosOptions};
 use crate::linearization::{Linearize, SparseLinearization};
@@ -260,9 +261,28 @@ impl SparseAt {
 
 impl<L: Linearize + ?Sized> crate::damped_newton::NewtonSystem for Sparse<'_, L> {
     type At = SparseAt;
+    type Trial = TrialEnd<SparseLinearization>;
 
-    fn at(&self, q: &[f64]) -> SparseAt {
-        SparseAt::new(self.lin.at_sparse(q))
+    fn trial(&self, q: &[f64]) -> Self::Trial {
+        if self.lin.force_alone() {
+            TrialEnd::Force(self.lin.force(q))
+        } else {
+            TrialEnd::Whole(self.lin.at_sparse(q))
+        }
+    }
+
+    fn trial_residual(&self, trial: &Self::Trial) -> f64 {
+        norm(match trial {
+            TrialEnd::Force(f) => f,
+            TrialEnd::Whole(at) => &at.force,
+        })
+    }
+
+    fn taken(&self, q: &[f64], trial: Self::Trial) -> SparseAt {
+        SparseAt::new(match trial {
+            TrialEnd::Force(f) => self.lin.at_sparse_with(q, f),
+            TrialEnd::Whole(at) => at,
+        })
     }
 
     fn residual(&self, at: &SparseAt) -> f64 {
