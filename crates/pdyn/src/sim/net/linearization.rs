@@ -24,7 +24,7 @@ use pdyn_mech::linearization::{Linearize, SparseLinearization};
 use pdyn_mech::model::CoordinateKind;
 use pdyn_mech::sparse::{Assembly, Csr, SparseError};
 use pdyn_mech::Model;
-use std::cell::{Cell, RefCell};
+use std::cell::RefCell;
 
 /// The linearization of a model of free particles in Cartesian coordinates, numeric.
 pub struct NetLinearization {
@@ -40,8 +40,6 @@ pub struct NetLinearization {
     /// How the terms of `K` and of `C` land in their matrices: the elements' pattern, found at
     /// the first linearization and refilled at the next (damped Newton's steps).
     assembly: RefCell<[Option<Assembly>; 2]>,
-    /// How many terms of `K` and of `C` the last linearization had.
-    terms: Cell<[usize; 2]>,
 }
 
 impl NetLinearization {
@@ -92,7 +90,6 @@ impl NetLinearization {
             kernels,
             input,
             assembly: RefCell::new([None, None]),
-            terms: Cell::new([0, 0]),
         })
     }
 
@@ -128,10 +125,38 @@ impl NetLinearization {
 
     /// `M`, `K`, `C` at `input` (at rest), with `force` the loads there.
     fn matrices(&self, input: &[f64], force: Vec<f64>) -> SparseLinearization {
+        // The elements' terms straight into the matrices through the assemblies kept (after
+        // the first linearization: the same numbers as collecting them, without the triplets).
+        if let [Some(k_assembly), Some(c_assembly)] = &*self.assembly.borrow() {
+            let n = self.names.len();
+            let (mut k, mut c) = (k_assembly.filler(), c_assembly.filler());
+            let compiled = self
+                .kernels
+                .jacobian_terms(input, &mut |row, column, value| {
+                    let entry = -self.mass[row] * value;
+                    if column < n {
+                        k.add(row, column, entry);
+                    } else {
+                        c.add(row, column - n, entry);
+                    }
+                });
+            if let (true, Some(stiffness), Some(damping)) = (compiled, k.finish(), c.finish()) {
+                return SparseLinearization {
+                    mass: Csr::diagonal(&self.mass),
+                    stiffness,
+                    damping,
+                    force,
+                };
+            }
+        }
+        self.matrices_by_triplets(input, force)
+    }
+
+    /// [`NetLinearization::matrices`] through triplets, whose assemblies are kept: the first
+    /// time (or should the terms' sequence change).
+    fn matrices_by_triplets(&self, input: &[f64], force: Vec<f64>) -> SparseLinearization {
         let n = self.names.len();
-        // As many terms as the last time (the same, for one net): no growing by doubling.
-        let [k_terms, c_terms] = self.terms.get();
-        let (mut k, mut c) = (Vec::with_capacity(k_terms), Vec::with_capacity(c_terms));
+        let (mut k, mut c) = (Vec::new(), Vec::new());
         let compiled = self
             .kernels
             .jacobian_terms(input, &mut |row, column, value| {
@@ -145,7 +170,6 @@ impl NetLinearization {
         // Rows and columns are free coordinates of this model, hence in bounds; a kernel of
         // derivatives that would not compile (it cannot: the same operations as the loads')
         // gives NaN matrices, which the solvers refuse.
-        self.terms.set([k.len(), c.len()]);
         let csr = |t: &[(usize, usize, f64)], which: usize| match self.assemble(t, which) {
             Ok(a) if compiled => a,
             _ => Csr::diagonal(&vec![f64::NAN; n]),
