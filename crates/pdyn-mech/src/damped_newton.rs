@@ -27,7 +27,7 @@ use crate::equilibrium::{EquilibriumError, EquilibriumOptions, FreeDirection};
 /// [`NewtonSystem::trial`] gives (`f` alone where the linearization computes it apart from
 /// the matrices, the whole linearization otherwise), and [`NewtonSystem::taken`] completes it
 /// for a step taken: on the 20 × 20 hanging net 8 of 27 trial steps are refused, and the
-/// matrices at one cost as much as 40 evaluations of `f`.
+/// matrices at one cost as much as some twenty evaluations of `f`.
 pub(crate) trait NewtonSystem {
     /// The linearization at a state (`f`, `K`, ... and whatever the solves reuse).
     type At;

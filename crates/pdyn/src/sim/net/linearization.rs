@@ -203,7 +203,7 @@ impl Linearize for NetLinearization {
     }
 
     fn force_alone(&self) -> bool {
-        // The loads' kernels alone: about a sixtieth of the linearization on the 20 × 20
+        // The loads' kernels alone: about a twentieth of the linearization on the 20 × 20
         // hanging net (the derivatives' kernels and the matrices' assembly are the rest).
         true
     }
