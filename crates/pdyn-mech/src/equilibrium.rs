@@ -12,6 +12,7 @@
 //! forces: the stiffness is singular along the directions the forces push (a mechanism),
 //! which are named.
 
+use crate::damped_newton::TrialEnd;
 use crate::linearization::{Linearization, Linearize};
 use nalgebra::{DMatrix, DVector};
 
@@ -214,9 +215,31 @@ struct Dense<'a, L: ?Sized>(&'a L);
 
 impl<L: Linearize + ?Sized> crate::damped_newton::NewtonSystem for Dense<'_, L> {
     type At = Linearization;
+    type Trial = TrialEnd<Linearization>;
 
-    fn at(&self, q: &[f64]) -> Linearization {
-        self.0.at(q)
+    fn trial(&self, q: &[f64]) -> Self::Trial {
+        if self.0.force_alone() {
+            TrialEnd::Force(self.0.force(q))
+        } else {
+            TrialEnd::Whole(self.0.at(q))
+        }
+    }
+
+    fn trial_residual(&self, trial: &Self::Trial) -> f64 {
+        match trial {
+            // nalgebra's norm, as `residual` takes it of the linearization's `f`.
+            TrialEnd::Force(f) => DVector::from_column_slice(f).norm(),
+            TrialEnd::Whole(at) => at.force.norm(),
+        }
+    }
+
+    fn taken(&self, q: &[f64], trial: Self::Trial) -> Linearization {
+        match trial {
+            // `f` again with the matrices (one evaluation of the loads, cheap where
+            // `force_alone`; the dense path is for small systems): the same numbers.
+            TrialEnd::Force(_) => self.0.at(q),
+            TrialEnd::Whole(at) => at,
+        }
     }
 
     fn residual(&self, at: &Linearization) -> f64 {

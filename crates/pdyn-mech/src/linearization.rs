@@ -118,9 +118,25 @@ pub trait Linearize {
     /// `M`, `K`, `C` and `f` at rest at `q` (t = 0), sparse.
     fn at_sparse(&self, q: &[f64]) -> SparseLinearization;
     /// `f` alone at rest at `q` (t = 0): what damped Newton's work along a step reads (a
-    /// linearization that can compute it without the matrices says so).
+    /// linearization that can compute it without the matrices says so), bit for bit the
+    /// `force` of [`Linearize::at_sparse`] at `q`.
     fn force(&self, q: &[f64]) -> Vec<f64> {
         self.at_sparse(q).force
+    }
+    /// Whether [`Linearize::force`] computes `f` without the matrices (for less than
+    /// [`Linearize::at_sparse`] costs): damped Newton then judges a trial step by `f` alone
+    /// and computes the matrices only where it takes the step
+    /// ([`Linearize::at_sparse_with`]). False by default: `force` is `at_sparse`'s.
+    fn force_alone(&self) -> bool {
+        false
+    }
+    /// [`Linearize::at_sparse`] at `q`, given `force`, [`Linearize::force`] at `q` (computed
+    /// already): the same numbers, without computing `f` again where the linearization can.
+    fn at_sparse_with(&self, q: &[f64], force: Vec<f64>) -> SparseLinearization {
+        SparseLinearization {
+            force,
+            ..self.at_sparse(q)
+        }
     }
     /// The same, dense (for small systems).
     fn at(&self, q: &[f64]) -> Linearization {

@@ -353,6 +353,18 @@ impl Assembly {
         Some(self.values(entries))
     }
 
+    /// The matrix of terms added one at a time ([`AssemblyFill::add`]) in this assembly's
+    /// order: what [`Assembly::fill`] gives of the same terms (the same sums in the same
+    /// order), without collecting them as triplets first.
+    pub fn filler(&self) -> AssemblyFill<'_> {
+        AssemblyFill {
+            assembly: self,
+            val: vec![0.0; self.col.len()],
+            next: 0,
+            matches: true,
+        }
+    }
+
     /// The matrix of `entries`, known to be this assembly's sequence.
     fn values(&self, entries: &[(usize, usize, f64)]) -> Csr {
         let mut val = vec![0.0f64; self.col.len()];
@@ -370,6 +382,51 @@ impl Assembly {
             col: self.col.clone(),
             val,
         }
+    }
+}
+
+/// A matrix being filled term by term through an [`Assembly`] ([`Assembly::filler`]).
+pub struct AssemblyFill<'a> {
+    assembly: &'a Assembly,
+    val: Vec<f64>,
+    /// Terms added so far.
+    next: usize,
+    /// Whether every term so far was the assembly's next `(row, column)`.
+    matches: bool,
+}
+
+impl AssemblyFill<'_> {
+    /// Adds the term `(row, column, value)`, the next of the sequence (a term out of it makes
+    /// [`AssemblyFill::finish`] give nothing).
+    pub fn add(&mut self, row: usize, column: usize, value: f64) {
+        let k = self.next;
+        self.next += 1;
+        if !self.matches {
+            return;
+        }
+        let a = self.assembly;
+        if a.at.get(k) != Some(&(row, column)) {
+            self.matches = false;
+            return;
+        }
+        let s = a.slot[k];
+        if a.first[k] {
+            self.val[s] = value;
+        } else {
+            self.val[s] += value;
+        }
+    }
+
+    /// The matrix, or `None` when the terms were not the assembly's sequence (then a new
+    /// [`Assembly`] is needed).
+    pub fn finish(self) -> Option<Csr> {
+        let a = self.assembly;
+        (self.matches && self.next == a.at.len()).then(|| Csr {
+            n: a.n,
+            ptr: a.ptr.clone(),
+            col: a.col.clone(),
+            val: self.val,
+        })
     }
 }
 
@@ -839,6 +896,36 @@ mod tests {
         assert!(assembly.fill(&u[1..]).is_none());
         // An index outside the matrix is an error.
         assert!(Csr::from_triplets(n, &[(0, n, 1.0)]).is_err());
+    }
+
+    #[test]
+    fn an_assembly_filled_term_by_term_is_the_matrix_from_triplets() {
+        let n = 40;
+        let t = random_triplets(n, 4000, 13);
+        let (assembly, _) = Assembly::new(n, &t).unwrap();
+        let mut r = rng(14);
+        let u: Vec<(usize, usize, f64)> = t.iter().map(|&(i, j, _)| (i, j, r())).collect();
+        let mut fill = assembly.filler();
+        for &(i, j, v) in &u {
+            fill.add(i, j, v);
+        }
+        assert!(same_bits(
+            &fill.finish().unwrap(),
+            &Csr::from_triplets(n, &u).unwrap()
+        ));
+        // A term out of the sequence, one term short, one too many: nothing.
+        let refill = |terms: &[(usize, usize, f64)]| {
+            let mut fill = assembly.filler();
+            for &(i, j, v) in terms {
+                fill.add(i, j, v);
+            }
+            fill.finish()
+        };
+        let mut other = u.clone();
+        other[3].1 = (other[3].1 + 1) % n;
+        assert!(refill(&other).is_none());
+        assert!(refill(&u[1..]).is_none());
+        assert!(refill(&[&u[..], &u[..1]].concat()).is_none());
     }
 
     #[test]

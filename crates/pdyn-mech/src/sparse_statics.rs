@@ -17,6 +17,7 @@
 //! - **Free directions** (a mechanism, a neutral equilibrium): the eigenvectors of
 //!   `K_s φ = λ D φ` with `|λ| ≤ 10⁻⁹ max_i |K_ii| / D_ii`, the lowest six looked at.
 
+use crate::damped_newton::TrialEnd;
 use crate::equilibrium::{EquilibriumError, EquilibriumOptions, FreeDirection};
 use crate::lanczos::{nearest, LanczosError, LanczosOptions};
 use crate::linearization::{Linearize, SparseLinearization};
@@ -74,11 +75,13 @@ pub fn solve<L: Linearize + ?Sized>(
         .collect();
     let dmax = diag.iter().fold(0.0f64, |m, x| m.max(*x));
     let ratio = stiff.max(f64::MIN_POSITIVE) / dmax;
-    let at = SparseAt::new(at);
+    let mirror = Mirror::of(&at.stiffness);
+    let at = SparseAt::new(at, mirror.as_ref());
     let sparse = Sparse {
         lin,
         solver: RefCell::new(StepSolver::new(&at.ks.add(1.0, &Csr::diagonal(&diag), 1.0))),
         diag: &diag,
+        mirror,
     };
     let end = crate::damped_newton::solve(&sparse, q, at, &diag, ratio, target, opts)?;
     // The steps' factors freed before the free directions' Lanczos factors its own matrix:
@@ -108,6 +111,8 @@ struct Sparse<'a, L: ?Sized> {
     /// storage is reused by every step.
     solver: RefCell<StepSolver>,
     diag: &'a [f64],
+    /// The mirror of the start's pattern of `K`, when symmetric.
+    mirror: Option<Mirror>,
 }
 
 /// How the steps `(K_s + diag(damping)) δq = f` are solved: the analysis of their pattern,
@@ -230,10 +235,54 @@ struct SparseAt {
     conservative: bool,
 }
 
+/// Where each entry's mirror image is in a symmetric pattern (`(j, i)` for `(i, j)`): the
+/// transpose of a matrix with this pattern, as values in the same places, without
+/// transposing it (damped Newton forms `K_s` at every step taken; the pattern of the net's and
+/// of the symbolic path's `K` does not change from step to step).
+struct Mirror {
+    ptr: Vec<usize>,
+    col: Vec<usize>,
+    of: Vec<usize>,
+}
+
+impl Mirror {
+    /// The mirror of `a`'s pattern, when it is symmetric.
+    fn of(a: &Csr) -> Option<Mirror> {
+        let mut of = Vec::with_capacity(a.col.len());
+        for i in 0..a.n {
+            for &j in &a.col[a.ptr[i]..a.ptr[i + 1]] {
+                let row = &a.col[a.ptr[j]..a.ptr[j + 1]];
+                of.push(a.ptr[j] + row.binary_search(&i).ok()?);
+            }
+        }
+        Some(Mirror {
+            ptr: a.ptr.clone(),
+            col: a.col.clone(),
+            of,
+        })
+    }
+
+    /// `aᵀ`'s values (in `a`'s places) when `a` has this pattern.
+    fn transposed_values(&self, a: &Csr) -> Option<Vec<f64>> {
+        (a.ptr == self.ptr && a.col == self.col)
+            .then(|| self.of.iter().map(|&k| a.val[k]).collect())
+    }
+}
+
 impl SparseAt {
-    fn new(at: SparseLinearization) -> SparseAt {
+    /// `at` with `K_s`; `mirror`, when it is the pattern of `K`, gives `Kᵀ` (the numbers of
+    /// [`Csr::transpose`]: the same values in the same places).
+    fn new(at: SparseLinearization, mirror: Option<&Mirror>) -> SparseAt {
         let k = &at.stiffness;
-        let kt = k.transpose();
+        let kt = match mirror.and_then(|m| m.transposed_values(k)) {
+            Some(val) => Csr {
+                n: k.n,
+                ptr: k.ptr.clone(),
+                col: k.col.clone(),
+                val,
+            },
+            None => k.transpose(),
+        };
         let ks = k.add(0.5, &kt, 0.5);
         // max |K_ij − K_ji| / max |K_ij|, as `Csr::asymmetry` (without a search per entry;
         // entry by entry where the pattern is symmetric, as a net's and a truss's are).
@@ -260,9 +309,29 @@ impl SparseAt {
 
 impl<L: Linearize + ?Sized> crate::damped_newton::NewtonSystem for Sparse<'_, L> {
     type At = SparseAt;
+    type Trial = TrialEnd<SparseLinearization>;
 
-    fn at(&self, q: &[f64]) -> SparseAt {
-        SparseAt::new(self.lin.at_sparse(q))
+    fn trial(&self, q: &[f64]) -> Self::Trial {
+        if self.lin.force_alone() {
+            TrialEnd::Force(self.lin.force(q))
+        } else {
+            TrialEnd::Whole(self.lin.at_sparse(q))
+        }
+    }
+
+    fn trial_residual(&self, trial: &Self::Trial) -> f64 {
+        norm(match trial {
+            TrialEnd::Force(f) => f,
+            TrialEnd::Whole(at) => &at.force,
+        })
+    }
+
+    fn taken(&self, q: &[f64], trial: Self::Trial) -> SparseAt {
+        let at = match trial {
+            TrialEnd::Force(f) => self.lin.at_sparse_with(q, f),
+            TrialEnd::Whole(at) => at,
+        };
+        SparseAt::new(at, self.mirror.as_ref())
     }
 
     fn residual(&self, at: &SparseAt) -> f64 {
@@ -502,6 +571,28 @@ mod tests {
         for (u, v) in z.iter().zip(dense.iter()) {
             assert!((u - v).abs() <= 1e-12, "{u} vs {v}");
         }
+    }
+
+    #[test]
+    fn a_mirror_transposes_as_the_transpose_does() {
+        // A grid's pattern is symmetric, its values are not (`grid` mirrors them; changed
+        // here entry by entry): `Kᵀ`'s values from the mirror are the transpose's, bit for bit.
+        let mut k = grid(5, 2.0, 4);
+        for (e, v) in k.val.iter_mut().enumerate() {
+            *v += 0.001 * e as f64;
+        }
+        let mirror = Mirror::of(&k).unwrap();
+        let kt = k.transpose();
+        assert_eq!((&kt.ptr, &kt.col), (&k.ptr, &k.col));
+        let val = mirror.transposed_values(&k).unwrap();
+        assert!(val
+            .iter()
+            .zip(&kt.val)
+            .all(|(a, b)| a.to_bits() == b.to_bits()));
+        // Another pattern is not read through it; an asymmetric pattern has no mirror.
+        assert!(mirror.transposed_values(&grid(4, 2.0, 4)).is_none());
+        let upper = Csr::from_triplets(2, &[(0, 0, 1.0), (0, 1, 2.0), (1, 1, 3.0)]).unwrap();
+        assert!(Mirror::of(&upper).is_none());
     }
 
     #[test]

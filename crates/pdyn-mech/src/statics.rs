@@ -185,18 +185,20 @@ pub fn modes_of<L: crate::linearization::Linearize + ?Sized>(
         neutral: false,
         ..EquilibriumOptions::default()
     };
-    let (q, residual) = match request.about {
+    // The sparse equilibrium's linearization there is the one the modes need (the same
+    // numbers as `at_sparse` at its `q`): not computed again.
+    let (q, residual, found) = match request.about {
         About::Equilibrium if sparse => {
             let eq = crate::sparse_statics::solve(lin, None, &balance)?;
-            (eq.q, eq.residual)
+            (eq.q, eq.residual, Some(eq.linearization))
         }
         About::Equilibrium => {
             let eq = crate::equilibrium::solve(lin, None, &balance)?;
-            (eq.q, eq.residual)
+            (eq.q, eq.residual, None)
         }
-        About::Initial => (lin.initial().to_vec(), f64::NAN),
+        About::Initial => (lin.initial().to_vec(), f64::NAN, None),
     };
-    let matrices = lin.at_sparse(&q);
+    let matrices = found.unwrap_or_else(|| lin.at_sparse(&q));
     let residual = if residual.is_nan() {
         matrices.force.iter().map(|x| x * x).sum::<f64>().sqrt()
     } else {

@@ -991,3 +991,97 @@ fn auto_takes_dop853_for_a_net_at_the_default_rtol() {
         .fold(0.0, f64::max);
     assert!(gap < 1e-4, "auto and DOPRI5 end {gap:e} apart");
 }
+
+/// The net's linearization counting what damped Newton asks of it: the matrices (`K`, `C`,
+/// `M` with `f`) and `f` alone. With `force_alone` false it hides that the kernels compute
+/// `f` apart (as the symbolic linearizer cannot), and damped Newton computes the whole
+/// linearization at every trial step.
+struct Counted<'a> {
+    lin: &'a NetLinearization,
+    force_alone: bool,
+    matrices: std::cell::Cell<usize>,
+    forces: std::cell::Cell<usize>,
+}
+
+impl<'a> Counted<'a> {
+    fn new(lin: &'a NetLinearization, force_alone: bool) -> Counted<'a> {
+        Counted {
+            lin,
+            force_alone,
+            matrices: Default::default(),
+            forces: Default::default(),
+        }
+    }
+}
+
+impl Linearize for Counted<'_> {
+    fn names(&self) -> &[String] {
+        self.lin.names()
+    }
+    fn initial(&self) -> &[f64] {
+        self.lin.initial()
+    }
+    fn at_sparse(&self, q: &[f64]) -> pdyn_mech::linearization::SparseLinearization {
+        self.matrices.set(self.matrices.get() + 1);
+        self.lin.at_sparse(q)
+    }
+    fn force(&self, q: &[f64]) -> Vec<f64> {
+        self.forces.set(self.forces.get() + 1);
+        self.lin.force(q)
+    }
+    fn force_alone(&self) -> bool {
+        self.force_alone
+    }
+    fn at_sparse_with(
+        &self,
+        q: &[f64],
+        force: Vec<f64>,
+    ) -> pdyn_mech::linearization::SparseLinearization {
+        self.matrices.set(self.matrices.get() + 1);
+        self.lin.at_sparse_with(q, force)
+    }
+    fn inertia_at(&self, q: &[f64]) -> [Vec<f64>; 3] {
+        self.lin.inertia_at(q)
+    }
+}
+
+/// Damped Newton judges a trial step by `f` at its end and computes the matrices only for
+/// the steps it takes: on the 10 × 10 hanging net, by the sparse path and by the dense one,
+/// the matrices are computed once at the start and once per step taken, `f` once more per
+/// trial than when each trial computes the whole linearization, and the path is the same to
+/// the last bit (the same `f` at each trial, the same decisions).
+#[test]
+fn newton_computes_the_matrices_only_for_the_steps_it_takes() {
+    let opts = EquilibriumOptions::default();
+    let mut model = load_deferring(&net_source(10, 10, Some(0.02)));
+    let lin = net_linearization(&mut model);
+    let bits = |q: &[f64]| q.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+    for sparse in [true, false] {
+        let solve = |counted: &Counted| -> (Vec<f64>, f64, usize) {
+            if sparse {
+                let e = pdyn_mech::sparse_statics::solve(counted, None, &opts).unwrap();
+                (e.q, e.residual, e.steps)
+            } else {
+                let e = pdyn_mech::equilibrium::solve(counted, None, &opts).unwrap();
+                (e.q, e.residual, e.steps)
+            }
+        };
+        let (whole, alone) = (Counted::new(&lin, false), Counted::new(&lin, true));
+        let (q_whole, r_whole, steps_whole) = solve(&whole);
+        let (q_alone, r_alone, steps) = solve(&alone);
+        let path = if sparse { "sparse" } else { "dense" };
+        assert_eq!(bits(&q_whole), bits(&q_alone), "{path}");
+        assert_eq!(r_whole.to_bits(), r_alone.to_bits(), "{path}");
+        assert_eq!(steps_whole, steps, "{path}");
+        // Each trial step computed the whole linearization at its end (after the start's).
+        let trials = whole.matrices.get() - 1;
+        assert_eq!(alone.matrices.get(), 1 + steps, "{path}: {trials} trials");
+        assert_eq!(
+            alone.forces.get(),
+            whole.forces.get() + trials,
+            "{path}: {steps} steps of {trials} trials"
+        );
+        // Some trial steps were refused (their matrices are what is saved).
+        assert!(trials > steps, "{path}: {steps} steps of {trials} trials");
+    }
+}

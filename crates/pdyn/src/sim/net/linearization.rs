@@ -123,34 +123,43 @@ impl NetLinearization {
         Ok(a)
     }
 
-    /// Operations per evaluation of the loads (every kernel over its elements): a
-    /// deterministic count, linear in the elements.
-    pub fn operations(&self) -> usize {
-        self.kernels.operations()
+    /// `M`, `K`, `C` at `input` (at rest), with `force` the loads there.
+    fn matrices(&self, input: &[f64], force: Vec<f64>) -> SparseLinearization {
+        // The elements' terms straight into the matrices through the assemblies kept (after
+        // the first linearization: the same numbers as collecting them, without the triplets).
+        if let [Some(k_assembly), Some(c_assembly)] = &*self.assembly.borrow() {
+            let n = self.names.len();
+            let (mut k, mut c) = (k_assembly.filler(), c_assembly.filler());
+            let compiled = self
+                .kernels
+                .jacobian_terms(input, &mut |row, column, value| {
+                    let entry = -self.mass[row] * value;
+                    if column < n {
+                        k.add(row, column, entry);
+                    } else {
+                        c.add(row, column - n, entry);
+                    }
+                });
+            if let (true, Some(stiffness), Some(damping)) = (compiled, k.finish(), c.finish()) {
+                return SparseLinearization {
+                    mass: Csr::diagonal(&self.mass),
+                    stiffness,
+                    damping,
+                    force,
+                };
+            }
+        }
+        self.matrices_by_triplets(input, force)
     }
-}
 
-impl Linearize for NetLinearization {
-    fn names(&self) -> &[String] {
-        &self.names
-    }
-
-    fn initial(&self) -> &[f64] {
-        &self.initial
-    }
-
-    fn force(&self, q: &[f64]) -> Vec<f64> {
-        self.force_with(&self.input_at(q))
-    }
-
-    fn at_sparse(&self, q: &[f64]) -> SparseLinearization {
+    /// [`NetLinearization::matrices`] through triplets, whose assemblies are kept: the first
+    /// time (or should the terms' sequence change).
+    fn matrices_by_triplets(&self, input: &[f64], force: Vec<f64>) -> SparseLinearization {
         let n = self.names.len();
-        let input = self.input_at(q);
-        let force = self.force_with(&input);
         let (mut k, mut c) = (Vec::new(), Vec::new());
         let compiled = self
             .kernels
-            .jacobian_terms(&input, &mut |row, column, value| {
+            .jacobian_terms(input, &mut |row, column, value| {
                 let entry = -self.mass[row] * value;
                 if column < n {
                     k.push((row, column, entry));
@@ -171,6 +180,43 @@ impl Linearize for NetLinearization {
             damping: csr(&c, 1),
             force,
         }
+    }
+
+    /// Operations per evaluation of the loads (every kernel over its elements): a
+    /// deterministic count, linear in the elements.
+    pub fn operations(&self) -> usize {
+        self.kernels.operations()
+    }
+}
+
+impl Linearize for NetLinearization {
+    fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    fn initial(&self) -> &[f64] {
+        &self.initial
+    }
+
+    fn force(&self, q: &[f64]) -> Vec<f64> {
+        self.force_with(&self.input_at(q))
+    }
+
+    fn force_alone(&self) -> bool {
+        // The loads' kernels alone: about a twentieth of the linearization on the 20 × 20
+        // hanging net (the derivatives' kernels and the matrices' assembly are the rest).
+        true
+    }
+
+    fn at_sparse(&self, q: &[f64]) -> SparseLinearization {
+        let input = self.input_at(q);
+        let force = self.force_with(&input);
+        self.matrices(&input, force)
+    }
+
+    fn at_sparse_with(&self, q: &[f64], force: Vec<f64>) -> SparseLinearization {
+        // `force` is `force(q)`, `force_with` of this same input: the numbers of `at_sparse`.
+        self.matrices(&self.input_at(q), force)
     }
 
     fn inertia_at(&self, _q: &[f64]) -> [Vec<f64>; 3] {
