@@ -452,24 +452,10 @@ impl Indices {
         bindings: &[(String, i64)],
         rows: &[(usize, usize)],
     ) -> Result<Option<String>, IndexError> {
-        let Some(subscript) = self.subscript(name)? else {
-            return Ok(None);
-        };
-        // One or two indices in practice: kept on the stack (this is once per reference per
-        // member).
-        let mut inline = [0i64; 4];
-        let mut spilled = Vec::new();
-        let n = subscript.parts.len();
-        let values: &[i64] = if n <= inline.len() {
-            self.subscript_values(&subscript, bindings, rows, &mut inline[..n])?;
-            &inline[..n]
-        } else {
-            spilled.resize(n, 0);
-            self.subscript_values(&subscript, bindings, rows, &mut spilled)?;
-            &spilled
-        };
-        self.check_member(&subscript, values, name, rows)?;
-        Ok(Some(member(&subscript.base, values)))
+        let mut out = String::new();
+        Ok(self
+            .member_name_into(name, bindings, rows, &mut out)?
+            .then_some(out))
     }
 
     /// [`Indices::member_name`] written into `buf` (cleared first) instead of a new string:
@@ -485,6 +471,8 @@ impl Indices {
         let Some(subscript) = self.subscript(name)? else {
             return Ok(false);
         };
+        // One or two indices in practice: kept on the stack (this is once per reference per
+        // member).
         let n = subscript.parts.len();
         let mut inline = [0i64; 4];
         let mut spilled = Vec::new();
