@@ -167,16 +167,7 @@ mod tests {
         let mut x = b.clone();
         let mut work = vec![0.0; a.n];
         f.solve_in_place(&mut x, &mut work);
-        let dense = a
-            .to_dense()
-            .lu()
-            .solve(&nalgebra::DVector::from_vec(b))
-            .unwrap();
-        let err = x
-            .iter()
-            .zip(dense.iter())
-            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-        err / dense.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+        crate::sparse::tests::error_against_dense(a, b, &x)
     }
 
     /// `max |A x − b| / max (|A| |x|)`: the solve's backward error, entry by entry.
