@@ -539,7 +539,7 @@ impl BatchKernel {
             return s.interpret(inputs, outputs, n);
         };
         // column pointers on the stack for the usual few columns
-        const FEW: usize = 8;
+        const FEW: usize = 16;
         if inputs.len() <= FEW && outputs.len() <= FEW {
             let mut ip = [std::ptr::null::<f64>(); FEW];
             let mut op = [std::ptr::null_mut::<f64>(); FEW];
@@ -552,6 +552,79 @@ impl BatchKernel {
             let ip: Vec<*const f64> = inputs.iter().map(|x| x.as_ptr()).collect();
             let op: Vec<*mut f64> = outputs.iter_mut().map(|o| o.as_mut_ptr()).collect();
             call(code, &ip, &op, n);
+        }
+    }
+}
+
+impl BatchKernel {
+    /// [`BatchKernel::run`] over stretches of the columns, read where they are: for stretch
+    /// `k = (first, len)`, input `c` is `inputs[c][from[k n_in + c]..][..len]` and output `o`
+    /// is written to `outputs[o][first..first + len]`. A net's family reads its coordinates
+    /// in place this way, stretch by stretch, where a gather would copy each column first;
+    /// the column pointers are set per stretch with no allocation and no per-column length
+    /// check beyond the stretch's bounds.
+    ///
+    /// # Panics
+    /// If the number of columns is not [`BatchKernel::n_inputs`] and
+    /// [`BatchKernel::n_outputs`], `from` does not hold `n_inputs` starts per stretch, or a
+    /// stretch reaches past the end of a column (a programming error).
+    pub fn run_stretches(
+        &self,
+        inputs: &[&[f64]],
+        from: &[u32],
+        outputs: &mut [&mut [f64]],
+        stretches: &[(u32, u32)],
+    ) {
+        let s = &self.steps;
+        let (n_in, n_out) = (s.n_inputs, s.outs.len());
+        assert!(
+            inputs.len() == n_in && outputs.len() == n_out && from.len() == stretches.len() * n_in,
+            "BatchKernel::run_stretches: {} input and {} output columns, {} starts for {} \
+             stretches given; {n_in} and {n_out} columns expected",
+            inputs.len(),
+            outputs.len(),
+            from.len(),
+            stretches.len()
+        );
+        const FEW: usize = 16;
+        let code = match &self.code {
+            Some(code) if n_in <= FEW && n_out <= FEW => code,
+            _ => {
+                // The interpreter (or many columns): each stretch as a run of its own.
+                for (k, &(first, len)) in stretches.iter().enumerate() {
+                    let starts = &from[k * n_in..(k + 1) * n_in];
+                    let (first, len) = (first as usize, len as usize);
+                    let ins: Vec<&[f64]> = inputs
+                        .iter()
+                        .zip(starts)
+                        .map(|(col, &f)| &col[f as usize..f as usize + len])
+                        .collect();
+                    let mut outs: Vec<&mut [f64]> = outputs
+                        .iter_mut()
+                        .map(|col| &mut col[first..first + len])
+                        .collect();
+                    self.run(&ins, &mut outs);
+                }
+                return;
+            }
+        };
+        let mut ip = [std::ptr::null::<f64>(); FEW];
+        let mut op = [std::ptr::null_mut::<f64>(); FEW];
+        for (k, &(first, len)) in stretches.iter().enumerate() {
+            let (first, len) = (first as usize, len as usize);
+            for ((p, col), &f) in ip
+                .iter_mut()
+                .zip(inputs)
+                .zip(&from[k * n_in..(k + 1) * n_in])
+            {
+                *p = col[f as usize..f as usize + len].as_ptr();
+            }
+            for (p, col) in op.iter_mut().zip(outputs.iter_mut()) {
+                *p = col[first..first + len].as_mut_ptr();
+            }
+            // Each pointer starts a range of `len` values inside its column (the slicing
+            // above checked it); the outputs are distinct mutable columns, none an input.
+            call(code, &ip, &op, len);
         }
     }
 }
@@ -697,5 +770,47 @@ mod tests {
                 });
             }
         });
+    }
+
+    /// Stretches read in place give, element by element, the bits of the whole columns
+    /// gathered first: two inputs read from one long column at their own starts, one from a
+    /// column of its own; stretches of every length 0..=9 (the vector loop and its tail),
+    /// outputs written only inside the stretches (the rest keeps its NaN).
+    #[test]
+    fn stretches_read_in_place_give_the_gathered_bits() {
+        let (native, interp, _) =
+            kernels(&["sqrt(x*x + y*y) - z", "x/(y + 2*z)"], &["x", "y", "z"]);
+        let state = random_inputs(300, 11, true);
+        let z = random_inputs(100, 12, true);
+        let mut stretches = Vec::new();
+        let mut from = Vec::new();
+        let mut first = 0u32;
+        for len in 0..=9u32 {
+            stretches.push((first, len));
+            // x from state[7 first + ..], y from state[150 + first + ..], z from its column.
+            from.extend([7 * first % 100, 150 + first, first]);
+            first += len + 1;
+        }
+        let elements = first as usize;
+        for k in [&native, &interp] {
+            let mut outs = vec![vec![f64::NAN; elements]; 2];
+            let mut cols: Vec<&mut [f64]> = outs.iter_mut().map(|c| &mut c[..]).collect();
+            k.run_stretches(&[&state, &state, &z], &from, &mut cols, &stretches);
+            for (s, &(first, len)) in stretches.iter().enumerate() {
+                let (first, len) = (first as usize, len as usize);
+                let start = |c: usize| from[3 * s + c] as usize;
+                let x = state[start(0)..start(0) + len].to_vec();
+                let y = state[start(1)..start(1) + len].to_vec();
+                let zs = z[start(2)..start(2) + len].to_vec();
+                let (mut a, mut b) = (vec![0.0; len], vec![0.0; len]);
+                interp.run(&[&x, &y, &zs], &mut [&mut a, &mut b]);
+                for e in 0..len {
+                    assert!(same(outs[0][first + e], a[e]) && same(outs[1][first + e], b[e]));
+                }
+                if first + len < elements {
+                    assert!(outs[0][first + len].is_nan(), "written past stretch {s}");
+                }
+            }
+        }
     }
 }

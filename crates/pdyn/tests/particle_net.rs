@@ -294,15 +294,109 @@ fn each_spring_is_one_element_and_parameters_are_not_gathered() {
             "{nx}x{ny}: gathered values"
         );
         // Terms of the accelerations: a spring's force on each free end (three components),
-        // the drag on each particle (three), gravity (along z). All but gravity's are summed
-        // three at a time, a particle's x, y and z together.
+        // the drag on each particle (three), gravity (along z). Declared as families, the
+        // outputs and the accelerations they add to step together: the sums go by runs, at
+        // least four terms each on average. (Summed particle by particle instead, all but
+        // gravity's terms would go three at a time, a particle's x, y and z together.)
         let together = 6 * (springs - at_corners) + 3 * at_corners + 3 * particles;
-        assert_eq!(
-            k.terms_summed(),
-            (together as usize, (together + particles) as usize),
-            "{nx}x{ny}: terms summed together, in all"
-        );
+        let terms = (together + particles) as usize;
+        match k.summed_by_runs() {
+            Some(runs) => {
+                assert_eq!(k.terms_summed(), (0, terms), "{nx}x{ny}: terms summed");
+                assert!(4 * runs <= terms, "{nx}x{ny}: {runs} runs of {terms} terms");
+            }
+            None => assert_eq!(k.terms_summed(), (together as usize, terms), "{nx}x{ny}"),
+        }
+        // The interior springs and the drag read their inputs (the 3 + 3 positions of a
+        // spring's ends, the 3 velocities of a drag) in place, stretch by stretch, at 10 x 10,
+        // where each family's stretches are 8 or more elements long: two spring templates
+        // (the horizontal and vertical springs share one, same k and l0; the two diagonal
+        // families the other) and the drag. The springs at the corners (one free end each)
+        // are too few and gather.
+        let (in_place, stretches, reading) = k.read_in_place();
+        if (nx, ny) == (10, 10) {
+            assert!(
+                k.summed_by_runs().is_some(),
+                "the 10 x 10 net's sums go by runs"
+            );
+            assert_eq!(
+                (in_place, reading),
+                (3, 3 + 4),
+                "{nx}x{ny}: kernels read in place"
+            );
+            // The drag's one stretch; the structural springs: the horizontal ones (i, j) for
+            // i < 9 one stretch but at a corner's spring, the vertical ones (i, j) for j < 9
+            // one per i; the diagonals: one per i for each family.
+            assert!(
+                stretches <= 1 + (2 + 10) + 2 * 9 + 4,
+                "{stretches} stretches"
+            );
+        }
+        assert!(in_place <= reading);
     }
+}
+
+/// The springs at the pinned corners are templates of a few elements, interpreted: after
+/// `NATIVE_AFTER` evaluations they are compiled too, and give the same bits.
+#[test]
+fn small_templates_compiled_late_give_the_interpreters_bits() {
+    use pdyn::sim::net::kernels::NATIVE_AFTER;
+    let (_, prep) = prepare(&net_source(5, 4, Some(0.02)), NetPath::Always);
+    let k = prep.system.net_kernels().expect("a net");
+    let y = perturbed(&prep.y0);
+    let n = y.len() / 2;
+    let parameters = prep.system.parameters();
+    let input: Vec<f64> = [0.25]
+        .iter()
+        .chain(&y)
+        .chain(&parameters)
+        .copied()
+        .collect();
+    let mut first = vec![0.0; n];
+    k.accelerations(&input, &mut first);
+    let mut again = vec![0.0; n];
+    for _ in 1..NATIVE_AFTER {
+        k.accelerations_of_state(&y, &input, &mut again);
+    }
+    assert_eq!(
+        k.compiled_late(),
+        0,
+        "not before {NATIVE_AFTER} evaluations"
+    );
+    k.accelerations(&input, &mut again);
+    if k.is_native() {
+        // The two corners' springs (one free end each): one template per corner and family
+        // kind (structural, diagonal), each a few elements.
+        assert_eq!(k.compiled_late(), 4);
+    }
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&again), bits(&first));
+}
+
+/// The kernels that read their inputs in place, stretch by stretch, give the bits of the
+/// same kernels gathering every input into columns, on a 10 x 10 net at a perturbed state.
+#[test]
+fn kernels_reading_in_place_give_the_bits_of_gathered_columns() {
+    let (_, prep) = prepare(&net_source(10, 10, Some(0.02)), NetPath::Always);
+    let k = prep.system.net_kernels().expect("a net");
+    let gathering = k.gathering_copy();
+    assert_eq!(k.read_in_place().0, 3);
+    assert_eq!(gathering.read_in_place(), (0, 0, 7));
+    let y = perturbed(&prep.y0);
+    let n = y.len() / 2;
+    let parameters = prep.system.parameters();
+    let input: Vec<f64> = [0.25]
+        .iter()
+        .chain(&y)
+        .chain(&parameters)
+        .copied()
+        .collect();
+    let (mut in_place, mut gathered) = (vec![0.0; n], vec![1.0; n]);
+    k.accelerations_of_state(&y, &input, &mut in_place);
+    gathering.accelerations_of_state(&y, &input, &mut gathered);
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&in_place), bits(&gathered));
+    assert!(in_place.iter().all(|a| a.is_finite()) && in_place.iter().any(|&a| a != 0.0));
 }
 
 /// The right-hand side reads the state where the integrator keeps it and writes the

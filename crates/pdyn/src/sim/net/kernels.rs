@@ -8,16 +8,23 @@
 //! element, an index into that vector (the gather table), or one index for every element (a
 //! parameter, `t`: its column is refilled only when its value changes).
 
+use super::runs::MIN_MEAN_RUN;
 use super::structure::{self, Group, Source, Structure};
 use super::sums::Sums;
 use pdyn_expr::compile::CompileError;
 use pdyn_expr::{Id, Pool, Program};
 use pdyn_jit::{BatchKernel, JitMode};
-use std::cell::{OnceCell, RefCell};
+use std::cell::{Cell, OnceCell, RefCell};
 
 /// Templates with fewer elements than this are interpreted (no machine code to generate for a
 /// pinned corner's few springs); the others run as native loops.
 pub const NATIVE_FROM: usize = 16;
+
+/// Evaluations after which the small templates are compiled too: Cranelift's cost for one
+/// (about 0.5–1 M instructions) is that of interpreting its few elements ~500 times, so a
+/// short run never pays it and a long one (the 20 × 20 net's 8 s: 17,000 evaluations, 4 %
+/// of its time in the interpreter) soon gets it back.
+pub const NATIVE_AFTER: u32 = 500;
 
 /// "No coordinate" in a scatter table: the component is constant in time.
 const NONE: u32 = u32::MAX;
@@ -47,6 +54,12 @@ struct Kernel {
     /// Compiled on first use: an explicit method never asks for it.
     jacobian_kernel: OnceCell<Option<BatchKernel>>,
     mode: JitMode,
+    /// A template interpreted for its few elements although native code is allowed: its
+    /// program and the mode, compiled after [`NATIVE_AFTER`] evaluations.
+    late: Option<Late>,
+    /// When they pay, the stretches of elements over which every per-element input steps by
+    /// one in the state: the kernel then reads those inputs where they are, nothing gathered.
+    stretches: Option<Stretches>,
     elements: usize,
     /// The gathered input columns, kept between evaluations: the columns of parameters are
     /// refilled only when a parameter's value changed.
@@ -56,6 +69,61 @@ struct Kernel {
     /// once per gather, not once per value.
     input_len: usize,
     state_len: usize,
+}
+
+/// Consecutive elements whose per-element inputs are each consecutive in the state (a family
+/// declared over the same indices as the coordinates: `spring[i,j]` reads `x[i,j]` and
+/// `x[i+1,j]`, which step with `j`): the kernel runs once per stretch on slices of the
+/// state, where gathering would copy each input column value by value.
+#[derive(Clone)]
+struct Stretches {
+    /// `(first element, elements)` of each stretch.
+    stretches: Vec<(u32, u32)>,
+    /// Per stretch, per input: where the first element's value is, in the state, or (a
+    /// broadcast input) in the input's column, at the stretch's first element.
+    from: Vec<u32>,
+}
+
+impl Stretches {
+    /// The stretches of a kernel's `elements` reading by `gather`, when there are per-element
+    /// inputs and the stretches are [`MIN_MEAN_RUN`] elements long on average.
+    fn new(gather: &[Gather], elements: usize) -> Option<Stretches> {
+        let each: Vec<&[u32]> = gather
+            .iter()
+            .filter_map(|g| match g {
+                Gather::Each(from) => Some(from.as_slice()),
+                Gather::Broadcast(_) => None,
+            })
+            .collect();
+        if each.is_empty() || each.iter().any(|from| from.len() != elements) {
+            return None;
+        }
+        let mut stretches = Vec::new();
+        let mut from = Vec::new();
+        let mut first = 0;
+        for e in 1..=elements {
+            let goes_on =
+                e < elements && each.iter().all(|f| f[e - 1].checked_add(1) == Some(f[e]));
+            if goes_on {
+                continue;
+            }
+            stretches.push((first as u32, (e - first) as u32));
+            from.extend(gather.iter().map(|g| match g {
+                Gather::Each(f) => f[first],
+                Gather::Broadcast(_) => first as u32,
+            }));
+            first = e;
+        }
+        (stretches.len() * MIN_MEAN_RUN <= elements).then_some(Stretches { stretches, from })
+    }
+}
+
+/// A small template's native code, made once the run has shown itself long.
+#[derive(Clone)]
+struct Late {
+    program: Program,
+    mode: JitMode,
+    native: OnceCell<Option<BatchKernel>>,
 }
 
 /// Where one kernel input comes from, element by element.
@@ -102,6 +170,8 @@ pub struct NetKernels {
     native: bool,
     /// Whether a kernel reads a velocity.
     reads_rates: bool,
+    /// Evaluations of the accelerations so far (up to [`NATIVE_AFTER`]).
+    evaluations: Cell<u32>,
 }
 
 impl NetKernels {
@@ -130,10 +200,15 @@ impl NetKernels {
                 .any(|s| matches!(s, Source::Slot { order: 1, .. }));
             let program = Program::compile(pool, &leaves, &outputs)?;
             let elements = g.particles.len() / g.slots;
-            let mode = if elements >= NATIVE_FROM {
-                jit
+            let (mode, late) = if elements >= NATIVE_FROM || jit == JitMode::Off {
+                (jit, None)
             } else {
-                JitMode::Off
+                let late = Late {
+                    program: program.clone(),
+                    mode: jit,
+                    native: OnceCell::new(),
+                };
+                (JitMode::Off, Some(late))
             };
             let Some(kernel) = BatchKernel::new(&program, mode) else {
                 return Ok(None);
@@ -186,6 +261,7 @@ impl NetKernels {
                     .unwrap_or(0)
             };
             let (input_len, state_len) = (len(false), len(true));
+            let stretches = Stretches::new(&gather, elements);
             let columns = Columns {
                 inputs: vec![vec![0.0; elements]; kernel.n_inputs()],
                 filled: vec![f64::NAN.to_bits(); kernel.n_inputs()],
@@ -202,6 +278,8 @@ impl NetKernels {
                 jacobian_program,
                 jacobian_kernel: OnceCell::new(),
                 mode,
+                late,
+                stretches,
                 elements,
                 columns: RefCell::new(columns),
                 input_len,
@@ -232,6 +310,7 @@ impl NetKernels {
             n,
             native: native && jit == JitMode::Auto,
             reads_rates,
+            evaluations: Cell::new(0),
         }))
     }
 
@@ -282,6 +361,36 @@ impl NetKernels {
         (self.sums.together(), self.sums.terms())
     }
 
+    /// The runs the accelerations are summed by, output by output, when they pay
+    /// ([`Sums`]): a deterministic count.
+    pub fn summed_by_runs(&self) -> Option<usize> {
+        self.sums.runs()
+    }
+
+    /// Of the kernels with per-element inputs, those that read them in place, stretch by
+    /// stretch (nothing gathered), and their stretches; and the kernels with per-element
+    /// inputs in all (deterministic counts).
+    pub fn read_in_place(&self) -> (usize, usize, usize) {
+        let reading = self
+            .kernels
+            .iter()
+            .filter(|k| k.elements > 0 && k.gather.iter().any(|g| matches!(g, Gather::Each(_))));
+        reading.fold((0, 0, 0), |(kernels, stretches, all), k| {
+            match &k.stretches {
+                Some(s) => (kernels + 1, stretches + s.stretches.len(), all + 1),
+                None => (kernels, stretches, all + 1),
+            }
+        })
+    }
+
+    /// A copy whose kernels all gather their inputs into columns, none reading in place:
+    /// the reference the stretches are checked against.
+    pub fn gathering_copy(&self) -> NetKernels {
+        let mut copy = self.clone();
+        copy.kernels.iter_mut().for_each(|k| k.stretches = None);
+        copy
+    }
+
     /// Whether the large kernels run as native code.
     pub fn is_native(&self) -> bool {
         self.native
@@ -292,12 +401,33 @@ impl NetKernels {
         self.reads_rates
     }
 
+    /// Counts one evaluation of the accelerations: true once there have been
+    /// [`NATIVE_AFTER`], when the small templates run as native code too.
+    fn count_evaluation(&self) -> bool {
+        let done = self.evaluations.get();
+        if done < NATIVE_AFTER {
+            self.evaluations.set(done + 1);
+        }
+        done >= NATIVE_AFTER
+    }
+
+    /// Small templates compiled late, after [`NATIVE_AFTER`] evaluations, and running
+    /// native code (a deterministic count).
+    pub fn compiled_late(&self) -> usize {
+        self.kernels
+            .iter()
+            .filter_map(|k| k.late.as_ref()?.native.get()?.as_ref())
+            .filter(|native| native.is_native())
+            .count()
+    }
+
     /// The accelerations `q''` (free coordinates in state order) at `input = [t, q, q',
     /// parameters]`.
     pub fn accelerations(&self, input: &[f64], acc: &mut [f64]) {
         let outputs = &mut *self.outputs.borrow_mut();
+        let late = self.count_evaluation();
         for k in &self.kernels {
-            run_kernel(k, Values::Input(input), outputs);
+            run_kernel(k, Values::Input(input), outputs, late);
         }
         self.sums.sum_into(outputs, &mut acc[..self.n]);
     }
@@ -307,8 +437,9 @@ impl NetKernels {
     /// caller need not copy the state there at every evaluation).
     pub fn accelerations_of_state(&self, y: &[f64], input: &[f64], acc: &mut [f64]) {
         let outputs = &mut *self.outputs.borrow_mut();
+        let late = self.count_evaluation();
         for k in &self.kernels {
-            run_kernel(k, Values::State { y, input }, outputs);
+            run_kernel(k, Values::State { y, input }, outputs, late);
         }
         self.sums.sum_into(outputs, &mut acc[..self.n]);
     }
@@ -341,7 +472,7 @@ impl NetKernels {
                 continue;
             }
             let outputs = &mut *self.outputs.borrow_mut();
-            run_kernel(k, Values::Input(input), outputs);
+            run_kernel(k, Values::Input(input), outputs, false);
             let outs = &outputs[k.at..k.at + k.scatter.len() * k.elements];
             for (a, pushed) in k.acts.iter().enumerate() {
                 for (e, &p) in pushed.iter().enumerate() {
@@ -432,18 +563,68 @@ impl NetKernels {
 }
 
 /// Runs `k` over its elements at `input`: its output columns, one value per element, in its
-/// part of `outputs`.
-fn run_kernel(k: &Kernel, input: Values, outputs: &mut [f64]) {
+/// part of `outputs`; with `late`, a small template's native code (compiled now if it is not
+/// yet: the same bits as the interpreter's).
+fn run_kernel(k: &Kernel, input: Values, outputs: &mut [f64], late: bool) {
     if k.elements == 0 {
         return;
     }
+    let kernel = match &k.late {
+        Some(l) if late => l
+            .native
+            .get_or_init(|| BatchKernel::new(&l.program, l.mode))
+            .as_ref()
+            .unwrap_or(&k.kernel),
+        _ => &k.kernel,
+    };
     let cols = &mut *k.columns.borrow_mut();
+    let outputs = &mut outputs[k.at..k.at + k.scatter.len() * k.elements];
+    // The columns' slices on the stack for the usual few columns: two allocations per kernel
+    // and evaluation were 2 % of a net's run.
+    const FEW: usize = 16;
+    if let (Some(stretches), true) = (
+        &k.stretches,
+        k.gather.len() <= FEW && k.scatter.len() <= FEW,
+    ) {
+        let (state, input) = sources(k, input);
+        fill_broadcast(k, input, cols);
+        let mut ins: [&[f64]; FEW] = [&[]; FEW];
+        for ((slot, g), col) in ins.iter_mut().zip(&k.gather).zip(&cols.inputs) {
+            *slot = match g {
+                Gather::Each(_) => state,
+                Gather::Broadcast(_) => col,
+            };
+        }
+        let mut outs: [&mut [f64]; FEW] = Default::default();
+        for (slot, column) in outs.iter_mut().zip(outputs.chunks_mut(k.elements)) {
+            *slot = column;
+        }
+        kernel.run_stretches(
+            &ins[..k.gather.len()],
+            &stretches.from,
+            &mut outs[..k.scatter.len()],
+            &stretches.stretches,
+        );
+        return;
+    }
     gather(k, input, cols);
+    let outputs = outputs.chunks_mut(k.elements);
+    if cols.inputs.len() <= FEW && k.scatter.len() <= FEW {
+        let mut ins: [&[f64]; FEW] = [&[]; FEW];
+        let mut outs: [&mut [f64]; FEW] = Default::default();
+        for (slot, c) in ins.iter_mut().zip(&cols.inputs) {
+            *slot = c;
+        }
+        for (slot, c) in outs.iter_mut().zip(outputs) {
+            *slot = c;
+        }
+        let (n_in, n_out) = (cols.inputs.len(), k.scatter.len());
+        kernel.run(&ins[..n_in], &mut outs[..n_out]);
+        return;
+    }
     let ins: Vec<&[f64]> = cols.inputs.iter().map(|c| c.as_slice()).collect();
-    let mut outs: Vec<&mut [f64]> = outputs[k.at..k.at + k.scatter.len() * k.elements]
-        .chunks_mut(k.elements)
-        .collect();
-    k.kernel.run(&ins, &mut outs);
+    let mut outs: Vec<&mut [f64]> = outputs.collect();
+    kernel.run(&ins, &mut outs);
 }
 
 /// The terms of each acceleration (the rows [`Sums`] is built from): every output not identically
@@ -494,6 +675,21 @@ enum Values<'a> {
 /// Fills the input columns of kernel `k` from `values`: every element's coordinates, and a
 /// parameter's column only when its value changed since it was filled.
 fn gather(k: &Kernel, values: Values, cols: &mut Columns) {
+    let (state, input) = sources(k, values);
+    fill_broadcast(k, input, cols);
+    for (col, from) in cols.inputs.iter_mut().zip(&k.gather) {
+        if let Gather::Each(from) = from {
+            for (x, &i) in col.iter_mut().zip(from) {
+                // SAFETY: `i < k.state_len <= state.len()` (asserted by `sources`).
+                *x = unsafe { *state.get_unchecked(i as usize) };
+            }
+        }
+    }
+}
+
+/// The state `[q, q']` and the input vector `[t, q, q', parameters]` kernel `k` reads,
+/// checked once to be as long as its tables need.
+fn sources<'a>(k: &Kernel, values: Values<'a>) -> (&'a [f64], &'a [f64]) {
     let (state, input) = match values {
         Values::Input(input) => (input.get(1..).unwrap_or_default(), input),
         Values::State { y, input } => (y, input),
@@ -506,20 +702,17 @@ fn gather(k: &Kernel, values: Values, cols: &mut Columns) {
         k.input_len,
         k.state_len
     );
+    (state, input)
+}
+
+/// Fills each broadcast input column of `k` (a parameter, `t`) whose value changed since.
+fn fill_broadcast(k: &Kernel, input: &[f64], cols: &mut Columns) {
     for ((col, from), filled) in cols.inputs.iter_mut().zip(&k.gather).zip(&mut cols.filled) {
-        match from {
-            Gather::Each(from) => {
-                for (x, &i) in col.iter_mut().zip(from) {
-                    // SAFETY: `i < k.state_len <= state.len()` (asserted above).
-                    *x = unsafe { *state.get_unchecked(i as usize) };
-                }
-            }
-            Gather::Broadcast(i) => {
-                let v = input[*i as usize];
-                if v.to_bits() != *filled {
-                    col.iter_mut().for_each(|x| *x = v);
-                    *filled = v.to_bits();
-                }
+        if let Gather::Broadcast(i) = from {
+            let v = input[*i as usize];
+            if v.to_bits() != *filled {
+                col.iter_mut().for_each(|x| *x = v);
+                *filled = v.to_bits();
             }
         }
     }

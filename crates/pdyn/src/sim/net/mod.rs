@@ -22,6 +22,7 @@
 pub mod axial;
 pub mod kernels;
 pub mod linearization;
+mod runs;
 pub mod statics;
 pub mod structure;
 mod sums;

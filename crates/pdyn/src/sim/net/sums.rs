@@ -12,6 +12,13 @@
 //! other rows (gravity's, along `z` alone) is a step of its own row. Every sum adds the same
 //! terms in the same order, from the same starting value, as summing its row alone with
 //! `Iterator::sum`: the same bits.
+//!
+//! When the outputs and the rows they add to step together (a net declared as families,
+//! [`super::runs`]), the sums go instead output by output in the outputs' order, each
+//! output added into its row in memory, run by run: each row still adds its terms in its
+//! order (the outputs' order) from the same starting value, so the bits are again the same.
+
+use super::runs::Runs;
 
 /// One step of a particle's three sums.
 #[derive(Clone, Copy, Debug)]
@@ -40,6 +47,12 @@ pub(super) struct Sums {
     singles: Vec<u32>,
     single_start: Vec<u32>,
     terms: Vec<u32>,
+    /// Every term as `(row, output)` in the outputs' order, when its runs pay: the sums then
+    /// go by these runs, and `triples` and `singles` are empty.
+    by_output: Option<Runs>,
+    rows: usize,
+    /// Terms in all.
+    total: usize,
     /// The value `Iterator::sum` of `f64` starts from (−0.0 in current Rust), so that a sum is
     /// bit for bit that of its terms summed alone.
     zero: f64,
@@ -64,6 +77,20 @@ impl Sums {
         let rows = start.len().checked_sub(1)?;
         if terms.len() != *start.last()? as usize || terms.iter().any(|&t| t as usize >= outputs) {
             return None;
+        }
+        let by_output = in_output_order(start, terms, outputs);
+        if by_output.pay() {
+            return Some(Sums {
+                triples: Vec::new(),
+                steps: Vec::new(),
+                singles: Vec::new(),
+                single_start: vec![0],
+                terms: Vec::new(),
+                by_output: Some(by_output),
+                rows,
+                total: terms.len(),
+                zero: std::iter::empty::<f64>().sum(),
+            });
         }
         let row = |r: u32| -> Option<&[u32]> {
             let r = r as usize;
@@ -102,6 +129,9 @@ impl Sums {
             singles,
             single_start,
             terms: single_terms,
+            by_output: None,
+            rows,
+            total: terms.len(),
             zero: std::iter::empty::<f64>().sum(),
         })
     }
@@ -117,12 +147,22 @@ impl Sums {
 
     /// Terms added per evaluation, in all.
     pub(super) fn terms(&self) -> usize {
-        let alone = self.steps.len() - self.together() / 3;
-        self.together() + alone + self.terms.len()
+        self.total
+    }
+
+    /// The runs the sums go by, output by output, if they do (a deterministic count).
+    pub(super) fn runs(&self) -> Option<usize> {
+        self.by_output.as_ref().map(Runs::len)
     }
 
     /// `acc[r]` = the sum of row `r`'s terms in `outputs`, for every row.
     pub(super) fn sum_into(&self, outputs: &[f64], acc: &mut [f64]) {
+        if let Some(runs) = &self.by_output {
+            let acc = &mut acc[..self.rows];
+            acc.fill(self.zero);
+            runs.add(outputs, acc);
+            return;
+        }
         // SAFETY (every `get_unchecked` below): `new` checked that every term indexes
         // `outputs`, whose length the kernels never change; a step's indices are such terms.
         let at = |i: u32| unsafe { *outputs.get_unchecked(i as usize) };
@@ -154,6 +194,37 @@ impl Sums {
             acc[r as usize] = s;
         }
     }
+}
+
+/// Every term `(row, output)` in the order of the outputs (`start`, `terms` as for
+/// [`Sums::new`], which checked them; each output is a term of one row at most). A row's terms
+/// are in the order of their outputs, so that adding them in this order adds each row's in
+/// its order.
+fn in_output_order(start: &[u32], terms: &[u32], outputs: usize) -> Runs {
+    const NONE: u32 = u32::MAX;
+    let mut row_of = vec![NONE; outputs];
+    let mut ordered = true;
+    for (r, w) in start.windows(2).enumerate() {
+        let Some(row) = terms.get(w[0] as usize..w[1] as usize) else {
+            return Runs::default();
+        };
+        ordered &= row.windows(2).all(|p| p[0] < p[1]);
+        for &i in row {
+            ordered &= row_of[i as usize] == NONE;
+            row_of[i as usize] = r as u32;
+        }
+    }
+    if !ordered {
+        // Not a table the kernels build: no runs (the steps keep each row's order).
+        return Runs::default();
+    }
+    Runs::new(
+        row_of
+            .iter()
+            .enumerate()
+            .filter(|(_, &r)| r != NONE)
+            .map(|(i, &r)| (r, i as u32)),
+    )
 }
 
 /// The steps summing three rows, each row's terms in its order: together while the next
@@ -254,6 +325,7 @@ mod tests {
             "together: 3, 1 and 2 steps"
         );
         assert_eq!(sums.terms(), terms.len());
+        assert_eq!(sums.runs(), None, "scattered terms: no runs");
         let mut acc = vec![f64::NAN; rows.len()];
         sums.sum_into(&outputs, &mut acc);
         for (r, (a, b)) in acc.iter().zip(alone(&start, &terms, &outputs)).enumerate() {
@@ -261,5 +333,46 @@ mod tests {
         }
         // A term outside the outputs is refused, not read.
         assert!(Sums::new(&start, &terms, &particles, 19).is_none());
+    }
+
+    /// A family of 8 springs along a line of 9 particles (x, y, z of particle `p` the rows
+    /// `p`, `9 + p`, `18 + p`; spring `e` from particle `e` to `e + 1`) and gravity on each:
+    /// the outputs and their rows step together, so the sums go by runs, one per output column,
+    /// and give each row's sum alone bit for bit (the middle particles add two springs' terms
+    /// and gravity's, in that order).
+    #[test]
+    fn sums_by_runs_are_those_of_each_row_alone_bit_for_bit() {
+        let (particles, springs) = (9u32, 8u32);
+        let mut rows: Vec<Vec<u32>> = vec![Vec::new(); 3 * particles as usize];
+        for o in 0..6 {
+            let (slot, axis) = (o / 3, o % 3);
+            for e in 0..springs {
+                rows[(axis * particles + e + slot) as usize].push(o * springs + e);
+            }
+        }
+        for p in 0..particles {
+            rows[(2 * particles + p) as usize].push(6 * springs + p);
+        }
+        let mut start = vec![0u32];
+        let mut terms = Vec::new();
+        for r in &mut rows {
+            r.sort_unstable();
+            terms.extend_from_slice(r);
+            start.push(terms.len() as u32);
+        }
+        let outputs: Vec<f64> = (0..6 * springs + particles)
+            .map(|k| (1.0 + k as f64 * 0.1).powi(7) * if k % 3 == 0 { -1e-9 } else { 1.0 })
+            .collect();
+        let axes: Vec<[Option<u32>; 3]> = (0..particles)
+            .map(|p| [Some(p), Some(particles + p), Some(2 * particles + p)])
+            .collect();
+        let sums = Sums::new(&start, &terms, &axes, outputs.len()).unwrap();
+        assert_eq!(sums.runs(), Some(7), "six spring columns and gravity's");
+        assert_eq!(sums.terms(), terms.len());
+        let mut acc = vec![f64::NAN; rows.len()];
+        sums.sum_into(&outputs, &mut acc);
+        for (r, (a, b)) in acc.iter().zip(alone(&start, &terms, &outputs)).enumerate() {
+            assert_eq!(a.to_bits(), b.to_bits(), "row {r}: {a:e} against {b:e}");
+        }
     }
 }
