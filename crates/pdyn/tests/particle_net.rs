@@ -105,6 +105,20 @@ fn prepare(src: &str, path: NetPath) -> (Model, sim::Prepared) {
     (m, prep)
 }
 
+/// A perturbed state of `prep` and the input vector `[t, q, q', parameters]` of the kernels at
+/// it, `t = 0.25`.
+fn perturbed_input(prep: &sim::Prepared) -> (Vec<f64>, Vec<f64>) {
+    let y = perturbed(&prep.y0);
+    let parameters = prep.system.parameters();
+    let input = [0.25]
+        .iter()
+        .chain(&y)
+        .chain(&parameters)
+        .copied()
+        .collect();
+    (y, input)
+}
+
 /// A state away from the initial one, deterministic: every coordinate moved and moving.
 fn perturbed(y0: &[f64]) -> Vec<f64> {
     y0.iter()
@@ -343,15 +357,8 @@ fn small_templates_compiled_late_give_the_interpreters_bits() {
     use pdyn::sim::net::kernels::NATIVE_AFTER;
     let (_, prep) = prepare(&net_source(5, 4, Some(0.02)), NetPath::Always);
     let k = prep.system.net_kernels().expect("a net");
-    let y = perturbed(&prep.y0);
+    let (y, input) = perturbed_input(&prep);
     let n = y.len() / 2;
-    let parameters = prep.system.parameters();
-    let input: Vec<f64> = [0.25]
-        .iter()
-        .chain(&y)
-        .chain(&parameters)
-        .copied()
-        .collect();
     let mut first = vec![0.0; n];
     k.accelerations(&input, &mut first);
     let mut again = vec![0.0; n];
@@ -382,15 +389,8 @@ fn kernels_reading_in_place_give_the_bits_of_gathered_columns() {
     let gathering = k.gathering_copy();
     assert_eq!(k.read_in_place().0, 3);
     assert_eq!(gathering.read_in_place(), (0, 0, 7));
-    let y = perturbed(&prep.y0);
+    let (y, input) = perturbed_input(&prep);
     let n = y.len() / 2;
-    let parameters = prep.system.parameters();
-    let input: Vec<f64> = [0.25]
-        .iter()
-        .chain(&y)
-        .chain(&parameters)
-        .copied()
-        .collect();
     let (mut in_place, mut gathered) = (vec![0.0; n], vec![1.0; n]);
     k.accelerations_of_state(&y, &input, &mut in_place);
     gathering.accelerations_of_state(&y, &input, &mut gathered);
@@ -407,22 +407,15 @@ fn kernels_reading_in_place_give_the_bits_of_gathered_columns() {
 fn the_state_read_in_place_gives_the_accelerations_of_the_input_vector() {
     let (_, prep) = prepare(&net_source(5, 4, Some(0.02)), NetPath::Always);
     let k = prep.system.net_kernels().expect("a net");
-    let y = perturbed(&prep.y0);
+    let (y, input) = perturbed_input(&prep);
     let n = y.len() / 2;
-    let parameters = prep.system.parameters();
-    let input: Vec<f64> = [0.25]
-        .iter()
-        .chain(&y)
-        .chain(&parameters)
-        .copied()
-        .collect();
     let mut from_input = vec![0.0; n];
     k.accelerations(&input, &mut from_input);
     // A stale state in the vector: only t and the parameters are read from it.
     let stale: Vec<f64> = [0.25]
         .iter()
         .chain(&prep.y0)
-        .chain(&parameters)
+        .chain(&prep.system.parameters())
         .copied()
         .collect();
     let mut in_place = vec![f64::NAN; n];
