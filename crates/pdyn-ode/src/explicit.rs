@@ -428,18 +428,59 @@ pub(crate) fn stiffness_ratio(
     }
 }
 
+/// Dimensions from which a step's vector loops run as AVX code where the processor has it
+/// (four lanes per instruction instead of SSE2's two): a net's thousands of components. The
+/// same operations in the same order (no fused multiply-add, sums still one component at a
+/// time), so the same bits on every processor.
+#[cfg(target_arch = "x86_64")]
+pub(crate) const AVX_FROM: usize = 64;
+
 /// Calls `$self.attempt_n::<S, N>(args)` with `N` the system dimension when it is one of the
 /// listed sizes (loops of compile-time length: unrolled and vectorised), `N = 0` (run-time
-/// length) otherwise. The arithmetic is the same in every variant.
+/// length) otherwise, compiled for AVX ([`avx_attempt`]) from [`AVX_FROM`] components where
+/// the processor has it. The arithmetic is the same in every variant.
 macro_rules! dispatch_dim {
-    ($self:ident, $S:ty, [$($n:literal),*], $args:tt) => {
+    ($self:ident, $S:ty, [$($n:literal),*], $args:tt) => {{
+        #[cfg(target_arch = "x86_64")]
+        if $self.n >= crate::explicit::AVX_FROM && std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the processor has AVX (checked just above).
+            return unsafe { $self.attempt_avx::<$S> $args };
+        }
         match $self.n {
             $($n => $self.attempt_n::<$S, $n> $args,)*
             _ => $self.attempt_n::<$S, 0> $args,
         }
-    };
+    }};
 }
 pub(crate) use dispatch_dim;
+
+/// Defines `attempt_avx`, a method's `attempt_n::<S, 0>` compiled for AVX, for
+/// [`dispatch_dim`].
+macro_rules! avx_attempt {
+    () => {
+        /// `attempt_n` of any dimension, compiled for AVX.
+        ///
+        /// # Safety
+        /// The processor must have AVX.
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx")]
+        #[allow(clippy::too_many_arguments)]
+        unsafe fn attempt_avx<S: OdeSystem + ?Sized>(
+            &mut self,
+            sys: &S,
+            t: f64,
+            y: &[f64],
+            h: f64,
+            y_new: &mut [f64],
+            atol: &[f64],
+            rtol: &[f64],
+            stats: &mut Stats,
+        ) -> f64 {
+            self.attempt_n::<S, 0>(sys, t, y, h, y_new, atol, rtol, stats)
+        }
+    };
+}
+pub(crate) use avx_attempt;
 
 /// `out_j = y_j + h Σ_m a_m k_{m,j}` over the nonzero `a_m` (stage-major `k`).
 ///
@@ -525,5 +566,59 @@ pub(crate) fn combine(k: &[f64], n: usize, w: &[f64], out: &mut [f64]) {
     }
     if first {
         out.fill(0.0);
+    }
+}
+
+/// The AVX step against the baseline build, for each method's tests.
+#[cfg(test)]
+pub(crate) mod avx_check {
+    use super::ExplicitRk;
+    use crate::problem::OdeSystem;
+    use crate::Stats;
+
+    /// 60 masses in a row between springs, a pendulum's restoring force each, forced: 120
+    /// components, from `AVX_FROM` on.
+    pub(crate) struct Chain;
+
+    impl OdeSystem for Chain {
+        fn dim(&self) -> usize {
+            120
+        }
+        fn rhs(&self, t: f64, y: &[f64], d: &mut [f64]) {
+            let m = y.len() / 2;
+            for i in 0..m {
+                let left = if i > 0 { y[i - 1] } else { 0.0 };
+                let right = if i + 1 < m { y[i + 1] } else { 0.0 };
+                d[i] = y[m + i];
+                d[m + i] = 300.0 * (left - 2.0 * y[i] + right) - libm::sin(y[i])
+                    + 0.1 * libm::cos(3.0 * t);
+            }
+        }
+    }
+
+    /// A step's result `(error, y_new)` by `attempt` (the AVX code where the processor has it)
+    /// and by `baseline` (`attempt_n::<_, 0>` compiled for the baseline processor): the same
+    /// bits. Returns the first method, stepped, for further checks.
+    #[allow(clippy::type_complexity)]
+    pub(crate) fn same_bits<M: ExplicitRk>(
+        baseline: impl Fn(&mut M, f64, &[f64], f64, &mut [f64], &[f64], &[f64], &mut Stats) -> f64,
+    ) -> (M, M, Vec<f64>) {
+        let n = Chain.dim();
+        let y: Vec<f64> = (0..n).map(|i| libm::sin(i as f64 * 0.37) * 0.3).collect();
+        let (mut a, mut b) = (M::new(n), M::new(n));
+        Chain.rhs(0.2, &y, a.f_start());
+        Chain.rhs(0.2, &y, b.f_start());
+        let (atol, rtol) = (vec![1e-9; n], vec![1e-7; n]);
+        let (mut ya, mut yb) = (vec![0.0; n], vec![0.0; n]);
+        let (mut sa, mut sb) = (Stats::default(), Stats::default());
+        let h = 0.013;
+        let ea = a.attempt(&Chain, 0.2, &y, h, &mut ya, &atol, &rtol, &mut sa);
+        let eb = baseline(&mut b, 0.2, &y, h, &mut yb, &atol, &rtol, &mut sb);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(ea.to_bits(), eb.to_bits(), "error {ea:e} against {eb:e}");
+        assert!(ea > 0.0 && ea.is_finite());
+        assert_eq!(bits(&ya), bits(&yb));
+        assert_ne!(bits(&ya), bits(&y), "a step was taken");
+        (a, b, ya)
     }
 }

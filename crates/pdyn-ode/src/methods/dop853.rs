@@ -672,11 +672,6 @@ impl ExplicitRk for Dop853 {
         rtol: &[f64],
         stats: &mut Stats,
     ) -> f64 {
-        #[cfg(target_arch = "x86_64")]
-        if self.n >= AVX_FROM && std::arch::is_x86_feature_detected!("avx") {
-            // SAFETY: the processor has AVX (checked just above).
-            return unsafe { self.attempt_avx(sys, t, y, h, y_new, atol, rtol, stats) };
-        }
         crate::explicit::dispatch_dim!(
             self,
             S,
@@ -720,7 +715,7 @@ impl ExplicitRk for Dop853 {
         // As `attempt`: the same arithmetic, with loops of compile-time length for the usual
         // small dimensions (with output at many points this runs at nearly every step).
         #[cfg(target_arch = "x86_64")]
-        if self.n >= AVX_FROM && std::arch::is_x86_feature_detected!("avx") {
+        if self.n >= crate::explicit::AVX_FROM && std::arch::is_x86_feature_detected!("avx") {
             // SAFETY: the processor has AVX (checked just above).
             return unsafe { self.prepare_dense_avx(sys, t, y, h, y_new, stats) };
         }
@@ -741,31 +736,8 @@ impl ExplicitRk for Dop853 {
     }
 }
 
-/// Dimensions from which a step's vector loops run as AVX code where the processor has it
-/// (four lanes per instruction instead of SSE2's two): a net's thousands of components.
-/// The same operations in the same order (no fused multiply-add, sums still one component
-/// at a time), so the same bits on every processor.
-#[cfg(target_arch = "x86_64")]
-const AVX_FROM: usize = 64;
-
 impl Dop853 {
-    /// [`ExplicitRk::attempt`] of any dimension, compiled for AVX.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx")]
-    #[allow(clippy::too_many_arguments)]
-    unsafe fn attempt_avx<S: OdeSystem + ?Sized>(
-        &mut self,
-        sys: &S,
-        t: f64,
-        y: &[f64],
-        h: f64,
-        y_new: &mut [f64],
-        atol: &[f64],
-        rtol: &[f64],
-        stats: &mut Stats,
-    ) -> f64 {
-        self.attempt_n::<S, 0>(sys, t, y, h, y_new, atol, rtol, stats)
-    }
+    crate::explicit::avx_attempt!();
 
     /// [`ExplicitRk::prepare_dense`] of any dimension, compiled for AVX.
     #[cfg(target_arch = "x86_64")]
@@ -953,40 +925,16 @@ mod tests {
     /// code compiled for the baseline processor (`attempt_n`, `prepare_dense_n` called here).
     #[test]
     fn avx_steps_give_the_baseline_bits() {
-        struct Chain;
-        impl OdeSystem for Chain {
-            fn dim(&self) -> usize {
-                120
-            }
-            fn rhs(&self, t: f64, y: &[f64], d: &mut [f64]) {
-                let m = y.len() / 2;
-                for i in 0..m {
-                    let left = if i > 0 { y[i - 1] } else { 0.0 };
-                    let right = if i + 1 < m { y[i + 1] } else { 0.0 };
-                    d[i] = y[m + i];
-                    d[m + i] = 300.0 * (left - 2.0 * y[i] + right) - libm::sin(y[i])
-                        + 0.1 * libm::cos(3.0 * t);
-                }
-            }
-        }
-        let n = 120;
-        let y: Vec<f64> = (0..n).map(|i| libm::sin(i as f64 * 0.37) * 0.3).collect();
-        let (mut a, mut b) = (Dop853::new(n), Dop853::new(n));
-        Chain.rhs(0.2, &y, &mut a.k[..n]);
-        b.k.copy_from_slice(&a.k);
-        let (atol, rtol) = (vec![1e-9; n], vec![1e-7; n]);
-        let (mut ya, mut yb) = (vec![0.0; n], vec![0.0; n]);
-        let (mut sa, mut sb) = (Stats::default(), Stats::default());
-        let h = 0.013;
-        let ea = a.attempt(&Chain, 0.2, &y, h, &mut ya, &atol, &rtol, &mut sa);
-        let eb = b.attempt_n::<_, 0>(&Chain, 0.2, &y, h, &mut yb, &atol, &rtol, &mut sb);
+        use crate::explicit::avx_check::{same_bits, Chain};
+        let (mut a, mut b, y_new) = same_bits::<Dop853>(|m, t, y, h, y_new, atol, rtol, stats| {
+            m.attempt_n::<_, 0>(&Chain, t, y, h, y_new, atol, rtol, stats)
+        });
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-        assert_eq!(ea.to_bits(), eb.to_bits(), "error {ea:e} against {eb:e}");
-        assert!(ea > 0.0 && ea.is_finite());
-        assert_eq!(bits(&ya), bits(&yb));
         assert_eq!(bits(&a.k), bits(&b.k));
-        a.prepare_dense(&Chain, 0.2, &y, h, &ya, &mut sa);
-        b.prepare_dense_n::<_, 0>(&Chain, 0.2, &y, h, &yb, &mut sb);
+        let y: Vec<f64> = (0..120).map(|i| libm::sin(i as f64 * 0.37) * 0.3).collect();
+        let mut stats = Stats::default();
+        a.prepare_dense(&Chain, 0.2, &y, 0.013, &y_new, &mut stats);
+        b.prepare_dense_n::<_, 0>(&Chain, 0.2, &y, 0.013, &y_new, &mut stats);
         assert_eq!(bits(&a.cont), bits(&b.cont));
         assert!(a.cont.iter().any(|&x| x != 0.0));
     }

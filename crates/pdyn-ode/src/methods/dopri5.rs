@@ -150,6 +150,8 @@ impl DenseOutput for Dopri5 {
 }
 
 impl Dopri5 {
+    crate::explicit::avx_attempt!();
+
     /// One step; `N > 0` fixes the dimension at compile time (`N = 0`: use `self.n`).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
@@ -348,5 +350,15 @@ mod tests {
             assert!((TABLEAU.b[i] - bh[i] - E[i]).abs() < 1e-16);
             assert_eq!(TABLEAU.b[i], TABLEAU.a[6][i], "FSAL: b is the last row");
         }
+    }
+
+    /// A step of a 120-component system by the AVX code where the processor has it: the
+    /// baseline build's bits.
+    #[test]
+    fn avx_steps_give_the_baseline_bits() {
+        use crate::explicit::avx_check::{same_bits, Chain};
+        same_bits::<Dopri5>(|m, t, y, h, y_new, atol, rtol, stats| {
+            m.attempt_n::<_, 0>(&Chain, t, y, h, y_new, atol, rtol, stats)
+        });
     }
 }

@@ -178,6 +178,8 @@ impl DenseOutput for Tsit5 {
 }
 
 impl Tsit5 {
+    crate::explicit::avx_attempt!();
+
     /// One step; `N > 0` fixes the dimension at compile time (`N = 0`: use `self.n`).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
@@ -321,5 +323,15 @@ mod tests {
             let s: f64 = R[i].iter().sum();
             assert!((s - B[i]).abs() < 1e-13, "b_{i}(1) = {s}");
         }
+    }
+
+    /// A step of a 120-component system by the AVX code where the processor has it: the
+    /// baseline build's bits.
+    #[test]
+    fn avx_steps_give_the_baseline_bits() {
+        use crate::explicit::avx_check::{same_bits, Chain};
+        same_bits::<Tsit5>(|m, t, y, h, y_new, atol, rtol, stats| {
+            m.attempt_n::<_, 0>(&Chain, t, y, h, y_new, atol, rtol, stats)
+        });
     }
 }

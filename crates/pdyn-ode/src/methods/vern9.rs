@@ -393,6 +393,8 @@ impl DenseOutput for Vern9 {
 }
 
 impl Vern9 {
+    crate::explicit::avx_attempt!();
+
     /// One step; `N > 0` fixes the dimension at compile time (`N = 0`: use `self.n`).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
@@ -537,5 +539,15 @@ mod tests {
         );
         let r8 = order_residual(&a, &TABLEAU.b_hat.unwrap(), 8);
         assert!(r8 < 1e-12, "embedded order 8 residual {r8}");
+    }
+
+    /// A step of a 120-component system by the AVX code where the processor has it: the
+    /// baseline build's bits.
+    #[test]
+    fn avx_steps_give_the_baseline_bits() {
+        use crate::explicit::avx_check::{same_bits, Chain};
+        same_bits::<Vern9>(|m, t, y, h, y_new, atol, rtol, stats| {
+            m.attempt_n::<_, 0>(&Chain, t, y, h, y_new, atol, rtol, stats)
+        });
     }
 }
