@@ -402,7 +402,7 @@ impl CompiledModel {
                 // The unknowns are the accelerations in state order, as the tree's
                 // coordinates are numbered.
                 if tree
-                    .solve(&s.tree_values, &mut s.tree_ws, &mut s.out)
+                    .solve_f64(&s.tree_values, &mut s.tree_ws, &mut s.out)
                     .is_err()
                 {
                     s.out.iter_mut().for_each(|x| *x = f64::NAN);
