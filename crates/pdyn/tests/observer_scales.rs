@@ -34,7 +34,8 @@ l0 = "1"
 /// A four-link chain under gravity (the tree path): energy conserved, its scale
 /// `Σ ½ m v² + Σ |V|` made of the energy column's terms.
 fn chain() -> String {
-    let mut src = String::from("name = \"chain\"\ngravity = \"[0, -g, 0]\"\n[parameters]\ng = 9.81\n");
+    let mut src =
+        String::from("name = \"chain\"\ngravity = \"[0, -g, 0]\"\n[parameters]\ng = 9.81\n");
     src += "[coordinates]\n";
     for i in 1..=4 {
         src += &format!("q{i} = {{ initial = {}, rate = 0.0 }}\n", 0.3 * i as f64);
