@@ -370,6 +370,52 @@ impl TreeForm {
         ws: &mut TreeWorkspace<T>,
         qdd: &mut [T],
     ) -> Result<(), SingularTree> {
+        self.solve_inlined(values, ws, qdd)
+    }
+
+    /// [`TreeForm::solve`] on `f64`, compiled for AVX where the processor has it: the same
+    /// operations in the same order (no fused multiply-add: Rust never contracts `a * b + c`),
+    /// hence the same bits, in three-operand instructions. The recursion's SSE2 code spent
+    /// many of its ~160 instructions per link copying registers before the two-operand
+    /// `mulpd`, `addpd` that overwrite one (the 100-link chain's profile, a third of its run).
+    pub fn solve_f64(
+        &self,
+        values: &[f64],
+        ws: &mut TreeWorkspace,
+        qdd: &mut [f64],
+    ) -> Result<(), SingularTree> {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the processor has AVX (checked just above).
+            return unsafe { self.solve_avx(values, ws, qdd) };
+        }
+        self.solve_inlined(values, ws, qdd)
+    }
+
+    /// [`TreeForm::solve_inlined`] compiled with AVX.
+    ///
+    /// # Safety
+    /// The processor must have AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn solve_avx(
+        &self,
+        values: &[f64],
+        ws: &mut TreeWorkspace,
+        qdd: &mut [f64],
+    ) -> Result<(), SingularTree> {
+        self.solve_inlined(values, ws, qdd)
+    }
+
+    /// The body of [`TreeForm::solve`], inlined into each caller so that it is compiled with
+    /// the caller's target features.
+    #[inline(always)]
+    fn solve_inlined<T: Scalar>(
+        &self,
+        values: &[T],
+        ws: &mut TreeWorkspace<T>,
+        qdd: &mut [T],
+    ) -> Result<(), SingularTree> {
         let n = self.nodes.len();
         let zero = T::of(0.0);
         if values.len() < NODE_INPUTS * n || qdd.len() < n {
@@ -688,6 +734,58 @@ mod tests {
         values[NODE_INPUTS * (n - 1)] = 0.0;
         let e = planar.solve(&values, &mut TreeWorkspace::default(), &mut x);
         assert_eq!(e, Err(SingularTree { node: n - 1 }));
+    }
+
+    /// `solve_f64` (AVX where the processor has it) gives `solve`'s bits on the three paths
+    /// (a planar chain, a spatial chain, a general tree), on links whose numbers span signs
+    /// and magnitudes, and refuses the same singular node.
+    #[test]
+    fn solve_f64_gives_the_bits_of_solve() {
+        let n = 23;
+        let planar = TreeForm::new((0..n).map(|k| node(k, k.checked_sub(1))).collect());
+        let spatial = TreeForm {
+            planar: false,
+            ..planar.clone()
+        };
+        let general = TreeForm {
+            chain: false,
+            ..spatial.clone()
+        };
+        let mut values = Vec::new();
+        let mut x = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for k in 0..n {
+            let (q, l, rate) = (7.0 * next(), 0.5 + next(), 20.0 * next());
+            let (sq, cq) = (libm::sin(q), libm::cos(q));
+            let m = 1.0 + next();
+            values.extend([m, l * cq, l * sq, 0.0]);
+            values.extend([-l * sq * rate * rate, l * cq * rate * rate, 0.0]);
+            values.extend([next() * k as f64, -9.81 * m, 0.0]);
+        }
+        let bits = |v: &[f64]| v.iter().map(|a| a.to_bits()).collect::<Vec<_>>();
+        for (tree, z) in [(&planar, 0.0), (&spatial, 0.3), (&general, -0.2)] {
+            let mut v = values.clone();
+            for k in 0..n {
+                v[NODE_INPUTS * k + 3] = z * next();
+                v[NODE_INPUTS * k + 6] = z * next();
+                v[NODE_INPUTS * k + 9] = z * next();
+            }
+            let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
+            tree.solve(&v, &mut TreeWorkspace::default(), &mut a)
+                .unwrap();
+            tree.solve_f64(&v, &mut TreeWorkspace::default(), &mut b)
+                .unwrap();
+            assert!(a.iter().all(|v| v.is_finite() && *v != 0.0));
+            assert_eq!(bits(&a), bits(&b));
+            v[NODE_INPUTS * (n - 1)] = 0.0;
+            let e = tree.solve_f64(&v, &mut TreeWorkspace::default(), &mut b);
+            assert_eq!(e, Err(SingularTree { node: n - 1 }));
+        }
     }
 
     /// A link with no inertia along its direction is refused, naming the node.

@@ -402,7 +402,7 @@ impl CompiledModel {
                 // The unknowns are the accelerations in state order, as the tree's
                 // coordinates are numbered.
                 if tree
-                    .solve(&s.tree_values, &mut s.tree_ws, &mut s.out)
+                    .solve_f64(&s.tree_values, &mut s.tree_ws, &mut s.out)
                     .is_err()
                 {
                     s.out.iter_mut().for_each(|x| *x = f64::NAN);
@@ -683,6 +683,12 @@ pub struct Observer {
     /// The expressions read at most the first `inputs_read` inputs (one past the largest
     /// index among the inputs that appear in them; 0 when none does).
     inputs_read: usize,
+    /// Outputs after the named ones ([`Observer::with_trailing`]), given by
+    /// [`Observer::eval_with_trailing`] only.
+    trailing: usize,
+    /// All the program's outputs, for [`Observer::eval`] when there are trailing ones (native
+    /// code writes every output).
+    all: RefCell<Vec<f64>>,
 }
 
 impl Observer {
@@ -693,6 +699,24 @@ impl Observer {
         names: Vec<String>,
         exprs: &[Id],
     ) -> Result<Observer, CompileError> {
+        Observer::with_trailing(pool, inputs, names, exprs, &[])
+    }
+
+    /// As [`Observer::new`], with `trailing` expressions after the named ones in the same
+    /// program: evaluated with them by [`Observer::eval_with_trailing`], their common
+    /// subexpressions computed once. A run's conservation scales follow its output columns
+    /// so: the chain's scale `Σ ½ m v² + Σ |V|` reuses the energy column's terms, where a
+    /// program of its own computed every particle's velocity and height again (half the
+    /// 16-link chain's interpreted output work).
+    pub fn with_trailing(
+        pool: &mut Pool,
+        inputs: &[Id],
+        names: Vec<String>,
+        exprs: &[Id],
+        trailing: &[Id],
+    ) -> Result<Observer, CompileError> {
+        let exprs: Vec<Id> = exprs.iter().chain(trailing).copied().collect();
+        let exprs = &exprs[..];
         let prog = Evaluator::Interpreted(Program::compile(pool, inputs, exprs)?);
         let ws = RefCell::new(prog.workspace());
         // Every leaf of the expressions is an input (or compilation failed above).
@@ -708,12 +732,24 @@ impl Observer {
             .filter_map(|e| position.get(&e).copied())
             .max()
             .map_or(0, |k| k + 1);
+        let all = RefCell::new(if trailing.is_empty() {
+            Vec::new()
+        } else {
+            vec![0.0; exprs.len()]
+        });
         Ok(Observer {
             names,
             prog,
             ws,
             inputs_read,
+            trailing: trailing.len(),
+            all,
         })
+    }
+
+    /// Number of outputs after the named ones.
+    pub fn trailing(&self) -> usize {
+        self.trailing
     }
 
     /// True when no expression reads an input at index `k` or later: it may then be evaluated
@@ -752,8 +788,21 @@ impl Observer {
         self.prog.is_native()
     }
 
-    /// Evaluates every expression.
+    /// Evaluates the named expressions (`out`: [`Observer::len`] numbers).
     pub fn eval(&self, input: &[f64], out: &mut [f64]) {
+        if self.trailing == 0 {
+            self.prog.eval(input, &mut self.ws.borrow_mut(), out);
+        } else {
+            let all = &mut *self.all.borrow_mut();
+            self.prog.eval(input, &mut self.ws.borrow_mut(), all);
+            let n = out.len().min(self.names.len());
+            out[..n].copy_from_slice(&all[..n]);
+        }
+    }
+
+    /// Evaluates the named expressions and the trailing ones after them (`out`:
+    /// [`Observer::len`] + [`Observer::trailing`] numbers).
+    pub fn eval_with_trailing(&self, input: &[f64], out: &mut [f64]) {
         self.prog.eval(input, &mut self.ws.borrow_mut(), out);
     }
 

@@ -342,17 +342,16 @@ pub(crate) struct Tally {
     non_finite: NonFiniteScan,
     conserved: Vec<usize>,
     input: Vec<f64>,
+    /// The output columns, then the conservation scales (the observer's trailing outputs).
     extra: Vec<f64>,
-    scale_out: Vec<f64>,
     row: Vec<f64>,
     /// Whether a program evaluated at each output point reads the solved unknowns
     /// (accelerations, reactions): only then is the right-hand side solved there, as
     /// `tabulate` does; the other programs give the same bits without them.
     solve: bool,
-    /// The observer and the scales as native code (the same bits), made once the rows still
-    /// to come are enough to pay for their compilation ([`Tally::consider_native`]).
+    /// The observer (with the scales) as native code (the same bits), made once the rows
+    /// still to come are enough to pay for its compilation ([`Tally::consider_native`]).
     native_observer: Option<super::Observer>,
-    native_scales: Option<super::Observer>,
     native_decided: bool,
     /// This process's first output point: its time and the outputs before it (a restart
     /// continues a count), where the projection of the rows to come starts.
@@ -363,6 +362,8 @@ pub(crate) struct Tally {
 
 impl Tally {
     fn new(prep: &Prepared) -> Tally {
+        // The scales follow the columns in the observer's program (`sim::observations`).
+        debug_assert_eq!(prep.observer.trailing(), prep.scales.len());
         Tally {
             outputs: 0,
             last: None,
@@ -375,19 +376,17 @@ impl Tally {
                 .filter(|&j| prep.conserved[j])
                 .collect(),
             input: Vec::new(),
-            extra: vec![0.0; prep.observer.len()],
-            scale_out: vec![0.0; prep.scales.len()],
+            extra: vec![0.0; prep.observer.len() + prep.observer.trailing()],
             row: Vec::new(),
             solve: reads_unknowns(prep),
             native_observer: None,
-            native_scales: None,
             native_decided: false,
             since: None,
             t_end: f64::NAN,
         }
     }
 
-    /// Compiles the observer and the scales to native code when the run's rows still to
+    /// Compiles the observer (and the scales it carries) to native code when the run's rows still to
     /// come, projected from this process's rows so far at their rate per unit of time, reach
     /// [`NATIVE_FOR_ROWS_TO_COME`]: a streamed run does not know its number of rows in
     /// advance. The 100-link chain's 4,286 rows interpreted cost about a seventh of its run.
@@ -409,9 +408,6 @@ impl Tally {
         let to_come = rows as f64 * (left / done);
         if to_come >= NATIVE_FOR_ROWS_TO_COME as f64 {
             self.native_observer = super::native_for(prep, &prep.observer, NATIVE_PAYS_FROM);
-            if !self.scale_out.is_empty() {
-                self.native_scales = super::native_for(prep, &prep.scales, NATIVE_PAYS_FROM);
-            }
             self.native_decided = true;
         }
     }
@@ -428,13 +424,14 @@ impl Tally {
             self.since = Some((t, self.outputs));
         }
         let observer = self.native_observer.as_ref().unwrap_or(&prep.observer);
-        observer.eval(&self.input, &mut self.extra);
+        observer.eval_with_trailing(&self.input, &mut self.extra);
+        let (columns, scales) = self.extra.split_at(prep.observer.len());
         self.watch.check(prep, &self.input, t);
-        self.push.check(prep, t, &self.extra);
+        self.push.check(prep, t, columns);
         self.row.clear();
         self.row.push(t);
         self.row.extend_from_slice(y);
-        self.row.extend_from_slice(&self.extra);
+        self.row.extend_from_slice(columns);
         self.non_finite.row(t, self.row.iter().copied());
         if self.outputs == 0 {
             self.drifts = self
@@ -452,12 +449,8 @@ impl Tally {
                 d.1.max(dev)
             };
         }
-        if !self.scale_out.is_empty() {
-            let scales = self.native_scales.as_ref().unwrap_or(&prep.scales);
-            scales.eval(&self.input, &mut self.scale_out);
-            for (s, &v) in self.scale_series.iter_mut().zip(&self.scale_out) {
-                s.push(v.abs());
-            }
+        for (s, &v) in self.scale_series.iter_mut().zip(scales) {
+            s.push(v.abs());
         }
         match &mut self.last {
             Some(last) => last.clone_from(&self.row),

@@ -69,9 +69,10 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
         .collect();
     let points = sol.len();
     let mut input = Vec::new();
-    let mut extra = vec![0.0; prep.observer.len()];
-    let mut scale_out = vec![0.0; prep.scales.len()];
-    let mut scale_series = vec![Vec::with_capacity(points); prep.scales.len()];
+    // The columns, then the scales: the observer's trailing outputs (`super::observations`).
+    let columns = prep.observer.len();
+    let mut extra = vec![0.0; columns + prep.observer.trailing()];
+    let mut scale_series = vec![Vec::with_capacity(points); prep.observer.trailing()];
     let mut meas_out = vec![0.0; n_meas];
     let mut series = vec![Vec::with_capacity(points); n_meas];
     let mut drifts: Vec<(f64, f64)> = Vec::with_capacity(conserved.len());
@@ -94,11 +95,12 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
         } else {
             sys.observation_input_without_unknowns(t, y, &mut input);
         }
-        prep.observer.eval(&input, &mut extra);
+        prep.observer.eval_with_trailing(&input, &mut extra);
+        let (extra, scales) = extra.split_at(columns);
         watch.check(prep, &input, t);
-        push.check(prep, t, &extra);
+        push.check(prep, t, extra);
         // The row `[t, y, extra]` the full path would tabulate.
-        non_finite.row(t, std::iter::once(&t).chain(y).chain(&extra).copied());
+        non_finite.row(t, std::iter::once(&t).chain(y).chain(extra).copied());
         if k == 0 {
             drifts.extend(conserved.iter().map(|&j| (extra[j], 0.0)));
         }
@@ -111,11 +113,8 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
                 d.1.max(dev)
             };
         }
-        if !scale_out.is_empty() {
-            prep.scales.eval(&input, &mut scale_out);
-            for (s, &v) in scale_series.iter_mut().zip(&scale_out) {
-                s.push(v.abs());
-            }
+        for (s, &v) in scale_series.iter_mut().zip(scales) {
+            s.push(v.abs());
         }
         if let Some(m) = &prep.measures {
             m.eval(&input, &mut meas_out);
@@ -125,7 +124,7 @@ pub fn measure(prep: &Prepared, set: &RunSettings, stats: &[Stat]) -> Result<Mea
         }
     }
     let scales: Vec<f64> = if points == 0 {
-        vec![f64::NAN; prep.scales.len()]
+        vec![f64::NAN; scale_series.len()]
     } else {
         scale_series.into_iter().map(scale_of).collect()
     };

@@ -788,8 +788,6 @@ fn observations(
         exprs.push(m.expr);
         conserved.push(false);
     }
-    let observer = Observer::new(&mut model.pool, &system.observation_inputs, names, &exprs)
-        .map_err(|error| compile_error("", error))?;
     let scales = Observer::new(
         &mut model.pool,
         &system.observation_inputs,
@@ -797,6 +795,16 @@ fn observations(
         &scale_exprs,
     )
     .map_err(|error| compile_error("conservation scale", error))?;
+    // The scales again after the columns, in the columns' program: a table's rows evaluate
+    // both at every output point, and the scales' terms are the energy's.
+    let observer = Observer::with_trailing(
+        &mut model.pool,
+        &system.observation_inputs,
+        names,
+        &exprs,
+        &scale_exprs,
+    )
+    .map_err(|error| compile_error("", error))?;
     Ok((observer, conserved, scales))
 }
 
@@ -1234,35 +1242,6 @@ pub(crate) fn native_for(
     }
 }
 
-fn conservation_scales(prep: &Prepared, sol: &Solution) -> Vec<f64> {
-    let n = prep.scales.len();
-    if n == 0 || sol.is_empty() {
-        return vec![f64::NAN; n];
-    }
-    let mut per_quantity = vec![Vec::with_capacity(sol.len()); n];
-    let mut input = Vec::new();
-    let mut out = vec![0.0; n];
-    // As in `tabulate`: no solve when the scales do not read the unknowns, native code for
-    // long runs (the same bits either way).
-    let solve = !prep.scales.reads_only_first(prep.system.inputs.len());
-    let native = native_for(prep, &prep.scales, sol.len());
-    let scales = native.as_ref().unwrap_or(&prep.scales);
-    for k in 0..sol.len() {
-        let (t, y) = (sol.t[k], sol.y_at(k));
-        if solve {
-            prep.system.observation_input(t, y, &mut input);
-        } else {
-            prep.system
-                .observation_input_without_unknowns(t, y, &mut input);
-        }
-        scales.eval(&input, &mut out);
-        for (series, &v) in per_quantity.iter_mut().zip(&out) {
-            series.push(v.abs());
-        }
-    }
-    per_quantity.into_iter().map(scale_of).collect()
-}
-
 /// The larger of the first value and the median of `|Q|` along a run (not empty).
 pub(crate) fn scale_of(mut v: Vec<f64>) -> f64 {
     let first = v[0];
@@ -1276,8 +1255,8 @@ pub(crate) fn tabulate(
     set: &RunSettings,
     failure: Option<RunFailure>,
 ) -> RunResult {
-    let scales = conservation_scales(prep, sol);
     let extras = observed_columns(prep, sol);
+    let scales = extras.scales;
     let rows = (0..sol.len())
         .zip(extras.outputs)
         .map(|(k, extra)| row(sol.t[k], sol.y_at(k), &extra))
@@ -1303,8 +1282,8 @@ pub(crate) fn tabulate_owned(
     set: &RunSettings,
     failure: Option<RunFailure>,
 ) -> RunResult {
-    let scales = conservation_scales(prep, &sol);
     let extras = observed_columns(prep, &sol);
+    let scales = extras.scales;
     let width = sol.n;
     let mut rows = Vec::with_capacity(sol.len());
     for (k, extra) in extras.outputs.into_iter().enumerate().rev() {
@@ -1334,19 +1313,24 @@ fn row(t: f64, y: &[f64], extra: &[f64]) -> Vec<f64> {
     row
 }
 
-/// The observer's columns at each output point, and what the friction and push watches saw
-/// along them (in time order).
+/// The observer's columns at each output point, what the friction and push watches saw
+/// along them (in time order), and the scale of each conserved quantity.
 struct Observed {
     outputs: Vec<Vec<f64>>,
     watch: FrictionWatch,
     push: PushWatch,
+    scales: Vec<f64>,
 }
 
+/// The columns and the conservation scales come from one program, the observer's (the
+/// scales are its trailing outputs: [`observations`]), evaluated once per row.
 fn observed_columns(prep: &Prepared, sol: &Solution) -> Observed {
     let sys = &prep.system;
     let mut outputs = Vec::with_capacity(sol.len());
     let mut input = Vec::new();
-    let mut extra = vec![0.0; prep.observer.len()];
+    let columns = prep.observer.len();
+    let mut extra = vec![0.0; columns + prep.observer.trailing()];
+    let mut scale_series = vec![Vec::with_capacity(sol.len()); prep.observer.trailing()];
     let mut watch = FrictionWatch::default();
     let mut push = PushWatch::default();
     // Solve for the accelerations and reactions at each row only when a program evaluated
@@ -1367,15 +1351,25 @@ fn observed_columns(prep: &Prepared, sol: &Solution) -> Observed {
         } else {
             sys.observation_input_without_unknowns(t, y, &mut input);
         }
-        observer.eval(&input, &mut extra);
+        observer.eval_with_trailing(&input, &mut extra);
+        let (row, scales) = extra.split_at(columns);
         watch.check(prep, &input, t);
-        push.check(prep, t, &extra);
-        outputs.push(extra.clone());
+        push.check(prep, t, row);
+        outputs.push(row.to_vec());
+        for (series, &v) in scale_series.iter_mut().zip(scales) {
+            series.push(v.abs());
+        }
     }
+    let scales = if sol.is_empty() {
+        vec![f64::NAN; scale_series.len()]
+    } else {
+        scale_series.into_iter().map(scale_of).collect()
+    };
     Observed {
         outputs,
         watch,
         push,
+        scales,
     }
 }
 
