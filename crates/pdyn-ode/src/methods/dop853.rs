@@ -488,31 +488,6 @@ pub(crate) fn eval_cont<const N: usize>(c: &[f64], n: usize, s: f64, out: &mut [
 }
 
 impl Dop853 {
-    /// [`Dop853::attempt_n`] of a system of more than 8 components compiled with AVX: its
-    /// stage loops take four components to a register instead of two, with the same
-    /// operations on each component in the same order (Rust never fuses `a * b + c`; the
-    /// error norms' sums stay sequential), hence the same bits. The stage loops were ~7 % of
-    /// the 16- and 100-link chains' runs.
-    ///
-    /// # Safety
-    /// The processor must have AVX.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx")]
-    #[allow(clippy::too_many_arguments)]
-    unsafe fn attempt_avx<S: OdeSystem + ?Sized>(
-        &mut self,
-        sys: &S,
-        t: f64,
-        y: &[f64],
-        h: f64,
-        y_new: &mut [f64],
-        atol: &[f64],
-        rtol: &[f64],
-        stats: &mut Stats,
-    ) -> f64 {
-        self.attempt_n::<S, 0>(sys, t, y, h, y_new, atol, rtol, stats)
-    }
-
     /// One step; `N > 0` fixes the dimension at compile time (`N = 0`: use `self.n`).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
@@ -697,11 +672,6 @@ impl ExplicitRk for Dop853 {
         rtol: &[f64],
         stats: &mut Stats,
     ) -> f64 {
-        #[cfg(target_arch = "x86_64")]
-        if self.n > 8 && std::arch::is_x86_feature_detected!("avx") {
-            // SAFETY: the processor has AVX (checked just above).
-            return unsafe { self.attempt_avx(sys, t, y, h, y_new, atol, rtol, stats) };
-        }
         crate::explicit::dispatch_dim!(
             self,
             S,
@@ -860,46 +830,6 @@ mod tests {
     use super::*;
     use crate::tableau::order_residual;
 
-    /// A nonlinear chain of 37 components: each one pulled by its neighbours' sines.
-    struct Coupled;
-
-    impl OdeSystem for Coupled {
-        fn dim(&self) -> usize {
-            37
-        }
-        fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
-            let n = y.len();
-            for i in 0..n {
-                let (l, r) = (y[(i + n - 1) % n], y[(i + 1) % n]);
-                dy[i] = libm::sin(l - y[i]) - 0.3 * libm::sin(y[i] - r) + 0.01 * t * i as f64;
-            }
-        }
-    }
-
-    /// A step of a long system (AVX where the processor has it) gives the portable code's
-    /// bits: the new state, the error estimate and every stage, over steps of several sizes.
-    #[test]
-    fn a_long_systems_step_has_the_portable_bits() {
-        let sys = Coupled;
-        let n = sys.dim();
-        let y: Vec<f64> = (0..n).map(|i| libm::sin(1.7 * i as f64) * 3.0).collect();
-        let (atol, rtol) = (vec![1e-12; n], vec![1e-9; n]);
-        for h in [1e-3, 0.05, 0.37, -0.2] {
-            let (mut a, mut b) = (Dop853::new(n), Dop853::new(n));
-            sys.rhs(0.1, &y, a.f_start());
-            sys.rhs(0.1, &y, b.f_start());
-            let (mut ya, mut yb) = (vec![0.0; n], vec![0.0; n]);
-            let (mut sa, mut sb) = (Stats::default(), Stats::default());
-            let ea = a.attempt(&sys, 0.1, &y, h, &mut ya, &atol, &rtol, &mut sa);
-            let eb = b.attempt_n::<Coupled, 0>(&sys, 0.1, &y, h, &mut yb, &atol, &rtol, &mut sb);
-            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-            assert_eq!(ea.to_bits(), eb.to_bits(), "h = {h}");
-            assert_eq!(bits(&ya), bits(&yb), "h = {h}");
-            assert_eq!(bits(&a.k), bits(&b.k), "h = {h}");
-            assert!(ea > 0.0 && ya.iter().zip(&y).all(|(p, q)| p != q));
-        }
-    }
-
     #[test]
     fn tableau_row_sums_and_order_conditions() {
         assert!(TABLEAU.row_sum_residual() < 1e-14);
@@ -990,9 +920,10 @@ mod tests {
         }
     }
 
-    /// A step of a 120-component system takes the AVX code where the processor has it
+    /// Steps of a 120-component system take the AVX code where the processor has it
     /// (`attempt`, `prepare_dense` from `AVX_FROM` components): the same bits as the same
-    /// code compiled for the baseline processor (`attempt_n`, `prepare_dense_n` called here).
+    /// code compiled for the baseline processor (`attempt_n`, `prepare_dense_n` called here),
+    /// the stages and the dense output too.
     #[test]
     fn avx_steps_give_the_baseline_bits() {
         use crate::explicit::avx_check::{same_bits, Chain};
