@@ -12,8 +12,8 @@
 //! copied in when pivot `k` is reached; the rest of the upper triangle is never read into the
 //! lower one): they are neither zeroed nor assembled, and hold whatever an earlier front left
 //! there. The update matrices go on the stack as packed lower triangles. On the 20 × 20
-//! hanging net (fronts up to ~100 wide) a factorization of `K_s + μD` took 18.0 M instructions
-//! with whole fronts zeroed, assembled and stacked, 14.4 M with their lower triangles alone.
+//! hanging net a factorization of `K_s + μD` took 18.0 M instructions with whole fronts
+//! zeroed, assembled and stacked, 14.3 M with their lower triangles alone.
 //!
 //! A symmetric factorization also keeps only half of the factors: the `ns` rows of each
 //! supernode's pivots (`U11`, `U12`, unscaled, and `L11` below the diagonal block's
