@@ -264,6 +264,13 @@ impl<L: Linearize + ?Sized> crate::damped_newton::NewtonSystem for Dense<'_, L> 
         self.0.force(q)
     }
 
+    fn stiffness_mul(&self, at: &Linearization, v: &[f64]) -> Vec<f64> {
+        (&at.stiffness * DVector::from_column_slice(v))
+            .iter()
+            .copied()
+            .collect()
+    }
+
     fn conservative(&self, at: &Linearization) -> bool {
         let k = &at.stiffness;
         let big = k.iter().fold(0.0f64, |m, x| m.max(x.abs()));

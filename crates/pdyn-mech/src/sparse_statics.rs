@@ -352,6 +352,12 @@ impl<L: Linearize + ?Sized> crate::damped_newton::NewtonSystem for Sparse<'_, L>
         self.lin.force(q)
     }
 
+    fn stiffness_mul(&self, at: &SparseAt, v: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; v.len()];
+        at.ks.mul_vec(v, &mut out);
+        out
+    }
+
     fn conservative(&self, at: &SparseAt) -> bool {
         at.conservative
     }

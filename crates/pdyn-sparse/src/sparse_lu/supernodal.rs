@@ -41,6 +41,9 @@ pub(crate) struct Supernodes {
     /// `assembly[asm_start[s]..asm_start[s + 1]]` = (position in the front, value index).
     pub asm_start: Vec<usize>,
     pub assembly: Vec<(usize, usize)>,
+    /// The entries of `s`'s front on and below its diagonal come first in its part of
+    /// `assembly`, up to `asm_lower[s]` (a symmetric factorization assembles only those).
+    pub asm_lower: Vec<usize>,
     /// The children of `s` (ascending; in the numeric phase their update matrices are the
     /// top of the stack, the last child's on top).
     pub child_start: Vec<usize>,
@@ -279,6 +282,7 @@ impl Supernodes {
         // Positions in fronts.
         let mut relpos = vec![NONE; n];
         let mut assembly = vec![(0usize, 0usize); pattern.nnz()];
+        let mut asm_lower = vec![0usize; ns_count];
         let mut rel = vec![0usize; rows.len()];
         let (mut max_front, mut stack, mut max_stack) = (0usize, 0usize, 0usize);
         for s in 0..ns_count {
@@ -293,9 +297,19 @@ impl Supernodes {
             for (a, &i) in srows.iter().enumerate() {
                 relpos[i] = ns + a;
             }
-            for t in asm_start[s]..asm_start[s + 1] {
-                let (pi, pj, q) = raw[t];
-                assembly[t] = (relpos[pi] + relpos[pj] * m, q);
+            // The lower triangle's entries first, then the upper's (a stable partition: the
+            // values landing on one position are still added in the pattern's order).
+            let mut t = asm_start[s];
+            for upper in [false, true] {
+                for &(pi, pj, q) in &raw[asm_start[s]..asm_start[s + 1]] {
+                    if (relpos[pi] < relpos[pj]) == upper {
+                        assembly[t] = (relpos[pi] + relpos[pj] * m, q);
+                        t += 1;
+                    }
+                }
+                if !upper {
+                    asm_lower[s] = t;
+                }
             }
             for &c in &children[child_start[s]..child_start[s + 1]] {
                 for t in row_start[c]..row_start[c + 1] {
@@ -318,6 +332,7 @@ impl Supernodes {
             sym_start,
             asm_start,
             assembly,
+            asm_lower,
             child_start,
             children,
             rel,
