@@ -368,8 +368,8 @@ impl NetKernels {
     }
 
     /// Of the kernels with per-element inputs, those that read them in place, stretch by
-    /// stretch (nothing gathered), and their stretches; and the kernels with per-element
-    /// inputs in all (deterministic counts).
+    /// stretch (nothing gathered), when they run native code, and their stretches; and the
+    /// kernels with per-element inputs in all (deterministic counts).
     pub fn read_in_place(&self) -> (usize, usize, usize) {
         let reading = self
             .kernels
@@ -582,9 +582,11 @@ fn run_kernel(k: &Kernel, input: Values, outputs: &mut [f64], late: bool) {
     // The columns' slices on the stack for the usual few columns: two allocations per kernel
     // and evaluation were 2 % of a net's run.
     const FEW: usize = 16;
+    // Stretches for native code only: the column interpreter (WebAssembly, small templates)
+    // pays its dispatch per call, which a whole gathered column amortises better.
     if let (Some(stretches), true) = (
         &k.stretches,
-        k.gather.len() <= FEW && k.scatter.len() <= FEW,
+        kernel.is_native() && k.gather.len() <= FEW && k.scatter.len() <= FEW,
     ) {
         let (state, input) = sources(k, input);
         fill_broadcast(k, input, cols);
