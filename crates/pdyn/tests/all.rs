@@ -25,8 +25,6 @@ mod md_interrupt;
 mod md_sampling;
 #[path = "md_thermo_csv.rs"]
 mod md_thermo_csv;
-#[path = "observer_scales.rs"]
-mod observer_scales;
 #[path = "optimize.rs"]
 mod optimize;
 #[path = "particle_net.rs"]

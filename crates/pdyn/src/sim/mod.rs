@@ -20,6 +20,8 @@ pub mod linearize;
 pub mod long_run;
 pub mod measured;
 pub mod net;
+#[cfg(test)]
+mod observer_scales_tests;
 pub mod report;
 pub mod request;
 pub mod sweep;

@@ -3,7 +3,8 @@
 //! At any state they must give the bits of the scales' own program, and the columns those
 //! the columns alone give.
 
-use pdyn::sim::prepare;
+use super::prepare;
+use super::tree_tests::released_chain;
 
 /// Two bodies on a spring, free in space: energy, momentum and angular momentum conserved
 /// (several scales, in order).
@@ -30,28 +31,6 @@ between = ["a", "b"]
 k = "k"
 l0 = "1"
 "#;
-
-/// A four-link chain under gravity (the tree path): energy conserved, its scale
-/// `Σ ½ m v² + Σ |V|` made of the energy column's terms.
-fn chain() -> String {
-    let mut src =
-        String::from("name = \"chain\"\ngravity = \"[0, -g, 0]\"\n[parameters]\ng = 9.81\n");
-    src += "[coordinates]\n";
-    for i in 1..=4 {
-        src += &format!("q{i} = {{ initial = {}, rate = 0.0 }}\n", 0.3 * i as f64);
-    }
-    for i in 1..=4 {
-        let pos: Vec<String> = (1..=i)
-            .map(|j| format!("{}*[sin(q{j}), -cos(q{j}), 0]", 1.0 + 0.1 * j as f64))
-            .collect();
-        src += &format!(
-            "[particles.p{i}]\nmass = \"{}\"\nposition = \"{}\"\n",
-            1.0 + 0.2 * i as f64,
-            pos.join(" + ")
-        );
-    }
-    src
-}
 
 fn bits(v: &[f64]) -> Vec<u64> {
     v.iter().map(|x| x.to_bits()).collect()
@@ -95,5 +74,7 @@ fn two_bodies_scales_in_the_columns_program_have_their_own_bits() {
 
 #[test]
 fn a_chains_energy_scale_in_the_columns_program_has_its_own_bits() {
-    trailing_scales_have_their_own_programs_bits(&chain(), 1);
+    // A four-link chain under gravity (the tree path): energy conserved, its scale
+    // `Σ ½ m v² + Σ |V|` made of the energy column's terms.
+    trailing_scales_have_their_own_programs_bits(&released_chain(4), 1);
 }
