@@ -40,6 +40,28 @@ struct Triple {
 /// How every acceleration is summed from the outputs.
 #[derive(Clone, Debug)]
 pub(super) struct Sums {
+    order: Order,
+    rows: usize,
+    /// Terms in all.
+    total: usize,
+    /// The value `Iterator::sum` of `f64` starts from (−0.0 in current Rust), so that a sum is
+    /// bit for bit that of its terms summed alone.
+    zero: f64,
+}
+
+/// The order the terms are added in.
+#[derive(Clone, Debug)]
+enum Order {
+    /// Output by output: every term as `(row, output)` in the outputs' order, in runs (when
+    /// they pay).
+    ByOutput(Runs),
+    /// Particle by particle, row by row.
+    ByParticle(ByParticle),
+}
+
+/// The sums particle by particle: the triples, then the rows of no triple.
+#[derive(Clone, Debug)]
+struct ByParticle {
     triples: Vec<Triple>,
     steps: Vec<Step>,
     /// Rows of no triple (a particle with an axis that is not a coordinate) and their terms:
@@ -47,15 +69,6 @@ pub(super) struct Sums {
     singles: Vec<u32>,
     single_start: Vec<u32>,
     terms: Vec<u32>,
-    /// Every term as `(row, output)` in the outputs' order, when its runs pay: the sums then
-    /// go by these runs, and `triples` and `singles` are empty.
-    by_output: Option<Runs>,
-    rows: usize,
-    /// Terms in all.
-    total: usize,
-    /// The value `Iterator::sum` of `f64` starts from (−0.0 in current Rust), so that a sum is
-    /// bit for bit that of its terms summed alone.
-    zero: f64,
 }
 
 /// Whether outputs `a`, `b`, `c` are one step apart each (`b - a == c - b > 0`).
@@ -81,12 +94,7 @@ impl Sums {
         let by_output = in_output_order(start, terms, outputs);
         if by_output.pay() {
             return Some(Sums {
-                triples: Vec::new(),
-                steps: Vec::new(),
-                singles: Vec::new(),
-                single_start: vec![0],
-                terms: Vec::new(),
-                by_output: Some(by_output),
+                order: Order::ByOutput(by_output),
                 rows,
                 total: terms.len(),
                 zero: std::iter::empty::<f64>().sum(),
@@ -124,12 +132,13 @@ impl Sums {
             single_start.push(single_terms.len() as u32);
         }
         Some(Sums {
-            triples,
-            steps,
-            singles,
-            single_start,
-            terms: single_terms,
-            by_output: None,
+            order: Order::ByParticle(ByParticle {
+                triples,
+                steps,
+                singles,
+                single_start,
+                terms: single_terms,
+            }),
             rows,
             total: terms.len(),
             zero: std::iter::empty::<f64>().sum(),
@@ -138,11 +147,16 @@ impl Sums {
 
     /// Terms added per evaluation three at a time (a deterministic count).
     pub(super) fn together(&self) -> usize {
-        3 * self
-            .steps
-            .iter()
-            .filter(|s| matches!(s, Step::Together { .. }))
-            .count()
+        match &self.order {
+            Order::ByOutput(_) => 0,
+            Order::ByParticle(p) => {
+                let together = p
+                    .steps
+                    .iter()
+                    .filter(|s| matches!(s, Step::Together { .. }));
+                3 * together.count()
+            }
+        }
     }
 
     /// Terms added per evaluation, in all.
@@ -152,24 +166,30 @@ impl Sums {
 
     /// The runs the sums go by, output by output, if they do (a deterministic count).
     pub(super) fn runs(&self) -> Option<usize> {
-        self.by_output.as_ref().map(Runs::len)
+        match &self.order {
+            Order::ByOutput(runs) => Some(runs.len()),
+            Order::ByParticle(_) => None,
+        }
     }
 
     /// `acc[r]` = the sum of row `r`'s terms in `outputs`, for every row.
     pub(super) fn sum_into(&self, outputs: &[f64], acc: &mut [f64]) {
-        if let Some(runs) = &self.by_output {
-            let acc = &mut acc[..self.rows];
-            acc.fill(self.zero);
-            runs.add(outputs, acc);
-            return;
-        }
+        let p = match &self.order {
+            Order::ByOutput(runs) => {
+                let acc = &mut acc[..self.rows];
+                acc.fill(self.zero);
+                runs.add(outputs, acc);
+                return;
+            }
+            Order::ByParticle(p) => p,
+        };
         // SAFETY (every `get_unchecked` below): `new` checked that every term indexes
         // `outputs`, whose length the kernels never change; a step's indices are such terms.
         let at = |i: u32| unsafe { *outputs.get_unchecked(i as usize) };
-        for t in &self.triples {
+        for t in &p.triples {
             // Three locals, not an array indexed by the axis: they stay in registers.
             let (mut x, mut y, mut z) = (self.zero, self.zero, self.zero);
-            for step in &self.steps[t.start as usize..t.end as usize] {
+            for step in &p.steps[t.start as usize..t.end as usize] {
                 match *step {
                     Step::Together { i, s } => {
                         x += at(i);
@@ -186,9 +206,9 @@ impl Sums {
             acc[ry as usize] = y;
             acc[rz as usize] = z;
         }
-        for (&r, w) in self.singles.iter().zip(self.single_start.windows(2)) {
+        for (&r, w) in p.singles.iter().zip(p.single_start.windows(2)) {
             let mut s = self.zero;
-            for &i in &self.terms[w[0] as usize..w[1] as usize] {
+            for &i in &p.terms[w[0] as usize..w[1] as usize] {
                 s += at(i);
             }
             acc[r as usize] = s;
